@@ -1,0 +1,46 @@
+//! The machines of the seeds, embedded so they work with no files around.
+
+use super::{Machine, MachineError};
+
+/// `(name, TOML text)` of every built-in machine.
+pub const BUILTIN_SOURCES: [(&str, &str); 5] = [
+    ("3K152VF20", include_str!("../../machines/3k152vf20.toml")),
+    ("LZ-250", include_str!("../../machines/lz-250.toml")),
+    ("Mannesmann", include_str!("../../machines/mannesmann.toml")),
+    (
+        "fanuc-0i-tc",
+        include_str!("../../machines/fanuc-0i-tc.toml"),
+    ),
+    (
+        "vertical-mill",
+        include_str!("../../machines/vertical-mill.toml"),
+    ),
+];
+
+/// The names of the built-in machines.
+pub const BUILTIN_MACHINES: [&str; 5] = [
+    BUILTIN_SOURCES[0].0,
+    BUILTIN_SOURCES[1].0,
+    BUILTIN_SOURCES[2].0,
+    BUILTIN_SOURCES[3].0,
+    BUILTIN_SOURCES[4].0,
+];
+
+impl Machine {
+    /// A built-in machine by name (case-insensitive): `3K152VF20` (mandrel
+    /// grinder with CNC steady rest), `LZ-250` and `Mannesmann` (caliber
+    /// grinders), `fanuc-0i-tc` (lathe), `vertical-mill` (MATH §1's example).
+    ///
+    /// # Failures
+    /// [`MachineError::UnknownMachine`] listing the built-ins.
+    pub fn builtin(name: &str) -> Result<Machine, MachineError> {
+        let (key, text) = BUILTIN_SOURCES
+            .iter()
+            .find(|(n, _)| n.eq_ignore_ascii_case(name))
+            .ok_or_else(|| MachineError::UnknownMachine {
+                name: name.to_owned(),
+                known: BUILTIN_MACHINES.join(", "),
+            })?;
+        Machine::from_toml_str(text, &format!("built-in machine {key}"))
+    }
+}

@@ -1,0 +1,462 @@
+//! Machines: named axes with travel and feed limits, the kinematic chain
+//! from tool to part, and the chains of other moving bodies (a steady rest).
+//!
+//! A machine is data: a TOML file (see [`Machine::from_toml_str`] for the
+//! format) or one of the built-ins of the seeds ([`Machine::builtin`]).
+//! Units in files are millimetres and degrees (`_deg` keys); inside,
+//! millimetres and radians.
+//!
+//! ```
+//! use pilgrim_kernel::Machine;
+//! let m = Machine::builtin("3K152VF20").unwrap();
+//! assert_eq!(m.chain().axis_names(), ["Z", "X"]);
+//! assert!(m.axis("U").is_some());
+//! ```
+
+mod builtin;
+mod file;
+
+pub use builtin::{BUILTIN_MACHINES, BUILTIN_SOURCES};
+
+use crate::math::{Real, Vec3};
+use crate::transform::{Chain, IkOptions, IkSolution, Target, ToolFrame, TransformError};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// What an axis does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AxisKind {
+    /// A slide (mm).
+    Linear,
+    /// A positioned rotary axis (rad inside, degrees in files and programs).
+    Rotary,
+    /// A spindle turning at a speed (rpm), not positioned.
+    Spindle,
+}
+
+/// One axis of a machine.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Axis {
+    /// The name, as the control's address letter (X, Z, U, A...).
+    pub name: String,
+    /// Linear, rotary or spindle.
+    pub kind: AxisKind,
+    /// Lower travel limit (mm or rad; 0 for a spindle).
+    pub min: Real,
+    /// Upper travel limit (mm or rad; the top speed in rpm for a spindle).
+    pub max: Real,
+    /// Top speed (mm/min or rad/min; rpm for a spindle).
+    pub max_feed: Real,
+    /// Whether blocks carry its position.
+    pub programmed: bool,
+    /// What it moves and which way is positive, in words.
+    pub description: String,
+    /// For linear axes: the tool's (or body's) displacement in the part frame
+    /// per unit of the axis, at the home pose: the sign, stated and tested.
+    pub moves: Option<Vec3>,
+    /// For rotary axes: the axis the tool (or body) turns about relative to
+    /// the part for a positive value (right-handed), at the home pose.
+    pub turns: Option<Vec3>,
+    /// The body it moves: `None` for the tool, else a body's name.
+    pub body: Option<String>,
+}
+
+impl Axis {
+    /// A value in file/program units (mm, deg) from kernel units (mm, rad).
+    pub fn to_user(&self, v: Real) -> Real {
+        if self.kind == AxisKind::Rotary {
+            v.to_degrees()
+        } else {
+            v
+        }
+    }
+
+    /// The unit of [`Self::to_user`] values.
+    pub fn unit(&self) -> &'static str {
+        match self.kind {
+            AxisKind::Linear => "mm",
+            AxisKind::Rotary => "deg",
+            AxisKind::Spindle => "rpm",
+        }
+    }
+
+    /// The unit of feeds.
+    pub fn feed_unit(&self) -> &'static str {
+        match self.kind {
+            AxisKind::Linear => "mm/min",
+            AxisKind::Rotary => "deg/min",
+            AxisKind::Spindle => "rpm",
+        }
+    }
+}
+
+/// Errors of machine files and machine limits.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MachineError {
+    /// A machine file that cannot be read or is wrong at a place.
+    #[error("{file}:{line}:{column}: {message}")]
+    File {
+        /// The file (or built-in) name.
+        file: String,
+        /// Line (from 1).
+        line: usize,
+        /// Column (from 1).
+        column: usize,
+        /// What is wrong, naming the key.
+        message: String,
+    },
+    /// A file that could not be opened.
+    #[error("{file}: {message}")]
+    Io {
+        /// The file.
+        file: String,
+        /// The system's message.
+        message: String,
+    },
+    /// No built-in machine of that name.
+    #[error("no built-in machine '{name}' (built-ins: {known})")]
+    UnknownMachine {
+        /// The name asked for.
+        name: String,
+        /// The names there are.
+        known: String,
+    },
+    /// An axis name the machine does not have.
+    #[error("machine {machine} has no axis '{axis}' (axes: {known})")]
+    UnknownAxis {
+        /// The machine.
+        machine: String,
+        /// The name asked for.
+        axis: String,
+        /// The axes there are.
+        known: String,
+    },
+    /// A point outside an axis's travel.
+    #[error("point {point}: axis {axis} at {value:.4} {unit} is outside its travel [{min}, {max}] {unit}")]
+    OutsideTravel {
+        /// Index of the point (block).
+        point: usize,
+        /// The axis.
+        axis: String,
+        /// The value (mm or deg).
+        value: Real,
+        /// Lower limit (mm or deg).
+        min: Real,
+        /// Upper limit (mm or deg).
+        max: Real,
+        /// mm or deg.
+        unit: &'static str,
+    },
+    /// A move faster than an axis can go.
+    #[error("point {point}: axis {axis} would move at {speed:.1} {unit}, above its maximum {max} {unit}")]
+    FeedExceeded {
+        /// Index of the point (block) the move ends at.
+        point: usize,
+        /// The axis.
+        axis: String,
+        /// The speed needed (mm/min or deg/min).
+        speed: Real,
+        /// The axis's maximum.
+        max: Real,
+        /// mm/min or deg/min.
+        unit: &'static str,
+    },
+    /// A bad feed, or a malformed batch of points.
+    #[error("point {point}: {message}")]
+    BadPoint {
+        /// Index of the point.
+        point: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A kinematics failure (inverse kinematics, chain evaluation).
+    #[error(transparent)]
+    Transform(#[from] TransformError),
+}
+
+/// A machine tool: axes, the tool chain and other bodies' chains.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Machine {
+    name: String,
+    description: String,
+    control: Option<String>,
+    axes: Vec<Axis>,
+    chain: Chain,
+    tool: ToolFrame,
+    bodies: BTreeMap<String, Chain>,
+    constants: BTreeMap<String, Real>,
+}
+
+impl Machine {
+    /// The machine's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// A description in words.
+    pub fn description(&self) -> &str {
+        &self.description
+    }
+
+    /// The control's dialect name (e.g. `sinumerik`, `fanuc`), if stated.
+    pub fn control(&self) -> Option<&str> {
+        self.control.as_deref()
+    }
+
+    /// All axes, in the file's order.
+    pub fn axes(&self) -> &[Axis] {
+        &self.axes
+    }
+
+    /// The axis called `name`.
+    pub fn axis(&self, name: &str) -> Option<&Axis> {
+        self.axes.iter().find(|a| a.name == name)
+    }
+
+    fn axis_or_err(&self, name: &str) -> Result<&Axis, MachineError> {
+        self.axis(name).ok_or_else(|| MachineError::UnknownAxis {
+            machine: self.name.clone(),
+            axis: name.to_owned(),
+            known: self
+                .axes
+                .iter()
+                .map(|a| a.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
+    }
+
+    /// The chain from the tool's frame to the part's: `r_part = A(q) r_tool`.
+    pub fn chain(&self) -> &Chain {
+        &self.chain
+    }
+
+    /// The tool's default reference point and axis in its own frame.
+    pub fn tool_frame(&self) -> &ToolFrame {
+        &self.tool
+    }
+
+    /// The chain placing another body (e.g. `rest`) in the part frame.
+    pub fn body_chain(&self, body: &str) -> Option<&Chain> {
+        self.bodies.get(body)
+    }
+
+    /// The names of the other bodies.
+    pub fn body_names(&self) -> impl Iterator<Item = &str> {
+        self.bodies.keys().map(String::as_str)
+    }
+
+    /// A named machine constant (mm or rad), e.g. the rest's offset `B`.
+    pub fn constant(&self, name: &str) -> Option<Real> {
+        self.constants.get(name).copied()
+    }
+
+    /// All named constants.
+    pub fn constants(&self) -> &BTreeMap<String, Real> {
+        &self.constants
+    }
+
+    /// The travel `(min, max)` of each of `chain`'s axes, in its order.
+    pub fn travel_of(&self, chain: &Chain) -> Result<Vec<(Real, Real)>, MachineError> {
+        chain
+            .axis_names()
+            .iter()
+            .map(|n| self.axis_or_err(n).map(|a| (a.min, a.max)))
+            .collect()
+    }
+
+    /// Inverse kinematics of the tool chain within travel. The seed defaults
+    /// to each axis's 0 clamped into its travel.
+    ///
+    /// # Failures
+    /// As [`Chain::inverse`].
+    pub fn inverse(
+        &self,
+        target: &Target,
+        tool: &ToolFrame,
+        seed: Option<&[Real]>,
+        opts: &IkOptions,
+    ) -> Result<IkSolution, MachineError> {
+        let travel = self.travel_of(&self.chain)?;
+        let home: Vec<Real> = travel
+            .iter()
+            .map(|&(lo, hi)| 0.0_f64.clamp(lo, hi))
+            .collect();
+        Ok(self
+            .chain
+            .inverse(target, tool, seed.unwrap_or(&home), Some(&travel), opts)?)
+    }
+
+    /// Checks that every point lies within travel. `axes` names the columns
+    /// of `rows` (row after row, kernel units: mm, rad).
+    ///
+    /// # Failures
+    /// [`MachineError::OutsideTravel`] naming the first offending point and
+    /// axis; an unknown axis; a ragged batch.
+    pub fn check_travel(&self, axes: &[&str], rows: &[Real]) -> Result<(), MachineError> {
+        let cols = self.columns(axes, rows)?;
+        for (p, row) in rows.chunks_exact(axes.len()).enumerate() {
+            for (a, &v) in cols.iter().zip(row) {
+                if a.kind == AxisKind::Spindle {
+                    continue;
+                }
+                if !v.is_finite() || v < a.min || v > a.max {
+                    return Err(MachineError::OutsideTravel {
+                        point: p,
+                        axis: a.name.clone(),
+                        value: a.to_user(v),
+                        min: a.to_user(a.min),
+                        max: a.to_user(a.max),
+                        unit: a.unit(),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks that no axis moves faster than its maximum between points.
+    /// `feeds[i]` is the programmed feed (mm/min) of the move ending at point
+    /// `i` (`feeds[0]` is unused); the move lasts its linear axes' path
+    /// length over the feed (or, for a rotary-only move, its angle in
+    /// degrees over the feed in deg/min).
+    ///
+    /// # Failures
+    /// [`MachineError::FeedExceeded`] naming the first offending point and
+    /// axis; a non-positive feed; an unknown axis; a ragged batch.
+    pub fn check_feed(
+        &self,
+        axes: &[&str],
+        rows: &[Real],
+        feeds: &[Real],
+    ) -> Result<(), MachineError> {
+        let cols = self.columns(axes, rows)?;
+        let n = rows.len() / axes.len().max(1);
+        if feeds.len() != n {
+            return Err(MachineError::BadPoint {
+                point: feeds.len().min(n),
+                message: format!("{} feeds for {n} points", feeds.len()),
+            });
+        }
+        for p in 1..n {
+            let (a0, a1) = (
+                &rows[(p - 1) * axes.len()..p * axes.len()],
+                &rows[p * axes.len()..(p + 1) * axes.len()],
+            );
+            let f = feeds[p];
+            if !(f.is_finite() && f > 0.0) {
+                return Err(MachineError::BadPoint {
+                    point: p,
+                    message: format!("feed {f} mm/min is not positive"),
+                });
+            }
+            let user_delta = |i: usize| cols[i].to_user(a1[i]) - cols[i].to_user(a0[i]);
+            let linear: Real = (0..axes.len())
+                .filter(|&i| cols[i].kind == AxisKind::Linear)
+                .map(|i| user_delta(i).powi(2))
+                .sum::<Real>()
+                .sqrt();
+            let path = if linear > 0.0 {
+                linear
+            } else {
+                (0..axes.len())
+                    .filter(|&i| cols[i].kind == AxisKind::Rotary)
+                    .map(|i| user_delta(i).powi(2))
+                    .sum::<Real>()
+                    .sqrt()
+            };
+            if path == 0.0 {
+                continue;
+            }
+            let minutes = path / f;
+            for (i, a) in cols.iter().enumerate() {
+                if a.kind == AxisKind::Spindle {
+                    continue;
+                }
+                let speed = user_delta(i).abs() / minutes;
+                let max = a.to_user(a.max_feed);
+                if speed > max * (1.0 + 1e-9) {
+                    return Err(MachineError::FeedExceeded {
+                        point: p,
+                        axis: a.name.clone(),
+                        speed,
+                        max,
+                        unit: a.feed_unit(),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn columns(&self, axes: &[&str], rows: &[Real]) -> Result<Vec<&Axis>, MachineError> {
+        let cols = axes
+            .iter()
+            .map(|n| self.axis_or_err(n))
+            .collect::<Result<Vec<_>, _>>()?;
+        if axes.is_empty() || rows.len() % axes.len() != 0 {
+            return Err(MachineError::BadPoint {
+                point: rows.len() / axes.len().max(1),
+                message: format!(
+                    "{} values do not fill rows of {} axes",
+                    rows.len(),
+                    axes.len()
+                ),
+            });
+        }
+        Ok(cols)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn travel_and_feed_errors_name_point_and_axis() {
+        let m = Machine::builtin("fanuc-0i-tc").unwrap();
+        let rows = [10.0, 0.0, 20.0, -5.0, 30.0, -900.0];
+        let e = m.check_travel(&["X", "Z"], &rows).unwrap_err();
+        assert!(
+            matches!(&e, MachineError::OutsideTravel { point: 2, axis, .. } if axis == "Z"),
+            "{e}"
+        );
+        assert!(
+            e.to_string().starts_with("point 2: axis Z at -900.0000 mm"),
+            "{e}"
+        );
+        // 100 mm of Z in a move at 50000 mm/min is over the axis's maximum.
+        let rows = [10.0, 0.0, 10.0, -100.0];
+        let e = m
+            .check_feed(&["X", "Z"], &rows, &[0.0, 50000.0])
+            .unwrap_err();
+        assert!(
+            matches!(&e, MachineError::FeedExceeded { point: 1, axis, .. } if axis == "Z"),
+            "{e}"
+        );
+        assert!(m.check_feed(&["X", "Z"], &rows, &[0.0, 100.0]).is_ok());
+        let e = m.check_feed(&["X", "Z"], &rows, &[0.0, -1.0]).unwrap_err();
+        assert!(e.to_string().contains("point 1: feed -1"), "{e}");
+        let e = m.check_travel(&["Q"], &[1.0]).unwrap_err();
+        assert!(e.to_string().contains("no axis 'Q'"), "{e}");
+    }
+
+    #[test]
+    fn rotary_limits_are_reported_in_degrees() {
+        let m = Machine::builtin("LZ-250").unwrap();
+        let b = m.axis("B").unwrap();
+        let too_far = b.max + 0.1;
+        let e = m.check_travel(&["B"], &[too_far]).unwrap_err();
+        let MachineError::OutsideTravel {
+            value, max, unit, ..
+        } = e
+        else {
+            panic!("{e}")
+        };
+        assert_eq!(unit, "deg");
+        assert!(
+            (value - too_far.to_degrees()).abs() < 1e-9 && (max - b.max.to_degrees()).abs() < 1e-9
+        );
+    }
+}

@@ -1,0 +1,396 @@
+//! A whole part profile chained from lines, arcs and the mandrel law.
+
+use super::{MandrelLaw, Profile, ProfileError};
+use crate::error::InputError;
+use crate::math::{finite, positive, Real};
+use serde::{Deserialize, Serialize};
+
+/// Which way an arc bulges.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Bulge {
+    /// Toward +x: convex seen from outside (centre below the arc), like a
+    /// rounded shoulder.
+    Out,
+    /// Toward the axis: concave seen from outside (centre above), like a fillet.
+    In,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+enum Segment {
+    Line {
+        z: Real,
+        x: Real,
+    },
+    Arc {
+        z: Real,
+        x: Real,
+        radius: Real,
+        bulge: Bulge,
+    },
+    Law(MandrelLaw),
+}
+
+/// Chains segments into one profile, left to right along z: lines (a
+/// thread's major diameter, a cylinder, a cone), arcs, and the mandrel law.
+/// Each segment starts where the previous one ended.
+///
+/// ```
+/// use pilgrim_kernel::{MandrelLaw, ProfileBuilder};
+/// let law = MandrelLaw::new(40.0, 48.0, 300.0, 0.01, 2.5).unwrap();
+/// let p = ProfileBuilder::start(-80.0, 18.0)
+///     .cylinder(40.0)              // threaded tail, at the thread's major radius
+///     .line_to(-30.0, 20.0)        // chamfer up to the transition
+///     .cylinder(30.0)              // transition cylinder, d = 40
+///     .law(law)                    // working part
+///     .line_to(360.0, 20.0)        // cone
+///     .build(0.001, 1.0)
+///     .unwrap();
+/// assert_eq!(p.z_range(), (-80.0, 360.0));
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ProfileBuilder {
+    start: (Real, Real),
+    current: (Real, Real),
+    segments: Vec<Segment>,
+}
+
+/// Nodes of one segment with their analytic derivatives.
+#[derive(Default)]
+struct Nodes {
+    z: Vec<Real>,
+    x: Vec<Real>,
+    d1: Vec<Real>,
+    d2: Vec<Real>,
+}
+
+impl Nodes {
+    fn push(&mut self, z: Real, x: Real, d1: Real, d2: Real) {
+        self.z.push(z);
+        self.x.push(x);
+        self.d1.push(d1);
+        self.d2.push(d2);
+    }
+
+    /// Appends `other`, merging the shared joint node (kinks get an
+    /// infinite second derivative signed by the slope's jump).
+    fn append(&mut self, other: Nodes) {
+        if self.z.is_empty() {
+            *self = other;
+            return;
+        }
+        let last = self.z.len() - 1;
+        let (l1, r1) = (self.d1[last], other.d1[0]);
+        if (l1 - r1).abs() <= 1e-9 * (1.0 + l1.abs()) {
+            let (l2, r2) = (self.d2[last], other.d2[0]);
+            self.d2[last] = if r2.abs() > l2.abs() { r2 } else { l2 };
+        } else {
+            self.d1[last] = 0.5 * (l1 + r1);
+            self.d2[last] = if r1 > l1 {
+                Real::INFINITY
+            } else {
+                Real::NEG_INFINITY
+            };
+        }
+        self.z.extend_from_slice(&other.z[1..]);
+        self.x.extend_from_slice(&other.x[1..]);
+        self.d1.extend_from_slice(&other.d1[1..]);
+        self.d2.extend_from_slice(&other.d2[1..]);
+    }
+}
+
+impl ProfileBuilder {
+    /// Starts at the point `(z, x)`.
+    pub fn start(z: Real, x: Real) -> Self {
+        Self {
+            start: (z, x),
+            current: (z, x),
+            segments: Vec::new(),
+        }
+    }
+
+    /// A straight segment to `(z, x)` (a cone, or a cylinder if x is unchanged).
+    pub fn line_to(mut self, z: Real, x: Real) -> Self {
+        self.segments.push(Segment::Line { z, x });
+        self.current = (z, x);
+        self
+    }
+
+    /// A cylinder of the given length at the current x.
+    pub fn cylinder(self, length: Real) -> Self {
+        let (z, x) = self.current;
+        self.line_to(z + length, x)
+    }
+
+    /// A circular arc of `radius` to `(z, x)`, bulging as `bulge` says (the
+    /// shorter of the two arcs). It must be a graph x(z): both ends on the
+    /// same side of the centre, neither at a vertical tangent.
+    pub fn arc_to(mut self, z: Real, x: Real, radius: Real, bulge: Bulge) -> Self {
+        self.segments.push(Segment::Arc {
+            z,
+            x,
+            radius,
+            bulge,
+        });
+        self.current = (z, x);
+        self
+    }
+
+    /// The mandrel law from the current z over its length L_r. The current x
+    /// must be the law's start, `d_min / 2`.
+    pub fn law(mut self, law: MandrelLaw) -> Self {
+        self.segments.push(Segment::Law(law));
+        self.current = (self.current.0 + law.l_r, law.x(law.l_r));
+        self
+    }
+
+    /// The end point so far.
+    pub fn current(&self) -> (Real, Real) {
+        self.current
+    }
+
+    /// Samples every segment and joins them.
+    ///
+    /// `tol` is the chordal tolerance (mm): arcs and the law are sampled so
+    /// that the chord between two nodes strays at most `tol` from the curve;
+    /// `max_step` caps the distance in z between nodes on every segment.
+    ///
+    /// # Failures
+    /// A non-positive `tol` or `max_step`; a segment that does not advance
+    /// in z; an arc that cannot join its ends as a graph; the law not
+    /// starting at the current x. Each names the segment's index.
+    pub fn build(&self, tol: Real, max_step: Real) -> Result<Profile, ProfileError> {
+        positive("profile chordal tolerance", tol)?;
+        positive("profile max step", max_step)?;
+        finite("profile start z", self.start.0)?;
+        finite("profile start x", self.start.1)?;
+        if self.segments.is_empty() {
+            return Err(InputError::TooFew {
+                what: "profile segments".into(),
+                got: 0,
+                min: 1,
+            }
+            .into());
+        }
+        let mut all = Nodes::default();
+        let mut at = self.start;
+        for (i, seg) in self.segments.iter().enumerate() {
+            let nodes = match *seg {
+                Segment::Line { z, x } => line(i, at, (z, x), max_step)?,
+                Segment::Arc {
+                    z,
+                    x,
+                    radius,
+                    bulge,
+                } => arc(i, at, (z, x), radius, bulge, tol, max_step)?,
+                Segment::Law(law) => {
+                    let x0 = law.x(0.0);
+                    if (x0 - at.1).abs() > 1e-9 * (1.0 + x0.abs()) {
+                        return Err(ProfileError::Discontinuous {
+                            segment: i,
+                            z: at.0,
+                            x_end: at.1,
+                            x_start: x0,
+                        });
+                    }
+                    law_nodes(&law, at.0, tol, max_step)?
+                }
+            };
+            at = (*nodes.z.last().unwrap(), *nodes.x.last().unwrap());
+            all.append(nodes);
+        }
+        Profile::with_derivatives(all.z, all.x, all.d1, all.d2)
+    }
+}
+
+fn advance(segment: usize, from: Real, to: Real) -> Result<(), ProfileError> {
+    finite(&format!("segment {segment} end z"), to)?;
+    if to <= from {
+        return Err(InputError::NotIncreasing {
+            what: format!("profile segment {segment} end z"),
+            index: segment + 1,
+            prev: from,
+            value: to,
+        }
+        .into());
+    }
+    Ok(())
+}
+
+fn line(
+    segment: usize,
+    a: (Real, Real),
+    b: (Real, Real),
+    max_step: Real,
+) -> Result<Nodes, ProfileError> {
+    advance(segment, a.0, b.0)?;
+    finite(&format!("segment {segment} end x"), b.1)?;
+    let slope = (b.1 - a.1) / (b.0 - a.0);
+    let n = ((b.0 - a.0) / max_step).ceil().max(1.0) as usize;
+    let mut nodes = Nodes::default();
+    for k in 0..=n {
+        let t = k as Real / n as Real;
+        let (z, x) = if k == n {
+            b
+        } else {
+            (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1))
+        };
+        nodes.push(z, x, slope, 0.0);
+    }
+    Ok(nodes)
+}
+
+fn arc(
+    segment: usize,
+    a: (Real, Real),
+    b: (Real, Real),
+    r: Real,
+    bulge: Bulge,
+    tol: Real,
+    max_step: Real,
+) -> Result<Nodes, ProfileError> {
+    advance(segment, a.0, b.0)?;
+    finite(&format!("segment {segment} end x"), b.1)?;
+    positive(&format!("segment {segment} arc radius"), r)?;
+    let (dz, dx) = (b.0 - a.0, b.1 - a.1);
+    let chord = dz.hypot(dx);
+    let bad = || ProfileError::BadArc {
+        segment,
+        radius: r,
+        chord,
+    };
+    if 2.0 * r < chord {
+        return Err(bad());
+    }
+    // Centre on the chord's bisector, on the side away from the bulge.
+    let h = (r * r - 0.25 * chord * chord).max(0.0).sqrt();
+    let (nz, nx) = (-dx / chord, dz / chord); // unit normal toward +x side
+    let sign = match bulge {
+        Bulge::Out => -1.0,
+        Bulge::In => 1.0,
+    };
+    let (cz, cx) = (
+        a.0 + 0.5 * dz + sign * h * nz,
+        a.1 + 0.5 * dx + sign * h * nx,
+    );
+    // Upper half of the circle for Out, lower half for In; ends strictly inside.
+    let side = -sign;
+    let margin = 1e-9 * r;
+    if (a.1 - cx) * side <= margin || (b.1 - cx) * side <= margin {
+        return Err(bad());
+    }
+    let ang = |p: (Real, Real)| (p.1 - cx).atan2(p.0 - cz);
+    let (t0, t1) = (ang(a), ang(b));
+    let max_angle = (2.0 * (1.0 - tol / r).clamp(-1.0, 1.0).acos()).min(max_step / r);
+    let n = ((t1 - t0).abs() / max_angle).ceil().max(1.0) as usize;
+    let mut nodes = Nodes::default();
+    for k in 0..=n {
+        let (z, x) = if k == 0 {
+            a
+        } else if k == n {
+            b
+        } else {
+            let t = t0 + (t1 - t0) * k as Real / n as Real;
+            (cz + r * t.cos(), cx + r * t.sin())
+        };
+        let u = x - cx;
+        nodes.push(z, x, -(z - cz) / u, -r * r / (u * u * u));
+    }
+    Ok(nodes)
+}
+
+fn law_nodes(law: &MandrelLaw, z0: Real, tol: Real, max_step: Real) -> Result<Nodes, ProfileError> {
+    // Chordal step sqrt(8 tol / max|x''|), the curvature taken away from z = 0
+    // where it may be infinite.
+    let k = (1..=1000)
+        .map(|i| law.d2x(law.l_r * i as Real / 1000.0).abs())
+        .fold(0.0, Real::max);
+    let step = if k > 0.0 {
+        (8.0 * tol / k).sqrt().min(max_step)
+    } else {
+        max_step
+    };
+    Ok(law.profile(step, z0)?.into())
+}
+
+impl From<Profile> for Nodes {
+    fn from(p: Profile) -> Self {
+        Self {
+            d1: p.slopes().into_owned(),
+            d2: p.second_derivatives().into_owned(),
+            z: p.z,
+            x: p.x,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assert_near;
+
+    #[test]
+    fn arcs_are_circles_with_exact_derivatives() {
+        let p = ProfileBuilder::start(0.0, 10.0)
+            .arc_to(10.0, 10.0, 8.0, Bulge::Out)
+            .build(1e-4, 1.0)
+            .unwrap();
+        // Centre at (5, 10 - sqrt(64 - 25)).
+        let cx = 10.0 - 39.0_f64.sqrt();
+        for (z, x) in p.z().iter().zip(p.x()) {
+            assert_near!((z - 5.0).hypot(x - cx), 8.0, 1e-12);
+        }
+        for k in p.curvature() {
+            assert_near!(k, -1.0 / 8.0, 1e-12);
+        }
+        let e = ProfileBuilder::start(0.0, 10.0)
+            .arc_to(10.0, 10.0, 4.0, Bulge::Out)
+            .build(1e-4, 1.0);
+        assert!(matches!(e, Err(ProfileError::BadArc { segment: 0, .. })));
+    }
+
+    #[test]
+    fn kinks_are_marked_and_law_must_meet() {
+        let p = ProfileBuilder::start(0.0, 5.0)
+            .cylinder(10.0)
+            .line_to(20.0, 8.0)
+            .build(0.01, 2.0)
+            .unwrap();
+        let i = p.z().iter().position(|&z| z == 10.0).unwrap();
+        assert_eq!(p.second_derivatives()[i], Real::INFINITY); // concave corner
+        assert_eq!(p.curvature_radius()[i], 0.0);
+        let law = MandrelLaw::new(40.0, 48.0, 300.0, 0.01, 2.5).unwrap();
+        let e = ProfileBuilder::start(0.0, 19.0)
+            .law(law)
+            .build(0.01, 1.0)
+            .unwrap_err();
+        assert!(
+            matches!(e, ProfileError::Discontinuous { segment: 0, .. }),
+            "{e}"
+        );
+        let e = ProfileBuilder::start(0.0, 19.0)
+            .line_to(-1.0, 2.0)
+            .build(0.01, 1.0)
+            .unwrap_err();
+        assert!(e.to_string().contains("segment 0"), "{e}");
+    }
+
+    #[test]
+    fn whole_mandrel_follows_the_law() {
+        let law = MandrelLaw::new(40.0, 48.0, 300.0, 0.01, 2.5).unwrap();
+        let p = ProfileBuilder::start(-80.0, 18.0)
+            .cylinder(40.0)
+            .line_to(-30.0, 20.0)
+            .cylinder(30.0)
+            .law(law)
+            .line_to(360.0, 20.0)
+            .build(1e-4, 0.5)
+            .unwrap();
+        for (z, x) in p.z().iter().zip(p.x()) {
+            if (0.0..=300.0).contains(z) {
+                assert_near!(*x, law.x(*z), 1e-12);
+            }
+        }
+        assert!(p.len() > 600);
+    }
+}

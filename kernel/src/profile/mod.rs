@@ -1,0 +1,528 @@
+//! Profiles: the "digital array" `(z_i, x_i)` of a 2-D curve (MATH §2.1, §3.2).
+//!
+//! A [`Profile`] is a curve `x(z)` sampled at strictly increasing `z`: the
+//! radius of a body of revolution along its axis, a groove's depth along the
+//! roll angle, a table of measurements. It may carry analytic first and
+//! second derivatives (generators know them); otherwise derivatives are
+//! estimated from the samples by three-point formulas.
+//!
+//! ```
+//! use pilgrim_kernel::Profile;
+//! let p = Profile::new(vec![0.0, 1.0, 2.0, 3.0], vec![1.0, 2.0, 5.0, 10.0]).unwrap();
+//! assert_eq!(p.divided_differences(), vec![1.0, 3.0, 5.0]);
+//! assert_eq!(p.second_derivatives()[1], 2.0); // x = z^2 + 1 exactly
+//! ```
+
+mod builder;
+mod ellipse;
+mod law;
+mod smooth;
+mod table;
+
+pub use builder::{Bulge, ProfileBuilder};
+pub use ellipse::EllipseSection;
+pub use law::{uniform_grid, MandrelLaw};
+pub use smooth::Smoothing;
+pub use table::{read_table, read_table_str, Table, TableError, TableFormat};
+
+use crate::error::InputError;
+use crate::math::{fixed, Real};
+use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
+
+/// The fewest points a profile may have.
+pub const MIN_POINTS: usize = 3;
+
+/// Errors of profiles, their generators, equidistants and envelopes.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ProfileError {
+    /// A rejected number or array.
+    #[error(transparent)]
+    Input(#[from] InputError),
+    /// The tool is rounder than the profile: its radius exceeds the
+    /// profile's radius of curvature where the profile is concave seen from
+    /// the tool (MATH §2.2). Every such place is listed.
+    #[error("tool radius {tool_radius} mm exceeds the profile's radius of curvature at {} place(s): {}",
+        violations.len(), list_violations(violations))]
+    CurvatureBelowTool {
+        /// The tool's radius (mm).
+        tool_radius: Real,
+        /// Each violating node.
+        violations: Vec<CurvatureViolation>,
+    },
+    /// Two chained segments do not meet.
+    #[error(
+        "segment {segment} starts at x = {x_start} but the profile is at x = {x_end} (z = {z})"
+    )]
+    Discontinuous {
+        /// Index of the segment that does not meet the previous one.
+        segment: usize,
+        /// Where they should meet.
+        z: Real,
+        /// The previous segment's end.
+        x_end: Real,
+        /// This segment's start.
+        x_start: Real,
+    },
+    /// An arc whose radius is too small for its chord, or which would not be
+    /// a function of z.
+    #[error(
+        "segment {segment}: an arc of radius {radius} cannot join points {chord} mm apart as x(z)"
+    )]
+    BadArc {
+        /// Index of the segment.
+        segment: usize,
+        /// The radius given.
+        radius: Real,
+        /// The chord between its ends.
+        chord: Real,
+    },
+    /// A query outside the profile's z range.
+    #[error("{what} at z = {z} is outside the profile's range [{z_min}, {z_max}]")]
+    OutsideProfile {
+        /// What was asked.
+        what: String,
+        /// The z asked for.
+        z: Real,
+        /// First z of the profile.
+        z_min: Real,
+        /// Last z of the profile.
+        z_max: Real,
+    },
+}
+
+/// A node where the tool's radius exceeds the profile's radius of curvature.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CurvatureViolation {
+    /// Index of the node.
+    pub index: usize,
+    /// Its z (mm).
+    pub z: Real,
+    /// The profile's radius of curvature there (mm).
+    pub rho: Real,
+}
+
+fn list_violations(v: &[CurvatureViolation]) -> String {
+    const SHOWN: usize = 12;
+    let mut s: Vec<String> = v
+        .iter()
+        .take(SHOWN)
+        .map(|c| format!("z = {} (rho = {})", fixed(c.z, 4), fixed(c.rho, 4)))
+        .collect();
+    if v.len() > SHOWN {
+        s.push(format!("... and {} more", v.len() - SHOWN));
+    }
+    s.join(", ")
+}
+
+/// A curve `x(z)` sampled at strictly increasing `z`. See the [module docs](self).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Profile {
+    z: Vec<Real>,
+    x: Vec<Real>,
+    /// Analytic dx/dz at the nodes, when known.
+    dx: Option<Vec<Real>>,
+    /// Analytic d2x/dz2 at the nodes, when known (may be infinite at a kink).
+    d2x: Option<Vec<Real>>,
+}
+
+/// Validates an abscissa array: finite, long enough, strictly increasing.
+pub(crate) fn check_abscissa(what: &str, z: &[Real]) -> Result<(), InputError> {
+    if z.len() < MIN_POINTS {
+        return Err(InputError::TooFew {
+            what: what.to_owned(),
+            got: z.len(),
+            min: MIN_POINTS,
+        });
+    }
+    crate::math::all_finite(what, z)?;
+    if let Some(i) = (1..z.len()).find(|&i| z[i] <= z[i - 1]) {
+        return Err(InputError::NotIncreasing {
+            what: what.to_owned(),
+            index: i,
+            prev: z[i - 1],
+            value: z[i],
+        });
+    }
+    Ok(())
+}
+
+fn check_same_len(what: &str, a: usize, b: usize) -> Result<(), InputError> {
+    if a != b {
+        return Err(InputError::LengthMismatch {
+            what: what.to_owned(),
+            left: a,
+            right: b,
+        });
+    }
+    Ok(())
+}
+
+impl Profile {
+    /// A profile from its samples.
+    ///
+    /// # Failures
+    /// Fewer than [`MIN_POINTS`] points, arrays of different lengths, a
+    /// non-finite value, or z not strictly increasing: each names the index.
+    pub fn new(z: Vec<Real>, x: Vec<Real>) -> Result<Self, ProfileError> {
+        check_same_len("profile z and x", z.len(), x.len())?;
+        check_abscissa("profile z", &z)?;
+        crate::math::all_finite("profile x", &x)?;
+        Ok(Self {
+            z,
+            x,
+            dx: None,
+            d2x: None,
+        })
+    }
+
+    /// A profile with analytic first and second derivatives at its nodes.
+    /// Second derivatives may be infinite (a kink: `+inf` where the slope
+    /// jumps up, `-inf` where it jumps down), never NaN.
+    ///
+    /// # Failures
+    /// As [`Profile::new`], and for derivatives of the wrong length or NaN.
+    pub fn with_derivatives(
+        z: Vec<Real>,
+        x: Vec<Real>,
+        dx: Vec<Real>,
+        d2x: Vec<Real>,
+    ) -> Result<Self, ProfileError> {
+        let mut p = Self::new(z, x)?;
+        check_same_len("profile z and dx/dz", p.z.len(), dx.len())?;
+        check_same_len("profile z and d2x/dz2", p.z.len(), d2x.len())?;
+        crate::math::all_finite("profile dx/dz", &dx)?;
+        if let Some(i) = d2x.iter().position(|v| v.is_nan()) {
+            return Err(InputError::NonFinite {
+                what: "profile d2x/dz2".into(),
+                index: Some(i),
+                value: d2x[i],
+            }
+            .into());
+        }
+        p.dx = Some(dx);
+        p.d2x = Some(d2x);
+        Ok(p)
+    }
+
+    /// Number of nodes (at least [`MIN_POINTS`]).
+    pub fn len(&self) -> usize {
+        self.z.len()
+    }
+
+    /// Always `false`: a profile has at least [`MIN_POINTS`] nodes.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// The abscissae (mm).
+    pub fn z(&self) -> &[Real] {
+        &self.z
+    }
+
+    /// The ordinates (mm).
+    pub fn x(&self) -> &[Real] {
+        &self.x
+    }
+
+    /// First and last z.
+    pub fn z_range(&self) -> (Real, Real) {
+        (self.z[0], self.z[self.z.len() - 1])
+    }
+
+    /// Whether the derivatives are analytic (given by a generator).
+    pub fn has_analytic_derivatives(&self) -> bool {
+        self.dx.is_some()
+    }
+
+    /// Drops the analytic derivatives, so that estimates are used.
+    pub fn without_derivatives(mut self) -> Self {
+        self.dx = None;
+        self.d2x = None;
+        self
+    }
+
+    /// First divided differences `(x_{i+1} - x_i) / (z_{i+1} - z_i)`, one per
+    /// interval (`len() - 1` values).
+    pub fn divided_differences(&self) -> Vec<Real> {
+        self.z
+            .windows(2)
+            .zip(self.x.windows(2))
+            .map(|(z, x)| (x[1] - x[0]) / (z[1] - z[0]))
+            .collect()
+    }
+
+    /// Second divided differences times two, `2 x[z_{i-1}, z_i, z_{i+1}]`:
+    /// the second derivative of the parabola through three neighbours, one
+    /// per interior node (`len() - 2` values).
+    pub fn second_divided_differences(&self) -> Vec<Real> {
+        let d = self.divided_differences();
+        (1..self.len() - 1)
+            .map(|i| 2.0 * (d[i] - d[i - 1]) / (self.z[i + 1] - self.z[i - 1]))
+            .collect()
+    }
+
+    /// dx/dz at every node: analytic if known, else the derivative of the
+    /// parabola through the node and its neighbours (one-sided at the ends).
+    ///
+    /// # Tolerance
+    /// The estimate's error is at most `h_i h_{i+1} max|x'''| / 6` inside
+    /// and `h (h + h') max|x'''| / 6` at the ends, for steps `h`.
+    pub fn slopes(&self) -> Cow<'_, [Real]> {
+        if let Some(d) = &self.dx {
+            return Cow::Borrowed(d);
+        }
+        let (z, x) = (&self.z, &self.x);
+        let n = z.len();
+        let mut out = vec![0.0; n];
+        // Derivative at node k of the parabola through nodes a, b, c.
+        let parabola = |k: usize, a: usize, b: usize, c: usize| -> Real {
+            let (za, zb, zc, zk) = (z[a], z[b], z[c], z[k]);
+            x[a] * ((zk - zb) + (zk - zc)) / ((za - zb) * (za - zc))
+                + x[b] * ((zk - za) + (zk - zc)) / ((zb - za) * (zb - zc))
+                + x[c] * ((zk - za) + (zk - zb)) / ((zc - za) * (zc - zb))
+        };
+        out[0] = parabola(0, 0, 1, 2);
+        for i in 1..n - 1 {
+            out[i] = parabola(i, i - 1, i, i + 1);
+        }
+        out[n - 1] = parabola(n - 1, n - 3, n - 2, n - 1);
+        Cow::Owned(out)
+    }
+
+    /// d2x/dz2 at every node: analytic if known, else the second divided
+    /// difference of the node's neighbourhood (the nearest one at the ends).
+    pub fn second_derivatives(&self) -> Cow<'_, [Real]> {
+        if let Some(d) = &self.d2x {
+            return Cow::Borrowed(d);
+        }
+        let mut d2 = self.second_divided_differences();
+        let (first, last) = (d2[0], d2[d2.len() - 1]);
+        d2.insert(0, first);
+        d2.push(last);
+        Cow::Owned(d2)
+    }
+
+    /// Tangent angle `gamma_i = atan(dx/dz)` at every node (rad).
+    pub fn tangent_angles(&self) -> Vec<Real> {
+        self.slopes().iter().map(|s| s.atan()).collect()
+    }
+
+    /// Signed curvature `x'' / (1 + x'^2)^(3/2)` at every node (1/mm):
+    /// positive where the profile is concave seen from +x (its centre of
+    /// curvature on the +x side).
+    pub fn curvature(&self) -> Vec<Real> {
+        let (d1, d2) = (self.slopes(), self.second_derivatives());
+        d1.iter()
+            .zip(d2.iter())
+            .map(|(a, b)| curvature_of(*a, *b))
+            .collect()
+    }
+
+    /// Radius of curvature `1 / |curvature|` at every node (mm; infinite on
+    /// straight parts, 0 at a kink).
+    pub fn curvature_radius(&self) -> Vec<Real> {
+        self.curvature().iter().map(|k| 1.0 / k.abs()).collect()
+    }
+
+    /// Cumulative arc length from the first node, by chords (mm).
+    ///
+    /// # Tolerance
+    /// A chord is shorter than its arc by about `h^3 kappa^2 / 24` per step.
+    pub fn arc_length(&self) -> Vec<Real> {
+        let mut s = Vec::with_capacity(self.len());
+        let mut acc = 0.0;
+        s.push(0.0);
+        for i in 1..self.len() {
+            acc += (self.z[i] - self.z[i - 1]).hypot(self.x[i] - self.x[i - 1]);
+            s.push(acc);
+        }
+        s
+    }
+
+    /// x at any z of the range, by cubic Hermite interpolation with the
+    /// node slopes of [`Self::slopes`].
+    ///
+    /// # Failures
+    /// z outside the profile's range, or not finite.
+    pub fn eval(&self, z: Real) -> Result<Real, ProfileError> {
+        crate::math::finite("profile query z", z)?;
+        let (lo, hi) = self.z_range();
+        if !(lo..=hi).contains(&z) {
+            return Err(ProfileError::OutsideProfile {
+                what: "profile value".into(),
+                z,
+                z_min: lo,
+                z_max: hi,
+            });
+        }
+        let slopes = self.slopes();
+        Ok(hermite(&self.z, &self.x, &slopes, z))
+    }
+
+    /// The profile resampled at a uniform step of z from its first to its
+    /// last z (the last step may be shorter), by cubic Hermite
+    /// interpolation. Analytic derivatives are not carried over.
+    ///
+    /// # Failures
+    /// A step that is not positive and finite, or one so small that the
+    /// result would exceed 100 million points.
+    pub fn resample_uniform(&self, step: Real) -> Result<Profile, ProfileError> {
+        self.resample_by(&self.z.clone(), step)
+    }
+
+    /// The profile resampled at a uniform step of a monotone parameter `t`
+    /// given at the nodes (for example [`Self::arc_length`]): z and x are
+    /// both interpolated in `t` (cubic Hermite).
+    ///
+    /// # Failures
+    /// `t` of the wrong length, not finite or not strictly increasing; a bad
+    /// step; a parameter under which the resampled z would not increase.
+    pub fn resample_by(&self, t: &[Real], step: Real) -> Result<Profile, ProfileError> {
+        check_same_len("resampling parameter and profile", t.len(), self.len())?;
+        check_abscissa("resampling parameter", t)?;
+        crate::math::positive("resampling step", step)?;
+        let ts = law::uniform_grid(t[0], t[t.len() - 1], step)?;
+        let tz = Profile::new(t.to_vec(), self.z.clone())?;
+        let tx = Profile::new(t.to_vec(), self.x.clone())?;
+        let (sz, sx) = (tz.slopes(), tx.slopes());
+        let z = ts.iter().map(|&tk| hermite(t, &self.z, &sz, tk)).collect();
+        let x = ts.iter().map(|&tk| hermite(t, &self.x, &sx, tk)).collect();
+        Profile::new(z, x)
+    }
+
+    /// Pointwise minimum of this profile and `other`, on this profile's nodes
+    /// (where `other` covers them; elsewhere this profile's value). Useful
+    /// for "the current surface": the stock left and the wheel's envelope.
+    pub fn min_with(&self, other: &Profile) -> Profile {
+        let (lo, hi) = other.z_range();
+        let slopes = other.slopes();
+        let x = self
+            .z
+            .iter()
+            .zip(&self.x)
+            .map(|(&z, &x)| {
+                if (lo..=hi).contains(&z) {
+                    x.min(hermite(&other.z, &other.x, &slopes, z))
+                } else {
+                    x
+                }
+            })
+            .collect();
+        Profile {
+            z: self.z.clone(),
+            x,
+            dx: None,
+            d2x: None,
+        }
+    }
+}
+
+/// Signed curvature of a graph from its first and second derivatives.
+#[inline]
+pub fn curvature_of(d1: Real, d2: Real) -> Real {
+    d2 / (1.0 + d1 * d1).powf(1.5)
+}
+
+/// Cubic Hermite interpolation of nodes `(t, v)` with slopes `s` at `tq`
+/// (clamped to the range).
+pub(crate) fn hermite(t: &[Real], v: &[Real], s: &[Real], tq: Real) -> Real {
+    let n = t.len();
+    let i = crate::math::floor_index(t, tq).unwrap_or(0).min(n - 2);
+    let h = t[i + 1] - t[i];
+    let u = ((tq - t[i]) / h).clamp(0.0, 1.0);
+    let (u2, u3) = (u * u, u * u * u);
+    let h00 = 2.0 * u3 - 3.0 * u2 + 1.0;
+    let h10 = u3 - 2.0 * u2 + u;
+    let h01 = -2.0 * u3 + 3.0 * u2;
+    let h11 = u3 - u2;
+    h00 * v[i] + h10 * h * s[i] + h01 * v[i + 1] + h11 * h * s[i + 1]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assert_near;
+
+    fn cubic() -> Profile {
+        // x = z^3 - z on a non-uniform grid.
+        let z: Vec<Real> = (0..40)
+            .map(|i| -2.0 + 0.1 * i as Real + 0.002 * (i % 3) as Real)
+            .collect();
+        let x = z.iter().map(|z| z * z * z - z).collect();
+        Profile::new(z, x).unwrap()
+    }
+
+    #[test]
+    fn estimated_derivatives_within_documented_bound() {
+        let p = cubic();
+        let s = p.slopes();
+        for (i, &z) in p.z().iter().enumerate() {
+            // |x'''| = 6; steps about 0.1: the bound is h h' 6 / 6 (interior), h(h+h') at the ends.
+            let h = 0.104;
+            let bound = if i == 0 || i == p.len() - 1 {
+                2.0 * h * h
+            } else {
+                h * h
+            };
+            assert_near!(s[i], 3.0 * z * z - 1.0, bound, "node {i}");
+        }
+        let d2 = p.second_derivatives();
+        for i in 1..p.len() - 1 {
+            assert_near!(d2[i], 6.0 * p.z()[i], 0.7, "node {i}");
+        }
+    }
+
+    #[test]
+    fn curvature_of_a_circle() {
+        let r = 5.0;
+        let z: Vec<Real> = (0..201).map(|i| -3.0 + 0.03 * i as Real).collect();
+        let x: Vec<Real> = z.iter().map(|z| -(r * r - z * z).sqrt()).collect();
+        let p = Profile::new(z, x).unwrap();
+        for (i, k) in p.curvature().iter().enumerate().skip(1).take(198) {
+            assert_near!(*k, 1.0 / r, 1e-4, "node {i}");
+        }
+        assert_near!(p.curvature_radius()[100], r, 1e-3);
+        // Arc length of the arc from -3 to 3 on a circle of radius 5.
+        let s = p.arc_length();
+        // Chords fall short by about h^3 kappa^2 / 24 per step: 200 steps of up to 0.0375.
+        assert_near!(
+            s[200],
+            2.0 * r * (3.0_f64 / r).asin(),
+            200.0 * 0.0375_f64.powi(3) / 25.0 / 24.0
+        );
+    }
+
+    #[test]
+    fn resampling_keeps_the_curve() {
+        let p = cubic();
+        let r = p.resample_uniform(0.013).unwrap();
+        let (a, b) = r.z_range();
+        assert_eq!((a, b), p.z_range());
+        for (z, x) in r.z().iter().zip(r.x()) {
+            assert_near!(*x, z * z * z - z, 2e-3, "z = {z}");
+        }
+        let s = p.arc_length();
+        let r = p.resample_by(&s, 0.05).unwrap();
+        let rs = r.arc_length();
+        for w in rs.windows(2).take(rs.len() - 2) {
+            assert_near!(w[1] - w[0], 0.05, 5e-3);
+        }
+    }
+
+    #[test]
+    fn bad_profiles_are_named() {
+        let e = Profile::new(vec![0.0, 1.0], vec![0.0, 1.0]).unwrap_err();
+        assert!(e.to_string().contains("at least 3"), "{e}");
+        let e = Profile::new(vec![0.0, 1.0, 1.0], vec![0.0, 1.0, 2.0]).unwrap_err();
+        assert!(e.to_string().contains("[2] = 1 follows [1] = 1"), "{e}");
+        let e = Profile::new(vec![0.0, 1.0, 2.0], vec![0.0, f64::INFINITY, 2.0]).unwrap_err();
+        assert!(e.to_string().contains("profile x[1] = inf"), "{e}");
+        let e = Profile::new(vec![0.0, 1.0, 2.0], vec![0.0, 1.0]).unwrap_err();
+        assert!(e.to_string().contains("lengths differ"), "{e}");
+        let p = cubic();
+        assert!(p.eval(5.0).is_err());
+        assert!(p.resample_uniform(0.0).is_err());
+        assert!(p.resample_uniform(1e-12).is_err());
+    }
+}

@@ -1,0 +1,468 @@
+//! Tables of numbers from CSV and spreadsheet files (XLSX, XLS, ODS).
+//!
+//! Engineers keep profiles and groove tables (`Hp = f1(theta)`,
+//! `B = f2(theta)`, MATH §3.1) in spreadsheets. A [`Table`] reads the first
+//! sheet (or a CSV file), takes the first row as headers when any of its
+//! cells is not a number, and converts a column to numbers only when it is
+//! asked for, so a notes column does not get in the way. Every error names
+//! the file, the row (as the spreadsheet numbers it, from 1) and the column
+//! (letter and header).
+//!
+//! CSV files may use `,`, `;` or tab as the delimiter (detected from the
+//! first line); with `;` or tab, a decimal comma (`12,5`) is accepted.
+//! Lines starting with `#` are comments.
+
+use super::{Profile, ProfileError};
+use crate::error::InputError;
+use crate::math::Real;
+use std::path::Path;
+
+/// Errors reading tables; each names the file, and the row and column where
+/// there is one.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TableError {
+    /// The file could not be read or parsed as its format.
+    #[error("{file}: {message}")]
+    Read {
+        /// The file.
+        file: String,
+        /// What went wrong.
+        message: String,
+    },
+    /// The file's extension names no format this reader knows.
+    #[error(
+        "{file}: unknown table format '{extension}' (use .csv, .txt, .xlsx, .xlsm, .xls or .ods)"
+    )]
+    UnknownFormat {
+        /// The file.
+        file: String,
+        /// Its extension.
+        extension: String,
+    },
+    /// No data rows.
+    #[error("{file}: the table has no data rows")]
+    Empty {
+        /// The file.
+        file: String,
+    },
+    /// A column asked for is not in the table.
+    #[error("{file}: no column '{column}' (columns: {available})")]
+    UnknownColumn {
+        /// The file.
+        file: String,
+        /// The name asked for.
+        column: String,
+        /// The columns there are.
+        available: String,
+    },
+    /// A cell in a used column is empty.
+    #[error("{file}, row {row}, column {column}: the cell is empty")]
+    MissingCell {
+        /// The file.
+        file: String,
+        /// Row number (from 1, as the spreadsheet shows it).
+        row: usize,
+        /// Column letter and header.
+        column: String,
+    },
+    /// A cell in a used column is not a number.
+    #[error("{file}, row {row}, column {column}: '{text}' is not a number")]
+    NotNumber {
+        /// The file.
+        file: String,
+        /// Row number (from 1).
+        row: usize,
+        /// Column letter and header.
+        column: String,
+        /// The cell's text.
+        text: String,
+    },
+    /// A value that is a number but not acceptable where it stands.
+    #[error("{file}, row {row}, column {column}: {message}")]
+    BadValue {
+        /// The file.
+        file: String,
+        /// Row number (from 1).
+        row: usize,
+        /// Column letter and header.
+        column: String,
+        /// Why.
+        message: String,
+    },
+}
+
+/// The formats [`read_table`] reads, chosen by extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TableFormat {
+    /// Comma-, semicolon- or tab-separated text (`.csv`, `.txt`, `.tsv`).
+    Csv,
+    /// A spreadsheet (`.xlsx`, `.xlsm`, `.xls`, `.ods`), first sheet.
+    Spreadsheet,
+}
+
+impl TableFormat {
+    /// The format for a path's extension.
+    pub fn of(path: &Path) -> Option<Self> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "csv" | "txt" | "tsv" => Some(Self::Csv),
+            "xlsx" | "xlsm" | "xls" | "xlsb" | "ods" => Some(Self::Spreadsheet),
+            _ => None,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+enum Cell {
+    Number(Real),
+    Text(String),
+    Empty,
+}
+
+/// A table of cells with optional headers. See the [module docs](self).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table {
+    source: String,
+    headers: Vec<String>,
+    /// (row number from 1, cells)
+    rows: Vec<(usize, Vec<Cell>)>,
+}
+
+/// Reads a table from a file, by its extension.
+///
+/// # Failures
+/// An unreadable file, an unknown extension, a malformed file, or a table
+/// with no data rows.
+pub fn read_table(path: impl AsRef<Path>) -> Result<Table, TableError> {
+    let path = path.as_ref();
+    let file = path.display().to_string();
+    let format = TableFormat::of(path).ok_or_else(|| TableError::UnknownFormat {
+        file: file.clone(),
+        extension: path
+            .extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or("")
+            .to_owned(),
+    })?;
+    match format {
+        TableFormat::Csv => {
+            let bytes = std::fs::read(path).map_err(|e| TableError::Read {
+                file: file.clone(),
+                message: e.to_string(),
+            })?;
+            let text = String::from_utf8_lossy(&bytes);
+            read_table_str(&text, &file)
+        }
+        TableFormat::Spreadsheet => read_spreadsheet(path, file),
+    }
+}
+
+/// Parses CSV text; `source` names it in errors.
+pub fn read_table_str(text: &str, source: &str) -> Result<Table, TableError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let first = text
+        .lines()
+        .find(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
+        .unwrap_or("");
+    let delimiter = [b';', b'\t', b',']
+        .into_iter()
+        .max_by_key(|d| {
+            first.bytes().filter(|b| b == d).count() * 4
+                + usize::from(*d == b';') * 2
+                + usize::from(*d == b'\t')
+        })
+        .unwrap_or(b',');
+    let decimal_comma = delimiter != b',';
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .delimiter(delimiter)
+        .comment(Some(b'#'))
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let mut rows = Vec::new();
+    for rec in reader.records() {
+        let rec = rec.map_err(|e| TableError::Read {
+            file: source.to_owned(),
+            message: e.to_string(),
+        })?;
+        let line = rec.position().map_or(0, |p| p.line() as usize);
+        let cells = rec
+            .iter()
+            .map(|s| {
+                if s.is_empty() {
+                    Cell::Empty
+                } else {
+                    let t = if decimal_comma {
+                        s.replace(',', ".")
+                    } else {
+                        s.to_owned()
+                    };
+                    match t.parse::<Real>() {
+                        Ok(v) => Cell::Number(v),
+                        Err(_) => Cell::Text(s.to_owned()),
+                    }
+                }
+            })
+            .collect();
+        rows.push((line, cells));
+    }
+    Table::from_rows(source.to_owned(), rows)
+}
+
+fn read_spreadsheet(path: &Path, file: String) -> Result<Table, TableError> {
+    use calamine::{Data, Reader};
+    let read_err = |e: &dyn std::fmt::Display| TableError::Read {
+        file: file.clone(),
+        message: e.to_string(),
+    };
+    let mut book = calamine::open_workbook_auto(path).map_err(|e| read_err(&e))?;
+    let range = book
+        .worksheet_range_at(0)
+        .ok_or_else(|| read_err(&"the workbook has no sheets"))?
+        .map_err(|e| read_err(&e))?;
+    let (row0, col0) = range.start().unwrap_or((0, 0));
+    let rows = range
+        .rows()
+        .enumerate()
+        .map(|(i, r)| {
+            let mut cells: Vec<Cell> = vec![Cell::Empty; col0 as usize];
+            cells.extend(r.iter().map(|c| match c {
+                Data::Int(v) => Cell::Number(*v as Real),
+                Data::Float(v) => Cell::Number(*v),
+                Data::Empty => Cell::Empty,
+                Data::String(s) => match s.trim().parse::<Real>() {
+                    Ok(v) => Cell::Number(v),
+                    Err(_) if s.trim().is_empty() => Cell::Empty,
+                    Err(_) => Cell::Text(s.clone()),
+                },
+                other => Cell::Text(other.to_string()),
+            }));
+            (row0 as usize + i + 1, cells)
+        })
+        .collect();
+    Table::from_rows(file, rows)
+}
+
+/// Spreadsheet column letters: 0 -> A, 25 -> Z, 26 -> AA.
+fn column_letter(mut i: usize) -> String {
+    let mut s = Vec::new();
+    loop {
+        s.push(b'A' + (i % 26) as u8);
+        if i < 26 {
+            break;
+        }
+        i = i / 26 - 1;
+    }
+    s.reverse();
+    String::from_utf8(s).unwrap_or_default()
+}
+
+impl Table {
+    fn from_rows(source: String, mut rows: Vec<(usize, Vec<Cell>)>) -> Result<Self, TableError> {
+        rows.retain(|(_, cells)| cells.iter().any(|c| *c != Cell::Empty));
+        let mut headers = Vec::new();
+        if let Some((_, first)) = rows.first() {
+            if first.iter().any(|c| matches!(c, Cell::Text(_))) {
+                headers = first
+                    .iter()
+                    .map(|c| match c {
+                        Cell::Text(t) => t.trim().to_owned(),
+                        Cell::Number(v) => v.to_string(),
+                        Cell::Empty => String::new(),
+                    })
+                    .collect();
+                rows.remove(0);
+            }
+        }
+        if rows.is_empty() {
+            return Err(TableError::Empty { file: source });
+        }
+        Ok(Self {
+            source,
+            headers,
+            rows,
+        })
+    }
+
+    /// Where the table came from (a file name).
+    pub fn source(&self) -> &str {
+        &self.source
+    }
+
+    /// The header row (empty if the first row held numbers only).
+    pub fn headers(&self) -> &[String] {
+        &self.headers
+    }
+
+    /// Number of data rows.
+    pub fn row_count(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// The row number (from 1, as the file shows it) of data row `i`.
+    pub fn row_number(&self, i: usize) -> usize {
+        self.rows.get(i).map_or(0, |r| r.0)
+    }
+
+    fn width(&self) -> usize {
+        self.rows
+            .iter()
+            .map(|r| r.1.len())
+            .chain([self.headers.len()])
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// `B (Hp)`: the column's letter, and its header if it has one.
+    fn label(&self, col: usize) -> String {
+        match self.headers.get(col).filter(|h| !h.is_empty()) {
+            Some(h) => format!("{} ({h})", column_letter(col)),
+            None => column_letter(col),
+        }
+    }
+
+    /// The index of a column given by header (case-insensitive), letter
+    /// (`"B"`) or number from 1 (`"2"`).
+    pub fn column_index(&self, name: &str) -> Result<usize, TableError> {
+        let key = name.trim();
+        let width = self.width();
+        if let Some(i) = self
+            .headers
+            .iter()
+            .position(|h| h.eq_ignore_ascii_case(key))
+        {
+            return Ok(i);
+        }
+        if let Ok(n) = key.parse::<usize>() {
+            if (1..=width).contains(&n) {
+                return Ok(n - 1);
+            }
+        }
+        if let Some(i) = (0..width).find(|&i| column_letter(i).eq_ignore_ascii_case(key)) {
+            return Ok(i);
+        }
+        Err(TableError::UnknownColumn {
+            file: self.source.clone(),
+            column: name.to_owned(),
+            available: (0..width)
+                .map(|i| self.label(i))
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
+    }
+
+    /// The numbers of one column, every data row.
+    ///
+    /// # Failures
+    /// An unknown column; an empty, non-numeric or non-finite cell (named
+    /// by row and column).
+    pub fn column(&self, name: &str) -> Result<Vec<Real>, TableError> {
+        let col = self.column_index(name)?;
+        self.rows
+            .iter()
+            .map(
+                |(row, cells)| match cells.get(col).unwrap_or(&Cell::Empty) {
+                    Cell::Number(v) if v.is_finite() => Ok(*v),
+                    Cell::Number(v) => Err(TableError::BadValue {
+                        file: self.source.clone(),
+                        row: *row,
+                        column: self.label(col),
+                        message: format!("{v} is not a finite number"),
+                    }),
+                    Cell::Text(t) => Err(TableError::NotNumber {
+                        file: self.source.clone(),
+                        row: *row,
+                        column: self.label(col),
+                        text: t.clone(),
+                    }),
+                    Cell::Empty => Err(TableError::MissingCell {
+                        file: self.source.clone(),
+                        row: *row,
+                        column: self.label(col),
+                    }),
+                },
+            )
+            .collect()
+    }
+
+    /// A profile from two columns: `z` (must increase strictly) and `x`.
+    ///
+    /// # Failures
+    /// As [`Self::column`]; z not increasing or fewer than 3 rows, named by
+    /// row and column.
+    pub fn profile(&self, z_column: &str, x_column: &str) -> Result<Profile, TableError> {
+        let z = self.column(z_column)?;
+        let x = self.column(x_column)?;
+        let zc = self.column_index(z_column)?;
+        Profile::new(z, x).map_err(|e| match e {
+            ProfileError::Input(InputError::NotIncreasing {
+                index, prev, value, ..
+            }) => TableError::BadValue {
+                file: self.source.clone(),
+                row: self.row_number(index),
+                column: self.label(zc),
+                message: format!("{value} does not increase on the row before ({prev})"),
+            },
+            other => TableError::Read {
+                file: self.source.clone(),
+                message: other.to_string(),
+            },
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn letters() {
+        assert_eq!(column_letter(0), "A");
+        assert_eq!(column_letter(25), "Z");
+        assert_eq!(column_letter(26), "AA");
+        assert_eq!(column_letter(27), "AB");
+        assert_eq!(column_letter(701), "ZZ");
+        assert_eq!(column_letter(702), "AAA");
+    }
+
+    #[test]
+    fn csv_with_headers_comments_and_decimal_commas() {
+        let t = read_table_str(
+            "# groove\ntheta;Hp;B;note\n0;5,5;12;a\n1;5,6;12,1;\n\n2;5,7;12,2;x\n",
+            "g.csv",
+        )
+        .unwrap();
+        assert_eq!(t.headers(), ["theta", "Hp", "B", "note"]);
+        assert_eq!(t.column("hp").unwrap(), vec![5.5, 5.6, 5.7]);
+        assert_eq!(t.column("C").unwrap(), vec![12.0, 12.1, 12.2]);
+        assert_eq!(t.column("1").unwrap(), vec![0.0, 1.0, 2.0]);
+        let e = t.column("note").unwrap_err().to_string();
+        assert_eq!(e, "g.csv, row 3, column D (note): 'a' is not a number");
+        let e = t.column("depth").unwrap_err().to_string();
+        assert!(
+            e.contains("no column 'depth'") && e.contains("B (Hp)"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn missing_cells_and_bad_z_name_row_and_column() {
+        let t = read_table_str("z,x\n0,1\n1,\n2,3\n", "p.csv").unwrap();
+        assert_eq!(
+            t.column("x").unwrap_err().to_string(),
+            "p.csv, row 3, column B (x): the cell is empty"
+        );
+        let t = read_table_str("0,1\n1,2\n0.5,3\n", "q.csv").unwrap();
+        let e = t.profile("A", "B").unwrap_err().to_string();
+        assert!(e.contains("q.csv, row 3, column A"), "{e}");
+        assert!(matches!(
+            read_table_str("a,b\n", "e.csv"),
+            Err(TableError::Empty { .. })
+        ));
+        let e = read_table("x.dwg").unwrap_err().to_string();
+        assert!(e.contains("unknown table format 'dwg'"), "{e}");
+        let e = read_table("no/such/file.csv").unwrap_err().to_string();
+        assert!(e.starts_with("no/such/file.csv: "), "{e}");
+    }
+}

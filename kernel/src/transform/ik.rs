@@ -1,0 +1,544 @@
+//! Numerical inverse kinematics for any [`Chain`] (Levenberg–Marquardt).
+//!
+//! The residual is the tool point's position error (mm) and, when the
+//! target gives one, the tool axis's direction error scaled by
+//! [`IkOptions::axis_weight`] (mm per unit chord) so that both weigh alike.
+//! The Jacobian is exact: one backward sweep carries the tool point and axis
+//! through the factors, one forward sweep accumulates the rotations, so an
+//! iteration costs about two chain evaluations.
+
+use super::{Chain, FactorKind, FactorValue, Frame, ToolFrame, TransformError};
+use crate::error::InputError;
+use crate::math::{Point3, Real, Vec3};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
+
+/// What inverse kinematics should reach.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Target {
+    /// The tool's reference point in the part frame (mm).
+    pub point: Point3,
+    /// The tool's axis in the part frame, if it is prescribed (any length
+    /// but zero; it is normalised).
+    pub axis: Option<Vec3>,
+}
+
+impl Target {
+    /// A position-only target.
+    pub fn point(point: Point3) -> Self {
+        Self { point, axis: None }
+    }
+
+    /// A position and tool-axis target.
+    pub fn pose(point: Point3, axis: Vec3) -> Self {
+        Self {
+            point,
+            axis: Some(axis),
+        }
+    }
+}
+
+/// Tolerances and limits of [`Chain::inverse`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct IkOptions {
+    /// Largest accepted position error (mm). Default 1e-7 mm.
+    pub tol_pos: Real,
+    /// Largest accepted tool-axis error, as the chord between unit vectors
+    /// (about the angle in rad). Default 1e-9.
+    pub tol_dir: Real,
+    /// Iteration limit per start. Default 100.
+    pub max_iter: usize,
+    /// Weight of the axis error against the position error (mm). Default 100 mm.
+    pub axis_weight: Real,
+    /// Whether to try further starts (rotary axes turned by a quarter or
+    /// half turn) when the given seed fails. Default true.
+    pub restarts: bool,
+}
+
+impl Default for IkOptions {
+    fn default() -> Self {
+        Self {
+            tol_pos: 1e-7,
+            tol_dir: 1e-9,
+            max_iter: 100,
+            axis_weight: 100.0,
+            restarts: true,
+        }
+    }
+}
+
+/// A solution of [`Chain::inverse`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IkSolution {
+    /// Axis values in the chain's order (mm, rad).
+    pub q: Vec<Real>,
+    /// Iterations spent over all starts.
+    pub iterations: usize,
+    /// Position error reached (mm).
+    pub pos_err: Real,
+    /// Tool-axis error reached (chord).
+    pub dir_err: Real,
+}
+
+/// Scratch space and the evaluation of residual and Jacobian.
+struct Solver<'a> {
+    chain: &'a Chain,
+    tool: &'a ToolFrame,
+    target_p: Vec3,
+    target_w: Option<Vec3>,
+    weight: Real,
+    m: usize,
+    /// Residual rows: 3, or 6 with an axis target.
+    rows: usize,
+    sincos: Vec<(Real, Real)>,
+    s: Vec<Vec3>,
+    w: Vec<Vec3>,
+    /// Jacobian, row-major `rows x m`.
+    jac: Vec<Real>,
+    res: [Real; 6],
+}
+
+#[inline]
+fn rotate(kind: FactorKind, s: Real, c: Real, v: &Vec3) -> Vec3 {
+    match kind {
+        FactorKind::Rx => Vec3::new(v.x, c * v.y - s * v.z, s * v.y + c * v.z),
+        FactorKind::Ry => Vec3::new(c * v.x + s * v.z, v.y, -s * v.x + c * v.z),
+        _ => Vec3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z),
+    }
+}
+
+impl<'a> Solver<'a> {
+    fn new(chain: &'a Chain, tool: &'a ToolFrame, target: &Target, weight: Real) -> Self {
+        let n = chain.factors.len();
+        let m = chain.dof();
+        let rows = if target.axis.is_some() { 6 } else { 3 };
+        Self {
+            chain,
+            tool,
+            target_p: target.point.coords,
+            target_w: target.axis.map(|a| a.normalize()),
+            weight,
+            m,
+            rows,
+            sincos: vec![(0.0, 1.0); n],
+            s: vec![Vec3::zeros(); n],
+            w: vec![Vec3::zeros(); n],
+            jac: vec![0.0; rows * m],
+            res: [0.0; 6],
+        }
+    }
+
+    /// Evaluates residual (and the Jacobian if `with_jac`); returns the
+    /// weighted squared norm of the residual.
+    fn eval(&mut self, q: &[Real], with_jac: bool) -> Real {
+        let factors = &self.chain.factors;
+        let mut s = self.tool.point.coords;
+        let mut w = self.tool.axis;
+        for (k, f) in factors.iter().enumerate().rev() {
+            let v = f.value_at(q);
+            if f.kind.is_rotation() {
+                let (sn, cs) = v.sin_cos();
+                self.sincos[k] = (sn, cs);
+                s = rotate(f.kind, sn, cs, &s);
+                w = rotate(f.kind, sn, cs, &w);
+            } else {
+                s[f.kind.direction_index()] += v;
+            }
+            self.s[k] = s;
+            self.w[k] = w;
+        }
+        let dp = s - self.target_p;
+        self.res[..3].copy_from_slice(dp.as_slice());
+        if let Some(tw) = self.target_w {
+            let dw = (w - tw) * self.weight;
+            self.res[3..].copy_from_slice(dw.as_slice());
+        }
+        if with_jac {
+            self.jac.iter_mut().for_each(|x| *x = 0.0);
+            let mut fr = Frame::identity();
+            for (k, f) in factors.iter().enumerate() {
+                if let FactorValue::Axis { axis, scale, .. } = f.value {
+                    let e = f.kind.direction();
+                    let (dp, dw) = if f.kind.is_rotation() {
+                        (fr.rot * e.cross(&self.s[k]), fr.rot * e.cross(&self.w[k]))
+                    } else {
+                        (fr.rot * e, Vec3::zeros())
+                    };
+                    for r in 0..3 {
+                        self.jac[r * self.m + axis] += scale * dp[r];
+                    }
+                    if self.rows == 6 {
+                        for r in 0..3 {
+                            self.jac[(r + 3) * self.m + axis] += scale * dw[r] * self.weight;
+                        }
+                    }
+                }
+                if f.kind.is_rotation() {
+                    let (sn, cs) = self.sincos[k];
+                    fr.push_rotation(f.kind, sn, cs);
+                }
+            }
+        }
+        self.res[..self.rows].iter().map(|r| r * r).sum()
+    }
+
+    fn errors(&self) -> (Real, Real) {
+        let pos = Vec3::new(self.res[0], self.res[1], self.res[2]).norm();
+        let dir = if self.rows == 6 {
+            Vec3::new(self.res[3], self.res[4], self.res[5]).norm() / self.weight
+        } else {
+            0.0
+        };
+        (pos, dir)
+    }
+
+    /// Runs Levenberg–Marquardt from `q`; returns (converged, iterations).
+    fn solve(&mut self, q: &mut [Real], opts: &IkOptions) -> (bool, usize) {
+        let m = self.m;
+        let mut a = vec![0.0; m * m];
+        let mut g = vec![0.0; m];
+        let mut delta = vec![0.0; m];
+        let mut trial = q.to_vec();
+        let mut lambda = 1e-3;
+        let mut cost = self.eval(q, true);
+        for it in 0..opts.max_iter {
+            let (pe, de) = self.errors();
+            if pe <= opts.tol_pos && de <= opts.tol_dir {
+                return (true, it);
+            }
+            // Normal equations A = J^T J, g = J^T r.
+            for i in 0..m {
+                g[i] = (0..self.rows)
+                    .map(|r| self.jac[r * m + i] * self.res[r])
+                    .sum();
+                for j in 0..=i {
+                    let v: Real = (0..self.rows)
+                        .map(|r| self.jac[r * m + i] * self.jac[r * m + j])
+                        .sum();
+                    a[i * m + j] = v;
+                    a[j * m + i] = v;
+                }
+            }
+            let max_diag = (0..m).map(|i| a[i * m + i]).fold(0.0, Real::max);
+            let floor = 1e-12 * max_diag.max(1e-300);
+            let mut improved = false;
+            while lambda < 1e12 {
+                let mut damped = a.clone();
+                for i in 0..m {
+                    damped[i * m + i] += lambda * a[i * m + i].max(floor);
+                }
+                delta.iter_mut().zip(&g).for_each(|(d, gi)| *d = -gi);
+                if solve_spd(&mut damped, &mut delta, m) {
+                    trial
+                        .iter_mut()
+                        .zip(q.iter().zip(&delta))
+                        .for_each(|(t, (qi, d))| *t = qi + d);
+                    let c = self.eval(&trial, false);
+                    if c.is_finite() && c < cost {
+                        q.copy_from_slice(&trial);
+                        cost = self.eval(q, true);
+                        lambda = (lambda / 3.0).max(1e-12);
+                        improved = true;
+                        break;
+                    }
+                }
+                lambda *= 4.0;
+            }
+            if !improved {
+                let (pe, de) = self.errors();
+                return (pe <= opts.tol_pos && de <= opts.tol_dir, it + 1);
+            }
+        }
+        let (pe, de) = self.errors();
+        (pe <= opts.tol_pos && de <= opts.tol_dir, opts.max_iter)
+    }
+}
+
+/// Solves `a x = b` in place for a symmetric positive definite `a` (m x m,
+/// row-major) by Cholesky; `false` if `a` is not positive definite.
+fn solve_spd(a: &mut [Real], b: &mut [Real], m: usize) -> bool {
+    for j in 0..m {
+        let mut d = a[j * m + j];
+        for k in 0..j {
+            d -= a[j * m + k] * a[j * m + k];
+        }
+        if d <= 0.0 || !d.is_finite() {
+            return false;
+        }
+        let d = d.sqrt();
+        a[j * m + j] = d;
+        for i in j + 1..m {
+            let mut v = a[i * m + j];
+            for k in 0..j {
+                v -= a[i * m + k] * a[j * m + k];
+            }
+            a[i * m + j] = v / d;
+        }
+    }
+    for i in 0..m {
+        let mut v = b[i];
+        for k in 0..i {
+            v -= a[i * m + k] * b[k];
+        }
+        b[i] = v / a[i * m + i];
+    }
+    for i in (0..m).rev() {
+        let mut v = b[i];
+        for k in i + 1..m {
+            v -= a[k * m + i] * b[k];
+        }
+        b[i] = v / a[i * m + i];
+    }
+    true
+}
+
+/// Brings rotary values into their travel by whole turns; returns the first
+/// axis still outside travel, if any.
+fn fit_travel(chain: &Chain, q: &mut [Real], travel: &[(Real, Real)]) -> Option<usize> {
+    for (i, (v, &(lo, hi))) in q.iter_mut().zip(travel).enumerate() {
+        if chain.is_rotary(i) && (*v < lo || *v > hi) {
+            let turned = *v + TAU * ((lo - *v) / TAU).ceil();
+            if turned <= hi {
+                *v = turned;
+            }
+        }
+        if *v < lo || *v > hi {
+            return Some(i);
+        }
+    }
+    None
+}
+
+impl Chain {
+    /// Axis values that put `tool` at `target`, starting from `seed`.
+    ///
+    /// `travel`, if given, holds each axis's `(min, max)` in the chain's
+    /// order (mm, rad); rotary values are moved by whole turns to fit it.
+    /// When the seed fails and [`IkOptions::restarts`] is set, starts with
+    /// the rotary axes turned by a quarter and half turn are tried.
+    ///
+    /// # Failures
+    /// - [`TransformError::Unreachable`]: no start reached the target within
+    ///   the tolerances (the error gives the best errors reached);
+    /// - [`TransformError::OutsideTravel`]: the target was reached only with
+    ///   an axis outside its travel (named with the value it needs);
+    /// - a seed or travel of the wrong length, a non-finite target or a zero
+    ///   target axis; a chain with no axes.
+    ///
+    /// ```
+    /// use pilgrim_kernel::{Chain, FactorKind::*, IkOptions, Point3, Target, ToolFrame};
+    /// let mill = Chain::builder().axis(Rz, "C").axis(Tx, "X").axis(Ty, "Y").build().unwrap();
+    /// let target = Target::point(Point3::new(0.0, 25.0, 0.0));
+    /// let sol = mill
+    ///     .inverse(&target, &ToolFrame::default(), &[0.0, 10.0, 0.0], None, &IkOptions::default())
+    ///     .unwrap();
+    /// let reached = mill.apply(&sol.q, &Point3::origin()).unwrap();
+    /// assert!((reached - target.point).norm() < 1e-7);
+    /// ```
+    pub fn inverse(
+        &self,
+        target: &Target,
+        tool: &ToolFrame,
+        seed: &[Real],
+        travel: Option<&[(Real, Real)]>,
+        opts: &IkOptions,
+    ) -> Result<IkSolution, TransformError> {
+        self.check_len(seed)?;
+        crate::math::all_finite("IK seed", seed)?;
+        crate::math::all_finite("IK target point", target.point.coords.as_slice())?;
+        if let Some(a) = target.axis {
+            crate::math::all_finite("IK target axis", a.as_slice())?;
+            if a.norm() == 0.0 {
+                return Err(InputError::NotPositive {
+                    what: "IK target axis length".into(),
+                    value: 0.0,
+                }
+                .into());
+            }
+        }
+        if let Some(t) = travel {
+            if t.len() != self.dof() {
+                return Err(InputError::LengthMismatch {
+                    what: "travel limits vs chain axes".into(),
+                    left: t.len(),
+                    right: self.dof(),
+                }
+                .into());
+            }
+        }
+        if self.dof() == 0 {
+            return Err(TransformError::NoAxes);
+        }
+        crate::math::positive("IK position tolerance", opts.tol_pos)?;
+        crate::math::positive("IK axis tolerance", opts.tol_dir)?;
+        crate::math::positive("IK axis weight", opts.axis_weight)?;
+
+        let mut solver = Solver::new(self, tool, target, opts.axis_weight);
+        let rotary: Vec<usize> = (0..self.dof()).filter(|&i| self.is_rotary(i)).collect();
+        let mut starts = vec![seed.to_vec()];
+        if opts.restarts && !rotary.is_empty() {
+            for turn in [FRAC_PI_2, -FRAC_PI_2, PI] {
+                let mut s = seed.to_vec();
+                rotary.iter().for_each(|&i| s[i] += turn);
+                starts.push(s);
+            }
+            if rotary.len() == 2 {
+                for (t0, t1) in [
+                    (PI, 0.0),
+                    (0.0, PI),
+                    (FRAC_PI_2, -FRAC_PI_2),
+                    (-FRAC_PI_2, FRAC_PI_2),
+                ] {
+                    let mut s = seed.to_vec();
+                    s[rotary[0]] += t0;
+                    s[rotary[1]] += t1;
+                    starts.push(s);
+                }
+            }
+        }
+        let mut iterations = 0;
+        let mut best = (Real::INFINITY, Real::INFINITY);
+        let mut outside: Option<TransformError> = None;
+        for mut q in starts {
+            let (ok, it) = solver.solve(&mut q, opts);
+            iterations += it;
+            let (pe, de) = solver.errors();
+            if pe + de * opts.axis_weight < best.0 + best.1 * opts.axis_weight {
+                best = (pe, de);
+            }
+            if !ok {
+                continue;
+            }
+            match travel.and_then(|t| fit_travel(self, &mut q, t).map(|i| (i, t[i]))) {
+                None => {
+                    return Ok(IkSolution {
+                        q,
+                        iterations,
+                        pos_err: pe,
+                        dir_err: de,
+                    })
+                }
+                Some((i, (min, max))) => {
+                    outside.get_or_insert(TransformError::OutsideTravel {
+                        axis: self.axes[i].clone(),
+                        value: q[i],
+                        min,
+                        max,
+                    });
+                }
+            }
+        }
+        Err(outside.unwrap_or(TransformError::Unreachable {
+            point: [target.point.x, target.point.y, target.point.z],
+            pos_err: best.0,
+            dir_err: best.1,
+            iterations,
+        }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::transform::FactorKind::*;
+
+    fn five_axis() -> Chain {
+        Chain::builder()
+            .axis_scaled(Rz, "A", -1.0, 0.0)
+            .axis(Tz, "X")
+            .axis(Tx, "Z")
+            .axis(Ty, "Y")
+            .axis(Rx, "B")
+            .build()
+            .unwrap()
+    }
+
+    #[test]
+    fn jacobian_matches_finite_differences() {
+        let ch = five_axis();
+        let tool = ToolFrame {
+            point: Point3::new(1.0, 2.0, 3.0),
+            axis: Vec3::new(0.0, 0.6, 0.8),
+        };
+        let target = Target::pose(Point3::origin(), Vec3::x());
+        let mut s = Solver::new(&ch, &tool, &target, 10.0);
+        let q = [0.3, 5.0, 120.0, -4.0, 0.2];
+        s.eval(&q, true);
+        let jac = s.jac.clone();
+        let h = 1e-6;
+        for i in 0..5 {
+            let mut qp = q;
+            qp[i] += h;
+            s.eval(&qp, false);
+            let rp = s.res;
+            let mut qm = q;
+            qm[i] -= h;
+            s.eval(&qm, false);
+            for r in 0..6 {
+                let fd = (rp[r] - s.res[r]) / (2.0 * h);
+                assert!(
+                    (fd - jac[r * 5 + i]).abs() < 1e-5 * (1.0 + fd.abs()),
+                    "row {r} axis {i}: {fd} vs {}",
+                    jac[r * 5 + i]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn unreachable_and_outside_travel_are_named() {
+        // A lathe moves only in X and Z: a target off the XZ plane is unreachable.
+        let lathe = Chain::builder()
+            .axis(Tz, "Z")
+            .axis_scaled(Tx, "X", 0.5, 0.0)
+            .build()
+            .unwrap();
+        let e = lathe
+            .inverse(
+                &Target::point(Point3::new(10.0, 3.0, 5.0)),
+                &ToolFrame::default(),
+                &[0.0, 0.0],
+                None,
+                &IkOptions::default(),
+            )
+            .unwrap_err();
+        assert!(matches!(e, TransformError::Unreachable { .. }), "{e}");
+        assert!(e.to_string().contains("unreachable"), "{e}");
+        let e = lathe
+            .inverse(
+                &Target::point(Point3::new(10.0, 0.0, 5.0)),
+                &ToolFrame::default(),
+                &[0.0, 0.0],
+                Some(&[(-100.0, 100.0), (0.0, 15.0)]),
+                &IkOptions::default(),
+            )
+            .unwrap_err();
+        match e {
+            TransformError::OutsideTravel { axis, value, .. } => {
+                assert_eq!(axis, "X");
+                assert!((value - 20.0).abs() < 1e-6);
+            }
+            other => panic!("{other}"),
+        }
+    }
+
+    #[test]
+    fn rotary_values_wrap_into_travel() {
+        let ch = Chain::builder()
+            .axis(Rz, "C")
+            .constant(Tx, 10.0)
+            .build()
+            .unwrap();
+        let target = Target::point(Point3::new(0.0, -10.0, 0.0));
+        let sol = ch
+            .inverse(
+                &target,
+                &ToolFrame::default(),
+                &[0.0],
+                Some(&[(0.0, TAU)]),
+                &IkOptions::default(),
+            )
+            .unwrap();
+        assert!((sol.q[0] - 1.5 * PI).abs() < 1e-6, "{:?}", sol.q);
+    }
+}
