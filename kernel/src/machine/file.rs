@@ -86,7 +86,11 @@ struct Source<'a> {
 
 impl Source<'_> {
     fn err(&self, span: Range<usize>, message: impl Into<String>) -> MachineError {
-        let before = &self.text[..span.start.min(self.text.len())];
+        let mut start = span.start.min(self.text.len());
+        while !self.text.is_char_boundary(start) {
+            start -= 1;
+        }
+        let before = &self.text[..start];
         let line = before.matches('\n').count() + 1;
         let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
         MachineError::File {

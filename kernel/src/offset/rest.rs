@@ -7,12 +7,18 @@
 //! - [`exact_u`], the exact drop of the circle onto the surface.
 //!
 //! # How far apart they are
-//! On a surface `s(z)` with `|s''| <= K` near `z_r` and node spacing `h`,
-//! the chord line stays within `K (R_o + h)(R_o + 2h) / 2` of the surface
-//! over the circle's reach, and a drop moves by no more than the surface
-//! does, so
+//! Let the surface `s(z)` have `|s''| <= K` and `|sin(slope angle)| <= S`
+//! near `z_r`, and node spacing `h`. The seed's `u` is the exact drop onto
+//! the chord line `L` through `z_3` and the next node. A circle resting on a
+//! line or a smooth curve touches it where the normal passes through its
+//! centre, within `R_o S` of `z_r`; there `|s - L| <= K (R_o S + h)(R_o S + 2h) / 2`
+//! (linear interpolation error), and the sampled surface is within `K h^2 / 8`
+//! of `s`. Since the drop onto `s` is at least the value of `s + circle` at the
+//! line's contact and at most `L + circle` plus `s - L` at its own contact,
 //!
-//! `|seed_u - exact_u| <= K (R_o + h) (R_o + 2h) / 2` ([`seed_error_bound`]):
+//! `|seed_u - exact_u| <= K (R_o S + h)(R_o S + 2h) / 2 + K h^2 / 8`
+//! ([`seed_error_bound`]),
+//!
 //! the O(R_o^2 s'') of MATH §2.3. On a ground surface with a cusp or a step
 //! (the edge of the current pass) the seed's model has no such bound: that
 //! is why the exact model is the default.
@@ -84,8 +90,12 @@ pub fn exact_u(surface: &Profile, z_r: Real, r_o: Real) -> Result<Drop, ProfileE
     drop_circle(surface, z_r, r_o, Side::Outside)
 }
 
-/// The bound `K (R_o + h)(R_o + 2h) / 2` on `|seed_u - exact_u|` for a surface
-/// with `|s''| <= max_curvature` (K) and node spacing at most `h`.
-pub fn seed_error_bound(max_curvature: Real, h: Real, r_o: Real) -> Real {
-    0.5 * max_curvature.abs() * (r_o + h) * (r_o + 2.0 * h)
+/// The bound `K (R_o S + h)(R_o S + 2h) / 2 + K h^2 / 8` on
+/// `|seed_u - exact_u|` for a surface with `|s''| <= max_curvature` (K),
+/// `|sin(slope angle)| <= max_sin_slope` (S) over the support's reach, and
+/// node spacing at most `h` (see the [module docs](self)).
+pub fn seed_error_bound(max_curvature: Real, max_sin_slope: Real, h: Real, r_o: Real) -> Real {
+    let k = max_curvature.abs();
+    let reach = r_o * max_sin_slope.abs().min(1.0);
+    0.5 * k * (reach + h) * (reach + 2.0 * h) + 0.125 * k * h * h
 }

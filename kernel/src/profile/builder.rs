@@ -226,7 +226,11 @@ fn line(
     advance(segment, a.0, b.0)?;
     finite(&format!("segment {segment} end x"), b.1)?;
     let slope = (b.1 - a.1) / (b.0 - a.0);
-    let n = ((b.0 - a.0) / max_step).ceil().max(1.0) as usize;
+    let n = super::check_node_count(
+        &format!("segment {segment} max step"),
+        ((b.0 - a.0) / max_step).ceil().max(1.0),
+        max_step,
+    )?;
     let mut nodes = Nodes::default();
     for k in 0..=n {
         let t = k as Real / n as Real;
@@ -282,7 +286,11 @@ fn arc(
     let ang = |p: (Real, Real)| (p.1 - cx).atan2(p.0 - cz);
     let (t0, t1) = (ang(a), ang(b));
     let max_angle = (2.0 * (1.0 - tol / r).clamp(-1.0, 1.0).acos()).min(max_step / r);
-    let n = ((t1 - t0).abs() / max_angle).ceil().max(1.0) as usize;
+    let n = super::check_node_count(
+        &format!("segment {segment} chordal tolerance"),
+        ((t1 - t0).abs() / max_angle).ceil().max(1.0),
+        tol,
+    )?;
     let mut nodes = Nodes::default();
     for k in 0..=n {
         let (z, x) = if k == 0 {

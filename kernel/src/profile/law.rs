@@ -114,7 +114,7 @@ impl MandrelLaw {
     /// along the axis.
     ///
     /// # Failures
-    /// A step that is not positive, or more than 100 million points.
+    /// A step that is not positive, or more than [`super::MAX_NODES`] nodes.
     pub fn profile(&self, step: Real, z_start: Real) -> Result<Profile, ProfileError> {
         let zs = uniform_grid(0.0, self.l_r, step)?;
         let (mut z, mut x, mut d1, mut d2) = (vec![], vec![], vec![], vec![]);
@@ -132,21 +132,12 @@ impl MandrelLaw {
 /// least 3 nodes: a range shorter than two steps is halved).
 ///
 /// # Failures
-/// A step that is not positive and finite, or more than 1e8 nodes.
+/// A step that is not positive and finite, or more than [`super::MAX_NODES`] nodes.
 pub fn uniform_grid(a: Real, b: Real, step: Real) -> Result<Vec<Real>, ProfileError> {
     positive("grid step", step)?;
     // The small margin keeps a range that is a whole number of steps from
     // getting a sliver of a last step through rounding.
-    let count = ((b - a) / step - 1e-9).ceil();
-    if !(count <= 1e8) {
-        return Err(InputError::out_of_range(
-            "grid step",
-            step,
-            "a step giving at most 1e8 points",
-        )
-        .into());
-    }
-    let count = (count as usize).max(2);
+    let count = super::check_node_count("grid step", ((b - a) / step - 1e-9).ceil(), step)?.max(2);
     let h = if count == 2 && 2.0 * step > b - a {
         0.5 * (b - a)
     } else {

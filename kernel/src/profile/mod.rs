@@ -33,6 +33,24 @@ use std::borrow::Cow;
 /// The fewest points a profile may have.
 pub const MIN_POINTS: usize = 3;
 
+/// The most nodes a generator or resampling will make (10 million: 80 MB per
+/// array). A step that would need more is refused rather than exhausting
+/// memory on a mistyped value.
+pub const MAX_NODES: usize = 10_000_000;
+
+/// Checks a node count a generator is about to make.
+pub(crate) fn check_node_count(what: &str, count: Real, step: Real) -> Result<usize, InputError> {
+    if count.is_finite() && count <= MAX_NODES as Real {
+        Ok(count as usize)
+    } else {
+        Err(InputError::out_of_range(
+            what,
+            step,
+            format!("a step giving at most {MAX_NODES} nodes (this one gives {count:.3e})"),
+        ))
+    }
+}
+
 /// Errors of profiles, their generators, equidistants and envelopes.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ProfileError {
@@ -366,7 +384,7 @@ impl Profile {
     ///
     /// # Failures
     /// A step that is not positive and finite, or one so small that the
-    /// result would exceed 100 million points.
+    /// result would exceed [`MAX_NODES`] nodes.
     pub fn resample_uniform(&self, step: Real) -> Result<Profile, ProfileError> {
         self.resample_by(&self.z.clone(), step)
     }
@@ -524,5 +542,6 @@ mod tests {
         assert!(p.eval(5.0).is_err());
         assert!(p.resample_uniform(0.0).is_err());
         assert!(p.resample_uniform(1e-12).is_err());
+        assert!(p.resample_uniform(1e-7).is_err()); // 39 million nodes
     }
 }

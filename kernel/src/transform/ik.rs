@@ -314,8 +314,9 @@ impl Chain {
     ///
     /// `travel`, if given, holds each axis's `(min, max)` in the chain's
     /// order (mm, rad); rotary values are moved by whole turns to fit it.
-    /// When the seed fails and [`IkOptions::restarts`] is set, starts with
-    /// the rotary axes turned by a quarter and half turn are tried.
+    /// When the seed fails and [`IkOptions::restarts`] is set, further starts
+    /// are tried: the linear axes at the middle of their travel, and the
+    /// rotary axes turned by quarter and half turns (mirrored solutions).
     ///
     /// # Failures
     /// - [`TransformError::Unreachable`]: no start reached the target within
@@ -375,12 +376,25 @@ impl Chain {
 
         let mut solver = Solver::new(self, tool, target, opts.axis_weight);
         let rotary: Vec<usize> = (0..self.dof()).filter(|&i| self.is_rotary(i)).collect();
-        let mut starts = vec![seed.to_vec()];
-        if opts.restarts && !rotary.is_empty() {
+        // Starts: the seed; then (with restarts) the seed with the linear
+        // axes at the middle of their travel; each also with the rotary axes
+        // turned by quarter and half turns, where mirrored solutions lie.
+        let mut bases = vec![seed.to_vec()];
+        if opts.restarts {
+            if let Some(t) = travel {
+                let mut mid = seed.to_vec();
+                for (i, &(lo, hi)) in t.iter().enumerate() {
+                    if !self.is_rotary(i) {
+                        mid[i] = 0.5 * (lo + hi);
+                    }
+                }
+                bases.push(mid);
+            }
+        }
+        let mut turns: Vec<Vec<(usize, Real)>> = vec![vec![]];
+        if opts.restarts {
             for turn in [FRAC_PI_2, -FRAC_PI_2, PI] {
-                let mut s = seed.to_vec();
-                rotary.iter().for_each(|&i| s[i] += turn);
-                starts.push(s);
+                turns.push(rotary.iter().map(|&i| (i, turn)).collect());
             }
             if rotary.len() == 2 {
                 for (t0, t1) in [
@@ -389,13 +403,17 @@ impl Chain {
                     (FRAC_PI_2, -FRAC_PI_2),
                     (-FRAC_PI_2, FRAC_PI_2),
                 ] {
-                    let mut s = seed.to_vec();
-                    s[rotary[0]] += t0;
-                    s[rotary[1]] += t1;
-                    starts.push(s);
+                    turns.push(vec![(rotary[0], t0), (rotary[1], t1)]);
                 }
             }
         }
+        let starts = bases.iter().flat_map(|b| {
+            turns.iter().map(move |t| {
+                let mut s = b.clone();
+                t.iter().for_each(|&(i, d)| s[i] += d);
+                s
+            })
+        });
         let mut iterations = 0;
         let mut best = (Real::INFINITY, Real::INFINITY);
         let mut outside: Option<TransformError> = None;

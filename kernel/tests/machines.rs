@@ -1,0 +1,182 @@
+//! The built-in machines: each loads (which checks its stated signs against
+//! its chain), their geometry is the seeds', and bad files are refused with
+//! the key and line named.
+
+use pilgrim_kernel::machine::{BUILTIN_MACHINES, BUILTIN_SOURCES};
+use pilgrim_kernel::{assert_near, AxisKind, Machine, MachineError, Point3, ToolFrame};
+
+#[test]
+fn every_builtin_loads_and_states_every_sign() {
+    for name in BUILTIN_MACHINES {
+        let m = Machine::builtin(name).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(m.name(), name);
+        for a in m.axes() {
+            match a.kind {
+                AxisKind::Linear => assert!(a.moves.is_some(), "{name} {}", a.name),
+                AxisKind::Rotary => assert!(a.turns.is_some(), "{name} {}", a.name),
+                AxisKind::Spindle => assert!(!a.programmed),
+            }
+        }
+    }
+    assert!(Machine::builtin("3k152vf20").is_ok());
+    let e = Machine::builtin("planer").unwrap_err();
+    assert!(
+        e.to_string().contains("built-ins: 3K152VF20, LZ-250"),
+        "{e}"
+    );
+}
+
+#[test]
+fn mandrel_grinder_moves_wheel_and_rest_as_stated() {
+    let m = Machine::builtin("3K152VF20").unwrap();
+    assert_eq!(m.chain().axis_names(), ["Z", "X"]);
+    let p = m.chain().apply(&[250.0, 30.0], &Point3::origin()).unwrap();
+    assert_eq!(p, Point3::new(30.0, 0.0, 250.0));
+    // The rest: at Z + B along the axis, U from the axis on the far side.
+    let b = m.constant("rest_offset_b").unwrap();
+    let rest = m.body_chain("rest").unwrap();
+    assert_eq!(rest.axis_names(), ["Z", "U"]);
+    let r = rest.apply(&[250.0, 40.0], &Point3::origin()).unwrap();
+    assert_near!(r.x, -40.0, 1e-12);
+    assert_near!(r.y, 0.0, 1e-12);
+    assert_near!(r.z, 250.0 + b, 1e-12);
+    assert!(m.constant("rest_radius").unwrap() > 0.0);
+    assert_eq!(m.control(), Some("sinumerik"));
+}
+
+#[test]
+fn caliber_grinders_turn_the_roll_and_swivel_the_wheel_as_stated() {
+    for name in ["LZ-250", "Mannesmann"] {
+        let m = Machine::builtin(name).unwrap();
+        let c = m.chain();
+        let mut q = vec![0.0; c.dof()];
+        q[c.axis_index("Z").unwrap()] = 200.0;
+        q[c.axis_index("A").unwrap()] = 90f64.to_radians();
+        // The roll turned +90 deg: the wheel is at -90 deg round it.
+        let p = c.pose(&q, &ToolFrame::default()).unwrap();
+        assert_near!(p.point.x, 0.0, 1e-12);
+        assert_near!(p.point.y, -200.0, 1e-12);
+        // A +10 deg swivel at A = 0 tilts the wheel's axis toward -Y.
+        q[c.axis_index("A").unwrap()] = 0.0;
+        q[c.axis_index("B").unwrap()] = 10f64.to_radians();
+        let p = c.pose(&q, &ToolFrame::default()).unwrap();
+        assert_near!(p.axis.y, -(10f64.to_radians().sin()), 1e-12);
+    }
+    assert!(Machine::builtin("LZ-250").unwrap().axis("Y").is_none());
+    assert!(Machine::builtin("Mannesmann").unwrap().axis("Y").is_some());
+}
+
+#[test]
+fn lathe_programs_diameter() {
+    let m = Machine::builtin("fanuc-0i-tc").unwrap();
+    assert_eq!(m.chain().axis_names(), ["X", "Z"]);
+    let p = m.chain().apply(&[100.0, -30.0], &Point3::origin()).unwrap();
+    assert_eq!(p, Point3::new(50.0, 0.0, -30.0));
+    assert_eq!(m.control(), Some("fanuc"));
+}
+
+fn lathe_text() -> &'static str {
+    BUILTIN_SOURCES
+        .iter()
+        .find(|(n, _)| *n == "fanuc-0i-tc")
+        .unwrap()
+        .1
+}
+
+/// Line (from 1) of the first line of `text` containing `needle`.
+fn line_of(text: &str, needle: &str) -> usize {
+    text.lines().position(|l| l.contains(needle)).unwrap() + 1
+}
+
+fn file_error(text: &str) -> (usize, String) {
+    match Machine::from_toml_str(text, "m.toml").unwrap_err() {
+        MachineError::File {
+            line,
+            message,
+            file,
+            ..
+        } => {
+            assert_eq!(file, "m.toml");
+            (line, message)
+        }
+        other => panic!("not a file error: {other}"),
+    }
+}
+
+#[test]
+fn bad_machine_files_name_the_key_and_line() {
+    let base = lathe_text();
+    // A wrong stated sign.
+    let t = base.replacen("moves = [0.5, 0.0, 0.0]", "moves = [-0.5, 0.0, 0.0]", 1);
+    let (line, msg) = file_error(&t);
+    assert_eq!(line, line_of(&t, "moves = [-0.5"));
+    assert!(
+        msg.contains("axis X: moves = [-0.5, 0, 0] but the chain moves it by [0.5"),
+        "{msg}"
+    );
+    // A missing limit.
+    let t = base.replacen("max_feed = 12000.0\n", "", 1);
+    let (line, msg) = file_error(&t);
+    assert_eq!(line, line_of(&t, "name = \"X\""));
+    assert!(
+        msg.contains("axis X (linear) needs key 'max_feed'"),
+        "{msg}"
+    );
+    // An undeclared axis in the chain.
+    let t = base.replacen("axis = \"Z\"", "axis = \"W\"", 1);
+    let (line, msg) = file_error(&t);
+    assert_eq!(line, line_of(&t, "axis = \"W\""));
+    assert!(msg.contains("'W', which is not declared"), "{msg}");
+    // Reversed travel.
+    let t = base.replacen("max = 400.0", "max = -400.0", 1);
+    let (line, msg) = file_error(&t);
+    assert_eq!(line, line_of(&t, "max = -400.0"));
+    assert!(msg.contains("travel max must exceed min"), "{msg}");
+    // Degrees on a linear axis, an unknown key, a syntax error, infinity.
+    let t = base.replacen("min = -10.0", "min_deg = -10.0", 1);
+    let (line, msg) = file_error(&t);
+    assert_eq!(line, line_of(&t, "min_deg"));
+    assert!(
+        msg.contains("'min_deg' does not apply to a linear axis"),
+        "{msg}"
+    );
+    let t = base.replacen("min = -10.0", "minimum = -10.0", 1);
+    let (line, msg) = file_error(&t);
+    assert_eq!(line, line_of(&t, "minimum"));
+    assert!(msg.contains("minimum"), "{msg}");
+    let t = base.replacen("max = 400.0", "max = 400.0.0", 1);
+    assert_eq!(file_error(&t).0, line_of(&t, "400.0.0"));
+    let t = base.replacen("max = 400.0", "max = inf", 1);
+    let (line, msg) = file_error(&t);
+    assert_eq!(line, line_of(&t, "max = inf"));
+    assert!(msg.contains("not a finite number"), "{msg}");
+    // A spindle bound in the chain, and a rotary factor on a linear axis.
+    let t = base.replacen(
+        "factor = \"tz\"\naxis = \"Z\"",
+        "factor = \"rz\"\naxis = \"Z\"",
+        1,
+    );
+    let (_, msg) = file_error(&t);
+    assert!(
+        msg.contains("axis Z is linear but factor rz needs a rotary axis"),
+        "{msg}"
+    );
+    let t = base.replacen("axis = \"Z\"", "axis = \"S\"", 1);
+    let (_, msg) = file_error(&t);
+    assert!(msg.contains("axis S is spindle"), "{msg}");
+}
+
+#[test]
+fn machine_files_load_from_disk_and_say_which_file_is_missing() {
+    let dir = std::env::temp_dir().join(format!("pilgrim-machines-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("lathe.toml");
+    std::fs::write(&path, lathe_text()).unwrap();
+    let m = Machine::from_file(&path).unwrap();
+    assert_eq!(m.name(), "fanuc-0i-tc");
+    let e = Machine::from_file(dir.join("none.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("none.toml"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
