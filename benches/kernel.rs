@@ -1,1 +1,141 @@
-fn main() {}
+//! Kernel benchmarks (issue: geometry kernel). Run: `cargo bench --bench kernel`.
+//!
+//! Groups and targets:
+//! - `chain_fk`: the universal 15-factor chain, forward kinematics of a batch
+//!   of 1M poses (<= 50 ns per pose);
+//! - `ik_5axis`: inverse kinematics on the Mannesmann 5-axis chain (<= 10 us
+//!   per pose), cold (from the machine's home) and warm (from the previous
+//!   pose's solution, as along a toolpath);
+//! - `equidistant_1m`: the equidistant of a 1M-point profile (<= 30 ms);
+//! - `envelope_100k`: the envelope of 100k wheel positions evaluated at a
+//!   100k-point profile (<= 100 ms).
+
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
+use pilgrim_kernel::{
+    equidistant, Chain, CircleEnvelope, IkOptions, Machine, MandrelLaw, Point3, Pose, Side, Target,
+    ToolFrame,
+};
+use std::hint::black_box;
+use std::time::Duration;
+
+fn lcg(state: &mut u64) -> f64 {
+    *state = state
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    (*state >> 11) as f64 / (1u64 << 53) as f64
+}
+
+fn chain_fk(c: &mut Criterion) {
+    const N: usize = 1_000_000;
+    let chain = Chain::universal();
+    let mut s = 1u64;
+    let rows: Vec<f64> = (0..N * 15).map(|_| 400.0 * lcg(&mut s) - 200.0).collect();
+    let tool = ToolFrame::default();
+    let mut out: Vec<Pose> = Vec::with_capacity(N);
+    let mut g = c.benchmark_group("chain_fk");
+    g.throughput(Throughput::Elements(N as u64));
+    g.sample_size(10).measurement_time(Duration::from_secs(4));
+    g.bench_function("universal_1M_poses", |b| {
+        b.iter(|| {
+            chain.poses_into(black_box(&rows), &tool, &mut out).unwrap();
+            black_box(out.len())
+        })
+    });
+    g.finish();
+}
+
+/// Reachable Mannesmann poses along a path: a wheel winding round the roll.
+fn mannesmann_targets(n: usize) -> (Machine, ToolFrame, Vec<Target>) {
+    let m = Machine::builtin("Mannesmann").unwrap();
+    let tool = ToolFrame {
+        point: Point3::new(-60.0, 0.0, 0.0),
+        ..ToolFrame::default()
+    };
+    let chain = m.chain().clone();
+    let targets = (0..n)
+        .map(|i| {
+            let t = i as f64 / n as f64;
+            // X, Z, Y, A, B
+            let q = [
+                40.0 * (6.0 * t).sin(),
+                300.0 + 20.0 * (9.0 * t).cos(),
+                10.0 * t,
+                (300.0 * t - 150.0).to_radians(),
+                (25.0 * (4.0 * t).sin()).to_radians(),
+            ];
+            let p = chain.pose(&q, &tool).unwrap();
+            Target::pose(p.point, p.axis)
+        })
+        .collect();
+    (m, tool, targets)
+}
+
+fn ik_5axis(c: &mut Criterion) {
+    const N: usize = 1000;
+    let (m, tool, targets) = mannesmann_targets(N);
+    let opts = IkOptions::default();
+    let mut g = c.benchmark_group("ik_5axis");
+    g.throughput(Throughput::Elements(N as u64));
+    g.sample_size(10).measurement_time(Duration::from_secs(4));
+    g.bench_function("cold_from_home", |b| {
+        b.iter(|| {
+            for t in &targets {
+                black_box(m.inverse(t, &tool, None, &opts).unwrap());
+            }
+        })
+    });
+    g.bench_function("warm_along_path", |b| {
+        b.iter(|| {
+            let mut seed = m.inverse(&targets[0], &tool, None, &opts).unwrap().q;
+            for t in &targets {
+                seed = m.inverse(t, &tool, Some(&seed), &opts).unwrap().q;
+            }
+            black_box(seed)
+        })
+    });
+    g.finish();
+}
+
+fn law() -> MandrelLaw {
+    MandrelLaw::new(38.0, 52.0, 400.0, 0.012, 2.3).unwrap()
+}
+
+fn equidistant_1m(c: &mut Criterion) {
+    const N: usize = 1_000_000;
+    let analytic = law().profile(400.0 / (N - 1) as f64, 0.0).unwrap();
+    assert_eq!(analytic.len(), N);
+    let estimated = analytic.clone().without_derivatives();
+    let mut g = c.benchmark_group("equidistant_1m");
+    g.throughput(Throughput::Elements(N as u64));
+    g.sample_size(10).measurement_time(Duration::from_secs(4));
+    g.bench_function("analytic_derivatives", |b| {
+        b.iter(|| black_box(equidistant(&analytic, 20.0, Side::Outside).unwrap()))
+    });
+    g.bench_function("divided_differences", |b| {
+        b.iter(|| black_box(equidistant(&estimated, 20.0, Side::Outside).unwrap()))
+    });
+    g.finish();
+}
+
+fn envelope_100k(c: &mut Criterion) {
+    const N: usize = 100_000;
+    let profile = law().profile(400.0 / (N - 1) as f64, 0.0).unwrap();
+    let e = equidistant(&profile, 20.0, Side::Outside).unwrap();
+    let mut g = c.benchmark_group("envelope_100k");
+    g.throughput(Throughput::Elements(N as u64));
+    g.sample_size(10).measurement_time(Duration::from_secs(4));
+    g.bench_function("build_and_evaluate", |b| {
+        b.iter_batched(
+            || (e.z.clone(), e.x.clone()),
+            |(z, x)| {
+                let env = CircleEnvelope::new(&z, &x, 20.0, Side::Outside).unwrap();
+                black_box(env.eval_many(profile.z()))
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    g.finish();
+}
+
+criterion_group!(kernel, chain_fk, ik_5axis, equidistant_1m, envelope_100k);
+criterion_main!(kernel);

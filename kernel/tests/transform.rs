@@ -152,7 +152,7 @@ fn ik_round_trips_fk_on_the_mannesmann_chain() {
     let opts = IkOptions::default();
     let mut s = 7u64;
     let mut worst: f64 = 0.0;
-    for k in 0..300 {
+    for k in 0..1000 {
         let q = [
             -100.0 + 200.0 * lcg(&mut s),
             200.0 + 300.0 * lcg(&mut s),

@@ -267,7 +267,8 @@ impl Machine {
     }
 
     /// Inverse kinematics of the tool chain within travel. The seed defaults
-    /// to each axis's 0 clamped into its travel.
+    /// to the middle of each linear axis's travel and 0 (clamped into
+    /// travel) for rotary axes.
     ///
     /// # Failures
     /// As [`Chain::inverse`].
@@ -395,7 +396,7 @@ impl Machine {
             .iter()
             .map(|n| self.axis_or_err(n))
             .collect::<Result<Vec<_>, _>>()?;
-        if axes.is_empty() || rows.len() % axes.len() != 0 {
+        if axes.is_empty() || !rows.len().is_multiple_of(axes.len()) {
             return Err(MachineError::BadPoint {
                 point: rows.len() / axes.len().max(1),
                 message: format!(

@@ -137,7 +137,7 @@ impl<'a> Solver<'a> {
         for (k, f) in factors.iter().enumerate().rev() {
             let v = f.value_at(q);
             if f.kind.is_rotation() {
-                let (sn, cs) = v.sin_cos();
+                let (sn, cs) = crate::math::sin_cos(v);
                 self.sincos[k] = (sn, cs);
                 s = rotate(f.kind, sn, cs, &s);
                 w = rotate(f.kind, sn, cs, &w);
@@ -193,18 +193,36 @@ impl<'a> Solver<'a> {
     }
 
     /// Runs Levenberg–Marquardt from `q`; returns (converged, iterations).
-    fn solve(&mut self, q: &mut [Real], opts: &IkOptions) -> (bool, usize) {
+    /// With `bounds`, every trial point is projected into the box (the
+    /// entries that are `None`, rotary axes, stay free).
+    fn solve(
+        &mut self,
+        q: &mut [Real],
+        opts: &IkOptions,
+        bounds: &[Option<(Real, Real)>],
+    ) -> (bool, usize) {
         let m = self.m;
         let mut a = vec![0.0; m * m];
         let mut g = vec![0.0; m];
         let mut delta = vec![0.0; m];
+        let mut damped = vec![0.0; m * m];
         let mut trial = q.to_vec();
         let mut lambda = 1e-3;
         let mut cost = self.eval(q, true);
+        // A start that gains less than 10% in STALL iterations is stuck
+        // (against the travel box, or in a local minimum): give it up.
+        const STALL: usize = 6;
+        let mut checkpoint = cost;
         for it in 0..opts.max_iter {
             let (pe, de) = self.errors();
             if pe <= opts.tol_pos && de <= opts.tol_dir {
                 return (true, it);
+            }
+            if it > 0 && it % STALL == 0 {
+                if cost > 0.9 * checkpoint {
+                    return (false, it);
+                }
+                checkpoint = cost;
             }
             // Normal equations A = J^T J, g = J^T r.
             for i in 0..m {
@@ -223,16 +241,18 @@ impl<'a> Solver<'a> {
             let floor = 1e-12 * max_diag.max(1e-300);
             let mut improved = false;
             while lambda < 1e12 {
-                let mut damped = a.clone();
+                damped.copy_from_slice(&a);
                 for i in 0..m {
                     damped[i * m + i] += lambda * a[i * m + i].max(floor);
                 }
                 delta.iter_mut().zip(&g).for_each(|(d, gi)| *d = -gi);
                 if solve_spd(&mut damped, &mut delta, m) {
-                    trial
-                        .iter_mut()
-                        .zip(q.iter().zip(&delta))
-                        .for_each(|(t, (qi, d))| *t = qi + d);
+                    for (i, t) in trial.iter_mut().enumerate() {
+                        *t = q[i] + delta[i];
+                        if let Some(Some((lo, hi))) = bounds.get(i) {
+                            *t = t.clamp(*lo, *hi);
+                        }
+                    }
                     let c = self.eval(&trial, false);
                     if c.is_finite() && c < cost {
                         q.copy_from_slice(&trial);
@@ -388,7 +408,9 @@ impl Chain {
                         mid[i] = 0.5 * (lo + hi);
                     }
                 }
-                bases.push(mid);
+                if mid != seed {
+                    bases.push(mid);
+                }
             }
         }
         let mut turns: Vec<Vec<(usize, Real)>> = vec![vec![]];
@@ -414,44 +436,62 @@ impl Chain {
                 s
             })
         });
+        // Phase 1: each start, with the linear axes kept inside their travel
+        // (so that a mirrored solution outside it is not where LM ends up).
+        let boxed: Vec<Option<(Real, Real)>> = match travel {
+            Some(t) => t
+                .iter()
+                .enumerate()
+                .map(|(i, &b)| (!self.is_rotary(i)).then_some(b))
+                .collect(),
+            None => vec![],
+        };
         let mut iterations = 0;
         let mut best = (Real::INFINITY, Real::INFINITY);
-        let mut outside: Option<TransformError> = None;
         for mut q in starts {
-            let (ok, it) = solver.solve(&mut q, opts);
+            for (v, b) in q.iter_mut().zip(&boxed) {
+                if let Some((lo, hi)) = b {
+                    *v = v.clamp(*lo, *hi);
+                }
+            }
+            let (ok, it) = solver.solve(&mut q, opts, &boxed);
             iterations += it;
             let (pe, de) = solver.errors();
             if pe + de * opts.axis_weight < best.0 + best.1 * opts.axis_weight {
                 best = (pe, de);
             }
-            if !ok {
-                continue;
+            if ok && travel.is_none_or(|t| fit_travel(self, &mut q, t).is_none()) {
+                return Ok(IkSolution {
+                    q,
+                    iterations,
+                    pos_err: pe,
+                    dir_err: de,
+                });
             }
-            match travel.and_then(|t| fit_travel(self, &mut q, t).map(|i| (i, t[i]))) {
-                None => {
-                    return Ok(IkSolution {
-                        q,
-                        iterations,
-                        pos_err: pe,
-                        dir_err: de,
-                    })
-                }
-                Some((i, (min, max))) => {
-                    outside.get_or_insert(TransformError::OutsideTravel {
+        }
+        // Phase 2 (only to explain the failure): free of travel, from the
+        // seed, is the target reachable at all, and with which axis outside?
+        if let Some(t) = travel {
+            let mut q = seed.to_vec();
+            let (ok, it) = solver.solve(&mut q, opts, &[]);
+            iterations += it;
+            if ok {
+                if let Some(i) = fit_travel(self, &mut q, t) {
+                    return Err(TransformError::OutsideTravel {
                         axis: self.axes[i].clone(),
                         value: q[i],
-                        min,
-                        max,
+                        min: t[i].0,
+                        max: t[i].1,
                     });
                 }
             }
         }
-        Err(outside.unwrap_or(TransformError::Unreachable {
+        Err(TransformError::Unreachable {
             point: [target.point.x, target.point.y, target.point.z],
             pos_err: best.0,
             dir_err: best.1,
             iterations,
-        }))
+        })
     }
 }
 

@@ -15,6 +15,7 @@
 //! pilgrim_kernel::assert_near!(p.y, 10.0, 1e-12);
 //! ```
 
+mod batch;
 mod ik;
 mod universal;
 
@@ -71,7 +72,7 @@ impl FactorKind {
     /// The 4x4 matrix of the factor at `value`, as printed in MATH §1.
     pub fn matrix(self, value: Real) -> Mat4 {
         let mut m = Mat4::identity();
-        let (s, c) = value.sin_cos();
+        let (s, c) = crate::math::sin_cos(value);
         match self {
             Self::Tx | Self::Ty | Self::Tz => m[(self.direction_index(), 3)] = value,
             Self::Rx => {
@@ -251,7 +252,7 @@ impl Frame {
     #[inline]
     pub fn push(&mut self, kind: FactorKind, value: Real) {
         if kind.is_rotation() {
-            let (s, c) = value.sin_cos();
+            let (s, c) = crate::math::sin_cos(value);
             self.push_rotation(kind, s, c);
         } else {
             let col = self.rot.column(kind.direction_index()).into_owned();
@@ -540,17 +541,8 @@ impl Chain {
         let n = self.check_rows(q_rows)?;
         out.clear();
         out.reserve(n);
-        let dof = self.dof().max(1);
-        for q in q_rows.chunks_exact(dof).take(n) {
-            let fr = self.frame_unchecked(q);
-            out.push(Pose {
-                point: fr.transform_point(&tool.point),
-                axis: fr.transform_vector(&tool.axis),
-            });
-        }
-        if self.dof() == 0 {
-            // A chain without axes has one pose per empty row: none are given.
-            out.clear();
+        if n > 0 {
+            batch::Program::new(self).poses(q_rows, self.dof(), tool, out);
         }
         Ok(())
     }
@@ -561,7 +553,7 @@ impl Chain {
         if dof == 0 {
             return Ok(0);
         }
-        if q_rows.len() % dof != 0 {
+        if !q_rows.len().is_multiple_of(dof) {
             return Err(TransformError::AxisCount {
                 expected: dof,
                 got: q_rows.len() % dof,
@@ -642,15 +634,39 @@ mod tests {
     }
 
     #[test]
-    fn batch_matches_single_poses() {
-        let ch = Chain::universal();
-        let rows: Vec<f64> = (0..45).map(|i| (i as f64 * 0.37).sin() * 3.0).collect();
-        let tool = ToolFrame::default();
-        let poses = ch.poses(&rows, &tool).unwrap();
-        assert_eq!(poses.len(), 3);
-        for (r, p) in rows.chunks(15).zip(&poses) {
-            let single = ch.pose(r, &tool).unwrap();
-            assert_eq!(single, *p);
+    fn batch_matches_the_product_of_factors() {
+        let tool = ToolFrame {
+            point: Point3::new(3.0, -2.0, 7.0),
+            axis: Vec3::new(0.0, 0.6, 0.8),
+        };
+        let chains = [
+            Chain::universal(),
+            Chain::builder()
+                .constant(Tx, 5.0)
+                .axis_scaled(Tx, "u", -1.0, 2.0)
+                .axis(Rz, "c")
+                .constant(Ry, 0.3)
+                .axis_scaled(Tz, "w", 0.5, -1.0)
+                .axis(Tz, "u")
+                .constant(Ty, 4.0)
+                .build()
+                .unwrap(),
+        ];
+        for ch in chains {
+            let rows: Vec<f64> = (0..ch.dof() * 7)
+                .map(|i| (i as f64 * 0.37).sin() * 3.0)
+                .collect();
+            let poses = ch.poses(&rows, &tool).unwrap();
+            assert_eq!(poses.len(), 7);
+            for (r, p) in rows.chunks(ch.dof()).zip(&poses) {
+                let m = ch.matrix_by_product(r).unwrap();
+                let hp = m * tool.point.to_homogeneous();
+                let ha = m * tool.axis.to_homogeneous();
+                for k in 0..3 {
+                    assert_near!(p.point[k], hp[k], 1e-12);
+                    assert_near!(p.axis[k], ha[k], 1e-14);
+                }
+            }
         }
     }
 }
