@@ -52,5 +52,10 @@ pub use transform::{
     Target, ToolFrame, TransformError, UNIVERSAL_PARAMETERS,
 };
 
+/// The README's examples, compiled and run as doc tests.
+#[cfg(doctest)]
+#[doc = include_str!("../../README.md")]
+pub struct ReadmeDoctests;
+
 /// The kernel's version, as in its `Cargo.toml`.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");

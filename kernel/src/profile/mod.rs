@@ -439,7 +439,8 @@ impl Profile {
 /// Signed curvature of a graph from its first and second derivatives.
 #[inline]
 pub fn curvature_of(d1: Real, d2: Real) -> Real {
-    d2 / (1.0 + d1 * d1).powf(1.5)
+    let t = 1.0 + d1 * d1;
+    d2 / (t * t.sqrt())
 }
 
 /// Cubic Hermite interpolation of nodes `(t, v)` with slopes `s` at `tq`
