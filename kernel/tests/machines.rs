@@ -105,65 +105,77 @@ fn file_error(text: &str) -> (usize, String) {
 
 #[test]
 fn bad_machine_files_name_the_key_and_line() {
-    let base = lathe_text();
-    // A wrong stated sign.
-    let t = base.replacen("moves = [0.5, 0.0, 0.0]", "moves = [-0.5, 0.0, 0.0]", 1);
-    let (line, msg) = file_error(&t);
-    assert_eq!(line, line_of(&t, "moves = [-0.5"));
-    assert!(
-        msg.contains("axis X: moves = [-0.5, 0, 0] but the chain moves it by [0.5"),
-        "{msg}"
-    );
-    // A missing limit.
-    let t = base.replacen("max_feed = 12000.0\n", "", 1);
-    let (line, msg) = file_error(&t);
-    assert_eq!(line, line_of(&t, "name = \"X\""));
-    assert!(
-        msg.contains("axis X (linear) needs key 'max_feed'"),
-        "{msg}"
-    );
-    // An undeclared axis in the chain.
-    let t = base.replacen("axis = \"Z\"", "axis = \"W\"", 1);
-    let (line, msg) = file_error(&t);
-    assert_eq!(line, line_of(&t, "axis = \"W\""));
-    assert!(msg.contains("'W', which is not declared"), "{msg}");
-    // Reversed travel.
-    let t = base.replacen("max = 400.0", "max = -400.0", 1);
-    let (line, msg) = file_error(&t);
-    assert_eq!(line, line_of(&t, "max = -400.0"));
-    assert!(msg.contains("travel max must exceed min"), "{msg}");
-    // Degrees on a linear axis, an unknown key, a syntax error, infinity.
-    let t = base.replacen("min = -10.0", "min_deg = -10.0", 1);
-    let (line, msg) = file_error(&t);
-    assert_eq!(line, line_of(&t, "min_deg"));
-    assert!(
-        msg.contains("'min_deg' does not apply to a linear axis"),
-        "{msg}"
-    );
-    let t = base.replacen("min = -10.0", "minimum = -10.0", 1);
-    let (line, msg) = file_error(&t);
-    assert_eq!(line, line_of(&t, "minimum"));
-    assert!(msg.contains("minimum"), "{msg}");
-    let t = base.replacen("max = 400.0", "max = 400.0.0", 1);
-    assert_eq!(file_error(&t).0, line_of(&t, "400.0.0"));
-    let t = base.replacen("max = 400.0", "max = inf", 1);
-    let (line, msg) = file_error(&t);
-    assert_eq!(line, line_of(&t, "max = inf"));
-    assert!(msg.contains("not a finite number"), "{msg}");
-    // A spindle bound in the chain, and a rotary factor on a linear axis.
-    let t = base.replacen(
-        "factor = \"tz\"\naxis = \"Z\"",
-        "factor = \"rz\"\naxis = \"Z\"",
-        1,
-    );
-    let (_, msg) = file_error(&t);
-    assert!(
-        msg.contains("axis Z is linear but factor rz needs a rotary axis"),
-        "{msg}"
-    );
-    let t = base.replacen("axis = \"Z\"", "axis = \"S\"", 1);
-    let (_, msg) = file_error(&t);
-    assert!(msg.contains("axis S is spindle"), "{msg}");
+    // (edit of the lathe's file: from, to; the line the error must name, by a
+    // piece of its text, or None for any line; a piece of the message)
+    let cases: [(&str, &str, Option<&str>, &str); 11] = [
+        // A wrong stated sign.
+        (
+            "moves = [0.5, 0.0, 0.0]",
+            "moves = [-0.5, 0.0, 0.0]",
+            Some("moves = [-0.5"),
+            "axis X: moves = [-0.5, 0, 0] but the chain moves it by [0.5",
+        ),
+        // A missing limit, named at its axis.
+        (
+            "max_feed = 12000.0\n",
+            "",
+            Some("name = \"X\""),
+            "axis X (linear) needs key 'max_feed'",
+        ),
+        // An undeclared axis in the chain.
+        (
+            "axis = \"Z\"",
+            "axis = \"W\"",
+            Some("axis = \"W\""),
+            "'W', which is not declared",
+        ),
+        // Reversed travel.
+        (
+            "max = 400.0",
+            "max = -400.0",
+            Some("max = -400.0"),
+            "travel max must exceed min",
+        ),
+        // Degrees on a linear axis, an unknown key, a syntax error, infinity.
+        (
+            "min = -10.0",
+            "min_deg = -10.0",
+            Some("min_deg"),
+            "'min_deg' does not apply to a linear axis",
+        ),
+        ("min = -10.0", "minimum = -10.0", Some("minimum"), "minimum"),
+        ("max = 400.0", "max = 400.0.0", Some("400.0.0"), ""),
+        (
+            "max = 400.0",
+            "max = inf",
+            Some("max = inf"),
+            "not a finite number",
+        ),
+        // A rotary factor on a linear axis, and a spindle bound in the chain.
+        (
+            "factor = \"tz\"\naxis = \"Z\"",
+            "factor = \"rz\"\naxis = \"Z\"",
+            None,
+            "axis Z is linear but factor rz needs a rotary axis",
+        ),
+        ("axis = \"Z\"", "axis = \"S\"", None, "axis S is spindle"),
+        // A feed that is not positive.
+        (
+            "max_feed = 12000.0",
+            "max_feed = -1.0",
+            Some("name = \"X\""),
+            "axis X: the maximum feed must be > 0",
+        ),
+    ];
+    for (from, to, at, expected) in cases {
+        let text = lathe_text().replacen(from, to, 1);
+        assert_ne!(text, lathe_text(), "the edit {from:?} did not apply");
+        let (line, msg) = file_error(&text);
+        if let Some(piece) = at {
+            assert_eq!(line, line_of(&text, piece), "{to:?}: {msg}");
+        }
+        assert!(msg.contains(expected), "{to:?}: {msg}");
+    }
 }
 
 #[test]

@@ -530,6 +530,15 @@ mod tests {
     }
 
     #[test]
+    fn min_with_takes_the_lower_surface_where_both_exist() {
+        let stock = Profile::new(vec![0.0, 1.0, 2.0, 3.0, 4.0], vec![5.0; 5]).unwrap();
+        let cut = Profile::new(vec![1.5, 2.0, 2.5, 3.0], vec![4.0, 6.0, 4.5, 4.5]).unwrap();
+        let m = stock.min_with(&cut);
+        assert_eq!(m.z(), stock.z());
+        assert_eq!(m.x(), [5.0, 5.0, 5.0, 4.5, 5.0]);
+    }
+
+    #[test]
     fn bad_profiles_are_named() {
         let e = Profile::new(vec![0.0, 1.0], vec![0.0, 1.0]).unwrap_err();
         assert!(e.to_string().contains("at least 3"), "{e}");
