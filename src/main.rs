@@ -1,12 +1,18 @@
 //! `pilgrim`: the command-line program of the pilgrim CAM kernel.
 //!
 //! Thin by design: parsing, printing and files; every computation is a
-//! kernel call.
+//! kernel call. Exit codes: 0 done, 1 the job failed (the message says
+//! why, naming file, line, parameter or block), 2 a bad command line.
+
+mod machines;
+mod run;
 
 use clap::{Parser, Subcommand};
 use pilgrim_kernel::machine::BUILTIN_MACHINES;
-use pilgrim_kernel::{AxisKind, Machine};
-use std::path::PathBuf;
+use pilgrim_kernel::plugin::PluginMachine;
+use pilgrim_kernel::script::{Access, Family, Limits};
+use pilgrim_kernel::{AxisKind, MachineInfo, MachineKinematics};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// CAM for special grinders and lathes: cold-pilger mandrels and calibers,
@@ -14,32 +20,77 @@ use std::process::ExitCode;
 #[derive(Parser)]
 #[command(name = "pilgrim", version, about, long_about = None)]
 struct Cli {
+    /// Print nothing but errors.
+    #[arg(long, short, global = true)]
+    quiet: bool,
     #[command(subcommand)]
     command: Command,
 }
 
 #[derive(Subcommand)]
 enum Command {
-    /// List the built-in machines with their axes; with --file, read and
-    /// check machine files (TOML) and list them too.
+    /// Run a part family: toolpath, program and report into --out.
+    Run {
+        /// The family's script (.rhai).
+        script: PathBuf,
+        /// Parameter values from a TOML file (name = value).
+        #[arg(long, value_name = "FILE.toml")]
+        params: Option<PathBuf>,
+        /// A parameter value (repeatable); wins over --params.
+        #[arg(long = "set", value_name = "NAME=VALUE", value_parser = parse_set)]
+        sets: Vec<(String, String)>,
+        /// The machine: a built-in's name, a plugin (.so), a machine file
+        /// (.toml) or a machine script (.rhai). Default: the family's
+        /// default_machine().
+        #[arg(long)]
+        machine: Option<String>,
+        /// The output directory (replaced as a whole when the run succeeds).
+        #[arg(long, default_value = "out/run")]
+        out: PathBuf,
+    },
+    /// List the built-in machines; with --plugin or --file, those too.
     Machines {
+        /// A plugin library to load and list (repeatable).
+        #[arg(long = "plugin", value_name = "LIB")]
+        plugins: Vec<PathBuf>,
         /// A machine file to check and list (repeatable).
         #[arg(long = "file", value_name = "MACHINE.toml")]
         files: Vec<PathBuf>,
-        /// Only the machines from --file.
+        /// Only the machines from --plugin and --file.
         #[arg(long)]
         only_files: bool,
     },
+    /// List a family's parameters: name, default, unit, description.
+    Params {
+        /// The family's script (.rhai).
+        script: PathBuf,
+    },
+    /// Load a plugin and print its descriptor, or say exactly why not.
+    PluginCheck {
+        /// The shared library.
+        lib: PathBuf,
+    },
+    /// Write the script API reference (Markdown).
+    ApiDocs {
+        /// Where to write it; standard output if not given.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
 }
 
-fn describe(m: &Machine) -> String {
+fn parse_set(s: &str) -> Result<(String, String), String> {
+    let (k, v) = s
+        .split_once('=')
+        .ok_or_else(|| format!("'{s}' is not NAME=VALUE"))?;
+    Ok((k.trim().to_owned(), v.to_owned()))
+}
+
+fn describe(info: &MachineInfo, origin: &str) -> String {
     let mut s = format!(
-        "{}  ({})\n  {}\n",
-        m.name(),
-        m.control().unwrap_or("no control stated"),
-        m.description()
+        "{}  ({}){origin}\n  {}\n",
+        info.name, info.control, info.description
     );
-    for a in m.axes() {
+    for a in &info.axes {
         let range = match a.kind {
             AxisKind::Spindle => format!("up to {} rpm", a.max),
             _ => format!(
@@ -69,32 +120,116 @@ fn describe(m: &Machine) -> String {
     s
 }
 
-fn machines(files: &[PathBuf], only_files: bool) -> Result<(), String> {
+fn list_machines(
+    plugins: &[PathBuf],
+    files: &[PathBuf],
+    only_files: bool,
+) -> Result<String, String> {
     let mut out = String::new();
     if !only_files {
         for name in BUILTIN_MACHINES {
-            let m = Machine::builtin(name).map_err(|e| e.to_string())?;
-            out += &describe(&m);
+            let m = machines::open(name)?;
+            let origin = if name == "3K152VF20" {
+                ", built-in plugin"
+            } else {
+                ""
+            };
+            out += &describe(m.info(), origin);
             out.push('\n');
         }
     }
-    for f in files {
-        let m = Machine::from_file(f).map_err(|e| e.to_string())?;
-        out += &format!("from {}:\n", f.display());
-        out += &describe(&m);
+    for p in plugins {
+        let m = PluginMachine::load(p).map_err(|e| e.to_string())?;
+        out += &describe(m.info(), &format!(", plugin {}", p.display()));
         out.push('\n');
     }
-    print!("{out}");
-    Ok(())
+    for f in files {
+        let m = machines::open(&f.display().to_string())?;
+        out += &describe(m.info(), &format!(", from {}", f.display()));
+        out.push('\n');
+    }
+    Ok(out)
+}
+
+fn params(script: &Path) -> Result<String, String> {
+    let fam =
+        Family::load(script, &Limits::default(), &Access::default()).map_err(|e| e.to_string())?;
+    let mut rows = vec![(
+        "name".to_owned(),
+        "default".to_owned(),
+        "unit".to_owned(),
+        "description".to_owned(),
+    )];
+    for p in fam.params() {
+        rows.push((
+            p.name.clone(),
+            p.default.to_string(),
+            p.unit.clone(),
+            p.doc.clone(),
+        ));
+    }
+    let w0 = rows.iter().map(|r| r.0.len()).max().unwrap_or(0);
+    let w1 = rows.iter().map(|r| r.1.len()).max().unwrap_or(0);
+    let w2 = rows.iter().map(|r| r.2.len()).max().unwrap_or(0);
+    Ok(rows
+        .iter()
+        .map(|r| format!("{:<w0$}  {:<w1$}  {:<w2$}  {}\n", r.0, r.1, r.2, r.3))
+        .collect())
+}
+
+fn plugin_check(lib: &Path) -> Result<String, String> {
+    let m = PluginMachine::load(lib).map_err(|e| e.to_string())?;
+    let (major, minor) = m.abi_version();
+    let descriptor = serde_json::to_string_pretty(m.info()).map_err(|e| e.to_string())?;
+    Ok(format!(
+        "{}: pilgrim machine plugin, ABI {major}.{minor}, machine {} ({}), solves {}\n{descriptor}\n",
+        lib.display(),
+        m.info().name,
+        m.info().control,
+        m.info().solved_axes.join(", ")
+    ))
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
-        Command::Machines { files, only_files } => machines(files, *only_files),
+        Command::Run {
+            script,
+            params,
+            sets,
+            machine,
+            out,
+        } => run::run(&run::RunArgs {
+            script: script.clone(),
+            params: params.clone(),
+            sets: sets.clone(),
+            machine: machine.clone(),
+            out: out.clone(),
+            quiet: cli.quiet,
+        })
+        .map(|s| s + "\n"),
+        Command::Machines {
+            plugins,
+            files,
+            only_files,
+        } => list_machines(plugins, files, *only_files),
+        Command::Params { script } => params(script),
+        Command::PluginCheck { lib } => plugin_check(lib),
+        Command::ApiDocs { out } => {
+            let text = pilgrim_kernel::script::api_reference();
+            match out {
+                Some(p) => run::write_file(p, &text).map(|_| String::new()),
+                None => Ok(text),
+            }
+        }
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(text) => {
+            if !cli.quiet || !matches!(cli.command, Command::Run { .. }) {
+                print!("{text}");
+            }
+            ExitCode::SUCCESS
+        }
         Err(e) => {
             eprintln!("pilgrim: {e}");
             ExitCode::FAILURE

@@ -1,9 +1,11 @@
 //! The `pilgrim` program, run as a user runs it.
 
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn pilgrim(args: &[&str]) -> (i32, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_pilgrim"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
         .args(args)
         .output()
         .unwrap();
@@ -13,6 +15,30 @@ fn pilgrim(args: &[&str]) -> (i32, String, String) {
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
 }
+
+/// A fresh scratch directory for one test.
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("pilgrim-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn lib(name: &str) -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    let dir = exe.parent().and_then(Path::parent).unwrap();
+    dir.join(format!(
+        "{}{name}{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    ))
+}
+
+const DEMO: &str = "scripts/examples/mill_circle.rhai";
 
 #[test]
 fn version_and_machines() {
@@ -25,7 +51,7 @@ fn version_and_machines() {
     let (code, out, _) = pilgrim(&["machines"]);
     assert_eq!(code, 0);
     for name in [
-        "3K152VF20",
+        "3K152VF20  (sinumerik), built-in plugin",
         "LZ-250",
         "Mannesmann",
         "fanuc-0i-tc",
@@ -38,16 +64,22 @@ fn version_and_machines() {
         "{out}"
     );
     assert!(out.contains("A   rotary   [-370, 370] deg"), "{out}");
+    let grinder = lib("grinder_3k152vf20");
+    let (code, out, _) = pilgrim(&["machines", "--only-files", "--plugin", s(&grinder)]);
+    assert_eq!(code, 0);
+    assert!(
+        out.contains("3K152VF20  (sinumerik), plugin") && !out.contains("LZ-250"),
+        "{out}"
+    );
 }
 
 #[test]
 fn machine_file_errors_name_file_and_line() {
-    let dir = std::env::temp_dir().join(format!("pilgrim-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let good = dir.join("lathe.toml");
+    let dir = scratch("machines");
     let text = pilgrim_kernel::machine::BUILTIN_SOURCES[3].1;
+    let good = dir.join("lathe.toml");
     std::fs::write(&good, text.replace("fanuc-0i-tc", "my-lathe")).unwrap();
-    let (code, out, _) = pilgrim(&["machines", "--only-files", "--file", good.to_str().unwrap()]);
+    let (code, out, _) = pilgrim(&["machines", "--only-files", "--file", s(&good)]);
     assert_eq!(code, 0);
     assert!(
         out.contains("my-lathe") && !out.contains("3K152VF20"),
@@ -55,7 +87,7 @@ fn machine_file_errors_name_file_and_line() {
     );
     let bad = dir.join("bad.toml");
     std::fs::write(&bad, text.replace("max_feed = 12000.0", "max_feed = -1.0")).unwrap();
-    let (code, _, err) = pilgrim(&["machines", "--file", bad.to_str().unwrap()]);
+    let (code, _, err) = pilgrim(&["machines", "--file", s(&bad)]);
     assert_eq!(code, 1);
     assert!(
         err.contains("bad.toml:") && err.contains("axis X: the maximum feed must be > 0"),
@@ -66,5 +98,239 @@ fn machine_file_errors_name_file_and_line() {
     assert!(err.contains("/no/such.toml"), "{err}");
     let (code, _, _) = pilgrim(&["frobnicate"]);
     assert_eq!(code, 2);
-    std::fs::remove_dir_all(&dir).ok();
+}
+
+const FILES: [&str; 5] = [
+    "toolpath.json",
+    "program.json",
+    "program.mpf",
+    "program.cld",
+    "report.json",
+];
+
+#[test]
+fn demo_writes_every_file_and_the_same_bytes_twice() {
+    let dir = scratch("demo");
+    let (a, b) = (dir.join("a"), dir.join("b"));
+    for out in [&a, &b] {
+        let (code, stdout, err) = pilgrim(&["run", DEMO, "--out", s(out)]);
+        assert_eq!(code, 0, "{err}");
+        assert!(stdout.contains("365 blocks for vertical-mill"), "{stdout}");
+    }
+    for f in FILES {
+        let (x, y) = (
+            std::fs::read(a.join(f)).unwrap(),
+            std::fs::read(b.join(f)).unwrap(),
+        );
+        assert!(!x.is_empty(), "{f} empty");
+        assert_eq!(x, y, "{f} differs between two runs");
+    }
+    let mpf = std::fs::read_to_string(a.join("program.mpf")).unwrap();
+    assert!(
+        mpf.starts_with("%_N_MILL_CIRCLE_MPF\n;$PATH=/_N_MPF_DIR\n"),
+        "{mpf}"
+    );
+    assert!(
+        mpf.contains("N40 G0 X45.000 Y0.000 Z5.000 C0.000\n") && mpf.ends_with("M30\n"),
+        "{mpf}"
+    );
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(a.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["blocks"], 365);
+    assert_eq!(report["parameters"]["radius"]["value"], 40.0);
+    // A parameter file and --set, a TOML machine and a Rhai machine.
+    let params = dir.join("p.toml");
+    std::fs::write(&params, "radius = 30.0\npoints = 36\n").unwrap();
+    let toml_machine = dir.join("mill.toml");
+    std::fs::write(&toml_machine, pilgrim_kernel::machine::BUILTIN_SOURCES[4].1).unwrap();
+    let (code, out, err) = pilgrim(&[
+        "run",
+        DEMO,
+        "--params",
+        s(&params),
+        "--set",
+        "turn_table=false",
+        "--machine",
+        s(&toml_machine),
+        "--out",
+        s(&a),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("41 blocks"), "{out}");
+    let rhai_machine = dir.join("mill.rhai");
+    std::fs::write(
+        &rhai_machine,
+        r#"fn machine() {
+    let lin = |n, v| #{ name: n, kind: "linear", min: -v, max: v, max_feed: 5000.0, moves: [0.0, 0.0, 0.0] };
+    let x = lin.call("X", 300.0); x.moves = [1.0, 0.0, 0.0];
+    let y = lin.call("Y", 300.0); y.moves = [0.0, 1.0, 0.0];
+    let z = lin.call("Z", 300.0); z.moves = [0.0, 0.0, 1.0];
+    let c = #{ name: "C", kind: "rotary", min_deg: -720.0, max_deg: 720.0, max_feed_deg: 3600.0, turns: [0.0, 0.0, 1.0] };
+    #{ name: "scripted-mill", control: "fanuc", axes: [x, y, z, c],
+       chain: [#{ factor: "rz", axis: "C" }, #{ factor: "tx", axis: "X" }, #{ factor: "ty", axis: "Y" }, #{ factor: "tz", axis: "Z" }] }
+}"#,
+    )
+    .unwrap();
+    let (code, out, err) = pilgrim(&[
+        "run",
+        DEMO,
+        "--machine",
+        s(&rhai_machine),
+        "--out",
+        s(&b),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.is_empty());
+    let nc = std::fs::read_to_string(b.join("program.nc")).unwrap();
+    assert!(nc.starts_with("%\nO0001 (MILL_CIRCLE)\n"), "{nc}");
+}
+
+#[test]
+fn bad_input_is_refused_and_nothing_is_written() {
+    let dir = scratch("bad");
+    let out = dir.join("out");
+    let (code, _, err) = pilgrim(&["run", DEMO, "--out", s(&out)]);
+    assert_eq!(code, 0, "{err}");
+    let before: Vec<Vec<u8>> = FILES
+        .iter()
+        .map(|f| std::fs::read(out.join(f)).unwrap())
+        .collect();
+    // An unknown parameter lists the valid names.
+    let (code, _, err) = pilgrim(&["run", DEMO, "--set", "radious=3", "--out", s(&out)]);
+    assert_eq!(code, 1);
+    assert!(err.contains("unknown parameter 'radious' from --set (parameters: clearance, depth, feed, points, radius"), "{err}");
+    // A block outside travel: X would reach 505 mm on a 400 mm axis.
+    let (code, _, err) = pilgrim(&[
+        "run",
+        DEMO,
+        "--set",
+        "radius=500",
+        "--set",
+        "turn_table=false",
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("block 1 (pass 1, point 1): axis X would need 505.0000 mm, outside its travel [-400, 400] mm"),
+        "{err}"
+    );
+    // A syntax error names file, line and column.
+    let broken = dir.join("broken.rhai");
+    std::fs::write(
+        &broken,
+        "fn params() { #{} }\nfn toolpath(p) {\n  let x = 1 +;\n}\n",
+    )
+    .unwrap();
+    let (code, _, err) = pilgrim(&[
+        "run",
+        s(&broken),
+        "--machine",
+        "vertical-mill",
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(code, 1);
+    assert!(err.contains("broken.rhai:3:"), "{err}");
+    // The first output is untouched, and no temporary directory is left.
+    let after: Vec<Vec<u8>> = FILES
+        .iter()
+        .map(|f| std::fs::read(out.join(f)).unwrap())
+        .collect();
+    assert_eq!(before, after);
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name())
+        .collect();
+    assert_eq!(leftovers.len(), 2, "{leftovers:?}");
+    // A machine that does not exist.
+    let (code, _, err) = pilgrim(&["run", DEMO, "--machine", "planer", "--out", s(&out)]);
+    assert_eq!(code, 1);
+    assert!(err.contains("unknown machine 'planer'"), "{err}");
+}
+
+#[test]
+fn params_and_plugin_check() {
+    let (code, out, _) = pilgrim(&["params", DEMO]);
+    assert_eq!(code, 0);
+    assert!(
+        out.lines().any(|l| l.starts_with("radius")
+            && l.contains("40")
+            && l.contains("mm")
+            && l.contains("finished edge")),
+        "{out}"
+    );
+    let (code, out, err) = pilgrim(&["plugin-check", s(&lib("grinder_3k152vf20"))]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains("ABI 1.0, machine 3K152VF20 (sinumerik), solves Z, X"),
+        "{out}"
+    );
+    let dir = scratch("check");
+    let other = dir.join(format!(
+        "{}other_abi{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    ));
+    std::fs::copy(lib("plugin_fixture"), &other).unwrap();
+    let (code, _, err) = pilgrim(&["plugin-check", s(&other)]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("ABI 99.3") && err.contains("pilgrim ABI 1.0"),
+        "{err}"
+    );
+}
+
+/// Every script under scripts/ runs with its defaults.
+#[test]
+fn every_script_runs_with_its_defaults() {
+    fn scripts(dir: &Path, found: &mut Vec<PathBuf>) {
+        for e in std::fs::read_dir(dir).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                scripts(&p, found);
+            } else if p.extension().is_some_and(|x| x == "rhai") {
+                found.push(p);
+            }
+        }
+    }
+    let mut found = vec![];
+    scripts(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts"),
+        &mut found,
+    );
+    assert!(!found.is_empty());
+    let dir = scratch("scripts");
+    for (i, script) in found.iter().enumerate() {
+        let out = dir.join(format!("run{i}"));
+        let (code, _, err) = pilgrim(&["run", s(script), "--out", s(&out), "--quiet"]);
+        assert_eq!(code, 0, "{}: {err}", script.display());
+        assert!(out.join("report.json").exists());
+    }
+}
+
+/// docs/script-api.md is what `pilgrim api-docs` writes now.
+#[test]
+fn api_reference_is_current() {
+    let (code, out, _) = pilgrim(&["api-docs"]);
+    assert_eq!(code, 0);
+    let committed =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/script-api.md"))
+            .unwrap();
+    assert!(
+        committed == out,
+        "docs/script-api.md is stale: run `cargo run -- api-docs --out docs/script-api.md`"
+    );
+    for f in [
+        "linspace",
+        "add_pass",
+        "equidistant",
+        "wheel_tool",
+        "read_table",
+        "mandrel_law",
+    ] {
+        assert!(out.contains(&format!("## `{f}(")), "{f} missing");
+    }
 }

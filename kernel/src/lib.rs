@@ -34,7 +34,12 @@ pub mod error;
 pub mod machine;
 pub mod math;
 pub mod offset;
+pub mod plugin;
 pub mod profile;
+pub mod program;
+pub mod script;
+pub mod tool;
+pub mod toolpath;
 pub mod transform;
 
 pub use error::{Error, InputError};
@@ -47,6 +52,9 @@ pub use profile::{
     read_table, read_table_str, uniform_grid, Bulge, CurvatureViolation, EllipseSection,
     MandrelLaw, Profile, ProfileBuilder, ProfileError, Smoothing, Table, TableError,
 };
+pub use program::{AxisProgram, Block, ChainMachine, MachineInfo, MachineKinematics, ProgramError};
+pub use tool::{Tool, ToolShape, Wheel};
+pub use toolpath::{ClPoint, Motion, Pass, Toolpath, ToolpathError};
 pub use transform::{
     Chain, ChainBuilder, Factor, FactorKind, FactorValue, Frame, IkOptions, IkSolution, Pose,
     Target, ToolFrame, TransformError, UNIVERSAL_PARAMETERS,

@@ -296,99 +296,21 @@ impl Machine {
     /// [`MachineError::OutsideTravel`] naming the first offending point and
     /// axis; an unknown axis; a ragged batch.
     pub fn check_travel(&self, axes: &[&str], rows: &[Real]) -> Result<(), MachineError> {
-        let cols = self.columns(axes, rows)?;
-        for (p, row) in rows.chunks_exact(axes.len()).enumerate() {
-            for (a, &v) in cols.iter().zip(row) {
-                if a.kind == AxisKind::Spindle {
-                    continue;
-                }
-                if !v.is_finite() || v < a.min || v > a.max {
-                    return Err(MachineError::OutsideTravel {
-                        point: p,
-                        axis: a.name.clone(),
-                        value: a.to_user(v),
-                        min: a.to_user(a.min),
-                        max: a.to_user(a.max),
-                        unit: a.unit(),
-                    });
-                }
-            }
-        }
-        Ok(())
+        check_travel(&self.columns(axes, rows)?, rows)
     }
 
-    /// Checks that no axis moves faster than its maximum between points.
-    /// `feeds[i]` is the programmed feed (mm/min) of the move ending at point
-    /// `i` (`feeds[0]` is unused); the move lasts its linear axes' path
-    /// length over the feed (or, for a rotary-only move, its angle in
-    /// degrees over the feed in deg/min).
+    /// Checks that no axis moves faster than its maximum between points;
+    /// see [`check_feed`].
     ///
     /// # Failures
-    /// [`MachineError::FeedExceeded`] naming the first offending point and
-    /// axis; a non-positive feed; an unknown axis; a ragged batch.
+    /// As [`check_feed`]; an unknown axis.
     pub fn check_feed(
         &self,
         axes: &[&str],
         rows: &[Real],
         feeds: &[Real],
     ) -> Result<(), MachineError> {
-        let cols = self.columns(axes, rows)?;
-        let n = rows.len() / axes.len().max(1);
-        if feeds.len() != n {
-            return Err(MachineError::BadPoint {
-                point: feeds.len().min(n),
-                message: format!("{} feeds for {n} points", feeds.len()),
-            });
-        }
-        for p in 1..n {
-            let (a0, a1) = (
-                &rows[(p - 1) * axes.len()..p * axes.len()],
-                &rows[p * axes.len()..(p + 1) * axes.len()],
-            );
-            let f = feeds[p];
-            if !(f.is_finite() && f > 0.0) {
-                return Err(MachineError::BadPoint {
-                    point: p,
-                    message: format!("feed {f} mm/min is not positive"),
-                });
-            }
-            let user_delta = |i: usize| cols[i].to_user(a1[i]) - cols[i].to_user(a0[i]);
-            let linear: Real = (0..axes.len())
-                .filter(|&i| cols[i].kind == AxisKind::Linear)
-                .map(|i| user_delta(i).powi(2))
-                .sum::<Real>()
-                .sqrt();
-            let path = if linear > 0.0 {
-                linear
-            } else {
-                (0..axes.len())
-                    .filter(|&i| cols[i].kind == AxisKind::Rotary)
-                    .map(|i| user_delta(i).powi(2))
-                    .sum::<Real>()
-                    .sqrt()
-            };
-            if path == 0.0 {
-                continue;
-            }
-            let minutes = path / f;
-            for (i, a) in cols.iter().enumerate() {
-                if a.kind == AxisKind::Spindle {
-                    continue;
-                }
-                let speed = user_delta(i).abs() / minutes;
-                let max = a.to_user(a.max_feed);
-                if speed > max * (1.0 + 1e-9) {
-                    return Err(MachineError::FeedExceeded {
-                        point: p,
-                        axis: a.name.clone(),
-                        speed,
-                        max,
-                        unit: a.feed_unit(),
-                    });
-                }
-            }
-        }
-        Ok(())
+        check_feed(&self.columns(axes, rows)?, rows, feeds)
     }
 
     fn columns(&self, axes: &[&str], rows: &[Real]) -> Result<Vec<&Axis>, MachineError> {
@@ -396,18 +318,125 @@ impl Machine {
             .iter()
             .map(|n| self.axis_or_err(n))
             .collect::<Result<Vec<_>, _>>()?;
-        if axes.is_empty() || !rows.len().is_multiple_of(axes.len()) {
-            return Err(MachineError::BadPoint {
-                point: rows.len() / axes.len().max(1),
-                message: format!(
-                    "{} values do not fill rows of {} axes",
-                    rows.len(),
-                    axes.len()
-                ),
-            });
-        }
+        check_rows(&cols, rows)?;
         Ok(cols)
     }
+}
+
+fn check_rows(axes: &[&Axis], rows: &[Real]) -> Result<usize, MachineError> {
+    if axes.is_empty() || !rows.len().is_multiple_of(axes.len()) {
+        return Err(MachineError::BadPoint {
+            point: rows.len() / axes.len().max(1),
+            message: format!(
+                "{} values do not fill rows of {} axes",
+                rows.len(),
+                axes.len()
+            ),
+        });
+    }
+    Ok(rows.len() / axes.len())
+}
+
+/// Checks that every row of `rows` (one value per axis of `axes`, kernel
+/// units) lies within travel; spindles are not checked.
+///
+/// # Failures
+/// [`MachineError::OutsideTravel`] naming the first offending point (row,
+/// from 0) and axis, with values in mm or degrees; a ragged batch.
+pub fn check_travel(axes: &[&Axis], rows: &[Real]) -> Result<(), MachineError> {
+    check_rows(axes, rows)?;
+    for (p, row) in rows.chunks_exact(axes.len()).enumerate() {
+        for (a, &v) in axes.iter().zip(row) {
+            if a.kind == AxisKind::Spindle {
+                continue;
+            }
+            if !v.is_finite() || v < a.min || v > a.max {
+                return Err(MachineError::OutsideTravel {
+                    point: p,
+                    axis: a.name.clone(),
+                    value: a.to_user(v),
+                    min: a.to_user(a.min),
+                    max: a.to_user(a.max),
+                    unit: a.unit(),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Linear motion shorter than this (mm) counts as none in feed checks.
+const LINEAR_RESOLUTION: Real = 1e-4;
+
+/// Checks that no axis moves faster than its maximum between rows.
+/// `feeds[i]` is the programmed feed (mm/min) of the move ending at row `i`
+/// (`feeds[0]` is unused; `+inf` marks a rapid, not checked); the move lasts
+/// its linear axes' path length over the feed (or, for a rotary-only move,
+/// one whose linear motion is under 0.0001 mm, its angle in degrees over the
+/// feed in deg/min).
+///
+/// # Failures
+/// [`MachineError::FeedExceeded`] naming the first offending point and axis;
+/// a feed that is not positive; a ragged batch.
+pub fn check_feed(axes: &[&Axis], rows: &[Real], feeds: &[Real]) -> Result<(), MachineError> {
+    let n = check_rows(axes, rows)?;
+    let w = axes.len();
+    if feeds.len() != n {
+        return Err(MachineError::BadPoint {
+            point: feeds.len().min(n),
+            message: format!("{} feeds for {n} points", feeds.len()),
+        });
+    }
+    for p in 1..n {
+        let (a0, a1) = (&rows[(p - 1) * w..p * w], &rows[p * w..(p + 1) * w]);
+        let f = feeds[p];
+        if f == Real::INFINITY {
+            continue;
+        }
+        if !(f.is_finite() && f > 0.0) {
+            return Err(MachineError::BadPoint {
+                point: p,
+                message: format!("feed {f} mm/min is not positive"),
+            });
+        }
+        let user_delta = |i: usize| axes[i].to_user(a1[i]) - axes[i].to_user(a0[i]);
+        let length_of = |kind: AxisKind| -> Real {
+            (0..w)
+                .filter(|&i| axes[i].kind == kind)
+                .map(|i| user_delta(i).powi(2))
+                .sum::<Real>()
+                .sqrt()
+        };
+        // Linear motion below the programs' 0.001 mm resolution is no motion:
+        // the move is a pure turn and F reads in degrees per minute.
+        let linear = length_of(AxisKind::Linear);
+        let path = if linear > LINEAR_RESOLUTION {
+            linear
+        } else {
+            length_of(AxisKind::Rotary)
+        };
+        if path == 0.0 {
+            continue;
+        }
+        let minutes = path / f;
+        for (i, a) in axes.iter().enumerate() {
+            if a.kind == AxisKind::Spindle {
+                continue;
+            }
+            let speed = user_delta(i).abs() / minutes;
+            let max = a.to_user(a.max_feed);
+            if speed > max * (1.0 + 1e-9) {
+                return Err(MachineError::FeedExceeded {
+                    point: p,
+                    axis: a.name.clone(),
+                    speed,
+                    max,
+                    unit: a.feed_unit(),
+                });
+            }
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

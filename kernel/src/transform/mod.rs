@@ -439,6 +439,51 @@ impl Chain {
         self.axes.iter().position(|a| a == name)
     }
 
+    /// The chain with some axes fixed: `values[i]` (when `Some`) replaces
+    /// axis `i` by a constant, which leaves the chain without that axis.
+    ///
+    /// # Failures
+    /// `values` of another length than the axes, or a non-finite value.
+    ///
+    /// ```
+    /// use pilgrim_kernel::{Chain, FactorKind::*, Point3};
+    /// let ch = Chain::builder().axis(Rz, "C").axis(Tx, "X").build().unwrap();
+    /// let fixed = ch.with_fixed(&[Some(0.0), None]).unwrap();
+    /// assert_eq!(fixed.axis_names(), ["X"]);
+    /// ```
+    pub fn with_fixed(&self, values: &[Option<Real>]) -> Result<Chain, TransformError> {
+        if values.len() != self.dof() {
+            return Err(TransformError::AxisCount {
+                expected: self.dof(),
+                got: values.len(),
+                names: self.axes.join(", "),
+            });
+        }
+        let mut b = Chain::builder();
+        for (name, v) in self.axes.iter().zip(values) {
+            if v.is_none() {
+                b = b.declare(name);
+            }
+        }
+        for f in &self.factors {
+            b = match f.value {
+                FactorValue::Const(c) => b.constant(f.kind, c),
+                FactorValue::Axis {
+                    axis,
+                    scale,
+                    offset,
+                } => match values[axis] {
+                    Some(v) => b.constant(
+                        f.kind,
+                        scale * crate::math::finite("fixed axis value", v)? + offset,
+                    ),
+                    None => b.axis_scaled(f.kind, &self.axes[axis], scale, offset),
+                },
+            };
+        }
+        b.build()
+    }
+
     /// Whether axis `i` is bound to rotations (radians); `false` for linear
     /// axes and for axes bound to no factor.
     pub fn is_rotary(&self, i: usize) -> bool {

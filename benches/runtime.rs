@@ -1,0 +1,160 @@
+//! Runtime benchmarks (issue: runtime). Run: `cargo bench --bench runtime`.
+//!
+//! - `rhai_overhead`: the demo family's toolpath for 100k points through
+//!   Rhai, against the same computation written in Rust (target: ratio <= 1.5);
+//! - `plugin_batch`: inverse kinematics of 10k poses through the 3K152VF20
+//!   plugin loaded as a shared library, against the compiled-in machine
+//!   (target: <= 5% slower).
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use grinder_3k152vf20::Grinder;
+use pilgrim_kernel::plugin::PluginMachine;
+use pilgrim_kernel::script::{Access, Family, Limits};
+use pilgrim_kernel::{
+    ClPoint, MachineKinematics, Motion, Pass, Point3, Tool, ToolFrame, Toolpath, Vec3,
+};
+use std::hint::black_box;
+use std::path::Path;
+use std::time::Duration;
+
+const POINTS: usize = 100_000;
+
+/// The demo's toolpath, written in Rust with the same steps as the script.
+fn demo_in_rust(
+    radius: f64,
+    tool_d: f64,
+    depth: f64,
+    feed: f64,
+    rpm: f64,
+    clearance: f64,
+) -> Toolpath {
+    let tool = Tool::end_mill("end mill", 1, tool_d, 3.0 * depth).unwrap();
+    let r = radius + tool_d / 2.0;
+    let n = POINTS + 1;
+    let beta: Vec<f64> = (0..n)
+        .map(|i| 2.0 * std::f64::consts::PI * i as f64 / (n - 1) as f64)
+        .collect();
+    let deg = 180.0 / std::f64::consts::PI;
+    let xs: Vec<f64> = beta.iter().map(|b| b.cos() * r).collect();
+    let ys: Vec<f64> = beta.iter().map(|b| b.sin() * r).collect();
+    let cs: Vec<f64> = beta.iter().map(|b| b * deg).collect();
+    let mut tp = Toolpath::new("mill_circle", tool, rpm, vec!["C".into()]);
+    let pt = |x: f64, y: f64, z: f64, motion, feed, c: f64| ClPoint {
+        point: [x, y, z],
+        axis: [0.0, 0.0, 1.0],
+        motion,
+        feed,
+        aux: vec![c],
+    };
+    tp.passes.push(Pass {
+        name: "approach".into(),
+        points: vec![
+            pt(r, 0.0, clearance, Motion::Rapid, 0.0, 0.0),
+            pt(r, 0.0, 1.0, Motion::Rapid, 0.0, 0.0),
+        ],
+    });
+    tp.passes.push(Pass {
+        name: "plunge".into(),
+        points: vec![pt(r, 0.0, -depth, Motion::Linear, feed / 3.0, 0.0)],
+    });
+    tp.passes.push(Pass {
+        name: "contour".into(),
+        points: (0..n)
+            .map(|i| pt(xs[i], ys[i], -depth, Motion::Linear, feed / r * deg, cs[i]))
+            .collect(),
+    });
+    tp.passes.push(Pass {
+        name: "retract".into(),
+        points: vec![pt(r, 0.0, clearance, Motion::Rapid, 0.0, 360.0)],
+    });
+    tp
+}
+
+fn rhai_overhead(c: &mut Criterion) {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/examples/mill_circle.rhai");
+    let family = Family::load(&script, &Limits::default(), &Access::default()).unwrap();
+    let values = family
+        .resolve(None, &[("points".into(), POINTS.to_string())])
+        .unwrap();
+    let from_script = family.toolpath(&values).unwrap();
+    let native = demo_in_rust(40.0, 10.0, 5.0, 600.0, 3000.0, 5.0);
+    assert_eq!(from_script.point_count(), native.point_count());
+    let mut g = c.benchmark_group("rhai_overhead");
+    g.sample_size(10).measurement_time(Duration::from_secs(4));
+    g.bench_function("demo_100k_points_rhai", |b| {
+        b.iter(|| black_box(family.toolpath(&values).unwrap()))
+    });
+    g.bench_function("demo_100k_points_rust", |b| {
+        b.iter(|| black_box(demo_in_rust(40.0, 10.0, 5.0, 600.0, 3000.0, 5.0)))
+    });
+    g.finish();
+}
+
+fn plugin_batch(c: &mut Criterion) {
+    const N: usize = 10_000;
+    let exe = std::env::current_exe().unwrap();
+    let lib = exe.parent().and_then(Path::parent).unwrap().join(format!(
+        "{}grinder_3k152vf20{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    ));
+    if !lib.exists() {
+        // `cargo bench` builds the plugin crate as a dependency (rlib) only:
+        // build its shared library, in this same profile.
+        let status = std::process::Command::new(env!("CARGO"))
+            .args([
+                "build",
+                "--release",
+                "-p",
+                "pilgrim-grinder-3k152vf20",
+                "--lib",
+            ])
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .status()
+            .expect("cargo runs");
+        assert!(
+            status.success(),
+            "building the plugin's shared library failed"
+        );
+    }
+    let loaded = PluginMachine::load(&lib).unwrap();
+    let built_in = Grinder::new();
+    let tool = ToolFrame {
+        point: Point3::new(20.0, 0.0, 0.0),
+        axis: Vec3::z(),
+    };
+    let poses: Vec<f64> = (0..N)
+        .flat_map(|i| {
+            [
+                45.0 + (i as f64 * 0.01).sin(),
+                0.0,
+                0.04 * i as f64,
+                0.0,
+                0.0,
+                1.0,
+            ]
+        })
+        .collect();
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    built_in.inverse(&poses, &tool, &mut a).unwrap();
+    loaded.inverse(&poses, &tool, &mut b).unwrap();
+    assert_eq!(a, b);
+    let mut g = c.benchmark_group("plugin_batch");
+    g.sample_size(50).measurement_time(Duration::from_secs(4));
+    g.bench_function("ik_10k_in_process", |bch| {
+        bch.iter(|| {
+            built_in.inverse(black_box(&poses), &tool, &mut a).unwrap();
+            black_box(a.len())
+        })
+    });
+    g.bench_function("ik_10k_shared_library", |bch| {
+        bch.iter(|| {
+            loaded.inverse(black_box(&poses), &tool, &mut b).unwrap();
+            black_box(b.len())
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(runtime, rhai_overhead, plugin_batch);
+criterion_main!(runtime);

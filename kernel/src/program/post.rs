@@ -1,0 +1,451 @@
+//! The post-processor: one writer, dialects as data.
+//!
+//! A [`Dialect`] is a small set of settings (block numbers, comment style,
+//! motion words, decimals, header and footer templates) on the one shared
+//! writer, [`post`]. The G-code dialects write modal words (a word only when
+//! its value changes; the first block writes every axis); the APT-style CL
+//! file (ISO 4343 flavour) writes `GOTO/` records with all of the machine's
+//! coordinates. Numbers have fixed decimals and never read `-0.000`; the
+//! output depends on nothing but the program (no dates), so the same
+//! program gives the same bytes.
+//!
+//! | dialect | file | numbers | comments | motion |
+//! |---|---|---|---|---|
+//! | `sinumerik` (840D) | `.mpf`, `%_N_<NAME>_MPF` | `N10`, step 10 | `; text` | `G0 G1 G33 K<lead>` |
+//! | `fanuc` (0i) | `.nc`, `%` `O<number>` ... `%` | none (5-digit N would overflow) | `(TEXT)` | `G00 G01 G32 F<lead>` |
+//! | `cld` (APT) | `.cld` | none | `PPRINT/text` | `RAPID`, `FEDRAT/`, `GOTO/` |
+
+use super::AxisProgram;
+use crate::math::fixed;
+use crate::toolpath::Motion;
+
+/// How blocks are written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Style {
+    /// Word-address G-code, modal.
+    GCode,
+    /// APT-style CL records.
+    Apt,
+}
+
+/// The settings of one output format. Templates may use `{NAME}`,
+/// `{ONUM}` (four digits), `{MACHINE}`, `{TOOL}`, `{TOOL2}` (two digits),
+/// `{TOOLNAME}`, `{S}` (rpm) and `{VERSION}`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Dialect {
+    /// The dialect's name, as `--control` and machine files say it.
+    pub name: &'static str,
+    /// The file extension.
+    pub extension: &'static str,
+    /// G-code or APT.
+    pub style: Style,
+    /// Text before and after a comment.
+    pub comment: (&'static str, &'static str),
+    /// Whether comments are upper-cased (Fanuc).
+    pub upper_comments: bool,
+    /// First block number and step, or `None` for no numbers.
+    pub numbering: Option<(u64, u64)>,
+    /// Lines before the program, unnumbered.
+    pub header: &'static [&'static str],
+    /// Blocks before the first move, numbered.
+    pub preamble: &'static [&'static str],
+    /// Blocks after the last move, numbered.
+    pub footer: &'static [&'static str],
+    /// Lines after the program, unnumbered.
+    pub trailer: &'static [&'static str],
+    /// Word of a rapid move.
+    pub rapid: &'static str,
+    /// Word of a linear move.
+    pub linear: &'static str,
+    /// Word of a thread move.
+    pub thread: &'static str,
+    /// Address of a thread's lead.
+    pub lead: &'static str,
+    /// Decimals of axis values (mm and degrees alike: 0.001).
+    pub decimals: usize,
+    /// Decimals of feeds.
+    pub feed_decimals: usize,
+    /// Decimals of leads.
+    pub lead_decimals: usize,
+}
+
+/// Siemens Sinumerik 840D part program (`.MPF`).
+pub const SINUMERIK: Dialect = Dialect {
+    name: "sinumerik",
+    extension: "mpf",
+    style: Style::GCode,
+    comment: ("; ", ""),
+    upper_comments: false,
+    numbering: Some((10, 10)),
+    header: &[
+        "%_N_{NAME}_MPF",
+        ";$PATH=/_N_MPF_DIR",
+        "; {NAME} for {MACHINE}, written by pilgrim {VERSION}",
+        "; tool T{TOOL}: {TOOLNAME}",
+    ],
+    preamble: &["G90 G94 G71", "T{TOOL} D1", "S{S} M3"],
+    footer: &["M5", "M30"],
+    trailer: &[],
+    rapid: "G0",
+    linear: "G1",
+    thread: "G33",
+    lead: "K",
+    decimals: 3,
+    feed_decimals: 1,
+    lead_decimals: 4,
+};
+
+/// Fanuc 0i (lathe, G-code system A: absolute by axis address, feed per minute).
+pub const FANUC: Dialect = Dialect {
+    name: "fanuc",
+    extension: "nc",
+    style: Style::GCode,
+    comment: ("(", ")"),
+    upper_comments: true,
+    numbering: None,
+    header: &[
+        "%",
+        "O{ONUM} ({NAME})",
+        "({MACHINE}, WRITTEN BY PILGRIM {VERSION})",
+        "(TOOL T{TOOL2}: {TOOLNAME})",
+    ],
+    preamble: &["G21 G40 G97 G98", "T{TOOL2}{TOOL2}", "S{S} M03"],
+    footer: &["M05", "M30"],
+    trailer: &["%"],
+    rapid: "G00",
+    linear: "G01",
+    thread: "G32",
+    lead: "F",
+    decimals: 3,
+    feed_decimals: 1,
+    lead_decimals: 4,
+};
+
+/// APT-style cutter-location file (ISO 4343 flavour) in machine coordinates.
+pub const CLD: Dialect = Dialect {
+    name: "cld",
+    extension: "cld",
+    style: Style::Apt,
+    comment: ("PPRINT/", ""),
+    upper_comments: false,
+    numbering: None,
+    header: &[
+        "PARTNO/{NAME}",
+        "MACHIN/{MACHINE}",
+        "PPRINT/written by pilgrim {VERSION}",
+        "UNITS/MM",
+        "LOADTL/{TOOL}",
+        "SPINDL/{S},RPM,CLW",
+    ],
+    preamble: &[],
+    footer: &["SPINDL/OFF", "FINI"],
+    trailer: &[],
+    rapid: "RAPID",
+    linear: "",
+    thread: "",
+    lead: "",
+    decimals: 3,
+    feed_decimals: 3,
+    lead_decimals: 4,
+};
+
+/// Every dialect.
+pub const DIALECTS: [&Dialect; 3] = [&SINUMERIK, &FANUC, &CLD];
+
+/// The dialect called `name`.
+pub fn dialect(name: &str) -> Option<&'static Dialect> {
+    DIALECTS
+        .iter()
+        .copied()
+        .find(|d| d.name.eq_ignore_ascii_case(name))
+}
+
+/// Errors writing a program.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PostError {
+    /// No dialect of that name.
+    #[error("no post-processor dialect '{name}' (dialects: sinumerik, fanuc, cld)")]
+    UnknownDialect {
+        /// The name asked for.
+        name: String,
+    },
+    /// A block that cannot be written.
+    #[error("block {block}: {message}")]
+    BadBlock {
+        /// Block number (from 1).
+        block: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A plugin's post-processor failed.
+    #[error("post-processor: {0}")]
+    Plugin(String),
+}
+
+/// [`post`] with the dialect named.
+///
+/// # Failures
+/// An unknown dialect; as [`post`].
+pub fn post_by_name(program: &AxisProgram, name: &str) -> Result<String, PostError> {
+    let d = dialect(name).ok_or_else(|| PostError::UnknownDialect {
+        name: name.to_owned(),
+    })?;
+    post(program, d)
+}
+
+struct Writer<'a> {
+    d: &'a Dialect,
+    out: String,
+    next: Option<u64>,
+}
+
+impl Writer<'_> {
+    fn line(&mut self, text: &str) {
+        self.out.push_str(text);
+        self.out.push('\n');
+    }
+
+    fn block(&mut self, text: &str) {
+        match (self.d.numbering, self.next) {
+            (Some((_, step)), Some(n)) => {
+                self.out.push_str(&format!("N{n} {text}\n"));
+                self.next = Some(n + step);
+            }
+            _ => self.line(text),
+        }
+    }
+
+    fn comment(&mut self, text: &str) {
+        let closes_with_paren = self.d.comment.1 == ")";
+        let mut t: String = text
+            .chars()
+            .filter(|c| match c {
+                '\n' | '\r' => false,
+                '(' | ')' => !closes_with_paren,
+                _ => true,
+            })
+            .collect();
+        if self.d.upper_comments {
+            t = t.to_uppercase();
+        }
+        let (open, close) = self.d.comment;
+        self.line(&format!("{open}{t}{close}"));
+    }
+}
+
+/// A template filled in for `p`; names are upper-cased and freed of
+/// parentheses where the dialect's comments need it.
+fn fill(template: &str, p: &AxisProgram, d: &Dialect) -> String {
+    let text = |s: &str| {
+        let s = if d.upper_comments {
+            s.to_uppercase()
+        } else {
+            s.to_owned()
+        };
+        if d.comment.1 == ")" {
+            s.replace(['(', ')'], "")
+        } else {
+            s
+        }
+    };
+    let (tool_name, machine) = (text(&p.tool_name), text(&p.machine));
+    template
+        .replace("{NAME}", &p.name)
+        .replace("{ONUM}", &format!("{:04}", p.number % 10000))
+        .replace("{MACHINE}", &machine)
+        .replace("{TOOL2}", &format!("{:02}", p.tool_number % 100))
+        .replace("{TOOLNAME}", &tool_name)
+        .replace("{TOOL}", &p.tool_number.to_string())
+        .replace("{S}", &format!("{}", p.spindle_rpm.round() as i64))
+        .replace("{VERSION}", crate::VERSION)
+}
+
+/// Writes `program` in `dialect`.
+///
+/// # Failures
+/// A block whose number of values is not the number of axes, or a value or
+/// feed that is not finite (named by block).
+pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostError> {
+    let d = dialect;
+    let width = program.axes.len();
+    for (i, b) in program.blocks.iter().enumerate() {
+        let bad = |message: String| PostError::BadBlock {
+            block: i + 1,
+            message,
+        };
+        if b.values.len() != width {
+            return Err(bad(format!("{} values for {width} axes", b.values.len())));
+        }
+        if let Some(v) = b.values.iter().chain([&b.feed]).find(|v| !v.is_finite()) {
+            return Err(bad(format!("value {v} is not a finite number")));
+        }
+    }
+    let mut w = Writer {
+        d,
+        out: String::new(),
+        next: d.numbering.map(|n| n.0),
+    };
+    for h in d.header {
+        w.line(&fill(h, program, d));
+    }
+    for h in d.preamble {
+        w.block(&fill(h, program, d));
+    }
+    let mut last_words: Vec<Option<String>> = vec![None; width];
+    let mut last_motion: Option<&str> = None;
+    let mut last_feed: Option<String> = None;
+    for b in &program.blocks {
+        if let Some(c) = &b.comment {
+            w.comment(c);
+        }
+        let values: Vec<String> = b.values.iter().map(|v| fixed(*v, d.decimals)).collect();
+        match d.style {
+            Style::Apt => {
+                match b.motion {
+                    Motion::Rapid => w.line("RAPID"),
+                    Motion::Linear => {
+                        let f = format!("FEDRAT/{},MMPM", fixed(b.feed, d.feed_decimals));
+                        if last_feed.as_ref() != Some(&f) {
+                            w.line(&f);
+                            last_feed = Some(f);
+                        }
+                    }
+                    Motion::Thread { lead } => {
+                        let f = format!("FEDRAT/{},MMPR", fixed(lead, d.lead_decimals));
+                        if last_feed.as_ref() != Some(&f) {
+                            w.line(&f);
+                            last_feed = Some(f);
+                        }
+                    }
+                }
+                w.line(&format!("GOTO/{}", values.join(",")));
+            }
+            Style::GCode => {
+                let motion = match b.motion {
+                    Motion::Rapid => d.rapid,
+                    Motion::Linear => d.linear,
+                    Motion::Thread { .. } => d.thread,
+                };
+                let mut words = Vec::new();
+                for (k, v) in values.into_iter().enumerate() {
+                    if last_words[k].as_ref() != Some(&v) {
+                        words.push(format!("{}{v}", program.axes[k].name));
+                        last_words[k] = Some(v);
+                    }
+                }
+                if words.is_empty() {
+                    continue; // no axis moves: nothing to write
+                }
+                if last_motion != Some(motion) {
+                    words.insert(0, motion.to_owned());
+                    last_motion = Some(motion);
+                }
+                let feed = match b.motion {
+                    Motion::Rapid => None,
+                    Motion::Linear => Some(format!("F{}", fixed(b.feed, d.feed_decimals))),
+                    Motion::Thread { lead } => {
+                        Some(format!("{}{}", d.lead, fixed(lead, d.lead_decimals)))
+                    }
+                };
+                if let Some(f) = feed {
+                    if last_feed.as_ref() != Some(&f) {
+                        words.push(f.clone());
+                        last_feed = Some(f);
+                    }
+                }
+                w.block(&words.join(" "));
+            }
+        }
+    }
+    for f in d.footer {
+        w.block(&fill(f, program, d));
+    }
+    for t in d.trailer {
+        w.line(&fill(t, program, d));
+    }
+    Ok(w.out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::program::{Block, ProgramAxis};
+
+    fn program() -> AxisProgram {
+        let axis = |n: &str| ProgramAxis {
+            name: n.into(),
+            unit: "mm".into(),
+        };
+        let block = |motion, v: [f64; 2], feed, comment: Option<&str>| Block {
+            motion,
+            values: v.to_vec(),
+            feed,
+            comment: comment.map(str::to_owned),
+        };
+        AxisProgram {
+            name: "DEMO".into(),
+            number: 7,
+            machine: "test-lathe".into(),
+            control: "fanuc".into(),
+            tool_number: 3,
+            tool_name: "thread insert (60)".into(),
+            spindle_rpm: 399.4,
+            axes: vec![axis("X"), axis("Z")],
+            blocks: vec![
+                block(Motion::Rapid, [50.0, 5.0], 0.0, Some("pass 1")),
+                block(Motion::Linear, [40.0, 5.0], 100.0, None),
+                block(Motion::Linear, [40.0, -0.0001], 100.0, None),
+                block(Motion::Linear, [40.0, -0.0001], 100.0, None),
+                block(Motion::Thread { lead: 6.35 }, [40.0, -60.0], 0.0, None),
+                block(Motion::Rapid, [50.0, -60.0], 0.0, None),
+            ],
+        }
+    }
+
+    #[test]
+    fn sinumerik_program() {
+        let text = post(&program(), &SINUMERIK).unwrap();
+        let expected = "%_N_DEMO_MPF\n;$PATH=/_N_MPF_DIR\n; DEMO for test-lathe, written by pilgrim VERSION\n\
+; tool T3: thread insert (60)\nN10 G90 G94 G71\nN20 T3 D1\nN30 S399 M3\n; pass 1\nN40 G0 X50.000 Z5.000\n\
+N50 G1 X40.000 F100.0\nN60 Z0.000\nN70 G33 Z-60.000 K6.3500\nN80 G0 X50.000\nN90 M5\nN100 M30\n";
+        assert_eq!(text, expected.replace("VERSION", crate::VERSION));
+    }
+
+    #[test]
+    fn fanuc_program() {
+        let text = post(&program(), &FANUC).unwrap();
+        let expected = "%\nO0007 (DEMO)\n(TEST-LATHE, WRITTEN BY PILGRIM VERSION)\n(TOOL T03: THREAD INSERT 60)\n\
+G21 G40 G97 G98\nT0303\nS399 M03\n(PASS 1)\nG00 X50.000 Z5.000\nG01 X40.000 F100.0\nZ0.000\n\
+G32 Z-60.000 F6.3500\nG00 X50.000\nM05\nM30\n%\n";
+        assert_eq!(text, expected.replace("VERSION", crate::VERSION));
+    }
+
+    #[test]
+    fn cld_program() {
+        let text = post(&program(), &CLD).unwrap();
+        let expected = "PARTNO/DEMO\nMACHIN/test-lathe\nPPRINT/written by pilgrim VERSION\nUNITS/MM\nLOADTL/3\n\
+SPINDL/399,RPM,CLW\nPPRINT/pass 1\nRAPID\nGOTO/50.000,5.000\nFEDRAT/100.000,MMPM\nGOTO/40.000,5.000\n\
+GOTO/40.000,0.000\nGOTO/40.000,0.000\nFEDRAT/6.3500,MMPR\nGOTO/40.000,-60.000\nRAPID\nGOTO/50.000,-60.000\n\
+SPINDL/OFF\nFINI\n";
+        assert_eq!(text, expected.replace("VERSION", crate::VERSION));
+    }
+
+    #[test]
+    fn bad_blocks_and_dialects_are_named() {
+        let mut p = program();
+        p.blocks[2].values[1] = f64::NAN;
+        assert_eq!(
+            post(&p, &SINUMERIK).unwrap_err().to_string(),
+            "block 3: value NaN is not a finite number"
+        );
+        p.blocks[2].values.pop();
+        assert!(post(&p, &CLD)
+            .unwrap_err()
+            .to_string()
+            .contains("block 3: 1 values for 2 axes"));
+        assert!(post_by_name(&program(), "heidenhain")
+            .unwrap_err()
+            .to_string()
+            .contains("'heidenhain'"));
+    }
+}

@@ -1,0 +1,173 @@
+//! Toolpaths (CL data): passes of tool poses in the part frame.
+//!
+//! A [`Toolpath`] is what a part family makes: the tool, the spindle speed,
+//! and passes of [`ClPoint`]s, each the tool's tracked point and axis in the
+//! part frame, the motion that reaches it, the feed, and named auxiliary
+//! values (the steady rest's `U` is one: an axis value the family computes
+//! itself). It serialises to JSON (`toolpath.json`), one object per point:
+//!
+//! ```json
+//! {"point":[30.0,0.0,12.5],"axis":[0.0,0.0,1.0],"motion":{"type":"linear"},"feed":2000.0,"aux":[41.2]}
+//! ```
+
+use crate::math::Real;
+use crate::tool::Tool;
+use serde::{Deserialize, Serialize};
+
+/// How a point is reached.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum Motion {
+    /// At the machine's rapid traverse.
+    Rapid,
+    /// A straight cut at the point's feed.
+    Linear,
+    /// A thread cut synchronised with the spindle at `lead` mm per turn.
+    Thread {
+        /// Lead (mm per spindle turn).
+        lead: Real,
+    },
+}
+
+/// One tool position.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ClPoint {
+    /// The tracked point in the part frame (mm).
+    pub point: [Real; 3],
+    /// The tool's axis in the part frame (unit).
+    pub axis: [Real; 3],
+    /// How the point is reached.
+    pub motion: Motion,
+    /// Feed (mm/min) of the move to this point (ignored for rapids).
+    pub feed: Real,
+    /// Auxiliary values, in the order of [`Toolpath::aux_names`].
+    #[serde(default)]
+    pub aux: Vec<Real>,
+}
+
+/// A pass: a run of points cut in one go.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Pass {
+    /// A name for the program's comments and reports.
+    pub name: String,
+    /// The points, in order.
+    pub points: Vec<ClPoint>,
+}
+
+/// The CL data of one job.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Toolpath {
+    /// The part's name (the program's name).
+    pub part: String,
+    /// The tool.
+    pub tool: Tool,
+    /// Spindle speed (rpm).
+    pub spindle_rpm: Real,
+    /// Names of the auxiliary values every point carries (e.g. `U`).
+    pub aux_names: Vec<String>,
+    /// The passes, in order.
+    pub passes: Vec<Pass>,
+}
+
+/// A bad toolpath, named by pass and point.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ToolpathError {
+    /// A value at a point is wrong.
+    #[error("pass {pass} ({name}), point {point}: {message}")]
+    Point {
+        /// Pass index (from 1).
+        pass: usize,
+        /// Pass name.
+        name: String,
+        /// Point index in the pass (from 1).
+        point: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// Something about the whole toolpath.
+    #[error("toolpath: {0}")]
+    Whole(String),
+}
+
+impl Toolpath {
+    /// An empty toolpath.
+    pub fn new(part: &str, tool: Tool, spindle_rpm: Real, aux_names: Vec<String>) -> Self {
+        Self {
+            part: part.to_owned(),
+            tool,
+            spindle_rpm,
+            aux_names,
+            passes: Vec::new(),
+        }
+    }
+
+    /// Number of points over all passes.
+    pub fn point_count(&self) -> usize {
+        self.passes.iter().map(|p| p.points.len()).sum()
+    }
+
+    /// The points of all passes in order, with (pass index, point index).
+    pub fn points(&self) -> impl Iterator<Item = (usize, usize, &ClPoint)> {
+        self.passes
+            .iter()
+            .enumerate()
+            .flat_map(|(i, p)| p.points.iter().enumerate().map(move |(j, c)| (i, j, c)))
+    }
+
+    /// Checks every value: finite coordinates, unit axes, positive feeds on
+    /// cutting moves, positive leads, the right number of auxiliary values,
+    /// a positive spindle speed, at least one point.
+    ///
+    /// # Failures
+    /// [`ToolpathError`] naming the pass and point.
+    pub fn validate(&self) -> Result<(), ToolpathError> {
+        if !(self.spindle_rpm.is_finite() && self.spindle_rpm > 0.0) {
+            return Err(ToolpathError::Whole(format!(
+                "spindle speed {} rpm is not positive",
+                self.spindle_rpm
+            )));
+        }
+        if self.point_count() == 0 {
+            return Err(ToolpathError::Whole("no points".into()));
+        }
+        for (i, j, c) in self.points() {
+            let err = |message: String| ToolpathError::Point {
+                pass: i + 1,
+                name: self.passes[i].name.clone(),
+                point: j + 1,
+                message,
+            };
+            if let Some(v) = c
+                .point
+                .iter()
+                .chain(&c.axis)
+                .chain(&c.aux)
+                .find(|v| !v.is_finite())
+            {
+                return Err(err(format!("value {v} is not a finite number")));
+            }
+            let n = c.axis.iter().map(|a| a * a).sum::<Real>().sqrt();
+            if (n - 1.0).abs() > 1e-9 {
+                return Err(err(format!("tool axis has length {n}, not 1")));
+            }
+            let feed_ok = c.feed.is_finite() && c.feed > 0.0;
+            if c.motion != Motion::Rapid && !feed_ok {
+                return Err(err(format!("feed {} mm/min is not positive", c.feed)));
+            }
+            if let Motion::Thread { lead } = c.motion {
+                if !(lead.is_finite() && lead > 0.0) {
+                    return Err(err(format!("thread lead {lead} is not positive")));
+                }
+            }
+            if c.aux.len() != self.aux_names.len() {
+                return Err(err(format!(
+                    "{} auxiliary values for {} names ({})",
+                    c.aux.len(),
+                    self.aux_names.len(),
+                    self.aux_names.join(", ")
+                )));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,228 @@
+//! Part families in Rhai: the contract, limits, errors, parameters.
+
+use pilgrim_kernel::script::{Access, Family, Limits, ScriptError};
+use pilgrim_kernel::{AxisProgram, ChainMachine, Machine};
+use std::path::Path;
+
+fn demo() -> Family {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scripts/examples/mill_circle.rhai");
+    Family::load(&path, &Limits::default(), &Access::default()).unwrap()
+}
+
+#[test]
+fn demo_family_runs_to_a_program() {
+    let fam = demo();
+    let names: Vec<&str> = fam.params().iter().map(|p| p.name.as_str()).collect();
+    assert!(
+        names.contains(&"radius") && names.contains(&"turn_table"),
+        "{names:?}"
+    );
+    let values = fam.resolve(None, &[]).unwrap();
+    let tp = fam.toolpath(&values).unwrap();
+    assert_eq!(tp.point_count(), 2 + 1 + 361 + 1);
+    let mill = ChainMachine::new(Machine::builtin("vertical-mill").unwrap());
+    let prog = AxisProgram::build(&tp, &mill, "mill_circle").unwrap();
+    assert_eq!(
+        prog.axes
+            .iter()
+            .map(|a| a.name.as_str())
+            .collect::<Vec<_>>(),
+        ["X", "Y", "Z", "C"]
+    );
+    // Seed 003's example: X stays at R + D/2 = 45 while the table turns.
+    let x = prog.column("X").unwrap();
+    let c = prog.column("C").unwrap();
+    for (k, b) in prog.blocks.iter().enumerate().skip(3).take(361) {
+        assert!((x[k] - 45.0).abs() < 1e-6, "block {k}: X {}", x[k]);
+        assert!(
+            (c[k] - 360.0 * (k - 3) as f64 / 360.0).abs() < 1e-9,
+            "block {k}: C {}",
+            c[k]
+        );
+        assert!(b.values[1].abs() < 1e-6);
+    }
+    // With the table still, X and Y trace the circle and C stays 0.
+    let values = fam
+        .resolve(None, &[("turn_table".into(), "false".into())])
+        .unwrap();
+    let prog = AxisProgram::build(&fam.toolpath(&values).unwrap(), &mill, "m").unwrap();
+    let (x, y) = (prog.column("X").unwrap(), prog.column("Y").unwrap());
+    assert!(prog.column("C").unwrap().iter().all(|c| *c == 0.0));
+    for k in 3..364 {
+        assert!((x[k].hypot(y[k]) - 45.0).abs() < 1e-6);
+    }
+    let checks = fam.checks(&fam.resolve(None, &[]).unwrap()).unwrap();
+    assert_eq!(checks.len(), 2);
+    assert!(checks.iter().all(|c| c.ok));
+}
+
+#[test]
+fn unknown_and_bad_parameters_are_named() {
+    let fam = demo();
+    let e = fam
+        .resolve(None, &[("radiuss".into(), "3".into())])
+        .unwrap_err();
+    let text = e.to_string();
+    assert!(
+        text.contains("unknown parameter 'radiuss' from --set"),
+        "{text}"
+    );
+    assert!(
+        text.contains("radius, spindle, tool_diameter, turn_table"),
+        "{text}"
+    );
+    let e = fam
+        .resolve(None, &[("radius".into(), "big".into())])
+        .unwrap_err()
+        .to_string();
+    assert_eq!(e, "parameter 'radius' from --set: 'big' is not a number");
+    let e = fam
+        .resolve(Some(("p.toml", "points = 1.5")), &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("parameter 'points' from p.toml: expected a whole number, got 1.5"),
+        "{e}"
+    );
+    let e = fam
+        .resolve(Some(("p.toml", "radius = nan")), &[])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("not a finite number"), "{e}");
+    let v = fam
+        .resolve(
+            Some(("p.toml", "radius = 30")),
+            &[("depth".into(), "2".into())],
+        )
+        .unwrap();
+    assert_eq!(v["radius"].to_string(), "30");
+    assert_eq!(v["depth"].to_string(), "2");
+}
+
+fn family(src: &str) -> Result<Family, ScriptError> {
+    Family::from_source(src, "t.rhai", &Limits::default(), &Access::default())
+}
+
+const HEAD: &str = "fn params() { #{ n: #{ value: 3, unit: \"\", doc: \"n\" } } }\n";
+
+#[test]
+fn syntax_errors_and_runtime_errors_carry_file_line_column() {
+    let e = family("fn params() { #{ }\nfn toolpath(p) { let x = ; }").unwrap_err();
+    let ScriptError::At {
+        file, line, column, ..
+    } = &e
+    else {
+        panic!("{e}")
+    };
+    assert_eq!((file.as_str(), *line), ("t.rhai", 2));
+    assert!(*column > 0, "{e}");
+    let src = format!("{HEAD}fn toolpath(p) {{\n  let t = linspace(0.0, 1.0, 1);\n  t\n}}");
+    let fam = family(&src).unwrap();
+    let e = fam.toolpath(&fam.resolve(None, &[]).unwrap()).unwrap_err();
+    let text = e.to_string();
+    assert!(text.starts_with("t.rhai:3:"), "{text}");
+    assert!(text.contains("linspace needs at least 2 points"), "{text}");
+    let e = family("fn toolpath(p) { 1 }").unwrap_err().to_string();
+    assert!(e.contains("defines fn params()"), "{e}");
+}
+
+#[test]
+fn endless_loop_is_stopped() {
+    let src = format!("{HEAD}fn toolpath(p) {{\n  let i = 0;\n  loop {{ i += 1; }}\n}}");
+    let limits = Limits {
+        max_operations: 200_000,
+        ..Limits::default()
+    };
+    let fam = Family::from_source(&src, "loop.rhai", &limits, &Access::default()).unwrap();
+    let e = fam
+        .toolpath(&fam.resolve(None, &[]).unwrap())
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("loop.rhai: "), "{e}");
+    assert!(
+        e.contains("operation limit and was stopped (an endless loop?) (in fn toolpath)"),
+        "{e}"
+    );
+    let src = format!("{HEAD}fn f(x) {{ f(x + 1) }}\nfn toolpath(p) {{ f(0) }}");
+    let e = family(&src).unwrap();
+    let e = e
+        .toolpath(&e.resolve(None, &[]).unwrap())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("nest too deep"), "{e}");
+}
+
+#[test]
+fn files_only_inside_the_input_directories() {
+    let dir = std::env::temp_dir().join(format!("pilgrim-script-{}", std::process::id()));
+    let inside = dir.join("in");
+    std::fs::create_dir_all(&inside).unwrap();
+    std::fs::write(inside.join("t.csv"), "z,x\n0,1\n1,2\n2,3\n").unwrap();
+    std::fs::write(dir.join("secret.csv"), "z,x\n0,1\n").unwrap();
+    let access = Access {
+        input_dirs: vec![inside.clone()],
+    };
+    let src = format!("{HEAD}fn toolpath(p) {{ let t = read_table(\"t.csv\"); if t.x.len != 3 {{ throw \"bad\"; }} read_table(\"../secret.csv\") }}");
+    let fam = Family::from_source(&src, "f.rhai", &Limits::default(), &access).unwrap();
+    let e = fam
+        .toolpath(&fam.resolve(None, &[]).unwrap())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("secret.csv is outside the input directories"),
+        "{e}"
+    );
+    let e = family("fn params() { #{} }\nimport \"x\" as y;\nfn toolpath(p) {}")
+        .map(|f| f.toolpath(&Default::default()));
+    assert!(matches!(e, Err(_) | Ok(Err(_))));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The universal chain in a script: the mill example of S003-4.
+#[test]
+fn transforms_in_scripts_follow_the_universal_chain() {
+    let src = format!(
+        "{HEAD}fn toolpath(p) {{\n\
+           let a = universal([3.0, 4.0, 5.0, 90.0, 1.0, 2.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);\n\
+           let b = transform(\"tx\", 1.0) * transform(\"ty\", 2.0) * transform(\"tz\", 0.5) * transform(\"rz\", 90.0)\n\
+                 * transform(\"tx\", 3.0) * transform(\"ty\", 4.0) * transform(\"tz\", 5.0);\n\
+           let r = 8.0; let beta = linspace(0.0, 6.0, 7);\n\
+           let pa = apply(a, cos(beta) * r, sin(beta) * r, filled(7, 2.0));\n\
+           let pb = apply(b, cos(beta) * r, sin(beta) * r, filled(7, 2.0));\n\
+           let tp = new_toolpath(\"t\", end_mill(\"m\", 1, 6.0, 10.0), 1000.0, []);\n\
+           tp.add_pass(\"a\", #{{ x: pa.x, y: pa.y, z: pa.z, feed: 100.0 }});\n\
+           tp.add_pass(\"b\", #{{ x: pb.x, y: pb.y, z: pb.z, feed: 100.0 }});\n\
+           tp\n}}"
+    );
+    let fam = family(&src).unwrap();
+    let tp = fam.toolpath(&fam.resolve(None, &[]).unwrap()).unwrap();
+    // r0 = (R cos(phi+beta) + a1 + a cos phi - b sin phi, R sin(phi+beta) + b1 + a sin phi + b cos phi, Z + c1 + c)
+    let phi = std::f64::consts::FRAC_PI_2;
+    for pass in &tp.passes {
+        for (k, c) in pass.points.iter().enumerate() {
+            let beta = k as f64;
+            let expect = [
+                8.0 * (phi + beta).cos() + 1.0 + 3.0 * phi.cos() - 4.0 * phi.sin(),
+                8.0 * (phi + beta).sin() + 2.0 + 3.0 * phi.sin() + 4.0 * phi.cos(),
+                2.0 + 0.5 + 5.0,
+            ];
+            for i in 0..3 {
+                assert!(
+                    (c.point[i] - expect[i]).abs() < 1e-12,
+                    "{} point {k}: {:?} vs {expect:?}",
+                    pass.name,
+                    c.point
+                );
+            }
+        }
+    }
+    let e = family(&format!(
+        "{HEAD}fn toolpath(p) {{ transform(\"rw\", 1.0) }}"
+    ))
+    .unwrap();
+    let text = e
+        .toolpath(&e.resolve(None, &[]).unwrap())
+        .unwrap_err()
+        .to_string();
+    assert!(text.contains("not 'rw'"), "{text}");
+}

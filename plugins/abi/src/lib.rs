@@ -1,0 +1,463 @@
+//! # pilgrim-plugin-abi
+//!
+//! The C ABI between pilgrim and a machine plugin (a shared library), on
+//! the model of LinuxCNC's kinematics modules: a fixed, small set of entry
+//! points with plain `double` arrays and integer status codes. No Rust type,
+//! trait object or allocation crosses the boundary; this crate does not
+//! depend on the kernel.
+//!
+//! A plugin exports one function, `pilgrim_plugin_<name>`, `<name>` being
+//! its library's file name without `lib` and the extension (so that two
+//! plugins compiled into one binary never clash, as Python's
+//! `PyInit_<module>`). It returns a pointer to a static [`PluginTable`]:
+//!
+//! - `abi_major`, `abi_minor`, `size` first: the host refuses another major
+//!   and reads only the fields below `size` (fields are only ever appended);
+//! - coarse calls carry JSON: `describe` (the machine's descriptor), `post`
+//!   (`{"dialect": "...", "program": {...}}` in, the program's text out);
+//! - hot calls are batches of `f64`: `inverse` (poses to axis values) and
+//!   `forward` (axis values to poses), many rows per call;
+//! - every entry catches panics and returns a status ([`STATUS_OK`],
+//!   [`STATUS_ERROR`], [`STATUS_PANIC`]); `last_error` gives the message;
+//! - a [`Buffer`] is freed by whoever allocated it: buffers a plugin returns
+//!   go back through its `free_buffer`.
+//!
+//! A Rust plugin implements [`Plugin`] and exports it with [`export_plugin!`]:
+//!
+//! ```
+//! use pilgrim_plugin_abi::{export_plugin, Plugin, PluginError};
+//!
+//! #[derive(Default)]
+//! struct Lathe;
+//!
+//! impl Plugin for Lathe {
+//!     fn describe(&self) -> String {
+//!         r#"{"name":"lathe","control":"fanuc","axes":[],"solved_axes":["X","Z"]}"#.into()
+//!     }
+//!     fn solved_axis_count(&self) -> usize {
+//!         2
+//!     }
+//!     fn inverse(&self, poses: &[f64], tool: &[f64; 6], out: &mut [f64]) -> Result<(), PluginError> {
+//!         for (p, q) in poses.chunks_exact(6).zip(out.chunks_exact_mut(2)) {
+//!             q[0] = 2.0 * (p[0] - tool[0]); // diameter
+//!             q[1] = p[2] - tool[2];
+//!         }
+//!         Ok(())
+//!     }
+//!     fn forward(&self, axes: &[f64], tool: &[f64; 6], out: &mut [f64]) -> Result<(), PluginError> {
+//!         for (q, p) in axes.chunks_exact(2).zip(out.chunks_exact_mut(6)) {
+//!             p.copy_from_slice(&[0.5 * q[0] + tool[0], tool[1], q[1] + tool[2], tool[3], tool[4], tool[5]]);
+//!         }
+//!         Ok(())
+//!     }
+//!     fn post(&self, _request: &str) -> Result<String, PluginError> {
+//!         Err(PluginError::new("this example has no post-processor"))
+//!     }
+//! }
+//!
+//! export_plugin!(pilgrim_plugin_lathe, Lathe);
+//!
+//! let table = unsafe { &*pilgrim_plugin_lathe() };
+//! assert_eq!(table.abi_major, pilgrim_plugin_abi::ABI_MAJOR);
+//! ```
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+/// The ABI's major version: a host refuses a plugin of another major.
+pub const ABI_MAJOR: u32 = 1;
+/// The ABI's minor version: fields appended to the table since the major.
+pub const ABI_MINOR: u32 = 0;
+
+/// The call succeeded.
+pub const STATUS_OK: i32 = 0;
+/// The call failed; `last_error` has the message.
+pub const STATUS_ERROR: i32 = 1;
+/// The call panicked (and was stopped at the boundary); `last_error` has the message.
+pub const STATUS_PANIC: i32 = 2;
+
+/// `failed_row` when a failure is not tied to a row.
+pub const NO_ROW: usize = usize::MAX;
+
+/// Bytes allocated by the plugin and handed to the host, which copies them
+/// and returns the buffer through the table's `free_buffer`.
+#[repr(C)]
+#[derive(Debug)]
+pub struct Buffer {
+    /// Start of the bytes (UTF-8 text).
+    pub ptr: *mut u8,
+    /// Number of bytes.
+    pub len: usize,
+    /// Allocated capacity (for the plugin's own freeing).
+    pub cap: usize,
+}
+
+impl Buffer {
+    /// An empty buffer (nothing to free).
+    pub const fn empty() -> Self {
+        Self {
+            ptr: std::ptr::null_mut(),
+            len: 0,
+            cap: 0,
+        }
+    }
+
+    /// Hands a string's bytes over.
+    pub fn from_string(s: String) -> Self {
+        let mut v = std::mem::ManuallyDrop::new(s.into_bytes());
+        Self {
+            ptr: v.as_mut_ptr(),
+            len: v.len(),
+            cap: v.capacity(),
+        }
+    }
+}
+
+/// `describe(out)`: writes the JSON descriptor into `out`.
+pub type DescribeFn = unsafe extern "C" fn(out: *mut Buffer) -> i32;
+/// `inverse(poses, count, tool, out, width, failed_row)`: `poses` holds
+/// `count` rows of 6 (point, unit axis; part frame, mm); `tool` 6 values
+/// (the tracked point and axis in the tool's frame); `out` room for `count`
+/// rows of `width` values, the descriptor's `solved_axes` (mm, rad), which
+/// the plugin checks. On failure `failed_row` receives the row or [`NO_ROW`].
+pub type InverseFn = unsafe extern "C" fn(
+    poses: *const f64,
+    count: usize,
+    tool: *const f64,
+    out: *mut f64,
+    width: usize,
+    failed_row: *mut usize,
+) -> i32;
+/// `forward(axes, count, width, tool, out)`: `count` rows of `width` solved
+/// axes to `count` rows of 6 (point, axis).
+pub type ForwardFn = unsafe extern "C" fn(
+    axes: *const f64,
+    count: usize,
+    width: usize,
+    tool: *const f64,
+    out: *mut f64,
+) -> i32;
+/// `post(request, len, out)`: a JSON request `{"dialect", "program"}` of
+/// `len` bytes to the program's text.
+pub type PostFn = unsafe extern "C" fn(request: *const u8, len: usize, out: *mut Buffer) -> i32;
+/// `last_error(out)`: the message of this thread's last failed call.
+pub type LastErrorFn = unsafe extern "C" fn(out: *mut Buffer) -> i32;
+/// `free_buffer(buffer)`: frees a buffer this plugin returned.
+pub type FreeBufferFn = unsafe extern "C" fn(buffer: Buffer);
+/// The exported entry: returns the plugin's static table.
+pub type EntryFn = unsafe extern "C" fn() -> *const PluginTable;
+
+/// The entry table. Fields are only ever appended; `size` says how many a
+/// plugin has. Entries are `Option` so that a C plugin's `NULL` is seen,
+/// not called.
+#[repr(C)]
+#[derive(Debug)]
+pub struct PluginTable {
+    /// [`ABI_MAJOR`] of the plugin's build.
+    pub abi_major: u32,
+    /// [`ABI_MINOR`] of the plugin's build.
+    pub abi_minor: u32,
+    /// `size_of::<PluginTable>()` in the plugin's build.
+    pub size: u32,
+    /// See [`DescribeFn`].
+    pub describe: Option<DescribeFn>,
+    /// See [`InverseFn`].
+    pub inverse: Option<InverseFn>,
+    /// See [`ForwardFn`].
+    pub forward: Option<ForwardFn>,
+    /// See [`PostFn`].
+    pub post: Option<PostFn>,
+    /// See [`LastErrorFn`].
+    pub last_error: Option<LastErrorFn>,
+    /// See [`FreeBufferFn`].
+    pub free_buffer: Option<FreeBufferFn>,
+}
+
+/// The size of the table in this build (what `size` says).
+pub const TABLE_SIZE: u32 = std::mem::size_of::<PluginTable>() as u32;
+
+/// A plugin's failure: a message, and the row of a batch it happened at.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PluginError {
+    /// The row, for batch calls.
+    pub row: Option<usize>,
+    /// What went wrong.
+    pub message: String,
+}
+
+impl PluginError {
+    /// A failure not tied to a row.
+    pub fn new(message: impl Into<String>) -> Self {
+        Self {
+            row: None,
+            message: message.into(),
+        }
+    }
+
+    /// A failure at a row of a batch.
+    pub fn at(row: usize, message: impl Into<String>) -> Self {
+        Self {
+            row: Some(row),
+            message: message.into(),
+        }
+    }
+}
+
+/// What a Rust plugin implements; [`export_plugin!`] makes the C entry
+/// points from it. Slices are the batches described at [`InverseFn`] and
+/// [`ForwardFn`], already checked for length.
+pub trait Plugin {
+    /// The machine's descriptor as JSON.
+    fn describe(&self) -> String;
+    /// How many axes inverse kinematics solves for (the descriptor's
+    /// `solved_axes`): the width of axis rows.
+    fn solved_axis_count(&self) -> usize;
+    /// Inverse kinematics of a batch.
+    fn inverse(&self, poses: &[f64], tool: &[f64; 6], out: &mut [f64]) -> Result<(), PluginError>;
+    /// Forward kinematics of a batch.
+    fn forward(&self, axes: &[f64], tool: &[f64; 6], out: &mut [f64]) -> Result<(), PluginError>;
+    /// The program's text for a JSON request `{"dialect", "program"}`.
+    fn post(&self, request: &str) -> Result<String, PluginError>;
+}
+
+/// The glue [`export_plugin!`] expands to: each function catches panics and
+/// keeps the last error. Not for direct use.
+pub mod entry {
+    use super::*;
+    use std::cell::RefCell;
+
+    thread_local! {
+        static LAST_ERROR: RefCell<String> = const { RefCell::new(String::new()) };
+    }
+
+    fn set_error(message: String) {
+        LAST_ERROR.with(|e| *e.borrow_mut() = message);
+    }
+
+    fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
+        let text = p
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| p.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown panic".into());
+        format!("the plugin panicked: {text}")
+    }
+
+    /// Runs `f`, turning an error or a panic into a status.
+    fn guarded(failed_row: *mut usize, f: impl FnOnce() -> Result<(), PluginError>) -> i32 {
+        match catch_unwind(AssertUnwindSafe(f)) {
+            Ok(Ok(())) => STATUS_OK,
+            Ok(Err(e)) => {
+                if !failed_row.is_null() {
+                    // SAFETY: the host passes a valid pointer or null.
+                    unsafe { *failed_row = e.row.unwrap_or(NO_ROW) };
+                }
+                set_error(e.message);
+                STATUS_ERROR
+            }
+            Err(p) => {
+                set_error(panic_message(p));
+                STATUS_PANIC
+            }
+        }
+    }
+
+    fn write(out: *mut Buffer, s: String) -> Result<(), PluginError> {
+        if out.is_null() {
+            return Err(PluginError::new("null output buffer"));
+        }
+        // SAFETY: the host passes a valid, writable Buffer.
+        unsafe { *out = Buffer::from_string(s) };
+        Ok(())
+    }
+
+    fn tool6(tool: *const f64) -> Result<[f64; 6], PluginError> {
+        if tool.is_null() {
+            return Err(PluginError::new("null tool frame"));
+        }
+        let mut t = [0.0; 6];
+        // SAFETY: the host passes 6 readable values.
+        t.copy_from_slice(unsafe { std::slice::from_raw_parts(tool, 6) });
+        Ok(t)
+    }
+
+    fn check_width(p: &impl Plugin, width: usize) -> Result<usize, PluginError> {
+        let n = p.solved_axis_count();
+        if width != n {
+            return Err(PluginError::new(format!(
+                "the host gives rows of {width} axis values, the plugin solves {n} axes"
+            )));
+        }
+        Ok(n)
+    }
+
+    /// `describe` for plugin `p`.
+    ///
+    /// # Safety
+    /// `out` must be a valid pointer to a `Buffer`.
+    pub unsafe fn describe(p: &impl Plugin, out: *mut Buffer) -> i32 {
+        guarded(std::ptr::null_mut(), || write(out, p.describe()))
+    }
+
+    /// `inverse` for plugin `p`.
+    ///
+    /// # Safety
+    /// Pointers as [`InverseFn`] says.
+    pub unsafe fn inverse(
+        p: &impl Plugin,
+        poses: *const f64,
+        count: usize,
+        tool: *const f64,
+        out: *mut f64,
+        width: usize,
+        failed_row: *mut usize,
+    ) -> i32 {
+        guarded(failed_row, || {
+            let n = check_width(p, width)?;
+            if count == 0 {
+                return Ok(());
+            }
+            if poses.is_null() || out.is_null() {
+                return Err(PluginError::new("null pose or output array"));
+            }
+            let t = tool6(tool)?;
+            // SAFETY: the host passes count*6 poses and count*n outputs.
+            let (poses, out) = unsafe {
+                (
+                    std::slice::from_raw_parts(poses, count * 6),
+                    std::slice::from_raw_parts_mut(out, count * n),
+                )
+            };
+            p.inverse(poses, &t, out)
+        })
+    }
+
+    /// `forward` for plugin `p`.
+    ///
+    /// # Safety
+    /// Pointers as [`ForwardFn`] says.
+    pub unsafe fn forward(
+        p: &impl Plugin,
+        axes: *const f64,
+        count: usize,
+        width: usize,
+        tool: *const f64,
+        out: *mut f64,
+    ) -> i32 {
+        guarded(std::ptr::null_mut(), || {
+            let n = check_width(p, width)?;
+            if count == 0 {
+                return Ok(());
+            }
+            if axes.is_null() || out.is_null() {
+                return Err(PluginError::new("null axis or output array"));
+            }
+            let t = tool6(tool)?;
+            // SAFETY: the host passes count*n axis values and count*6 outputs.
+            let (axes, out) = unsafe {
+                (
+                    std::slice::from_raw_parts(axes, count * n),
+                    std::slice::from_raw_parts_mut(out, count * 6),
+                )
+            };
+            p.forward(axes, &t, out)
+        })
+    }
+
+    /// `post` for plugin `p`.
+    ///
+    /// # Safety
+    /// `request` must point to `len` readable bytes; `out` to a `Buffer`.
+    pub unsafe fn post(p: &impl Plugin, request: *const u8, len: usize, out: *mut Buffer) -> i32 {
+        guarded(std::ptr::null_mut(), || {
+            if request.is_null() {
+                return Err(PluginError::new("null request"));
+            }
+            // SAFETY: the host passes len readable bytes.
+            let bytes = unsafe { std::slice::from_raw_parts(request, len) };
+            let text = std::str::from_utf8(bytes)
+                .map_err(|e| PluginError::new(format!("request is not UTF-8: {e}")))?;
+            write(out, p.post(text)?)
+        })
+    }
+
+    /// `last_error`.
+    ///
+    /// # Safety
+    /// `out` must be a valid pointer to a `Buffer`.
+    pub unsafe extern "C" fn last_error(out: *mut Buffer) -> i32 {
+        let message = LAST_ERROR.with(|e| e.borrow().clone());
+        guarded(std::ptr::null_mut(), || write(out, message))
+    }
+
+    /// `free_buffer`.
+    ///
+    /// # Safety
+    /// `buffer` must have come from this plugin and not been freed.
+    pub unsafe extern "C" fn free_buffer(buffer: Buffer) {
+        if !buffer.ptr.is_null() {
+            // SAFETY: made by Buffer::from_string in this library.
+            drop(unsafe { Vec::from_raw_parts(buffer.ptr, buffer.len, buffer.cap) });
+        }
+    }
+}
+
+/// Exports a [`Plugin`] (a type with `Default`) as the C entry `$symbol`,
+/// which must be `pilgrim_plugin_<library name>`.
+#[macro_export]
+macro_rules! export_plugin {
+    ($symbol:ident, $ty:ty) => {
+        /// The pilgrim plugin entry: the static entry table.
+        #[no_mangle]
+        pub extern "C" fn $symbol() -> *const $crate::PluginTable {
+            static INSTANCE: ::std::sync::OnceLock<$ty> = ::std::sync::OnceLock::new();
+            fn get() -> &'static $ty {
+                INSTANCE.get_or_init(<$ty as ::core::default::Default>::default)
+            }
+            unsafe extern "C" fn describe(out: *mut $crate::Buffer) -> i32 {
+                // SAFETY: forwarded from the host's call.
+                unsafe { $crate::entry::describe(get(), out) }
+            }
+            unsafe extern "C" fn inverse(
+                poses: *const f64,
+                count: usize,
+                tool: *const f64,
+                out: *mut f64,
+                width: usize,
+                failed_row: *mut usize,
+            ) -> i32 {
+                // SAFETY: forwarded from the host's call.
+                unsafe { $crate::entry::inverse(get(), poses, count, tool, out, width, failed_row) }
+            }
+            unsafe extern "C" fn forward(
+                axes: *const f64,
+                count: usize,
+                width: usize,
+                tool: *const f64,
+                out: *mut f64,
+            ) -> i32 {
+                // SAFETY: forwarded from the host's call.
+                unsafe { $crate::entry::forward(get(), axes, count, width, tool, out) }
+            }
+            unsafe extern "C" fn post(
+                request: *const u8,
+                len: usize,
+                out: *mut $crate::Buffer,
+            ) -> i32 {
+                // SAFETY: forwarded from the host's call.
+                unsafe { $crate::entry::post(get(), request, len, out) }
+            }
+            static TABLE: $crate::PluginTable = $crate::PluginTable {
+                abi_major: $crate::ABI_MAJOR,
+                abi_minor: $crate::ABI_MINOR,
+                size: $crate::TABLE_SIZE,
+                describe: Some(describe),
+                inverse: Some(inverse),
+                forward: Some(forward),
+                post: Some(post),
+                last_error: Some($crate::entry::last_error),
+                free_buffer: Some($crate::entry::free_buffer),
+            };
+            &TABLE
+        }
+    };
+}

@@ -1,0 +1,213 @@
+//! Machine plugins loaded from shared libraries: the 3K152VF20 plugin
+//! against its compiled-in self, and fixtures that break the ABI.
+
+use grinder_3k152vf20::Grinder;
+use pilgrim_kernel::plugin::{PluginLoadError, PluginMachine};
+use pilgrim_kernel::{
+    equidistant, AxisProgram, ClPoint, MachineKinematics, MandrelLaw, Motion, Pass, Side, Tool,
+    ToolFrame, Toolpath, Wheel,
+};
+use std::path::{Path, PathBuf};
+
+/// Where cargo put this build's shared libraries (target/<profile>).
+fn lib_dir() -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    exe.parent().and_then(Path::parent).unwrap().to_owned()
+}
+
+fn lib(name: &str) -> PathBuf {
+    let p = lib_dir().join(format!(
+        "{}{name}{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    ));
+    assert!(p.exists(), "{} was not built", p.display());
+    p
+}
+
+/// The fixture library under another name, selecting its entry.
+fn fixture_as(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("pilgrim-plugins-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let to = dir.join(format!(
+        "{}{name}{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    ));
+    std::fs::copy(lib("plugin_fixture"), &to).unwrap();
+    to
+}
+
+/// Two passes of a 20 mm wheel rounding over a mandrel's working part,
+/// with the steady rest's U alongside.
+fn grinder_toolpath() -> Toolpath {
+    let wheel = Wheel::new(500.0, 20.0, 50.0).unwrap();
+    let law = MandrelLaw::new(38.0, 52.0, 400.0, 0.012, 2.3).unwrap();
+    let e = equidistant(&law.profile(2.0, 100.0).unwrap(), 20.0, Side::Outside).unwrap();
+    let mut tp = Toolpath::new(
+        "mandrel",
+        Tool::wheel("wheel 500x50 R20", 1, wheel),
+        399.0,
+        vec!["U".into()],
+    );
+    for (k, stock) in [0.1, 0.0].into_iter().enumerate() {
+        let mut idx: Vec<usize> = (0..e.z.len()).collect();
+        if k % 2 == 1 {
+            idx.reverse();
+        }
+        tp.passes.push(Pass {
+            name: format!("pass {}", k + 1),
+            points: idx
+                .iter()
+                .map(|&i| ClPoint {
+                    point: [e.x[i] + stock, 0.0, e.z[i]],
+                    axis: [0.0, 0.0, 1.0],
+                    motion: Motion::Linear,
+                    feed: 2000.0,
+                    aux: vec![e.x[i] - 20.0 + 25.0],
+                })
+                .collect(),
+        });
+    }
+    tp
+}
+
+#[test]
+fn grinder_plugin_loaded_gives_byte_identical_programs() {
+    let built_in = Grinder::new();
+    let loaded = PluginMachine::load(lib("grinder_3k152vf20")).unwrap();
+    assert_eq!(
+        loaded.abi_version(),
+        (pilgrim_plugin_abi::ABI_MAJOR, pilgrim_plugin_abi::ABI_MINOR)
+    );
+    assert_eq!(loaded.info(), built_in.info());
+    let tp = grinder_toolpath();
+    let a = AxisProgram::build(&tp, &built_in, "mandrel").unwrap();
+    let b = AxisProgram::build(&tp, &loaded, "mandrel").unwrap();
+    assert_eq!(a, b);
+    assert_eq!(
+        a.axes.iter().map(|x| x.name.as_str()).collect::<Vec<_>>(),
+        ["Z", "X", "U"]
+    );
+    for dialect in ["sinumerik", "cld"] {
+        let (ta, tb) = (
+            built_in.post(&a, dialect).unwrap(),
+            loaded.post(&b, dialect).unwrap(),
+        );
+        assert_eq!(ta, tb, "{dialect}");
+        assert!(ta.len() > 1000);
+    }
+    // The programmed X is the wheel's lowest point: the rounding centre minus R_s.
+    let x = a.column("X").unwrap();
+    assert!((x[0] - (tp.passes[0].points[0].point[0] - 20.0)).abs() < 1e-12);
+    // Forward kinematics through the library returns the toolpath's points.
+    let rows: Vec<f64> = a
+        .blocks
+        .iter()
+        .flat_map(|b| [b.values[0], b.values[1]])
+        .collect();
+    let mut poses = vec![];
+    loaded
+        .forward(&rows, &tp.tool.reference, &mut poses)
+        .unwrap();
+    for ((_, _, c), p) in tp.points().zip(poses.chunks(6)) {
+        assert!((c.point[0] - p[0]).abs() < 1e-12 && (c.point[2] - p[2]).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn another_abi_major_is_refused_naming_both() {
+    let e = PluginMachine::load(fixture_as("other_abi")).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            PluginLoadError::Version {
+                plugin_major: 99,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let text = e.to_string();
+    assert!(
+        text.contains("ABI 99.3")
+            && text.contains(&format!("pilgrim ABI {}.", pilgrim_plugin_abi::ABI_MAJOR)),
+        "{text}"
+    );
+}
+
+#[test]
+fn broken_plugins_are_clear_errors() {
+    let e = PluginMachine::load(fixture_as("null_table"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("returned no table"), "{e}");
+    let e = PluginMachine::load(fixture_as("no_post"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no 'post' entry"), "{e}");
+    let e = PluginMachine::load(fixture_as("bad_descriptor"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("bad machine descriptor"), "{e}");
+    let e = PluginMachine::load(fixture_as("no_such_entry"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("no entry symbol 'pilgrim_plugin_no_such_entry'"),
+        "{e}"
+    );
+    let e = PluginMachine::load("/no/such/libplugin.so")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("/no/such/libplugin.so: cannot load"), "{e}");
+}
+
+#[test]
+fn a_panicking_plugin_returns_an_error_and_the_host_goes_on() {
+    let m = PluginMachine::load(fixture_as("panics")).unwrap();
+    let tool = ToolFrame::default();
+    let mut out = vec![];
+    m.inverse(&[10.0, 0.0, -5.0, 0.0, 0.0, 1.0], &tool, &mut out)
+        .unwrap();
+    assert_eq!(out, [20.0, -5.0]);
+    let e = m
+        .inverse(
+            &[
+                10.0, 0.0, -5.0, 0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+            ],
+            &tool,
+            &mut out,
+        )
+        .unwrap_err();
+    assert!(
+        e.message.contains("panicked") && e.message.contains("negative radius -1"),
+        "{e}"
+    );
+    let e = m.forward(&[1.0, 2.0], &tool, &mut out).unwrap_err();
+    assert!(e.message.contains("not offered"), "{e}");
+    // The host goes on: the same plugin answers again.
+    m.inverse(&[3.0, 0.0, 1.0, 0.0, 0.0, 1.0], &tool, &mut out)
+        .unwrap();
+    assert_eq!(out, [6.0, 1.0]);
+    assert_eq!(m.info().name, "fixture-lathe");
+}
+
+/// A value beyond travel that kinematics does not see (the rest's U) is
+/// caught by the program's checks, naming the block and the axis.
+#[test]
+fn rest_beyond_travel_names_the_block() {
+    let mut tp = grinder_toolpath();
+    tp.passes[1].points[4].aux[0] = 151.0;
+    let first = tp.passes[0].points.len();
+    let e = AxisProgram::build(&tp, &Grinder::new(), "mandrel")
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        e,
+        format!(
+            "block {}: axis U at 151.0000 mm is outside its travel [0, 150] mm",
+            first + 5
+        )
+    );
+}
