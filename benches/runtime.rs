@@ -98,9 +98,9 @@ fn plugin_batch(c: &mut Criterion) {
         std::env::consts::DLL_PREFIX,
         std::env::consts::DLL_SUFFIX
     ));
-    if !lib.exists() {
+    {
         // `cargo bench` builds the plugin crate as a dependency (rlib) only:
-        // build its shared library, in this same profile.
+        // build its shared library, in this same profile (a no-op when current).
         let status = std::process::Command::new(env!("CARGO"))
             .args([
                 "build",

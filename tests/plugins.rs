@@ -7,7 +7,7 @@ use pilgrim_kernel::{
     equidistant, AxisProgram, ClPoint, MachineKinematics, MandrelLaw, Motion, Pass, Side, Tool,
     ToolFrame, Toolpath, Wheel,
 };
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Where cargo put this build's shared libraries (target/<profile>).
 fn lib_dir() -> PathBuf {
