@@ -28,15 +28,8 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
-fn lib(name: &str) -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let dir = exe.parent().and_then(Path::parent).unwrap();
-    dir.join(format!(
-        "{}{name}{}",
-        std::env::consts::DLL_PREFIX,
-        std::env::consts::DLL_SUFFIX
-    ))
-}
+mod common;
+use common::shared_lib as lib;
 
 const DEMO: &str = "scripts/examples/mill_circle.rhai";
 

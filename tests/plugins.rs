@@ -9,21 +9,8 @@ use pilgrim_kernel::{
 };
 use std::path::PathBuf;
 
-/// Where cargo put this build's shared libraries (target/<profile>).
-fn lib_dir() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    exe.parent().and_then(Path::parent).unwrap().to_owned()
-}
-
-fn lib(name: &str) -> PathBuf {
-    let p = lib_dir().join(format!(
-        "{}{name}{}",
-        std::env::consts::DLL_PREFIX,
-        std::env::consts::DLL_SUFFIX
-    ));
-    assert!(p.exists(), "{} was not built", p.display());
-    p
-}
+mod common;
+use common::shared_lib as lib;
 
 /// The fixture library under another name, selecting its entry.
 fn fixture_as(name: &str) -> PathBuf {

@@ -19,15 +19,29 @@ pub fn shared_lib(name: &str) -> PathBuf {
     BUILT.get_or_init(|| {
         let dir = artifact_dir();
         let mut cmd = std::process::Command::new(env!("CARGO"));
-        cmd.args(["build", "--lib", "-p", "pilgrim-grinder-3k152vf20", "-p", "pilgrim-plugin-fixture"])
-            .current_dir(env!("CARGO_MANIFEST_DIR"));
+        cmd.args([
+            "build",
+            "--lib",
+            "-p",
+            "pilgrim-grinder-3k152vf20",
+            "-p",
+            "pilgrim-plugin-fixture",
+        ])
+        .current_dir(env!("CARGO_MANIFEST_DIR"));
         if dir.file_name().is_some_and(|n| n == "release") {
             cmd.arg("--release");
         }
         let status = cmd.status().expect("cargo runs");
-        assert!(status.success(), "building the plugins' shared libraries failed");
+        assert!(
+            status.success(),
+            "building the plugins' shared libraries failed"
+        );
     });
-    let p = artifact_dir().join(format!("{}{name}{}", std::env::consts::DLL_PREFIX, std::env::consts::DLL_SUFFIX));
+    let p = artifact_dir().join(format!(
+        "{}{name}{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    ));
     assert!(p.exists(), "{} was not built", p.display());
     p
 }
