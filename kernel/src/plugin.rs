@@ -289,7 +289,7 @@ impl MachineKinematics for PluginMachine {
         tool: &ToolFrame,
         out: &mut Vec<f64>,
     ) -> Result<(), KinematicsError> {
-        let count = crate::program::kinematics_rows(poses, 6, "pose")?;
+        let count = crate::program::batch_rows(poses, 6, "pose")?;
         let width = self.info.solved_axes.len();
         out.clear();
         out.resize(count * width, 0.0);
@@ -323,7 +323,7 @@ impl MachineKinematics for PluginMachine {
         out: &mut Vec<f64>,
     ) -> Result<(), KinematicsError> {
         let width = self.info.solved_axes.len();
-        let count = crate::program::kinematics_rows(axes, width, "axis")?;
+        let count = crate::program::batch_rows(axes, width, "axis")?;
         out.clear();
         out.resize(count * 6, 0.0);
         let t = tool6(tool);

@@ -186,8 +186,9 @@ impl ChainMachine {
     }
 }
 
-/// Splits a batch into rows of `width`, naming a ragged end.
-pub(crate) fn rows(values: &[Real], width: usize, what: &str) -> Result<usize, KinematicsError> {
+/// The number of rows of `width` values in a batch; a ragged end (or a
+/// zero width) is an error naming `what` the values are.
+pub fn batch_rows(values: &[Real], width: usize, what: &str) -> Result<usize, KinematicsError> {
     if width == 0 || !values.len().is_multiple_of(width) {
         return Err(KinematicsError::whole(format!(
             "{} {what} values do not fill rows of {width}",
@@ -208,7 +209,7 @@ impl MachineKinematics for ChainMachine {
         tool: &ToolFrame,
         out: &mut Vec<Real>,
     ) -> Result<(), KinematicsError> {
-        rows(poses, 6, "pose")?;
+        batch_rows(poses, 6, "pose")?;
         out.clear();
         let chain = self.machine.chain();
         let rotary = (0..chain.dof()).any(|i| chain.is_rotary(i));
@@ -257,7 +258,7 @@ impl MachineKinematics for ChainMachine {
         if held.is_empty() {
             return self.inverse(poses, tool, out);
         }
-        let n = rows(poses, 6, "pose")?;
+        let n = batch_rows(poses, 6, "pose")?;
         if values.len() != n * held.len() {
             return Err(KinematicsError::whole(format!(
                 "{} held values for {n} poses of {} held axes",
@@ -342,7 +343,7 @@ impl MachineKinematics for ChainMachine {
         out: &mut Vec<Real>,
     ) -> Result<(), KinematicsError> {
         let chain = self.machine.chain();
-        rows(axes, chain.dof(), "axis")?;
+        batch_rows(axes, chain.dof(), "axis")?;
         let poses = chain
             .poses(axes, tool)
             .map_err(|e| KinematicsError::whole(e.to_string()))?;

@@ -10,8 +10,7 @@
 mod kinematics;
 pub mod post;
 
-pub(crate) use kinematics::rows as kinematics_rows;
-pub use kinematics::{ChainMachine, KinematicsError, MachineInfo, MachineKinematics};
+pub use kinematics::{batch_rows, ChainMachine, KinematicsError, MachineInfo, MachineKinematics};
 pub use post::{post, Dialect, PostError};
 
 use crate::machine::{Axis, AxisKind, MachineError};
@@ -38,6 +37,9 @@ pub struct Block {
     /// Feed (mm/min) for linear blocks; the lead for thread blocks is in
     /// the motion; 0 for rapids.
     pub feed: Real,
+    /// A spindle speed (rpm) set from this block on; `None` keeps the last.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spindle: Option<Real>,
     /// A comment to print before the block (a pass's name).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub comment: Option<String>,
@@ -316,6 +318,7 @@ impl AxisProgram {
                     Motion::Linear => c.feed,
                     Motion::Thread { lead } => lead * toolpath.spindle_rpm,
                 },
+                spindle: (k == 0).then_some(toolpath.spindle_rpm),
                 comment: (j == 0).then(|| toolpath.passes[p].name.clone()),
             });
         }

@@ -276,7 +276,13 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
         if b.values.len() != width {
             return Err(bad(format!("{} values for {width} axes", b.values.len())));
         }
-        if let Some(v) = b.values.iter().chain([&b.feed]).find(|v| !v.is_finite()) {
+        if let Some(v) = b
+            .values
+            .iter()
+            .chain([&b.feed])
+            .chain(b.spindle.as_ref())
+            .find(|v| !v.is_finite())
+        {
             return Err(bad(format!("value {v} is not a finite number")));
         }
     }
@@ -294,13 +300,25 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
     let mut last_words: Vec<Option<String>> = vec![None; width];
     let mut last_motion: Option<&str> = None;
     let mut last_feed: Option<String> = None;
+    // The preamble started the spindle at the program's speed.
+    let mut last_spindle = program.spindle_rpm.round() as i64;
     for b in &program.blocks {
         if let Some(c) = &b.comment {
             w.comment(c);
         }
+        let spindle = b
+            .spindle
+            .map(|s| s.round() as i64)
+            .filter(|s| *s != last_spindle);
+        if let Some(s) = spindle {
+            last_spindle = s;
+        }
         let values: Vec<String> = b.values.iter().map(|v| fixed(*v, d.decimals)).collect();
         match d.style {
             Style::Apt => {
+                if let Some(s) = spindle {
+                    w.line(&format!("SPINDL/{s},RPM,CLW"));
+                }
                 match b.motion {
                     Motion::Rapid => w.line("RAPID"),
                     Motion::Linear => {
@@ -334,7 +352,11 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
                     }
                 }
                 if words.is_empty() {
-                    continue; // no axis moves: nothing to write
+                    // No axis moves: only a new spindle speed is worth a block.
+                    if let Some(s) = spindle {
+                        w.block(&format!("S{s}"));
+                    }
+                    continue;
                 }
                 if last_motion != Some(motion) {
                     words.insert(0, motion.to_owned());
@@ -352,6 +374,9 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
                         words.push(f.clone());
                         last_feed = Some(f);
                     }
+                }
+                if let Some(s) = spindle {
+                    words.push(format!("S{s}"));
                 }
                 w.block(&words.join(" "));
             }
@@ -380,6 +405,7 @@ mod tests {
             motion,
             values: v.to_vec(),
             feed,
+            spindle: None,
             comment: comment.map(str::to_owned),
         };
         AxisProgram {
@@ -428,6 +454,21 @@ SPINDL/399,RPM,CLW\nPPRINT/pass 1\nRAPID\nGOTO/50.000,5.000\nFEDRAT/100.000,MMPM
 GOTO/40.000,0.000\nGOTO/40.000,0.000\nFEDRAT/6.3500,MMPR\nGOTO/40.000,-60.000\nRAPID\nGOTO/50.000,-60.000\n\
 SPINDL/OFF\nFINI\n";
         assert_eq!(text, expected.replace("VERSION", crate::VERSION));
+    }
+
+    #[test]
+    fn spindle_changes_are_written_where_they_happen() {
+        let mut p = program();
+        p.blocks[0].spindle = Some(399.0); // the preamble's speed: nothing new
+        p.blocks[4].spindle = Some(120.0);
+        let g = post(&p, &SINUMERIK).unwrap();
+        assert!(g.contains("N40 G0 X50.000 Z5.000\n"), "{g}");
+        assert!(g.contains("N70 G33 Z-60.000 K6.3500 S120\n"), "{g}");
+        let a = post(&p, &CLD).unwrap();
+        assert!(
+            a.contains("GOTO/40.000,0.000\nSPINDL/120,RPM,CLW\nFEDRAT/6.3500,MMPR\n"),
+            "{a}"
+        );
     }
 
     #[test]

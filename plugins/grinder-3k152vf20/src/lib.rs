@@ -14,7 +14,7 @@
 //! cdylib it is `libgrinder_3k152vf20.so`, exporting
 //! `pilgrim_plugin_grinder_3k152vf20`.
 
-use pilgrim_kernel::program::{KinematicsError, MachineInfo, MachineKinematics};
+use pilgrim_kernel::program::{batch_rows, KinematicsError, MachineInfo, MachineKinematics};
 use pilgrim_kernel::{AxisProgram, Machine, ToolFrame};
 use pilgrim_plugin_abi::{export_plugin, Plugin, PluginError};
 
@@ -85,16 +85,6 @@ impl Grinder {
     }
 }
 
-fn check_rows(values: &[f64], width: usize, what: &str) -> Result<(), KinematicsError> {
-    if !values.len().is_multiple_of(width) {
-        return Err(KinematicsError::whole(format!(
-            "{} {what} values do not fill rows of {width}",
-            values.len()
-        )));
-    }
-    Ok(())
-}
-
 impl MachineKinematics for Grinder {
     fn info(&self) -> &MachineInfo {
         &self.info
@@ -107,7 +97,7 @@ impl MachineKinematics for Grinder {
         tool: &ToolFrame,
         out: &mut Vec<f64>,
     ) -> Result<(), KinematicsError> {
-        check_rows(poses, 6, "pose")?;
+        batch_rows(poses, 6, "pose")?;
         out.clear();
         out.resize(poses.len() / 3, 0.0);
         self.solve_into(poses, tool, out)
@@ -119,7 +109,7 @@ impl MachineKinematics for Grinder {
         tool: &ToolFrame,
         out: &mut Vec<f64>,
     ) -> Result<(), KinematicsError> {
-        check_rows(axes, 2, "axis")?;
+        batch_rows(axes, 2, "axis")?;
         out.clear();
         let (r, w) = (tool.point, tool.axis);
         for q in axes.chunks_exact(2) {
