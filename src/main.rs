@@ -6,6 +6,7 @@
 
 mod machines;
 mod run;
+mod scene;
 
 use clap::{Parser, Subcommand};
 use pilgrim_kernel::machine::BUILTIN_MACHINES;
@@ -47,6 +48,21 @@ enum Command {
         /// The output directory (replaced as a whole when the run succeeds).
         #[arg(long, default_value = "out/run")]
         out: PathBuf,
+        /// The block (from 1) to place the tool at in the 3-D models.
+        /// Default: the first block of the last pass.
+        #[arg(long, value_name = "N")]
+        pose_block: Option<usize>,
+        /// Chordal tolerance of the 3-D models (mm).
+        #[arg(long, default_value_t = pilgrim_kernel::mesh::DEFAULT_TOLERANCE)]
+        tolerance: f64,
+    },
+    /// Re-export a finished run's 3-D scene with the tool at another block.
+    Export {
+        /// The run's output directory.
+        dir: PathBuf,
+        /// The block (from 1). Default: the first block of the last pass.
+        #[arg(long, value_name = "N")]
+        block: Option<usize>,
     },
     /// List the built-in machines; with --plugin or --file, those too.
     Machines {
@@ -199,7 +215,11 @@ fn main() -> ExitCode {
             sets,
             machine,
             out,
+            pose_block,
+            tolerance,
         } => run::run(&run::RunArgs {
+            pose_block: *pose_block,
+            tolerance: *tolerance,
             script: script.clone(),
             params: params.clone(),
             sets: sets.clone(),
@@ -213,12 +233,13 @@ fn main() -> ExitCode {
             files,
             only_files,
         } => list_machines(plugins, files, *only_files),
+        Command::Export { dir, block } => run::export(dir, *block).map(|s| s + "\n"),
         Command::Params { script } => params(script),
         Command::PluginCheck { lib } => plugin_check(lib),
         Command::ApiDocs { out } => {
             let text = pilgrim_kernel::script::api_reference();
             match out {
-                Some(p) => run::write_file(p, &text).map(|_| String::new()),
+                Some(p) => run::write_file(p, text.as_bytes()).map(|_| String::new()),
                 None => Ok(text),
             }
         }

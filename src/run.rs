@@ -12,6 +12,8 @@ use std::path::{Path, PathBuf};
 
 /// What `run` was asked.
 pub struct RunArgs {
+    pub pose_block: Option<usize>,
+    pub tolerance: f64,
     pub script: PathBuf,
     pub params: Option<PathBuf>,
     pub sets: Vec<(String, String)>,
@@ -20,17 +22,19 @@ pub struct RunArgs {
     pub quiet: bool,
 }
 
-#[derive(Serialize)]
+#[derive(Serialize, serde::Deserialize)]
 struct ReportParam {
     value: ParamValue,
     unit: String,
 }
 
-#[derive(Serialize)]
+#[derive(Serialize, serde::Deserialize)]
 struct Report {
-    pilgrim: &'static str,
+    pilgrim: String,
     script: String,
     machine: String,
+    /// The --machine given (or the family's default), to reopen it.
+    machine_spec: String,
     control: String,
     parameters: BTreeMap<String, ReportParam>,
     passes: usize,
@@ -39,6 +43,14 @@ struct Report {
     cycle_time_min: f64,
     files: Vec<String>,
     checks: Vec<Check>,
+    /// The block (from 1) the 3-D scene places the tool at.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pose_block: Option<usize>,
+    /// Chordal tolerance of the meshes (mm).
+    tolerance_mm: f64,
+    /// The bodies written as STL.
+    #[serde(default)]
+    bodies: Vec<crate::scene::BodyFile>,
 }
 
 /// Minutes of cutting and rapid moves, from the program's feeds (rapids at
@@ -102,7 +114,7 @@ impl Stages {
 /// Runs the job; on any error nothing is written and the previous output
 /// directory is left as it was.
 pub fn run(args: &RunArgs) -> Result<String, String> {
-    let stages = Stages::new(args.quiet, 6);
+    let stages = Stages::new(args.quiet, 7);
     stages.next("reading the family");
     let mut access = Access::default();
     if let Some(dir) = args.params.as_ref().and_then(|p| p.parent()) {
@@ -169,16 +181,34 @@ pub fn run(args: &RunArgs) -> Result<String, String> {
         .post(&program, CLD.name)
         .map_err(|e| e.to_string())?;
     let control_file = format!("program.{}", control.extension);
-    let mut files: Vec<(String, String)> = vec![
-        ("toolpath.json".into(), json(&toolpath)?),
-        ("program.json".into(), json(&program)?),
-        (control_file, control_text),
-        ("program.cld".into(), cld_text),
+    let mut files: Vec<(String, Vec<u8>)> = vec![
+        ("toolpath.json".into(), json(&toolpath)?.into_bytes()),
+        ("program.json".into(), json(&program)?.into_bytes()),
+        (control_file, control_text.into_bytes()),
+        ("program.cld".into(), cld_text.into_bytes()),
     ];
+    stages.next("3-D models");
+    let (pose_block, bodies) = if family.has_fn("part", 1) {
+        let parts = part_meshes(&family, &values, args.tolerance)?;
+        let lengths: Vec<usize> = toolpath.passes.iter().map(|p| p.points.len()).collect();
+        let index = match args.pose_block {
+            Some(0) => return Err("--pose-block counts blocks from 1".into()),
+            Some(n) => n - 1,
+            None => crate::scene::default_pose_block(&lengths),
+        };
+        let pose = crate::scene::tool_pose(&program, machine.as_ref(), &toolpath.tool, index)?;
+        let tool = crate::scene::tool_mesh(&toolpath.tool, args.tolerance)?;
+        let (mesh_files, bodies) = crate::scene::files(&parts, tool, pose)?;
+        files.extend(mesh_files);
+        (Some(index + 1), bodies)
+    } else {
+        (None, vec![])
+    };
     let report = Report {
-        pilgrim: env!("CARGO_PKG_VERSION"),
+        pilgrim: env!("CARGO_PKG_VERSION").into(),
         script: args.script.display().to_string(),
         machine: info.name.clone(),
+        machine_spec: machine_spec.clone(),
         control: info.control.clone(),
         parameters: family
             .params()
@@ -203,8 +233,11 @@ pub fn run(args: &RunArgs) -> Result<String, String> {
             .chain(["report.json".to_owned()])
             .collect(),
         checks,
+        pose_block,
+        tolerance_mm: args.tolerance,
+        bodies,
     };
-    files.push(("report.json".into(), json(&report)?));
+    files.push(("report.json".into(), json(&report)?.into_bytes()));
     stages.next("writing");
     write_atomically(&args.out, &files)?;
     stages.bar.finish_and_clear();
@@ -228,7 +261,7 @@ fn json<T: Serialize>(v: &T) -> Result<String, String> {
 
 /// Writes the files into a temporary directory beside `out`, then swaps it
 /// in: a failure leaves `out` as it was and no half-written file.
-pub fn write_atomically(out: &Path, files: &[(String, String)]) -> Result<(), String> {
+pub fn write_atomically(out: &Path, files: &[(String, Vec<u8>)]) -> Result<(), String> {
     let parent = match out.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
         _ => PathBuf::from("."),
@@ -263,8 +296,114 @@ pub fn write_atomically(out: &Path, files: &[(String, String)]) -> Result<(), St
     result
 }
 
+/// The part's bodies from `fn part(p)`: a profile, or a map of named
+/// profiles, each turned about Z into a solid.
+fn part_meshes(
+    family: &Family,
+    values: &BTreeMap<String, ParamValue>,
+    tol: f64,
+) -> Result<Vec<(String, pilgrim_kernel::mesh::TriMesh)>, String> {
+    let d = family
+        .call_with_params("part", values)
+        .map_err(|e| e.to_string())?;
+    let shape = || {
+        format!(
+            "{}: fn part(p) must return a profile or a map of named profiles",
+            family.file()
+        )
+    };
+    let profiles: Vec<(String, pilgrim_kernel::Profile)> =
+        if let Some(p) = d.clone().try_cast::<pilgrim_kernel::Profile>() {
+            vec![("part".into(), p)]
+        } else {
+            let map = d.try_cast::<rhai::Map>().ok_or_else(shape)?;
+            map.into_iter()
+                .map(|(k, v)| {
+                    v.try_cast::<pilgrim_kernel::Profile>()
+                        .map(|p| (k.to_string(), p))
+                        .ok_or_else(shape)
+                })
+                .collect::<Result<_, _>>()?
+        };
+    profiles
+        .iter()
+        .map(|(name, p)| {
+            pilgrim_kernel::mesh::body_of_revolution(p, tol)
+                .map(|m| (name.clone(), m))
+                .map_err(|e| format!("{}: part '{name}': {e}", family.file()))
+        })
+        .collect()
+}
+
+/// `pilgrim export DIR --block N`: the scene of a finished run placed at
+/// another block (the tool's STL, `scene.glb`, and the report's block).
+pub fn export(dir: &Path, block: Option<usize>) -> Result<String, String> {
+    let read = |name: &str| {
+        std::fs::read_to_string(dir.join(name))
+            .map_err(|e| format!("{}: {e}", dir.join(name).display()))
+    };
+    let mut report: Report =
+        serde_json::from_str(&read("report.json")?).map_err(|e| format!("report.json: {e}"))?;
+    let program: AxisProgram =
+        serde_json::from_str(&read("program.json")?).map_err(|e| format!("program.json: {e}"))?;
+    let toolpath: Toolpath =
+        serde_json::from_str(&read("toolpath.json")?).map_err(|e| format!("toolpath.json: {e}"))?;
+    if report.bodies.is_empty() {
+        return Err(format!(
+            "{}: the run has no 3-D models (its family has no fn part(p))",
+            dir.display()
+        ));
+    }
+    let machine = machines::open(&report.machine_spec)?;
+    let index = match block {
+        Some(0) => return Err("--block counts blocks from 1".into()),
+        Some(n) => n - 1,
+        None => crate::scene::default_pose_block(
+            &toolpath
+                .passes
+                .iter()
+                .map(|p| p.points.len())
+                .collect::<Vec<_>>(),
+        ),
+    };
+    let parts = report
+        .bodies
+        .iter()
+        .filter(|b| b.kind == "part")
+        .map(|b| {
+            pilgrim_kernel::mesh::read_stl(&dir.join(&b.file))
+                .map(|m| (b.name.clone(), m))
+                .map_err(|e| e.to_string())
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let pose = crate::scene::tool_pose(&program, machine.as_ref(), &toolpath.tool, index)?;
+    let tool = crate::scene::tool_mesh(&toolpath.tool, report.tolerance_mm)?;
+    let (files, bodies) = crate::scene::files(&parts, tool, pose)?;
+    report.pose_block = Some(index + 1);
+    report.bodies = bodies;
+    let mut all: Vec<(String, Vec<u8>)> = files
+        .into_iter()
+        .filter(|(n, _)| {
+            n == "scene.glb"
+                || !report
+                    .bodies
+                    .iter()
+                    .any(|b| b.kind == "part" && &b.file == n)
+        })
+        .collect();
+    all.push(("report.json".into(), json(&report)?.into_bytes()));
+    for (name, bytes) in &all {
+        write_file(&dir.join(name), bytes)?;
+    }
+    Ok(format!(
+        "{}: the scene placed at block {}",
+        dir.display(),
+        index + 1
+    ))
+}
+
 /// Writes one file through a temporary file and a rename.
-pub fn write_file(path: &Path, text: &str) -> Result<(), String> {
+pub fn write_file(path: &Path, text: &[u8]) -> Result<(), String> {
     let tmp = path.with_extension(format!("tmp-{}", std::process::id()));
     std::fs::write(&tmp, text).map_err(|e| format!("{}: {e}", tmp.display()))?;
     std::fs::rename(&tmp, path).map_err(|e| {

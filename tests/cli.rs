@@ -238,6 +238,21 @@ fn bad_input_is_refused_and_nothing_is_written() {
         .map(|e| e.file_name())
         .collect();
     assert_eq!(leftovers.len(), 2, "{leftovers:?}");
+    // A tolerance that is not positive, a pose block beyond the program.
+    let (code, _, err) = pilgrim(&["run", DEMO, "--tolerance", "0", "--out", s(&out)]);
+    assert_eq!(code, 1);
+    assert!(err.contains("chordal tolerance must be > 0"), "{err}");
+    let (code, _, err) = pilgrim(&["run", DEMO, "--pose-block", "9999", "--out", s(&out)]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("block 9999 is beyond the program's 365 blocks"),
+        "{err}"
+    );
+    let after: Vec<Vec<u8>> = FILES
+        .iter()
+        .map(|f| std::fs::read(out.join(f)).unwrap())
+        .collect();
+    assert_eq!(before, after);
     // A machine that does not exist.
     let (code, _, err) = pilgrim(&["run", DEMO, "--machine", "planer", "--out", s(&out)]);
     assert_eq!(code, 1);

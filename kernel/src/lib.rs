@@ -33,6 +33,7 @@
 pub mod error;
 pub mod machine;
 pub mod math;
+pub mod mesh;
 pub mod offset;
 pub mod plugin;
 pub mod profile;

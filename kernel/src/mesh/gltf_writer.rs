@@ -1,0 +1,255 @@
+//! glTF 2.0 scenes (`.glb`, or `.gltf` with a `.bin`), built with `gltf-json`.
+//!
+//! Mesh data stay in the part's millimetres with Z up; the root node alone
+//! carries the unit scale (0.001, to metres) and the turn of Z up to glTF's
+//! Y up (-90 degrees about X). Each body is a node with its own mesh
+//! (positions, normals, indices) and material.
+
+use super::{MeshError, Scene};
+use gltf_json as json;
+use json::validation::{Checked::Valid, USize64};
+use std::borrow::Cow;
+use std::collections::BTreeMap;
+use std::io::Write;
+
+fn io(file: &str) -> impl Fn(String) -> MeshError + '_ {
+    move |message| MeshError::Io {
+        file: file.to_owned(),
+        message,
+    }
+}
+
+/// The document and its binary buffer; `uri` names the buffer for `.gltf`.
+fn build(scene: &Scene, uri: Option<String>) -> Result<(json::Root, Vec<u8>), MeshError> {
+    let mut root = json::Root {
+        asset: json::Asset {
+            version: "2.0".into(),
+            generator: Some(format!("pilgrim {}", crate::VERSION)),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let size: usize = scene
+        .nodes
+        .iter()
+        .map(|n| n.mesh.positions.len() * 24 + n.mesh.triangles.len() * 12)
+        .sum();
+    let mut bin: Vec<u8> = Vec::with_capacity(size);
+    let buffer = root.push(json::Buffer {
+        byte_length: USize64(size as u64),
+        name: None,
+        uri,
+        extensions: None,
+        extras: Default::default(),
+    });
+    let mut children = Vec::new();
+    for node in &scene.nodes {
+        let m = &node.mesh;
+        if m.triangles.is_empty() {
+            return Err(MeshError::Degenerate(format!(
+                "body '{}' has no triangles",
+                node.name
+            )));
+        }
+        let mut view = |bin: &mut Vec<u8>, bytes: &dyn Fn(&mut Vec<u8>), target| {
+            let start = bin.len();
+            bytes(bin);
+            root.push(json::buffer::View {
+                buffer,
+                byte_length: USize64((bin.len() - start) as u64),
+                byte_offset: Some(USize64(start as u64)),
+                byte_stride: None,
+                name: None,
+                target: Some(Valid(target)),
+                extensions: None,
+                extras: Default::default(),
+            })
+        };
+        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        let pos_view = view(
+            &mut bin,
+            &|b: &mut Vec<u8>| {
+                for p in &m.positions {
+                    for v in p {
+                        b.extend_from_slice(&(*v as f32).to_le_bytes());
+                    }
+                }
+            },
+            json::buffer::Target::ArrayBuffer,
+        );
+        for p in &m.positions {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k] as f32);
+                hi[k] = hi[k].max(p[k] as f32);
+            }
+        }
+        let nrm_view = view(
+            &mut bin,
+            &|b: &mut Vec<u8>| {
+                for n in &m.normals {
+                    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+                    for v in n {
+                        b.extend_from_slice(&((*v / len) as f32).to_le_bytes());
+                    }
+                }
+            },
+            json::buffer::Target::ArrayBuffer,
+        );
+        let idx_view = view(
+            &mut bin,
+            &|b: &mut Vec<u8>| {
+                for t in &m.triangles {
+                    for i in t {
+                        b.extend_from_slice(&i.to_le_bytes());
+                    }
+                }
+            },
+            json::buffer::Target::ElementArrayBuffer,
+        );
+        let accessor = |root: &mut json::Root,
+                        view,
+                        count: usize,
+                        kind,
+                        ty,
+                        bounds: Option<([f32; 3], [f32; 3])>| {
+            root.push(json::Accessor {
+                buffer_view: Some(view),
+                byte_offset: None,
+                count: USize64(count as u64),
+                component_type: Valid(json::accessor::GenericComponentType(kind)),
+                extensions: None,
+                extras: Default::default(),
+                type_: Valid(ty),
+                min: bounds.map(|b| json::Value::from(b.0.to_vec())),
+                max: bounds.map(|b| json::Value::from(b.1.to_vec())),
+                name: None,
+                normalized: false,
+                sparse: None,
+            })
+        };
+        use json::accessor::{ComponentType, Type};
+        let pos = accessor(
+            &mut root,
+            pos_view,
+            m.positions.len(),
+            ComponentType::F32,
+            Type::Vec3,
+            Some((lo, hi)),
+        );
+        let nrm = accessor(
+            &mut root,
+            nrm_view,
+            m.normals.len(),
+            ComponentType::F32,
+            Type::Vec3,
+            None,
+        );
+        let idx = accessor(
+            &mut root,
+            idx_view,
+            m.triangles.len() * 3,
+            ComponentType::U32,
+            Type::Scalar,
+            None,
+        );
+        let material = root.push(json::Material {
+            name: Some(node.name.clone()),
+            pbr_metallic_roughness: json::material::PbrMetallicRoughness {
+                base_color_factor: json::material::PbrBaseColorFactor(node.color),
+                metallic_factor: json::material::StrengthFactor(0.2),
+                roughness_factor: json::material::StrengthFactor(0.6),
+                ..Default::default()
+            },
+            ..Default::default()
+        });
+        let mut attributes = BTreeMap::new();
+        attributes.insert(Valid(json::mesh::Semantic::Positions), pos);
+        attributes.insert(Valid(json::mesh::Semantic::Normals), nrm);
+        let mesh = root.push(json::Mesh {
+            name: Some(node.name.clone()),
+            primitives: vec![json::mesh::Primitive {
+                attributes,
+                indices: Some(idx),
+                material: Some(material),
+                mode: Valid(json::mesh::Mode::Triangles),
+                targets: None,
+                extensions: None,
+                extras: Default::default(),
+            }],
+            weights: None,
+            extensions: None,
+            extras: Default::default(),
+        });
+        let r = node.pose.fixed_view::<3, 3>(0, 0).into_owned();
+        let t = node.pose.fixed_view::<3, 1>(0, 3).into_owned();
+        let q = nalgebra::UnitQuaternion::from_rotation_matrix(
+            &nalgebra::Rotation3::from_matrix_unchecked(r),
+        );
+        let identity_turn = q.angle() == 0.0;
+        children.push(root.push(json::Node {
+            name: Some(node.name.clone()),
+            mesh: Some(mesh),
+            translation: (t.norm() > 0.0).then(|| [t.x as f32, t.y as f32, t.z as f32]),
+            rotation: (!identity_turn).then(|| {
+                json::scene::UnitQuaternion([q.i as f32, q.j as f32, q.k as f32, q.w as f32])
+            }),
+            ..Default::default()
+        }));
+    }
+    let half = std::f32::consts::FRAC_1_SQRT_2;
+    let top = root.push(json::Node {
+        name: Some("pilgrim part frame (mm, Z up)".into()),
+        children: Some(children),
+        scale: Some([0.001; 3]),
+        rotation: Some(json::scene::UnitQuaternion([-half, 0.0, 0.0, half])),
+        ..Default::default()
+    });
+    let scene_index = root.push(json::Scene {
+        name: Some("pilgrim".into()),
+        nodes: vec![top],
+        extensions: None,
+        extras: Default::default(),
+    });
+    root.scene = Some(scene_index);
+    Ok((root, bin))
+}
+
+/// Writes the scene as one binary glTF (`.glb`).
+///
+/// # Failures
+/// A body without triangles; a write error.
+pub fn write_glb<W: Write>(scene: &Scene, out: &mut W) -> Result<(), MeshError> {
+    let err = io("scene.glb");
+    let (root, bin) = build(scene, None)?;
+    let text = json::serialize::to_vec(&root).map_err(|e| err(e.to_string()))?;
+    let glb = gltf::binary::Glb {
+        header: gltf::binary::Header {
+            magic: *b"glTF",
+            version: 2,
+            length: 0, // to_writer computes it
+        },
+        json: Cow::Owned(text),
+        bin: Some(Cow::Borrowed(&bin)),
+    };
+    glb.to_writer(out).map_err(|e| err(e.to_string()))
+}
+
+/// Writes the scene as `.gltf` JSON (to `json_out`) and its buffer (to
+/// `bin_out`), the JSON naming the buffer `bin_name`.
+///
+/// # Failures
+/// A body without triangles; a write error.
+pub fn write_gltf<J: Write, B: Write>(
+    scene: &Scene,
+    bin_name: &str,
+    json_out: &mut J,
+    bin_out: &mut B,
+) -> Result<(), MeshError> {
+    let err = io(bin_name);
+    let (root, bin) = build(scene, Some(bin_name.to_owned()))?;
+    let text = json::serialize::to_string_pretty(&root).map_err(|e| err(e.to_string()))?;
+    json_out
+        .write_all(text.as_bytes())
+        .map_err(|e| err(e.to_string()))?;
+    bin_out.write_all(&bin).map_err(|e| err(e.to_string()))
+}

@@ -1,0 +1,136 @@
+//! 3-D output of a run: the part's bodies, the tool placed where the program
+//! puts it at one block, as STL files and one glTF scene.
+
+use pilgrim_kernel::mesh::{self, frame_from_pose, Scene, StlFormat, TriMesh};
+use pilgrim_kernel::{AxisKind, AxisProgram, MachineKinematics, Point3, Tool, ToolShape, Vec3};
+use serde::{Deserialize, Serialize};
+
+/// A body written to a file, for the report.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct BodyFile {
+    /// The body's name.
+    pub name: String,
+    /// `part` or `tool`.
+    pub kind: String,
+    /// Its STL file.
+    pub file: String,
+    /// Triangles.
+    pub triangles: usize,
+    /// Enclosed volume (mm^3).
+    pub volume_mm3: f64,
+}
+
+const PART_COLOR: [f32; 4] = [0.72, 0.72, 0.76, 1.0];
+const TOOL_COLOR: [f32; 4] = [0.25, 0.42, 0.85, 1.0];
+
+/// The tool's solid in its own frame and the file name it is written as.
+pub fn tool_mesh(tool: &Tool, tol: f64) -> Result<Option<(TriMesh, &'static str)>, String> {
+    Ok(match tool.shape {
+        ToolShape::Wheel(w) => Some((mesh::wheel(&w, tol).map_err(|e| e.to_string())?, "wheel")),
+        ToolShape::EndMill { diameter, length } => Some((
+            mesh::cylinder(diameter / 2.0, length, tol).map_err(|e| e.to_string())?,
+            "cutter",
+        )),
+        ToolShape::Insert { .. } => None,
+    })
+}
+
+/// Block index (from 0) of the first block of the last pass.
+pub fn default_pose_block(pass_lengths: &[usize]) -> usize {
+    let total: usize = pass_lengths.iter().sum();
+    total - pass_lengths.last().copied().unwrap_or(0)
+}
+
+/// The rigid motion of the tool at block `index` (from 0): the machine's
+/// forward kinematics of the block's axis values.
+pub fn tool_pose(
+    program: &AxisProgram,
+    machine: &dyn MachineKinematics,
+    tool: &Tool,
+    index: usize,
+) -> Result<pilgrim_kernel::Mat4, String> {
+    let info = machine.info();
+    let block = program.blocks.get(index).ok_or_else(|| {
+        format!(
+            "block {} is beyond the program's {} blocks",
+            index + 1,
+            program.blocks.len()
+        )
+    })?;
+    let row = info
+        .solved_axes
+        .iter()
+        .map(|name| {
+            let col = program
+                .axes
+                .iter()
+                .position(|a| &a.name == name)
+                .ok_or_else(|| format!("the program has no axis {name}"))?;
+            let v = block.values[col];
+            Ok(match info.axis(name).map(|a| a.kind) {
+                Some(AxisKind::Rotary) => v.to_radians(),
+                _ => v,
+            })
+        })
+        .collect::<Result<Vec<f64>, String>>()?;
+    let mut pose = Vec::new();
+    machine
+        .forward(&row, &tool.reference, &mut pose)
+        .map_err(|e| format!("block {}: {e}", index + 1))?;
+    Ok(frame_from_pose(
+        &tool.reference,
+        Point3::new(pose[0], pose[1], pose[2]),
+        Vec3::new(pose[3], pose[4], pose[5]),
+    ))
+}
+
+/// Files to write: (name, bytes).
+pub type Files = Vec<(String, Vec<u8>)>;
+
+/// The files of the scene: each part body's STL, the tool's STL placed at
+/// the block, and `scene.glb`; with the bodies' records.
+pub fn files(
+    parts: &[(String, TriMesh)],
+    tool: Option<(TriMesh, &'static str)>,
+    tool_pose: pilgrim_kernel::Mat4,
+) -> Result<(Files, Vec<BodyFile>), String> {
+    let mut scene = Scene::new();
+    let mut out = Vec::new();
+    let mut bodies = Vec::new();
+    let mut stl = |name: &str,
+                   kind: &str,
+                   m: &TriMesh,
+                   out: &mut Vec<(String, Vec<u8>)>|
+     -> Result<(), String> {
+        m.check_closed().map_err(|e| format!("{name}: {e}"))?;
+        let file = format!("{name}.stl");
+        let mut bytes = Vec::new();
+        mesh::write_stl(m, name, StlFormat::Binary, &mut bytes).map_err(|e| e.to_string())?;
+        bodies.push(BodyFile {
+            name: name.to_owned(),
+            kind: kind.to_owned(),
+            file: file.clone(),
+            triangles: m.triangle_count(),
+            volume_mm3: (m.volume() * 1000.0).round() / 1000.0,
+        });
+        out.push((file, bytes));
+        Ok(())
+    };
+    for (name, m) in parts {
+        stl(name, "part", m, &mut out)?;
+        scene.add(
+            name,
+            m.clone(),
+            pilgrim_kernel::Mat4::identity(),
+            PART_COLOR,
+        );
+    }
+    if let Some((m, name)) = tool {
+        stl(name, "tool", &m.transformed(&tool_pose), &mut out)?;
+        scene.add(name, m, tool_pose, TOOL_COLOR);
+    }
+    let mut glb = Vec::new();
+    mesh::write_glb(&scene, &mut glb).map_err(|e| e.to_string())?;
+    out.push(("scene.glb".into(), glb));
+    Ok((out, bodies))
+}
