@@ -55,6 +55,12 @@ enum Command {
         /// Chordal tolerance of the 3-D models (mm).
         #[arg(long, default_value_t = pilgrim_kernel::mesh::DEFAULT_TOLERANCE)]
         tolerance: f64,
+        /// Write the STL files as ASCII instead of binary.
+        #[arg(long)]
+        stl_ascii: bool,
+        /// Also write the scene as scene.gltf + scene.bin.
+        #[arg(long)]
+        gltf: bool,
     },
     /// Re-export a finished run's 3-D scene with the tool at another block.
     Export {
@@ -63,6 +69,12 @@ enum Command {
         /// The block (from 1). Default: the first block of the last pass.
         #[arg(long, value_name = "N")]
         block: Option<usize>,
+        /// Write the STL files as ASCII instead of binary.
+        #[arg(long)]
+        stl_ascii: bool,
+        /// Also write the scene as scene.gltf + scene.bin.
+        #[arg(long)]
+        gltf: bool,
     },
     /// List the built-in machines; with --plugin or --file, those too.
     Machines {
@@ -217,7 +229,13 @@ fn main() -> ExitCode {
             out,
             pose_block,
             tolerance,
+            stl_ascii,
+            gltf,
         } => run::run(&run::RunArgs {
+            formats: scene::Formats {
+                stl_ascii: *stl_ascii,
+                gltf: *gltf,
+            },
             pose_block: *pose_block,
             tolerance: *tolerance,
             script: script.clone(),
@@ -233,7 +251,20 @@ fn main() -> ExitCode {
             files,
             only_files,
         } => list_machines(plugins, files, *only_files),
-        Command::Export { dir, block } => run::export(dir, *block).map(|s| s + "\n"),
+        Command::Export {
+            dir,
+            block,
+            stl_ascii,
+            gltf,
+        } => run::export(
+            dir,
+            *block,
+            scene::Formats {
+                stl_ascii: *stl_ascii,
+                gltf: *gltf,
+            },
+        )
+        .map(|s| s + "\n"),
         Command::Params { script } => params(script),
         Command::PluginCheck { lib } => plugin_check(lib),
         Command::ApiDocs { out } => {

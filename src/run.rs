@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 
 /// What `run` was asked.
 pub struct RunArgs {
+    pub formats: crate::scene::Formats,
     pub pose_block: Option<usize>,
     pub tolerance: f64,
     pub script: PathBuf,
@@ -198,7 +199,7 @@ pub fn run(args: &RunArgs) -> Result<String, String> {
         };
         let pose = crate::scene::tool_pose(&program, machine.as_ref(), &toolpath.tool, index)?;
         let tool = crate::scene::tool_mesh(&toolpath.tool, args.tolerance)?;
-        let (mesh_files, bodies) = crate::scene::files(&parts, tool, pose)?;
+        let (mesh_files, bodies) = crate::scene::files(&parts, tool, pose, args.formats)?;
         files.extend(mesh_files);
         (Some(index + 1), bodies)
     } else {
@@ -337,7 +338,11 @@ fn part_meshes(
 
 /// `pilgrim export DIR --block N`: the scene of a finished run placed at
 /// another block (the tool's STL, `scene.glb`, and the report's block).
-pub fn export(dir: &Path, block: Option<usize>) -> Result<String, String> {
+pub fn export(
+    dir: &Path,
+    block: Option<usize>,
+    formats: crate::scene::Formats,
+) -> Result<String, String> {
     let read = |name: &str| {
         std::fs::read_to_string(dir.join(name))
             .map_err(|e| format!("{}: {e}", dir.join(name).display()))
@@ -378,7 +383,7 @@ pub fn export(dir: &Path, block: Option<usize>) -> Result<String, String> {
         .collect::<Result<Vec<_>, _>>()?;
     let pose = crate::scene::tool_pose(&program, machine.as_ref(), &toolpath.tool, index)?;
     let tool = crate::scene::tool_mesh(&toolpath.tool, report.tolerance_mm)?;
-    let (files, bodies) = crate::scene::files(&parts, tool, pose)?;
+    let (files, bodies) = crate::scene::files(&parts, tool, pose, formats)?;
     report.pose_block = Some(index + 1);
     report.bodies = bodies;
     let mut all: Vec<(String, Vec<u8>)> = files

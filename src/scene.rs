@@ -84,6 +84,15 @@ pub fn tool_pose(
     ))
 }
 
+/// Which 3-D files to write beside the default binary STL and `.glb`.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Formats {
+    /// STL as ASCII instead of binary.
+    pub stl_ascii: bool,
+    /// Also `scene.gltf` + `scene.bin`.
+    pub gltf: bool,
+}
+
 /// Files to write: (name, bytes).
 pub type Files = Vec<(String, Vec<u8>)>;
 
@@ -93,6 +102,7 @@ pub fn files(
     parts: &[(String, TriMesh)],
     tool: Option<(TriMesh, &'static str)>,
     tool_pose: pilgrim_kernel::Mat4,
+    formats: Formats,
 ) -> Result<(Files, Vec<BodyFile>), String> {
     let mut scene = Scene::new();
     let mut out = Vec::new();
@@ -105,7 +115,12 @@ pub fn files(
         m.check_closed().map_err(|e| format!("{name}: {e}"))?;
         let file = format!("{name}.stl");
         let mut bytes = Vec::new();
-        mesh::write_stl(m, name, StlFormat::Binary, &mut bytes).map_err(|e| e.to_string())?;
+        let format = if formats.stl_ascii {
+            StlFormat::Ascii
+        } else {
+            StlFormat::Binary
+        };
+        mesh::write_stl(m, name, format, &mut bytes).map_err(|e| e.to_string())?;
         bodies.push(BodyFile {
             name: name.to_owned(),
             kind: kind.to_owned(),
@@ -132,5 +147,11 @@ pub fn files(
     let mut glb = Vec::new();
     mesh::write_glb(&scene, &mut glb).map_err(|e| e.to_string())?;
     out.push(("scene.glb".into(), glb));
+    if formats.gltf {
+        let (mut text, mut bin) = (Vec::new(), Vec::new());
+        mesh::write_gltf(&scene, "scene.bin", &mut text, &mut bin).map_err(|e| e.to_string())?;
+        out.push(("scene.gltf".into(), text));
+        out.push(("scene.bin".into(), bin));
+    }
     Ok((out, bodies))
 }

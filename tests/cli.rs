@@ -93,13 +93,28 @@ fn machine_file_errors_name_file_and_line() {
     assert_eq!(code, 2);
 }
 
-const FILES: [&str; 5] = [
+const FILES: [&str; 8] = [
     "toolpath.json",
     "program.json",
     "program.mpf",
     "program.cld",
     "report.json",
+    "part.stl",
+    "cutter.stl",
+    "scene.glb",
 ];
+
+/// Leaves a run's models for the external checkers of `.ci/run`.
+fn leave_for_checkers(dir: &Path, tag: &str) {
+    let exe = std::env::current_exe().unwrap();
+    let check = exe.ancestors().nth(3).unwrap().join("mesh-check");
+    std::fs::create_dir_all(&check).unwrap();
+    for f in ["part.stl", "cutter.stl", "wheel.stl", "scene.glb"] {
+        if dir.join(f).exists() {
+            std::fs::copy(dir.join(f), check.join(format!("{tag}-{f}"))).unwrap();
+        }
+    }
+}
 
 #[test]
 fn demo_writes_every_file_and_the_same_bytes_twice() {
@@ -131,6 +146,67 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
         serde_json::from_slice(&std::fs::read(a.join("report.json")).unwrap()).unwrap();
     assert_eq!(report["blocks"], 365);
     assert_eq!(report["parameters"]["radius"]["value"], 40.0);
+    // The disc and the cutter, placed at the first block of the last pass.
+    assert_eq!(report["pose_block"], 365);
+    let disc = pilgrim_kernel::mesh::read_stl(&a.join("part.stl")).unwrap();
+    disc.check_closed().unwrap();
+    let exact = std::f64::consts::PI * 40.0 * 40.0 * 10.0;
+    assert!(
+        (exact - disc.volume()).abs() < 0.01 * exact,
+        "{}",
+        disc.volume()
+    );
+    let cutter = pilgrim_kernel::mesh::read_stl(&a.join("cutter.stl")).unwrap();
+    cutter.check_closed().unwrap();
+    let (lo, hi) = cutter.bounds();
+    // The retract: the cutter's tip 5 mm above the top face, its axis at r = 45.
+    assert!(
+        (lo[2] - 5.0).abs() < 1e-4 && (0.5 * (lo[0] + hi[0]) - 45.0).abs() < 1e-3,
+        "{lo:?} {hi:?}"
+    );
+    leave_for_checkers(&a, "demo");
+    // Export at another block: block 200 is the contour point at C = 196 deg
+    // (block 4 is C = 0).
+    let (code, out, err) = pilgrim(&["export", s(&a), "--block", "200"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("block 200"), "{out}");
+    let moved = pilgrim_kernel::mesh::read_stl(&a.join("cutter.stl")).unwrap();
+    let (lo, hi) = moved.bounds();
+    let c = 196f64.to_radians();
+    let (cx, cy) = (0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]));
+    assert!(
+        (cx - 45.0 * c.cos()).abs() < 0.01 && (cy - 45.0 * c.sin()).abs() < 0.01,
+        "{cx} {cy}"
+    );
+    assert!((lo[2] + 5.0).abs() < 1e-4);
+    assert_eq!(
+        std::fs::read(a.join("part.stl")).unwrap(),
+        std::fs::read(b.join("part.stl")).unwrap()
+    );
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(a.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["pose_block"], 200);
+    leave_for_checkers(&a, "demo-block200");
+    // On request: ASCII STL, and .gltf with its .bin.
+    let c = dir.join("c");
+    let (code, _, err) = pilgrim(&["run", DEMO, "--stl-ascii", "--gltf", "--out", s(&c)]);
+    assert_eq!(code, 0, "{err}");
+    let text = std::fs::read_to_string(c.join("part.stl")).unwrap();
+    assert!(text.starts_with("solid part\n"), "{}", &text[..40]);
+    pilgrim_kernel::mesh::read_stl(&c.join("part.stl"))
+        .unwrap()
+        .check_closed()
+        .unwrap();
+    let gltf_doc = gltf::Gltf::from_slice(&std::fs::read(c.join("scene.gltf")).unwrap()).unwrap();
+    assert_eq!(
+        gltf_doc.buffers().next().unwrap().length(),
+        std::fs::read(c.join("scene.bin")).unwrap().len()
+    );
+    let exe = std::env::current_exe().unwrap();
+    let check = exe.ancestors().nth(3).unwrap().join("mesh-check");
+    for f in ["scene.gltf", "scene.bin"] {
+        std::fs::copy(c.join(f), check.join(f)).unwrap();
+    }
     // A parameter file and --set, a TOML machine and a Rhai machine.
     let params = dir.join("p.toml");
     std::fs::write(&params, "radius = 30.0\npoints = 36\n").unwrap();
