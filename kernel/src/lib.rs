@@ -42,6 +42,7 @@ pub mod script;
 pub mod tool;
 pub mod toolpath;
 pub mod transform;
+pub mod verify;
 
 pub use error::{Error, InputError};
 pub use machine::{Axis, AxisKind, Machine, MachineError};

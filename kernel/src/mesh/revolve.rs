@@ -243,30 +243,6 @@ pub fn revolve(section: &[[Real; 2]], tol: Real) -> Result<TriMesh, MeshError> {
     Ok(mesh)
 }
 
-/// Nodes of the profile kept so that the dropped ones lie within `tol` of
-/// the chords between kept ones (a greedy pass, windows of at most 1000).
-fn simplify(z: &[Real], x: &[Real], tol: Real) -> Vec<usize> {
-    let mut keep = vec![0];
-    let mut anchor = 0;
-    let mut i = 1;
-    while i < z.len() {
-        // Try to extend the chord from anchor to i + 1.
-        let next = i + 1;
-        let ok = next < z.len()
-            && next - anchor <= 1000
-            && (anchor + 1..next).all(|k| {
-                let t = (z[k] - z[anchor]) / (z[next] - z[anchor]);
-                (x[anchor] + t * (x[next] - x[anchor]) - x[k]).abs() <= tol
-            });
-        if !ok {
-            keep.push(i);
-            anchor = i;
-        }
-        i += 1;
-    }
-    keep
-}
-
 /// The solid of revolution of a profile `x(z)` about Z, with flat end caps
 /// (or poles where the profile reaches the axis at its ends). The profile is
 /// thinned to `tol / 2` and turned in steps keeping chords within `tol / 2`.
@@ -291,7 +267,7 @@ pub fn body_of_revolution(profile: &Profile, tol: Real) -> Result<TriMesh, MeshE
             )));
         }
     }
-    let keep = simplify(z, x, tol / 2.0);
+    let keep = crate::profile::simplify_polyline(z, x, tol / 2.0);
     let mut section = Vec::with_capacity(keep.len() + 3);
     section.push([z[0], 0.0]);
     section.push([z[n - 1], 0.0]);

@@ -38,6 +38,8 @@ pub struct CircleEnvelope {
     /// Pieces in z order: (start z, centre z, centre y) with y = sign * x,
     /// so both sides are a lower envelope in y.
     pieces: Vec<(Real, Real, Real)>,
+    /// For each piece, the index of its circle in the input.
+    sources: Vec<usize>,
 }
 
 impl CircleEnvelope {
@@ -68,23 +70,36 @@ impl CircleEnvelope {
         crate::math::all_finite("envelope centre z", zc)?;
         crate::math::all_finite("envelope centre x", xc)?;
         let sigma = side.sign();
-        let mut c: Vec<(Real, Real)> = zc.iter().zip(xc).map(|(&z, &x)| (z, sigma * x)).collect();
-        c.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        let mut c: Vec<(Real, Real, usize)> = zc
+            .iter()
+            .zip(xc)
+            .enumerate()
+            .map(|(i, (&z, &x))| (z, sigma * x, i))
+            .collect();
+        c.sort_unstable_by(|a, b| {
+            a.0.total_cmp(&b.0)
+                .then(a.1.total_cmp(&b.1))
+                .then(a.2.cmp(&b.2))
+        });
         c.dedup_by(|later, kept| later.0 == kept.0); // equal z: keep the lowest
         let mut pieces: Vec<(Real, Real, Real)> = Vec::with_capacity(c.len());
-        for &(z, y) in &c {
+        let mut sources: Vec<usize> = Vec::with_capacity(c.len());
+        for &(z, y, i) in &c {
             loop {
                 match pieces.last() {
                     None => {
                         pieces.push((Real::NEG_INFINITY, z, y));
+                        sources.push(i);
                         break;
                     }
                     Some(&(start, zi, yi)) => {
                         let s = takeover(zi, yi, z, y, radius);
                         if s <= start {
                             pieces.pop();
+                            sources.pop();
                         } else {
                             pieces.push((s, z, y));
+                            sources.push(i);
                             break;
                         }
                     }
@@ -95,6 +110,7 @@ impl CircleEnvelope {
             radius,
             side,
             pieces,
+            sources,
         })
     }
 
@@ -123,8 +139,18 @@ impl CircleEnvelope {
 
     /// The envelope's x at `z`.
     pub fn eval(&self, z: Real) -> Real {
-        let k = self.pieces.partition_point(|p| p.0 <= z).saturating_sub(1);
-        self.value(k, z)
+        self.value(self.piece_at(z), z)
+    }
+
+    fn piece_at(&self, z: Real) -> usize {
+        self.pieces.partition_point(|p| p.0 <= z).saturating_sub(1)
+    }
+
+    /// The index (in the input) of the circle that forms the envelope at
+    /// `z`, or `None` where no circle reaches.
+    pub fn source_at(&self, z: Real) -> Option<usize> {
+        let k = self.piece_at(z);
+        self.value(k, z).is_finite().then(|| self.sources[k])
     }
 
     /// The envelope at many z; linear time when `zs` is sorted ascending
@@ -210,6 +236,13 @@ mod tests {
                     assert_eq!(v, Real::INFINITY, "trial {trial} z {z}");
                 }
                 assert_eq!(env.eval(*z), v);
+                // The source circle is the one that gives that value.
+                if let Some(i) = env.source_at(*z) {
+                    let own = xc[i] - (r * r - (z - zc[i]).powi(2)).sqrt();
+                    assert_near!(own, v, 1e-9);
+                } else {
+                    assert_eq!(v, Real::INFINITY);
+                }
             }
             // Inside is the mirror image.
             let neg: Vec<Real> = xc.iter().map(|x| -x).collect();

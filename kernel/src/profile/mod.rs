@@ -16,12 +16,14 @@
 mod builder;
 mod ellipse;
 mod law;
+mod simplify;
 mod smooth;
 mod table;
 
 pub use builder::{Bulge, ProfileBuilder};
 pub use ellipse::EllipseSection;
 pub use law::{uniform_grid, MandrelLaw};
+pub use simplify::simplify_polyline;
 pub use smooth::Smoothing;
 pub use table::{read_table, read_table_str, Table, TableError, TableFormat};
 
