@@ -69,27 +69,7 @@ impl SweptWheel {
             }
             .into());
         }
-        let spacing = (8.0 * radius * resolution).sqrt();
-        let (mut cz, mut cx, mut block_of) = (vec![z[0]], vec![x[0]], vec![0]);
-        for k in 1..z.len() {
-            let len = (z[k] - z[k - 1]).hypot(x[k] - x[k - 1]);
-            let n = (len / spacing).ceil().max(1.0);
-            if cz.len() as Real + n > 5e7 {
-                return Err(crate::error::InputError::out_of_range(
-                    "verification resolution",
-                    resolution,
-                    "coarse enough for at most 50 million circles",
-                )
-                .into());
-            }
-            let n = n as usize;
-            for j in 1..=n {
-                let t = j as Real / n as Real;
-                cz.push(z[k - 1] + t * (z[k] - z[k - 1]));
-                cx.push(x[k - 1] + t * (x[k] - x[k - 1]));
-                block_of.push(k);
-            }
-        }
+        let (cz, cx, block_of) = crate::offset::swept_circles(z, x, radius, resolution)?;
         Ok(Self {
             envelope: CircleEnvelope::new(&cz, &cx, radius, Side::Outside)?,
             block_of,
@@ -137,6 +117,7 @@ impl SweptWheel {
         zs.sort_by(Real::total_cmp);
         zs.dedup();
         let surface = self.envelope.eval_many(&zs);
+        let profile = nominal.eval_many(&zs)?;
         let mut d = Deviation {
             max_above: Real::NEG_INFINITY,
             above_z: z_from,
@@ -146,7 +127,7 @@ impl SweptWheel {
             at_z: z_from,
             block: None,
         };
-        for (&z, &s) in zs.iter().zip(&surface) {
+        for ((&z, &s), &p) in zs.iter().zip(&surface).zip(&profile) {
             if !s.is_finite() {
                 return Err(ProfileError::OutsideProfile {
                     what: "the wheel never reached the profile".into(),
@@ -155,7 +136,7 @@ impl SweptWheel {
                     z_max: z_to,
                 });
             }
-            let e = s - nominal.eval(z)?;
+            let e = s - p;
             if e > d.max_above {
                 (d.max_above, d.above_z) = (e, z);
             }

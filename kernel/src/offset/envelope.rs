@@ -171,6 +171,48 @@ impl CircleEnvelope {
     }
 }
 
+/// Circle centres (z, x) and, for each, the block whose move placed it.
+pub type SweptCircles = (Vec<Real>, Vec<Real>, Vec<usize>);
+
+/// The circles a wheel's rounding of `radius` leaves along straight moves:
+/// circles along the moves through `(z[i], x[i])`, at most
+/// `sqrt(8 radius resolution)` apart: their centres, and for each the block
+/// whose move placed it (block 0 places the first). Their envelope differs
+/// from the continuously swept circle by at most `resolution` (the scallop
+/// `spacing^2 / (8 radius)`).
+///
+/// # Failures
+/// More than 50 million circles.
+pub fn swept_circles(
+    z: &[Real],
+    x: &[Real],
+    radius: Real,
+    resolution: Real,
+) -> Result<SweptCircles, ProfileError> {
+    let spacing = (8.0 * radius * resolution).sqrt();
+    let (mut cz, mut cx, mut block_of) = (vec![z[0]], vec![x[0]], vec![0]);
+    for k in 1..z.len() {
+        let len = (z[k] - z[k - 1]).hypot(x[k] - x[k - 1]);
+        let n = (len / spacing).ceil().max(1.0);
+        if cz.len() as Real + n > 5e7 {
+            return Err(crate::error::InputError::out_of_range(
+                "verification resolution",
+                resolution,
+                "coarse enough for at most 50 million circles",
+            )
+            .into());
+        }
+        let n = n as usize;
+        for j in 1..=n {
+            let t = j as Real / n as Real;
+            cz.push(z[k - 1] + t * (z[k] - z[k - 1]));
+            cx.push(x[k - 1] + t * (x[k] - x[k - 1]));
+            block_of.push(k);
+        }
+    }
+    Ok((cz, cx, block_of))
+}
+
 /// The z from which circle j (centre zj > zi) is below circle i on the lower
 /// envelope of lower arcs (or i has ended).
 fn takeover(zi: Real, yi: Real, zj: Real, yj: Real, r: Real) -> Real {

@@ -15,7 +15,7 @@ mod envelope;
 pub mod rest;
 
 pub use drop::{drop_circle, Drop};
-pub use envelope::CircleEnvelope;
+pub use envelope::{swept_circles, CircleEnvelope, SweptCircles};
 
 use crate::math::{positive, Real};
 use crate::profile::{CurvatureViolation, Profile, ProfileError};

@@ -99,3 +99,140 @@ pub fn seed_error_bound(max_curvature: Real, max_sin_slope: Real, h: Real, r_o: 
     let reach = r_o * max_sin_slope.abs().min(1.0);
     0.5 * k * (reach + h) * (reach + 2.0 * h) + 0.125 * k * h * h
 }
+
+/// The steady rest along one pass: for each block, the support's centre x
+/// on the current surface (the exact drop), the contact point, and the
+/// seed's formula on the same surface.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RestTrack {
+    /// The support centre's x at each block (exact model).
+    pub centre_x: Vec<Real>,
+    /// The contact point's z at each block.
+    pub contact_z: Vec<Real>,
+    /// The contact point's x at each block.
+    pub contact_x: Vec<Real>,
+    /// The support centre's x by the seed's formula.
+    pub seed_centre_x: Vec<Real>,
+    /// The largest |seed - exact| over the pass (mm).
+    pub max_model_difference: Real,
+}
+
+/// What the rest rides on during a pass.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RestSetup {
+    /// The support's radius R_o (mm).
+    pub radius: Real,
+    /// The offset B: the support's centre stands at z_r = z_k + B.
+    pub offset_b: Real,
+    /// Spacing of the surface samples under the support (mm).
+    pub sample: Real,
+    /// Resolution of the wheel's swept surface (mm), as in [`swept_circles`](super::swept_circles).
+    pub resolution: Real,
+}
+
+/// The steady rest's track along a pass whose wheel rounding (radius
+/// `wheel_radius`) moves through the centres `(z[k], x[k])` in order (a
+/// pass runs one way along z), over a workpiece whose surface before the
+/// pass is `previous`. At block k the rest at `z_r = z[k] + B` rides the
+/// current surface: the previous surface where the wheel has not been, the
+/// surface the wheel has left where it has, their minimum where the
+/// support's reach straddles both (MATH §2.3). The surface under the
+/// support is sampled at `setup.sample` and the exact drop taken on it.
+///
+/// # Failures
+/// Bad numbers; centres of different lengths or fewer than one; a rest
+/// position whose support misses the previous surface altogether.
+pub fn track(
+    previous: &Profile,
+    z: &[Real],
+    x: &[Real],
+    wheel_radius: Real,
+    setup: &RestSetup,
+) -> Result<RestTrack, ProfileError> {
+    positive("rest support radius R_o", setup.radius)?;
+    positive("rest surface sample", setup.sample)?;
+    finite("rest offset B", setup.offset_b)?;
+    let (cz, cx, block_of) = super::swept_circles(z, x, wheel_radius, setup.resolution)?;
+    let full = super::CircleEnvelope::new(&cz, &cx, wheel_radius, Side::Outside)?;
+    // The last circle placed by each block (where the wheel stands then).
+    let mut last_of_block = vec![0usize; z.len()];
+    for (i, &b) in block_of.iter().enumerate() {
+        last_of_block[b] = i;
+    }
+    let increasing = z.last() >= z.first();
+    let reach = setup.radius + wheel_radius;
+    let (lo_prev, hi_prev) = previous.z_range();
+    let slopes = previous.slopes();
+    let prev_at = |zq: Real| crate::profile::hermite(previous.z(), previous.x(), &slopes, zq);
+    let mut out = RestTrack {
+        centre_x: Vec::with_capacity(z.len()),
+        contact_z: Vec::with_capacity(z.len()),
+        contact_x: Vec::with_capacity(z.len()),
+        seed_centre_x: Vec::with_capacity(z.len()),
+        max_model_difference: 0.0,
+    };
+    for k in 0..z.len() {
+        let z_r = z[k] + setup.offset_b;
+        let (a, b) = (
+            (z_r - setup.radius).max(lo_prev),
+            (z_r + setup.radius).min(hi_prev),
+        );
+        if a >= b {
+            return Err(ProfileError::OutsideProfile {
+                what: format!("the steady rest at block {k}"),
+                z: z_r,
+                z_min: lo_prev,
+                z_max: hi_prev,
+            });
+        }
+        // Circles whose reach meets the support's: a run of the pass.
+        let near: Vec<usize> = if increasing {
+            let s = cz.partition_point(|&c| c < z_r - reach);
+            let e = cz.partition_point(|&c| c <= z_r + reach);
+            (s..e).collect()
+        } else {
+            let s = cz.partition_point(|&c| c > z_r + reach);
+            let e = cz.partition_point(|&c| c >= z_r - reach);
+            (s..e).collect()
+        };
+        let now = last_of_block[k];
+        let cut: Option<super::CircleEnvelope> = match (near.first(), near.last()) {
+            (Some(_), Some(&last)) if last <= now => None, // all cut: the full envelope serves
+            (Some(&first), Some(_)) if first <= now => {
+                let (pz, px): (Vec<Real>, Vec<Real>) =
+                    (first..=now).map(|i| (cz[i], cx[i])).unzip();
+                Some(super::CircleEnvelope::new(
+                    &pz,
+                    &px,
+                    wheel_radius,
+                    Side::Outside,
+                )?)
+            }
+            _ => None,
+        };
+        let all_cut = matches!((near.first(), near.last()), (Some(_), Some(&last)) if last <= now);
+        let grid = crate::profile::uniform_grid(a, b, setup.sample)?;
+        let surface: Vec<Real> = grid
+            .iter()
+            .map(|&g| {
+                let p = prev_at(g);
+                if all_cut {
+                    p.min(full.eval(g))
+                } else if let Some(env) = &cut {
+                    p.min(env.eval(g))
+                } else {
+                    p
+                }
+            })
+            .collect();
+        let window = Profile::new(grid, surface)?;
+        let d = super::drop_circle(&window, z_r, setup.radius, Side::Outside)?;
+        let seed = seed_u(&window, z_r.clamp(a, b), setup.radius)?;
+        out.max_model_difference = out.max_model_difference.max((seed - d.centre_x).abs());
+        out.centre_x.push(d.centre_x);
+        out.contact_z.push(d.contact_z);
+        out.contact_x.push(d.contact_x);
+        out.seed_centre_x.push(seed);
+    }
+    Ok(out)
+}

@@ -361,14 +361,24 @@ impl Profile {
     }
 
     /// x at any z of the range, by cubic Hermite interpolation with the
-    /// node slopes of [`Self::slopes`].
+    /// node slopes of [`Self::slopes`]. Without analytic derivatives the
+    /// slopes are estimated on each call: for many points use
+    /// [`Self::eval_many`].
     ///
     /// # Failures
     /// z outside the profile's range, or not finite.
     pub fn eval(&self, z: Real) -> Result<Real, ProfileError> {
-        crate::math::finite("profile query z", z)?;
+        Ok(self.eval_many(&[z])?[0])
+    }
+
+    /// x at many z (as [`Self::eval`]), the slopes estimated once.
+    ///
+    /// # Failures
+    /// A z outside the profile's range, or not finite (the first one).
+    pub fn eval_many(&self, zs: &[Real]) -> Result<Vec<Real>, ProfileError> {
         let (lo, hi) = self.z_range();
-        if !(lo..=hi).contains(&z) {
+        if let Some(&z) = zs.iter().find(|z| !(lo..=hi).contains(*z)) {
+            crate::math::finite("profile query z", z)?;
             return Err(ProfileError::OutsideProfile {
                 what: "profile value".into(),
                 z,
@@ -377,7 +387,10 @@ impl Profile {
             });
         }
         let slopes = self.slopes();
-        Ok(hermite(&self.z, &self.x, &slopes, z))
+        Ok(zs
+            .iter()
+            .map(|&z| hermite(&self.z, &self.x, &slopes, z))
+            .collect())
     }
 
     /// The profile resampled at a uniform step of z from its first to its
