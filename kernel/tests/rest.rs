@@ -30,7 +30,7 @@ fn rest_rides_the_cut_behind_the_wheel_and_the_stock_ahead() {
         let z_r = zk - 100.0;
         let u = behind.centre_x[k];
         assert!(
-            u >= 29.9 + R_O - 1e-9 && u <= 30.0 + R_O + 1e-9,
+            (29.9 + R_O - 1e-9..=30.0 + R_O + 1e-9).contains(&u),
             "block {k}: {u}"
         );
         // On the cut, within the swept surface's resolution (its scallops).
