@@ -226,3 +226,68 @@ fn transforms_in_scripts_follow_the_universal_chain() {
         .to_string();
     assert!(text.contains("not 'rw'"), "{text}");
 }
+
+/// The segment builder, adaptive spacing and the rest's track from a
+/// script give what the same kernel calls give from Rust.
+#[test]
+fn mandrel_building_blocks_in_scripts() {
+    use pilgrim_kernel::offset::rest::{track, RestSetup};
+    use pilgrim_kernel::profile::simplify_polyline;
+    use pilgrim_kernel::{equidistant, MandrelLaw, ProfileBuilder, Side};
+    let src = format!(
+        "{HEAD}fn toolpath(p) {{\n\
+           let law = mandrel_law(38.0, 52.0, 400.0, 0.012, 2.3);\n\
+           let part = profile_start(-350.0, 19.0 - 350.0 * 0.006).line_to(0.0, 19.0).law(law)\n\
+                        .line_to(500.0, 26.0 + 100.0 * 0.0324).build(0.00001, 0.05);\n\
+           let e = equidistant(part, 20.0, \"outside\");\n\
+           let k = simplify(e.z, e.x, 0.0005);\n\
+           let stock = profile_start(-700.0, 30.0).cylinder(1600.0).build(0.001, 1.0);\n\
+           let rest = rest_track(stock, k.z, k.x, 20.0, 25.0, -150.0);\n\
+           let tp = new_toolpath(\"m\", wheel_tool(\"w\", 1, 500.0, 20.0, 50.0), 399.0, [\"U\"]);\n\
+           tp.add_pass(\"finish\", #{{ x: k.x, y: 0.0, z: k.z, feed: 2000.0, aux: #{{ U: rest.centre_x }} }});\n\
+           tp\n}}"
+    );
+    let fam = family(&src).unwrap();
+    let tp = fam.toolpath(&fam.resolve(None, &[]).unwrap()).unwrap();
+    let law = MandrelLaw::new(38.0, 52.0, 400.0, 0.012, 2.3).unwrap();
+    let part = ProfileBuilder::start(-350.0, 19.0 - 350.0 * 0.006)
+        .line_to(0.0, 19.0)
+        .law(law)
+        .line_to(500.0, 26.0 + 100.0 * 0.0324)
+        .build(0.00001, 0.05)
+        .unwrap();
+    let e = equidistant(&part, 20.0, Side::Outside).unwrap();
+    let keep = simplify_polyline(&e.z, &e.x, 0.0005);
+    let pass = &tp.passes[0].points;
+    assert_eq!(pass.len(), keep.len());
+    assert!(
+        keep.len() < e.z.len() / 50,
+        "{} of {}",
+        keep.len(),
+        e.z.len()
+    );
+    let stock = ProfileBuilder::start(-700.0, 30.0)
+        .cylinder(1600.0)
+        .build(0.001, 1.0)
+        .unwrap();
+    let (cz, cx): (Vec<f64>, Vec<f64>) = keep.iter().map(|&i| (e.z[i], e.x[i])).unzip();
+    let setup = RestSetup {
+        radius: 25.0,
+        offset_b: -150.0,
+        sample: 0.05,
+        resolution: 1e-5,
+    };
+    let t = track(&stock, &cz, &cx, 20.0, &setup).unwrap();
+    for (c, (u, (z, x))) in pass.iter().zip(t.centre_x.iter().zip(cz.iter().zip(&cx))) {
+        assert_eq!((c.point[2], c.point[0], c.aux[0]), (*z, *x, *u));
+    }
+    let e = family(&format!(
+        "{HEAD}fn toolpath(p) {{ profile_start(0.0, 1.0).arc_to(1.0, 1.0, 2.0, \"sideways\") }}"
+    ))
+    .unwrap();
+    let text = e
+        .toolpath(&e.resolve(None, &[]).unwrap())
+        .unwrap_err()
+        .to_string();
+    assert!(text.contains("\"out\" or \"in\""), "{text}");
+}

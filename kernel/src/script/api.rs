@@ -367,6 +367,100 @@ pub mod profile_api {
     }
 }
 
+/// A whole part profile chained from segments, for scripts.
+#[export_module]
+pub mod builder_api {
+    use super::*;
+    use crate::profile::{Bulge, ProfileBuilder};
+
+    /// Starts a whole part profile at `(z, x)`; chain segments left to right
+    /// along z, then `build`.
+    ///
+    /// ```rhai
+    /// let p = profile_start(-80.0, 18.0).cylinder(40.0).line_to(-30.0, 20.0)
+    ///             .law(mandrel_law(40.0, 48.0, 300.0, 0.01, 2.5)).build(0.001, 1.0);
+    /// ```
+    pub fn profile_start(z: Real, x: Real) -> ProfileBuilder {
+        ProfileBuilder::start(z, x)
+    }
+
+    /// A straight segment (cone or cylinder) to `(z, x)`.
+    #[rhai_fn(name = "line_to")]
+    pub fn line_to(b: ProfileBuilder, z: Real, x: Real) -> ProfileBuilder {
+        b.line_to(z, x)
+    }
+
+    /// A cylinder of `length` at the current radius.
+    #[rhai_fn(name = "cylinder")]
+    pub fn cylinder(b: ProfileBuilder, length: Real) -> ProfileBuilder {
+        b.cylinder(length)
+    }
+
+    /// An arc of `radius` to `(z, x)`, bulging "out" (convex, centre below)
+    /// or "in" (a fillet, centre above).
+    #[rhai_fn(name = "arc_to", return_raw)]
+    pub fn arc_to(
+        b: ProfileBuilder,
+        z: Real,
+        x: Real,
+        radius: Real,
+        bulge: &str,
+    ) -> Result<ProfileBuilder, Box<EvalAltResult>> {
+        let bulge = match bulge {
+            "out" => Bulge::Out,
+            "in" => Bulge::In,
+            other => {
+                return err(format!(
+                    "arc bulge must be \"out\" or \"in\", not \"{other}\""
+                ))
+            }
+        };
+        Ok(b.arc_to(z, x, radius, bulge))
+    }
+
+    /// The mandrel law from the current z (the current x must be d_min / 2).
+    #[rhai_fn(name = "law")]
+    pub fn law(b: ProfileBuilder, law: MandrelLaw) -> ProfileBuilder {
+        b.law(law)
+    }
+
+    /// The profile, chords within `tol` (mm), nodes at most `max_step` apart.
+    #[rhai_fn(name = "build", return_raw)]
+    pub fn build(
+        b: ProfileBuilder,
+        tol: Real,
+        max_step: Real,
+    ) -> Result<Profile, Box<EvalAltResult>> {
+        kernel(b.build(tol, max_step))
+    }
+
+    /// The fewest points of the polyline `(z, x)` keeping every dropped one
+    /// within `tol` of the chords (Douglas–Peucker): the adaptive spacing of
+    /// a wheel's moves along its equidistant. Returns `#{ z, x }`.
+    #[rhai_fn(return_raw)]
+    pub fn simplify(z: Floats, x: Floats, tol: Real) -> Result<Map, Box<EvalAltResult>> {
+        if z.0.len() != x.0.len() {
+            return err(format!(
+                "simplify: z has {} values, x {}",
+                z.0.len(),
+                x.0.len()
+            ));
+        }
+        crate::math::positive("simplify tolerance", tol).map_err(|e| e.to_string())?;
+        let keep = crate::profile::simplify_polyline(&z.0, &x.0, tol);
+        let mut m = Map::new();
+        m.insert(
+            "z".into(),
+            Dynamic::from(Floats::new(keep.iter().map(|&i| z.0[i]).collect())),
+        );
+        m.insert(
+            "x".into(),
+            Dynamic::from(Floats::new(keep.iter().map(|&i| x.0[i]).collect())),
+        );
+        Ok(m)
+    }
+}
+
 /// Equidistants, drops, envelopes and the steady rest.
 #[export_module]
 pub mod offset_api {
@@ -432,6 +526,50 @@ pub mod offset_api {
     #[rhai_fn(return_raw)]
     pub fn rest_seed_u(surface: Profile, z_r: Real, r_o: Real) -> Result<Real, Box<EvalAltResult>> {
         kernel(offset::rest::seed_u(&surface, z_r, r_o))
+    }
+
+    /// The steady rest along a pass (MATH §2.3): the wheel's rounding centre
+    /// moves through `(cz, cx)` (one way along z) over a workpiece whose
+    /// surface before the pass is `previous`; the rest's support (radius
+    /// `r_o`) stands at `z_r = z + b`. Returns per block `#{ centre_x,
+    /// contact_z, contact_x, seed_centre_x }` (Floats) and
+    /// `max_model_difference`: the exact drop on the current surface, and the
+    /// seed's formula on it.
+    #[rhai_fn(return_raw)]
+    pub fn rest_track(
+        previous: Profile,
+        cz: Floats,
+        cx: Floats,
+        wheel_radius: Real,
+        r_o: Real,
+        b: Real,
+    ) -> Result<Map, Box<EvalAltResult>> {
+        let setup = offset::rest::RestSetup {
+            radius: r_o,
+            offset_b: b,
+            sample: 0.05,
+            resolution: 1e-5,
+        };
+        let t = kernel(offset::rest::track(
+            &previous,
+            &cz.0,
+            &cx.0,
+            wheel_radius,
+            &setup,
+        ))?;
+        let mut m = Map::new();
+        m.insert("centre_x".into(), Dynamic::from(Floats::new(t.centre_x)));
+        m.insert("contact_z".into(), Dynamic::from(Floats::new(t.contact_z)));
+        m.insert("contact_x".into(), Dynamic::from(Floats::new(t.contact_x)));
+        m.insert(
+            "seed_centre_x".into(),
+            Dynamic::from(Floats::new(t.seed_centre_x)),
+        );
+        m.insert(
+            "max_model_difference".into(),
+            Dynamic::from_float(t.max_model_difference),
+        );
+        Ok(m)
     }
 
     /// The steady rest's centre x at `z_r` by the exact drop.
@@ -709,9 +847,11 @@ pub fn register(engine: &mut Engine) {
         .register_type_with_name::<MandrelLaw>("MandrelLaw")
         .register_type_with_name::<Tool>("Tool")
         .register_type_with_name::<Transform>("Transform")
+        .register_type_with_name::<crate::profile::ProfileBuilder>("ProfileBuilder")
         .register_type_with_name::<ToolpathHandle>("Toolpath");
     engine.register_global_module(exported_module!(floats_api).into());
     engine.register_global_module(exported_module!(profile_api).into());
+    engine.register_global_module(exported_module!(builder_api).into());
     engine.register_global_module(exported_module!(offset_api).into());
     engine.register_global_module(exported_module!(transform_api).into());
     engine.register_global_module(exported_module!(tool_api).into());
