@@ -46,8 +46,9 @@ enum Command {
         #[arg(long)]
         machine: Option<String>,
         /// The output directory (replaced as a whole when the run succeeds).
-        #[arg(long, default_value = "out/run")]
-        out: PathBuf,
+        /// Default: out/<script name>.
+        #[arg(long)]
+        out: Option<PathBuf>,
         /// The block (from 1) to place the tool at in the 3-D models.
         /// Default: the first block of the last pass.
         #[arg(long, value_name = "N")]
@@ -242,7 +243,9 @@ fn main() -> ExitCode {
             params: params.clone(),
             sets: sets.clone(),
             machine: machine.clone(),
-            out: out.clone(),
+            out: out.clone().unwrap_or_else(|| {
+                PathBuf::from("out").join(script.file_stem().unwrap_or_else(|| "run".as_ref()))
+            }),
             quiet: cli.quiet,
         })
         .map(|s| s + "\n"),

@@ -109,7 +109,13 @@ fn leave_for_checkers(dir: &Path, tag: &str) {
     let exe = std::env::current_exe().unwrap();
     let check = exe.ancestors().nth(3).unwrap().join("mesh-check");
     std::fs::create_dir_all(&check).unwrap();
-    for f in ["part.stl", "cutter.stl", "wheel.stl", "scene.glb"] {
+    for f in [
+        "part.stl",
+        "blank.stl",
+        "cutter.stl",
+        "wheel.stl",
+        "scene.glb",
+    ] {
         if dir.join(f).exists() {
             std::fs::copy(dir.join(f), check.join(format!("{tag}-{f}"))).unwrap();
         }
@@ -392,6 +398,8 @@ fn every_script_runs_with_its_defaults() {
         let (code, _, err) = pilgrim(&["run", s(script), "--out", s(&out), "--quiet"]);
         assert_eq!(code, 0, "{}: {err}", script.display());
         assert!(out.join("report.json").exists());
+        let stem = script.file_stem().unwrap().to_str().unwrap();
+        leave_for_checkers(&out, &format!("script-{stem}"));
     }
 }
 

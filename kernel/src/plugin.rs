@@ -197,6 +197,7 @@ impl PluginMachine {
                 axes: vec![],
                 solved_axes: vec![],
                 constants: Default::default(),
+                program_decimals: None,
             },
             abi: (major, minor),
         };

@@ -23,6 +23,7 @@ struct MachineFile {
     bodies: BTreeMap<String, BodyFile>,
     #[serde(default)]
     constants: BTreeMap<String, Spanned<Real>>,
+    program_decimals: Option<Spanned<i64>>,
 }
 
 #[derive(Deserialize)]
@@ -227,7 +228,18 @@ impl Machine {
                 None => constants.insert(k.clone(), x),
             };
         }
+        let program_decimals = match &file.program_decimals {
+            None => None,
+            Some(d) if (0..=6).contains(d.get_ref()) => Some(*d.get_ref() as usize),
+            Some(d) => {
+                return Err(src.err(
+                    d.span(),
+                    format!("program_decimals = {} must be 0 to 6", d.get_ref()),
+                ))
+            }
+        };
         let machine = Machine {
+            program_decimals,
             name: file.name.get_ref().clone(),
             description: file.description,
             control: file.control,

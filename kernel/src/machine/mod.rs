@@ -186,6 +186,7 @@ pub struct Machine {
     tool: ToolFrame,
     bodies: BTreeMap<String, Chain>,
     constants: BTreeMap<String, Real>,
+    program_decimals: Option<usize>,
 }
 
 impl Machine {
@@ -245,6 +246,12 @@ impl Machine {
     /// The names of the other bodies.
     pub fn body_names(&self) -> impl Iterator<Item = &str> {
         self.bodies.keys().map(String::as_str)
+    }
+
+    /// Decimals of axis values in this machine's programs, if it states them
+    /// (its resolution: 4 for 0.1 um); otherwise the dialect's.
+    pub fn program_decimals(&self) -> Option<usize> {
+        self.program_decimals
     }
 
     /// A named machine constant (mm or rad), e.g. the rest's offset `B`.

@@ -236,3 +236,29 @@ pub fn track(
     }
     Ok(out)
 }
+
+/// The surface after a pass: the lower of `previous` and the surface the
+/// wheel's rounding (radius `wheel_radius`) leaves moving through
+/// `(z[k], x[k])`, at `previous`'s nodes (the pass's own scallops, below
+/// `resolution`, are what lies between).
+///
+/// # Failures
+/// As [`swept_circles`](super::swept_circles) and [`Profile::new`].
+pub fn after_pass(
+    previous: &Profile,
+    z: &[Real],
+    x: &[Real],
+    wheel_radius: Real,
+    resolution: Real,
+) -> Result<Profile, ProfileError> {
+    let (cz, cx, _) = super::swept_circles(z, x, wheel_radius, resolution)?;
+    let env = super::CircleEnvelope::new(&cz, &cx, wheel_radius, Side::Outside)?;
+    let cut = env.eval_many(previous.z());
+    let xs = previous
+        .x()
+        .iter()
+        .zip(cut)
+        .map(|(p, c)| p.min(c))
+        .collect();
+    Profile::new(previous.z().to_vec(), xs)
+}

@@ -25,6 +25,9 @@ pub struct MachineInfo {
     /// Named machine constants (mm, rad).
     #[serde(default)]
     pub constants: BTreeMap<String, Real>,
+    /// Decimals of axis values in programs, if the machine states them.
+    #[serde(default)]
+    pub program_decimals: Option<usize>,
 }
 
 impl MachineInfo {
@@ -42,6 +45,7 @@ impl MachineInfo {
             axes: machine.axes().to_vec(),
             solved_axes: machine.chain().axis_names().to_vec(),
             constants: machine.constants().clone(),
+            program_decimals: machine.program_decimals(),
         }
     }
 }

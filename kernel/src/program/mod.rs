@@ -62,6 +62,10 @@ pub struct AxisProgram {
     pub tool_name: String,
     /// Spindle speed (rpm).
     pub spindle_rpm: Real,
+    /// Decimals of axis values, if the machine states them (else the
+    /// dialect's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub decimals: Option<usize>,
     /// The programmed axes.
     pub axes: Vec<ProgramAxis>,
     /// The blocks.
@@ -346,6 +350,7 @@ impl AxisProgram {
             tool_number: toolpath.tool.number,
             tool_name: toolpath.tool.name.clone(),
             spindle_rpm: toolpath.spindle_rpm,
+            decimals: info.program_decimals,
             axes: columns
                 .iter()
                 .map(|(a, _)| ProgramAxis {

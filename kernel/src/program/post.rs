@@ -313,7 +313,8 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
         if let Some(s) = spindle {
             last_spindle = s;
         }
-        let values: Vec<String> = b.values.iter().map(|v| fixed(*v, d.decimals)).collect();
+        let decimals = program.decimals.unwrap_or(d.decimals);
+        let values: Vec<String> = b.values.iter().map(|v| fixed(*v, decimals)).collect();
         match d.style {
             Style::Apt => {
                 if let Some(s) = spindle {
@@ -416,6 +417,7 @@ mod tests {
             tool_number: 3,
             tool_name: "thread insert (60)".into(),
             spindle_rpm: 399.4,
+            decimals: None,
             axes: vec![axis("X"), axis("Z")],
             blocks: vec![
                 block(Motion::Rapid, [50.0, 5.0], 0.0, Some("pass 1")),
@@ -468,6 +470,17 @@ SPINDL/OFF\nFINI\n";
         assert!(
             a.contains("GOTO/40.000,0.000\nSPINDL/120,RPM,CLW\nFEDRAT/6.3500,MMPR\n"),
             "{a}"
+        );
+    }
+
+    #[test]
+    fn a_machine_may_program_finer() {
+        let mut p = program();
+        p.decimals = Some(4);
+        let g = post(&p, &SINUMERIK).unwrap();
+        assert!(
+            g.contains("N40 G0 X50.0000 Z5.0000\n") && g.contains("N60 Z-0.0001\n"),
+            "{g}"
         );
     }
 

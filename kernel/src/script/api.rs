@@ -356,6 +356,12 @@ pub mod profile_api {
         law.x(z)
     }
 
+    /// The law's slope dx/dz at z.
+    #[rhai_fn(name = "dx")]
+    pub fn law_dx(law: &mut MandrelLaw, z: Real) -> Real {
+        law.dx(z)
+    }
+
     /// The law sampled at `step` from `z_start`, with analytic derivatives.
     #[rhai_fn(name = "profile", return_raw)]
     pub fn law_profile(
@@ -570,6 +576,48 @@ pub mod offset_api {
             Dynamic::from_float(t.max_model_difference),
         );
         Ok(m)
+    }
+
+    /// The surface after a pass: the lower of `previous` and what the wheel's
+    /// rounding leaves moving through `(cz, cx)`, at `previous`'s nodes.
+    #[rhai_fn(return_raw)]
+    pub fn cut(
+        previous: Profile,
+        cz: Floats,
+        cx: Floats,
+        wheel_radius: Real,
+    ) -> Result<Profile, Box<EvalAltResult>> {
+        kernel(offset::rest::after_pass(
+            &previous,
+            &cz.0,
+            &cx.0,
+            wheel_radius,
+            1e-5,
+        ))
+    }
+
+    /// The profile with `dx` added where `z_from <= z <= z_to` (a stock
+    /// allowance over the ground length: the blank).
+    #[rhai_fn(return_raw)]
+    pub fn raise(
+        p: Profile,
+        z_from: Real,
+        z_to: Real,
+        dx: Real,
+    ) -> Result<Profile, Box<EvalAltResult>> {
+        let x = p
+            .z()
+            .iter()
+            .zip(p.x())
+            .map(|(z, x)| {
+                if (z_from..=z_to).contains(z) {
+                    x + dx
+                } else {
+                    *x
+                }
+            })
+            .collect();
+        kernel(Profile::new(p.z().to_vec(), x))
     }
 
     /// The steady rest's centre x at `z_r` by the exact drop.

@@ -1,0 +1,233 @@
+//! The mandrel family (seed 000) checked from the program text it writes.
+
+use grinder_3k152vf20::Grinder;
+use pilgrim_kernel::offset::rest::after_pass;
+use pilgrim_kernel::offset::{swept_circles, CircleEnvelope};
+use pilgrim_kernel::script::{Access, Family, Limits};
+use pilgrim_kernel::{drop_circle, AxisProgram, MachineKinematics, MandrelLaw, Profile, Side};
+use std::path::Path;
+
+const R_S: f64 = 20.0;
+
+fn family() -> Family {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/mandrel.rhai");
+    Family::load(&path, &Limits::default(), &Access::default()).unwrap()
+}
+
+/// The blocks of each pass of a Sinumerik program: (Z, X, U), modal words
+/// carried over, passes split at their comments.
+fn passes_from_text(text: &str) -> Vec<(String, Vec<[f64; 3]>)> {
+    let mut passes: Vec<(String, Vec<[f64; 3]>)> = Vec::new();
+    let mut at = [f64::NAN; 3];
+    for line in text.lines() {
+        if let Some(c) = line.strip_prefix("; ") {
+            if c.starts_with("pass ") || c == "approach" || c == "retract" {
+                passes.push((c.to_owned(), vec![]));
+            }
+            continue;
+        }
+        if !line.starts_with('N') {
+            continue;
+        }
+        let mut moved = false;
+        for w in line.split_whitespace() {
+            let k = match w.as_bytes()[0] {
+                b'Z' => 0,
+                b'X' => 1,
+                b'U' => 2,
+                _ => continue,
+            };
+            at[k] = w[1..].parse().unwrap();
+            moved = true;
+        }
+        if moved {
+            if let Some(p) = passes.last_mut() {
+                p.1.push(at);
+            }
+        }
+    }
+    passes
+}
+
+fn program_text() -> (Family, String, AxisProgram) {
+    let fam = family();
+    let values = fam.resolve(None, &[]).unwrap();
+    let tp = fam.toolpath(&values).unwrap();
+    let grinder = Grinder::new();
+    let program = AxisProgram::build(&tp, &grinder, "mandrel").unwrap();
+    let text = grinder.post(&program, "sinumerik").unwrap();
+    (fam, text, program)
+}
+
+/// Every finishing block puts the rounding's centre (Z, X + R_s) at R_s from
+/// the nominal profile, within 0.1 um, read back from the program's text.
+#[test]
+fn finishing_blocks_stand_at_r_s_from_the_law() {
+    let (_, text, _) = program_text();
+    let passes = passes_from_text(&text);
+    let (name, finish) = passes
+        .iter()
+        .rev()
+        .find(|p| p.0.starts_with("pass "))
+        .unwrap();
+    assert!(name.contains("stock 0"), "{name}");
+    let law = MandrelLaw::new(38.0, 52.0, 400.0, 0.012, 2.3).unwrap();
+    // The ground profile: the law, and its end tangents over the overrun.
+    let x = |z: f64| {
+        if z < 0.0 {
+            law.x(0.0) + law.dx(0.0) * z
+        } else if z > 400.0 {
+            law.x(400.0) + law.dx(400.0) * (z - 400.0)
+        } else {
+            law.x(z)
+        }
+    };
+    let mut worst: f64 = 0.0;
+    for b in finish {
+        let (cz, cx) = (b[0], b[1] + R_S);
+        // Nearest point of the profile: a fine search, then golden sections.
+        let d2 = |z: f64| (z - cz).powi(2) + (x(z) - cx).powi(2);
+        let mut best = cz;
+        for i in 0..=400 {
+            let z = cz - 2.0 + 4.0 * i as f64 / 400.0;
+            if d2(z) < d2(best) {
+                best = z;
+            }
+        }
+        let (mut a, mut c) = (best - 0.01, best + 0.01);
+        for _ in 0..100 {
+            let (m1, m2) = (a + 0.382 * (c - a), a + 0.618 * (c - a));
+            if d2(m1) < d2(m2) {
+                c = m2;
+            } else {
+                a = m1;
+            }
+        }
+        let dist = d2(0.5 * (a + c)).sqrt();
+        worst = worst.max((dist - R_S).abs());
+    }
+    assert!(worst <= 1e-4, "a finishing block is {worst:e} mm off R_s");
+    assert!(finish.len() > 20);
+}
+
+/// U at every block is the exact drop of the rest's support on the current
+/// surface, simulated independently from the program's text: the blank,
+/// lowered by each earlier pass's swept wheel and by this pass's circles
+/// placed so far; never pressing in, never standing off, within 1 um.
+#[test]
+fn the_rest_rides_the_simulated_surface() {
+    let (fam, text, _) = program_text();
+    let values = fam.resolve(None, &[]).unwrap();
+    let part = fam.call_with_params("part", &values).unwrap();
+    let map = part.try_cast::<rhai::Map>().unwrap();
+    let mut surface = map["blank"].clone().cast::<Profile>();
+    let (r_o, b) = (25.0, -180.0);
+    let mut checked = 0;
+    for (name, blocks) in passes_from_text(&text)
+        .iter()
+        .filter(|p| p.0.starts_with("pass "))
+    {
+        let cz: Vec<f64> = blocks.iter().map(|b| b[0]).collect();
+        let cx: Vec<f64> = blocks.iter().map(|b| b[1] + R_S).collect();
+        let (dz, dx, block_of) = swept_circles(&cz, &cx, R_S, 1e-5).unwrap();
+        for k in (0..blocks.len()).step_by(4) {
+            let z_r = cz[k] + b;
+            let placed: Vec<usize> = (0..dz.len())
+                .filter(|&i| block_of[i] <= k && (dz[i] - z_r).abs() <= r_o + R_S)
+                .collect();
+            let grid: Vec<f64> = (0..=2500)
+                .map(|i| z_r - r_o + 2.0 * r_o * i as f64 / 2500.0)
+                .collect();
+            let mut s = surface.eval_many(&grid).unwrap();
+            if !placed.is_empty() {
+                let (pz, px): (Vec<f64>, Vec<f64>) = placed.iter().map(|&i| (dz[i], dx[i])).unzip();
+                let env = CircleEnvelope::new(&pz, &px, R_S, Side::Outside).unwrap();
+                for (v, e) in s.iter_mut().zip(env.eval_many(&grid)) {
+                    *v = v.min(e);
+                }
+            }
+            let under = Profile::new(grid, s).unwrap();
+            let exact = drop_circle(&under, z_r, r_o, Side::Outside)
+                .unwrap()
+                .centre_x;
+            let u = blocks[k][2];
+            assert!(
+                (u - exact).abs() <= 1e-3,
+                "{name}, block {k}: U {u}, simulated {exact}"
+            );
+            checked += 1;
+        }
+        surface = after_pass(&surface, &cz, &cx, R_S, 1e-5).unwrap();
+    }
+    assert!(checked >= 60, "only {checked} blocks checked");
+}
+
+/// Bad parameters stop the run with a clear message, and nothing is written.
+#[test]
+fn bad_mandrel_parameters_are_refused_and_nothing_is_written() {
+    let dir = std::env::temp_dir().join(format!("pilgrim-mandrel-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = dir.join("out");
+    let run = |sets: &[&str]| {
+        let mut args = vec![
+            "run".to_owned(),
+            "scripts/mandrel.rhai".into(),
+            "--out".into(),
+            out.display().to_string(),
+            "--quiet".into(),
+        ];
+        for s in sets {
+            args.push("--set".into());
+            args.push((*s).into());
+        }
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_pilgrim"))
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .args(&args)
+            .output()
+            .unwrap();
+        (
+            o.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let (code, err) = run(&[]);
+    assert_eq!(code, 0, "{err}");
+    let before = std::fs::read(out.join("program.mpf")).unwrap();
+    for (sets, expected) in [
+        (
+            vec!["d_min=60"],
+            "mandrel d_min = 60 is out of range: at most d_max = 52",
+        ),
+        (vec!["l_r=0"], "mandrel L_r must be > 0, got 0"),
+        (vec!["n=0"], "mandrel n must be > 0, got 0"),
+        (vec!["stock=-0.1"], "the stock is not negative"),
+        (
+            vec!["n=30", "wheel_r=60", "wheel_w=130"],
+            "tool radius 60 mm exceeds the profile's radius of curvature",
+        ),
+        (vec!["rest_r=140"], "axis U at 1"),
+        (
+            vec!["d_mn=40"],
+            "unknown parameter 'd_mn' from --set (parameters: cone_d, cone_len, d_max, d_min",
+        ),
+    ] {
+        let (code, err) = run(&sets);
+        assert_eq!(code, 1, "{sets:?}: {err}");
+        assert!(err.contains(expected), "{sets:?}: {err}");
+        assert_eq!(
+            std::fs::read(out.join("program.mpf")).unwrap(),
+            before,
+            "{sets:?}"
+        );
+    }
+    // The wheel too round is refused naming the places, near the law's end.
+    let (_, err) = run(&["n=30", "wheel_r=60", "wheel_w=130"]);
+    assert!(err.contains("z = 39"), "{err}");
+    // U beyond its travel names the block.
+    let (_, err) = run(&["rest_r=140"]);
+    assert!(
+        err.contains("block ") && err.contains("outside its travel [0, 150] mm"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
