@@ -52,6 +52,42 @@ struct Report {
     /// The bodies written as STL.
     #[serde(default)]
     bodies: Vec<crate::scene::BodyFile>,
+    /// Each programmed axis's range over the program: [min, max] (mm, deg).
+    #[serde(default)]
+    axis_ranges: BTreeMap<String, [f64; 2]>,
+    /// The program replayed against the nominal part (families with fn verify).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    verification: Option<pilgrim_kernel::verify::GrindingCheck>,
+    /// Figures the family noted.
+    #[serde(default)]
+    notes: BTreeMap<String, f64>,
+}
+
+/// One row per block: block number, pass, motion, axis values, feed.
+fn block_table(program: &AxisProgram, toolpath: &Toolpath) -> String {
+    let mut out = String::from("block,pass,motion");
+    for a in &program.axes {
+        out += &format!(",{} ({})", a.name, a.unit);
+    }
+    out += ",feed (mm/min)\n";
+    let names = toolpath
+        .passes
+        .iter()
+        .flat_map(|p| std::iter::repeat_n(p.name.as_str(), p.points.len()));
+    let decimals = program.decimals.unwrap_or(3);
+    for (i, (b, pass)) in program.blocks.iter().zip(names).enumerate() {
+        let motion = match b.motion {
+            Motion::Rapid => "rapid",
+            Motion::Linear => "linear",
+            Motion::Thread { .. } => "thread",
+        };
+        out += &format!("{},\"{}\",{motion}", i + 1, pass.replace('"', "'"));
+        for v in &b.values {
+            out += &format!(",{}", pilgrim_kernel::math::fixed(*v, decimals));
+        }
+        out += &format!(",{}\n", pilgrim_kernel::math::fixed(b.feed, 1));
+    }
+    out
 }
 
 /// Minutes of cutting and rapid moves, from the program's feeds (rapids at
@@ -171,6 +207,32 @@ pub fn run(args: &RunArgs) -> Result<String, String> {
         .unwrap_or("pilgrim");
     let program =
         AxisProgram::build(&toolpath, machine.as_ref(), name).map_err(|e| e.to_string())?;
+    let verification = match family.verification(&values).map_err(|e| e.to_string())? {
+        None => None,
+        Some(v) => {
+            let pilgrim_kernel::ToolShape::Wheel(w) = toolpath.tool.shape else {
+                return Err(format!(
+                    "{}: fn verify(p) needs a grinding wheel",
+                    family.file()
+                ));
+            };
+            let passes: Vec<(String, usize)> = toolpath
+                .passes
+                .iter()
+                .map(|p| (p.name.clone(), p.points.len()))
+                .collect();
+            Some(pilgrim_kernel::verify::check_grinding(
+                &program,
+                machine.as_ref(),
+                &toolpath.tool.reference,
+                w.rounding_radius,
+                &passes,
+                &v.profile,
+                (v.from, v.to),
+                v.tolerance,
+            )?)
+        }
+    };
     stages.next("post-processing");
     let info = machine.info();
     let control = dialect(&info.control)
@@ -187,6 +249,10 @@ pub fn run(args: &RunArgs) -> Result<String, String> {
         ("program.json".into(), json(&program)?.into_bytes()),
         (control_file, control_text.into_bytes()),
         ("program.cld".into(), cld_text.into_bytes()),
+        (
+            "report.csv".into(),
+            block_table(&program, &toolpath).into_bytes(),
+        ),
     ];
     stages.next("3-D models");
     let (pose_block, bodies) = if family.has_fn("part", 1) {
@@ -237,13 +303,36 @@ pub fn run(args: &RunArgs) -> Result<String, String> {
         pose_block,
         tolerance_mm: args.tolerance,
         bodies,
+        axis_ranges: program
+            .axes
+            .iter()
+            .filter_map(|a| {
+                let col = program.column(&a.name)?;
+                let lo = col.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = col.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                Some((a.name.clone(), [lo, hi]))
+            })
+            .collect(),
+        verification,
+        notes: toolpath.notes.clone(),
     };
     files.push(("report.json".into(), json(&report)?.into_bytes()));
     stages.next("writing");
     write_atomically(&args.out, &files)?;
     stages.bar.finish_and_clear();
+    let verified = report
+        .verification
+        .as_ref()
+        .and_then(|v| v.passes.last())
+        .map(|p| {
+            format!(
+                ", finish within {} mm of nominal",
+                pilgrim_kernel::math::fixed(p.deviation.max_abs, 5)
+            )
+        })
+        .unwrap_or_default();
     Ok(format!(
-        "{}: {} passes, {} blocks for {} ({}), about {:.1} min; written to {}",
+        "{}: {} passes, {} blocks for {} ({}), about {:.1} min{verified}; written to {}",
         family.file(),
         report.passes,
         report.blocks,

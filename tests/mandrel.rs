@@ -231,3 +231,48 @@ fn bad_mandrel_parameters_are_refused_and_nothing_is_written() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The default job verifies, and one corrupted block of the finishing pass
+/// fails verification naming that block.
+#[test]
+fn verification_catches_a_corrupted_block() {
+    let fam = family();
+    let values = fam.resolve(None, &[]).unwrap();
+    let tp = fam.toolpath(&values).unwrap();
+    let grinder = Grinder::new();
+    let mut program = AxisProgram::build(&tp, &grinder, "mandrel").unwrap();
+    let v = fam.verification(&values).unwrap().unwrap();
+    let passes: Vec<(String, usize)> = tp
+        .passes
+        .iter()
+        .map(|p| (p.name.clone(), p.points.len()))
+        .collect();
+    let check = |program: &AxisProgram| {
+        pilgrim_kernel::verify::check_grinding(
+            program,
+            &grinder,
+            &tp.tool.reference,
+            R_S,
+            &passes,
+            &v.profile,
+            (v.from, v.to),
+            v.tolerance,
+        )
+    };
+    let ok = check(&program).unwrap();
+    let finish = ok.passes.last().unwrap();
+    assert!(finish.deviation.max_abs <= 1e-3, "{finish:?}");
+    // Each earlier pass leaves its stock: the first pass 225 um.
+    assert!(
+        (ok.passes[0].deviation.max_below - 0.225).abs() < 1e-3,
+        "{:?}",
+        ok.passes[0]
+    );
+    // Block 40 of the finishing pass goes 5 um too deep.
+    let k = finish.first_block - 1 + 40;
+    let x = program.axes.iter().position(|a| a.name == "X").unwrap();
+    program.blocks[k].values[x] -= 0.005;
+    let e = check(&program).unwrap_err();
+    assert!(e.contains(&format!("where block {} cuts it", k + 1)), "{e}");
+    assert!(e.contains("strays -0.00"), "{e}");
+}

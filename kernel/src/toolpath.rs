@@ -13,6 +13,7 @@
 use crate::math::Real;
 use crate::tool::Tool;
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 
 /// How a point is reached.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -67,6 +68,9 @@ pub struct Toolpath {
     pub aux_names: Vec<String>,
     /// The passes, in order.
     pub passes: Vec<Pass>,
+    /// Figures the family reports about the toolpath (name to number).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub notes: BTreeMap<String, Real>,
 }
 
 /// A bad toolpath, named by pass and point.
@@ -98,6 +102,7 @@ impl Toolpath {
             spindle_rpm,
             aux_names,
             passes: Vec::new(),
+            notes: BTreeMap::new(),
         }
     }
 

@@ -158,3 +158,141 @@ impl SweptWheel {
         self.resolution
     }
 }
+
+/// The tool's pose at every block of a program, by the machine's forward
+/// kinematics of the block's values: rows of 6 (tracked point, axis).
+///
+/// # Failures
+/// A solved axis the program lacks; the machine's kinematics failing.
+pub fn replay(
+    program: &crate::AxisProgram,
+    machine: &dyn crate::MachineKinematics,
+    tool: &crate::ToolFrame,
+) -> Result<Vec<Real>, String> {
+    let info = machine.info();
+    let cols = info
+        .solved_axes
+        .iter()
+        .map(|name| {
+            let c = program
+                .axes
+                .iter()
+                .position(|a| &a.name == name)
+                .ok_or(format!("the program has no axis {name}"))?;
+            let rotary = info
+                .axis(name)
+                .is_some_and(|a| a.kind == crate::AxisKind::Rotary);
+            Ok((c, rotary))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    let rows: Vec<Real> = program
+        .blocks
+        .iter()
+        .flat_map(|b| {
+            cols.iter()
+                .map(|&(c, rot)| {
+                    if rot {
+                        b.values[c].to_radians()
+                    } else {
+                        b.values[c]
+                    }
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let mut poses = Vec::new();
+    machine
+        .forward(&rows, tool, &mut poses)
+        .map_err(|e| e.to_string())?;
+    Ok(poses)
+}
+
+/// One cutting pass's surface against the nominal profile.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PassCheck {
+    /// The pass's name.
+    pub name: String,
+    /// Its first block (from 1).
+    pub first_block: usize,
+    /// Its surface against the nominal (blocks from 1).
+    pub deviation: Deviation,
+}
+
+/// A grinding program replayed: each cutting pass's swept surface against
+/// the nominal profile; the last one must hold the tolerance.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GrindingCheck {
+    /// The tolerance held (mm).
+    pub tolerance: Real,
+    /// Each cutting pass (the last is the finish).
+    pub passes: Vec<PassCheck>,
+}
+
+/// Replays a grinding program (a wheel of rounding `rounding_radius` whose
+/// tracked point is its rounding's centre) through the machine, builds each
+/// cutting pass's swept surface in the axial section (radius from the axis,
+/// z), and compares it with `nominal` over `[from, to]`.
+///
+/// # Failures
+/// The replay failing; a pass that does not cover the range; the finishing
+/// pass straying more than `tolerance` from the nominal: the message names
+/// the deviation, its z and the block (from 1) whose move formed it.
+#[allow(clippy::too_many_arguments)]
+pub fn check_grinding(
+    program: &crate::AxisProgram,
+    machine: &dyn crate::MachineKinematics,
+    tool: &crate::ToolFrame,
+    rounding_radius: Real,
+    passes: &[(String, usize)],
+    nominal: &Profile,
+    range: (Real, Real),
+    tolerance: Real,
+) -> Result<GrindingCheck, String> {
+    positive("verification tolerance", tolerance).map_err(|e| e.to_string())?;
+    let poses = replay(program, machine, tool)?;
+    let mut out = GrindingCheck {
+        tolerance,
+        passes: Vec::new(),
+    };
+    let mut first = 0;
+    for (name, len) in passes {
+        let blocks = first..first + len;
+        first += len;
+        let cutting = blocks
+            .clone()
+            .any(|b| program.blocks[b].motion != crate::Motion::Rapid);
+        if !cutting || *len == 0 {
+            continue;
+        }
+        let z: Vec<Real> = blocks.clone().map(|b| poses[6 * b + 2]).collect();
+        let x: Vec<Real> = blocks
+            .clone()
+            .map(|b| poses[6 * b].hypot(poses[6 * b + 1]))
+            .collect();
+        let swept = SweptWheel::new(&z, &x, rounding_radius, tolerance / 20.0)
+            .map_err(|e| e.to_string())?;
+        let step = (tolerance * 20.0).clamp(0.005, 0.05);
+        let mut d = swept
+            .deviation(nominal, range.0, range.1, step)
+            .map_err(|e| format!("{name}: {e}"))?;
+        d.block = d.block.map(|k| blocks.start + k + 1);
+        out.passes.push(PassCheck {
+            name: name.clone(),
+            first_block: blocks.start + 1,
+            deviation: d,
+        });
+    }
+    let finish = out.passes.last().ok_or("the program has no cutting pass")?;
+    let d = finish.deviation;
+    if d.max_abs > tolerance {
+        return Err(format!(
+            "verification failed: the finished surface strays {} mm from the nominal profile at z = {}, \
+             where block {} cuts it (tolerance {} mm)",
+            crate::math::fixed(if d.max_above.abs() >= d.max_below.abs() { d.max_above } else { d.max_below }, 5),
+            crate::math::fixed(d.at_z, 3),
+            d.block.map_or("?".into(), |b| b.to_string()),
+            tolerance
+        ));
+    }
+    Ok(out)
+}

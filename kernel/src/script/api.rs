@@ -774,6 +774,18 @@ pub mod toolpath_api {
         Ok(Rc::new(RefCell::new(Toolpath::new(part, tool, rpm, names))))
     }
 
+    /// Notes a figure about the toolpath for the run's report.
+    #[rhai_fn(name = "note", return_raw)]
+    pub fn note(
+        tp: &mut ToolpathHandle,
+        name: &str,
+        value: Real,
+    ) -> Result<(), Box<EvalAltResult>> {
+        crate::math::finite(&format!("note {name}"), value).map_err(|e| e.to_string())?;
+        tp.borrow_mut().notes.insert(name.to_owned(), value);
+        Ok(())
+    }
+
     /// Number of points so far.
     #[rhai_fn(get = "point_count", pure)]
     pub fn point_count(tp: &mut ToolpathHandle) -> i64 {

@@ -262,6 +262,20 @@ pub struct ParamSpec {
     pub doc: String,
 }
 
+/// What a family's finished part must be: the nominal profile, over
+/// `[from, to]`, within `tolerance` (mm).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Verification {
+    /// The nominal profile.
+    pub profile: crate::Profile,
+    /// Start of the range held to the tolerance.
+    pub from: f64,
+    /// End of that range.
+    pub to: f64,
+    /// The tolerance (mm).
+    pub tolerance: f64,
+}
+
 /// The result of one of a family's checks.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Check {
@@ -647,6 +661,35 @@ impl Family {
                 "fn default_machine() must return a machine's name, not {t}"
             ))
         })
+    }
+
+    /// Runs `fn verify(p)`, if the family has it: what the finished part
+    /// must be, where, and how closely.
+    ///
+    /// # Failures
+    /// The script's error, or a result that is not
+    /// `#{ profile, from, to, tolerance }`.
+    pub fn verification(
+        &self,
+        values: &BTreeMap<String, ParamValue>,
+    ) -> Result<Option<Verification>, ScriptError> {
+        if !self.has_fn("verify", 1) {
+            return Ok(None);
+        }
+        let d = self.call("verify", (Self::param_map(values),))?;
+        let shape =
+            || self.contract("fn verify(p) must return #{ profile, from, to, tolerance }".into());
+        let m = d.try_cast::<Map>().ok_or_else(shape)?;
+        let num = |k: &str| m.get(k).and_then(api::number).ok_or_else(shape);
+        Ok(Some(Verification {
+            profile: m
+                .get("profile")
+                .and_then(|p| p.clone().try_cast::<crate::Profile>())
+                .ok_or_else(shape)?,
+            from: num("from")?,
+            to: num("to")?,
+            tolerance: num("tolerance")?,
+        }))
     }
 
     /// Runs `fn name(p)` and returns its raw result (for `part`).
