@@ -2,7 +2,7 @@
 //! puts it at one block, as STL files and one glTF scene.
 
 use pilgrim_kernel::mesh::{self, frame_from_pose, Scene, StlFormat, TriMesh};
-use pilgrim_kernel::{AxisKind, AxisProgram, MachineKinematics, Point3, Tool, ToolShape, Vec3};
+use pilgrim_kernel::{AxisProgram, MachineKinematics, Point3, Tool, ToolShape, Vec3};
 use serde::{Deserialize, Serialize};
 
 /// A body written to a file, for the report.
@@ -49,34 +49,8 @@ pub fn tool_pose(
     tool: &Tool,
     index: usize,
 ) -> Result<pilgrim_kernel::Mat4, String> {
-    let info = machine.info();
-    let block = program.blocks.get(index).ok_or_else(|| {
-        format!(
-            "block {} is beyond the program's {} blocks",
-            index + 1,
-            program.blocks.len()
-        )
-    })?;
-    let row = info
-        .solved_axes
-        .iter()
-        .map(|name| {
-            let col = program
-                .axes
-                .iter()
-                .position(|a| &a.name == name)
-                .ok_or_else(|| format!("the program has no axis {name}"))?;
-            let v = block.values[col];
-            Ok(match info.axis(name).map(|a| a.kind) {
-                Some(AxisKind::Rotary) => v.to_radians(),
-                _ => v,
-            })
-        })
-        .collect::<Result<Vec<f64>, String>>()?;
-    let mut pose = Vec::new();
-    machine
-        .forward(&row, &tool.reference, &mut pose)
-        .map_err(|e| format!("block {}: {e}", index + 1))?;
+    let pose =
+        pilgrim_kernel::verify::replay_blocks(program, machine, &tool.reference, index..index + 1)?;
     Ok(frame_from_pose(
         &tool.reference,
         Point3::new(pose[0], pose[1], pose[2]),

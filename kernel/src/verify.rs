@@ -163,12 +163,33 @@ impl SweptWheel {
 /// kinematics of the block's values: rows of 6 (tracked point, axis).
 ///
 /// # Failures
-/// A solved axis the program lacks; the machine's kinematics failing.
+/// As [`replay_blocks`].
 pub fn replay(
     program: &crate::AxisProgram,
     machine: &dyn crate::MachineKinematics,
     tool: &crate::ToolFrame,
 ) -> Result<Vec<Real>, String> {
+    replay_blocks(program, machine, tool, 0..program.blocks.len())
+}
+
+/// [`replay`] of the blocks in `blocks` (indices from 0).
+///
+/// # Failures
+/// A block beyond the program; a solved axis the program lacks; the
+/// machine's kinematics failing.
+pub fn replay_blocks(
+    program: &crate::AxisProgram,
+    machine: &dyn crate::MachineKinematics,
+    tool: &crate::ToolFrame,
+    blocks: std::ops::Range<usize>,
+) -> Result<Vec<Real>, String> {
+    if blocks.end > program.blocks.len() {
+        return Err(format!(
+            "block {} is beyond the program's {} blocks",
+            blocks.end,
+            program.blocks.len()
+        ));
+    }
     let info = machine.info();
     let cols = info
         .solved_axes
@@ -185,8 +206,7 @@ pub fn replay(
             Ok((c, rotary))
         })
         .collect::<Result<Vec<_>, String>>()?;
-    let rows: Vec<Real> = program
-        .blocks
+    let rows: Vec<Real> = program.blocks[blocks.clone()]
         .iter()
         .flat_map(|b| {
             cols.iter()
@@ -203,7 +223,7 @@ pub fn replay(
     let mut poses = Vec::new();
     machine
         .forward(&rows, tool, &mut poses)
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| format!("blocks {} to {}: {e}", blocks.start + 1, blocks.end))?;
     Ok(poses)
 }
 
