@@ -265,7 +265,8 @@ pub fn run(args: &RunArgs) -> Result<String, String> {
         };
         let pose = crate::scene::tool_pose(&program, machine.as_ref(), &toolpath.tool, index)?;
         let tool = crate::scene::tool_mesh(&toolpath.tool, args.tolerance)?;
-        let (mesh_files, bodies) = crate::scene::files(&parts, tool, pose, args.formats)?;
+        let others = crate::scene::machine_bodies(&info.name, &program, index, args.tolerance)?;
+        let (mesh_files, bodies) = crate::scene::files(&parts, tool, pose, others, args.formats)?;
         files.extend(mesh_files);
         (Some(index + 1), bodies)
     } else {
@@ -472,7 +473,9 @@ pub fn export(
         .collect::<Result<Vec<_>, _>>()?;
     let pose = crate::scene::tool_pose(&program, machine.as_ref(), &toolpath.tool, index)?;
     let tool = crate::scene::tool_mesh(&toolpath.tool, report.tolerance_mm)?;
-    let (files, bodies) = crate::scene::files(&parts, tool, pose, formats)?;
+    let others =
+        crate::scene::machine_bodies(&machine.info().name, &program, index, report.tolerance_mm)?;
+    let (files, bodies) = crate::scene::files(&parts, tool, pose, others, formats)?;
     report.pose_block = Some(index + 1);
     report.bodies = bodies;
     let mut all: Vec<(String, Vec<u8>)> = files

@@ -35,6 +35,53 @@ pub fn tool_mesh(tool: &Tool, tol: f64) -> Result<Option<(TriMesh, &'static str)
     })
 }
 
+const REST_COLOR: [f32; 4] = [0.85, 0.55, 0.2, 1.0];
+
+/// Other moving bodies of the machine placed at block `index` (from 0): for
+/// a built-in machine with a `rest` body (the 3K152VF20's steady rest), a
+/// roller of its `rest_radius` and 40 mm long across the axial section,
+/// placed by the body's chain at the block's axis values.
+pub fn machine_bodies(
+    machine_name: &str,
+    program: &AxisProgram,
+    index: usize,
+    tol: f64,
+) -> Result<Vec<(String, TriMesh, pilgrim_kernel::Mat4)>, String> {
+    let Ok(m) = pilgrim_kernel::Machine::builtin(machine_name) else {
+        return Ok(vec![]);
+    };
+    let Some(chain) = m.body_chain("rest") else {
+        return Ok(vec![]);
+    };
+    let Some(block) = program.blocks.get(index) else {
+        return Ok(vec![]);
+    };
+    let mut q = Vec::new();
+    for name in chain.axis_names() {
+        let Some(col) = program.axes.iter().position(|a| &a.name == name) else {
+            return Ok(vec![]); // the program does not drive the rest
+        };
+        let v = block.values[col];
+        let rotary = m
+            .axis(name)
+            .is_some_and(|a| a.kind == pilgrim_kernel::AxisKind::Rotary);
+        q.push(if rotary { v.to_radians() } else { v });
+    }
+    let radius = m.constant("rest_radius").unwrap_or(25.0);
+    let length = 40.0;
+    // The roller along Y, centred on the support's circle in the XZ section.
+    let roller = mesh::cylinder(radius, length, tol)
+        .map_err(|e| e.to_string())?
+        .transformed(
+            &(pilgrim_kernel::Mat4::from_axis_angle(
+                &pilgrim_kernel::Vec3::x_axis(),
+                std::f64::consts::FRAC_PI_2,
+            ) * pilgrim_kernel::Mat4::new_translation(&Vec3::new(0.0, 0.0, -length / 2.0))),
+        );
+    let pose = chain.matrix(&q).map_err(|e| e.to_string())?;
+    Ok(vec![("rest".into(), roller, pose)])
+}
+
 /// Block index (from 0) of the first block of the last pass.
 pub fn default_pose_block(pass_lengths: &[usize]) -> usize {
     let total: usize = pass_lengths.iter().sum();
@@ -76,6 +123,7 @@ pub fn files(
     parts: &[(String, TriMesh)],
     tool: Option<(TriMesh, &'static str)>,
     tool_pose: pilgrim_kernel::Mat4,
+    others: Vec<(String, TriMesh, pilgrim_kernel::Mat4)>,
     formats: Formats,
 ) -> Result<(Files, Vec<BodyFile>), String> {
     let mut scene = Scene::new();
@@ -117,6 +165,10 @@ pub fn files(
     if let Some((m, name)) = tool {
         stl(name, "tool", &m.transformed(&tool_pose), &mut out)?;
         scene.add(name, m, tool_pose, TOOL_COLOR);
+    }
+    for (name, m, pose) in others {
+        stl(&name, "machine", &m.transformed(&pose), &mut out)?;
+        scene.add(&name, m, pose, REST_COLOR);
     }
     let mut glb = Vec::new();
     mesh::write_glb(&scene, &mut glb).map_err(|e| e.to_string())?;

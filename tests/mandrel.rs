@@ -193,6 +193,22 @@ fn bad_mandrel_parameters_are_refused_and_nothing_is_written() {
     let (code, err) = run(&[]);
     assert_eq!(code, 0, "{err}");
     let before = std::fs::read(out.join("program.mpf")).unwrap();
+    // The rest's roller stands where the pose block's U puts it: its top
+    // on the far side at -(U - R_o), touching the part.
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    let block = report["pose_block"].as_u64().unwrap() as usize;
+    let csv = std::fs::read_to_string(out.join("report.csv")).unwrap();
+    let row: Vec<&str> = csv.lines().nth(block).unwrap().rsplit(',').collect();
+    let u: f64 = row[1].parse().unwrap();
+    let rest = pilgrim_kernel::mesh::read_stl(&out.join("rest.stl")).unwrap();
+    rest.check_closed().unwrap();
+    let (_, hi) = rest.bounds();
+    assert!(
+        (hi[0] + (u - 25.0)).abs() < 1e-3,
+        "roller top {} for U {u}",
+        hi[0]
+    );
     for (sets, expected) in [
         (
             vec!["d_min=60"],
