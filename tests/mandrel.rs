@@ -292,3 +292,33 @@ fn verification_catches_a_corrupted_block() {
     assert!(e.contains(&format!("where block {} cuts it", k + 1)), "{e}");
     assert!(e.contains("strays -0.00"), "{e}");
 }
+
+/// The example parameter files run and verify.
+#[test]
+fn example_parameter_files_run() {
+    for f in ["mandrel-small.toml", "mandrel-large.toml"] {
+        let out = std::env::temp_dir().join(format!(
+            "pilgrim-mandrel-example-{}-{f}",
+            std::process::id()
+        ));
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_pilgrim"))
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .args([
+                "run",
+                "scripts/mandrel.rhai",
+                "--params",
+                &format!("scripts/examples/{f}"),
+                "--out",
+            ])
+            .arg(&out)
+            .output()
+            .unwrap();
+        let (stdout, stderr) = (
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr),
+        );
+        assert!(o.status.success(), "{f}: {stderr}");
+        assert!(stdout.contains("finish within 0.000"), "{f}: {stdout}");
+        std::fs::remove_dir_all(&out).ok();
+    }
+}
