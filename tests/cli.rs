@@ -114,6 +114,7 @@ fn leave_for_checkers(dir: &Path, tag: &str) {
         "blank.stl",
         "cutter.stl",
         "wheel.stl",
+        "rest.stl",
         "scene.glb",
     ] {
         if dir.join(f).exists() {
