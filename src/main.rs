@@ -7,6 +7,7 @@
 mod machines;
 mod run;
 mod scene;
+mod svg;
 
 use clap::{Parser, Subcommand};
 use pilgrim_kernel::machine::BUILTIN_MACHINES;

@@ -63,6 +63,90 @@ struct Report {
     notes: BTreeMap<String, f64>,
 }
 
+/// `profile.svg`: the part's profiles and the wheel centre's path on the
+/// finishing pass; the steady rest's track (U against z + B, when the family
+/// notes `rest_offset_b_mm`); the nominal's curvature against the wheel's
+/// limit 1/R_s.
+fn profile_svg(
+    profiles: &[(String, pilgrim_kernel::Profile)],
+    toolpath: &Toolpath,
+    v: &pilgrim_kernel::script::Verification,
+    rounding: f64,
+) -> String {
+    use crate::svg::{Panel, Series};
+    const COLORS: [&str; 4] = ["#444444", "#d08000", "#2a6fd8", "#2a9d4b"];
+    let cutting: Vec<&pilgrim_kernel::Pass> = toolpath
+        .passes
+        .iter()
+        .filter(|p| p.points.iter().any(|c| c.motion != Motion::Rapid))
+        .collect();
+    let mut shape: Vec<Series> = profiles
+        .iter()
+        .enumerate()
+        .map(|(i, (name, p))| Series {
+            name: name.clone(),
+            color: COLORS[i % 2],
+            points: p.z().iter().copied().zip(p.x().iter().copied()).collect(),
+        })
+        .collect();
+    if let Some(last) = cutting.last() {
+        shape.push(Series {
+            name: format!("wheel centre, {}", last.name),
+            color: COLORS[2],
+            points: last
+                .points
+                .iter()
+                .map(|c| (c.point[2], c.point[0].hypot(c.point[1])))
+                .collect(),
+        });
+    }
+    let mut panels = vec![Panel {
+        title: "profile (mm) and the wheel's path".into(),
+        y_label: "radius x".into(),
+        series: shape,
+    }];
+    let u = toolpath.aux_names.iter().position(|a| a == "U");
+    if let (Some(u), Some(b)) = (u, toolpath.notes.get("rest_offset_b_mm")) {
+        panels.push(Panel {
+            title: "steady rest: support centre U at z + B, every pass".into(),
+            y_label: "U".into(),
+            series: cutting
+                .iter()
+                .enumerate()
+                .map(|(i, p)| Series {
+                    name: p.name.clone(),
+                    color: COLORS[i % COLORS.len()],
+                    points: p
+                        .points
+                        .iter()
+                        .map(|c| (c.point[2] + b, c.aux[u]))
+                        .collect(),
+                })
+                .collect(),
+        });
+    }
+    let z = v.profile.z();
+    panels.push(Panel {
+        title: format!(
+            "curvature of the nominal (1/mm) against the wheel's limit 1/R_s = 1/{rounding}"
+        ),
+        y_label: "curvature".into(),
+        series: vec![
+            Series {
+                name: "curvature".into(),
+                color: COLORS[0],
+                points: z.iter().copied().zip(v.profile.curvature()).collect(),
+            },
+            Series {
+                name: "1/R_s".into(),
+                color: "#cc2222",
+                points: vec![(z[0], 1.0 / rounding), (z[z.len() - 1], 1.0 / rounding)],
+            },
+        ],
+    });
+    crate::svg::render(&panels)
+}
+
 /// One row per block: block number, pass, motion, axis values, feed.
 fn block_table(program: &AxisProgram, toolpath: &Toolpath) -> String {
     let mut out = String::from("block,pass,motion");
@@ -207,7 +291,8 @@ pub fn run(args: &RunArgs) -> Result<String, String> {
         .unwrap_or("pilgrim");
     let program =
         AxisProgram::build(&toolpath, machine.as_ref(), name).map_err(|e| e.to_string())?;
-    let verification = match family.verification(&values).map_err(|e| e.to_string())? {
+    let nominal = family.verification(&values).map_err(|e| e.to_string())?;
+    let verification = match &nominal {
         None => None,
         Some(v) => {
             let pilgrim_kernel::ToolShape::Wheel(w) = toolpath.tool.shape else {
@@ -255,8 +340,13 @@ pub fn run(args: &RunArgs) -> Result<String, String> {
         ),
     ];
     stages.next("3-D models");
+    let profiles = if family.has_fn("part", 1) {
+        part_profiles(&family, &values)?
+    } else {
+        vec![]
+    };
     let (pose_block, bodies) = if family.has_fn("part", 1) {
-        let parts = part_meshes(&family, &values, args.tolerance)?;
+        let parts = part_meshes(&family, &profiles, args.tolerance)?;
         let lengths: Vec<usize> = toolpath.passes.iter().map(|p| p.points.len()).collect();
         let index = match args.pose_block {
             Some(0) => return Err("--pose-block counts blocks from 1".into()),
@@ -272,7 +362,7 @@ pub fn run(args: &RunArgs) -> Result<String, String> {
     } else {
         (None, vec![])
     };
-    let report = Report {
+    let mut report = Report {
         pilgrim: env!("CARGO_PKG_VERSION").into(),
         script: args.script.display().to_string(),
         machine: info.name.clone(),
@@ -317,6 +407,13 @@ pub fn run(args: &RunArgs) -> Result<String, String> {
         verification,
         notes: toolpath.notes.clone(),
     };
+    if let (Some(v), pilgrim_kernel::ToolShape::Wheel(w)) = (&nominal, toolpath.tool.shape) {
+        files.push((
+            "profile.svg".into(),
+            profile_svg(&profiles, &toolpath, v, w.rounding_radius).into_bytes(),
+        ));
+        report.files.push("profile.svg".into());
+    }
     files.push(("report.json".into(), json(&report)?.into_bytes()));
     stages.next("writing");
     write_atomically(&args.out, &files)?;
@@ -388,12 +485,11 @@ pub fn write_atomically(out: &Path, files: &[(String, Vec<u8>)]) -> Result<(), S
 }
 
 /// The part's bodies from `fn part(p)`: a profile, or a map of named
-/// profiles, each turned about Z into a solid.
-fn part_meshes(
+/// profiles.
+fn part_profiles(
     family: &Family,
     values: &BTreeMap<String, ParamValue>,
-    tol: f64,
-) -> Result<Vec<(String, pilgrim_kernel::mesh::TriMesh)>, String> {
+) -> Result<Vec<(String, pilgrim_kernel::Profile)>, String> {
     let d = family
         .call_with_params("part", values)
         .map_err(|e| e.to_string())?;
@@ -416,6 +512,15 @@ fn part_meshes(
                 })
                 .collect::<Result<_, _>>()?
         };
+    Ok(profiles)
+}
+
+/// Each profile turned about Z into a solid.
+fn part_meshes(
+    family: &Family,
+    profiles: &[(String, pilgrim_kernel::Profile)],
+    tol: f64,
+) -> Result<Vec<(String, pilgrim_kernel::mesh::TriMesh)>, String> {
     profiles
         .iter()
         .map(|(name, p)| {

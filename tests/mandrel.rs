@@ -319,6 +319,13 @@ fn example_parameter_files_run() {
         );
         assert!(o.status.success(), "{f}: {stderr}");
         assert!(stdout.contains("finish within 0.000"), "{f}: {stdout}");
+        let svg = std::fs::read_to_string(out.join("profile.svg")).unwrap();
+        assert!(svg.starts_with("<svg ") && svg.ends_with("</svg>\n"), "{f}");
+        assert_eq!(
+            svg.matches("<polyline").count(),
+            3 + if f.contains("small") { 5 } else { 6 } + 2,
+            "{f}"
+        );
         std::fs::remove_dir_all(&out).ok();
     }
 }
