@@ -2,9 +2,20 @@
 //!
 //! - `mandrel_job`: the default job as a user runs it, through the release
 //!   `pilgrim` program: the family's script, inverse kinematics and limits,
-//!   the replay verification, the meshes and every file (target <= 0.5 s).
+//!   the replay verification, the meshes and every file (target <= 0.5 s);
+//! - `mandrel_rhai_vs_native`: the default toolpath through the family's
+//!   script, and the same toolpath built from Rust directly (target: the
+//!   Rhai run <= 1.5x).
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use pilgrim_kernel::offset::rest::{after_pass, track, RestSetup};
+use pilgrim_kernel::profile::simplify_polyline;
+use pilgrim_kernel::script::{Access, Family, Limits};
+use pilgrim_kernel::{
+    equidistant, ClPoint, MandrelLaw, Motion, Pass, Profile, ProfileBuilder, Side, Tool, Toolpath,
+    Wheel,
+};
+use std::hint::black_box;
 use std::path::Path;
 use std::process::Command;
 use std::time::Duration;
@@ -29,5 +40,120 @@ fn mandrel_job(c: &mut Criterion) {
     let _ = std::fs::remove_dir_all(&out);
 }
 
-criterion_group!(mandrel, mandrel_job);
+/// The family's default toolpath, step for step as `scripts/mandrel.rhai`.
+fn native_toolpath() -> Toolpath {
+    let (tol, r_s, stock, passes, over) = (0.001, 20.0, 0.3, 4, 10.0);
+    let law = MandrelLaw::new(38.0, 52.0, 400.0, 0.012, 2.3).unwrap();
+    let x0 = 19.0;
+    let part = ProfileBuilder::start(-240.0 - 3.0 - 60.0, 15.0)
+        .cylinder(60.0)
+        .line_to(-240.0, x0 - 0.006 * 240.0)
+        .line_to(0.0, x0)
+        .law(law)
+        .line_to(440.0, 22.0)
+        .build(tol / 10.0, 0.5)
+        .unwrap();
+    let ground = ProfileBuilder::start(-over, x0 - 0.006 * over)
+        .line_to(0.0, x0)
+        .law(law)
+        .line_to(400.0 + over, law.x(400.0) + law.dx(400.0) * over)
+        .build(tol / 10.0, 0.5)
+        .unwrap();
+    let e = equidistant(&ground, r_s, Side::Outside).unwrap();
+    let blank_x = part
+        .z()
+        .iter()
+        .zip(part.x())
+        .map(|(z, x)| {
+            if (-over..=400.0 + over).contains(z) {
+                x + stock
+            } else {
+                *x
+            }
+        })
+        .collect();
+    let mut surface = Profile::new(part.z().to_vec(), blank_x).unwrap();
+    let mut tp = Toolpath::new(
+        "mandrel",
+        Tool::wheel("wheel", 1, Wheel::new(500.0, r_s, 40.0).unwrap()),
+        399.0,
+        vec!["U".into()],
+    );
+    let setup = RestSetup {
+        radius: 25.0,
+        offset_b: -180.0,
+        sample: 0.05,
+        resolution: 1e-5,
+    };
+    let pt = |z: f64, x: f64, motion, feed, u: f64| ClPoint {
+        point: [x, 0.0, z],
+        axis: [0.0, 0.0, 1.0],
+        motion,
+        feed,
+        aux: vec![u],
+    };
+    let mut last = (0.0, 0.0, 0.0);
+    for j in 1..=passes {
+        let h = stock * (1.0 - j as f64 / passes as f64);
+        let ex: Vec<f64> = e.x.iter().map(|x| x + h).collect();
+        let keep = simplify_polyline(&e.z, &ex, tol / 2.0);
+        let (mut cz, mut cx): (Vec<f64>, Vec<f64>) = keep.iter().map(|&i| (e.z[i], ex[i])).unzip();
+        if j % 2 == 0 {
+            cz.reverse();
+            cx.reverse();
+        }
+        let rest = track(&surface, &cz, &cx, r_s, &setup).unwrap();
+        if j == 1 {
+            tp.passes.push(Pass {
+                name: "approach".into(),
+                points: vec![pt(cz[0], cx[0] + 2.0, Motion::Rapid, 0.0, rest.centre_x[0])],
+            });
+        }
+        tp.passes.push(Pass {
+            name: format!("pass {j}"),
+            points: (0..cz.len())
+                .map(|k| pt(cz[k], cx[k], Motion::Linear, 2000.0, rest.centre_x[k]))
+                .collect(),
+        });
+        surface = after_pass(&surface, &cz, &cx, r_s, 1e-5).unwrap();
+        let n = cz.len() - 1;
+        last = (cz[n], cx[n], rest.centre_x[n]);
+    }
+    tp.passes.push(Pass {
+        name: "retract".into(),
+        points: vec![pt(last.0, last.1 + 2.0, Motion::Rapid, 0.0, last.2)],
+    });
+    tp
+}
+
+fn mandrel_rhai_vs_native(c: &mut Criterion) {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/mandrel.rhai");
+    let family = Family::load(&script, &Limits::default(), &Access::default()).unwrap();
+    let values = family.resolve(None, &[]).unwrap();
+    // Both build the same toolpath: same points in the same passes.
+    let (a, b) = (family.toolpath(&values).unwrap(), native_toolpath());
+    assert_eq!(a.passes.len(), b.passes.len());
+    for (pa, pb) in a.passes.iter().zip(&b.passes) {
+        assert_eq!(pa.points.len(), pb.points.len(), "{}", pa.name);
+        for (x, y) in pa.points.iter().zip(&pb.points) {
+            assert_eq!(
+                (x.point, x.aux.clone()),
+                (y.point, y.aux.clone()),
+                "{}",
+                pa.name
+            );
+        }
+    }
+    let mut g = c.benchmark_group("mandrel_rhai_vs_native");
+    g.sample_size(20).measurement_time(Duration::from_secs(8));
+    g.bench_function("toolpath_rhai", |bch| {
+        bch.iter(|| black_box(family.toolpath(&values).unwrap()))
+    });
+    g.bench_function("toolpath_rust", |bch| {
+        bch.iter(|| black_box(native_toolpath()))
+    });
+    g.finish();
+}
+
+criterion_group!(mandrel, mandrel_job, mandrel_rhai_vs_native);
 criterion_main!(mandrel);
