@@ -361,7 +361,8 @@ impl Profile {
     }
 
     /// x at any z of the range, by cubic Hermite interpolation with the
-    /// node slopes of [`Self::slopes`]. Without analytic derivatives the
+    /// node slopes of [`Self::slopes`] (linear beside a kink, where a node's
+    /// slope is ambiguous). Without analytic derivatives the
     /// slopes are estimated on each call: for many points use
     /// [`Self::eval_many`].
     ///
@@ -387,9 +388,24 @@ impl Profile {
             });
         }
         let slopes = self.slopes();
+        let kinks = self.d2x.as_deref();
         Ok(zs
             .iter()
-            .map(|&z| hermite(&self.z, &self.x, &slopes, z))
+            .map(|&z| {
+                // Beside a kink (marked by an infinite second derivative) the
+                // node's slope is only the mean of its two sides: interpolate
+                // that interval linearly rather than bend it.
+                let i = crate::math::floor_index(&self.z, z)
+                    .unwrap_or(0)
+                    .min(self.z.len() - 2);
+                match kinks {
+                    Some(d2) if d2[i].is_infinite() || d2[i + 1].is_infinite() => {
+                        let t = (z - self.z[i]) / (self.z[i + 1] - self.z[i]);
+                        self.x[i] + t * (self.x[i + 1] - self.x[i])
+                    }
+                    _ => hermite(&self.z, &self.x, &slopes, z),
+                }
+            })
             .collect())
     }
 
@@ -551,6 +567,25 @@ mod tests {
         let m = stock.min_with(&cut);
         assert_eq!(m.z(), stock.z());
         assert_eq!(m.x(), [5.0, 5.0, 5.0, 4.5, 5.0]);
+    }
+
+    #[test]
+    fn evaluation_beside_a_kink_follows_the_segments() {
+        use crate::profile::ProfileBuilder;
+        // A cylinder, then a cone going down: a convex kink at z = 10.
+        let p = ProfileBuilder::start(0.0, 5.0)
+            .cylinder(10.0)
+            .line_to(20.0, 3.0)
+            .build(0.01, 4.0)
+            .unwrap();
+        for z in [7.5, 9.0, 9.99, 10.0, 10.01, 11.0, 12.5] {
+            let exact = if z <= 10.0 {
+                5.0
+            } else {
+                5.0 - 0.2 * (z - 10.0)
+            };
+            assert_near!(p.eval(z).unwrap(), exact, 1e-12, "z = {z}");
+        }
     }
 
     #[test]
