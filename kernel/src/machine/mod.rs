@@ -287,10 +287,7 @@ impl Machine {
         opts: &IkOptions,
     ) -> Result<IkSolution, MachineError> {
         let travel = self.travel_of(&self.chain)?;
-        let home: Vec<Real> = travel
-            .iter()
-            .map(|&(lo, hi)| 0.0_f64.clamp(lo, hi))
-            .collect();
+        let home = home_seed(&self.chain, &travel);
         Ok(self
             .chain
             .inverse(target, tool, seed.unwrap_or(&home), Some(&travel), opts)?)
@@ -328,6 +325,23 @@ impl Machine {
         check_rows(&cols, rows)?;
         Ok(cols)
     }
+}
+
+/// The start of inverse kinematics when nothing better is known: the middle
+/// of each linear axis's travel, 0 (clamped into travel) for rotary axes.
+/// `travel` holds the chain's axes' `(min, max)` in its order.
+pub fn home_seed(chain: &Chain, travel: &[(Real, Real)]) -> Vec<Real> {
+    travel
+        .iter()
+        .enumerate()
+        .map(|(i, &(lo, hi))| {
+            if chain.is_rotary(i) {
+                0.0_f64.clamp(lo, hi)
+            } else {
+                0.5 * (lo + hi)
+            }
+        })
+        .collect()
 }
 
 fn check_rows(axes: &[&Axis], rows: &[Real]) -> Result<usize, MachineError> {

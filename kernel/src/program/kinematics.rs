@@ -279,17 +279,8 @@ impl MachineKinematics for ChainMachine {
         let free: Vec<usize> = (0..dof).filter(|i| !held.contains(i)).collect();
         let free_travel: Vec<(Real, Real)> = free.iter().map(|&i| travel[i]).collect();
         out.clear();
-        let mut seed: Vec<Real> = free
-            .iter()
-            .map(|&i| {
-                let (lo, hi) = travel[i];
-                if chain.is_rotary(i) {
-                    0.0_f64.clamp(lo, hi)
-                } else {
-                    0.5 * (lo + hi)
-                }
-            })
-            .collect();
+        let home = crate::machine::home_seed(chain, &travel);
+        let mut seed: Vec<Real> = free.iter().map(|&i| home[i]).collect();
         for (k, p) in poses.chunks_exact(6).enumerate() {
             let mut fixed = vec![None; dof];
             for (j, &h) in held.iter().enumerate() {
