@@ -189,7 +189,7 @@ fn cycle_time(program: &AxisProgram, info: &pilgrim_kernel::MachineInfo) -> f64 
             .map(|(_, d)| d * d)
             .sum::<f64>()
             .sqrt();
-        let path = if linear > 1e-4 {
+        let path = if linear > pilgrim_kernel::machine::LINEAR_RESOLUTION {
             linear
         } else {
             deltas.iter().map(|d| d * d).sum::<f64>().sqrt()

@@ -386,8 +386,9 @@ pub fn check_travel(axes: &[&Axis], rows: &[Real]) -> Result<(), MachineError> {
     Ok(())
 }
 
-/// Linear motion shorter than this (mm) counts as none in feed checks.
-const LINEAR_RESOLUTION: Real = 1e-4;
+/// Linear motion shorter than this (mm) counts as none: a move that only
+/// turns reads its feed in degrees per minute (feed checks, cycle times).
+pub const LINEAR_RESOLUTION: Real = 1e-4;
 
 /// Checks that no axis moves faster than its maximum between rows.
 /// `feeds[i]` is the programmed feed (mm/min) of the move ending at row `i`
