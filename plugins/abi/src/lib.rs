@@ -290,6 +290,34 @@ pub mod entry {
         Ok(n)
     }
 
+    /// A batch's input and output.
+    type Batch<'a> = (&'a [f64], &'a mut [f64]);
+
+    /// A batch's input and output as slices; `None` for an empty batch.
+    ///
+    /// # Safety
+    /// Non-null pointers must be valid for `n_in` reads and `n_out` writes.
+    unsafe fn batch<'a>(
+        input: *const f64,
+        n_in: usize,
+        output: *mut f64,
+        n_out: usize,
+    ) -> Result<Option<Batch<'a>>, PluginError> {
+        if n_in == 0 && n_out == 0 {
+            return Ok(None);
+        }
+        if input.is_null() || output.is_null() {
+            return Err(PluginError::new("null input or output array"));
+        }
+        // SAFETY: as the caller promises.
+        Ok(Some(unsafe {
+            (
+                std::slice::from_raw_parts(input, n_in),
+                std::slice::from_raw_parts_mut(output, n_out),
+            )
+        }))
+    }
+
     /// `describe` for plugin `p`.
     ///
     /// # Safety
@@ -313,21 +341,11 @@ pub mod entry {
     ) -> i32 {
         guarded(failed_row, || {
             let n = check_width(p, width)?;
-            if count == 0 {
-                return Ok(());
-            }
-            if poses.is_null() || out.is_null() {
-                return Err(PluginError::new("null pose or output array"));
-            }
-            let t = tool6(tool)?;
             // SAFETY: the host passes count*6 poses and count*n outputs.
-            let (poses, out) = unsafe {
-                (
-                    std::slice::from_raw_parts(poses, count * 6),
-                    std::slice::from_raw_parts_mut(out, count * n),
-                )
-            };
-            p.inverse(poses, &t, out)
+            match unsafe { batch(poses, count * 6, out, count * n)? } {
+                Some((poses, out)) => p.inverse(poses, &tool6(tool)?, out),
+                None => Ok(()),
+            }
         })
     }
 
@@ -345,21 +363,11 @@ pub mod entry {
     ) -> i32 {
         guarded(std::ptr::null_mut(), || {
             let n = check_width(p, width)?;
-            if count == 0 {
-                return Ok(());
-            }
-            if axes.is_null() || out.is_null() {
-                return Err(PluginError::new("null axis or output array"));
-            }
-            let t = tool6(tool)?;
             // SAFETY: the host passes count*n axis values and count*6 outputs.
-            let (axes, out) = unsafe {
-                (
-                    std::slice::from_raw_parts(axes, count * n),
-                    std::slice::from_raw_parts_mut(out, count * 6),
-                )
-            };
-            p.forward(axes, &t, out)
+            match unsafe { batch(axes, count * n, out, count * 6)? } {
+                Some((axes, out)) => p.forward(axes, &tool6(tool)?, out),
+                None => Ok(()),
+            }
         })
     }
 
