@@ -130,6 +130,80 @@ fn envelope_of_the_wheel_reproduces_the_mandrel_profile() {
     // At s = 0.1 mm, R = 20 mm the bound is 6.25e-5 + 1e-5 mm: under 0.1 um.
 }
 
+/// At a convex corner the centres swing round the corner point on an arc of
+/// the tool's radius, and the circles at them leave the corner itself: the
+/// envelope meets the profile there and on both sides (outside and inside).
+#[test]
+fn convex_corners_get_an_arc_of_centres() {
+    let big_r = 20.0;
+    let peak = ProfileBuilder::start(0.0, 20.0)
+        .line_to(30.0, 20.3)
+        .line_to(40.0, 19.0)
+        .build(1e-4, 0.5)
+        .unwrap();
+    let valley = ProfileBuilder::start(0.0, 20.0)
+        .line_to(30.0, 19.7)
+        .line_to(40.0, 21.0)
+        .build(1e-4, 0.5)
+        .unwrap();
+    for (p, side, corner_x) in [(&peak, Side::Outside, 20.3), (&valley, Side::Inside, 19.7)] {
+        let e = equidistant(p, big_r, side).unwrap();
+        let round: Vec<usize> = (0..e.z.len())
+            .filter(|&i| ((e.z[i] - 30.0).hypot(e.x[i] - corner_x) - big_r).abs() < 1e-9)
+            .collect();
+        // From the normal of one line to the other's: the turn is
+        // atan(0.01) + atan(0.13), at steps whose sag is at most 1 nm.
+        let turn = 0.01_f64.atan() + 0.13_f64.atan();
+        let step = 2.0 * (2.0 * pilgrim_kernel::offset::CORNER_SAG / big_r).sqrt();
+        assert_eq!(round.len(), (turn / step).ceil() as usize + 1, "{side:?}");
+        assert!(
+            e.z.windows(2).all(|w| w[1] > w[0]),
+            "{side:?}: centres go back"
+        );
+        let env = CircleEnvelope::new(&e.z, &e.x, big_r, side).unwrap();
+        // Exact at the nodes (the corner is one), and between them off by no
+        // more than the scallop of centres 0.5 mm apart, never into the part.
+        for (z, g) in p.z().iter().zip(env.eval_many(p.z())) {
+            let w = p.eval(*z).unwrap();
+            assert_near!(g, w, 1e-9, "{side:?} at node z = {z}");
+        }
+        let at: Vec<f64> = (0..=400).map(|i| i as f64 * 0.1).collect();
+        let scallop = 0.5 * 0.5 / (8.0 * big_r);
+        for ((z, g), w) in at
+            .iter()
+            .zip(env.eval_many(&at))
+            .zip(p.eval_many(&at).unwrap())
+        {
+            let off = (g - w) * side.sign();
+            assert!(
+                (-1e-9..=scallop + 1e-9).contains(&off),
+                "{side:?} at z = {z}: {off:e}"
+            );
+        }
+    }
+    // Without the arc (one centre at the corner's mean normal), the envelope
+    // cuts into the corner: what the arc is for.
+    let e = equidistant(&peak, big_r, Side::Outside).unwrap();
+    let on_arc = |i: usize| ((e.z[i] - 30.0).hypot(e.x[i] - 20.3) - big_r).abs() < 1e-9;
+    let arc: Vec<usize> = (0..e.z.len()).filter(|&i| on_arc(i)).collect();
+    let mid = arc[arc.len() / 2];
+    let (cz, cx): (Vec<f64>, Vec<f64>) = (0..e.z.len())
+        .filter(|&i| i == mid || !on_arc(i))
+        .map(|i| (e.z[i], e.x[i]))
+        .unzip();
+    let (sz, sx, _) = pilgrim_kernel::offset::swept_circles(&cz, &cx, big_r, 0.01).unwrap();
+    let env = CircleEnvelope::new(&sz, &sx, big_r, Side::Outside).unwrap();
+    let at: Vec<f64> = (0..=200).map(|i| 29.0 + i as f64 * 0.01).collect();
+    let gouge = env
+        .eval_many(&at)
+        .iter()
+        .zip(peak.eval_many(&at).unwrap())
+        .map(|(g, w)| g - w)
+        .fold(f64::INFINITY, f64::min);
+    // Chords over a quarter of the turn each: R (1 - cos(turn / 4)), 12 um.
+    assert!(gouge < -0.01, "{gouge}");
+}
+
 /// A fillet tighter than the wheel is refused, naming every z.
 #[test]
 fn profile_tighter_than_the_wheel_is_refused_naming_z() {

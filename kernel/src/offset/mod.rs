@@ -43,14 +43,15 @@ impl Side {
 }
 
 /// The centres of a tool circle of radius `radius` touching a profile at
-/// each of its nodes (MATH §2.2).
+/// each of its nodes, and along an arc round each convex corner (MATH §2.2).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Equidistant {
     /// Centre z at each node (mm).
     pub z: Vec<Real>,
     /// Centre x at each node (mm).
     pub x: Vec<Real>,
-    /// The profile's slope dx/dz at each node (`tan gamma`).
+    /// The profile's slope dx/dz at each node (`tan gamma`); on a corner's
+    /// arc, the slope whose normal points to that centre.
     pub slope: Vec<Real>,
     /// The tool circle's radius (mm).
     pub radius: Real,
@@ -87,6 +88,13 @@ pub fn curvature_violations(
 /// `centre_i = (z_i - s R sin gamma_i, x_i + s R cos gamma_i)` with
 /// `gamma_i = atan(dx/dz)` and `s` the side's sign.
 ///
+/// At a convex corner (a kink of a built profile whose slope jumps away
+/// from the tool) the tool pivots on the corner: the centres run along the
+/// arc of radius R round it, from the normal of the segment before to the
+/// normal of the one after (the slopes of the chords beside the kink, as
+/// [`Profile::eval`] reads them), at points whose chords stay within
+/// [`CORNER_SAG`] of the arc. A concave corner is a curvature violation.
+///
 /// # Tolerance
 /// With analytic derivatives the centres are exact to rounding. With
 /// estimated ones (divided differences), a centre is off by at most
@@ -116,22 +124,57 @@ pub fn equidistant(
             violations,
         });
     }
-    let slope = profile.slopes().into_owned();
-    let r = radius * side.sign();
+    let slopes = profile.slopes();
+    let d2 = profile.second_derivatives();
+    let (pz, px) = (profile.z(), profile.x());
+    let sigma = side.sign();
     let n = profile.len();
-    let (mut z, mut x) = (Vec::with_capacity(n), Vec::with_capacity(n));
-    for ((&zi, &xi), &s) in profile.z().iter().zip(profile.x()).zip(&slope) {
-        let c = 1.0 / (1.0 + s * s).sqrt();
-        z.push(zi - r * s * c);
-        x.push(xi + r * c);
-    }
-    Ok(Equidistant {
-        z,
-        x,
-        slope,
+    let mut e = Equidistant {
+        z: Vec::with_capacity(n),
+        x: Vec::with_capacity(n),
+        slope: Vec::with_capacity(n),
         radius,
         side,
-    })
+    };
+    for i in 0..n {
+        // A convex kink (the slope jumps away from the tool; concave ones were
+        // refused above): the centre swings round the corner on an arc.
+        if d2[i].is_infinite() && d2[i] * sigma < 0.0 && i > 0 && i + 1 < n {
+            let left = (px[i] - px[i - 1]) / (pz[i] - pz[i - 1]);
+            let right = (px[i + 1] - px[i]) / (pz[i + 1] - pz[i]);
+            let (a, b) = (left.atan(), right.atan());
+            let steps = ((a - b).abs() / corner_step(radius)).ceil().max(1.0) as usize;
+            for k in 0..=steps {
+                let gamma = a + (b - a) * k as Real / steps as Real;
+                e.push(pz[i], px[i], gamma.tan());
+            }
+        } else {
+            e.push(pz[i], px[i], slopes[i]);
+        }
+    }
+    Ok(e)
+}
+
+/// Arc points round a corner are spaced so that their chords stay within
+/// this distance of the arc (mm).
+pub const CORNER_SAG: Real = 1e-6;
+
+/// The angle between arc points round a corner for a tool of `radius`:
+/// chords within [`CORNER_SAG`] of the arc.
+fn corner_step(radius: Real) -> Real {
+    2.0 * (2.0 * CORNER_SAG / radius).sqrt()
+}
+
+impl Equidistant {
+    /// Appends the centre of the tool touching the profile at `(z, x)` with
+    /// the tangent's slope `s`.
+    fn push(&mut self, z: Real, x: Real, s: Real) {
+        let r = self.radius * self.side.sign();
+        let c = 1.0 / (1.0 + s * s).sqrt();
+        self.z.push(z - r * s * c);
+        self.x.push(x + r * c);
+        self.slope.push(s);
+    }
 }
 
 #[cfg(test)]
