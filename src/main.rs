@@ -195,7 +195,10 @@ fn params(script: &Path) -> Result<String, String> {
             p.name.clone(),
             p.default.to_string(),
             p.unit.clone(),
-            p.doc.clone(),
+            match &p.machine {
+                Some(m) => format!("{} (default: the machine's constant {m})", p.doc),
+                None => p.doc.clone(),
+            },
         ));
     }
     let w0 = rows.iter().map(|r| r.0.len()).max().unwrap_or(0);

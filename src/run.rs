@@ -254,12 +254,6 @@ pub fn run(args: &RunArgs) -> Result<String, String> {
         )),
         None => None,
     };
-    let values = family
-        .resolve(
-            file_text.as_ref().map(|(n, t)| (n.as_str(), t.as_str())),
-            &args.sets,
-        )
-        .map_err(|e| e.to_string())?;
     let machine_spec = match &args.machine {
         Some(m) => m.clone(),
         None => family.default_machine().map_err(|e| e.to_string())?.ok_or_else(|| {
@@ -267,6 +261,14 @@ pub fn run(args: &RunArgs) -> Result<String, String> {
         })?,
     };
     let machine = machines::open(&machine_spec)?;
+    // Parameters tied to machine constants default to this machine's.
+    let values = family
+        .resolve_on(
+            &machine.info().constants,
+            file_text.as_ref().map(|(n, t)| (n.as_str(), t.as_str())),
+            &args.sets,
+        )
+        .map_err(|e| e.to_string())?;
     stages.next("checking");
     let checks = family.checks(&values).map_err(|e| e.to_string())?;
     let failed: Vec<String> = checks
@@ -347,11 +349,10 @@ pub fn run(args: &RunArgs) -> Result<String, String> {
     };
     let (pose_block, bodies) = if family.has_fn("part", 1) {
         let parts = part_meshes(&family, &profiles, args.tolerance)?;
-        let lengths: Vec<usize> = toolpath.passes.iter().map(|p| p.points.len()).collect();
         let index = match args.pose_block {
             Some(0) => return Err("--pose-block counts blocks from 1".into()),
             Some(n) => n - 1,
-            None => crate::scene::default_pose_block(&lengths),
+            None => crate::scene::default_pose_block(&toolpath.passes),
         };
         let pose = crate::scene::tool_pose(&program, machine.as_ref(), &toolpath.tool, index)?;
         let tool = crate::scene::tool_mesh(&toolpath.tool, args.tolerance)?;
@@ -558,13 +559,7 @@ pub fn export(
     let index = match block {
         Some(0) => return Err("--block counts blocks from 1".into()),
         Some(n) => n - 1,
-        None => crate::scene::default_pose_block(
-            &toolpath
-                .passes
-                .iter()
-                .map(|p| p.points.len())
-                .collect::<Vec<_>>(),
-        ),
+        None => crate::scene::default_pose_block(&toolpath.passes),
     };
     let parts = report
         .bodies

@@ -22,6 +22,7 @@ mod docs;
 pub use api::Floats;
 pub use docs::api_reference;
 
+use crate::math::Real;
 use crate::toolpath::Toolpath;
 use rhai::{Dynamic, Engine, EvalAltResult, Map, Position, Scope, AST};
 use serde::{Deserialize, Serialize};
@@ -188,6 +189,17 @@ impl ParamValue {
         }
     }
 
+    /// The value of a machine constant, of the same kind as `like`: a
+    /// number as it is, a whole number if it is one, true/false as not 0/0.
+    fn from_constant(x: Real, like: &ParamValue) -> Result<Self, String> {
+        match like {
+            Self::Float(_) => Ok(Self::Float(x)),
+            Self::Int(_) if x.fract() == 0.0 && x.abs() < 9e15 => Ok(Self::Int(x as i64)),
+            Self::Bool(_) => Ok(Self::Bool(x != 0.0)),
+            _ => Err(format!("{x} is not {}", like.kind())),
+        }
+    }
+
     /// The value of a TOML value, of the same kind as `like`.
     fn from_toml(v: &toml::Value, like: &ParamValue) -> Result<Self, String> {
         let got = || format!("expected {}, got {v}", like.kind());
@@ -260,6 +272,10 @@ pub struct ParamSpec {
     pub unit: String,
     /// One line of description.
     pub doc: String,
+    /// The machine constant that gives its default on a machine that has
+    /// it (`machine: "rest_radius"` in the spec), if any.
+    #[serde(default)]
+    pub machine: Option<String>,
 }
 
 /// What a family's finished part must be: the nominal profile, over
@@ -489,11 +505,19 @@ impl Family {
                     .and_then(|d| d.into_string().ok())
                     .unwrap_or_default()
             };
+            let machine = Some(text("machine")).filter(|m| !m.is_empty());
+            if machine.is_some() && ParamValue::from_constant(0.0, &default).is_err() {
+                return Err(fam.contract(format!(
+                    "parameter '{name}' takes its default from a machine constant, so it must be a number or true/false, not {}",
+                    default.kind()
+                )));
+            }
             fam.specs.push(ParamSpec {
                 name: name.to_string(),
                 default,
                 unit: text("unit"),
                 doc: text("doc"),
+                machine,
             });
         }
         Ok(fam)
@@ -549,11 +573,40 @@ impl Family {
         file: Option<(&str, &str)>,
         sets: &[(String, String)],
     ) -> Result<BTreeMap<String, ParamValue>, ScriptError> {
-        let mut values: BTreeMap<String, ParamValue> = self
-            .specs
-            .iter()
-            .map(|s| (s.name.clone(), s.default.clone()))
-            .collect();
+        self.resolve_on(&BTreeMap::new(), file, sets)
+    }
+
+    /// As [`Family::resolve`], on a machine with `constants`: a parameter
+    /// whose spec names a machine constant the machine has takes it as its
+    /// default (the file and `--set` still win).
+    ///
+    /// # Failures
+    /// As [`Family::resolve`]; a constant that is not of the parameter's
+    /// kind (a whole number, say), naming both.
+    pub fn resolve_on(
+        &self,
+        constants: &BTreeMap<String, Real>,
+        file: Option<(&str, &str)>,
+        sets: &[(String, String)],
+    ) -> Result<BTreeMap<String, ParamValue>, ScriptError> {
+        let mut values = BTreeMap::new();
+        for s in &self.specs {
+            let value = match s
+                .machine
+                .as_ref()
+                .and_then(|m| Some((m, constants.get(m)?)))
+            {
+                Some((m, &x)) => ParamValue::from_constant(x, &s.default).map_err(|message| {
+                    ScriptError::BadParam {
+                        name: s.name.clone(),
+                        source_name: format!("the machine's constant {m}"),
+                        message,
+                    }
+                })?,
+                None => s.default.clone(),
+            };
+            values.insert(s.name.clone(), value);
+        }
         let spec = |name: &str, source: &str| {
             self.specs
                 .iter()
