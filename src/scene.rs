@@ -82,10 +82,27 @@ pub fn machine_bodies(
     Ok(vec![("rest".into(), roller, pose)])
 }
 
-/// Block index (from 0) of the first block of the last pass.
-pub fn default_pose_block(pass_lengths: &[usize]) -> usize {
-    let total: usize = pass_lengths.iter().sum();
-    total - pass_lengths.last().copied().unwrap_or(0)
+/// Block index (from 0) where the scene shows the tool by default: the
+/// middle block of the last pass that cuts (has a move other than a rapid),
+/// the tool at work on the finish; else the first block of the last pass.
+pub fn default_pose_block(passes: &[pilgrim_kernel::Pass]) -> usize {
+    let starts: Vec<usize> = passes
+        .iter()
+        .scan(0, |at, p| {
+            let s = *at;
+            *at += p.points.len();
+            Some(s)
+        })
+        .collect();
+    let cutting = passes.iter().rposition(|p| {
+        p.points
+            .iter()
+            .any(|q| q.motion != pilgrim_kernel::Motion::Rapid)
+    });
+    match cutting {
+        Some(i) => starts[i] + passes[i].points.len() / 2,
+        None => starts.last().copied().unwrap_or(0),
+    }
 }
 
 /// The rigid motion of the tool at block `index` (from 0): the machine's

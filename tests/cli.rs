@@ -153,8 +153,9 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
         serde_json::from_slice(&std::fs::read(a.join("report.json")).unwrap()).unwrap();
     assert_eq!(report["blocks"], 365);
     assert_eq!(report["parameters"]["radius"]["value"], 40.0);
-    // The disc and the cutter, placed at the first block of the last pass.
-    assert_eq!(report["pose_block"], 365);
+    // The disc and the cutter, placed at the middle of the last cutting pass
+    // (the contour, blocks 4..=364 at C = 0..=360 deg): block 184, C = 180 deg.
+    assert_eq!(report["pose_block"], 184);
     let disc = pilgrim_kernel::mesh::read_stl(&a.join("part.stl")).unwrap();
     disc.check_closed().unwrap();
     let exact = std::f64::consts::PI * 40.0 * 40.0 * 10.0;
@@ -166,9 +167,12 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
     let cutter = pilgrim_kernel::mesh::read_stl(&a.join("cutter.stl")).unwrap();
     cutter.check_closed().unwrap();
     let (lo, hi) = cutter.bounds();
-    // The retract: the cutter's tip 5 mm above the top face, its axis at r = 45.
+    // On the contour at C = 180 deg: the tip 5 mm below the top face, the
+    // axis at (-45, 0).
     assert!(
-        (lo[2] - 5.0).abs() < 1e-4 && (0.5 * (lo[0] + hi[0]) - 45.0).abs() < 1e-3,
+        (lo[2] + 5.0).abs() < 1e-4
+            && (0.5 * (lo[0] + hi[0]) + 45.0).abs() < 1e-3
+            && (0.5 * (lo[1] + hi[1])).abs() < 1e-3,
         "{lo:?} {hi:?}"
     );
     leave_for_checkers(&a, "demo");
