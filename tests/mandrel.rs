@@ -3,8 +3,12 @@
 use grinder_3k152vf20::Grinder;
 use pilgrim_kernel::offset::rest::after_pass;
 use pilgrim_kernel::offset::{swept_circles, CircleEnvelope};
-use pilgrim_kernel::script::{Access, Family, Limits};
-use pilgrim_kernel::{drop_circle, AxisProgram, MachineKinematics, MandrelLaw, Profile, Side};
+use pilgrim_kernel::script::{Access, Family, Limits, ParamValue};
+use pilgrim_kernel::verify::GrindingCheck;
+use pilgrim_kernel::{
+    drop_circle, AxisProgram, MachineKinematics, MandrelLaw, Profile, Side, Toolpath,
+};
+use std::collections::BTreeMap;
 use std::path::Path;
 
 const R_S: f64 = 20.0;
@@ -72,12 +76,13 @@ fn finishing_blocks_stand_at_r_s_from_the_law() {
         .unwrap();
     assert!(name.contains("stock 0"), "{name}");
     let law = MandrelLaw::new(38.0, 52.0, 400.0, 0.012, 2.3).unwrap();
-    // The ground profile: the law, and its end tangents over the overrun.
+    // The ground profile: the transition's line before the law, the end
+    // cone (d 52 -> 44 mm over 40 mm) and its line beyond the part's end.
     let x = |z: f64| {
         if z < 0.0 {
             law.x(0.0) + law.dx(0.0) * z
         } else if z > 400.0 {
-            law.x(400.0) + law.dx(400.0) * (z - 400.0)
+            26.0 - 0.1 * (z - 400.0)
         } else {
             law.x(z)
         }
@@ -224,8 +229,13 @@ fn bad_mandrel_parameters_are_refused_and_nothing_is_written() {
         (vec!["rest_r=140"], "axis U at 1"),
         (
             vec!["d_mn=40"],
-            "unknown parameter 'd_mn' from --set (parameters: cone_d, cone_len, d_max, d_min",
+            "unknown parameter 'd_mn' from --set (parameters: cone_d, cone_len, cuts, d_max, d_min",
         ),
+        (
+            vec!["cuts=[0.15,0.1]"],
+            "the cuts add up to the stock (cuts add up to 0.25 mm, stock 0.3 mm)",
+        ),
+        (vec!["cuts=[0.4,-0.1]"], "no cut is negative"),
     ] {
         let (code, err) = run(&sets);
         assert_eq!(code, 1, "{sets:?}: {err}");
@@ -248,26 +258,31 @@ fn bad_mandrel_parameters_are_refused_and_nothing_is_written() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The default job verifies, and one corrupted block of the finishing pass
-/// fails verification naming that block.
-#[test]
-fn verification_catches_a_corrupted_block() {
-    let fam = family();
-    let values = fam.resolve(None, &[]).unwrap();
-    let tp = fam.toolpath(&values).unwrap();
+/// The family's toolpath and program for `values` on the 3K152VF20, and a
+/// replay verification of any program against the family's nominal.
+fn job(
+    fam: &Family,
+    values: &BTreeMap<String, ParamValue>,
+) -> (
+    Toolpath,
+    AxisProgram,
+    impl Fn(&AxisProgram) -> Result<GrindingCheck, String>,
+) {
+    let tp = fam.toolpath(values).unwrap();
     let grinder = Grinder::new();
-    let mut program = AxisProgram::build(&tp, &grinder, "mandrel").unwrap();
-    let v = fam.verification(&values).unwrap().unwrap();
+    let program = AxisProgram::build(&tp, &grinder, "mandrel").unwrap();
+    let v = fam.verification(values).unwrap().unwrap();
     let passes: Vec<(String, usize)> = tp
         .passes
         .iter()
         .map(|p| (p.name.clone(), p.points.len()))
         .collect();
-    let check = |program: &AxisProgram| {
+    let reference = tp.tool.reference;
+    let check = move |program: &AxisProgram| {
         pilgrim_kernel::verify::check_grinding(
             program,
             &grinder,
-            &tp.tool.reference,
+            &reference,
             R_S,
             &passes,
             &v.profile,
@@ -275,6 +290,16 @@ fn verification_catches_a_corrupted_block() {
             v.tolerance,
         )
     };
+    (tp, program, check)
+}
+
+/// The default job verifies, and one corrupted block of the finishing pass
+/// fails verification naming that block.
+#[test]
+fn verification_catches_a_corrupted_block() {
+    let fam = family();
+    let values = fam.resolve(None, &[]).unwrap();
+    let (_, mut program, check) = job(&fam, &values);
     let ok = check(&program).unwrap();
     let finish = ok.passes.last().unwrap();
     assert!(finish.deviation.max_abs <= 1e-3, "{finish:?}");
@@ -328,4 +353,139 @@ fn example_parameter_files_run() {
         );
         std::fs::remove_dir_all(&out).ok();
     }
+}
+
+/// The report's comparison is fair and the figure holds: the uniform step it
+/// names is the longest that keeps every chord of the wheel's path within
+/// half the tolerance (a fifth longer breaks it, round the end cone's
+/// corner), and the adaptive blocks are at least 3x fewer.
+#[test]
+fn adaptive_spacing_beats_the_uniform_step_threefold() {
+    let fam = family();
+    let values = fam.resolve(None, &[]).unwrap();
+    let tp = fam.toolpath(&values).unwrap();
+    let (adaptive, uniform, step) = (
+        tp.notes["adaptive_blocks"],
+        tp.notes["uniform_blocks"],
+        tp.notes["uniform_step_mm"],
+    );
+    assert!(uniform >= 3.0 * adaptive, "{adaptive} vs {uniform}");
+    let ground = fam
+        .call_with_params("ground_profile", &values)
+        .unwrap()
+        .cast::<Profile>();
+    let e = pilgrim_kernel::equidistant(&ground, R_S, Side::Outside).unwrap();
+    let path = Profile::new(e.z.clone(), e.x.clone()).unwrap();
+    let s = path.arc_length();
+    // The largest distance of the path from its chords at a uniform step h
+    // of arc length (points placed on the path by interpolation).
+    let at = |t: f64| {
+        let i = s.partition_point(|&v| v < t).clamp(1, s.len() - 1);
+        let f = (t - s[i - 1]) / (s[i] - s[i - 1]);
+        (
+            e.z[i - 1] + f * (e.z[i] - e.z[i - 1]),
+            e.x[i - 1] + f * (e.x[i] - e.x[i - 1]),
+        )
+    };
+    let worst = |h: f64| {
+        let total = s[s.len() - 1];
+        let mut worst: f64 = 0.0;
+        let mut t = 0.0;
+        while t < total {
+            let (a, b) = (at(t), at((t + h).min(total)));
+            let (dz, dx) = (b.0 - a.0, b.1 - a.1);
+            for k in s.partition_point(|&v| v <= t)..s.partition_point(|&v| v < t + h) {
+                let d = ((e.z[k] - a.0) * dx - (e.x[k] - a.1) * dz).abs() / dz.hypot(dx);
+                worst = worst.max(d);
+            }
+            t += h;
+        }
+        worst
+    };
+    let half = 0.5e-3;
+    assert!(worst(step) <= half * 1.01, "{}", worst(step));
+    assert!(worst(1.2 * step) > half, "{}", worst(1.2 * step));
+}
+
+/// A pass schedule given as a list of cuts: each pass leaves what the list
+/// says (checked by replay), a cut of 0 is a spark-out pass at the finish.
+#[test]
+fn a_list_of_cuts_sets_the_passes() {
+    let fam = family();
+    let sets = [("cuts".to_owned(), "[0.15, 0.1, 0.05, 0]".to_owned())];
+    let values = fam.resolve(None, &sets).unwrap();
+    let (tp, program, check) = job(&fam, &values);
+    let names: Vec<&str> = tp.passes.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "approach",
+            "pass 1, stock 150.0 um",
+            "pass 2, stock 50.0 um",
+            "pass 3, stock 0.0 um",
+            "pass 4, stock 0.0 um, spark-out",
+            "retract"
+        ]
+    );
+    let ok = check(&program).unwrap();
+    let left: Vec<f64> = ok.passes.iter().map(|p| p.deviation.max_below).collect();
+    for (got, want) in left.iter().zip([0.15, 0.05, 0.0, 0.0]) {
+        assert!((got - want).abs() < 1e-3, "{left:?}");
+    }
+}
+
+/// The rest's parameters follow the machine's constants unless set, and a
+/// machine whose U programs the support's tip gets U = centre - R_o.
+#[test]
+fn rest_parameters_follow_the_machine() {
+    let fam = family();
+    let default = fam.resolve(None, &[]).unwrap();
+    let constants: BTreeMap<String, f64> = [
+        ("rest_radius", 30.0),
+        ("rest_offset_b", -180.0),
+        ("rest_programs_centre", 0.0),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_owned(), v))
+    .collect();
+    let on = fam.resolve_on(&constants, None, &[]).unwrap();
+    assert_eq!(on["rest_r"], ParamValue::Float(30.0));
+    assert_eq!(on["rest_at_centre"], ParamValue::Bool(false));
+    let sets = [("rest_r".to_owned(), "25".to_owned())];
+    let set = fam.resolve_on(&constants, None, &sets).unwrap();
+    assert_eq!(set["rest_r"], ParamValue::Float(25.0), "--set wins");
+    let (centre, tip) = (fam.toolpath(&default).unwrap(), fam.toolpath(&set).unwrap());
+    let mut n = 0;
+    for (a, b) in centre.passes.iter().zip(&tip.passes) {
+        for (p, q) in a.points.iter().zip(&b.points) {
+            assert_eq!(p.point, q.point);
+            assert!(
+                (p.aux[0] - 25.0 - q.aux[0]).abs() < 1e-12,
+                "{} {}",
+                p.aux[0],
+                q.aux[0]
+            );
+            n += 1;
+        }
+    }
+    assert!(n > 100);
+    // A whole-number parameter cannot follow a fractional constant.
+    let bad = Family::from_source(
+        "fn params() { #{ n: #{ value: 3, machine: \"rest_radius\" } } }\nfn toolpath(p) { () }",
+        "bad.rhai",
+        &Limits::default(),
+        &Access::default(),
+    )
+    .unwrap();
+    let e = bad
+        .resolve_on(
+            &BTreeMap::from([("rest_radius".to_owned(), 2.5)]),
+            None,
+            &[],
+        )
+        .unwrap_err();
+    assert!(
+        e.to_string().contains("the machine's constant rest_radius"),
+        "{e}"
+    );
 }

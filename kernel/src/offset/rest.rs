@@ -115,6 +115,8 @@ pub struct RestTrack {
     pub seed_centre_x: Vec<Real>,
     /// The largest |seed - exact| over the pass (mm).
     pub max_model_difference: Real,
+    /// The block where it is (from 0).
+    pub max_difference_block: usize,
 }
 
 /// What the rest rides on during a pass.
@@ -170,6 +172,7 @@ pub fn track(
         contact_x: Vec::with_capacity(z.len()),
         seed_centre_x: Vec::with_capacity(z.len()),
         max_model_difference: 0.0,
+        max_difference_block: 0,
     };
     for k in 0..z.len() {
         let z_r = z[k] + setup.offset_b;
@@ -228,7 +231,10 @@ pub fn track(
         let window = Profile::new(grid, surface)?;
         let d = super::drop_circle(&window, z_r, setup.radius, Side::Outside)?;
         let seed = seed_u(&window, z_r.clamp(a, b), setup.radius)?;
-        out.max_model_difference = out.max_model_difference.max((seed - d.centre_x).abs());
+        if (seed - d.centre_x).abs() > out.max_model_difference {
+            out.max_model_difference = (seed - d.centre_x).abs();
+            out.max_difference_block = k;
+        }
         out.centre_x.push(d.centre_x);
         out.contact_z.push(d.contact_z);
         out.contact_x.push(d.contact_x);

@@ -538,9 +538,10 @@ pub mod offset_api {
     /// moves through `(cz, cx)` (one way along z) over a workpiece whose
     /// surface before the pass is `previous`; the rest's support (radius
     /// `r_o`) stands at `z_r = z + b`. Returns per block `#{ centre_x,
-    /// contact_z, contact_x, seed_centre_x }` (Floats) and
-    /// `max_model_difference`: the exact drop on the current surface, and the
-    /// seed's formula on it.
+    /// contact_z, contact_x, seed_centre_x }` (Floats),
+    /// `max_model_difference` (mm) between the exact drop on the current
+    /// surface and the seed's formula on it, and `max_difference_block`
+    /// (from 0), where that is.
     #[rhai_fn(return_raw)]
     pub fn rest_track(
         previous: Profile,
@@ -574,6 +575,10 @@ pub mod offset_api {
         m.insert(
             "max_model_difference".into(),
             Dynamic::from_float(t.max_model_difference),
+        );
+        m.insert(
+            "max_difference_block".into(),
+            Dynamic::from_int(t.max_difference_block as rhai::INT),
         );
         Ok(m)
     }
