@@ -125,24 +125,31 @@ fn profile_svg(
                 .collect(),
         });
     }
+    // Curvature as a share of the wheel's limit (1 = as round as the wheel):
+    // the margin reads directly, and the curve keeps its shape however far
+    // below the limit it is (the limit's line is drawn when it is near).
     let z = v.profile.z();
+    let share: Vec<f64> = v.profile.curvature().iter().map(|k| k * rounding).collect();
+    let top = share.iter().fold(0.0f64, |m, s| m.max(s.abs()));
+    let mut series = vec![Series {
+        name: "R_s x curvature".into(),
+        color: COLORS[0],
+        points: z.iter().copied().zip(share).collect(),
+    }];
+    if top >= 0.25 {
+        series.push(Series {
+            name: "the wheel's limit".into(),
+            color: "#cc2222",
+            points: vec![(z[0], 1.0), (z[z.len() - 1], 1.0)],
+        });
+    }
     panels.push(Panel {
         title: format!(
-            "curvature of the nominal (1/mm) against the wheel's limit 1/R_s = 1/{rounding}"
+            "curvature of the nominal against the wheel's limit 1/R_s (R_s = {rounding} mm): largest {}",
+            pilgrim_kernel::math::fixed(top, 4)
         ),
-        y_label: "curvature".into(),
-        series: vec![
-            Series {
-                name: "curvature".into(),
-                color: COLORS[0],
-                points: z.iter().copied().zip(v.profile.curvature()).collect(),
-            },
-            Series {
-                name: "1/R_s".into(),
-                color: "#cc2222",
-                points: vec![(z[0], 1.0 / rounding), (z[z.len() - 1], 1.0 / rounding)],
-            },
-        ],
+        y_label: "R_s x curvature".into(),
+        series,
     });
     crate::svg::render(&panels)
 }

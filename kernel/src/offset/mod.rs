@@ -67,16 +67,31 @@ pub fn curvature_violations(
     radius: Real,
     side: Side,
 ) -> Vec<CurvatureViolation> {
-    let d1 = profile.slopes();
-    let d2 = profile.second_derivatives();
+    violations(
+        profile.z(),
+        &profile.slopes(),
+        &profile.second_derivatives(),
+        radius,
+        side,
+    )
+}
+
+/// [`curvature_violations`] on derivatives already at hand.
+fn violations(
+    z: &[Real],
+    d1: &[Real],
+    d2: &[Real],
+    radius: Real,
+    side: Side,
+) -> Vec<CurvatureViolation> {
     let sigma = side.sign();
     let mut out = Vec::new();
-    for i in 0..profile.len() {
+    for i in 0..z.len() {
         let k = crate::profile::curvature_of(d1[i], d2[i]) * sigma;
         if k * radius > 1.0 {
             out.push(CurvatureViolation {
                 index: i,
-                z: profile.z()[i],
+                z: z[i],
                 rho: 1.0 / k,
             });
         }
@@ -117,18 +132,45 @@ pub fn equidistant(
     side: Side,
 ) -> Result<Equidistant, ProfileError> {
     positive("tool radius", radius)?;
-    let violations = curvature_violations(profile, radius, side);
-    if !violations.is_empty() {
-        return Err(ProfileError::CurvatureBelowTool {
-            tool_radius: radius,
-            violations,
-        });
-    }
     let slopes = profile.slopes();
     let d2 = profile.second_derivatives();
     let (pz, px) = (profile.z(), profile.x());
+    let found = violations(pz, &slopes, &d2, radius, side);
+    if !found.is_empty() {
+        return Err(ProfileError::CurvatureBelowTool {
+            tool_radius: radius,
+            violations: found,
+        });
+    }
     let sigma = side.sign();
     let n = profile.len();
+    // Convex kinks (the slope jumps away from the tool; concave ones were
+    // refused above): there the centre swings round the corner on an arc.
+    let corners: Vec<usize> = (1..n.saturating_sub(1))
+        .filter(|&i| d2[i].is_infinite() && d2[i] * sigma < 0.0)
+        .collect();
+    drop(d2);
+    let r = radius * sigma;
+    let centre = |z: Real, x: Real, s: Real| {
+        let c = 1.0 / (1.0 + s * s).sqrt();
+        (z - r * s * c, x + r * c)
+    };
+    if corners.is_empty() {
+        // One centre per node: the slopes become the result's as they are.
+        let (z, x) = pz
+            .iter()
+            .zip(px)
+            .zip(slopes.iter())
+            .map(|((&z, &x), &s)| centre(z, x, s))
+            .unzip();
+        return Ok(Equidistant {
+            z,
+            x,
+            slope: slopes.into_owned(),
+            radius,
+            side,
+        });
+    }
     let mut e = Equidistant {
         z: Vec::with_capacity(n),
         x: Vec::with_capacity(n),
@@ -136,20 +178,25 @@ pub fn equidistant(
         radius,
         side,
     };
+    let mut push = |z: Real, x: Real, s: Real| {
+        let (cz, cx) = centre(z, x, s);
+        e.z.push(cz);
+        e.x.push(cx);
+        e.slope.push(s);
+    };
+    let mut next = corners.iter().peekable();
     for i in 0..n {
-        // A convex kink (the slope jumps away from the tool; concave ones were
-        // refused above): the centre swings round the corner on an arc.
-        if d2[i].is_infinite() && d2[i] * sigma < 0.0 && i > 0 && i + 1 < n {
+        if next.next_if_eq(&&i).is_some() {
             let left = (px[i] - px[i - 1]) / (pz[i] - pz[i - 1]);
             let right = (px[i + 1] - px[i]) / (pz[i + 1] - pz[i]);
             let (a, b) = (left.atan(), right.atan());
             let steps = ((a - b).abs() / corner_step(radius)).ceil().max(1.0) as usize;
             for k in 0..=steps {
                 let gamma = a + (b - a) * k as Real / steps as Real;
-                e.push(pz[i], px[i], gamma.tan());
+                push(pz[i], px[i], gamma.tan());
             }
         } else {
-            e.push(pz[i], px[i], slopes[i]);
+            push(pz[i], px[i], slopes[i]);
         }
     }
     Ok(e)
@@ -163,18 +210,6 @@ pub const CORNER_SAG: Real = 1e-6;
 /// chords within [`CORNER_SAG`] of the arc.
 fn corner_step(radius: Real) -> Real {
     2.0 * (2.0 * CORNER_SAG / radius).sqrt()
-}
-
-impl Equidistant {
-    /// Appends the centre of the tool touching the profile at `(z, x)` with
-    /// the tangent's slope `s`.
-    fn push(&mut self, z: Real, x: Real, s: Real) {
-        let r = self.radius * self.side.sign();
-        let c = 1.0 / (1.0 + s * s).sqrt();
-        self.z.push(z - r * s * c);
-        self.x.push(x + r * c);
-        self.slope.push(s);
-    }
 }
 
 #[cfg(test)]
