@@ -39,6 +39,9 @@ struct Report {
     control: String,
     parameters: BTreeMap<String, ReportParam>,
     passes: usize,
+    /// Passes with a move other than a rapid.
+    #[serde(default)]
+    cutting_passes: usize,
     points: usize,
     blocks: usize,
     cycle_time_min: f64,
@@ -390,6 +393,11 @@ pub fn run(args: &RunArgs) -> Result<String, String> {
             })
             .collect(),
         passes: toolpath.passes.len(),
+        cutting_passes: toolpath
+            .passes
+            .iter()
+            .filter(|p| p.points.iter().any(|c| c.motion != Motion::Rapid))
+            .count(),
         points: toolpath.point_count(),
         blocks: program.blocks.len(),
         cycle_time_min: (cycle_time(&program, info) * 1e4).round() / 1e4,
@@ -438,8 +446,9 @@ pub fn run(args: &RunArgs) -> Result<String, String> {
         })
         .unwrap_or_default();
     Ok(format!(
-        "{}: {} passes, {} blocks for {} ({}), about {:.1} min{verified}; written to {}",
+        "{}: {} cutting passes ({} in all), {} blocks for {} ({}), about {:.1} min{verified}; written to {}",
         family.file(),
+        report.cutting_passes,
         report.passes,
         report.blocks,
         info.name,
