@@ -131,13 +131,20 @@ fn profile_svg(
     // Curvature as a share of the wheel's limit (1 = as round as the wheel):
     // the margin reads directly, and the curve keeps its shape however far
     // below the limit it is (the limit's line is drawn when it is near).
+    // Corners (infinite curvature) are left out: the wheel pivots on convex
+    // ones, and concave ones never get this far.
     let z = v.profile.z();
-    let share: Vec<f64> = v.profile.curvature().iter().map(|k| k * rounding).collect();
-    let top = share.iter().fold(0.0f64, |m, s| m.max(s.abs()));
+    let share: Vec<(f64, f64)> = z
+        .iter()
+        .zip(v.profile.curvature())
+        .map(|(&z, k)| (z, k * rounding))
+        .filter(|(_, s)| s.is_finite())
+        .collect();
+    let top = share.iter().fold(0.0f64, |m, (_, s)| m.max(s.abs()));
     let mut series = vec![Series {
         name: "R_s x curvature".into(),
         color: COLORS[0],
-        points: z.iter().copied().zip(share).collect(),
+        points: share,
     }];
     if top >= 0.25 {
         series.push(Series {
