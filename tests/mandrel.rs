@@ -414,7 +414,7 @@ fn adaptive_spacing_beats_the_uniform_step_threefold() {
 #[test]
 fn a_list_of_cuts_sets_the_passes() {
     let fam = family();
-    let sets = [("cuts".to_owned(), "[0.15, 0.1, 0.05, 0]".to_owned())];
+    let sets = [("cuts".to_owned(), "[0.15, 0.1, 0.04, 0.01, 0]".to_owned())];
     let values = fam.resolve(None, &sets).unwrap();
     let (tp, program, check) = job(&fam, &values);
     let names: Vec<&str> = tp.passes.iter().map(|p| p.name.as_str()).collect();
@@ -424,14 +424,21 @@ fn a_list_of_cuts_sets_the_passes() {
             "approach",
             "pass 1, stock 150.0 um",
             "pass 2, stock 50.0 um",
-            "pass 3, stock 0.0 um",
-            "pass 4, stock 0.0 um, spark-out",
+            "pass 3, stock 10.0 um",
+            "pass 4, stock 0.0 um",
+            "pass 5, stock 0.0 um, spark-out",
             "retract"
         ]
     );
+    // The uniform step's count is for the same five passes (the default
+    // job's four passes at the same step).
+    let four = fam.toolpath(&fam.resolve(None, &[]).unwrap()).unwrap();
+    let (adaptive, uniform) = (tp.notes["adaptive_blocks"], tp.notes["uniform_blocks"]);
+    assert_eq!(uniform, four.notes["uniform_blocks"] / 4.0 * 5.0);
+    assert!(uniform >= 3.0 * adaptive, "{adaptive} vs {uniform}");
     let ok = check(&program).unwrap();
     let left: Vec<f64> = ok.passes.iter().map(|p| p.deviation.max_below).collect();
-    for (got, want) in left.iter().zip([0.15, 0.05, 0.0, 0.0]) {
+    for (got, want) in left.iter().zip([0.15, 0.05, 0.01, 0.0, 0.0]) {
         assert!((got - want).abs() < 1e-3, "{left:?}");
     }
 }
