@@ -236,6 +236,10 @@ fn bad_mandrel_parameters_are_refused_and_nothing_is_written() {
             "the cuts add up to the stock (cuts add up to 0.25 mm, stock 0.3 mm)",
         ),
         (vec!["cuts=[0.4,-0.1]"], "no cut is negative"),
+        (
+            vec!["shank_len=100"],
+            "pass 1: the steady rest's support at block 1 of the pass (z_r = z + B, B = -180.0000 mm) has nothing under it: its centre at z = -190.1200",
+        ),
     ] {
         let (code, err) = run(&sets);
         assert_eq!(code, 1, "{sets:?}: {err}");

@@ -57,7 +57,10 @@ fn rest_rides_the_cut_behind_the_wheel_and_the_stock_ahead() {
     let e = track(&bar, &cz, &cx, R_S, &setup(-600.0))
         .unwrap_err()
         .to_string();
-    assert!(e.contains("steady rest at block 0"), "{e}");
+    assert!(
+        e.contains("support at block 1 of the pass") && e.contains("at z = -550.0000"),
+        "{e}"
+    );
 }
 
 /// On a mandrel pass the track agrees, within 1 um, with an independent

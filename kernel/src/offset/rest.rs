@@ -182,7 +182,11 @@ pub fn track(
         );
         if a >= b {
             return Err(ProfileError::OutsideProfile {
-                what: format!("the steady rest at block {k}"),
+                what: format!(
+                    "the steady rest's support at block {} of the pass (z_r = z + B, B = {} mm) has nothing under it: its centre",
+                    k + 1,
+                    crate::math::fixed(setup.offset_b, 4)
+                ),
                 z: z_r,
                 z_min: lo_prev,
                 z_max: hi_prev,

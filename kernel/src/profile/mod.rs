@@ -98,7 +98,7 @@ pub enum ProfileError {
         chord: Real,
     },
     /// A query outside the profile's z range.
-    #[error("{what} at z = {z} is outside the profile's range [{z_min}, {z_max}]")]
+    #[error("{what} at z = {} is outside the profile's range [{}, {}]", fixed(*z, 4), fixed(*z_min, 4), fixed(*z_max, 4))]
     OutsideProfile {
         /// What was asked.
         what: String,
