@@ -78,11 +78,7 @@ fn profile_svg(
 ) -> String {
     use crate::svg::{Panel, Series};
     const COLORS: [&str; 4] = ["#444444", "#d08000", "#2a6fd8", "#2a9d4b"];
-    let cutting: Vec<&pilgrim_kernel::Pass> = toolpath
-        .passes
-        .iter()
-        .filter(|p| p.points.iter().any(|c| c.motion != Motion::Rapid))
-        .collect();
+    let cutting: Vec<&pilgrim_kernel::Pass> = toolpath.passes.iter().filter(|p| p.cuts()).collect();
     let mut shape: Vec<Series> = profiles
         .iter()
         .enumerate()
@@ -400,11 +396,7 @@ pub fn run(args: &RunArgs) -> Result<String, String> {
             })
             .collect(),
         passes: toolpath.passes.len(),
-        cutting_passes: toolpath
-            .passes
-            .iter()
-            .filter(|p| p.points.iter().any(|c| c.motion != Motion::Rapid))
-            .count(),
+        cutting_passes: toolpath.passes.iter().filter(|p| p.cuts()).count(),
         points: toolpath.point_count(),
         blocks: program.blocks.len(),
         cycle_time_min: (cycle_time(&program, info) * 1e4).round() / 1e4,

@@ -94,11 +94,7 @@ pub fn default_pose_block(passes: &[pilgrim_kernel::Pass]) -> usize {
             Some(s)
         })
         .collect();
-    let cutting = passes.iter().rposition(|p| {
-        p.points
-            .iter()
-            .any(|q| q.motion != pilgrim_kernel::Motion::Rapid)
-    });
+    let cutting = passes.iter().rposition(|p| p.cuts());
     match cutting {
         Some(i) => starts[i] + passes[i].points.len() / 2,
         None => starts.last().copied().unwrap_or(0),

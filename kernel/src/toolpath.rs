@@ -55,6 +55,13 @@ pub struct Pass {
     pub points: Vec<ClPoint>,
 }
 
+impl Pass {
+    /// Whether the pass cuts: has a move other than a rapid.
+    pub fn cuts(&self) -> bool {
+        self.points.iter().any(|p| p.motion != Motion::Rapid)
+    }
+}
+
 /// The CL data of one job.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Toolpath {
