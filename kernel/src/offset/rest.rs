@@ -193,43 +193,31 @@ pub fn track(
             });
         }
         // Circles whose reach meets the support's: a run of the pass.
-        let near: Vec<usize> = if increasing {
-            let s = cz.partition_point(|&c| c < z_r - reach);
-            let e = cz.partition_point(|&c| c <= z_r + reach);
-            (s..e).collect()
+        let near = if increasing {
+            cz.partition_point(|&c| c < z_r - reach)..cz.partition_point(|&c| c <= z_r + reach)
         } else {
-            let s = cz.partition_point(|&c| c > z_r + reach);
-            let e = cz.partition_point(|&c| c >= z_r - reach);
-            (s..e).collect()
+            cz.partition_point(|&c| c > z_r + reach)..cz.partition_point(|&c| c >= z_r - reach)
         };
+        // Of those, the ones the wheel has placed by now: none, all (the
+        // pass's whole envelope serves), or the first few.
         let now = last_of_block[k];
-        let cut: Option<super::CircleEnvelope> = match (near.first(), near.last()) {
-            (Some(_), Some(&last)) if last <= now => None, // all cut: the full envelope serves
-            (Some(&first), Some(_)) if first <= now => {
-                let (pz, px): (Vec<Real>, Vec<Real>) =
-                    (first..=now).map(|i| (cz[i], cx[i])).unzip();
-                Some(super::CircleEnvelope::new(
-                    &pz,
-                    &px,
-                    wheel_radius,
-                    Side::Outside,
-                )?)
-            }
-            _ => None,
+        let partial;
+        let cut = if near.is_empty() || near.start > now {
+            None
+        } else if near.end - 1 <= now {
+            Some(&full)
+        } else {
+            let (pz, px): (Vec<Real>, Vec<Real>) =
+                (near.start..=now).map(|i| (cz[i], cx[i])).unzip();
+            partial = super::CircleEnvelope::new(&pz, &px, wheel_radius, Side::Outside)?;
+            Some(&partial)
         };
-        let all_cut = matches!((near.first(), near.last()), (Some(_), Some(&last)) if last <= now);
         let grid = crate::profile::uniform_grid(a, b, setup.sample)?;
         let surface: Vec<Real> = grid
             .iter()
-            .map(|&g| {
-                let p = prev_at(g);
-                if all_cut {
-                    p.min(full.eval(g))
-                } else if let Some(env) = &cut {
-                    p.min(env.eval(g))
-                } else {
-                    p
-                }
+            .map(|&g| match cut {
+                Some(env) => prev_at(g).min(env.eval(g)),
+                None => prev_at(g),
             })
             .collect();
         let window = Profile::new(grid, surface)?;
