@@ -86,19 +86,15 @@ pub fn machine_bodies(
 /// middle block of the last pass that cuts (has a move other than a rapid),
 /// the tool at work on the finish; else the first block of the last pass.
 pub fn default_pose_block(passes: &[pilgrim_kernel::Pass]) -> usize {
-    let starts: Vec<usize> = passes
-        .iter()
-        .scan(0, |at, p| {
-            let s = *at;
-            *at += p.points.len();
-            Some(s)
-        })
-        .collect();
-    let cutting = passes.iter().rposition(|p| p.cuts());
-    match cutting {
-        Some(i) => starts[i] + passes[i].points.len() / 2,
-        None => starts.last().copied().unwrap_or(0),
+    let (mut start, mut last_start, mut pick) = (0, 0, None);
+    for p in passes {
+        if p.cuts() {
+            pick = Some(start + p.points.len() / 2);
+        }
+        last_start = start;
+        start += p.points.len();
     }
+    pick.unwrap_or(last_start)
 }
 
 /// The rigid motion of the tool at block `index` (from 0): the machine's
