@@ -1,44 +1,52 @@
 //! Mandrel benchmarks (issue: mandrel family). Run: `cargo bench --bench mandrel`.
 //!
-//! - `mandrel_job`: the default job as a user runs it, through the release
-//!   `pilgrim` program: the family's script, inverse kinematics and limits,
-//!   the replay verification, the meshes and every file (target <= 0.5 s);
+//! - `mandrel_job`: the default job through the kernel's job call, in
+//!   process: the family's script loaded, the machine opened, parameters,
+//!   checks, toolpath, inverse kinematics and limits, the replay
+//!   verification, the posts, the meshes and the bytes of every file (not
+//!   written to disk) (target <= 0.5 s);
 //! - `mandrel_rhai_vs_native`: the default toolpath through the family's
 //!   script, and the same toolpath built from Rust directly (target: the
 //!   Rhai run <= 1.5x), after printing the adaptive spacing's block count
 //!   against the uniform step's (target: at least 3x fewer, asserted).
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use pilgrim_kernel::catalog::{Catalog, CompiledPlugin};
+use pilgrim_kernel::job::{self, JobOptions};
 use pilgrim_kernel::offset::rest::{after_pass, track, RestSetup};
 use pilgrim_kernel::profile::simplify_polyline;
-use pilgrim_kernel::script::{Access, Family, Limits};
+use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
 use pilgrim_kernel::{
-    equidistant, ClPoint, MandrelLaw, Motion, Pass, Profile, ProfileBuilder, Side, Tool, Toolpath,
-    Wheel,
+    equidistant, ClPoint, MandrelLaw, Motion, PartFamily, Pass, Profile, ProfileBuilder, Side,
+    Tool, Toolpath, Wheel,
 };
 use std::hint::black_box;
 use std::path::Path;
-use std::process::Command;
 use std::time::Duration;
 
 fn mandrel_job(c: &mut Criterion) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let out = std::env::temp_dir().join(format!("pilgrim-bench-mandrel-{}", std::process::id()));
-    let run = || {
-        let status = Command::new(env!("CARGO_BIN_EXE_pilgrim"))
-            .current_dir(root)
-            .args(["run", "scripts/mandrel.rhai", "--quiet", "--out"])
-            .arg(&out)
-            .status()
-            .unwrap();
-        assert!(status.success());
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/mandrel.rhai");
+    let catalog = Catalog::new(&[CompiledPlugin {
+        symbol: "pilgrim_plugin_grinder_3k152vf20",
+        entry: grinder_3k152vf20::pilgrim_plugin_grinder_3k152vf20,
+    }])
+    .unwrap();
+    let options = JobOptions {
+        program_name: "mandrel".into(),
+        ..JobOptions::default()
     };
-    run();
+    let run = || {
+        let family = ScriptFamily::load(&script, &Limits::default(), &Access::default()).unwrap();
+        let spec = family.default_machine().unwrap().unwrap();
+        let machine = catalog.open(&spec).unwrap();
+        job::run(&family, &machine, &[], &options, &mut |_| {}).unwrap()
+    };
+    let out = run();
+    assert!(out.files.len() >= 12, "{} files", out.files.len());
     let mut g = c.benchmark_group("mandrel_job");
     g.sample_size(20).measurement_time(Duration::from_secs(8));
-    g.bench_function("default_job_end_to_end", |b| b.iter(run));
+    g.bench_function("default_job_end_to_end", |b| b.iter(|| black_box(run())));
     g.finish();
-    let _ = std::fs::remove_dir_all(&out);
 }
 
 /// The family's default toolpath, step for step as `scripts/mandrel.rhai`.
@@ -129,8 +137,9 @@ fn native_toolpath() -> Toolpath {
 
 fn mandrel_rhai_vs_native(c: &mut Criterion) {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/mandrel.rhai");
-    let family = Family::load(&script, &Limits::default(), &Access::default()).unwrap();
-    let values = family.resolve(None, &[]).unwrap();
+    let family = ScriptFamily::load(&script, &Limits::default(), &Access::default()).unwrap();
+    let values =
+        pilgrim_kernel::params::resolve(family.params(), &Default::default(), &[]).unwrap();
     // Both build the same toolpath: same points in the same passes.
     let (a, b) = (family.toolpath(&values).unwrap(), native_toolpath());
     assert_eq!(a.passes.len(), b.passes.len());

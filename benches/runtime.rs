@@ -7,11 +7,11 @@
 //!   (target: <= 5% slower).
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use grinder_3k152vf20::Grinder;
+use pilgrim_kernel::params::{resolve, ParamSource};
 use pilgrim_kernel::plugin::PluginMachine;
-use pilgrim_kernel::script::{Access, Family, Limits};
+use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
 use pilgrim_kernel::{
-    ClPoint, MachineKinematics, Motion, Pass, Point3, Tool, ToolFrame, Toolpath, Vec3,
+    ClPoint, MachineKinematics, Motion, PartFamily, Pass, Point3, Tool, ToolFrame, Toolpath, Vec3,
 };
 use std::hint::black_box;
 use std::path::Path;
@@ -72,10 +72,16 @@ fn demo_in_rust(
 
 fn rhai_overhead(c: &mut Criterion) {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/examples/mill_circle.rhai");
-    let family = Family::load(&script, &Limits::default(), &Access::default()).unwrap();
-    let values = family
-        .resolve(None, &[("points".into(), POINTS.to_string())])
-        .unwrap();
+    let family = ScriptFamily::load(&script, &Limits::default(), &Access::default()).unwrap();
+    let values = resolve(
+        family.params(),
+        &Default::default(),
+        &[ParamSource::Pairs {
+            label: "--set".into(),
+            pairs: vec![("points".into(), POINTS.to_string())],
+        }],
+    )
+    .unwrap();
     let from_script = family.toolpath(&values).unwrap();
     let native = demo_in_rust(40.0, 10.0, 5.0, 600.0, 3000.0, 5.0);
     assert_eq!(from_script.point_count(), native.point_count());
@@ -118,7 +124,13 @@ fn plugin_batch(c: &mut Criterion) {
         );
     }
     let loaded = PluginMachine::load(&lib).unwrap();
-    let built_in = Grinder::new();
+    // Compiled in: the same ABI, without the library.
+    let built_in = PluginMachine::from_entry(
+        "3K152VF20",
+        "pilgrim_plugin_grinder_3k152vf20",
+        grinder_3k152vf20::pilgrim_plugin_grinder_3k152vf20,
+    )
+    .unwrap();
     let tool = ToolFrame {
         point: Point3::new(20.0, 0.0, 0.0),
         axis: Vec3::z(),

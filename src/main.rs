@@ -4,18 +4,23 @@
 //! kernel call. Exit codes: 0 done, 1 the job failed (the message says
 //! why, naming file, line, parameter or block), 2 a bad command line.
 
-mod machines;
 mod run;
-mod scene;
-mod svg;
 
 use clap::{Parser, Subcommand};
-use pilgrim_kernel::machine::BUILTIN_MACHINES;
+use pilgrim_kernel::catalog::{Catalog, CompiledPlugin, Origin};
+use pilgrim_kernel::job::Formats;
+use pilgrim_kernel::machine::{AxisKind, MachineInfo};
 use pilgrim_kernel::plugin::PluginMachine;
-use pilgrim_kernel::script::{Access, Family, Limits};
-use pilgrim_kernel::{AxisKind, MachineInfo, MachineKinematics};
+use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
+use pilgrim_kernel::PartFamily;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+
+/// The machine plugins compiled into the program.
+const COMPILED_PLUGINS: [CompiledPlugin; 1] = [CompiledPlugin {
+    symbol: "pilgrim_plugin_grinder_3k152vf20",
+    entry: grinder_3k152vf20::pilgrim_plugin_grinder_3k152vf20,
+}];
 
 /// CAM for special grinders and lathes: cold-pilger mandrels and calibers,
 /// worm threads.
@@ -115,7 +120,11 @@ fn parse_set(s: &str) -> Result<(String, String), String> {
     Ok((k.trim().to_owned(), v.to_owned()))
 }
 
-fn describe(info: &MachineInfo, origin: &str) -> String {
+fn describe(info: &MachineInfo, origin: &Origin) -> String {
+    let origin = match origin.to_string() {
+        o if o.is_empty() => o,
+        o => format!(", {o}"),
+    };
     let mut s = format!(
         "{}  ({}){origin}\n  {}\n",
         info.name, info.control, info.description
@@ -151,39 +160,29 @@ fn describe(info: &MachineInfo, origin: &str) -> String {
 }
 
 fn list_machines(
+    catalog: &Catalog,
     plugins: &[PathBuf],
     files: &[PathBuf],
     only_files: bool,
 ) -> Result<String, String> {
+    let mut specs: Vec<String> = if only_files {
+        vec![]
+    } else {
+        catalog.builtin_names()
+    };
+    specs.extend(plugins.iter().chain(files).map(|p| p.display().to_string()));
     let mut out = String::new();
-    if !only_files {
-        for name in BUILTIN_MACHINES {
-            let m = machines::open(name)?;
-            let origin = if name == "3K152VF20" {
-                ", built-in plugin"
-            } else {
-                ""
-            };
-            out += &describe(m.info(), origin);
-            out.push('\n');
-        }
-    }
-    for p in plugins {
-        let m = PluginMachine::load(p).map_err(|e| e.to_string())?;
-        out += &describe(m.info(), &format!(", plugin {}", p.display()));
-        out.push('\n');
-    }
-    for f in files {
-        let m = machines::open(&f.display().to_string())?;
-        out += &describe(m.info(), &format!(", from {}", f.display()));
+    for spec in specs {
+        let m = catalog.open(&spec).map_err(|e| e.to_string())?;
+        out += &describe(m.kinematics.info(), &m.origin);
         out.push('\n');
     }
     Ok(out)
 }
 
 fn params(script: &Path) -> Result<String, String> {
-    let fam =
-        Family::load(script, &Limits::default(), &Access::default()).map_err(|e| e.to_string())?;
+    let fam = ScriptFamily::load(script, &Limits::default(), &Access::default())
+        .map_err(|e| e.to_string())?;
     let mut rows = vec![(
         "name".to_owned(),
         "default".to_owned(),
@@ -211,6 +210,7 @@ fn params(script: &Path) -> Result<String, String> {
 }
 
 fn plugin_check(lib: &Path) -> Result<String, String> {
+    use pilgrim_kernel::MachineKinematics;
     let m = PluginMachine::load(lib).map_err(|e| e.to_string())?;
     let (major, minor) = m.abi_version();
     let descriptor = serde_json::to_string_pretty(m.info()).map_err(|e| e.to_string())?;
@@ -225,6 +225,13 @@ fn plugin_check(lib: &Path) -> Result<String, String> {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    let catalog = match Catalog::new(&COMPILED_PLUGINS) {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("pilgrim: a compiled-in machine plugin is broken: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
     let result = match &cli.command {
         Command::Run {
             script,
@@ -236,28 +243,31 @@ fn main() -> ExitCode {
             tolerance,
             stl_ascii,
             gltf,
-        } => run::run(&run::RunArgs {
-            formats: scene::Formats {
-                stl_ascii: *stl_ascii,
-                gltf: *gltf,
+        } => run::run(
+            &run::RunArgs {
+                formats: Formats {
+                    stl_ascii: *stl_ascii,
+                    gltf: *gltf,
+                },
+                pose_block: *pose_block,
+                mesh_tolerance: *tolerance,
+                script: script.clone(),
+                params: params.clone(),
+                sets: sets.clone(),
+                machine: machine.clone(),
+                out: out.clone().unwrap_or_else(|| {
+                    PathBuf::from("out").join(script.file_stem().unwrap_or_else(|| "run".as_ref()))
+                }),
+                quiet: cli.quiet,
             },
-            pose_block: *pose_block,
-            tolerance: *tolerance,
-            script: script.clone(),
-            params: params.clone(),
-            sets: sets.clone(),
-            machine: machine.clone(),
-            out: out.clone().unwrap_or_else(|| {
-                PathBuf::from("out").join(script.file_stem().unwrap_or_else(|| "run".as_ref()))
-            }),
-            quiet: cli.quiet,
-        })
+            &catalog,
+        )
         .map(|s| s + "\n"),
         Command::Machines {
             plugins,
             files,
             only_files,
-        } => list_machines(plugins, files, *only_files),
+        } => list_machines(&catalog, plugins, files, *only_files),
         Command::Export {
             dir,
             block,
@@ -265,8 +275,9 @@ fn main() -> ExitCode {
             gltf,
         } => run::export(
             dir,
+            &catalog,
             *block,
-            scene::Formats {
+            Formats {
                 stl_ascii: *stl_ascii,
                 gltf: *gltf,
             },

@@ -31,6 +31,15 @@ fn s(p: &Path) -> &str {
 mod common;
 use common::shared_lib as lib;
 
+/// The TOML text of the built-in data machine `name`.
+fn builtin_source(name: &str) -> &'static str {
+    pilgrim_kernel::machine::BUILTIN_SOURCES
+        .iter()
+        .find(|(n, _)| *n == name)
+        .unwrap()
+        .1
+}
+
 const DEMO: &str = "scripts/examples/mill_circle.rhai";
 
 #[test]
@@ -69,7 +78,7 @@ fn version_and_machines() {
 #[test]
 fn machine_file_errors_name_file_and_line() {
     let dir = scratch("machines");
-    let text = pilgrim_kernel::machine::BUILTIN_SOURCES[3].1;
+    let text = builtin_source("fanuc-0i-tc");
     let good = dir.join("lathe.toml");
     std::fs::write(&good, text.replace("fanuc-0i-tc", "my-lathe")).unwrap();
     let (code, out, _) = pilgrim(&["machines", "--only-files", "--file", s(&good)]);
@@ -222,7 +231,7 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
     let params = dir.join("p.toml");
     std::fs::write(&params, "radius = 30.0\npoints = 36\n").unwrap();
     let toml_machine = dir.join("mill.toml");
-    std::fs::write(&toml_machine, pilgrim_kernel::machine::BUILTIN_SOURCES[4].1).unwrap();
+    std::fs::write(&toml_machine, builtin_source("vertical-mill")).unwrap();
     let (code, out, err) = pilgrim(&[
         "run",
         DEMO,
@@ -360,7 +369,11 @@ fn params_and_plugin_check() {
     let (code, out, err) = pilgrim(&["plugin-check", s(&lib("grinder_3k152vf20"))]);
     assert_eq!(code, 0, "{err}");
     assert!(
-        out.contains("ABI 1.0, machine 3K152VF20 (sinumerik), solves Z, X"),
+        out.contains(&format!(
+            "ABI {}.{}, machine 3K152VF20 (sinumerik), solves Z, X",
+            pilgrim_plugin_abi::ABI_MAJOR,
+            pilgrim_plugin_abi::ABI_MINOR
+        )),
         "{out}"
     );
     let dir = scratch("check");
@@ -373,7 +386,12 @@ fn params_and_plugin_check() {
     let (code, _, err) = pilgrim(&["plugin-check", s(&other)]);
     assert_eq!(code, 1);
     assert!(
-        err.contains("ABI 99.3") && err.contains("pilgrim ABI 1.0"),
+        err.contains("ABI 99.3")
+            && err.contains(&format!(
+                "pilgrim ABI {}.{}",
+                pilgrim_plugin_abi::ABI_MAJOR,
+                pilgrim_plugin_abi::ABI_MINOR
+            )),
         "{err}"
     );
 }

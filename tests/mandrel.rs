@@ -1,21 +1,29 @@
 //! The mandrel family (seed 000) checked from the program text it writes.
 
-use grinder_3k152vf20::Grinder;
 use pilgrim_kernel::offset::rest::after_pass;
 use pilgrim_kernel::offset::{swept_circles, CircleEnvelope};
-use pilgrim_kernel::script::{Access, Family, Limits, ParamValue};
+use pilgrim_kernel::program::{build, AxisProgram, PostProcessor, SharedPost};
+use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
 use pilgrim_kernel::verify::GrindingCheck;
 use pilgrim_kernel::{
-    drop_circle, AxisProgram, MachineKinematics, MandrelLaw, Profile, Side, Toolpath,
+    drop_circle, MandrelLaw, ParamValue, Params, PartFamily, PartGeometry, Profile, Side, Toolpath,
 };
 use std::collections::BTreeMap;
 use std::path::Path;
 
+mod common;
+use common::{grinder, params_on};
+
 const R_S: f64 = 20.0;
 
-fn family() -> Family {
+fn family() -> ScriptFamily {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/mandrel.rhai");
-    Family::load(&path, &Limits::default(), &Access::default()).unwrap()
+    ScriptFamily::load(&path, &Limits::default(), &Access::default()).unwrap()
+}
+
+/// The family's parameters with `sets` over its defaults.
+fn params(fam: &ScriptFamily, sets: &[(&str, &str)]) -> Params {
+    params_on(fam, &BTreeMap::new(), sets)
 }
 
 /// The blocks of each pass of a Sinumerik program: (Z, X, U), modal words
@@ -53,13 +61,12 @@ fn passes_from_text(text: &str) -> Vec<(String, Vec<[f64; 3]>)> {
     passes
 }
 
-fn program_text() -> (Family, String, AxisProgram) {
+fn program_text() -> (ScriptFamily, String, AxisProgram) {
     let fam = family();
-    let values = fam.resolve(None, &[]).unwrap();
+    let values = params(&fam, &[]);
     let tp = fam.toolpath(&values).unwrap();
-    let grinder = Grinder::new();
-    let program = AxisProgram::build(&tp, &grinder, "mandrel").unwrap();
-    let text = grinder.post(&program, "sinumerik").unwrap();
+    let program = build(&tp, &grinder(), "mandrel").unwrap();
+    let text = SharedPost.post(&program, "sinumerik").unwrap();
     (fam, text, program)
 }
 
@@ -122,10 +129,16 @@ fn finishing_blocks_stand_at_r_s_from_the_law() {
 #[test]
 fn the_rest_rides_the_simulated_surface() {
     let (fam, text, _) = program_text();
-    let values = fam.resolve(None, &[]).unwrap();
-    let part = fam.call_with_params("part", &values).unwrap();
-    let map = part.try_cast::<rhai::Map>().unwrap();
-    let mut surface = map["blank"].clone().cast::<Profile>();
+    let values = params(&fam, &[]);
+    let blank = fam
+        .part(&values)
+        .unwrap()
+        .into_iter()
+        .find(|b| b.name == "blank")
+        .unwrap();
+    let PartGeometry::Revolution(mut surface) = blank.geometry else {
+        panic!("the blank is a body of revolution")
+    };
     let (r_o, b) = (25.0, -180.0);
     let mut checked = 0;
     for (name, blocks) in passes_from_text(&text)
@@ -265,22 +278,18 @@ fn bad_mandrel_parameters_are_refused_and_nothing_is_written() {
 /// The family's toolpath and program for `values` on the 3K152VF20, and a
 /// replay verification of any program against the family's nominal.
 fn job(
-    fam: &Family,
-    values: &BTreeMap<String, ParamValue>,
+    fam: &ScriptFamily,
+    values: &Params,
 ) -> (
     Toolpath,
     AxisProgram,
     impl Fn(&AxisProgram) -> Result<GrindingCheck, String>,
 ) {
     let tp = fam.toolpath(values).unwrap();
-    let grinder = Grinder::new();
-    let program = AxisProgram::build(&tp, &grinder, "mandrel").unwrap();
+    let grinder = grinder();
+    let program = build(&tp, &grinder, "mandrel").unwrap();
     let v = fam.verification(values).unwrap().unwrap();
-    let passes: Vec<(String, usize)> = tp
-        .passes
-        .iter()
-        .map(|p| (p.name.clone(), p.points.len()))
-        .collect();
+    let passes = tp.passes.clone();
     let reference = tp.tool.reference;
     let check = move |program: &AxisProgram| {
         pilgrim_kernel::verify::check_grinding(
@@ -293,6 +302,7 @@ fn job(
             (v.from, v.to),
             v.tolerance,
         )
+        .map_err(|e| e.to_string())
     };
     (tp, program, check)
 }
@@ -302,7 +312,7 @@ fn job(
 #[test]
 fn verification_catches_a_corrupted_block() {
     let fam = family();
-    let values = fam.resolve(None, &[]).unwrap();
+    let values = params(&fam, &[]);
     let (_, mut program, check) = job(&fam, &values);
     let ok = check(&program).unwrap();
     let finish = ok.passes.last().unwrap();
@@ -368,7 +378,7 @@ fn example_parameter_files_run() {
 #[test]
 fn adaptive_spacing_beats_the_uniform_step_threefold() {
     let fam = family();
-    let values = fam.resolve(None, &[]).unwrap();
+    let values = params(&fam, &[]);
     let tp = fam.toolpath(&values).unwrap();
     let (adaptive, uniform, step) = (
         tp.notes["adaptive_blocks"],
@@ -418,8 +428,7 @@ fn adaptive_spacing_beats_the_uniform_step_threefold() {
 #[test]
 fn a_list_of_cuts_sets_the_passes() {
     let fam = family();
-    let sets = [("cuts".to_owned(), "[0.15, 0.1, 0.04, 0.01, 0]".to_owned())];
-    let values = fam.resolve(None, &sets).unwrap();
+    let values = params(&fam, &[("cuts", "[0.15, 0.1, 0.04, 0.01, 0]")]);
     let (tp, program, check) = job(&fam, &values);
     let names: Vec<&str> = tp.passes.iter().map(|p| p.name.as_str()).collect();
     assert_eq!(
@@ -436,7 +445,7 @@ fn a_list_of_cuts_sets_the_passes() {
     );
     // The uniform step's count is for the same five passes (the default
     // job's four passes at the same step).
-    let four = fam.toolpath(&fam.resolve(None, &[]).unwrap()).unwrap();
+    let four = fam.toolpath(&params(&fam, &[])).unwrap();
     let (adaptive, uniform) = (tp.notes["adaptive_blocks"], tp.notes["uniform_blocks"]);
     assert_eq!(uniform, four.notes["uniform_blocks"] / 4.0 * 5.0);
     assert!(uniform >= 3.0 * adaptive, "{adaptive} vs {uniform}");
@@ -452,7 +461,7 @@ fn a_list_of_cuts_sets_the_passes() {
 #[test]
 fn rest_parameters_follow_the_machine() {
     let fam = family();
-    let default = fam.resolve(None, &[]).unwrap();
+    let default = params(&fam, &[]);
     let constants: BTreeMap<String, f64> = [
         ("rest_radius", 30.0),
         ("rest_offset_b", -180.0),
@@ -461,11 +470,10 @@ fn rest_parameters_follow_the_machine() {
     .into_iter()
     .map(|(k, v)| (k.to_owned(), v))
     .collect();
-    let on = fam.resolve_on(&constants, None, &[]).unwrap();
+    let on = params_on(&fam, &constants, &[]);
     assert_eq!(on["rest_r"], ParamValue::Float(30.0));
     assert_eq!(on["rest_at_centre"], ParamValue::Bool(false));
-    let sets = [("rest_r".to_owned(), "25".to_owned())];
-    let set = fam.resolve_on(&constants, None, &sets).unwrap();
+    let set = params_on(&fam, &constants, &[("rest_r", "25")]);
     assert_eq!(set["rest_r"], ParamValue::Float(25.0), "--set wins");
     let (centre, tip) = (fam.toolpath(&default).unwrap(), fam.toolpath(&set).unwrap());
     let mut n = 0;
@@ -483,20 +491,19 @@ fn rest_parameters_follow_the_machine() {
     }
     assert!(n > 100);
     // A whole-number parameter cannot follow a fractional constant.
-    let bad = Family::from_source(
+    let bad = ScriptFamily::from_source(
         "fn params() { #{ n: #{ value: 3, machine: \"rest_radius\" } } }\nfn toolpath(p) { () }",
         "bad.rhai",
         &Limits::default(),
         &Access::default(),
     )
     .unwrap();
-    let e = bad
-        .resolve_on(
-            &BTreeMap::from([("rest_radius".to_owned(), 2.5)]),
-            None,
-            &[],
-        )
-        .unwrap_err();
+    let e = pilgrim_kernel::params::resolve(
+        bad.params(),
+        &BTreeMap::from([("rest_radius".to_owned(), 2.5)]),
+        &[],
+    )
+    .unwrap_err();
     assert!(
         e.to_string().contains("the machine's constant rest_radius"),
         "{e}"

@@ -1,119 +1,105 @@
-//! Error types shared by the whole kernel.
-//!
-//! Every module has its own error enum naming the offending value and its
-//! place (index, row, axis, block); [`InputError`] is the validation error
-//! they share, and [`Error`] gathers them all for callers that do not care
-//! which stage failed.
+//! [`Error`]: any error of the kernel, one variant per stage, for callers
+//! (the `pilgrim` program, a job) that do not care which stage failed. It
+//! gathers the modules' own errors; no module below [`crate::job`] uses it,
+//! so the modules' dependencies stay one-way.
 
-use std::fmt;
-
-/// A rejected input value: what it is, where it stands and why.
-///
-/// Produced by every constructor that validates numbers; each variant names
-/// the value (`what`, e.g. `"profile x"` or `"wheel rounding radius"`).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum InputError {
-    /// A value is NaN or infinite.
-    #[error("{} = {value} is not a finite number", Place(what, *index))]
-    NonFinite {
-        /// What the value is.
-        what: String,
-        /// Its index in an array, if it came from one.
-        index: Option<usize>,
-        /// The value itself.
-        value: f64,
-    },
-    /// A value that must be strictly positive is zero or negative.
-    #[error("{what} must be > 0, got {value}")]
-    NotPositive {
-        /// What the value is.
-        what: String,
-        /// The value itself.
-        value: f64,
-    },
-    /// An array is too short for the operation.
-    #[error("{what} needs at least {min} points, got {got}")]
-    TooFew {
-        /// What the array is.
-        what: String,
-        /// Its length.
-        got: usize,
-        /// The least length accepted.
-        min: usize,
-    },
-    /// An abscissa that must increase strictly does not.
-    #[error("{what}: values must increase strictly, but [{index}] = {value} follows [{}] = {prev}", index - 1)]
-    NotIncreasing {
-        /// What the array is.
-        what: String,
-        /// Index of the offending value.
-        index: usize,
-        /// The value before it.
-        prev: f64,
-        /// The offending value.
-        value: f64,
-    },
-    /// Two arrays that must have equal lengths do not.
-    #[error("{what}: lengths differ ({left} vs {right})")]
-    LengthMismatch {
-        /// What the arrays are.
-        what: String,
-        /// Length of the first.
-        left: usize,
-        /// Length of the second.
-        right: usize,
-    },
-    /// A value outside the range an operation accepts.
-    #[error("{what} = {value} is out of range: {expected}")]
-    OutOfRange {
-        /// What the value is.
-        what: String,
-        /// The value itself.
-        value: f64,
-        /// The accepted range, in words.
-        expected: String,
-    },
-}
-
-impl InputError {
-    /// Shorthand for [`InputError::OutOfRange`].
-    pub fn out_of_range(what: impl Into<String>, value: f64, expected: impl Into<String>) -> Self {
-        Self::OutOfRange {
-            what: what.into(),
-            value,
-            expected: expected.into(),
-        }
-    }
-}
-
-/// `name` or `name[index]`, for messages.
-struct Place<'a>(&'a str, Option<usize>);
-
-impl fmt::Display for Place<'_> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.1 {
-            Some(i) => write!(f, "{}[{i}]", self.0),
-            None => f.write_str(self.0),
-        }
-    }
-}
+use crate::catalog::CatalogError;
+use crate::family::FamilyError;
+use crate::input::InputError;
+use crate::job::SceneError;
+use crate::machine::MachineError;
+use crate::mesh::MeshError;
+use crate::params::ParamError;
+use crate::plugin::PluginLoadError;
+use crate::profile::{ProfileError, TableError};
+use crate::program::{PostError, ProgramError};
+use crate::transform::TransformError;
+use crate::verify::VerifyError;
 
 /// Any error of the kernel.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Error {
     /// A rejected input value.
     #[error(transparent)]
-    Input(#[from] InputError),
+    Value(#[from] InputError),
     /// A transform chain or inverse kinematics failure.
     #[error(transparent)]
-    Transform(#[from] crate::transform::TransformError),
+    Transform(#[from] TransformError),
     /// A machine description or limit failure.
     #[error(transparent)]
-    Machine(#[from] crate::machine::MachineError),
+    Machine(#[from] MachineError),
+    /// A machine that cannot be opened.
+    #[error(transparent)]
+    Catalog(#[from] CatalogError),
+    /// A plugin that cannot be loaded.
+    #[error(transparent)]
+    Plugin(#[from] PluginLoadError),
     /// A profile, equidistant or envelope failure.
     #[error(transparent)]
-    Profile(#[from] crate::profile::ProfileError),
+    Profile(#[from] ProfileError),
     /// A table import failure.
     #[error(transparent)]
-    Table(#[from] crate::profile::TableError),
+    Table(#[from] TableError),
+    /// A parameter that cannot be resolved.
+    #[error(transparent)]
+    Params(#[from] ParamError),
+    /// The part family's failure (a script's error, with its place).
+    #[error(transparent)]
+    Family(#[from] FamilyError),
+    /// The family's checks failed.
+    #[error("{family}: checks failed: {failed}")]
+    Checks {
+        /// The family.
+        family: String,
+        /// Each failed check, with its details.
+        failed: String,
+    },
+    /// A toolpath that cannot become a program on the machine.
+    #[error(transparent)]
+    Program(#[from] ProgramError),
+    /// A program that cannot be written.
+    #[error(transparent)]
+    Post(#[from] PostError),
+    /// A machine whose control has no dialect.
+    #[error("machine {machine}: unknown control '{control}'")]
+    UnknownControl {
+        /// The machine.
+        machine: String,
+        /// Its control.
+        control: String,
+    },
+    /// The verification by replay.
+    #[error(transparent)]
+    Verify(#[from] VerifyError),
+    /// A mesh.
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    /// The 3-D scene.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// A part's body.
+    #[error("{family}: {source}")]
+    Part {
+        /// The family.
+        family: String,
+        /// What failed.
+        source: SceneError,
+    },
+    /// No machine was named, and the family names none.
+    #[error(
+        "{family}: no machine given: use --machine, or define fn default_machine() in the family"
+    )]
+    NoMachine {
+        /// The family.
+        family: String,
+    },
+    /// An option of the run that cannot be used.
+    #[error("{0}")]
+    Options(String),
+    /// A file of a finished run that cannot be read.
+    #[error("{0}")]
+    Read(String),
+    /// An output that cannot be made.
+    #[error("{0}")]
+    Output(String),
 }

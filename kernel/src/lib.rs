@@ -3,15 +3,24 @@
 //! The geometry kernel of pilgrim, a CAM system for special grinders and
 //! lathes: cold-pilger mandrels and calibers, worm threads.
 //!
+//! The modules, in the order data flows through them (ARCHITECTURE §1;
+//! `docs/architecture.md` says where each stage lives):
+//!
+//! - [`math`], [`input`]: the numbers and the one validation error;
 //! - [`transform`]: elementary factors, the [`Chain`] of a machine, the
-//!   universal 15-factor preset of seed 003, forward and inverse kinematics.
-//! - [`machine`]: [`Machine`]s with axes, limits and chains, read from TOML;
-//!   the machines of the seeds built in.
-//! - [`profile`]: the [`Profile`] ("digital array"), its derivatives,
-//!   curvature, smoothing and resampling; generators (the mandrel law,
-//!   chained segments, the ellipse section); CSV and spreadsheet tables.
-//! - [`offset`]: equidistants with the curvature check, the exact drop of a
-//!   circle, the envelope of a swept circle, the steady-rest models.
+//!   universal 15-factor preset of seed 003, forward and inverse kinematics;
+//! - [`machine`]: a machine's description ([`MachineInfo`], the plugin ABI's
+//!   type), [`Machine`]s compiled from it or read from TOML, the
+//!   [`MachineKinematics`] trait;
+//! - [`profile`], [`offset`], [`tool`]: profiles ("digital arrays"),
+//!   equidistants, envelopes, the steady-rest models, wheels and cutters;
+//! - [`params`], [`family`]: a part family's parameters and the
+//!   [`PartFamily`] trait;
+//! - [`toolpath`] (CL data), [`program`] (the axis program and its
+//!   post-processors), [`verify`] (the replay), [`mesh`] (3-D models);
+//! - [`script`] (part families in Rhai), [`plugin`] (machine plugins),
+//!   [`catalog`] (machines by name);
+//! - [`job`]: a run as one call; [`Error`]: any stage's error.
 //!
 //! Conventions (ARCHITECTURE §3): right-handed frames, millimetres and
 //! radians inside (degrees only in files, named `_deg`), the part frame's Z
@@ -30,11 +39,16 @@
 //! assert!(dev >= -1e-9 && dev < 0.1 * 0.1 / (8.0 * 20.0) + 1e-5);
 //! ```
 
+pub mod catalog;
 pub mod error;
+pub mod family;
+pub mod input;
+pub mod job;
 pub mod machine;
 pub mod math;
 pub mod mesh;
 pub mod offset;
+pub mod params;
 pub mod plugin;
 pub mod profile;
 pub mod program;
@@ -44,17 +58,23 @@ pub mod toolpath;
 pub mod transform;
 pub mod verify;
 
-pub use error::{Error, InputError};
-pub use machine::{Axis, AxisKind, Machine, MachineError};
+pub use catalog::{Catalog, OpenMachine};
+pub use error::Error;
+pub use family::{Check, PartBody, PartFamily, PartGeometry, VerifyRequest};
+pub use input::InputError;
+pub use machine::{
+    Axis, AxisKind, ChainMachine, Machine, MachineError, MachineInfo, MachineKinematics,
+};
 pub use math::{Mat3, Mat4, Point3, Real, Vec3};
 pub use offset::{
     curvature_violations, drop_circle, equidistant, rest, CircleEnvelope, Drop, Equidistant, Side,
 };
+pub use params::{ParamSource, ParamSpec, ParamValue, Params};
 pub use profile::{
     read_table, read_table_str, uniform_grid, Bulge, CurvatureViolation, EllipseSection,
     MandrelLaw, Profile, ProfileBuilder, ProfileError, Smoothing, Table, TableError,
 };
-pub use program::{AxisProgram, Block, ChainMachine, MachineInfo, MachineKinematics, ProgramError};
+pub use program::{AxisProgram, Block, ProgramError};
 pub use tool::{Tool, ToolShape, Wheel};
 pub use toolpath::{ClPoint, Motion, Pass, Toolpath, ToolpathError};
 pub use transform::{

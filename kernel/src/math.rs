@@ -4,7 +4,7 @@
 //! There is no global epsilon: every approximate operation takes its
 //! tolerance as an argument and documents what it bounds.
 
-use crate::error::InputError;
+use crate::input::InputError;
 
 /// The scalar type of the kernel.
 pub type Real = f64;

@@ -1,25 +1,36 @@
-//! The plugin host: machine plugins loaded from shared libraries
-//! (ARCHITECTURE §4, the ABI in the `pilgrim-plugin-abi` crate).
+//! The plugin host: machine plugins (ARCHITECTURE §4, the ABI in the
+//! `pilgrim-plugin-abi` crate), loaded from shared libraries or compiled
+//! in.
 //!
-//! [`PluginMachine::load`] opens a library, finds its entry
+//! [`PluginMachine::load`] opens a library and finds its entry
 //! `pilgrim_plugin_<name>` (`<name>`: the file name without `lib` and the
-//! extension, `-` read as `_`), checks the ABI version (another major is
-//! refused, naming both), the table's size and entries, and the machine's
-//! descriptor, and wraps it as a [`MachineKinematics`]. Every failure is an
-//! error naming the library; a plugin's panic comes back as an error and the
-//! host goes on. A loaded library stays loaded for the life of the process,
-//! so nothing from it can outlive it.
+//! extension, `-` read as `_`); [`PluginMachine::from_entry`] takes the
+//! entry of a plugin compiled into the program. Both then go the same way:
+//! the ABI version is checked (another major is refused, naming both), the
+//! table is read field by field, only the fields lying wholly below its
+//! declared `size`, the entries its capabilities promise must be there, and
+//! the machine's descriptor is read and checked
+//! ([`crate::machine::check_description`]). It is wrapped as a
+//! [`MachineKinematics`], and as a [`PostProcessor`] when it posts its own
+//! programs ([`PluginMachine::post_processor`]). Every failure is an error
+//! naming the library; a plugin's panic comes back as an error and the host
+//! goes on. A loaded library stays loaded for the life of the process, so
+//! nothing from it can outlive it.
 //!
 //! # Safety
 //! Loading a library runs its initialisation code and trusts its entry
 //! table to follow the ABI: load only plugins you would run as programs.
 
-use crate::program::{AxisProgram, KinematicsError, MachineInfo, MachineKinematics, PostError};
+use crate::machine::{batch_rows, KinematicsError, MachineInfo, MachineKinematics};
+use crate::program::{AxisProgram, PostError, PostProcessor};
 use crate::transform::ToolFrame;
 use pilgrim_plugin_abi::{
-    Buffer, EntryFn, PluginTable, ABI_MAJOR, ABI_MINOR, NO_ROW, STATUS_OK, STATUS_PANIC, TABLE_SIZE,
+    Buffer, EntryFn, PluginTable, PostRequest, ABI_MAJOR, ABI_MINOR, CAP_ABI_1_0, CAP_FORWARD,
+    CAP_INVERSE, CAP_POST, NO_ROW, STATUS_OK, STATUS_PANIC,
 };
+use std::mem::{offset_of, size_of};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Why a plugin could not be loaded or called.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -75,7 +86,7 @@ pub enum PluginLoadError {
         /// The table's declared size.
         size: u32,
     },
-    /// The descriptor is not valid JSON of a machine.
+    /// The descriptor is not valid JSON of a machine, or not a valid machine.
     #[error("{path}: bad machine descriptor: {message}")]
     Descriptor {
         /// The library.
@@ -85,11 +96,46 @@ pub enum PluginLoadError {
     },
 }
 
-/// A machine plugin loaded from a shared library.
-#[derive(Debug)]
+/// A plugin's entry table as read: the fields its size covers.
+#[derive(Debug, Clone, Copy)]
+struct Table {
+    table: *const PluginTable,
+    size: u32,
+    capabilities: u32,
+}
+
+// SAFETY: the table is a static of the plugin, which is never unloaded, and
+// its entries are `extern "C"` functions the ABI requires to be callable
+// from any thread (each keeps its last error per thread).
+unsafe impl Send for Table {}
+// SAFETY: as above; the table is never written.
+unsafe impl Sync for Table {}
+
+/// Reads field `$field` of the table at `$ptr` if it lies wholly below
+/// `$size`, else `None`.
+macro_rules! field {
+    ($ptr:expr, $size:expr, $field:ident) => {{
+        let end = offset_of!(PluginTable, $field) + size_of_field(|t: &PluginTable| &t.$field);
+        if ($size as usize) < end {
+            None
+        } else {
+            // SAFETY: the field lies inside the table the plugin declared,
+            // and reading it unaligned copies its bytes.
+            Some(unsafe { std::ptr::addr_of!((*$ptr).$field).read_unaligned() })
+        }
+    }};
+}
+
+/// The size of a field, from an accessor (for [`field!`]).
+fn size_of_field<T>(_: impl Fn(&PluginTable) -> &T) -> usize {
+    size_of::<T>()
+}
+
+/// A machine plugin, loaded from a shared library or compiled in.
+#[derive(Debug, Clone)]
 pub struct PluginMachine {
-    path: PathBuf,
-    table: PluginTable,
+    origin: String,
+    table: Arc<Table>,
     info: MachineInfo,
     abi: (u32, u32),
 }
@@ -101,14 +147,68 @@ pub fn entry_symbol(path: &Path) -> String {
     format!("pilgrim_plugin_{}", stem.replace(['-', '.'], "_"))
 }
 
-macro_rules! entry {
-    ($self:expr, $field:ident) => {
-        $self.table.$field.expect("checked when loaded")
-    };
+impl Table {
+    /// Calls entry `$field`, which loading checked is present.
+    fn describe(&self) -> Option<pilgrim_plugin_abi::DescribeFn> {
+        field!(self.table, self.size, describe).flatten()
+    }
+    fn inverse(&self) -> Option<pilgrim_plugin_abi::InverseFn> {
+        field!(self.table, self.size, inverse).flatten()
+    }
+    fn forward(&self) -> Option<pilgrim_plugin_abi::ForwardFn> {
+        field!(self.table, self.size, forward).flatten()
+    }
+    fn post(&self) -> Option<pilgrim_plugin_abi::PostFn> {
+        field!(self.table, self.size, post).flatten()
+    }
+    fn last_error(&self) -> Option<pilgrim_plugin_abi::LastErrorFn> {
+        field!(self.table, self.size, last_error).flatten()
+    }
+    fn free_buffer(&self) -> Option<pilgrim_plugin_abi::FreeBufferFn> {
+        field!(self.table, self.size, free_buffer).flatten()
+    }
+
+    /// The message of the plugin's last failure on this thread.
+    fn last_error_text(&self, status: i32) -> String {
+        let text = match self.last_error() {
+            // SAFETY: the entry fills the buffer it is given.
+            Some(f) => self.call_text(|out| unsafe { f(out) }).ok(),
+            None => None,
+        }
+        .unwrap_or_else(|| "unknown error".into());
+        if status == STATUS_PANIC && !text.contains("panick") {
+            format!("the plugin panicked: {text}")
+        } else {
+            text
+        }
+    }
+
+    /// Calls an entry that fills a buffer; copies its text and frees it.
+    fn call_text(&self, f: impl FnOnce(*mut Buffer) -> i32) -> Result<String, String> {
+        let mut buf = Buffer::empty();
+        let status = f(&mut buf);
+        let text = if buf.ptr.is_null() {
+            String::new()
+        } else {
+            // SAFETY: the plugin filled buf with len readable bytes.
+            let bytes = unsafe { std::slice::from_raw_parts(buf.ptr, buf.len) };
+            let t = String::from_utf8_lossy(bytes).into_owned();
+            if let Some(free) = self.free_buffer() {
+                // SAFETY: the buffer came from this plugin and is returned once.
+                unsafe { free(buf) };
+            }
+            t
+        };
+        if status == STATUS_OK {
+            Ok(text)
+        } else {
+            Err(self.last_error_text(status))
+        }
+    }
 }
 
 impl PluginMachine {
-    /// Loads and checks a plugin. See the [module docs](self).
+    /// Loads and checks a plugin library. See the [module docs](self).
     ///
     /// # Failures
     /// [`PluginLoadError`]: the library cannot be opened; no entry symbol; a
@@ -130,22 +230,31 @@ impl PluginMachine {
                 path: shown.clone(),
                 symbol: symbol.clone(),
             })?;
+        Self::from_entry(&shown, &symbol, *entry)
+    }
+
+    /// A plugin compiled into the program, from its entry function;
+    /// `origin` names it in messages. Checked as a loaded library is.
+    ///
+    /// # Failures
+    /// As [`Self::load`], but for opening the library.
+    pub fn from_entry(origin: &str, symbol: &str, entry: EntryFn) -> Result<Self, PluginLoadError> {
+        let shown = origin.to_owned();
         // SAFETY: calling the plugin's entry, which takes no arguments.
         let ptr = unsafe { entry() };
         if ptr.is_null() {
             return Err(PluginLoadError::NullTable {
                 path: shown,
-                symbol,
+                symbol: symbol.to_owned(),
             });
         }
         // The first three fields are fixed for every version.
         // SAFETY: any plugin's table starts with three u32s.
         let (major, minor, size) = unsafe {
-            let head = ptr as *const u32;
             (
-                head.read_unaligned(),
-                head.add(1).read_unaligned(),
-                head.add(2).read_unaligned(),
+                std::ptr::addr_of!((*ptr).abi_major).read_unaligned(),
+                std::ptr::addr_of!((*ptr).abi_minor).read_unaligned(),
+                std::ptr::addr_of!((*ptr).size).read_unaligned(),
             )
         };
         if major != ABI_MAJOR {
@@ -157,76 +266,71 @@ impl PluginMachine {
                 host_minor: ABI_MINOR,
             });
         }
-        // Read the fields below `size`; fields a smaller table lacks stay None.
-        // SAFETY: an all-zero PluginTable is valid (numbers and None entries);
-        // the copy reads no more than the plugin declares.
-        let table: PluginTable = unsafe {
-            let mut t = std::mem::zeroed::<PluginTable>();
-            let n = (size.min(TABLE_SIZE)) as usize;
-            std::ptr::copy_nonoverlapping(
-                ptr as *const u8,
-                &mut t as *mut PluginTable as *mut u8,
-                n,
-            );
-            t
+        let capabilities = field!(ptr, size, capabilities).unwrap_or(CAP_ABI_1_0);
+        let table = Table {
+            table: ptr,
+            size,
+            capabilities,
         };
         let missing = |entry: &'static str| PluginLoadError::MissingEntry {
             path: shown.clone(),
             entry,
             size,
         };
-        for (present, name) in [
-            (table.describe.is_some(), "describe"),
-            (table.inverse.is_some(), "inverse"),
-            (table.forward.is_some(), "forward"),
-            (table.post.is_some(), "post"),
-            (table.last_error.is_some(), "last_error"),
-            (table.free_buffer.is_some(), "free_buffer"),
+        for (present, needed, name) in [
+            (table.describe().is_some(), true, "describe"),
+            (
+                table.inverse().is_some(),
+                capabilities & CAP_INVERSE != 0,
+                "inverse",
+            ),
+            (
+                table.forward().is_some(),
+                capabilities & CAP_FORWARD != 0,
+                "forward",
+            ),
+            (table.post().is_some(), capabilities & CAP_POST != 0, "post"),
+            (table.last_error().is_some(), true, "last_error"),
+            (table.free_buffer().is_some(), true, "free_buffer"),
         ] {
-            if !present {
+            if needed && !present {
                 return Err(missing(name));
             }
         }
-        let mut plugin = Self {
-            path: path.to_owned(),
-            table,
-            info: MachineInfo {
-                name: String::new(),
-                description: String::new(),
-                control: String::new(),
-                axes: vec![],
-                solved_axes: vec![],
-                constants: Default::default(),
-                program_decimals: None,
-            },
-            abi: (major, minor),
+        let describe = table.describe().ok_or_else(|| missing("describe"))?;
+        let bad = |message: String| PluginLoadError::Descriptor {
+            path: shown.clone(),
+            message,
         };
-        let descriptor = plugin
-            .call_text(|out| unsafe { entry!(plugin, describe)(out) })
-            .map_err(|message| PluginLoadError::Descriptor {
-                path: shown.clone(),
-                message,
-            })?;
+        // SAFETY: the entry fills the buffer it is given.
+        let descriptor = table
+            .call_text(|out| unsafe { describe(out) })
+            .map_err(bad)?;
         let info: MachineInfo =
-            serde_json::from_str(&descriptor).map_err(|e| PluginLoadError::Descriptor {
-                path: shown.clone(),
-                message: e.to_string(),
-            })?;
+            serde_json::from_str(&descriptor).map_err(|e| bad(e.to_string()))?;
         for s in &info.solved_axes {
             if info.axis(s).is_none() {
-                return Err(PluginLoadError::Descriptor {
-                    path: shown,
-                    message: format!("solved axis '{s}' is not among the axes"),
-                });
+                return Err(bad(format!("solved axis '{s}' is not among the axes")));
             }
         }
-        plugin.info = info;
-        Ok(plugin)
+        crate::machine::check_description(&info).map_err(|e| bad(e.to_string()))?;
+        Ok(Self {
+            origin: shown,
+            table: Arc::new(table),
+            info,
+            abi: (major, minor),
+        })
     }
 
-    /// The library's path.
-    pub fn path(&self) -> &Path {
-        &self.path
+    /// Where the plugin came from: the library's path, or the name a
+    /// compiled-in plugin was given.
+    pub fn origin(&self) -> &str {
+        &self.origin
+    }
+
+    /// The library's path (its origin).
+    pub fn path(&self) -> PathBuf {
+        PathBuf::from(&self.origin)
     }
 
     /// The plugin's ABI version (major, minor).
@@ -234,37 +338,16 @@ impl PluginMachine {
         self.abi
     }
 
-    /// The message of the plugin's last failure on this thread.
-    fn last_error(&self, status: i32) -> String {
-        let text = self
-            .call_text(|out| unsafe { entry!(self, last_error)(out) })
-            .unwrap_or_else(|_| "unknown error".into());
-        if status == STATUS_PANIC && !text.contains("panick") {
-            format!("the plugin panicked: {text}")
-        } else {
-            text
-        }
+    /// The plugin's capabilities (`CAP_*` bits).
+    pub fn capabilities(&self) -> u32 {
+        self.table.capabilities
     }
 
-    /// Calls an entry that fills a buffer; copies its text and frees it.
-    fn call_text(&self, f: impl FnOnce(*mut Buffer) -> i32) -> Result<String, String> {
-        let mut buf = Buffer::empty();
-        let status = f(&mut buf);
-        let text = if buf.ptr.is_null() {
-            String::new()
-        } else {
-            // SAFETY: the plugin filled buf with len readable bytes.
-            let bytes = unsafe { std::slice::from_raw_parts(buf.ptr, buf.len) };
-            let t = String::from_utf8_lossy(bytes).into_owned();
-            // SAFETY: the buffer came from this plugin and is returned once.
-            unsafe { entry!(self, free_buffer)(buf) };
-            t
-        };
-        if status == STATUS_OK {
-            Ok(text)
-        } else {
-            Err(self.last_error(status))
-        }
+    /// The plugin's own post-processor, if it posts its programs.
+    pub fn post_processor(&self) -> Option<PluginPost> {
+        (self.table.capabilities & CAP_POST != 0).then(|| PluginPost {
+            table: self.table.clone(),
+        })
     }
 }
 
@@ -290,7 +373,11 @@ impl MachineKinematics for PluginMachine {
         tool: &ToolFrame,
         out: &mut Vec<f64>,
     ) -> Result<(), KinematicsError> {
-        let count = crate::program::batch_rows(poses, 6, "pose")?;
+        let count = batch_rows(poses, 6, "pose")?;
+        let inverse = self
+            .table
+            .inverse()
+            .ok_or_else(|| KinematicsError::whole("the plugin offers no inverse kinematics"))?;
         let width = self.info.solved_axes.len();
         out.clear();
         out.resize(count * width, 0.0);
@@ -298,7 +385,7 @@ impl MachineKinematics for PluginMachine {
         let mut failed = NO_ROW;
         // SAFETY: arrays of the sizes the ABI states.
         let status = unsafe {
-            entry!(self, inverse)(
+            inverse(
                 poses.as_ptr(),
                 count,
                 t.as_ptr(),
@@ -311,7 +398,7 @@ impl MachineKinematics for PluginMachine {
             out.clear();
             return Err(KinematicsError {
                 index: (failed != NO_ROW).then_some(failed),
-                message: self.last_error(status),
+                message: self.table.last_error_text(status),
             });
         }
         Ok(())
@@ -324,31 +411,44 @@ impl MachineKinematics for PluginMachine {
         out: &mut Vec<f64>,
     ) -> Result<(), KinematicsError> {
         let width = self.info.solved_axes.len();
-        let count = crate::program::batch_rows(axes, width, "axis")?;
+        let count = batch_rows(axes, width, "axis")?;
+        let forward = self
+            .table
+            .forward()
+            .ok_or_else(|| KinematicsError::whole("the plugin offers no forward kinematics"))?;
         out.clear();
         out.resize(count * 6, 0.0);
         let t = tool6(tool);
         // SAFETY: arrays of the sizes the ABI states.
-        let status = unsafe {
-            entry!(self, forward)(axes.as_ptr(), count, width, t.as_ptr(), out.as_mut_ptr())
-        };
+        let status = unsafe { forward(axes.as_ptr(), count, width, t.as_ptr(), out.as_mut_ptr()) };
         if status != STATUS_OK {
             out.clear();
-            return Err(KinematicsError::whole(self.last_error(status)));
+            return Err(KinematicsError::whole(self.table.last_error_text(status)));
         }
         Ok(())
     }
+}
 
+/// A plugin's own post-processor ([`PluginMachine::post_processor`]).
+#[derive(Debug, Clone)]
+pub struct PluginPost {
+    table: Arc<Table>,
+}
+
+impl PostProcessor for PluginPost {
     fn post(&self, program: &AxisProgram, dialect: &str) -> Result<String, PostError> {
-        #[derive(serde::Serialize)]
-        struct Request<'a> {
-            dialect: &'a str,
-            program: &'a AxisProgram,
-        }
-        let request = serde_json::to_string(&Request { dialect, program })
-            .map_err(|e| PostError::Plugin(e.to_string()))?;
+        let request = serde_json::to_string(&PostRequest {
+            dialect: dialect.to_owned(),
+            program: program.clone(),
+        })
+        .map_err(|e| PostError::Plugin(e.to_string()))?;
+        let post = self
+            .table
+            .post()
+            .ok_or_else(|| PostError::Plugin("the plugin offers no post-processor".into()))?;
         // SAFETY: the request's bytes are readable for its length.
-        self.call_text(|out| unsafe { entry!(self, post)(request.as_ptr(), request.len(), out) })
+        self.table
+            .call_text(|out| unsafe { post(request.as_ptr(), request.len(), out) })
             .map_err(PostError::Plugin)
     }
 }

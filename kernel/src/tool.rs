@@ -1,6 +1,6 @@
 //! Tools: grinding wheels and cutters, each parameter defined once.
 
-use crate::error::InputError;
+use crate::input::InputError;
 use crate::math::{positive, Point3, Real, Vec3};
 use crate::transform::ToolFrame;
 use serde::{Deserialize, Serialize};

@@ -14,21 +14,11 @@ use crate::math::Real;
 use crate::tool::Tool;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+use std::ops::Range;
 
-/// How a point is reached.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "type", rename_all = "snake_case")]
-pub enum Motion {
-    /// At the machine's rapid traverse.
-    Rapid,
-    /// A straight cut at the point's feed.
-    Linear,
-    /// A thread cut synchronised with the spindle at `lead` mm per turn.
-    Thread {
-        /// Lead (mm per spindle turn).
-        lead: Real,
-    },
-}
+/// How a point is reached: rapid, linear at the point's feed, or a thread
+/// at a lead (the plugin ABI's type, which programs carry too).
+pub use pilgrim_plugin_abi::types::Motion;
 
 /// One tool position.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -60,6 +50,16 @@ impl Pass {
     pub fn cuts(&self) -> bool {
         self.points.iter().any(|p| p.motion != Motion::Rapid)
     }
+}
+
+/// Each pass with the indices its points take over all passes: the blocks
+/// (from 0) the pass becomes in a program.
+pub fn pass_ranges(passes: &[Pass]) -> impl Iterator<Item = (&Pass, Range<usize>)> {
+    passes.iter().scan(0, |start, p| {
+        let r = *start..*start + p.points.len();
+        *start = r.end;
+        Some((p, r))
+    })
 }
 
 /// The CL data of one job.
@@ -116,6 +116,11 @@ impl Toolpath {
     /// Number of points over all passes.
     pub fn point_count(&self) -> usize {
         self.passes.iter().map(|p| p.points.len()).sum()
+    }
+
+    /// Each pass with its blocks' indices (from 0); see [`pass_ranges`].
+    pub fn pass_ranges(&self) -> impl Iterator<Item = (&Pass, Range<usize>)> {
+        pass_ranges(&self.passes)
     }
 
     /// The points of all passes in order, with (pass index, point index).

@@ -7,10 +7,70 @@
 //! below a stated resolution. [`SweptWheel::deviation`] compares it with the
 //! nominal profile and names the block whose move left the largest error.
 
+use crate::input::InputError;
+use crate::machine::{KinematicsError, MachineKinematics};
 use crate::math::{positive, Real};
 use crate::offset::{CircleEnvelope, Side};
 use crate::profile::{Profile, ProfileError};
+use crate::program::{axis_rows, AxisProgram};
+use crate::toolpath::{pass_ranges, Pass};
+use crate::transform::ToolFrame;
 use serde::{Deserialize, Serialize};
+
+/// Why a program could not be verified, or failed verification.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum VerifyError {
+    /// A rejected number (a tolerance that is not positive).
+    #[error(transparent)]
+    Input(#[from] InputError),
+    /// A surface that cannot be built or compared.
+    #[error(transparent)]
+    Profile(#[from] ProfileError),
+    /// The program cannot be replayed on the machine: a block beyond it,
+    /// an axis it lacks.
+    #[error("{0}")]
+    Replay(String),
+    /// The machine's forward kinematics failed over blocks `first..=last`
+    /// (from 1).
+    #[error("blocks {first} to {last}: {source}")]
+    Kinematics {
+        /// First block (from 1).
+        first: usize,
+        /// Last block.
+        last: usize,
+        /// The machine's message.
+        source: KinematicsError,
+    },
+    /// A pass whose surface does not cover the range held to the tolerance.
+    #[error("{pass}: {source}")]
+    Pass {
+        /// The pass's name.
+        pass: String,
+        /// What went wrong.
+        source: ProfileError,
+    },
+    /// Nothing cuts.
+    #[error("the program has no cutting pass")]
+    NoCuttingPass,
+    /// The finished surface strays from the nominal beyond the tolerance.
+    #[error(
+        "verification failed: the finished surface strays {} mm from the nominal profile at z = {}, \
+         where block {} cuts it (tolerance {tolerance} mm)",
+        crate::math::fixed(*deviation, 5),
+        crate::math::fixed(*z, 3),
+        block.map_or("?".into(), |b| b.to_string())
+    )]
+    Deviation {
+        /// The signed deviation (mm; negative: a gouge).
+        deviation: Real,
+        /// Where (z, mm).
+        z: Real,
+        /// The block (from 1) whose move formed the surface there.
+        block: Option<usize>,
+        /// The tolerance (mm).
+        tolerance: Real,
+    },
+}
 
 /// The surface left by a wheel's rounding moved in straight lines between
 /// centres (mm, axial section).
@@ -62,7 +122,7 @@ impl SweptWheel {
         crate::math::all_finite("wheel centre z", z)?;
         crate::math::all_finite("wheel centre x", x)?;
         if z.len() != x.len() || z.is_empty() {
-            return Err(crate::error::InputError::LengthMismatch {
+            return Err(crate::input::InputError::LengthMismatch {
                 what: "wheel centres z and x".into(),
                 left: z.len(),
                 right: x.len(),
@@ -165,10 +225,10 @@ impl SweptWheel {
 /// # Failures
 /// As [`replay_blocks`].
 pub fn replay(
-    program: &crate::AxisProgram,
-    machine: &dyn crate::MachineKinematics,
-    tool: &crate::ToolFrame,
-) -> Result<Vec<Real>, String> {
+    program: &AxisProgram,
+    machine: &dyn MachineKinematics,
+    tool: &ToolFrame,
+) -> Result<Vec<Real>, VerifyError> {
     replay_blocks(program, machine, tool, 0..program.blocks.len())
 }
 
@@ -178,52 +238,22 @@ pub fn replay(
 /// A block beyond the program; a solved axis the program lacks; the
 /// machine's kinematics failing.
 pub fn replay_blocks(
-    program: &crate::AxisProgram,
-    machine: &dyn crate::MachineKinematics,
-    tool: &crate::ToolFrame,
+    program: &AxisProgram,
+    machine: &dyn MachineKinematics,
+    tool: &ToolFrame,
     blocks: std::ops::Range<usize>,
-) -> Result<Vec<Real>, String> {
-    if blocks.end > program.blocks.len() {
-        return Err(format!(
-            "block {} is beyond the program's {} blocks",
-            blocks.end,
-            program.blocks.len()
-        ));
-    }
+) -> Result<Vec<Real>, VerifyError> {
     let info = machine.info();
-    let cols = info
-        .solved_axes
-        .iter()
-        .map(|name| {
-            let c = program
-                .axes
-                .iter()
-                .position(|a| &a.name == name)
-                .ok_or(format!("the program has no axis {name}"))?;
-            let rotary = info
-                .axis(name)
-                .is_some_and(|a| a.kind == crate::AxisKind::Rotary);
-            Ok((c, rotary))
-        })
-        .collect::<Result<Vec<_>, String>>()?;
-    let rows: Vec<Real> = program.blocks[blocks.clone()]
-        .iter()
-        .flat_map(|b| {
-            cols.iter()
-                .map(|&(c, rot)| {
-                    if rot {
-                        b.values[c].to_radians()
-                    } else {
-                        b.values[c]
-                    }
-                })
-                .collect::<Vec<_>>()
-        })
-        .collect();
+    let rows =
+        axis_rows(program, info, &info.solved_axes, blocks.clone()).map_err(VerifyError::Replay)?;
     let mut poses = Vec::new();
     machine
         .forward(&rows, tool, &mut poses)
-        .map_err(|e| format!("blocks {} to {}: {e}", blocks.start + 1, blocks.end))?;
+        .map_err(|source| VerifyError::Kinematics {
+            first: blocks.start + 1,
+            last: blocks.end,
+            source,
+        })?;
     Ok(poses)
 }
 
@@ -251,37 +281,33 @@ pub struct GrindingCheck {
 /// Replays a grinding program (a wheel of rounding `rounding_radius` whose
 /// tracked point is its rounding's centre) through the machine, builds each
 /// cutting pass's swept surface in the axial section (radius from the axis,
-/// z), and compares it with `nominal` over `[from, to]`.
+/// z), and compares it with `nominal` over `[from, to]`. `passes` are the
+/// toolpath's, whose points became the program's blocks.
 ///
 /// # Failures
 /// The replay failing; a pass that does not cover the range; the finishing
-/// pass straying more than `tolerance` from the nominal: the message names
-/// the deviation, its z and the block (from 1) whose move formed it.
+/// pass straying more than `tolerance` from the nominal
+/// ([`VerifyError::Deviation`], naming the deviation, its z and the block,
+/// from 1, whose move formed it).
 #[allow(clippy::too_many_arguments)]
 pub fn check_grinding(
-    program: &crate::AxisProgram,
-    machine: &dyn crate::MachineKinematics,
-    tool: &crate::ToolFrame,
+    program: &AxisProgram,
+    machine: &dyn MachineKinematics,
+    tool: &ToolFrame,
     rounding_radius: Real,
-    passes: &[(String, usize)],
+    passes: &[Pass],
     nominal: &Profile,
     range: (Real, Real),
     tolerance: Real,
-) -> Result<GrindingCheck, String> {
-    positive("verification tolerance", tolerance).map_err(|e| e.to_string())?;
+) -> Result<GrindingCheck, VerifyError> {
+    positive("verification tolerance", tolerance)?;
     let poses = replay(program, machine, tool)?;
     let mut out = GrindingCheck {
         tolerance,
         passes: Vec::new(),
     };
-    let mut first = 0;
-    for (name, len) in passes {
-        let blocks = first..first + len;
-        first += len;
-        let cutting = blocks
-            .clone()
-            .any(|b| program.blocks[b].motion != crate::Motion::Rapid);
-        if !cutting || *len == 0 {
+    for (pass, blocks) in pass_ranges(passes) {
+        if !pass.cuts() {
             continue;
         }
         let z: Vec<Real> = blocks.clone().map(|b| poses[6 * b + 2]).collect();
@@ -289,30 +315,34 @@ pub fn check_grinding(
             .clone()
             .map(|b| poses[6 * b].hypot(poses[6 * b + 1]))
             .collect();
-        let swept = SweptWheel::new(&z, &x, rounding_radius, tolerance / 20.0)
-            .map_err(|e| e.to_string())?;
+        let swept = SweptWheel::new(&z, &x, rounding_radius, tolerance / 20.0)?;
         let step = (tolerance * 20.0).clamp(0.005, 0.05);
         let mut d = swept
             .deviation(nominal, range.0, range.1, step)
-            .map_err(|e| format!("{name}: {e}"))?;
+            .map_err(|source| VerifyError::Pass {
+                pass: pass.name.clone(),
+                source,
+            })?;
         d.block = d.block.map(|k| blocks.start + k + 1);
         out.passes.push(PassCheck {
-            name: name.clone(),
+            name: pass.name.clone(),
             first_block: blocks.start + 1,
             deviation: d,
         });
     }
-    let finish = out.passes.last().ok_or("the program has no cutting pass")?;
+    let finish = out.passes.last().ok_or(VerifyError::NoCuttingPass)?;
     let d = finish.deviation;
     if d.max_abs > tolerance {
-        return Err(format!(
-            "verification failed: the finished surface strays {} mm from the nominal profile at z = {}, \
-             where block {} cuts it (tolerance {} mm)",
-            crate::math::fixed(if d.max_above.abs() >= d.max_below.abs() { d.max_above } else { d.max_below }, 5),
-            crate::math::fixed(d.at_z, 3),
-            d.block.map_or("?".into(), |b| b.to_string()),
-            tolerance
-        ));
+        return Err(VerifyError::Deviation {
+            deviation: if d.max_above.abs() >= d.max_below.abs() {
+                d.max_above
+            } else {
+                d.max_below
+            },
+            z: d.at_z,
+            block: d.block,
+            tolerance,
+        });
     }
     Ok(out)
 }

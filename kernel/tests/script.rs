@@ -1,12 +1,39 @@
 //! Part families in Rhai: the contract, limits, errors, parameters.
 
-use pilgrim_kernel::script::{Access, Family, Limits, ScriptError};
-use pilgrim_kernel::{AxisProgram, ChainMachine, Machine};
+use pilgrim_kernel::family::FamilyError;
+use pilgrim_kernel::params::{resolve, ParamError, ParamSource};
+use pilgrim_kernel::program::build;
+use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
+use pilgrim_kernel::{ChainMachine, Machine, Params, PartFamily};
 use std::path::Path;
 
-fn demo() -> Family {
+fn demo() -> ScriptFamily {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scripts/examples/mill_circle.rhai");
-    Family::load(&path, &Limits::default(), &Access::default()).unwrap()
+    ScriptFamily::load(&path, &Limits::default(), &Access::default()).unwrap()
+}
+
+/// The family's parameters from an optional TOML file `(name, text)` and
+/// `--set` pairs.
+fn values(
+    fam: &dyn PartFamily,
+    file: Option<(&str, &str)>,
+    sets: &[(&str, &str)],
+) -> Result<Params, ParamError> {
+    let mut sources: Vec<ParamSource> = file
+        .map(|(label, text)| ParamSource::Toml {
+            label: label.into(),
+            text: text.into(),
+        })
+        .into_iter()
+        .collect();
+    sources.push(ParamSource::Pairs {
+        label: "--set".into(),
+        pairs: sets
+            .iter()
+            .map(|(k, v)| ((*k).to_owned(), (*v).to_owned()))
+            .collect(),
+    });
+    resolve(fam.params(), &Default::default(), &sources)
 }
 
 #[test]
@@ -17,11 +44,11 @@ fn demo_family_runs_to_a_program() {
         names.contains(&"radius") && names.contains(&"turn_table"),
         "{names:?}"
     );
-    let values = fam.resolve(None, &[]).unwrap();
-    let tp = fam.toolpath(&values).unwrap();
+    let defaults = values(&fam, None, &[]).unwrap();
+    let tp = fam.toolpath(&defaults).unwrap();
     assert_eq!(tp.point_count(), 2 + 1 + 361 + 1);
     let mill = ChainMachine::new(Machine::builtin("vertical-mill").unwrap());
-    let prog = AxisProgram::build(&tp, &mill, "mill_circle").unwrap();
+    let prog = build(&tp, &mill, "mill_circle").unwrap();
     assert_eq!(
         prog.axes
             .iter()
@@ -42,16 +69,14 @@ fn demo_family_runs_to_a_program() {
         assert!(b.values[1].abs() < 1e-6);
     }
     // With the table still, X and Y trace the circle and C stays 0.
-    let values = fam
-        .resolve(None, &[("turn_table".into(), "false".into())])
-        .unwrap();
-    let prog = AxisProgram::build(&fam.toolpath(&values).unwrap(), &mill, "m").unwrap();
+    let still = values(&fam, None, &[("turn_table", "false")]).unwrap();
+    let prog = build(&fam.toolpath(&still).unwrap(), &mill, "m").unwrap();
     let (x, y) = (prog.column("X").unwrap(), prog.column("Y").unwrap());
     assert!(prog.column("C").unwrap().iter().all(|c| *c == 0.0));
     for k in 3..364 {
         assert!((x[k].hypot(y[k]) - 45.0).abs() < 1e-6);
     }
-    let checks = fam.checks(&fam.resolve(None, &[]).unwrap()).unwrap();
+    let checks = fam.checks(&values(&fam, None, &[]).unwrap()).unwrap();
     assert_eq!(checks.len(), 2);
     assert!(checks.iter().all(|c| c.ok));
 }
@@ -59,9 +84,7 @@ fn demo_family_runs_to_a_program() {
 #[test]
 fn unknown_and_bad_parameters_are_named() {
     let fam = demo();
-    let e = fam
-        .resolve(None, &[("radiuss".into(), "3".into())])
-        .unwrap_err();
+    let e = values(&fam, None, &[("radiuss", "3")]).unwrap_err();
     let text = e.to_string();
     assert!(
         text.contains("unknown parameter 'radiuss' from --set"),
@@ -71,36 +94,28 @@ fn unknown_and_bad_parameters_are_named() {
         text.contains("radius, spindle, tool_diameter, turn_table"),
         "{text}"
     );
-    let e = fam
-        .resolve(None, &[("radius".into(), "big".into())])
+    let e = values(&fam, None, &[("radius", "big")])
         .unwrap_err()
         .to_string();
     assert_eq!(e, "parameter 'radius' from --set: 'big' is not a number");
-    let e = fam
-        .resolve(Some(("p.toml", "points = 1.5")), &[])
+    let e = values(&fam, Some(("p.toml", "points = 1.5")), &[])
         .unwrap_err()
         .to_string();
     assert!(
         e.contains("parameter 'points' from p.toml: expected a whole number, got 1.5"),
         "{e}"
     );
-    let e = fam
-        .resolve(Some(("p.toml", "radius = nan")), &[])
+    let e = values(&fam, Some(("p.toml", "radius = nan")), &[])
         .unwrap_err()
         .to_string();
     assert!(e.contains("not a finite number"), "{e}");
-    let v = fam
-        .resolve(
-            Some(("p.toml", "radius = 30")),
-            &[("depth".into(), "2".into())],
-        )
-        .unwrap();
+    let v = values(&fam, Some(("p.toml", "radius = 30")), &[("depth", "2")]).unwrap();
     assert_eq!(v["radius"].to_string(), "30");
     assert_eq!(v["depth"].to_string(), "2");
 }
 
-fn family(src: &str) -> Result<Family, ScriptError> {
-    Family::from_source(src, "t.rhai", &Limits::default(), &Access::default())
+fn family(src: &str) -> Result<ScriptFamily, FamilyError> {
+    ScriptFamily::from_source(src, "t.rhai", &Limits::default(), &Access::default())
 }
 
 const HEAD: &str = "fn params() { #{ n: #{ value: 3, unit: \"\", doc: \"n\" } } }\n";
@@ -108,7 +123,7 @@ const HEAD: &str = "fn params() { #{ n: #{ value: 3, unit: \"\", doc: \"n\" } } 
 #[test]
 fn syntax_errors_and_runtime_errors_carry_file_line_column() {
     let e = family("fn params() { #{ }\nfn toolpath(p) { let x = ; }").unwrap_err();
-    let ScriptError::At {
+    let FamilyError::At {
         file, line, column, ..
     } = &e
     else {
@@ -118,7 +133,7 @@ fn syntax_errors_and_runtime_errors_carry_file_line_column() {
     assert!(*column > 0, "{e}");
     let src = format!("{HEAD}fn toolpath(p) {{\n  let t = linspace(0.0, 1.0, 1);\n  t\n}}");
     let fam = family(&src).unwrap();
-    let e = fam.toolpath(&fam.resolve(None, &[]).unwrap()).unwrap_err();
+    let e = fam.toolpath(&values(&fam, None, &[]).unwrap()).unwrap_err();
     let text = e.to_string();
     assert!(text.starts_with("t.rhai:3:"), "{text}");
     assert!(text.contains("linspace needs at least 2 points"), "{text}");
@@ -133,9 +148,9 @@ fn endless_loop_is_stopped() {
         max_operations: 200_000,
         ..Limits::default()
     };
-    let fam = Family::from_source(&src, "loop.rhai", &limits, &Access::default()).unwrap();
+    let fam = ScriptFamily::from_source(&src, "loop.rhai", &limits, &Access::default()).unwrap();
     let e = fam
-        .toolpath(&fam.resolve(None, &[]).unwrap())
+        .toolpath(&values(&fam, None, &[]).unwrap())
         .unwrap_err()
         .to_string();
     assert!(e.starts_with("loop.rhai: "), "{e}");
@@ -146,7 +161,7 @@ fn endless_loop_is_stopped() {
     let src = format!("{HEAD}fn f(x) {{ f(x + 1) }}\nfn toolpath(p) {{ f(0) }}");
     let e = family(&src).unwrap();
     let e = e
-        .toolpath(&e.resolve(None, &[]).unwrap())
+        .toolpath(&values(&e, None, &[]).unwrap())
         .unwrap_err()
         .to_string();
     assert!(e.contains("nest too deep"), "{e}");
@@ -163,9 +178,9 @@ fn files_only_inside_the_input_directories() {
         input_dirs: vec![inside.clone()],
     };
     let src = format!("{HEAD}fn toolpath(p) {{ let t = read_table(\"t.csv\"); if t.x.len != 3 {{ throw \"bad\"; }} read_table(\"../secret.csv\") }}");
-    let fam = Family::from_source(&src, "f.rhai", &Limits::default(), &access).unwrap();
+    let fam = ScriptFamily::from_source(&src, "f.rhai", &Limits::default(), &access).unwrap();
     let e = fam
-        .toolpath(&fam.resolve(None, &[]).unwrap())
+        .toolpath(&values(&fam, None, &[]).unwrap())
         .unwrap_err()
         .to_string();
     assert!(
@@ -195,7 +210,7 @@ fn transforms_in_scripts_follow_the_universal_chain() {
            tp\n}}"
     );
     let fam = family(&src).unwrap();
-    let tp = fam.toolpath(&fam.resolve(None, &[]).unwrap()).unwrap();
+    let tp = fam.toolpath(&values(&fam, None, &[]).unwrap()).unwrap();
     // r0 = (R cos(phi+beta) + a1 + a cos phi - b sin phi, R sin(phi+beta) + b1 + a sin phi + b cos phi, Z + c1 + c)
     let phi = std::f64::consts::FRAC_PI_2;
     for pass in &tp.passes {
@@ -221,7 +236,7 @@ fn transforms_in_scripts_follow_the_universal_chain() {
     ))
     .unwrap();
     let text = e
-        .toolpath(&e.resolve(None, &[]).unwrap())
+        .toolpath(&values(&e, None, &[]).unwrap())
         .unwrap_err()
         .to_string();
     assert!(text.contains("not 'rw'"), "{text}");
@@ -248,7 +263,7 @@ fn mandrel_building_blocks_in_scripts() {
            tp\n}}"
     );
     let fam = family(&src).unwrap();
-    let tp = fam.toolpath(&fam.resolve(None, &[]).unwrap()).unwrap();
+    let tp = fam.toolpath(&values(&fam, None, &[]).unwrap()).unwrap();
     let law = MandrelLaw::new(38.0, 52.0, 400.0, 0.012, 2.3).unwrap();
     let part = ProfileBuilder::start(-350.0, 19.0 - 350.0 * 0.006)
         .line_to(0.0, 19.0)
@@ -286,7 +301,7 @@ fn mandrel_building_blocks_in_scripts() {
     ))
     .unwrap();
     let text = e
-        .toolpath(&e.resolve(None, &[]).unwrap())
+        .toolpath(&values(&e, None, &[]).unwrap())
         .unwrap_err()
         .to_string();
     assert!(text.contains("\"out\" or \"in\""), "{text}");

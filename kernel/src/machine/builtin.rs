@@ -2,9 +2,9 @@
 
 use super::{Machine, MachineError};
 
-/// `(name, TOML text)` of every built-in machine.
-pub const BUILTIN_SOURCES: [(&str, &str); 5] = [
-    ("3K152VF20", include_str!("../../machines/3k152vf20.toml")),
+/// `(name, TOML text)` of every built-in data machine. (The 3K152VF20 is
+/// a plugin crate, `plugins/grinder-3k152vf20`, compiled into the program.)
+pub const BUILTIN_SOURCES: [(&str, &str); 4] = [
     ("LZ-250", include_str!("../../machines/lz-250.toml")),
     ("Mannesmann", include_str!("../../machines/mannesmann.toml")),
     (
@@ -17,19 +17,18 @@ pub const BUILTIN_SOURCES: [(&str, &str); 5] = [
     ),
 ];
 
-/// The names of the built-in machines.
-pub const BUILTIN_MACHINES: [&str; 5] = [
+/// The names of the built-in data machines.
+pub const BUILTIN_MACHINES: [&str; 4] = [
     BUILTIN_SOURCES[0].0,
     BUILTIN_SOURCES[1].0,
     BUILTIN_SOURCES[2].0,
     BUILTIN_SOURCES[3].0,
-    BUILTIN_SOURCES[4].0,
 ];
 
 impl Machine {
-    /// A built-in machine by name (case-insensitive): `3K152VF20` (mandrel
-    /// grinder with CNC steady rest), `LZ-250` and `Mannesmann` (caliber
-    /// grinders), `fanuc-0i-tc` (lathe), `vertical-mill` (MATH §1's example).
+    /// A built-in data machine by name (case-insensitive): `LZ-250` and
+    /// `Mannesmann` (caliber grinders), `fanuc-0i-tc` (lathe),
+    /// `vertical-mill` (MATH §1's example).
     ///
     /// # Failures
     /// [`MachineError::UnknownMachine`] listing the built-ins.

@@ -1,8 +1,10 @@
 //! Reading machines from TOML, with errors naming the key and its line.
 
-use super::{Axis, AxisKind, Machine, MachineError};
-use crate::math::{Real, Vec3};
-use crate::transform::{Chain, FactorKind, ToolFrame};
+use super::info::{Invalid, Place};
+use super::ToolSpec;
+use super::{Axis, AxisKind, BodyShape, BodySpec, FactorSpec, Machine, MachineError, MachineInfo};
+use crate::math::Real;
+use pilgrim_plugin_abi::types::FactorKind;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -24,6 +26,8 @@ struct MachineFile {
     #[serde(default)]
     constants: BTreeMap<String, Spanned<Real>>,
     program_decimals: Option<Spanned<i64>>,
+    #[serde(default)]
+    driven_axes: Vec<String>,
 }
 
 #[derive(Deserialize)]
@@ -68,15 +72,18 @@ struct FactorFile {
     offset_deg: Option<Spanned<Real>>,
     value: Option<Spanned<Real>>,
     value_deg: Option<Spanned<Real>>,
+    constant: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct BodyFile {
     #[serde(default)]
-    #[allow(dead_code)]
     description: String,
+    #[serde(default)]
+    label: String,
     chain: Spanned<Vec<FactorFile>>,
+    shape: Option<Spanned<BodyShape>>,
 }
 
 /// Turns byte spans into `file:line:column` errors.
@@ -163,11 +170,16 @@ impl Machine {
     /// ```
     ///
     /// Other moving bodies have their own chains (`[[bodies.rest.chain]]`),
-    /// and an axis that moves one says so (`body = "rest"`). `[constants]`
-    /// holds named machine constants (mm; a `_deg` key is stored in radians
-    /// without the suffix). Every linear axis states `moves` and every rotary
-    /// axis `turns` (the axis the tool turns about, relative to the part);
-    /// both are checked against the chain when the file is read.
+    /// a `label` (how reports name the point the body's origin tracks) and a
+    /// `shape` to draw (`shape = { kind = "roller", radius = "rest_radius",
+    /// length = 40.0 }`: a number, or a constant's name), and an axis that
+    /// moves one says so (`body = "rest"`). `[constants]` holds named machine
+    /// constants (mm; a `_deg` key is stored in radians without the suffix);
+    /// a constant factor may take one (`constant = "rest_offset_b"`).
+    /// `driven_axes` lists programmed axes the machine takes from the
+    /// toolpath rather than solving. Every linear axis states `moves` and
+    /// every rotary axis `turns` (the axis the tool turns about, relative to
+    /// the part); both are checked against the chain when the file is read.
     ///
     /// # Failures
     /// [`MachineError::File`] naming the line, column and key: TOML syntax;
@@ -186,39 +198,23 @@ impl Machine {
             .iter()
             .map(|a| read_axis(&src, a))
             .collect::<Result<Vec<_>, _>>()?;
-        for (i, a) in file.axes.iter().enumerate() {
-            if axes[..i].iter().any(|b| b.name == axes[i].name) {
-                return Err(src.err(
-                    a.name.span(),
-                    format!("axis '{}' is declared twice", axes[i].name),
-                ));
-            }
-        }
-        if file.chain.get_ref().is_empty() {
-            return Err(src.err(file.chain.span(), "the tool chain has no factors"));
-        }
-        let chain = read_chain(&src, &axes, file.chain.get_ref())?;
-        let mut bodies = BTreeMap::new();
+        let chain = read_chain(&src, file.chain.get_ref())?;
+        let mut bodies = Vec::new();
         for (name, body) in &file.bodies {
-            bodies.insert(name.clone(), read_chain(&src, &axes, body.chain.get_ref())?);
+            bodies.push(BodySpec {
+                name: name.clone(),
+                description: body.description.clone(),
+                label: body.label.clone(),
+                chain: read_chain(&src, body.chain.get_ref())?,
+                shape: body.shape.as_ref().map(|s| s.get_ref().clone()),
+            });
         }
         let tool = match &file.tool {
-            None => ToolFrame::default(),
-            Some(t) => {
-                let p = t.point.get_ref();
-                let a = t.axis.get_ref();
-                if p.iter().chain(a).any(|v| !v.is_finite()) {
-                    return Err(src.err(t.point.span(), "tool point and axis must be finite"));
-                }
-                let axis = Vec3::from(*a);
-                if axis.norm() == 0.0 {
-                    return Err(src.err(t.axis.span(), "tool axis must not be zero"));
-                }
-                ToolFrame {
-                    point: (*p).into(),
-                    axis: axis.normalize(),
-                }
-            }
+            None => ToolSpec::default(),
+            Some(t) => ToolSpec {
+                point: *t.point.get_ref(),
+                axis: *t.axis.get_ref(),
+            },
         };
         let mut constants = BTreeMap::new();
         for (k, v) in &file.constants {
@@ -230,47 +226,101 @@ impl Machine {
         }
         let program_decimals = match &file.program_decimals {
             None => None,
-            Some(d) if (0..=6).contains(d.get_ref()) => Some(*d.get_ref() as usize),
-            Some(d) => {
-                return Err(src.err(
-                    d.span(),
-                    format!("program_decimals = {} must be 0 to 6", d.get_ref()),
-                ))
-            }
+            Some(d) => match usize::try_from(*d.get_ref()) {
+                Ok(n) => Some(n),
+                Err(_) => {
+                    return Err(src.err(
+                        d.span(),
+                        format!("program_decimals = {} must be 0 to 6", d.get_ref()),
+                    ))
+                }
+            },
         };
-        let machine = Machine {
-            program_decimals,
+        // The tool chain's axes, in the machine's order, are what inverse
+        // kinematics solves.
+        let solved_axes = axes
+            .iter()
+            .filter(|a| chain.iter().any(|f| f.axis.as_deref() == Some(&a.name)))
+            .map(|a| a.name.clone())
+            .collect();
+        let info = MachineInfo {
             name: file.name.get_ref().clone(),
-            description: file.description,
-            control: file.control,
+            description: file.description.clone(),
+            control: file.control.clone().unwrap_or_else(|| "sinumerik".into()),
             axes,
+            solved_axes,
+            constants,
+            program_decimals,
+            driven_axes: file.driven_axes.clone(),
+            bodies,
             chain,
             tool,
-            bodies,
-            constants,
         };
-        for (a, af) in machine.axes.iter().zip(&file.axes) {
-            check_sign(&src, &machine, a, af)?;
+        Machine::compile(info).map_err(|e| src.err(span_of(&file, &e), e.message))
+    }
+}
+
+/// The span in the file of an invalid value's place.
+fn span_of(file: &MachineFile, e: &Invalid) -> Range<usize> {
+    let key = |v: Option<&Range<usize>>, fallback: Range<usize>| v.cloned().unwrap_or(fallback);
+    match &e.place {
+        Place::Axis(i, k) => {
+            let Some(a) = file.axes.get(*i) else {
+                return 0..0;
+            };
+            let name = a.name.span();
+            let span = |v: &Option<Spanned<Real>>| v.as_ref().map(Spanned::span);
+            match *k {
+                "max" => key(
+                    span(&a.max)
+                        .or(span(&a.max_deg))
+                        .or(span(&a.max_rpm))
+                        .as_ref(),
+                    name,
+                ),
+                "moves" => key(a.moves.as_ref().map(Spanned::span).as_ref(), name),
+                "turns" => key(a.turns.as_ref().map(Spanned::span).as_ref(), name),
+                "body" => key(a.body.as_ref().map(Spanned::span).as_ref(), name),
+                _ => name,
+            }
         }
-        Ok(machine)
+        Place::Chain(None) => file.chain.span(),
+        Place::Chain(Some(b)) | Place::Body(b, _) => {
+            file.bodies.get(b).map_or(0..0, |body| body.chain.span())
+        }
+        Place::Factor(owner, i, k) => {
+            let chain = match owner {
+                None => Some(file.chain.get_ref()),
+                Some(b) => file.bodies.get(b).map(|body| body.chain.get_ref()),
+            };
+            let Some(f) = chain.and_then(|c| c.get(*i)) else {
+                return 0..0;
+            };
+            let at = f.factor.span();
+            match *k {
+                "axis" => key(f.axis.as_ref().map(Spanned::span).as_ref(), at),
+                "scale" => key(
+                    f.scale.as_ref().map(Spanned::span).as_ref(),
+                    f.axis.as_ref().map_or(at, Spanned::span),
+                ),
+                "constant" => key(f.constant.as_ref().map(Spanned::span).as_ref(), at),
+                _ => at,
+            }
+        }
+        Place::Tool => file.tool.as_ref().map_or(0..0, |t| t.point.span()),
+        Place::Decimals => file.program_decimals.as_ref().map_or(0..0, Spanned::span),
     }
 }
 
 fn read_axis(src: &Source<'_>, a: &AxisFile) -> Result<Axis, MachineError> {
     let kind = *a.kind.get_ref();
     let name = a.name.get_ref().clone();
-    if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
-        return Err(src.err(
-            a.name.span(),
-            format!("axis name '{name}' must be letters, digits or _"),
-        ));
-    }
     let need = |v: &Option<Spanned<Real>>, key: &str| -> Result<Real, MachineError> {
         match v {
             Some(s) => src.finite(&format!("axis {name}: {key}"), s),
             None => Err(src.err(
                 a.name.span(),
-                format!("axis {name} ({}) needs key '{key}'", kind_word(kind)),
+                format!("axis {name} ({}) needs key '{key}'", kind.word()),
             )),
         }
     };
@@ -280,7 +330,7 @@ fn read_axis(src: &Source<'_>, a: &AxisFile) -> Result<Axis, MachineError> {
                 s.span(),
                 format!(
                     "axis {name}: key '{key}' does not apply to a {} axis",
-                    kind_word(kind)
+                    kind.word()
                 ),
             )),
             None => Ok(()),
@@ -332,47 +382,9 @@ fn read_axis(src: &Source<'_>, a: &AxisFile) -> Result<Axis, MachineError> {
             (0.0, rpm, rpm)
         }
     };
-    let span_of_max = a
-        .max
-        .as_ref()
-        .or(a.max_deg.as_ref())
-        .or(a.max_rpm.as_ref())
-        .map_or(a.name.span(), |s| s.span());
-    if min >= max {
-        return Err(src.err(
-            span_of_max,
-            format!("axis {name}: travel max must exceed min"),
-        ));
-    }
-    if feed <= 0.0 {
-        return Err(src.err(
-            a.name.span(),
-            format!("axis {name}: the maximum feed must be > 0"),
-        ));
-    }
-    let vec3 = |v: &Option<Spanned<[Real; 3]>>,
-                key: &str,
-                wanted: bool|
-     -> Result<Option<Vec3>, MachineError> {
-        match (v, wanted) {
-            (Some(s), true) => {
-                let x = Vec3::from(*s.get_ref());
-                if !x.iter().all(|c| c.is_finite()) || x.norm() == 0.0 {
-                    return Err(src.err(s.span(), format!("axis {name}: {key} must be a finite, non-zero vector")));
-                }
-                Ok(Some(x))
-            }
-            (Some(s), false) => Err(src.err(s.span(), format!("axis {name}: key '{key}' does not apply to a {} axis", kind_word(kind)))),
-            (None, true) => Err(src.err(
-                a.name.span(),
-                format!("axis {name}: state its sign with '{key}' (the tool's motion in the part frame for a positive move)"),
-            )),
-            (None, false) => Ok(None),
-        }
-    };
     Ok(Axis {
-        moves: vec3(&a.moves, "moves", kind == AxisKind::Linear)?,
-        turns: vec3(&a.turns, "turns", kind == AxisKind::Rotary)?,
+        moves: a.moves.as_ref().map(|s| *s.get_ref()),
+        turns: a.turns.as_ref().map(|s| *s.get_ref()),
         name,
         kind,
         min,
@@ -384,200 +396,85 @@ fn read_axis(src: &Source<'_>, a: &AxisFile) -> Result<Axis, MachineError> {
     })
 }
 
-fn kind_word(k: AxisKind) -> &'static str {
-    match k {
-        AxisKind::Linear => "linear",
-        AxisKind::Rotary => "rotary",
-        AxisKind::Spindle => "spindle",
+/// A constant factor has no scale or offset.
+fn no_scale_or_offset(
+    src: &Source<'_>,
+    f: &FactorFile,
+    offset_key: &Option<Spanned<Real>>,
+) -> Result<(), MachineError> {
+    match f.scale.as_ref().or(offset_key.as_ref()) {
+        Some(s) => Err(src.err(
+            s.span(),
+            "scale and offset apply only to a factor bound to an axis",
+        )),
+        None => Ok(()),
     }
 }
 
-fn read_chain(
-    src: &Source<'_>,
-    axes: &[Axis],
-    factors: &[FactorFile],
-) -> Result<Chain, MachineError> {
-    let mut b = Chain::builder();
-    // Axes take the machine's order.
-    for a in axes {
-        if factors
-            .iter()
-            .any(|f| f.axis.as_ref().is_some_and(|n| n.get_ref() == &a.name))
-        {
-            b = b.declare(&a.name);
-        }
-    }
+/// The factors of a chain as written, units converted (degrees to
+/// radians); whether the axes they name exist and fit is the description's
+/// check.
+fn read_chain(src: &Source<'_>, factors: &[FactorFile]) -> Result<Vec<FactorSpec>, MachineError> {
+    let mut out = Vec::with_capacity(factors.len());
     for f in factors {
         let kind = *f.factor.get_ref();
-        let rot = kind.is_rotation();
+        let rot = matches!(kind, FactorKind::Rx | FactorKind::Ry | FactorKind::Rz);
         let (good, bad) = if rot { ("_deg", "") } else { ("", "_deg") };
         let value_key = if rot { &f.value_deg } else { &f.value };
         let offset_key = if rot { &f.offset_deg } else { &f.offset };
         let wrong_value = if rot { &f.value } else { &f.value_deg };
         let wrong_offset = if rot { &f.offset } else { &f.offset_deg };
+        let word = format!("{kind:?}").to_lowercase();
         if let Some(s) = wrong_value.as_ref().or(wrong_offset.as_ref()) {
             return Err(src.err(
                 s.span(),
-                format!(
-                    "factor {kind:?}: use value{good}/offset{good}, not value{bad}/offset{bad}"
-                )
-                .to_lowercase(),
+                format!("factor {word}: use value{good}/offset{good}, not value{bad}/offset{bad}"),
             ));
         }
         let conv = |v: Real| if rot { v.to_radians() } else { v };
-        match (&f.axis, value_key) {
-            (Some(name), None) => {
-                let axis = axes
-                    .iter()
-                    .find(|a| &a.name == name.get_ref())
-                    .ok_or_else(|| {
-                        src.err(
-                            name.span(),
-                            format!(
-                                "chain names axis '{}', which is not declared (axes: {})",
-                                name.get_ref(),
-                                axes.iter()
-                                    .map(|a| a.name.as_str())
-                                    .collect::<Vec<_>>()
-                                    .join(", ")
-                            ),
-                        )
-                    })?;
-                let expected = if rot {
-                    AxisKind::Rotary
-                } else {
-                    AxisKind::Linear
-                };
-                if axis.kind != expected {
-                    return Err(src.err(
-                        name.span(),
-                        format!(
-                            "axis {} is {} but factor {} needs a {} axis",
-                            axis.name,
-                            kind_word(axis.kind),
-                            format!("{kind:?}").to_lowercase(),
-                            kind_word(expected)
-                        ),
-                    ));
-                }
-                let scale = match &f.scale {
+        let spec = match (&f.axis, value_key, &f.constant) {
+            (Some(name), None, _) => FactorSpec {
+                scale: match &f.scale {
                     Some(s) => src.finite("scale", s)?,
                     None => 1.0,
-                };
-                if scale == 0.0 {
-                    return Err(src.err(
-                        f.scale.as_ref().map_or(name.span(), |s| s.span()),
-                        "scale must not be 0",
-                    ));
-                }
-                let offset = match offset_key {
+                },
+                offset: match offset_key {
                     Some(s) => conv(src.finite("offset", s)?),
                     None => 0.0,
-                };
-                b = b.axis_scaled(kind, &axis.name, scale, offset);
+                },
+                constant: f.constant.as_ref().map(|c| c.get_ref().clone()),
+                ..FactorSpec::axis(kind, name.get_ref())
+            },
+            (None, Some(v), None) => {
+                no_scale_or_offset(src, f, offset_key)?;
+                FactorSpec::value(kind, conv(src.finite("value", v)?))
             }
-            (None, Some(v)) => {
-                if let Some(s) = f.scale.as_ref().or(offset_key.as_ref()) {
-                    return Err(src.err(
-                        s.span(),
-                        "scale and offset apply only to a factor bound to an axis",
-                    ));
-                }
-                b = b.constant(kind, conv(src.finite("value", v)?));
+            (None, None, Some(c)) => {
+                no_scale_or_offset(src, f, offset_key)?;
+                FactorSpec::constant(kind, c.get_ref())
             }
-            (Some(name), Some(_)) => {
+            (Some(name), Some(_), _) => {
                 return Err(src.err(
                     name.span(),
                     "a factor has either an axis or a constant value, not both",
                 ))
             }
-            (None, None) => {
+            (None, Some(v), Some(_)) => {
                 return Err(src.err(
-                    f.factor.span(),
-                    format!("factor needs an 'axis' or a constant 'value{good}'"),
+                    v.span(),
+                    "a factor has either a value or a constant, not both",
                 ))
             }
-        }
-    }
-    b.build().map_err(|e| src.err(0..0, e.to_string()))
-}
-
-/// Checks an axis's stated `moves`/`turns` against the chain that moves it.
-fn check_sign(src: &Source<'_>, m: &Machine, a: &Axis, af: &AxisFile) -> Result<(), MachineError> {
-    if a.kind == AxisKind::Spindle {
-        let used = std::iter::once(&m.chain)
-            .chain(m.bodies.values())
-            .any(|c| c.axis_index(&a.name).is_some());
-        if used {
-            return Err(src.err(
-                af.name.span(),
-                format!("spindle {} cannot be bound in a chain", a.name),
-            ));
-        }
-        return Ok(());
-    }
-    let (chain, origin) = match &a.body {
-        None => (&m.chain, m.tool.point),
-        Some(b) => match m.bodies.get(b) {
-            Some(c) => (c, crate::math::Point3::origin()),
-            None => {
-                let span = af.body.as_ref().map_or(af.name.span(), |s| s.span());
+            (None, None, _) => {
                 return Err(src.err(
-                    span,
+                    f.factor.span(),
                     format!(
-                        "axis {}: no body '{b}' (declare [[bodies.{b}.chain]])",
-                        a.name
+                        "factor needs an 'axis', a constant 'value{good}' or a machine 'constant'"
                     ),
-                ));
+                ))
             }
-        },
-    };
-    let Some(i) = chain.axis_index(&a.name) else {
-        let whose = a.body.as_deref().unwrap_or("tool");
-        return Err(src.err(
-            af.name.span(),
-            format!("axis {} is not bound in the {whose} chain", a.name),
-        ));
-    };
-    let travel = m.travel_of(chain)?;
-    let q0: Vec<Real> = travel
-        .iter()
-        .map(|&(lo, hi)| 0.0_f64.clamp(lo, hi))
-        .collect();
-    let f0 = chain.frame_unchecked(&q0);
-    let mut q1 = q0.clone();
-    match a.kind {
-        AxisKind::Linear => {
-            q1[i] += 1.0;
-            let d =
-                chain.frame_unchecked(&q1).transform_point(&origin) - f0.transform_point(&origin);
-            let stated = a.moves.unwrap_or_default();
-            if (d - stated).norm() > 1e-9 {
-                let span = af.moves.as_ref().map_or(af.name.span(), |s| s.span());
-                return Err(src.err(
-                    span,
-                    format!("axis {}: moves = [{}, {}, {}] but the chain moves it by [{:.6}, {:.6}, {:.6}]", a.name, stated.x, stated.y, stated.z, d.x, d.y, d.z),
-                ));
-            }
-        }
-        _ => {
-            let h = 1e-6;
-            q1[i] += h;
-            let r = chain.frame_unchecked(&q1).rot * f0.rot.transpose();
-            let w = Vec3::new(
-                r[(2, 1)] - r[(1, 2)],
-                r[(0, 2)] - r[(2, 0)],
-                r[(1, 0)] - r[(0, 1)],
-            ) / (2.0 * h);
-            let stated = a.turns.unwrap_or_default().normalize();
-            if (w - stated).norm() > 1e-5 {
-                let span = af.turns.as_ref().map_or(af.name.span(), |s| s.span());
-                return Err(src.err(
-                    span,
-                    format!("axis {}: turns = [{}, {}, {}] but the chain turns it about [{:.4}, {:.4}, {:.4}]", a.name, stated.x, stated.y, stated.z, w.x, w.y, w.z),
-                ));
-            }
-        }
+        };
+        out.push(spec);
     }
-    Ok(())
+    Ok(out)
 }

@@ -1,95 +1,40 @@
 //! Machines: named axes with travel and feed limits, the kinematic chain
 //! from tool to part, and the chains of other moving bodies (a steady rest).
 //!
-//! A machine is data: a TOML file (see [`Machine::from_toml_str`] for the
-//! format) or one of the built-ins of the seeds ([`Machine::builtin`]).
-//! Units in files are millimetres and degrees (`_deg` keys); inside,
-//! millimetres and radians.
+//! A machine is described as data, a [`MachineInfo`] (the type the plugin
+//! ABI carries): its axes, constants, the chains of the tool and of other
+//! moving bodies, and its capabilities. It comes from a TOML file (see
+//! [`Machine::from_toml_str`] for the format), one of the data built-ins of
+//! the seeds ([`Machine::builtin`]), or a plugin's descriptor
+//! ([`Machine::from_info`]). Units in files are millimetres and degrees
+//! (`_deg` keys); inside, millimetres and radians.
+//!
+//! The runtime uses a machine through [`MachineKinematics`]: inverse and
+//! forward kinematics in batches ([`ChainMachine`] for any data machine;
+//! plugins implement it natively).
 //!
 //! ```
-//! use pilgrim_kernel::Machine;
-//! let m = Machine::builtin("3K152VF20").unwrap();
-//! assert_eq!(m.chain().axis_names(), ["Z", "X"]);
-//! assert!(m.axis("U").is_some());
+//! use pilgrim_kernel::machine::Machine;
+//! let m = Machine::builtin("fanuc-0i-tc").unwrap();
+//! assert_eq!(m.chain().axis_names(), ["X", "Z"]);
+//! assert!(m.axis("S").is_some());
 //! ```
 
 mod builtin;
 mod file;
+mod info;
+mod kinematics;
 
 pub use builtin::{BUILTIN_MACHINES, BUILTIN_SOURCES};
+pub use info::{bodies_of, check_description, Body};
+pub use kinematics::{batch_rows, ChainMachine, KinematicsError, MachineKinematics};
+pub use pilgrim_plugin_abi::types::{
+    Axis, AxisKind, BodyShape, BodySpec, FactorSpec, MachineInfo, Quantity, ToolSpec,
+};
 
-use crate::math::{Real, Vec3};
+use crate::math::Real;
 use crate::transform::{Chain, IkOptions, IkSolution, Target, ToolFrame, TransformError};
-use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-
-/// What an axis does.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum AxisKind {
-    /// A slide (mm).
-    Linear,
-    /// A positioned rotary axis (rad inside, degrees in files and programs).
-    Rotary,
-    /// A spindle turning at a speed (rpm), not positioned.
-    Spindle,
-}
-
-/// One axis of a machine.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Axis {
-    /// The name, as the control's address letter (X, Z, U, A...).
-    pub name: String,
-    /// Linear, rotary or spindle.
-    pub kind: AxisKind,
-    /// Lower travel limit (mm or rad; 0 for a spindle).
-    pub min: Real,
-    /// Upper travel limit (mm or rad; the top speed in rpm for a spindle).
-    pub max: Real,
-    /// Top speed (mm/min or rad/min; rpm for a spindle).
-    pub max_feed: Real,
-    /// Whether blocks carry its position.
-    pub programmed: bool,
-    /// What it moves and which way is positive, in words.
-    pub description: String,
-    /// For linear axes: the tool's (or body's) displacement in the part frame
-    /// per unit of the axis, at the home pose: the sign, stated and tested.
-    pub moves: Option<Vec3>,
-    /// For rotary axes: the axis the tool (or body) turns about relative to
-    /// the part for a positive value (right-handed), at the home pose.
-    pub turns: Option<Vec3>,
-    /// The body it moves: `None` for the tool, else a body's name.
-    pub body: Option<String>,
-}
-
-impl Axis {
-    /// A value in file/program units (mm, deg) from kernel units (mm, rad).
-    pub fn to_user(&self, v: Real) -> Real {
-        if self.kind == AxisKind::Rotary {
-            v.to_degrees()
-        } else {
-            v
-        }
-    }
-
-    /// The unit of [`Self::to_user`] values.
-    pub fn unit(&self) -> &'static str {
-        match self.kind {
-            AxisKind::Linear => "mm",
-            AxisKind::Rotary => "deg",
-            AxisKind::Spindle => "rpm",
-        }
-    }
-
-    /// The unit of feeds.
-    pub fn feed_unit(&self) -> &'static str {
-        match self.kind {
-            AxisKind::Linear => "mm/min",
-            AxisKind::Rotary => "deg/min",
-            AxisKind::Spindle => "rpm",
-        }
-    }
-}
 
 /// Errors of machine files and machine limits.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -173,59 +118,60 @@ pub enum MachineError {
     /// A kinematics failure (inverse kinematics, chain evaluation).
     #[error(transparent)]
     Transform(#[from] TransformError),
+    /// A machine description (a plugin's descriptor) that is wrong.
+    #[error("machine {machine}: {message}")]
+    Description {
+        /// The machine's name.
+        machine: String,
+        /// What is wrong, naming the axis, factor, body or constant.
+        message: String,
+    },
 }
 
-/// A machine tool: axes, the tool chain and other bodies' chains.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// A machine tool: its description ([`MachineInfo`]: axes, constants,
+/// capabilities, chains as data) and the chains compiled from it, the
+/// tool's and every other body's.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Machine {
-    name: String,
-    description: String,
-    control: Option<String>,
-    axes: Vec<Axis>,
+    info: MachineInfo,
     chain: Chain,
     tool: ToolFrame,
-    bodies: BTreeMap<String, Chain>,
-    constants: BTreeMap<String, Real>,
-    program_decimals: Option<usize>,
+    bodies: BTreeMap<String, Body>,
 }
 
 impl Machine {
+    /// The machine's description.
+    pub fn info(&self) -> &MachineInfo {
+        &self.info
+    }
+
     /// The machine's name.
     pub fn name(&self) -> &str {
-        &self.name
+        &self.info.name
     }
 
     /// A description in words.
     pub fn description(&self) -> &str {
-        &self.description
+        &self.info.description
     }
 
-    /// The control's dialect name (e.g. `sinumerik`, `fanuc`), if stated.
-    pub fn control(&self) -> Option<&str> {
-        self.control.as_deref()
+    /// The control's dialect name (e.g. `sinumerik`, `fanuc`).
+    pub fn control(&self) -> &str {
+        &self.info.control
     }
 
-    /// All axes, in the file's order.
+    /// All axes, in the description's order.
     pub fn axes(&self) -> &[Axis] {
-        &self.axes
+        &self.info.axes
     }
 
     /// The axis called `name`.
     pub fn axis(&self, name: &str) -> Option<&Axis> {
-        self.axes.iter().find(|a| a.name == name)
+        self.info.axis(name)
     }
 
     fn axis_or_err(&self, name: &str) -> Result<&Axis, MachineError> {
-        self.axis(name).ok_or_else(|| MachineError::UnknownAxis {
-            machine: self.name.clone(),
-            axis: name.to_owned(),
-            known: self
-                .axes
-                .iter()
-                .map(|a| a.name.as_str())
-                .collect::<Vec<_>>()
-                .join(", "),
-        })
+        axis_or_err(&self.info, name)
     }
 
     /// The chain from the tool's frame to the part's: `r_part = A(q) r_tool`.
@@ -238,30 +184,36 @@ impl Machine {
         &self.tool
     }
 
-    /// The chain placing another body (e.g. `rest`) in the part frame.
-    pub fn body_chain(&self, body: &str) -> Option<&Chain> {
-        self.bodies.get(body)
+    /// Another moving body (e.g. `rest`), with the chain placing it in the
+    /// part frame.
+    pub fn body(&self, name: &str) -> Option<&Body> {
+        self.bodies.get(name)
     }
 
-    /// The names of the other bodies.
-    pub fn body_names(&self) -> impl Iterator<Item = &str> {
-        self.bodies.keys().map(String::as_str)
+    /// The chain placing another body (e.g. `rest`) in the part frame.
+    pub fn body_chain(&self, body: &str) -> Option<&Chain> {
+        self.bodies.get(body).map(Body::chain)
+    }
+
+    /// The other bodies, by name.
+    pub fn bodies(&self) -> impl Iterator<Item = &Body> {
+        self.bodies.values()
     }
 
     /// Decimals of axis values in this machine's programs, if it states them
     /// (its resolution: 4 for 0.1 um); otherwise the dialect's.
     pub fn program_decimals(&self) -> Option<usize> {
-        self.program_decimals
+        self.info.program_decimals
     }
 
     /// A named machine constant (mm or rad), e.g. the rest's offset `B`.
     pub fn constant(&self, name: &str) -> Option<Real> {
-        self.constants.get(name).copied()
+        self.info.constants.get(name).copied()
     }
 
     /// All named constants.
     pub fn constants(&self) -> &BTreeMap<String, Real> {
-        &self.constants
+        &self.info.constants
     }
 
     /// The travel `(min, max)` of each of `chain`'s axes, in its order.
@@ -344,6 +296,20 @@ pub fn home_seed(chain: &Chain, travel: &[(Real, Real)]) -> Vec<Real> {
         .collect()
 }
 
+/// The axis called `name` of the machine `info`, or an error listing its axes.
+fn axis_or_err<'a>(info: &'a MachineInfo, name: &str) -> Result<&'a Axis, MachineError> {
+    info.axis(name).ok_or_else(|| MachineError::UnknownAxis {
+        machine: info.name.clone(),
+        axis: name.to_owned(),
+        known: info
+            .axes
+            .iter()
+            .map(|a| a.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", "),
+    })
+}
+
 fn check_rows(axes: &[&Axis], rows: &[Real]) -> Result<usize, MachineError> {
     if axes.is_empty() || !rows.len().is_multiple_of(axes.len()) {
         return Err(MachineError::BadPoint {
@@ -390,6 +356,28 @@ pub fn check_travel(axes: &[&Axis], rows: &[Real]) -> Result<(), MachineError> {
 /// turns reads its feed in degrees per minute (feed checks, cycle times).
 pub const LINEAR_RESOLUTION: Real = 1e-4;
 
+/// The length of a move, which its feed divides to give its time: the
+/// linear axes' path (mm), or for a move that only turns (linear motion
+/// under [`LINEAR_RESOLUTION`]) the rotary axes' (degrees, the feed then in
+/// deg/min). `deltas` are the axes' changes in program units (mm, deg), one
+/// per axis of `axes`.
+pub fn move_length(axes: &[&Axis], deltas: &[Real]) -> Real {
+    let length_of = |kind: AxisKind| -> Real {
+        axes.iter()
+            .zip(deltas)
+            .filter(|(a, _)| a.kind == kind)
+            .map(|(_, d)| d * d)
+            .sum::<Real>()
+            .sqrt()
+    };
+    let linear = length_of(AxisKind::Linear);
+    if linear > LINEAR_RESOLUTION {
+        linear
+    } else {
+        length_of(AxisKind::Rotary)
+    }
+}
+
 /// Checks that no axis moves faster than its maximum between rows.
 /// `feeds[i]` is the programmed feed (mm/min) of the move ending at row `i`
 /// (`feeds[0]` is unused; `+inf` marks a rapid, not checked); the move lasts
@@ -422,21 +410,8 @@ pub fn check_feed(axes: &[&Axis], rows: &[Real], feeds: &[Real]) -> Result<(), M
             });
         }
         let user_delta = |i: usize| axes[i].to_user(a1[i]) - axes[i].to_user(a0[i]);
-        let length_of = |kind: AxisKind| -> Real {
-            (0..w)
-                .filter(|&i| axes[i].kind == kind)
-                .map(|i| user_delta(i).powi(2))
-                .sum::<Real>()
-                .sqrt()
-        };
-        // Linear motion below the programs' 0.001 mm resolution is no motion:
-        // the move is a pure turn and F reads in degrees per minute.
-        let linear = length_of(AxisKind::Linear);
-        let path = if linear > LINEAR_RESOLUTION {
-            linear
-        } else {
-            length_of(AxisKind::Rotary)
-        };
+        let deltas: Vec<Real> = (0..w).map(user_delta).collect();
+        let path = move_length(axes, &deltas);
         if path == 0.0 {
             continue;
         }
@@ -445,7 +420,7 @@ pub fn check_feed(axes: &[&Axis], rows: &[Real], feeds: &[Real]) -> Result<(), M
             if a.kind == AxisKind::Spindle {
                 continue;
             }
-            let speed = user_delta(i).abs() / minutes;
+            let speed = deltas[i].abs() / minutes;
             let max = a.to_user(a.max_feed);
             if speed > max * (1.0 + 1e-9) {
                 return Err(MachineError::FeedExceeded {

@@ -35,7 +35,7 @@ pub const DEFAULT_TOLERANCE: Real = 0.01;
 pub enum MeshError {
     /// A rejected number.
     #[error(transparent)]
-    Input(#[from] crate::error::InputError),
+    Input(#[from] crate::input::InputError),
     /// A section that does not close on itself.
     #[error("the section is open: its last point ({:.6}, {:.6}) does not return to its first ({:.6}, {:.6})", last[0], last[1], first[0], first[1])]
     Open {

@@ -2,7 +2,7 @@
 //! wheel leaves.
 
 use super::Side;
-use crate::error::InputError;
+use crate::input::InputError;
 use crate::math::{positive, Real};
 use crate::profile::ProfileError;
 
@@ -195,7 +195,7 @@ pub fn swept_circles(
         let len = (z[k] - z[k - 1]).hypot(x[k] - x[k - 1]);
         let n = (len / spacing).ceil().max(1.0);
         if cz.len() as Real + n > 5e7 {
-            return Err(crate::error::InputError::out_of_range(
+            return Err(crate::input::InputError::out_of_range(
                 "verification resolution",
                 resolution,
                 "coarse enough for at most 50 million circles",

@@ -1,7 +1,7 @@
 //! A whole part profile chained from lines, arcs and the mandrel law.
 
 use super::{MandrelLaw, Profile, ProfileError};
-use crate::error::InputError;
+use crate::input::InputError;
 use crate::math::{finite, positive, Real};
 use serde::{Deserialize, Serialize};
 

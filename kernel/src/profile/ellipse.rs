@@ -1,7 +1,7 @@
 //! The caliber groove's elliptical section (MATH §3.1, S001-3, S001-4).
 
 use super::{Profile, ProfileError};
-use crate::error::InputError;
+use crate::input::InputError;
 use crate::math::{positive, Real};
 use serde::{Deserialize, Serialize};
 

@@ -1,7 +1,7 @@
 //! The mandrel's working-part law (MATH §2.1, S000-1, corrected).
 
 use super::{Profile, ProfileError};
-use crate::error::InputError;
+use crate::input::InputError;
 use crate::math::{finite, positive, Real};
 use serde::{Deserialize, Serialize};
 

@@ -27,7 +27,7 @@ pub use simplify::simplify_polyline;
 pub use smooth::Smoothing;
 pub use table::{read_table, read_table_str, Table, TableError, TableFormat};
 
-use crate::error::InputError;
+use crate::input::InputError;
 use crate::math::{fixed, Real};
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;

@@ -1,7 +1,7 @@
 //! Three-point smoothing of a table's derivative (MATH §3.2, S001-1).
 
 use super::{Profile, ProfileError};
-use crate::error::InputError;
+use crate::input::InputError;
 use crate::math::Real;
 use serde::{Deserialize, Serialize};
 

@@ -13,7 +13,7 @@
 //! Lines starting with `#` are comments.
 
 use super::{Profile, ProfileError};
-use crate::error::InputError;
+use crate::input::InputError;
 use crate::math::Real;
 use std::path::Path;
 

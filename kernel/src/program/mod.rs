@@ -1,76 +1,21 @@
 //! Axis programs and post-processors.
 //!
 //! An [`AxisProgram`] is the toolpath in a machine's own terms: named axes
-//! in program units (mm, degrees) and blocks (rapid, linear, thread). It is
-//! made from a [`Toolpath`] by a [`MachineKinematics`] ([`AxisProgram::build`]:
-//! inverse kinematics of every point in one batch, then travel and feed
-//! checks naming the block and axis), and written as text by the shared
-//! post-processor ([`post`]) in a control's dialect.
+//! in program units (mm, degrees) and blocks (rapid, linear, thread); its
+//! type is the plugin ABI's, since plugins post it. It is made from a
+//! [`Toolpath`] by a [`MachineKinematics`] ([`build`]: inverse kinematics of
+//! every point in one batch, then travel and feed checks naming the block
+//! and axis), and written as text by a [`PostProcessor`]: the shared writer
+//! in a control's dialect ([`post`]), or a plugin's own.
 
-mod kinematics;
 pub mod post;
 
-pub use kinematics::{batch_rows, ChainMachine, KinematicsError, MachineInfo, MachineKinematics};
-pub use post::{post, Dialect, PostError};
+pub use pilgrim_plugin_abi::types::{AxisProgram, Block, ProgramAxis};
+pub use post::{post, Dialect, PostError, PostProcessor, SharedPost};
 
-use crate::machine::{Axis, AxisKind, MachineError};
+use crate::machine::{Axis, MachineError, MachineInfo, MachineKinematics};
 use crate::math::Real;
 use crate::toolpath::{Motion, Toolpath, ToolpathError};
-use serde::{Deserialize, Serialize};
-
-/// An axis of a program.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ProgramAxis {
-    /// The address letter.
-    pub name: String,
-    /// `mm` or `deg`.
-    pub unit: String,
-}
-
-/// One block of a program.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Block {
-    /// How the block moves.
-    pub motion: Motion,
-    /// Axis values in program units, in the order of [`AxisProgram::axes`].
-    pub values: Vec<Real>,
-    /// Feed (mm/min) for linear blocks; the lead for thread blocks is in
-    /// the motion; 0 for rapids.
-    pub feed: Real,
-    /// A spindle speed (rpm) set from this block on; `None` keeps the last.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub spindle: Option<Real>,
-    /// A comment to print before the block (a pass's name).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub comment: Option<String>,
-}
-
-/// A program for one machine.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct AxisProgram {
-    /// The program's name (letters, digits, `_`).
-    pub name: String,
-    /// The program number (Fanuc `O` word).
-    pub number: u32,
-    /// The machine's name.
-    pub machine: String,
-    /// The control's dialect.
-    pub control: String,
-    /// The tool's number.
-    pub tool_number: u32,
-    /// The tool's name.
-    pub tool_name: String,
-    /// Spindle speed (rpm).
-    pub spindle_rpm: Real,
-    /// Decimals of axis values, if the machine states them (else the
-    /// dialect's).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub decimals: Option<usize>,
-    /// The programmed axes.
-    pub axes: Vec<ProgramAxis>,
-    /// The blocks.
-    pub blocks: Vec<Block>,
-}
 
 /// Errors making a program from a toolpath; blocks are numbered from 1.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -143,8 +88,9 @@ pub enum ProgramError {
 }
 
 impl ProgramError {
-    /// A machine limit error, its point index read as a block (from 0).
-    fn from_limit(e: MachineError) -> Self {
+    /// A machine limit error, its point index read as a block (from 0), on
+    /// the machine called `machine`.
+    fn from_limit(machine: &str, e: MachineError) -> Self {
         match e {
             MachineError::OutsideTravel {
                 point,
@@ -175,207 +121,232 @@ impl ProgramError {
                 unit,
             },
             other => Self::Machine {
-                machine: String::new(),
+                machine: machine.to_owned(),
                 message: other.to_string(),
             },
         }
     }
 }
 
-impl AxisProgram {
-    /// The program for `toolpath` on `machine`: inverse kinematics of every
-    /// point (one batch), auxiliary values mapped to the machine's axes of
-    /// the same names (an auxiliary value named like an axis inverse
-    /// kinematics solves drives that axis, and the others are solved around
-    /// it), values in program units, then travel and feed checks.
-    /// Every pass's first block carries the pass's name as a comment.
-    ///
-    /// # Failures
-    /// A bad toolpath (named by pass and point); an auxiliary name that is
-    /// no programmed axis; inverse kinematics failing at a point; a block
-    /// outside travel or too fast for an axis (named by block and axis).
-    pub fn build(
-        toolpath: &Toolpath,
-        machine: &dyn MachineKinematics,
-        name: &str,
-    ) -> Result<Self, ProgramError> {
-        toolpath.validate()?;
-        let info = machine.info();
-        let machine_err = |message: String| ProgramError::Machine {
-            machine: info.name.clone(),
-            message,
-        };
-        let mut poses = Vec::with_capacity(toolpath.point_count() * 6);
-        for (_, _, c) in toolpath.points() {
-            poses.extend_from_slice(&c.point);
-            poses.extend_from_slice(&c.axis);
-        }
-        // Auxiliary values named like solved axes drive those axes.
-        let held: Vec<(usize, usize)> = info
-            .solved_axes
-            .iter()
-            .enumerate()
-            .filter_map(|(i, s)| {
-                toolpath
-                    .aux_names
-                    .iter()
-                    .position(|a| a == s)
-                    .map(|j| (i, j))
-            })
-            .collect();
-        let held_axes: Vec<usize> = held.iter().map(|h| h.0).collect();
-        let held_values: Vec<Real> = toolpath
-            .points()
-            .flat_map(|(_, _, c)| {
-                held.iter()
-                    .map(|&(_, j)| aux_internal(&info.axes, &toolpath.aux_names[j], c.aux[j]))
-                    .collect::<Vec<_>>()
-            })
-            .collect();
-        let mut solved = Vec::new();
-        machine
-            .inverse_held(
-                &poses,
-                &toolpath.tool.reference,
-                &held_axes,
-                &held_values,
-                &mut solved,
-            )
-            .map_err(|e| {
-                match e
-                    .index
-                    .and_then(|i| toolpath.points().nth(i).map(|(p, q, _)| (i, p, q)))
-                {
-                    Some((i, p, q)) => ProgramError::Kinematics {
-                        block: i + 1,
-                        pass: p + 1,
-                        point: q + 1,
-                        message: e.message,
-                    },
-                    None => machine_err(e.message),
-                }
-            })?;
-        let n_solved = info.solved_axes.len();
-        if solved.len() != toolpath.point_count() * n_solved {
-            return Err(machine_err(format!(
-                "inverse kinematics returned {} values for {} poses of {} axes",
-                solved.len(),
-                toolpath.point_count(),
-                n_solved
-            )));
-        }
-        // Program columns, in the machine's axis order: solved axes and
-        // auxiliary values, each a programmed axis.
-        let programmed: Vec<&Axis> = info
-            .axes
-            .iter()
-            .filter(|a| kinematics::is_programmed(a))
-            .collect();
-        for aux in &toolpath.aux_names {
-            if !programmed.iter().any(|a| &a.name == aux) {
-                return Err(ProgramError::UnknownAux {
-                    name: aux.clone(),
-                    machine: info.name.clone(),
-                    known: programmed
-                        .iter()
-                        .map(|a| a.name.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                });
-            }
-        }
-        enum Source {
-            Solved(usize),
-            Aux(usize),
-        }
-        let mut columns: Vec<(&Axis, Source)> = Vec::new();
-        for a in &programmed {
-            // Solved first: a driven solved axis is in the solved rows too.
-            if let Some(i) = info.solved_axes.iter().position(|s| s == &a.name) {
-                columns.push((a, Source::Solved(i)));
-            } else if let Some(i) = toolpath.aux_names.iter().position(|s| s == &a.name) {
-                columns.push((a, Source::Aux(i)));
-            }
-        }
-        let mut blocks = Vec::with_capacity(toolpath.point_count());
-        let mut rows_internal = Vec::with_capacity(toolpath.point_count() * columns.len());
-        for (k, (p, j, c)) in toolpath.points().enumerate() {
-            let row = &solved[k * n_solved..(k + 1) * n_solved];
-            let internal: Vec<Real> = columns
+/// The program for `toolpath` on `machine`: inverse kinematics of every
+/// point (one batch), auxiliary values mapped to the machine's axes of
+/// the same names (an auxiliary value named like an axis inverse
+/// kinematics solves drives that axis, and the others are solved around
+/// it), values in program units, then travel and feed checks.
+/// Every pass's first block carries the pass's name as a comment.
+///
+/// # Failures
+/// A bad toolpath (named by pass and point); an auxiliary name that is
+/// no programmed axis; inverse kinematics failing at a point; a block
+/// outside travel or too fast for an axis (named by block and axis).
+pub fn build(
+    toolpath: &Toolpath,
+    machine: &dyn MachineKinematics,
+    name: &str,
+) -> Result<AxisProgram, ProgramError> {
+    toolpath.validate()?;
+    let info = machine.info();
+    let machine_err = |message: String| ProgramError::Machine {
+        machine: info.name.clone(),
+        message,
+    };
+    let mut poses = Vec::with_capacity(toolpath.point_count() * 6);
+    for (_, _, c) in toolpath.points() {
+        poses.extend_from_slice(&c.point);
+        poses.extend_from_slice(&c.axis);
+    }
+    // Auxiliary values named like solved axes drive those axes.
+    let held: Vec<(usize, usize)> = info
+        .solved_axes
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| {
+            toolpath
+                .aux_names
                 .iter()
-                .map(|(_, s)| match s {
-                    Source::Solved(i) => row[*i],
-                    Source::Aux(i) => aux_internal(&info.axes, &toolpath.aux_names[*i], c.aux[*i]),
-                })
-                .collect();
-            let values = columns
-                .iter()
-                .zip(&internal)
-                .map(|((a, _), v)| a.to_user(*v))
-                .collect();
-            rows_internal.extend_from_slice(&internal);
-            blocks.push(Block {
-                motion: c.motion,
-                values,
-                feed: match c.motion {
-                    Motion::Rapid => 0.0,
-                    Motion::Linear => c.feed,
-                    Motion::Thread { lead } => lead * toolpath.spindle_rpm,
+                .position(|a| a == s)
+                .map(|j| (i, j))
+        })
+        .collect();
+    let held_axes: Vec<usize> = held.iter().map(|h| h.0).collect();
+    let held_values: Vec<Real> = toolpath
+        .points()
+        .flat_map(|(_, _, c)| {
+            held.iter()
+                .map(|&(_, j)| aux_internal(info, &toolpath.aux_names[j], c.aux[j]))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let mut solved = Vec::new();
+    machine
+        .inverse_held(
+            &poses,
+            &toolpath.tool.reference,
+            &held_axes,
+            &held_values,
+            &mut solved,
+        )
+        .map_err(|e| {
+            match e
+                .index
+                .and_then(|i| toolpath.points().nth(i).map(|(p, q, _)| (i, p, q)))
+            {
+                Some((i, p, q)) => ProgramError::Kinematics {
+                    block: i + 1,
+                    pass: p + 1,
+                    point: q + 1,
+                    message: e.message,
                 },
-                spindle: (k == 0).then_some(toolpath.spindle_rpm),
-                comment: (j == 0).then(|| toolpath.passes[p].name.clone()),
+                None => machine_err(e.message),
+            }
+        })?;
+    let n_solved = info.solved_axes.len();
+    if solved.len() != toolpath.point_count() * n_solved {
+        return Err(machine_err(format!(
+            "inverse kinematics returned {} values for {} poses of {} axes",
+            solved.len(),
+            toolpath.point_count(),
+            n_solved
+        )));
+    }
+    // Program columns, in the machine's axis order: solved axes and
+    // auxiliary values, each a programmed axis.
+    let programmed: Vec<&Axis> = info.axes.iter().filter(|a| a.is_programmed()).collect();
+    for aux in &toolpath.aux_names {
+        if !programmed.iter().any(|a| &a.name == aux) {
+            return Err(ProgramError::UnknownAux {
+                name: aux.clone(),
+                machine: info.name.clone(),
+                known: programmed
+                    .iter()
+                    .map(|a| a.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
             });
         }
-        let axes_refs: Vec<&Axis> = columns.iter().map(|(a, _)| *a).collect();
-        crate::machine::check_travel(&axes_refs, &rows_internal)
-            .map_err(ProgramError::from_limit)?;
-        // Feed: rapid blocks move at the machine's rapid rate, not checked.
-        let feeds: Vec<Real> = blocks
+    }
+    enum Source {
+        Solved(usize),
+        Aux(usize),
+    }
+    let mut columns: Vec<(&Axis, Source)> = Vec::new();
+    for a in &programmed {
+        // Solved first: a driven solved axis is in the solved rows too.
+        if let Some(i) = info.solved_axes.iter().position(|s| s == &a.name) {
+            columns.push((a, Source::Solved(i)));
+        } else if let Some(i) = toolpath.aux_names.iter().position(|s| s == &a.name) {
+            columns.push((a, Source::Aux(i)));
+        }
+    }
+    let mut blocks = Vec::with_capacity(toolpath.point_count());
+    let mut rows_internal = Vec::with_capacity(toolpath.point_count() * columns.len());
+    for (k, (p, j, c)) in toolpath.points().enumerate() {
+        let row = &solved[k * n_solved..(k + 1) * n_solved];
+        let internal: Vec<Real> = columns
             .iter()
-            .map(|b| {
-                if b.motion == Motion::Rapid {
-                    Real::INFINITY
-                } else {
-                    b.feed
-                }
+            .map(|(_, s)| match s {
+                Source::Solved(i) => row[*i],
+                Source::Aux(i) => aux_internal(info, &toolpath.aux_names[*i], c.aux[*i]),
             })
             .collect();
-        crate::machine::check_feed(&axes_refs, &rows_internal, &feeds)
-            .map_err(ProgramError::from_limit)?;
-        Ok(Self {
-            name: program_name(name),
-            number: 1,
-            machine: info.name.clone(),
-            control: info.control.clone(),
-            tool_number: toolpath.tool.number,
-            tool_name: toolpath.tool.name.clone(),
-            spindle_rpm: toolpath.spindle_rpm,
-            decimals: info.program_decimals,
-            axes: columns
-                .iter()
-                .map(|(a, _)| ProgramAxis {
-                    name: a.name.clone(),
-                    unit: a.unit().to_owned(),
-                })
-                .collect(),
-            blocks,
+        let values = columns
+            .iter()
+            .zip(&internal)
+            .map(|((a, _), v)| a.to_user(*v))
+            .collect();
+        rows_internal.extend_from_slice(&internal);
+        blocks.push(Block {
+            motion: c.motion,
+            values,
+            feed: match c.motion {
+                Motion::Rapid => 0.0,
+                Motion::Linear => c.feed,
+                Motion::Thread { lead } => lead * toolpath.spindle_rpm,
+            },
+            spindle: (k == 0).then_some(toolpath.spindle_rpm),
+            comment: (j == 0).then(|| toolpath.passes[p].name.clone()),
+        });
+    }
+    let axes_refs: Vec<&Axis> = columns.iter().map(|(a, _)| *a).collect();
+    crate::machine::check_travel(&axes_refs, &rows_internal)
+        .map_err(|e| ProgramError::from_limit(&info.name, e))?;
+    // Feed: rapid blocks move at the machine's rapid rate, not checked.
+    let feeds: Vec<Real> = blocks
+        .iter()
+        .map(|b| {
+            if b.motion == Motion::Rapid {
+                Real::INFINITY
+            } else {
+                b.feed
+            }
         })
-    }
-
-    /// The values of axis `name` over all blocks, in program units.
-    pub fn column(&self, name: &str) -> Option<Vec<Real>> {
-        let i = self.axes.iter().position(|a| a.name == name)?;
-        Some(self.blocks.iter().map(|b| b.values[i]).collect())
-    }
+        .collect();
+    crate::machine::check_feed(&axes_refs, &rows_internal, &feeds)
+        .map_err(|e| ProgramError::from_limit(&info.name, e))?;
+    Ok(AxisProgram {
+        name: program_name(name),
+        number: 1,
+        machine: info.name.clone(),
+        control: info.control.clone(),
+        tool_number: toolpath.tool.number,
+        tool_name: toolpath.tool.name.clone(),
+        spindle_rpm: toolpath.spindle_rpm,
+        decimals: info.program_decimals,
+        axes: columns
+            .iter()
+            .map(|(a, _)| ProgramAxis {
+                name: a.name.clone(),
+                unit: a.unit().to_owned(),
+            })
+            .collect(),
+        blocks,
+    })
 }
 
 /// An auxiliary value in kernel units: toolpaths give rotary aux values in
 /// degrees (as the family's user thinks of them) and linear in mm.
-fn aux_internal(axes: &[Axis], name: &str, v: Real) -> Real {
-    match axes.iter().find(|a| a.name == name) {
-        Some(a) if a.kind == AxisKind::Rotary => v.to_radians(),
-        _ => v,
+fn aux_internal(info: &MachineInfo, name: &str, v: Real) -> Real {
+    info.axis(name).map_or(v, |a| a.from_user(v))
+}
+
+/// The values of the axes `names` at the blocks `blocks` (indices from 0),
+/// row after row, in kernel units (mm, rad): what forward kinematics of the
+/// program takes.
+///
+/// # Failures
+/// A block beyond the program; an axis the program or the machine lacks
+/// (the message names it).
+pub fn axis_rows(
+    program: &AxisProgram,
+    info: &MachineInfo,
+    names: &[String],
+    blocks: std::ops::Range<usize>,
+) -> Result<Vec<Real>, String> {
+    if blocks.end > program.blocks.len() {
+        return Err(format!(
+            "block {} is beyond the program's {} blocks",
+            blocks.end,
+            program.blocks.len()
+        ));
     }
+    let cols = names
+        .iter()
+        .map(|name| {
+            let c = program
+                .axes
+                .iter()
+                .position(|a| &a.name == name)
+                .ok_or(format!("the program has no axis {name}"))?;
+            let axis = info
+                .axis(name)
+                .ok_or(format!("machine {} has no axis {name}", info.name))?;
+            Ok((c, axis))
+        })
+        .collect::<Result<Vec<(usize, &Axis)>, String>>()?;
+    Ok(program.blocks[blocks]
+        .iter()
+        .flat_map(|b| cols.iter().map(|&(c, a)| a.from_user(b.values[c])))
+        .collect())
 }
 
 /// A name a control accepts: upper case letters, digits and `_`, starting

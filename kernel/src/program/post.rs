@@ -19,6 +19,26 @@ use super::AxisProgram;
 use crate::math::fixed;
 use crate::toolpath::Motion;
 
+/// What writes a program as text in a dialect: the kernel's shared writer
+/// ([`SharedPost`]), or a machine plugin's own post-processor.
+pub trait PostProcessor {
+    /// The program's text in `dialect` (`sinumerik`, `fanuc`, `cld`).
+    ///
+    /// # Failures
+    /// An unknown dialect; a block that cannot be written.
+    fn post(&self, program: &AxisProgram, dialect: &str) -> Result<String, PostError>;
+}
+
+/// The kernel's shared writer with the dialects of [`DIALECTS`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SharedPost;
+
+impl PostProcessor for SharedPost {
+    fn post(&self, program: &AxisProgram, dialect: &str) -> Result<String, PostError> {
+        post_by_name(program, dialect)
+    }
+}
+
 /// How blocks are written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Style {

@@ -5,16 +5,19 @@
 //! - `fn params()`: a map of parameters, each `#{ value, unit, doc }` (the
 //!   default, its unit, a one-line description);
 //! - `fn toolpath(p)`: the toolpath for the parameter values `p` (a map);
-//! - optionally `fn part(p)` (the part's geometry, for export) and
-//!   `fn checks(p)` (an array of `#{ name, ok, detail }`).
+//! - optionally `fn part(p)` (the part's geometry, for export),
+//!   `fn checks(p)` (an array of `#{ name, ok, detail }`), `fn verify(p)`
+//!   and `fn default_machine()`.
 //!
-//! The engine runs with limits ([`Limits`]: operations, call depth,
-//! expression depth, array, string and map sizes): a script that runs away
-//! is stopped with a clear error. Scripts reach files only through kernel
-//! functions (`read_table`), and only inside the input directories given
+//! [`ScriptFamily`] is such a script as a [`PartFamily`]. The engine runs
+//! with limits ([`Limits`]: operations, call depth, expression depth,
+//! array, string and map sizes): a script that runs away is stopped with a
+//! clear error. Scripts reach files only through kernel functions
+//! (`read_table`), and only inside the input directories given
 //! ([`Access`]); `import` is off. Every error carries the script's file,
 //! line and column. The functions scripts can call are listed, from their
-//! doc comments, by [`api_reference`] (`docs/script-api.md`).
+//! doc comments, by [`api_reference`] (`docs/script-api.md`). A machine may
+//! be a script too ([`machine_from_script`]).
 
 mod api;
 mod docs;
@@ -22,11 +25,12 @@ mod docs;
 pub use api::Floats;
 pub use docs::api_reference;
 
-use crate::math::Real;
+use crate::family::{Check, FamilyError, PartBody, PartFamily, PartGeometry, VerifyRequest};
+use crate::machine::{Machine, MachineError};
+use crate::params::{ParamSpec, ParamValue, Params};
+use crate::profile::Profile;
 use crate::toolpath::Toolpath;
 use rhai::{Dynamic, Engine, EvalAltResult, Map, Position, Scope, AST};
-use serde::{Deserialize, Serialize};
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// The engine's limits.
@@ -69,251 +73,17 @@ pub struct Access {
     pub input_dirs: Vec<PathBuf>,
 }
 
-/// A script's error: where, and what.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum ScriptError {
-    /// The script file could not be read.
-    #[error("{file}: {message}")]
-    Io {
-        /// The file.
-        file: String,
-        /// The system's message.
-        message: String,
-    },
-    /// An error at a place in the script.
-    #[error("{file}:{line}:{column}: {message}")]
-    At {
-        /// The script.
-        file: String,
-        /// Line (from 1).
-        line: usize,
-        /// Column (from 1).
-        column: usize,
-        /// What went wrong.
-        message: String,
-    },
-    /// An error the engine gives no place for (a stopped runaway script).
-    #[error("{file}: {message}")]
-    Script {
-        /// The script.
-        file: String,
-        /// What went wrong.
-        message: String,
-    },
-    /// The script does not keep the family contract.
-    #[error("{file}: {message}")]
-    Contract {
-        /// The script.
-        file: String,
-        /// What is missing or wrong.
-        message: String,
-    },
-    /// A parameter given that the family does not have.
-    #[error("unknown parameter '{name}' from {source_name} (parameters: {known})")]
-    UnknownParam {
-        /// The name given.
-        name: String,
-        /// Where it was given (`--set`, a file).
-        source_name: String,
-        /// The family's parameters.
-        known: String,
-    },
-    /// A parameter value of the wrong kind.
-    #[error("parameter '{name}' from {source_name}: {message}")]
-    BadParam {
-        /// The parameter.
-        name: String,
-        /// Where it was given.
-        source_name: String,
-        /// What is wrong.
-        message: String,
-    },
-}
-
-/// A parameter's value.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
-pub enum ParamValue {
-    /// A whole number.
-    Int(i64),
-    /// A number.
-    Float(f64),
-    /// Yes or no.
-    Bool(bool),
-    /// Text.
-    Text(String),
-    /// A list of numbers.
-    List(Vec<f64>),
-}
-
-impl ParamValue {
-    fn kind(&self) -> &'static str {
-        match self {
-            Self::Int(_) => "a whole number",
-            Self::Float(_) => "a number",
-            Self::Bool(_) => "true or false",
-            Self::Text(_) => "text",
-            Self::List(_) => "a list of numbers",
-        }
-    }
-
-    fn to_dynamic(&self) -> Dynamic {
-        match self {
-            Self::Int(i) => Dynamic::from_int(*i),
-            Self::Float(f) => Dynamic::from_float(*f),
-            Self::Bool(b) => Dynamic::from_bool(*b),
-            Self::Text(s) => Dynamic::from(s.clone()),
-            Self::List(v) => {
-                Dynamic::from_array(v.iter().map(|x| Dynamic::from_float(*x)).collect())
-            }
-        }
-    }
-
-    fn from_dynamic(d: &Dynamic) -> Option<Self> {
-        if let Ok(i) = d.as_int() {
-            Some(Self::Int(i))
-        } else if let Ok(f) = d.as_float() {
-            Some(Self::Float(f))
-        } else if let Ok(b) = d.as_bool() {
-            Some(Self::Bool(b))
-        } else if d.is_string() {
-            Some(Self::Text(d.clone().into_string().ok()?))
-        } else if d.is_array() {
-            let a = d.clone().cast::<rhai::Array>();
-            a.iter()
-                .map(api::number)
-                .collect::<Option<Vec<_>>>()
-                .map(Self::List)
-        } else {
-            None
-        }
-    }
-
-    /// The value of a machine constant, of the same kind as `like`: a
-    /// number as it is, a whole number if it is one, true/false as not 0/0.
-    fn from_constant(x: Real, like: &ParamValue) -> Result<Self, String> {
-        match like {
-            Self::Float(_) => Ok(Self::Float(x)),
-            Self::Int(_) if x.fract() == 0.0 && x.abs() < 9e15 => Ok(Self::Int(x as i64)),
-            Self::Bool(_) => Ok(Self::Bool(x != 0.0)),
-            _ => Err(format!("{x} is not {}", like.kind())),
-        }
-    }
-
-    /// The value of a TOML value, of the same kind as `like`.
-    fn from_toml(v: &toml::Value, like: &ParamValue) -> Result<Self, String> {
-        let got = || format!("expected {}, got {v}", like.kind());
-        Ok(match (like, v) {
-            (Self::Int(_), toml::Value::Integer(i)) => Self::Int(*i),
-            (Self::Float(_), toml::Value::Float(f)) => Self::Float(*f),
-            (Self::Float(_), toml::Value::Integer(i)) => Self::Float(*i as f64),
-            (Self::Bool(_), toml::Value::Boolean(b)) => Self::Bool(*b),
-            (Self::Text(_), toml::Value::String(s)) => Self::Text(s.clone()),
-            (Self::List(_), toml::Value::Array(a)) => Self::List(
-                a.iter()
-                    .map(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64)))
-                    .collect::<Option<Vec<_>>>()
-                    .ok_or_else(got)?,
-            ),
-            _ => return Err(got()),
-        })
-    }
-
-    /// The value of a `--set` text, of the same kind as `like`.
-    fn parse(text: &str, like: &ParamValue) -> Result<Self, String> {
-        let t = text.trim();
-        let bad = || format!("'{text}' is not {}", like.kind());
-        Ok(match like {
-            Self::Int(_) => Self::Int(t.parse().map_err(|_| bad())?),
-            Self::Float(_) => Self::Float(t.parse().map_err(|_| bad())?),
-            Self::Bool(_) => Self::Bool(t.parse().map_err(|_| bad())?),
-            Self::Text(_) => Self::Text(text.to_owned()),
-            Self::List(_) => Self::List(
-                t.trim_matches(|c| c == '[' || c == ']')
-                    .split(',')
-                    .filter(|s| !s.trim().is_empty())
-                    .map(|s| s.trim().parse::<f64>().map_err(|_| bad()))
-                    .collect::<Result<_, _>>()?,
-            ),
-        })
-    }
-
-    fn check_finite(&self) -> Result<(), String> {
-        match self {
-            Self::Float(f) if !f.is_finite() => Err(format!("{f} is not a finite number")),
-            Self::List(v) if v.iter().any(|x| !x.is_finite()) => {
-                Err("the list holds a value that is not finite".into())
-            }
-            _ => Ok(()),
-        }
-    }
-}
-
-impl std::fmt::Display for ParamValue {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Self::Int(i) => write!(f, "{i}"),
-            Self::Float(x) => write!(f, "{x}"),
-            Self::Bool(b) => write!(f, "{b}"),
-            Self::Text(s) => write!(f, "\"{s}\""),
-            Self::List(v) => write!(f, "{v:?}"),
-        }
-    }
-}
-
-/// One parameter of a family.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ParamSpec {
-    /// Its name.
-    pub name: String,
-    /// The default.
-    pub default: ParamValue,
-    /// Its unit (may be empty).
-    pub unit: String,
-    /// One line of description.
-    pub doc: String,
-    /// The machine constant that gives its default on a machine that has
-    /// it (`machine: "rest_radius"` in the spec), if any.
-    #[serde(default)]
-    pub machine: Option<String>,
-}
-
-/// What a family's finished part must be: the nominal profile, over
-/// `[from, to]`, within `tolerance` (mm).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Verification {
-    /// The nominal profile.
-    pub profile: crate::Profile,
-    /// Start of the range held to the tolerance.
-    pub from: f64,
-    /// End of that range.
-    pub to: f64,
-    /// The tolerance (mm).
-    pub tolerance: f64,
-}
-
-/// The result of one of a family's checks.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Check {
-    /// What is checked.
-    pub name: String,
-    /// Whether it holds.
-    pub ok: bool,
-    /// Details (values, places).
-    pub detail: String,
-}
-
-/// A part family loaded from a script.
-pub struct Family {
+/// A part family written in Rhai: a script as a [`PartFamily`].
+pub struct ScriptFamily {
     engine: Engine,
     ast: AST,
     file: String,
     specs: Vec<ParamSpec>,
 }
 
-impl std::fmt::Debug for Family {
+impl std::fmt::Debug for ScriptFamily {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Family")
+        f.debug_struct("ScriptFamily")
             .field("file", &self.file)
             .field("params", &self.specs)
             .finish()
@@ -374,7 +144,7 @@ fn register_files(engine: &mut Engine, access: &Access) {
 }
 
 /// Where an error happened and what it says, from the innermost error.
-fn locate(file: &str, called: &str, e: &EvalAltResult) -> ScriptError {
+fn locate(file: &str, called: &str, e: &EvalAltResult) -> FamilyError {
     let mut inner = e;
     let mut outer_pos = e.position();
     let mut in_fn: Option<String> = None;
@@ -411,14 +181,14 @@ fn locate(file: &str, called: &str, e: &EvalAltResult) -> ScriptError {
     at(file, pos, message)
 }
 
-fn at(file: &str, pos: Position, message: String) -> ScriptError {
+fn at(file: &str, pos: Position, message: String) -> FamilyError {
     if pos.is_none() {
-        return ScriptError::Script {
-            file: file.to_owned(),
+        return FamilyError::Failed {
+            family: file.to_owned(),
             message,
         };
     }
-    ScriptError::At {
+    FamilyError::At {
         file: file.to_owned(),
         line: pos.line().unwrap_or(0),
         column: pos.position().unwrap_or(0),
@@ -426,7 +196,7 @@ fn at(file: &str, pos: Position, message: String) -> ScriptError {
     }
 }
 
-impl Family {
+impl ScriptFamily {
     /// Loads a family from its script file; the script's directory is an
     /// input directory too.
     ///
@@ -434,9 +204,9 @@ impl Family {
     /// An unreadable file; a syntax error (file:line:col); a script without
     /// `fn params()` or `fn toolpath(p)`, or whose `params()` fails or
     /// returns something other than a map of `#{value, unit, doc}`.
-    pub fn load(path: &Path, limits: &Limits, access: &Access) -> Result<Self, ScriptError> {
+    pub fn load(path: &Path, limits: &Limits, access: &Access) -> Result<Self, FamilyError> {
         let file = path.display().to_string();
-        let source = std::fs::read_to_string(path).map_err(|e| ScriptError::Io {
+        let source = std::fs::read_to_string(path).map_err(|e| FamilyError::Io {
             file: file.clone(),
             message: e.to_string(),
         })?;
@@ -461,7 +231,7 @@ impl Family {
         file: &str,
         limits: &Limits,
         access: &Access,
-    ) -> Result<Self, ScriptError> {
+    ) -> Result<Self, FamilyError> {
         let engine = engine(limits, access);
         let mut ast = engine
             .compile(source)
@@ -494,7 +264,7 @@ impl Family {
             let field = |k: &str| spec.get(k).cloned();
             let default = field("value")
                 .as_ref()
-                .and_then(ParamValue::from_dynamic)
+                .and_then(param_value)
                 .ok_or_else(|| {
                     fam.contract(format!(
                         "parameter '{name}' needs a value (number, bool, text or list)"
@@ -523,9 +293,9 @@ impl Family {
         Ok(fam)
     }
 
-    fn contract(&self, message: String) -> ScriptError {
-        ScriptError::Contract {
-            file: self.file.clone(),
+    fn contract(&self, message: String) -> FamilyError {
+        FamilyError::Contract {
+            family: self.file.clone(),
             message,
         }
     }
@@ -537,7 +307,7 @@ impl Family {
             .any(|f| f.name == name && f.params.len() == arity)
     }
 
-    fn call(&self, name: &str, args: impl rhai::FuncArgs) -> Result<Dynamic, ScriptError> {
+    fn call(&self, name: &str, args: impl rhai::FuncArgs) -> Result<Dynamic, FamilyError> {
         let mut scope = Scope::new();
         self.engine
             .call_fn::<Dynamic>(&mut scope, &self.ast, name, args)
@@ -549,133 +319,85 @@ impl Family {
         &self.file
     }
 
-    /// The family's parameters (by name).
-    pub fn params(&self) -> &[ParamSpec] {
-        &self.specs
-    }
-
-    fn known(&self) -> String {
-        self.specs
-            .iter()
-            .map(|s| s.name.as_str())
-            .collect::<Vec<_>>()
-            .join(", ")
-    }
-
-    /// The parameter values: defaults, then those of a TOML file's table
-    /// (`file`: its name and text), then `--set name=value` pairs.
-    ///
-    /// # Failures
-    /// A TOML syntax error; an unknown name (listing the valid ones); a
-    /// value of another kind than the default's, or not finite.
-    pub fn resolve(
-        &self,
-        file: Option<(&str, &str)>,
-        sets: &[(String, String)],
-    ) -> Result<BTreeMap<String, ParamValue>, ScriptError> {
-        self.resolve_on(&BTreeMap::new(), file, sets)
-    }
-
-    /// As [`Family::resolve`], on a machine with `constants`: a parameter
-    /// whose spec names a machine constant the machine has takes it as its
-    /// default (the file and `--set` still win).
-    ///
-    /// # Failures
-    /// As [`Family::resolve`]; a constant that is not of the parameter's
-    /// kind (a whole number, say), naming both.
-    pub fn resolve_on(
-        &self,
-        constants: &BTreeMap<String, Real>,
-        file: Option<(&str, &str)>,
-        sets: &[(String, String)],
-    ) -> Result<BTreeMap<String, ParamValue>, ScriptError> {
-        let mut values = BTreeMap::new();
-        for s in &self.specs {
-            let value = match s
-                .machine
-                .as_ref()
-                .and_then(|m| Some((m, constants.get(m)?)))
-            {
-                Some((m, &x)) => ParamValue::from_constant(x, &s.default).map_err(|message| {
-                    ScriptError::BadParam {
-                        name: s.name.clone(),
-                        source_name: format!("the machine's constant {m}"),
-                        message,
-                    }
-                })?,
-                None => s.default.clone(),
-            };
-            values.insert(s.name.clone(), value);
-        }
-        let spec = |name: &str, source: &str| {
-            self.specs
-                .iter()
-                .find(|s| s.name == name)
-                .ok_or_else(|| ScriptError::UnknownParam {
-                    name: name.to_owned(),
-                    source_name: source.to_owned(),
-                    known: self.known(),
-                })
-        };
-        let bad = |name: &str, source: &str, message: String| ScriptError::BadParam {
-            name: name.to_owned(),
-            source_name: source.to_owned(),
-            message,
-        };
-        if let Some((fname, text)) = file {
-            let table: toml::Table = toml::from_str(text).map_err(|e| ScriptError::Contract {
-                file: fname.to_owned(),
-                message: e.to_string().trim().to_owned(),
-            })?;
-            for (k, v) in &table {
-                let s = spec(k, fname)?;
-                let value = ParamValue::from_toml(v, &s.default).map_err(|m| bad(k, fname, m))?;
-                value.check_finite().map_err(|m| bad(k, fname, m))?;
-                values.insert(k.clone(), value);
-            }
-        }
-        for (k, text) in sets {
-            let s = spec(k, "--set")?;
-            let value = ParamValue::parse(text, &s.default).map_err(|m| bad(k, "--set", m))?;
-            value.check_finite().map_err(|m| bad(k, "--set", m))?;
-            values.insert(k.clone(), value);
-        }
-        Ok(values)
-    }
-
-    fn param_map(values: &BTreeMap<String, ParamValue>) -> Map {
+    fn param_map(values: &Params) -> Map {
         values
             .iter()
-            .map(|(k, v)| (k.as_str().into(), v.to_dynamic()))
+            .map(|(k, v)| (k.as_str().into(), param_dynamic(v)))
             .collect()
     }
 
-    /// Runs `fn toolpath(p)`.
+    /// Runs `fn name(p)` and returns its raw result.
     ///
     /// # Failures
-    /// The script's error (file:line:col), or a result that is not a toolpath.
-    pub fn toolpath(&self, values: &BTreeMap<String, ParamValue>) -> Result<Toolpath, ScriptError> {
-        let d = self.call("toolpath", (Self::param_map(values),))?;
-        let handle = d.try_cast::<api::ToolpathHandle>().ok_or_else(|| {
-            self.contract("fn toolpath(p) must return a toolpath (new_toolpath(...))".into())
-        })?;
-        // The script's variables are gone: the handle is the last owner, and
-        // the toolpath is moved out rather than copied.
-        Ok(std::rc::Rc::try_unwrap(handle)
-            .map(|c| c.into_inner())
-            .unwrap_or_else(|h| h.borrow().clone()))
+    /// The script's error.
+    pub fn call_with_params(&self, name: &str, values: &Params) -> Result<Dynamic, FamilyError> {
+        self.call(name, (Self::param_map(values),))
+    }
+}
+
+/// A parameter's value as Rhai sees it.
+fn param_dynamic(v: &ParamValue) -> Dynamic {
+    match v {
+        ParamValue::Int(i) => Dynamic::from_int(*i),
+        ParamValue::Float(f) => Dynamic::from_float(*f),
+        ParamValue::Bool(b) => Dynamic::from_bool(*b),
+        ParamValue::Text(s) => Dynamic::from(s.clone()),
+        ParamValue::List(v) => {
+            Dynamic::from_array(v.iter().map(|x| Dynamic::from_float(*x)).collect())
+        }
+    }
+}
+
+/// A parameter's default from what `fn params()` gave.
+fn param_value(d: &Dynamic) -> Option<ParamValue> {
+    if let Ok(i) = d.as_int() {
+        Some(ParamValue::Int(i))
+    } else if let Ok(f) = d.as_float() {
+        Some(ParamValue::Float(f))
+    } else if let Ok(b) = d.as_bool() {
+        Some(ParamValue::Bool(b))
+    } else if d.is_string() {
+        Some(ParamValue::Text(d.clone().into_string().ok()?))
+    } else if d.is_array() {
+        let a = d.clone().cast::<rhai::Array>();
+        a.iter()
+            .map(api::number)
+            .collect::<Option<Vec<_>>>()
+            .map(ParamValue::List)
+    } else {
+        None
+    }
+}
+
+impl PartFamily for ScriptFamily {
+    fn name(&self) -> &str {
+        &self.file
     }
 
-    /// Runs `fn checks(p)`, if the family has it.
-    ///
-    /// # Failures
-    /// The script's error, or a result that is not an array of
+    fn params(&self) -> &[ParamSpec] {
+        &self.specs
+    }
+
+    /// `fn default_machine()`, if the script has it.
+    fn default_machine(&self) -> Result<Option<String>, FamilyError> {
+        if !self.has_fn("default_machine", 0) {
+            return Ok(None);
+        }
+        let d = self.call("default_machine", ())?;
+        d.into_string().map(Some).map_err(|t| {
+            self.contract(format!(
+                "fn default_machine() must return a machine's name, not {t}"
+            ))
+        })
+    }
+
+    /// `fn checks(p)`, if the script has it: an array of
     /// `#{name, ok, detail}`.
-    pub fn checks(&self, values: &BTreeMap<String, ParamValue>) -> Result<Vec<Check>, ScriptError> {
+    fn checks(&self, values: &Params) -> Result<Vec<Check>, FamilyError> {
         if !self.has_fn("checks", 1) {
             return Ok(vec![]);
         }
-        let d = self.call("checks", (Self::param_map(values),))?;
+        let d = self.call_with_params("checks", values)?;
         let shape =
             || self.contract("fn checks(p) must return an array of #{ name, ok, detail }".into());
         let arr = d.try_cast::<rhai::Array>().ok_or_else(shape)?;
@@ -700,60 +422,92 @@ impl Family {
             .collect()
     }
 
-    /// The machine the family names with `fn default_machine()`, if it has one.
-    ///
-    /// # Failures
-    /// The script's error, or a result that is not text.
-    pub fn default_machine(&self) -> Result<Option<String>, ScriptError> {
-        if !self.has_fn("default_machine", 0) {
-            return Ok(None);
-        }
-        let d = self.call("default_machine", ())?;
-        d.into_string().map(Some).map_err(|t| {
-            self.contract(format!(
-                "fn default_machine() must return a machine's name, not {t}"
-            ))
-        })
+    /// `fn toolpath(p)`: the toolpath it builds.
+    fn toolpath(&self, values: &Params) -> Result<Toolpath, FamilyError> {
+        let d = self.call_with_params("toolpath", values)?;
+        let handle = d.try_cast::<api::ToolpathHandle>().ok_or_else(|| {
+            self.contract("fn toolpath(p) must return a toolpath (new_toolpath(...))".into())
+        })?;
+        // The script's variables are gone: the handle is the last owner, and
+        // the toolpath is moved out rather than copied.
+        Ok(std::rc::Rc::try_unwrap(handle)
+            .map(|c| c.into_inner())
+            .unwrap_or_else(|h| h.borrow().clone()))
     }
 
-    /// Runs `fn verify(p)`, if the family has it: what the finished part
-    /// must be, where, and how closely.
-    ///
-    /// # Failures
-    /// The script's error, or a result that is not
+    /// `fn part(p)`, if the script has it: a profile (the body `part`), or
+    /// a map of named profiles.
+    fn part(&self, values: &Params) -> Result<Vec<PartBody>, FamilyError> {
+        if !self.has_fn("part", 1) {
+            return Ok(vec![]);
+        }
+        let d = self.call_with_params("part", values)?;
+        let shape =
+            || self.contract("fn part(p) must return a profile or a map of named profiles".into());
+        let body = |name: String, p: Profile| PartBody {
+            name,
+            geometry: PartGeometry::Revolution(p),
+        };
+        if let Some(p) = d.clone().try_cast::<Profile>() {
+            return Ok(vec![body("part".into(), p)]);
+        }
+        let map = d.try_cast::<Map>().ok_or_else(shape)?;
+        map.into_iter()
+            .map(|(k, v)| {
+                v.try_cast::<Profile>()
+                    .map(|p| body(k.to_string(), p))
+                    .ok_or_else(shape)
+            })
+            .collect()
+    }
+
+    /// `fn verify(p)`, if the script has it:
     /// `#{ profile, from, to, tolerance }`.
-    pub fn verification(
-        &self,
-        values: &BTreeMap<String, ParamValue>,
-    ) -> Result<Option<Verification>, ScriptError> {
+    fn verification(&self, values: &Params) -> Result<Option<VerifyRequest>, FamilyError> {
         if !self.has_fn("verify", 1) {
             return Ok(None);
         }
-        let d = self.call("verify", (Self::param_map(values),))?;
+        let d = self.call_with_params("verify", values)?;
         let shape =
             || self.contract("fn verify(p) must return #{ profile, from, to, tolerance }".into());
         let m = d.try_cast::<Map>().ok_or_else(shape)?;
         let num = |k: &str| m.get(k).and_then(api::number).ok_or_else(shape);
-        Ok(Some(Verification {
+        Ok(Some(VerifyRequest {
             profile: m
                 .get("profile")
-                .and_then(|p| p.clone().try_cast::<crate::Profile>())
+                .and_then(|p| p.clone().try_cast::<Profile>())
                 .ok_or_else(shape)?,
             from: num("from")?,
             to: num("to")?,
             tolerance: num("tolerance")?,
         }))
     }
+}
 
-    /// Runs `fn name(p)` and returns its raw result (for `part`).
-    ///
-    /// # Failures
-    /// The script's error.
-    pub fn call_with_params(
-        &self,
-        name: &str,
-        values: &BTreeMap<String, ParamValue>,
-    ) -> Result<Dynamic, ScriptError> {
-        self.call(name, (Self::param_map(values),))
-    }
+/// A machine written in Rhai: the script's `fn machine()` returns the
+/// machine file's table (the same keys as a `.toml` machine), so a script
+/// can compute a machine's geometry; it is read and checked as a machine
+/// file is.
+///
+/// # Failures
+/// An unreadable file, a script error, a result that is not a machine
+/// file's table, or any error of [`Machine::from_toml_str`].
+pub fn machine_from_script(path: &Path) -> Result<Machine, MachineError> {
+    let shown = path.display().to_string();
+    let io = |message: String| MachineError::Io {
+        file: shown.clone(),
+        message,
+    };
+    let source = std::fs::read_to_string(path).map_err(|e| io(e.to_string()))?;
+    let engine = engine(&Limits::default(), &Access::default());
+    let ast = engine
+        .compile(&source)
+        .map_err(|e| io(format!("{}: {}", e.position(), e.err_type())))?;
+    let map: Dynamic = engine
+        .call_fn(&mut Scope::new(), &ast, "machine", ())
+        .map_err(|e| io(format!("fn machine(): {e}")))?;
+    let value: toml::Value = rhai::serde::from_dynamic(&map)
+        .map_err(|e| io(format!("fn machine() must return the machine's table: {e}")))?;
+    let text = toml::to_string(&value).map_err(|e| io(e.to_string()))?;
+    Machine::from_toml_str(&text, &format!("{shown} (fn machine())"))
 }

@@ -8,7 +8,7 @@
 //! iteration costs about two chain evaluations.
 
 use super::{Chain, FactorKind, FactorValue, Frame, ToolFrame, TransformError};
-use crate::error::InputError;
+use crate::input::InputError;
 use crate::math::{Point3, Real, Vec3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};

@@ -22,7 +22,7 @@ mod universal;
 pub use ik::{IkOptions, IkSolution, Target};
 pub use universal::UNIVERSAL_PARAMETERS;
 
-use crate::error::InputError;
+use crate::input::InputError;
 use crate::math::{Mat3, Mat4, Point3, Real, Vec3};
 use serde::{Deserialize, Serialize};
 

@@ -2,9 +2,10 @@
 //!
 //! The C ABI between pilgrim and a machine plugin (a shared library), on
 //! the model of LinuxCNC's kinematics modules: a fixed, small set of entry
-//! points with plain `double` arrays and integer status codes. No Rust type,
-//! trait object or allocation crosses the boundary; this crate does not
-//! depend on the kernel.
+//! points with plain `double` arrays and integer status codes, and the JSON
+//! types those entries carry ([`types`]). No Rust type, trait object or
+//! allocation crosses the boundary; this crate does not depend on the
+//! kernel, so a plugin links this crate (and serde) only.
 //!
 //! A plugin exports one function, `pilgrim_plugin_<name>`, `<name>` being
 //! its library's file name without `lib` and the extension (so that two
@@ -12,30 +13,43 @@
 //! `PyInit_<module>`). It returns a pointer to a static [`PluginTable`]:
 //!
 //! - `abi_major`, `abi_minor`, `size` first: the host refuses another major
-//!   and reads only the fields below `size` (fields are only ever appended);
-//! - coarse calls carry JSON: `describe` (the machine's descriptor), `post`
-//!   (`{"dialect": "...", "program": {...}}` in, the program's text out);
+//!   and reads only the fields that lie wholly below `size` (fields are only
+//!   ever appended);
+//! - `capabilities` (since 1.1): which entries the plugin offers
+//!   ([`CAP_INVERSE`], [`CAP_FORWARD`], [`CAP_POST`]); a 1.0 table, which has
+//!   no such field, offers all three;
+//! - coarse calls carry JSON: `describe` (the machine's [`MachineInfo`]),
+//!   `post` (a [`PostRequest`] in, the program's text out);
 //! - hot calls are batches of `f64`: `inverse` (poses to axis values) and
 //!   `forward` (axis values to poses), many rows per call;
-//! - every entry catches panics and returns a status ([`STATUS_OK`],
-//!   [`STATUS_ERROR`], [`STATUS_PANIC`]); `last_error` gives the message;
+//! - every entry catches panics (the plugin's own construction included) and
+//!   returns a status ([`STATUS_OK`], [`STATUS_ERROR`], [`STATUS_PANIC`]);
+//!   `last_error` gives the message;
 //! - a [`Buffer`] is freed by whoever allocated it: buffers a plugin returns
 //!   go back through its `free_buffer`.
 //!
 //! A Rust plugin implements [`Plugin`] and exports it with [`export_plugin!`]:
 //!
 //! ```
+//! use pilgrim_plugin_abi::types::{Axis, AxisKind, MachineInfo};
 //! use pilgrim_plugin_abi::{export_plugin, Plugin, PluginError};
 //!
 //! #[derive(Default)]
 //! struct Lathe;
 //!
 //! impl Plugin for Lathe {
-//!     fn describe(&self) -> String {
-//!         r#"{"name":"lathe","control":"fanuc","axes":[],"solved_axes":["X","Z"]}"#.into()
-//!     }
-//!     fn solved_axis_count(&self) -> usize {
-//!         2
+//!     fn describe(&self) -> MachineInfo {
+//!         let axis = |name: &str| Axis {
+//!             name: name.into(), kind: AxisKind::Linear, min: -500.0, max: 500.0,
+//!             max_feed: 8000.0, programmed: true, description: String::new(),
+//!             moves: None, turns: None, body: None,
+//!         };
+//!         MachineInfo {
+//!             name: "lathe".into(), description: String::new(), control: "fanuc".into(),
+//!             axes: vec![axis("X"), axis("Z")], solved_axes: vec!["X".into(), "Z".into()],
+//!             constants: Default::default(), program_decimals: None, driven_axes: vec![],
+//!             bodies: vec![], chain: vec![], tool: Default::default(),
+//!         }
 //!     }
 //!     fn inverse(&self, poses: &[f64], tool: &[f64; 6], out: &mut [f64]) -> Result<(), PluginError> {
 //!         for (p, q) in poses.chunks_exact(6).zip(out.chunks_exact_mut(2)) {
@@ -50,23 +64,28 @@
 //!         }
 //!         Ok(())
 //!     }
-//!     fn post(&self, _request: &str) -> Result<String, PluginError> {
-//!         Err(PluginError::new("this example has no post-processor"))
-//!     }
 //! }
 //!
 //! export_plugin!(pilgrim_plugin_lathe, Lathe);
 //!
 //! let table = unsafe { &*pilgrim_plugin_lathe() };
 //! assert_eq!(table.abi_major, pilgrim_plugin_abi::ABI_MAJOR);
+//! assert_eq!(table.capabilities, pilgrim_plugin_abi::CAP_INVERSE | pilgrim_plugin_abi::CAP_FORWARD);
+//! assert!(table.post.is_none());
 //! ```
+
+pub mod types;
+
+pub use types::{MachineInfo, PostRequest};
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 /// The ABI's major version: a host refuses a plugin of another major.
 pub const ABI_MAJOR: u32 = 1;
-/// The ABI's minor version: fields appended to the table since the major.
-pub const ABI_MINOR: u32 = 0;
+/// The ABI's minor version: fields appended to the table and to the JSON
+/// types since the major (1.1: the table's `capabilities`; the descriptor's
+/// `driven_axes`, `bodies`, `chain`, `tool`).
+pub const ABI_MINOR: u32 = 1;
 
 /// The call succeeded.
 pub const STATUS_OK: i32 = 0;
@@ -77,6 +96,16 @@ pub const STATUS_PANIC: i32 = 2;
 
 /// `failed_row` when a failure is not tied to a row.
 pub const NO_ROW: usize = usize::MAX;
+
+/// The plugin solves inverse kinematics (`inverse`).
+pub const CAP_INVERSE: u32 = 1;
+/// The plugin solves forward kinematics (`forward`).
+pub const CAP_FORWARD: u32 = 2;
+/// The plugin posts its own programs (`post`); without it the host's
+/// writer posts them in the descriptor's `control` dialect.
+pub const CAP_POST: u32 = 4;
+/// What a table without the `capabilities` field (ABI 1.0) offers.
+pub const CAP_ABI_1_0: u32 = CAP_INVERSE | CAP_FORWARD | CAP_POST;
 
 /// Bytes allocated by the plugin and handed to the host, which copies them
 /// and returns the buffer through the table's `free_buffer`.
@@ -112,7 +141,7 @@ impl Buffer {
     }
 }
 
-/// `describe(out)`: writes the JSON descriptor into `out`.
+/// `describe(out)`: writes the JSON descriptor ([`MachineInfo`]) into `out`.
 pub type DescribeFn = unsafe extern "C" fn(out: *mut Buffer) -> i32;
 /// `inverse(poses, count, tool, out, width, failed_row)`: `poses` holds
 /// `count` rows of 6 (point, unit axis; part frame, mm); `tool` 6 values
@@ -136,8 +165,8 @@ pub type ForwardFn = unsafe extern "C" fn(
     tool: *const f64,
     out: *mut f64,
 ) -> i32;
-/// `post(request, len, out)`: a JSON request `{"dialect", "program"}` of
-/// `len` bytes to the program's text.
+/// `post(request, len, out)`: a JSON [`PostRequest`] of `len` bytes to the
+/// program's text.
 pub type PostFn = unsafe extern "C" fn(request: *const u8, len: usize, out: *mut Buffer) -> i32;
 /// `last_error(out)`: the message of this thread's last failed call.
 pub type LastErrorFn = unsafe extern "C" fn(out: *mut Buffer) -> i32;
@@ -164,16 +193,21 @@ pub struct PluginTable {
     pub inverse: Option<InverseFn>,
     /// See [`ForwardFn`].
     pub forward: Option<ForwardFn>,
-    /// See [`PostFn`].
+    /// See [`PostFn`]; `None` unless [`CAP_POST`].
     pub post: Option<PostFn>,
     /// See [`LastErrorFn`].
     pub last_error: Option<LastErrorFn>,
     /// See [`FreeBufferFn`].
     pub free_buffer: Option<FreeBufferFn>,
+    /// Since 1.1: the `CAP_*` bits of the entries offered.
+    pub capabilities: u32,
 }
 
 /// The size of the table in this build (what `size` says).
 pub const TABLE_SIZE: u32 = std::mem::size_of::<PluginTable>() as u32;
+
+/// The size of an ABI 1.0 table: every field before `capabilities`.
+pub const TABLE_SIZE_1_0: u32 = std::mem::offset_of!(PluginTable, capabilities) as u32;
 
 /// A plugin's failure: a message, and the row of a batch it happened at.
 #[derive(Debug, Clone, PartialEq)]
@@ -204,23 +238,29 @@ impl PluginError {
 
 /// What a Rust plugin implements; [`export_plugin!`] makes the C entry
 /// points from it. Slices are the batches described at [`InverseFn`] and
-/// [`ForwardFn`], already checked for length.
+/// [`ForwardFn`], already checked for length against the descriptor's
+/// `solved_axes`.
 pub trait Plugin {
-    /// The machine's descriptor as JSON.
-    fn describe(&self) -> String;
-    /// How many axes inverse kinematics solves for (the descriptor's
-    /// `solved_axes`): the width of axis rows.
-    fn solved_axis_count(&self) -> usize;
+    /// Whether the plugin posts its own programs ([`CAP_POST`]); otherwise
+    /// the host's writer does, in the descriptor's `control` dialect.
+    const POSTS: bool = false;
+
+    /// The machine's descriptor.
+    fn describe(&self) -> MachineInfo;
     /// Inverse kinematics of a batch.
     fn inverse(&self, poses: &[f64], tool: &[f64; 6], out: &mut [f64]) -> Result<(), PluginError>;
     /// Forward kinematics of a batch.
     fn forward(&self, axes: &[f64], tool: &[f64; 6], out: &mut [f64]) -> Result<(), PluginError>;
-    /// The program's text for a JSON request `{"dialect", "program"}`.
-    fn post(&self, request: &str) -> Result<String, PluginError>;
+    /// The program's text for a request; called only if [`Self::POSTS`].
+    fn post(&self, request: &PostRequest) -> Result<String, PluginError> {
+        let _ = request;
+        Err(PluginError::new("this plugin does not post programs"))
+    }
 }
 
-/// The glue [`export_plugin!`] expands to: each function catches panics and
-/// keeps the last error. Not for direct use.
+/// The glue [`export_plugin!`] expands to: each function builds the plugin
+/// (on first use) and calls it inside one panic guard, and keeps the last
+/// error. Not for direct use.
 pub mod entry {
     use super::*;
     use std::cell::RefCell;
@@ -280,14 +320,40 @@ pub mod entry {
         Ok(t)
     }
 
-    fn check_width(p: &impl Plugin, width: usize) -> Result<usize, PluginError> {
-        let n = p.solved_axis_count();
+    /// A plugin built, with the width of its axis rows (its descriptor's
+    /// number of solved axes), read once.
+    #[derive(Debug)]
+    pub struct Built<P> {
+        plugin: P,
+        width: usize,
+    }
+
+    impl<P: Plugin + Default> Built<P> {
+        /// Builds the plugin and reads its width.
+        #[allow(clippy::new_without_default)]
+        pub fn new() -> Self {
+            let plugin = P::default();
+            let width = plugin.describe().solved_axes.len();
+            Self { plugin, width }
+        }
+    }
+
+    /// The host's `width` against the plugin's.
+    fn check_width<P>(p: &Built<P>, width: usize) -> Result<usize, PluginError> {
+        let n = p.width;
         if width != n {
             return Err(PluginError::new(format!(
                 "the host gives rows of {width} axis values, the plugin solves {n} axes"
             )));
         }
         Ok(n)
+    }
+
+    /// `count * width` values, or an error if that overflows.
+    fn values(count: usize, width: usize, what: &str) -> Result<usize, PluginError> {
+        count.checked_mul(width).ok_or_else(|| {
+            PluginError::new(format!("{count} rows of {width} {what} values overflow"))
+        })
     }
 
     /// A batch's input and output.
@@ -318,20 +384,29 @@ pub mod entry {
         }))
     }
 
-    /// `describe` for plugin `p`.
+    /// `describe` for the plugin `get` builds.
     ///
     /// # Safety
     /// `out` must be a valid pointer to a `Buffer`.
-    pub unsafe fn describe(p: &impl Plugin, out: *mut Buffer) -> i32 {
-        guarded(std::ptr::null_mut(), || write(out, p.describe()))
+    pub unsafe fn describe<P: Plugin + 'static>(
+        get: impl FnOnce() -> &'static Built<P>,
+        out: *mut Buffer,
+    ) -> i32 {
+        guarded(std::ptr::null_mut(), || {
+            let text = serde_json::to_string(&get().plugin.describe()).map_err(|e| {
+                PluginError::new(format!("the descriptor cannot be written as JSON: {e}"))
+            })?;
+            write(out, text)
+        })
     }
 
-    /// `inverse` for plugin `p`.
+    /// `inverse` for the plugin `get` builds.
     ///
     /// # Safety
     /// Pointers as [`InverseFn`] says.
-    pub unsafe fn inverse(
-        p: &impl Plugin,
+    #[allow(clippy::too_many_arguments)]
+    pub unsafe fn inverse<P: Plugin + 'static>(
+        get: impl FnOnce() -> &'static Built<P>,
         poses: *const f64,
         count: usize,
         tool: *const f64,
@@ -340,21 +415,23 @@ pub mod entry {
         failed_row: *mut usize,
     ) -> i32 {
         guarded(failed_row, || {
+            let p = get();
             let n = check_width(p, width)?;
+            let (n_in, n_out) = (values(count, 6, "pose")?, values(count, n, "axis")?);
             // SAFETY: the host passes count*6 poses and count*n outputs.
-            match unsafe { batch(poses, count * 6, out, count * n)? } {
-                Some((poses, out)) => p.inverse(poses, &tool6(tool)?, out),
+            match unsafe { batch(poses, n_in, out, n_out)? } {
+                Some((poses, out)) => p.plugin.inverse(poses, &tool6(tool)?, out),
                 None => Ok(()),
             }
         })
     }
 
-    /// `forward` for plugin `p`.
+    /// `forward` for the plugin `get` builds.
     ///
     /// # Safety
     /// Pointers as [`ForwardFn`] says.
-    pub unsafe fn forward(
-        p: &impl Plugin,
+    pub unsafe fn forward<P: Plugin + 'static>(
+        get: impl FnOnce() -> &'static Built<P>,
         axes: *const f64,
         count: usize,
         width: usize,
@@ -362,29 +439,36 @@ pub mod entry {
         out: *mut f64,
     ) -> i32 {
         guarded(std::ptr::null_mut(), || {
+            let p = get();
             let n = check_width(p, width)?;
+            let (n_in, n_out) = (values(count, n, "axis")?, values(count, 6, "pose")?);
             // SAFETY: the host passes count*n axis values and count*6 outputs.
-            match unsafe { batch(axes, count * n, out, count * 6)? } {
-                Some((axes, out)) => p.forward(axes, &tool6(tool)?, out),
+            match unsafe { batch(axes, n_in, out, n_out)? } {
+                Some((axes, out)) => p.plugin.forward(axes, &tool6(tool)?, out),
                 None => Ok(()),
             }
         })
     }
 
-    /// `post` for plugin `p`.
+    /// `post` for the plugin `get` builds.
     ///
     /// # Safety
     /// `request` must point to `len` readable bytes; `out` to a `Buffer`.
-    pub unsafe fn post(p: &impl Plugin, request: *const u8, len: usize, out: *mut Buffer) -> i32 {
+    pub unsafe fn post<P: Plugin + 'static>(
+        get: impl FnOnce() -> &'static Built<P>,
+        request: *const u8,
+        len: usize,
+        out: *mut Buffer,
+    ) -> i32 {
         guarded(std::ptr::null_mut(), || {
             if request.is_null() {
                 return Err(PluginError::new("null request"));
             }
             // SAFETY: the host passes len readable bytes.
             let bytes = unsafe { std::slice::from_raw_parts(request, len) };
-            let text = std::str::from_utf8(bytes)
-                .map_err(|e| PluginError::new(format!("request is not UTF-8: {e}")))?;
-            write(out, p.post(text)?)
+            let req: PostRequest = serde_json::from_slice(bytes)
+                .map_err(|e| PluginError::new(format!("bad post request: {e}")))?;
+            write(out, get().plugin.post(&req)?)
         })
     }
 
@@ -410,20 +494,23 @@ pub mod entry {
 }
 
 /// Exports a [`Plugin`] (a type with `Default`) as the C entry `$symbol`,
-/// which must be `pilgrim_plugin_<library name>`.
+/// which must be `pilgrim_plugin_<library name>`. The plugin is built on
+/// its first call, inside that call's panic guard: a `Default` that panics
+/// is an error the host reports, not an abort.
 #[macro_export]
 macro_rules! export_plugin {
     ($symbol:ident, $ty:ty) => {
         /// The pilgrim plugin entry: the static entry table.
         #[no_mangle]
         pub extern "C" fn $symbol() -> *const $crate::PluginTable {
-            static INSTANCE: ::std::sync::OnceLock<$ty> = ::std::sync::OnceLock::new();
-            fn get() -> &'static $ty {
-                INSTANCE.get_or_init(<$ty as ::core::default::Default>::default)
+            static INSTANCE: ::std::sync::OnceLock<$crate::entry::Built<$ty>> =
+                ::std::sync::OnceLock::new();
+            fn get() -> &'static $crate::entry::Built<$ty> {
+                INSTANCE.get_or_init($crate::entry::Built::new)
             }
             unsafe extern "C" fn describe(out: *mut $crate::Buffer) -> i32 {
                 // SAFETY: forwarded from the host's call.
-                unsafe { $crate::entry::describe(get(), out) }
+                unsafe { $crate::entry::describe(get, out) }
             }
             unsafe extern "C" fn inverse(
                 poses: *const f64,
@@ -434,7 +521,7 @@ macro_rules! export_plugin {
                 failed_row: *mut usize,
             ) -> i32 {
                 // SAFETY: forwarded from the host's call.
-                unsafe { $crate::entry::inverse(get(), poses, count, tool, out, width, failed_row) }
+                unsafe { $crate::entry::inverse(get, poses, count, tool, out, width, failed_row) }
             }
             unsafe extern "C" fn forward(
                 axes: *const f64,
@@ -444,7 +531,7 @@ macro_rules! export_plugin {
                 out: *mut f64,
             ) -> i32 {
                 // SAFETY: forwarded from the host's call.
-                unsafe { $crate::entry::forward(get(), axes, count, width, tool, out) }
+                unsafe { $crate::entry::forward(get, axes, count, width, tool, out) }
             }
             unsafe extern "C" fn post(
                 request: *const u8,
@@ -452,8 +539,9 @@ macro_rules! export_plugin {
                 out: *mut $crate::Buffer,
             ) -> i32 {
                 // SAFETY: forwarded from the host's call.
-                unsafe { $crate::entry::post(get(), request, len, out) }
+                unsafe { $crate::entry::post(get, request, len, out) }
             }
+            const POSTS: bool = <$ty as $crate::Plugin>::POSTS;
             static TABLE: $crate::PluginTable = $crate::PluginTable {
                 abi_major: $crate::ABI_MAJOR,
                 abi_minor: $crate::ABI_MINOR,
@@ -461,9 +549,12 @@ macro_rules! export_plugin {
                 describe: Some(describe),
                 inverse: Some(inverse),
                 forward: Some(forward),
-                post: Some(post),
+                post: if POSTS { Some(post) } else { None },
                 last_error: Some($crate::entry::last_error),
                 free_buffer: Some($crate::entry::free_buffer),
+                capabilities: $crate::CAP_INVERSE
+                    | $crate::CAP_FORWARD
+                    | if POSTS { $crate::CAP_POST } else { 0 },
             };
             &TABLE
         }

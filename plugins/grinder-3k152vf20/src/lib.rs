@@ -1,172 +1,208 @@
 //! The 3K152VF20 mandrel grinder (seed 000, MATH §2.3) as a pilgrim machine
 //! plugin: table Z, wheelhead X, CNC steady rest U, work spindle; a
-//! Sinumerik 840D control.
+//! Sinumerik 840D control (the host's writer posts its programs).
+//!
+//! Its description ([`describe`]) is the one definition of the machine: its
+//! axes and their signs, the wheel's chain and the steady rest's, and the
+//! rest's constants. The part frame has Z along the mandrel's axis and X
+//! radial (ARCHITECTURE §3). Signs (the host checks them against the
+//! chains whenever it loads the plugin):
+//!
+//! - `Z` +1 mm moves the wheel +1 mm along the part's axis relative to the
+//!   part (ISO 841: the table physically carries the part the other way);
+//! - `X` +1 mm moves the wheel's reference point 1 mm away from the axis;
+//! - `U` +1 mm moves the rest's support centre 1 mm away from the axis, on
+//!   the side opposite the wheel (the rest stands at 180 degrees).
+//!
+//! The tool frame's origin is the wheel's programmed point (the seed
+//! programs the lowest point of the wheel's rounding); its axis is the
+//! wheel's axis, parallel to the part's.
 //!
 //! The kinematics are closed-form: the wheel moves in the part's axial
 //! section with its axis parallel to the part's, so `X = x - r_x` and
 //! `Z = z - r_z` for a tracked point `(x, 0, z)` and the tool's reference
-//! `r`. The axes, travel and signs are those of the kernel's built-in
-//! machine file `3k152vf20.toml`. The steady rest's U comes with the
-//! toolpath (an auxiliary value the part family computes on the current
-//! surface).
+//! `r`. The steady rest's U is not solved but driven: the toolpath carries
+//! it (the part family computes it on the current surface).
 //!
-//! Built as an rlib it is compiled into the `pilgrim` program; built as a
-//! cdylib it is `libgrinder_3k152vf20.so`, exporting
-//! `pilgrim_plugin_grinder_3k152vf20`.
+//! Built as an rlib it is compiled into the `pilgrim` program (its entry,
+//! [`pilgrim_plugin_grinder_3k152vf20`], goes through the same ABI as the
+//! library's); built as a cdylib it is `libgrinder_3k152vf20.so`.
 
-use pilgrim_kernel::program::{batch_rows, KinematicsError, MachineInfo, MachineKinematics};
-use pilgrim_kernel::{AxisProgram, Machine, ToolFrame};
+use pilgrim_plugin_abi::types::{
+    Axis, AxisKind, BodyShape, BodySpec, FactorKind, FactorSpec, MachineInfo, Quantity, ToolSpec,
+};
 use pilgrim_plugin_abi::{export_plugin, Plugin, PluginError};
 
 /// How far off the axial section (y) or off the part's axis direction a
 /// pose may be and still be the grinder's.
 const POSE_TOL: f64 = 1e-9;
 
+/// The machine's name.
+pub const NAME: &str = "3K152VF20";
+
+fn linear(name: &str, min: f64, max: f64, max_feed: f64, moves: [f64; 3], what: &str) -> Axis {
+    Axis {
+        name: name.into(),
+        kind: AxisKind::Linear,
+        min,
+        max,
+        max_feed,
+        programmed: true,
+        description: what.into(),
+        moves: Some(moves),
+        turns: None,
+        body: None,
+    }
+}
+
+/// The 3K152VF20's description: axes, chains, constants, capabilities.
+pub fn describe() -> MachineInfo {
+    let mut u = linear(
+        "U",
+        0.0,
+        150.0,
+        2000.0,
+        [-1.0, 0.0, 0.0],
+        "steady rest: radial position of the support's centre, opposite the wheel",
+    );
+    u.body = Some("rest".into());
+    MachineInfo {
+        name: NAME.into(),
+        description:
+            "3K152VF20 CNC cylindrical grinder with a CNC steady rest (U) for cold-pilger mandrels"
+                .into(),
+        control: "sinumerik".into(),
+        axes: vec![
+            linear(
+                "Z",
+                -20.0,
+                1050.0,
+                6000.0,
+                [0.0, 0.0, 1.0],
+                "table, along the part's axis (wheel relative to part)",
+            ),
+            linear(
+                "X",
+                -5.0,
+                220.0,
+                3000.0,
+                [1.0, 0.0, 0.0],
+                "wheelhead infeed: radial position of the wheel's programmed point",
+            ),
+            u,
+            Axis {
+                name: "S".into(),
+                kind: AxisKind::Spindle,
+                min: 0.0,
+                max: 630.0,
+                max_feed: 630.0,
+                programmed: false,
+                description: "work spindle (the seed runs S1 = 399 rpm)".into(),
+                moves: None,
+                turns: None,
+                body: None,
+            },
+        ],
+        solved_axes: vec!["Z".into(), "X".into()],
+        constants: [
+            // z_r = z_k + B (mm): the rest stands 180 mm before the wheel along Z.
+            ("rest_offset_b".to_owned(), -180.0),
+            // Radius R_o of the rest's support in the axial section (mm).
+            ("rest_radius".to_owned(), 25.0),
+            // What U programs: 1 = the support's centre, 0 = its contact
+            // point (MATH §5; the seed: the centre).
+            ("rest_programs_centre".to_owned(), 1.0),
+        ]
+        .into_iter()
+        .collect(),
+        // The grinder's programs carry 0.1 um (its axes' resolution):
+        // mandrels are ground to microns, and 0.001 mm steps would be
+        // coarser than the tolerance.
+        program_decimals: Some(4),
+        driven_axes: vec!["U".into()],
+        bodies: vec![BodySpec {
+            name: "rest".into(),
+            description: "steady rest support (circle of radius rest_radius in the axial section)"
+                .into(),
+            label: "steady rest: support centre".into(),
+            // The support's centre travels with the wheel along Z at the
+            // offset B (z_r = z_k + B, MATH §2.3), at 180 degrees round the
+            // part.
+            chain: vec![
+                FactorSpec::axis(FactorKind::Tz, "Z"),
+                FactorSpec::constant(FactorKind::Tz, "rest_offset_b"),
+                FactorSpec::value(FactorKind::Rz, 180f64.to_radians()),
+                FactorSpec::axis(FactorKind::Tx, "U"),
+            ],
+            shape: Some(BodyShape::Roller {
+                radius: Quantity::Constant("rest_radius".into()),
+                length: Quantity::Value(40.0),
+            }),
+        }],
+        chain: vec![
+            FactorSpec::axis(FactorKind::Tz, "Z"),
+            FactorSpec::axis(FactorKind::Tx, "X"),
+        ],
+        tool: ToolSpec::default(),
+    }
+}
+
 /// The 3K152VF20.
-#[derive(Debug, Clone)]
-pub struct Grinder {
-    info: MachineInfo,
-}
+#[derive(Debug, Clone, Default)]
+pub struct Grinder;
 
-impl Default for Grinder {
-    fn default() -> Self {
-        let machine =
-            Machine::builtin("3K152VF20").expect("the built-in 3K152VF20 machine file is valid");
-        Self {
-            info: MachineInfo::of(&machine),
-        }
-    }
-}
-
-impl Grinder {
-    /// The grinder.
-    pub fn new() -> Self {
-        Self::default()
+impl Plugin for Grinder {
+    fn describe(&self) -> MachineInfo {
+        describe()
     }
 
-    /// Inverse kinematics into `out` (two values per pose), the one code
-    /// path of the compiled-in machine and of the shared library.
-    fn solve_into(
-        &self,
-        poses: &[f64],
-        tool: &ToolFrame,
-        out: &mut [f64],
-    ) -> Result<(), KinematicsError> {
-        let (r, w) = (tool.point, tool.axis);
+    /// Rows of `[Z, X]` (the solved axes' order).
+    fn inverse(&self, poses: &[f64], tool: &[f64; 6], out: &mut [f64]) -> Result<(), PluginError> {
         for (i, (p, q)) in poses
             .chunks_exact(6)
             .zip(out.chunks_exact_mut(2))
             .enumerate()
         {
-            if (p[1] - r.y).abs() > POSE_TOL {
-                return Err(KinematicsError::at(
+            if (p[1] - tool[1]).abs() > POSE_TOL {
+                return Err(PluginError::at(
                     i,
                     format!(
                         "the point is {:.6} mm off the wheel's plane (y must be {})",
-                        p[1] - r.y,
-                        r.y
+                        p[1] - tool[1],
+                        tool[1]
                     ),
                 ));
             }
-            let tilt = ((p[3] - w.x).powi(2) + (p[4] - w.y).powi(2) + (p[5] - w.z).powi(2)).sqrt();
+            let tilt =
+                ((p[3] - tool[3]).powi(2) + (p[4] - tool[4]).powi(2) + (p[5] - tool[5]).powi(2))
+                    .sqrt();
             if tilt > POSE_TOL {
-                return Err(KinematicsError::at(
+                return Err(PluginError::at(
                     i,
                     format!(
                         "the wheel's axis ({:.6}, {:.6}, {:.6}) must stay parallel to the part's ({}, {}, {})",
-                        p[3], p[4], p[5], w.x, w.y, w.z
+                        p[3], p[4], p[5], tool[3], tool[4], tool[5]
                     ),
                 ));
             }
-            q[0] = p[2] - r.z;
-            q[1] = p[0] - r.x;
+            q[0] = p[2] - tool[2];
+            q[1] = p[0] - tool[0];
         }
         Ok(())
-    }
-}
-
-impl MachineKinematics for Grinder {
-    fn info(&self) -> &MachineInfo {
-        &self.info
-    }
-
-    /// Rows of `[Z, X]` (the solved axes' order).
-    fn inverse(
-        &self,
-        poses: &[f64],
-        tool: &ToolFrame,
-        out: &mut Vec<f64>,
-    ) -> Result<(), KinematicsError> {
-        batch_rows(poses, 6, "pose")?;
-        out.clear();
-        out.resize(poses.len() / 3, 0.0);
-        self.solve_into(poses, tool, out)
-    }
-
-    fn forward(
-        &self,
-        axes: &[f64],
-        tool: &ToolFrame,
-        out: &mut Vec<f64>,
-    ) -> Result<(), KinematicsError> {
-        batch_rows(axes, 2, "axis")?;
-        out.clear();
-        let (r, w) = (tool.point, tool.axis);
-        for q in axes.chunks_exact(2) {
-            out.extend_from_slice(&[q[1] + r.x, r.y, q[0] + r.z, w.x, w.y, w.z]);
-        }
-        Ok(())
-    }
-}
-
-fn tool_frame(t: &[f64; 6]) -> ToolFrame {
-    ToolFrame {
-        point: pilgrim_kernel::Point3::new(t[0], t[1], t[2]),
-        axis: pilgrim_kernel::Vec3::new(t[3], t[4], t[5]),
-    }
-}
-
-fn from_kinematics(e: KinematicsError) -> PluginError {
-    PluginError {
-        row: e.index,
-        message: e.message,
-    }
-}
-
-/// A post request: `{"dialect": "...", "program": {...}}`.
-#[derive(serde::Deserialize)]
-struct PostRequest {
-    dialect: String,
-    program: AxisProgram,
-}
-
-impl Plugin for Grinder {
-    fn describe(&self) -> String {
-        serde_json::to_string(&self.info).unwrap_or_default()
-    }
-
-    fn solved_axis_count(&self) -> usize {
-        self.info.solved_axes.len()
-    }
-
-    fn inverse(&self, poses: &[f64], tool: &[f64; 6], out: &mut [f64]) -> Result<(), PluginError> {
-        self.solve_into(poses, &tool_frame(tool), out)
-            .map_err(from_kinematics)
     }
 
     fn forward(&self, axes: &[f64], tool: &[f64; 6], out: &mut [f64]) -> Result<(), PluginError> {
-        let mut v = Vec::with_capacity(out.len());
-        MachineKinematics::forward(self, axes, &tool_frame(tool), &mut v)
-            .map_err(from_kinematics)?;
-        out.copy_from_slice(&v);
+        for (q, p) in axes.chunks_exact(2).zip(out.chunks_exact_mut(6)) {
+            p.copy_from_slice(&[
+                q[1] + tool[0],
+                tool[1],
+                q[0] + tool[2],
+                tool[3],
+                tool[4],
+                tool[5],
+            ]);
+        }
         Ok(())
-    }
-
-    fn post(&self, request: &str) -> Result<String, PluginError> {
-        let req: PostRequest = serde_json::from_str(request)
-            .map_err(|e| PluginError::new(format!("bad post request: {e}")))?;
-        MachineKinematics::post(self, &req.program, &req.dialect)
-            .map_err(|e| PluginError::new(e.to_string()))
     }
 }
 
@@ -175,13 +211,26 @@ export_plugin!(pilgrim_plugin_grinder_3k152vf20, Grinder);
 #[cfg(test)]
 mod tests {
     use super::*;
-    use pilgrim_kernel::{ChainMachine, Point3, Vec3};
+    use pilgrim_kernel::machine::{ChainMachine, Machine, MachineKinematics};
+    use pilgrim_kernel::math::{Point3, Vec3};
+    use pilgrim_kernel::plugin::PluginMachine;
+    use pilgrim_kernel::transform::ToolFrame;
 
-    /// The closed form agrees with the machine file's chain solved numerically.
+    fn plugin() -> PluginMachine {
+        PluginMachine::from_entry(
+            NAME,
+            "pilgrim_plugin_grinder_3k152vf20",
+            pilgrim_plugin_grinder_3k152vf20,
+        )
+        .unwrap()
+    }
+
+    /// The closed form agrees with the description's chain solved
+    /// numerically, both ways.
     #[test]
     fn closed_form_matches_the_chain() {
-        let g = Grinder::new();
-        let chain = ChainMachine::new(Machine::builtin("3K152VF20").unwrap());
+        let g = plugin();
+        let chain = ChainMachine::new(Machine::from_info(describe()).unwrap());
         let tool = ToolFrame {
             point: Point3::new(20.0, 0.0, 3.0),
             axis: Vec3::z(),
@@ -190,20 +239,38 @@ mod tests {
             .flat_map(|i| [25.0 + 0.1 * i as f64, 0.0, 10.0 * i as f64, 0.0, 0.0, 1.0])
             .collect();
         let (mut a, mut b) = (vec![], vec![]);
-        MachineKinematics::inverse(&g, &poses, &tool, &mut a).unwrap();
+        g.inverse(&poses, &tool, &mut a).unwrap();
         chain.inverse(&poses, &tool, &mut b).unwrap();
         for (x, y) in a.iter().zip(&b) {
             assert!((x - y).abs() < 1e-7, "{x} vs {y}");
         }
         let mut back = vec![];
-        MachineKinematics::forward(&g, &a, &tool, &mut back).unwrap();
+        g.forward(&a, &tool, &mut back).unwrap();
         for (x, y) in back.iter().zip(&poses) {
             assert!((x - y).abs() < 1e-12);
         }
         let mut bad = poses.clone();
         bad[6 * 7 + 1] = 0.5;
-        let e = MachineKinematics::inverse(&g, &bad, &tool, &mut a).unwrap_err();
+        let e = g.inverse(&bad, &tool, &mut a).unwrap_err();
         assert_eq!(e.index, Some(7));
         assert!(e.message.contains("off the wheel's plane"), "{e}");
+    }
+
+    /// The rest's chain: at Z + B along the axis, U from the axis on the far
+    /// side; the description's signs hold (the host checked them).
+    #[test]
+    fn the_rest_moves_as_stated() {
+        let m = Machine::from_info(describe()).unwrap();
+        assert_eq!(m.chain().axis_names(), ["Z", "X"]);
+        let p = m.chain().apply(&[250.0, 30.0], &Point3::origin()).unwrap();
+        assert_eq!(p, Point3::new(30.0, 0.0, 250.0));
+        let b = m.constant("rest_offset_b").unwrap();
+        let rest = m.body_chain("rest").unwrap();
+        assert_eq!(rest.axis_names(), ["Z", "U"]);
+        let r = rest.apply(&[250.0, 40.0], &Point3::origin()).unwrap();
+        assert!((r.x + 40.0).abs() < 1e-12 && r.y.abs() < 1e-12 && (r.z - 250.0 - b).abs() < 1e-12);
+        assert!(m.constant("rest_radius").unwrap() > 0.0);
+        assert_eq!(m.control(), "sinumerik");
+        assert_eq!(plugin().info(), &describe());
     }
 }

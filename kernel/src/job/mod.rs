@@ -1,0 +1,279 @@
+//! A run, as one kernel call (ARCHITECTURE §1): a part family on a machine
+//! with parameters, to every output.
+//!
+//! [`run`] resolves the parameters (the family's defaults, the machine's
+//! constants, the caller's sources), runs the family's checks, builds the
+//! toolpath, the axis program (inverse kinematics, travel and feed checks),
+//! replays it against the family's nominal when the family asks, posts it
+//! in the control's dialect and as a CL file, builds the 3-D scene and the
+//! report, and returns them typed, with the bytes of every file
+//! ([`JobOutput::files`]). It writes nothing: the caller decides where
+//! (the `pilgrim` program writes them atomically). [`export`] places a
+//! finished run's tool at another block.
+
+mod export;
+mod report;
+mod scene;
+mod svg;
+
+pub use export::{export, Exported};
+pub use report::{axis_ranges, block_table, cycle_time, Report, ReportParam};
+pub use scene::{default_pose_block, BodyFile, Formats, SceneError};
+
+use crate::catalog::OpenMachine;
+use crate::error::Error;
+use crate::family::{PartFamily, PartGeometry};
+use crate::params::{resolve, ParamSource, Params};
+use crate::program::post::{dialect, CLD};
+use crate::program::{build, AxisProgram};
+use crate::tool::ToolShape;
+use crate::toolpath::Toolpath;
+use crate::verify::{check_grinding, GrindingCheck};
+use serde::Serialize;
+
+/// How a run makes its outputs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JobOptions {
+    /// The program's name (letters, digits, `_`; others become `_`).
+    pub program_name: String,
+    /// The block (from 1) to place the tool at in the 3-D models; `None`:
+    /// the middle of the last cutting pass.
+    pub pose_block: Option<usize>,
+    /// Chordal tolerance of the 3-D models (mm).
+    pub mesh_tolerance: f64,
+    /// Which 3-D files to write.
+    pub formats: Formats,
+}
+
+impl Default for JobOptions {
+    fn default() -> Self {
+        Self {
+            program_name: "pilgrim".into(),
+            pose_block: None,
+            mesh_tolerance: crate::mesh::DEFAULT_TOLERANCE,
+            formats: Formats::default(),
+        }
+    }
+}
+
+/// The stages of a run, in order, as [`run`] reports them.
+pub const STAGES: [&str; 5] = [
+    "checking",
+    "computing the toolpath",
+    "inverse kinematics and limits",
+    "post-processing",
+    "3-D models",
+];
+
+/// Everything a run made.
+#[derive(Debug, Clone)]
+pub struct JobOutput {
+    /// The parameter values used.
+    pub params: Params,
+    /// The CL data.
+    pub toolpath: Toolpath,
+    /// The axis program.
+    pub program: AxisProgram,
+    /// The program replayed against the nominal, if the family asked.
+    pub verification: Option<GrindingCheck>,
+    /// The report.
+    pub report: Report,
+    /// Every file's name and bytes, in the order they were made.
+    pub files: Vec<(String, Vec<u8>)>,
+}
+
+impl JobOutput {
+    /// One line saying what the run made: passes, blocks, machine, cycle
+    /// time and the verified finish.
+    pub fn summary(&self) -> String {
+        let r = &self.report;
+        let verified = self
+            .verification
+            .as_ref()
+            .and_then(|v| v.passes.last())
+            .map(|p| {
+                format!(
+                    ", finish within {} mm of nominal",
+                    crate::math::fixed(p.deviation.max_abs, 5)
+                )
+            })
+            .unwrap_or_default();
+        format!(
+            "{}: {} cutting passes ({} in all), {} blocks for {} ({}), about {:.1} min{verified}",
+            r.script, r.cutting_passes, r.passes, r.blocks, r.machine, r.control, r.cycle_time_min,
+        )
+    }
+}
+
+fn json<T: Serialize>(v: &T) -> Result<Vec<u8>, Error> {
+    serde_json::to_string_pretty(v)
+        .map(|s| (s + "\n").into_bytes())
+        .map_err(|e| Error::Output(e.to_string()))
+}
+
+/// Runs `family` on `machine` with the parameter `sources`; `stage` is
+/// called as each stage begins (for progress).
+///
+/// # Failures
+/// Any stage's error ([`Error`]): a parameter, a failed check (naming
+/// them), the family's script, a block beyond travel, the verification, a
+/// mesh.
+pub fn run(
+    family: &dyn PartFamily,
+    machine: &OpenMachine,
+    sources: &[ParamSource],
+    options: &JobOptions,
+    stage: &mut dyn FnMut(&str),
+) -> Result<JobOutput, Error> {
+    let kin = machine.kinematics.as_ref();
+    let info = kin.info();
+    // Parameters tied to machine constants default to this machine's.
+    let values = resolve(family.params(), &info.constants, sources)?;
+    stage(STAGES[0]);
+    let checks = family.checks(&values)?;
+    let failed: Vec<String> = checks
+        .iter()
+        .filter(|c| !c.ok)
+        .map(|c| format!("{} ({})", c.name, c.detail))
+        .collect();
+    if !failed.is_empty() {
+        return Err(Error::Checks {
+            family: family.name().to_owned(),
+            failed: failed.join("; "),
+        });
+    }
+    stage(STAGES[1]);
+    let toolpath = family.toolpath(&values)?;
+    stage(STAGES[2]);
+    let program = build(&toolpath, kin, &options.program_name)?;
+    let nominal = family.verification(&values)?;
+    let verification = match &nominal {
+        None => None,
+        Some(v) => {
+            let ToolShape::Wheel(w) = toolpath.tool.shape else {
+                return Err(Error::Family(crate::family::FamilyError::Contract {
+                    family: family.name().to_owned(),
+                    message: "fn verify(p) needs a grinding wheel".into(),
+                }));
+            };
+            Some(check_grinding(
+                &program,
+                kin,
+                &toolpath.tool.reference,
+                w.rounding_radius,
+                &toolpath.passes,
+                &v.profile,
+                (v.from, v.to),
+                v.tolerance,
+            )?)
+        }
+    };
+    stage(STAGES[3]);
+    let control = dialect(&info.control).ok_or_else(|| Error::UnknownControl {
+        machine: info.name.clone(),
+        control: info.control.clone(),
+    })?;
+    let control_text = machine.post.post(&program, control.name)?;
+    let cld_text = machine.post.post(&program, CLD.name)?;
+    let mut files: Vec<(String, Vec<u8>)> = vec![
+        ("toolpath.json".into(), json(&toolpath)?),
+        ("program.json".into(), json(&program)?),
+        (
+            format!("program.{}", control.extension),
+            control_text.into_bytes(),
+        ),
+        ("program.cld".into(), cld_text.into_bytes()),
+        (
+            "report.csv".into(),
+            block_table(&program, &toolpath).into_bytes(),
+        ),
+    ];
+    stage(STAGES[4]);
+    let parts = family.part(&values)?;
+    let tol = options.mesh_tolerance;
+    let (pose_block, bodies) = if parts.is_empty() {
+        (None, vec![])
+    } else {
+        let meshes = scene::part_meshes(&parts, tol).map_err(|source| Error::Part {
+            family: family.name().to_owned(),
+            source,
+        })?;
+        let index = match options.pose_block {
+            Some(0) => return Err(Error::Options("--pose-block counts blocks from 1".into())),
+            Some(n) => n - 1,
+            None => default_pose_block(&toolpath.passes),
+        };
+        let pose = scene::tool_pose(&program, kin, &toolpath.tool, index)?;
+        let tool = scene::tool_mesh(&toolpath.tool, tol)?;
+        let others = scene::machine_bodies(kin, &program, index, tol)?;
+        let (mesh_files, bodies) = scene::files(&meshes, tool, pose, others, options.formats)?;
+        files.extend(mesh_files);
+        (Some(index + 1), bodies)
+    };
+    let mut report = Report {
+        pilgrim: crate::VERSION.into(),
+        script: family.name().to_owned(),
+        machine: info.name.clone(),
+        machine_spec: machine.spec.clone(),
+        control: info.control.clone(),
+        parameters: family
+            .params()
+            .iter()
+            .map(|s| {
+                (
+                    s.name.clone(),
+                    ReportParam {
+                        value: values[&s.name].clone(),
+                        unit: s.unit.clone(),
+                    },
+                )
+            })
+            .collect(),
+        passes: toolpath.passes.len(),
+        cutting_passes: toolpath.passes.iter().filter(|p| p.cuts()).count(),
+        points: toolpath.point_count(),
+        blocks: program.blocks.len(),
+        cycle_time_min: (cycle_time(&program, info) * 1e4).round() / 1e4,
+        files: files
+            .iter()
+            .map(|f| f.0.clone())
+            .chain(["report.json".to_owned()])
+            .collect(),
+        checks,
+        pose_block,
+        tolerance_mm: tol,
+        bodies,
+        axis_ranges: axis_ranges(&program),
+        verification: verification.clone(),
+        notes: toolpath.notes.clone(),
+    };
+    if let (Some(v), ToolShape::Wheel(w)) = (&nominal, toolpath.tool.shape) {
+        let profiles: Vec<(String, crate::profile::Profile)> = parts
+            .iter()
+            .filter_map(|b| match &b.geometry {
+                PartGeometry::Revolution(p) => Some((b.name.clone(), p.clone())),
+                PartGeometry::Mesh(_) => None,
+            })
+            .collect();
+        let text = svg::profile_svg(
+            &profiles,
+            &toolpath,
+            &program,
+            kin,
+            &v.profile,
+            w.rounding_radius,
+        )
+        .map_err(|e| Error::Scene(SceneError::Place(e)))?;
+        files.push(("profile.svg".into(), text.into_bytes()));
+        report.files.push("profile.svg".into());
+    }
+    files.push(("report.json".into(), json(&report)?));
+    Ok(JobOutput {
+        params: values,
+        toolpath,
+        program,
+        verification,
+        report,
+        files,
+    })
+}

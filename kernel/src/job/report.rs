@@ -1,0 +1,146 @@
+//! What a run reports: `report.json` ([`Report`]) and `report.csv` (a row
+//! per block), with the program's cycle time and each axis's range.
+
+use super::scene::BodyFile;
+use crate::family::Check;
+use crate::machine::{move_length, Axis, MachineInfo};
+use crate::math::{fixed, Real};
+use crate::params::ParamValue;
+use crate::program::AxisProgram;
+use crate::toolpath::{Motion, Toolpath};
+use crate::verify::GrindingCheck;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// A parameter's value as used, with its unit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReportParam {
+    /// The value.
+    pub value: ParamValue,
+    /// Its unit.
+    pub unit: String,
+}
+
+/// `report.json`: what a run did, with what, and what it found.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Report {
+    /// pilgrim's version.
+    pub pilgrim: String,
+    /// The family (its script's file).
+    pub script: String,
+    /// The machine's name.
+    pub machine: String,
+    /// The machine as it was named (the --machine given, or the family's
+    /// default).
+    pub machine_spec: String,
+    /// The control's dialect.
+    pub control: String,
+    /// Every parameter's value as used, with its unit.
+    pub parameters: BTreeMap<String, ReportParam>,
+    /// Passes in all.
+    pub passes: usize,
+    /// Passes with a move other than a rapid.
+    #[serde(default)]
+    pub cutting_passes: usize,
+    /// Toolpath points.
+    pub points: usize,
+    /// Program blocks.
+    pub blocks: usize,
+    /// Minutes of cutting and rapid moves.
+    pub cycle_time_min: f64,
+    /// The files written.
+    pub files: Vec<String>,
+    /// The family's checks.
+    pub checks: Vec<Check>,
+    /// The block (from 1) the 3-D scene places the tool at.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pose_block: Option<usize>,
+    /// Chordal tolerance of the meshes (mm).
+    pub tolerance_mm: f64,
+    /// The bodies written as STL.
+    #[serde(default)]
+    pub bodies: Vec<BodyFile>,
+    /// Each programmed axis's range over the program: [min, max] (mm, deg).
+    #[serde(default)]
+    pub axis_ranges: BTreeMap<String, [f64; 2]>,
+    /// The program replayed against the nominal part (families that ask).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub verification: Option<GrindingCheck>,
+    /// Figures the family noted.
+    #[serde(default)]
+    pub notes: BTreeMap<String, f64>,
+}
+
+/// Each programmed axis's range over the program: `[min, max]` in program
+/// units.
+pub fn axis_ranges(program: &AxisProgram) -> BTreeMap<String, [f64; 2]> {
+    program
+        .axes
+        .iter()
+        .filter_map(|a| {
+            let col = program.column(&a.name)?;
+            let lo = col.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = col.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            Some((a.name.clone(), [lo, hi]))
+        })
+        .collect()
+}
+
+/// Minutes of cutting and rapid moves: a feed move lasts its length
+/// ([`move_length`], the model the feed checks use) over its feed; a rapid
+/// as long as its slowest axis at that axis's maximum speed.
+pub fn cycle_time(program: &AxisProgram, info: &MachineInfo) -> Real {
+    let axes: Vec<Option<&Axis>> = program.axes.iter().map(|a| info.axis(&a.name)).collect();
+    let known: Vec<&Axis> = axes.iter().flatten().copied().collect();
+    let mut minutes = 0.0;
+    for w in program.blocks.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        let deltas: Vec<Real> = a.values.iter().zip(&b.values).map(|(x, y)| y - x).collect();
+        minutes += match b.motion {
+            Motion::Rapid => axes
+                .iter()
+                .zip(&deltas)
+                .filter_map(|(ax, d)| ax.map(|a| d.abs() / a.to_user(a.max_feed)))
+                .fold(0.0, f64::max),
+            _ if b.feed > 0.0 => {
+                let known_deltas: Vec<Real> = axes
+                    .iter()
+                    .zip(&deltas)
+                    .filter(|(ax, _)| ax.is_some())
+                    .map(|(_, d)| *d)
+                    .collect();
+                move_length(&known, &known_deltas) / b.feed
+            }
+            _ => 0.0,
+        };
+    }
+    minutes
+}
+
+/// `report.csv`: one row per block: block number, pass, motion, axis
+/// values (the program's decimals), feed.
+pub fn block_table(program: &AxisProgram, toolpath: &Toolpath) -> String {
+    let mut out = String::from("block,pass,motion");
+    for a in &program.axes {
+        out += &format!(",{} ({})", a.name, a.unit);
+    }
+    out += ",feed (mm/min)\n";
+    let names = toolpath
+        .passes
+        .iter()
+        .flat_map(|p| std::iter::repeat_n(p.name.as_str(), p.points.len()));
+    let decimals = program.decimals.unwrap_or(3);
+    for (i, (b, pass)) in program.blocks.iter().zip(names).enumerate() {
+        let motion = match b.motion {
+            Motion::Rapid => "rapid",
+            Motion::Linear => "linear",
+            Motion::Thread { .. } => "thread",
+        };
+        out += &format!("{},\"{}\",{motion}", i + 1, pass.replace('"', "'"));
+        for v in &b.values {
+            out += &format!(",{}", fixed(*v, decimals));
+        }
+        out += &format!(",{}\n", fixed(b.feed, 1));
+    }
+    out
+}

@@ -1,0 +1,243 @@
+//! 3-D output of a run: the part's bodies, the tool placed where the program
+//! puts it at one block, the machine's other moving bodies (a steady rest)
+//! placed by their chains, as STL files and one glTF scene.
+
+use crate::family::{PartBody, PartGeometry};
+use crate::machine::{bodies_of, BodyShape, MachineKinematics};
+use crate::math::{Mat4, Point3, Vec3};
+use crate::mesh::{self, frame_from_pose, MeshError, Scene, StlFormat, TriMesh};
+use crate::program::{axis_rows, AxisProgram};
+use crate::tool::{Tool, ToolShape};
+use crate::toolpath::{pass_ranges, Pass};
+use serde::{Deserialize, Serialize};
+
+/// A body written to a file, for the report.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BodyFile {
+    /// The body's name.
+    pub name: String,
+    /// `part`, `tool` or `machine`.
+    pub kind: String,
+    /// Its STL file.
+    pub file: String,
+    /// Triangles.
+    pub triangles: usize,
+    /// Enclosed volume (mm^3).
+    pub volume_mm3: f64,
+}
+
+const PART_COLOR: [f32; 4] = [0.72, 0.72, 0.76, 1.0];
+const TOOL_COLOR: [f32; 4] = [0.25, 0.42, 0.85, 1.0];
+const MACHINE_COLOR: [f32; 4] = [0.85, 0.55, 0.2, 1.0];
+
+/// Why the scene could not be made.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SceneError {
+    /// A body's mesh failed.
+    #[error("{body}: {source}")]
+    Mesh {
+        /// The body.
+        body: String,
+        /// The mesh's error.
+        source: MeshError,
+    },
+    /// Placing a body failed (a block beyond the program, a chain).
+    #[error("{0}")]
+    Place(String),
+}
+
+fn mesh_err(body: &str) -> impl Fn(MeshError) -> SceneError + '_ {
+    move |source| SceneError::Mesh {
+        body: body.to_owned(),
+        source,
+    }
+}
+
+/// The part's bodies as closed meshes (bodies of revolution turned about Z).
+///
+/// # Failures
+/// A body whose mesh fails, named.
+pub fn part_meshes(parts: &[PartBody], tol: f64) -> Result<Vec<(String, TriMesh)>, SceneError> {
+    parts
+        .iter()
+        .map(|b| {
+            let m = match &b.geometry {
+                PartGeometry::Revolution(p) => mesh::body_of_revolution(p, tol)
+                    .map_err(mesh_err(&format!("part '{}'", b.name)))?,
+                PartGeometry::Mesh(m) => m.clone(),
+            };
+            Ok((b.name.clone(), m))
+        })
+        .collect()
+}
+
+/// The tool's solid in its own frame and the file name it is written as.
+///
+/// # Failures
+/// The tool's mesh failing.
+pub fn tool_mesh(tool: &Tool, tol: f64) -> Result<Option<(TriMesh, &'static str)>, SceneError> {
+    Ok(match tool.shape {
+        ToolShape::Wheel(w) => Some((mesh::wheel(&w, tol).map_err(mesh_err("wheel"))?, "wheel")),
+        ToolShape::EndMill { diameter, length } => Some((
+            mesh::cylinder(diameter / 2.0, length, tol).map_err(mesh_err("cutter"))?,
+            "cutter",
+        )),
+        ToolShape::Insert { .. } => None,
+    })
+}
+
+/// A body placed in the part frame: name, mesh in its own frame, pose.
+pub type Placed = (String, TriMesh, Mat4);
+
+/// The machine's other moving bodies that have a shape, placed by their
+/// chains at block `index` (from 0); a body whose chain needs an axis the
+/// program does not drive is left out.
+///
+/// # Failures
+/// A body's description or mesh failing.
+pub fn machine_bodies(
+    machine: &dyn MachineKinematics,
+    program: &AxisProgram,
+    index: usize,
+    tol: f64,
+) -> Result<Vec<Placed>, SceneError> {
+    let info = machine.info();
+    let bodies = bodies_of(info).map_err(|e| SceneError::Place(e.to_string()))?;
+    let mut out = Vec::new();
+    for body in bodies {
+        let Some(BodyShape::Roller { radius, length }) = &body.spec().shape else {
+            continue;
+        };
+        let Ok(q) = axis_rows(program, info, body.chain().axis_names(), index..index + 1) else {
+            continue; // the program does not drive the body
+        };
+        let size = |q: &crate::machine::Quantity| {
+            q.resolve(&info.constants)
+                .map_err(|m| SceneError::Place(format!("body {}: {m}", body.name())))
+        };
+        let (radius, length) = (size(radius)?, size(length)?);
+        // The roller along Y, centred on the body's origin.
+        let roller = mesh::cylinder(radius, length, tol)
+            .map_err(mesh_err(body.name()))?
+            .transformed(
+                &(Mat4::from_axis_angle(&Vec3::x_axis(), std::f64::consts::FRAC_PI_2)
+                    * Mat4::new_translation(&Vec3::new(0.0, 0.0, -length / 2.0))),
+            );
+        let pose = body
+            .chain()
+            .matrix(&q)
+            .map_err(|e| SceneError::Place(e.to_string()))?;
+        out.push((body.name().to_owned(), roller, pose));
+    }
+    Ok(out)
+}
+
+/// Block index (from 0) where the scene shows the tool by default: the
+/// middle block of the last pass that cuts (has a move other than a rapid),
+/// the tool at work on the finish; else the first block of the last pass.
+pub fn default_pose_block(passes: &[Pass]) -> usize {
+    let (mut last_start, mut pick) = (0, None);
+    for (p, blocks) in pass_ranges(passes) {
+        if p.cuts() {
+            pick = Some(blocks.start + p.points.len() / 2);
+        }
+        last_start = blocks.start;
+    }
+    pick.unwrap_or(last_start)
+}
+
+/// The rigid motion of the tool at block `index` (from 0): the machine's
+/// forward kinematics of the block's axis values.
+///
+/// # Failures
+/// A block beyond the program; the replay failing.
+pub fn tool_pose(
+    program: &AxisProgram,
+    machine: &dyn MachineKinematics,
+    tool: &Tool,
+    index: usize,
+) -> Result<Mat4, SceneError> {
+    let pose = crate::verify::replay_blocks(program, machine, &tool.reference, index..index + 1)
+        .map_err(|e| SceneError::Place(e.to_string()))?;
+    Ok(frame_from_pose(
+        &tool.reference,
+        Point3::new(pose[0], pose[1], pose[2]),
+        Vec3::new(pose[3], pose[4], pose[5]),
+    ))
+}
+
+/// Which 3-D files to write beside the default binary STL and `.glb`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Formats {
+    /// STL as ASCII instead of binary.
+    pub stl_ascii: bool,
+    /// Also `scene.gltf` + `scene.bin`.
+    pub gltf: bool,
+}
+
+/// Files to write: (name, bytes).
+pub type Files = Vec<(String, Vec<u8>)>;
+
+/// The files of the scene: each part body's STL, the tool's STL placed at
+/// the block, the machine's bodies' STLs, and `scene.glb`; with the bodies'
+/// records.
+///
+/// # Failures
+/// A mesh that is not closed, or a writer failing.
+pub fn files(
+    parts: &[(String, TriMesh)],
+    tool: Option<(TriMesh, &'static str)>,
+    tool_pose: Mat4,
+    others: Vec<Placed>,
+    formats: Formats,
+) -> Result<(Files, Vec<BodyFile>), SceneError> {
+    let mut scene = Scene::new();
+    let mut out = Vec::new();
+    let mut bodies = Vec::new();
+    let mut stl = |name: &str,
+                   kind: &str,
+                   m: &TriMesh,
+                   out: &mut Vec<(String, Vec<u8>)>|
+     -> Result<(), SceneError> {
+        m.check_closed().map_err(mesh_err(name))?;
+        let file = format!("{name}.stl");
+        let mut bytes = Vec::new();
+        let format = if formats.stl_ascii {
+            StlFormat::Ascii
+        } else {
+            StlFormat::Binary
+        };
+        mesh::write_stl(m, name, format, &mut bytes).map_err(mesh_err(name))?;
+        bodies.push(BodyFile {
+            name: name.to_owned(),
+            kind: kind.to_owned(),
+            file: file.clone(),
+            triangles: m.triangle_count(),
+            volume_mm3: (m.volume() * 1000.0).round() / 1000.0,
+        });
+        out.push((file, bytes));
+        Ok(())
+    };
+    for (name, m) in parts {
+        stl(name, "part", m, &mut out)?;
+        scene.add(name, m.clone(), Mat4::identity(), PART_COLOR);
+    }
+    if let Some((m, name)) = tool {
+        stl(name, "tool", &m.transformed(&tool_pose), &mut out)?;
+        scene.add(name, m, tool_pose, TOOL_COLOR);
+    }
+    for (name, m, pose) in others {
+        stl(&name, "machine", &m.transformed(&pose), &mut out)?;
+        scene.add(&name, m, pose, MACHINE_COLOR);
+    }
+    let mut glb = Vec::new();
+    mesh::write_glb(&scene, &mut glb).map_err(mesh_err("scene"))?;
+    out.push(("scene.glb".into(), glb));
+    if formats.gltf {
+        let (mut text, mut bin) = (Vec::new(), Vec::new());
+        mesh::write_gltf(&scene, "scene.bin", &mut text, &mut bin).map_err(mesh_err("scene"))?;
+        out.push(("scene.gltf".into(), text));
+        out.push(("scene.bin".into(), bin));
+    }
+    Ok((out, bodies))
+}

@@ -1,0 +1,494 @@
+//! A machine's description ([`MachineInfo`]) checked and compiled: the
+//! tool's chain and every other body's, from their factors as data, and the
+//! axes' stated signs checked against them.
+//!
+//! One validation serves every source: a machine file (whose reader turns
+//! each [`Invalid`]'s place into the file's line and column) and a plugin's
+//! descriptor ([`Machine::from_info`]).
+
+use super::{Axis, AxisKind, BodyShape, BodySpec, FactorSpec, Machine, MachineError, MachineInfo};
+use crate::math::{Point3, Real, Vec3};
+use crate::transform::{Chain, FactorKind, ToolFrame};
+use pilgrim_plugin_abi::types::FactorKind as SpecFactor;
+use std::collections::BTreeMap;
+
+/// A moving body other than the tool (a steady rest): its description and
+/// the chain placing its frame in the part frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Body {
+    spec: BodySpec,
+    chain: Chain,
+}
+
+impl Body {
+    /// Its name.
+    pub fn name(&self) -> &str {
+        &self.spec.name
+    }
+
+    /// Its description as data.
+    pub fn spec(&self) -> &BodySpec {
+        &self.spec
+    }
+
+    /// The chain placing it in the part frame.
+    pub fn chain(&self) -> &Chain {
+        &self.chain
+    }
+}
+
+/// Where in a description a value is wrong.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) enum Place {
+    /// The axis at this index, at this key (`name`, `max`, `moves`, ...).
+    Axis(usize, &'static str),
+    /// The tool's chain (`None`) or a body's, as a whole.
+    Chain(Option<String>),
+    /// A factor of the tool's chain (`None`) or a body's, at this key.
+    Factor(Option<String>, usize, &'static str),
+    /// A body, at this key (`name`, `shape`).
+    Body(String, &'static str),
+    /// The tool frame.
+    Tool,
+    /// The program decimals.
+    Decimals,
+}
+
+/// A wrong value in a description: where, and what.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Invalid {
+    pub(super) place: Place,
+    pub(super) message: String,
+}
+
+fn invalid(place: Place, message: impl Into<String>) -> Invalid {
+    Invalid {
+        place,
+        message: message.into(),
+    }
+}
+
+/// Whether `name` is a plain name: letters, digits, `_`, `-` (safe as a
+/// file name).
+pub(crate) fn is_plain_name(name: &str) -> bool {
+    !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+}
+
+fn kind_of(f: SpecFactor) -> FactorKind {
+    match f {
+        SpecFactor::Tx => FactorKind::Tx,
+        SpecFactor::Ty => FactorKind::Ty,
+        SpecFactor::Tz => FactorKind::Tz,
+        SpecFactor::Rx => FactorKind::Rx,
+        SpecFactor::Ry => FactorKind::Ry,
+        SpecFactor::Rz => FactorKind::Rz,
+    }
+}
+
+/// Compiles the factors of `body`'s chain (`None`: the tool's).
+fn compile_chain(
+    info: &MachineInfo,
+    body: Option<&str>,
+    factors: &[FactorSpec],
+) -> Result<Chain, Invalid> {
+    let owner = body.map(str::to_owned);
+    if factors.is_empty() {
+        let whose = body.map_or("the tool chain".to_owned(), |b| format!("body {b}'s chain"));
+        return Err(invalid(
+            Place::Chain(owner),
+            format!("{whose} has no factors"),
+        ));
+    }
+    let mut b = Chain::builder();
+    // Axes take the machine's order.
+    for a in &info.axes {
+        if factors.iter().any(|f| f.axis.as_deref() == Some(&a.name)) {
+            b = b.declare(&a.name);
+        }
+    }
+    for (i, f) in factors.iter().enumerate() {
+        let at = |key| Place::Factor(owner.clone(), i, key);
+        let kind = kind_of(f.factor);
+        let word = format!("{kind:?}").to_lowercase();
+        let finite = |v: Real, key| {
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(invalid(
+                    at(key),
+                    format!("factor {word}: {key} = {v} is not a finite number"),
+                ))
+            }
+        };
+        match (&f.axis, &f.constant) {
+            (Some(name), None) => {
+                let axis = info.axis(name).ok_or_else(|| {
+                    invalid(
+                        at("axis"),
+                        format!(
+                            "chain names axis '{name}', which is not declared (axes: {})",
+                            info.axes
+                                .iter()
+                                .map(|a| a.name.as_str())
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        ),
+                    )
+                })?;
+                let expected = if kind.is_rotation() {
+                    AxisKind::Rotary
+                } else {
+                    AxisKind::Linear
+                };
+                if axis.kind != expected {
+                    return Err(invalid(
+                        at("axis"),
+                        format!(
+                            "axis {} is {} but factor {word} needs a {} axis",
+                            axis.name,
+                            axis.kind.word(),
+                            expected.word()
+                        ),
+                    ));
+                }
+                let scale = finite(f.scale, "scale")?;
+                if scale == 0.0 {
+                    return Err(invalid(at("scale"), "scale must not be 0"));
+                }
+                b = b.axis_scaled(kind, name, scale, finite(f.offset, "offset")?);
+            }
+            (None, Some(c)) => {
+                let v = info.constants.get(c).copied().ok_or_else(|| {
+                    invalid(
+                        at("constant"),
+                        format!("factor {word}: no machine constant '{c}'"),
+                    )
+                })?;
+                b = b.constant(kind, finite(v, "constant")?);
+            }
+            (None, None) => b = b.constant(kind, finite(f.offset, "value")?),
+            (Some(_), Some(_)) => {
+                return Err(invalid(
+                    at("axis"),
+                    "a factor has either an axis or a constant value, not both",
+                ))
+            }
+        }
+    }
+    b.build()
+        .map_err(|e| invalid(Place::Chain(owner), e.to_string()))
+}
+
+/// Checks the description's axes, decimals and tool frame.
+fn check_axes(info: &MachineInfo) -> Result<ToolFrame, Invalid> {
+    for (i, a) in info.axes.iter().enumerate() {
+        let at = |key| Place::Axis(i, key);
+        let name = &a.name;
+        if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+            return Err(invalid(
+                at("name"),
+                format!("axis name '{name}' must be letters, digits or _"),
+            ));
+        }
+        if info.axes[..i].iter().any(|b| &b.name == name) {
+            return Err(invalid(
+                at("name"),
+                format!("axis '{name}' is declared twice"),
+            ));
+        }
+        for (v, key) in [(a.min, "min"), (a.max, "max"), (a.max_feed, "max_feed")] {
+            if !v.is_finite() {
+                return Err(invalid(
+                    at(key),
+                    format!("axis {name}: {key} = {v} is not a finite number"),
+                ));
+            }
+        }
+        if a.min >= a.max {
+            return Err(invalid(
+                at("max"),
+                format!("axis {name}: travel max must exceed min"),
+            ));
+        }
+        if a.max_feed <= 0.0 {
+            return Err(invalid(
+                at("name"),
+                format!("axis {name}: the maximum feed must be > 0"),
+            ));
+        }
+        for (v, key, wanted) in [
+            (a.moves, "moves", a.kind == AxisKind::Linear),
+            (a.turns, "turns", a.kind == AxisKind::Rotary),
+        ] {
+            match (v, wanted) {
+                (Some(x), true) => {
+                    let x = Vec3::from(x);
+                    if !x.iter().all(|c| c.is_finite()) || x.norm() == 0.0 {
+                        return Err(invalid(
+                            at(key),
+                            format!("axis {name}: {key} must be a finite, non-zero vector"),
+                        ));
+                    }
+                }
+                (Some(_), false) => {
+                    return Err(invalid(
+                        at(key),
+                        format!("axis {name}: key '{key}' does not apply to a {} axis", a.kind.word()),
+                    ))
+                }
+                (None, true) => {
+                    return Err(invalid(
+                        at("name"),
+                        format!("axis {name}: state its sign with '{key}' (the tool's motion in the part frame for a positive move)"),
+                    ))
+                }
+                (None, false) => {}
+            }
+        }
+        if a.kind == AxisKind::Spindle && a.programmed {
+            return Err(invalid(
+                at("name"),
+                format!("spindle {name} cannot be programmed as a position"),
+            ));
+        }
+    }
+    if let Some(d) = info.program_decimals {
+        if d > 6 {
+            return Err(invalid(
+                Place::Decimals,
+                format!("program_decimals = {d} must be 0 to 6"),
+            ));
+        }
+    }
+    let (p, a) = (info.tool.point, info.tool.axis);
+    if p.iter().chain(&a).any(|v| !v.is_finite()) {
+        return Err(invalid(Place::Tool, "tool point and axis must be finite"));
+    }
+    let axis = Vec3::from(a);
+    if axis.norm() == 0.0 {
+        return Err(invalid(Place::Tool, "tool axis must not be zero"));
+    }
+    Ok(ToolFrame {
+        point: Point3::from(p),
+        axis: axis.normalize(),
+    })
+}
+
+/// Checks a body's name and shape.
+fn check_body(info: &MachineInfo, b: &BodySpec) -> Result<(), Invalid> {
+    if !is_plain_name(&b.name) {
+        return Err(invalid(
+            Place::Body(b.name.clone(), "name"),
+            format!(
+                "body name '{}' must be a plain name (letters, digits, _ or -)",
+                b.name
+            ),
+        ));
+    }
+    match &b.shape {
+        None => Ok(()),
+        Some(BodyShape::Roller { radius, length }) => {
+            for (q, what) in [(radius, "radius"), (length, "length")] {
+                let v = q.resolve(&info.constants).map_err(|m| {
+                    invalid(
+                        Place::Body(b.name.clone(), "shape"),
+                        format!("body {}: {what}: {m}", b.name),
+                    )
+                })?;
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(invalid(
+                        Place::Body(b.name.clone(), "shape"),
+                        format!("body {}: {what} = {v} must be > 0", b.name),
+                    ));
+                }
+            }
+            Ok(())
+        }
+    }
+}
+
+/// The stated sign of axis `a` against the chain that moves it: `Ok` if
+/// it holds, else the key (`moves`, `turns`, `name`, `body`) and the message.
+fn sign_error(m: &Machine, a: &Axis) -> Result<(), (&'static str, String)> {
+    if a.kind == AxisKind::Spindle {
+        let used = std::iter::once(&m.chain)
+            .chain(m.bodies.values().map(|b| &b.chain))
+            .any(|c| c.axis_index(&a.name).is_some());
+        if used {
+            return Err((
+                "name",
+                format!("spindle {} cannot be bound in a chain", a.name),
+            ));
+        }
+        return Ok(());
+    }
+    let (chain, origin) = match &a.body {
+        None => (&m.chain, m.tool.point),
+        Some(b) => match m.bodies.get(b) {
+            Some(body) => (&body.chain, Point3::origin()),
+            None => {
+                return Err((
+                    "body",
+                    format!(
+                        "axis {}: no body '{b}' (declare [[bodies.{b}.chain]])",
+                        a.name
+                    ),
+                ))
+            }
+        },
+    };
+    let Some(i) = chain.axis_index(&a.name) else {
+        let whose = a.body.as_deref().unwrap_or("tool");
+        return Err((
+            "name",
+            format!("axis {} is not bound in the {whose} chain", a.name),
+        ));
+    };
+    let travel = m.travel_of(chain).map_err(|e| ("name", e.to_string()))?;
+    let q0: Vec<Real> = travel
+        .iter()
+        .map(|&(lo, hi)| 0.0_f64.clamp(lo, hi))
+        .collect();
+    let f0 = chain.frame_unchecked(&q0);
+    let mut q1 = q0.clone();
+    match a.kind {
+        AxisKind::Linear => {
+            q1[i] += 1.0;
+            let d =
+                chain.frame_unchecked(&q1).transform_point(&origin) - f0.transform_point(&origin);
+            let stated = Vec3::from(a.moves.unwrap_or_default());
+            if (d - stated).norm() > 1e-9 {
+                return Err((
+                    "moves",
+                    format!("axis {}: moves = [{}, {}, {}] but the chain moves it by [{:.6}, {:.6}, {:.6}]", a.name, stated.x, stated.y, stated.z, d.x, d.y, d.z),
+                ));
+            }
+        }
+        _ => {
+            let h = 1e-6;
+            q1[i] += h;
+            let r = chain.frame_unchecked(&q1).rot * f0.rot.transpose();
+            let w = Vec3::new(
+                r[(2, 1)] - r[(1, 2)],
+                r[(0, 2)] - r[(2, 0)],
+                r[(1, 0)] - r[(0, 1)],
+            ) / (2.0 * h);
+            let stated = Vec3::from(a.turns.unwrap_or_default()).normalize();
+            if (w - stated).norm() > 1e-5 {
+                return Err((
+                    "turns",
+                    format!("axis {}: turns = [{}, {}, {}] but the chain turns it about [{:.4}, {:.4}, {:.4}]", a.name, stated.x, stated.y, stated.z, w.x, w.y, w.z),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Checks the bodies and compiles their chains.
+fn compile_bodies(info: &MachineInfo) -> Result<BTreeMap<String, Body>, Invalid> {
+    let mut bodies = BTreeMap::new();
+    for b in &info.bodies {
+        check_body(info, b)?;
+        if bodies.contains_key(&b.name) {
+            return Err(invalid(
+                Place::Body(b.name.clone(), "name"),
+                format!("body '{}' is declared twice", b.name),
+            ));
+        }
+        let chain = compile_chain(info, Some(&b.name), &b.chain)?;
+        bodies.insert(
+            b.name.clone(),
+            Body {
+                spec: b.clone(),
+                chain,
+            },
+        );
+    }
+    Ok(bodies)
+}
+
+/// Checks that the solved and driven axes are programmed axes.
+fn check_capabilities(info: &MachineInfo) -> Result<(), Invalid> {
+    for s in info.solved_axes.iter().chain(&info.driven_axes) {
+        if !info.axis(s).is_some_and(Axis::is_programmed) {
+            return Err(invalid(
+                Place::Chain(None),
+                format!("'{s}' is not a programmed axis of the machine"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn described(info: &MachineInfo, e: Invalid) -> MachineError {
+    MachineError::Description {
+        machine: info.name.clone(),
+        message: e.message,
+    }
+}
+
+/// The other moving bodies of a machine, their chains compiled from its
+/// description.
+///
+/// # Failures
+/// As [`check_description`].
+pub fn bodies_of(info: &MachineInfo) -> Result<Vec<Body>, MachineError> {
+    compile_bodies(info)
+        .map(|b| b.into_values().collect())
+        .map_err(|e| described(info, e))
+}
+
+/// Checks a machine's description as far as it goes: its axes, the axes it
+/// solves and takes from the toolpath, its bodies; and, when it states its
+/// tool's chain, the axes' signs against the chains ([`Machine::from_info`]).
+///
+/// # Failures
+/// [`MachineError::Description`] naming the axis, factor or body.
+pub fn check_description(info: &MachineInfo) -> Result<(), MachineError> {
+    if !info.chain.is_empty() {
+        return Machine::from_info(info.clone()).map(|_| ());
+    }
+    check_axes(info)
+        .and_then(|_| check_capabilities(info))
+        .and_then(|_| compile_bodies(info).map(|_| ()))
+        .map_err(|e| described(info, e))
+}
+
+impl Machine {
+    /// Checks and compiles a description; the one path of machine files and
+    /// plugin descriptors.
+    pub(super) fn compile(info: MachineInfo) -> Result<Machine, Invalid> {
+        let tool = check_axes(&info)?;
+        let chain = compile_chain(&info, None, &info.chain)?;
+        let bodies = compile_bodies(&info)?;
+        check_capabilities(&info)?;
+        let machine = Machine {
+            info,
+            chain,
+            tool,
+            bodies,
+        };
+        for (i, a) in machine.info.axes.iter().enumerate() {
+            sign_error(&machine, a).map_err(|(key, m)| invalid(Place::Axis(i, key), m))?;
+        }
+        Ok(machine)
+    }
+
+    /// A machine from its description: a plugin's descriptor, or one built
+    /// in code. Checked as a machine file is: axis names, travel, feeds, the
+    /// stated signs against the chains, bodies and their shapes.
+    ///
+    /// # Failures
+    /// [`MachineError::Description`] naming the axis, factor or body.
+    pub fn from_info(info: MachineInfo) -> Result<Machine, MachineError> {
+        let name = info.name.clone();
+        Self::compile(info).map_err(|e| MachineError::Description {
+            machine: name,
+            message: e.message,
+        })
+    }
+}

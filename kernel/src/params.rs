@@ -1,0 +1,341 @@
+//! A part family's parameters: their specs (name, default, unit, doc, the
+//! machine constant a default may come from) and the resolution of values
+//! from the defaults, a machine's constants and the sources a caller gives
+//! (a TOML file's table, `NAME=VALUE` pairs), each labelled by the caller
+//! (`--set`, a file's name) for messages. Nothing here knows how a family
+//! is written.
+
+use crate::math::Real;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// A parameter's value.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum ParamValue {
+    /// A whole number.
+    Int(i64),
+    /// A number.
+    Float(f64),
+    /// Yes or no.
+    Bool(bool),
+    /// Text.
+    Text(String),
+    /// A list of numbers.
+    List(Vec<f64>),
+}
+
+/// Parameter values by name.
+pub type Params = BTreeMap<String, ParamValue>;
+
+impl ParamValue {
+    /// What kind of value it is, in words (`a whole number`, ...).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::Int(_) => "a whole number",
+            Self::Float(_) => "a number",
+            Self::Bool(_) => "true or false",
+            Self::Text(_) => "text",
+            Self::List(_) => "a list of numbers",
+        }
+    }
+
+    /// The number, if the value is one (whole or not).
+    pub fn as_number(&self) -> Option<Real> {
+        match self {
+            Self::Int(i) => Some(*i as Real),
+            Self::Float(f) => Some(*f),
+            _ => None,
+        }
+    }
+
+    /// The value of a machine constant, of the same kind as `like`: a
+    /// number as it is, a whole number if it is one, true/false as not 0/0.
+    ///
+    /// # Failures
+    /// A kind a constant cannot give (text, a list), or a fractional value
+    /// for a whole number.
+    pub fn from_constant(x: Real, like: &ParamValue) -> Result<Self, String> {
+        match like {
+            Self::Float(_) => Ok(Self::Float(x)),
+            Self::Int(_) if x.fract() == 0.0 && x.abs() < 9e15 => Ok(Self::Int(x as i64)),
+            Self::Bool(_) => Ok(Self::Bool(x != 0.0)),
+            _ => Err(format!("{x} is not {}", like.kind())),
+        }
+    }
+
+    /// The value of a TOML value, of the same kind as `like`.
+    fn from_toml(v: &toml::Value, like: &ParamValue) -> Result<Self, String> {
+        let got = || format!("expected {}, got {v}", like.kind());
+        Ok(match (like, v) {
+            (Self::Int(_), toml::Value::Integer(i)) => Self::Int(*i),
+            (Self::Float(_), toml::Value::Float(f)) => Self::Float(*f),
+            (Self::Float(_), toml::Value::Integer(i)) => Self::Float(*i as f64),
+            (Self::Bool(_), toml::Value::Boolean(b)) => Self::Bool(*b),
+            (Self::Text(_), toml::Value::String(s)) => Self::Text(s.clone()),
+            (Self::List(_), toml::Value::Array(a)) => Self::List(
+                a.iter()
+                    .map(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64)))
+                    .collect::<Option<Vec<_>>>()
+                    .ok_or_else(got)?,
+            ),
+            _ => return Err(got()),
+        })
+    }
+
+    /// The value of a `NAME=VALUE` text, of the same kind as `like`.
+    fn parse(text: &str, like: &ParamValue) -> Result<Self, String> {
+        let t = text.trim();
+        let bad = || format!("'{text}' is not {}", like.kind());
+        Ok(match like {
+            Self::Int(_) => Self::Int(t.parse().map_err(|_| bad())?),
+            Self::Float(_) => Self::Float(t.parse().map_err(|_| bad())?),
+            Self::Bool(_) => Self::Bool(t.parse().map_err(|_| bad())?),
+            Self::Text(_) => Self::Text(text.to_owned()),
+            Self::List(_) => Self::List(
+                t.trim_matches(|c| c == '[' || c == ']')
+                    .split(',')
+                    .filter(|s| !s.trim().is_empty())
+                    .map(|s| s.trim().parse::<f64>().map_err(|_| bad()))
+                    .collect::<Result<_, _>>()?,
+            ),
+        })
+    }
+
+    fn check_finite(&self) -> Result<(), String> {
+        match self {
+            Self::Float(f) if !f.is_finite() => Err(format!("{f} is not a finite number")),
+            Self::List(v) if v.iter().any(|x| !x.is_finite()) => {
+                Err("the list holds a value that is not finite".into())
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+impl std::fmt::Display for ParamValue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Int(i) => write!(f, "{i}"),
+            Self::Float(x) => write!(f, "{x}"),
+            Self::Bool(b) => write!(f, "{b}"),
+            Self::Text(s) => write!(f, "\"{s}\""),
+            Self::List(v) => write!(f, "{v:?}"),
+        }
+    }
+}
+
+/// One parameter of a family.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ParamSpec {
+    /// Its name.
+    pub name: String,
+    /// The default.
+    pub default: ParamValue,
+    /// Its unit (may be empty).
+    pub unit: String,
+    /// One line of description.
+    pub doc: String,
+    /// The machine constant that gives its default on a machine that has
+    /// it, if any.
+    #[serde(default)]
+    pub machine: Option<String>,
+}
+
+/// Where parameter values come from, in the order they apply (a later
+/// source wins). `label` names the source in messages: `--set`, a file's
+/// name.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ParamSource {
+    /// A TOML table of `name = value`.
+    Toml {
+        /// The source's name in messages.
+        label: String,
+        /// The TOML text.
+        text: String,
+    },
+    /// `NAME=VALUE` pairs as typed.
+    Pairs {
+        /// The source's name in messages.
+        label: String,
+        /// The pairs.
+        pairs: Vec<(String, String)>,
+    },
+}
+
+/// A parameter that cannot be resolved.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ParamError {
+    /// A source that cannot be read (a TOML syntax error).
+    #[error("{source_name}: {message}")]
+    Source {
+        /// The source.
+        source_name: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A parameter given that the family does not have.
+    #[error("unknown parameter '{name}' from {source_name} (parameters: {known})")]
+    Unknown {
+        /// The name given.
+        name: String,
+        /// Where it was given (`--set`, a file).
+        source_name: String,
+        /// The family's parameters.
+        known: String,
+    },
+    /// A parameter value of the wrong kind.
+    #[error("parameter '{name}' from {source_name}: {message}")]
+    Bad {
+        /// The parameter.
+        name: String,
+        /// Where it was given.
+        source_name: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// The values of the parameters `specs`: defaults (a machine constant's
+/// value for a parameter tied to one that `constants` has), then each
+/// source in order.
+///
+/// # Failures
+/// A TOML syntax error; an unknown name (listing the valid ones); a value
+/// of another kind than the default's, or not finite; a machine constant
+/// that is not of its parameter's kind (a whole number, say), naming both.
+pub fn resolve(
+    specs: &[ParamSpec],
+    constants: &BTreeMap<String, Real>,
+    sources: &[ParamSource],
+) -> Result<Params, ParamError> {
+    let mut values = BTreeMap::new();
+    for s in specs {
+        let value = match s
+            .machine
+            .as_ref()
+            .and_then(|m| Some((m, constants.get(m)?)))
+        {
+            Some((m, &x)) => {
+                ParamValue::from_constant(x, &s.default).map_err(|message| ParamError::Bad {
+                    name: s.name.clone(),
+                    source_name: format!("the machine's constant {m}"),
+                    message,
+                })?
+            }
+            None => s.default.clone(),
+        };
+        values.insert(s.name.clone(), value);
+    }
+    let spec = |name: &str, source: &str| {
+        specs
+            .iter()
+            .find(|s| s.name == name)
+            .ok_or_else(|| ParamError::Unknown {
+                name: name.to_owned(),
+                source_name: source.to_owned(),
+                known: specs
+                    .iter()
+                    .map(|s| s.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })
+    };
+    let bad = |name: &str, source: &str, message: String| ParamError::Bad {
+        name: name.to_owned(),
+        source_name: source.to_owned(),
+        message,
+    };
+    for source in sources {
+        match source {
+            ParamSource::Toml { label, text } => {
+                let table: toml::Table = toml::from_str(text).map_err(|e| ParamError::Source {
+                    source_name: label.clone(),
+                    message: e.to_string().trim().to_owned(),
+                })?;
+                for (k, v) in &table {
+                    let s = spec(k, label)?;
+                    let value =
+                        ParamValue::from_toml(v, &s.default).map_err(|m| bad(k, label, m))?;
+                    value.check_finite().map_err(|m| bad(k, label, m))?;
+                    values.insert(k.clone(), value);
+                }
+            }
+            ParamSource::Pairs { label, pairs } => {
+                for (k, text) in pairs {
+                    let s = spec(k, label)?;
+                    let value =
+                        ParamValue::parse(text, &s.default).map_err(|m| bad(k, label, m))?;
+                    value.check_finite().map_err(|m| bad(k, label, m))?;
+                    values.insert(k.clone(), value);
+                }
+            }
+        }
+    }
+    Ok(values)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn specs() -> Vec<ParamSpec> {
+        let spec = |name: &str, default, machine: Option<&str>| ParamSpec {
+            name: name.into(),
+            default,
+            unit: String::new(),
+            doc: String::new(),
+            machine: machine.map(str::to_owned),
+        };
+        vec![
+            spec("n", ParamValue::Int(3), None),
+            spec("r", ParamValue::Float(25.0), Some("rest_radius")),
+            spec("on", ParamValue::Bool(true), Some("rest_programs_centre")),
+        ]
+    }
+
+    #[test]
+    fn sources_apply_in_order_and_name_themselves() {
+        let constants = BTreeMap::from([
+            ("rest_radius".to_owned(), 30.0),
+            ("rest_programs_centre".to_owned(), 0.0),
+        ]);
+        let sources = [
+            ParamSource::Toml {
+                label: "p.toml".into(),
+                text: "n = 5\nr = 20".into(),
+            },
+            ParamSource::Pairs {
+                label: "--set".into(),
+                pairs: vec![("r".into(), "22.5".into())],
+            },
+        ];
+        let v = resolve(&specs(), &constants, &sources).unwrap();
+        assert_eq!(v["n"], ParamValue::Int(5));
+        assert_eq!(v["r"], ParamValue::Float(22.5));
+        assert_eq!(v["on"], ParamValue::Bool(false), "from the machine");
+        let e = resolve(
+            &specs(),
+            &constants,
+            &[ParamSource::Pairs {
+                label: "the command line".into(),
+                pairs: vec![("m".into(), "1".into())],
+            }],
+        )
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "unknown parameter 'm' from the command line (parameters: n, r, on)"
+        );
+        let e = resolve(
+            &specs(),
+            &BTreeMap::new(),
+            &[ParamSource::Toml {
+                label: "q.toml".into(),
+                text: "n = ".into(),
+            }],
+        )
+        .unwrap_err();
+        assert!(e.to_string().starts_with("q.toml: "), "{e}");
+    }
+}

@@ -1,0 +1,471 @@
+//! The data the ABI carries as JSON: a machine's descriptor
+//! ([`MachineInfo`]) and the programs posted ([`AxisProgram`], in a
+//! [`PostRequest`]). Both sides use these types, so a plugin needs this
+//! crate only, not the kernel.
+//!
+//! Units are the kernel's: millimetres and radians (degrees only in
+//! programs, where [`ProgramAxis::unit`] says `deg`). Fields are only ever
+//! appended, with defaults, so that a descriptor written by an older plugin
+//! of the same major version still reads.
+
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// What an axis does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AxisKind {
+    /// A slide (mm).
+    Linear,
+    /// A positioned rotary axis (rad inside, degrees in files and programs).
+    Rotary,
+    /// A spindle turning at a speed (rpm), not positioned.
+    Spindle,
+}
+
+impl AxisKind {
+    /// `linear`, `rotary` or `spindle`.
+    pub fn word(self) -> &'static str {
+        match self {
+            Self::Linear => "linear",
+            Self::Rotary => "rotary",
+            Self::Spindle => "spindle",
+        }
+    }
+}
+
+/// One axis of a machine.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Axis {
+    /// The name, as the control's address letter (X, Z, U, A...).
+    pub name: String,
+    /// Linear, rotary or spindle.
+    pub kind: AxisKind,
+    /// Lower travel limit (mm or rad; 0 for a spindle).
+    pub min: f64,
+    /// Upper travel limit (mm or rad; the top speed in rpm for a spindle).
+    pub max: f64,
+    /// Top speed (mm/min or rad/min; rpm for a spindle).
+    pub max_feed: f64,
+    /// Whether blocks carry its position.
+    pub programmed: bool,
+    /// What it moves and which way is positive, in words.
+    #[serde(default)]
+    pub description: String,
+    /// For linear axes: the tool's (or body's) displacement in the part frame
+    /// per unit of the axis, at the home pose: the sign, stated and tested.
+    #[serde(default)]
+    pub moves: Option<[f64; 3]>,
+    /// For rotary axes: the axis the tool (or body) turns about relative to
+    /// the part for a positive value (right-handed), at the home pose.
+    #[serde(default)]
+    pub turns: Option<[f64; 3]>,
+    /// The body it moves: `None` for the tool, else a body's name.
+    #[serde(default)]
+    pub body: Option<String>,
+}
+
+impl Axis {
+    /// A value in file/program units (mm, deg) from kernel units (mm, rad).
+    pub fn to_user(&self, v: f64) -> f64 {
+        if self.kind == AxisKind::Rotary {
+            v.to_degrees()
+        } else {
+            v
+        }
+    }
+
+    /// A value in kernel units (mm, rad) from file/program units (mm, deg):
+    /// the inverse of [`Self::to_user`].
+    pub fn from_user(&self, v: f64) -> f64 {
+        if self.kind == AxisKind::Rotary {
+            v.to_radians()
+        } else {
+            v
+        }
+    }
+
+    /// The unit of [`Self::to_user`] values.
+    pub fn unit(&self) -> &'static str {
+        match self.kind {
+            AxisKind::Linear => "mm",
+            AxisKind::Rotary => "deg",
+            AxisKind::Spindle => "rpm",
+        }
+    }
+
+    /// The unit of feeds.
+    pub fn feed_unit(&self) -> &'static str {
+        match self.kind {
+            AxisKind::Linear => "mm/min",
+            AxisKind::Rotary => "deg/min",
+            AxisKind::Spindle => "rpm",
+        }
+    }
+
+    /// Whether blocks position it (programmed, and not a spindle).
+    pub fn is_programmed(&self) -> bool {
+        self.programmed && self.kind != AxisKind::Spindle
+    }
+}
+
+/// One of the six elementary factors of a transform chain (MATH §1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FactorKind {
+    /// Translation along X (mm).
+    Tx,
+    /// Translation along Y (mm).
+    Ty,
+    /// Translation along Z (mm).
+    Tz,
+    /// Rotation about X (rad), right-handed.
+    Rx,
+    /// Rotation about Y (rad), right-handed.
+    Ry,
+    /// Rotation about Z (rad), right-handed.
+    Rz,
+}
+
+/// A number, or the name of a machine constant that gives it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Quantity {
+    /// The number itself (mm or rad).
+    Value(f64),
+    /// The machine constant of this name (see [`MachineInfo::constants`]).
+    Constant(String),
+}
+
+impl Quantity {
+    /// The number: itself, or the constant's value.
+    ///
+    /// # Failures
+    /// A constant the machine does not have: the message names it.
+    pub fn resolve(&self, constants: &BTreeMap<String, f64>) -> Result<f64, String> {
+        match self {
+            Self::Value(v) => Ok(*v),
+            Self::Constant(name) => constants
+                .get(name)
+                .copied()
+                .ok_or_else(|| format!("no machine constant '{name}'")),
+        }
+    }
+}
+
+/// One factor of a chain as data: a constant (`value`), or bound to an
+/// axis (`scale * axis + offset`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FactorSpec {
+    /// Which elementary factor.
+    pub factor: FactorKind,
+    /// The axis it is bound to, if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis: Option<String>,
+    /// Multiplies the axis value (+1 or -1 for the sign, 0.5 for a
+    /// diameter-programmed lathe X).
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub scale: f64,
+    /// Added after scaling (mm or rad); for a constant factor, its value.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub offset: f64,
+    /// A constant factor whose value is this machine constant (the offset
+    /// is then unused).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub constant: Option<String>,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+fn is_one(v: &f64) -> bool {
+    *v == 1.0
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
+impl FactorSpec {
+    /// A factor bound to `axis` (scale 1, offset 0).
+    pub fn axis(factor: FactorKind, axis: &str) -> Self {
+        Self {
+            factor,
+            axis: Some(axis.to_owned()),
+            scale: 1.0,
+            offset: 0.0,
+            constant: None,
+        }
+    }
+
+    /// A constant factor of `value` (mm or rad).
+    pub fn value(factor: FactorKind, value: f64) -> Self {
+        Self {
+            factor,
+            axis: None,
+            scale: 1.0,
+            offset: value,
+            constant: None,
+        }
+    }
+
+    /// A constant factor whose value is the machine constant `name`.
+    pub fn constant(factor: FactorKind, name: &str) -> Self {
+        Self {
+            factor,
+            axis: None,
+            scale: 1.0,
+            offset: 0.0,
+            constant: Some(name.to_owned()),
+        }
+    }
+}
+
+/// The solid of a moving body, in the body's own frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum BodyShape {
+    /// A cylinder of `radius` and `length`, centred on the body's origin,
+    /// its axis along the body frame's Y (across the part's axial section):
+    /// a steady rest's roller.
+    Roller {
+        /// Radius (mm), or the constant that gives it.
+        radius: Quantity,
+        /// Length (mm), or the constant that gives it.
+        length: Quantity,
+    },
+}
+
+/// A moving body of the machine other than the tool (a steady rest).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BodySpec {
+    /// Its name (a scene node and file name: letters, digits, `_`, `-`).
+    pub name: String,
+    /// What it is, in words.
+    #[serde(default)]
+    pub description: String,
+    /// How reports and plots name the point its origin tracks (e.g.
+    /// `steady rest: support centre`).
+    #[serde(default)]
+    pub label: String,
+    /// The chain placing the body's frame in the part frame, left to right.
+    pub chain: Vec<FactorSpec>,
+    /// Its solid, if it is drawn.
+    #[serde(default)]
+    pub shape: Option<BodyShape>,
+}
+
+/// The tool's tracked point and axis in the tool's own frame, as the
+/// machine's chain defines that frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ToolSpec {
+    /// The point (mm).
+    pub point: [f64; 3],
+    /// The unit axis.
+    pub axis: [f64; 3],
+}
+
+impl Default for ToolSpec {
+    /// The origin and +Z.
+    fn default() -> Self {
+        Self {
+            point: [0.0; 3],
+            axis: [0.0, 0.0, 1.0],
+        }
+    }
+}
+
+/// What a machine says of itself: the descriptor a plugin returns. Besides
+/// its axes it declares its capabilities, as LinuxCNC's kinematics modules
+/// declare theirs: the axes its inverse kinematics solves
+/// ([`Self::solved_axes`]), the axes it takes from the toolpath instead
+/// ([`Self::driven_axes`]) and its other moving bodies ([`Self::bodies`]).
+/// Whether it posts its own programs is the entry table's capability
+/// (`CAP_POST`); without it the host's writer posts them in the dialect of
+/// [`Self::control`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MachineInfo {
+    /// The machine's name.
+    pub name: String,
+    /// A description in words.
+    #[serde(default)]
+    pub description: String,
+    /// The control's dialect: `sinumerik`, `fanuc`.
+    pub control: String,
+    /// All axes (kernel units: mm, rad).
+    pub axes: Vec<Axis>,
+    /// The axes inverse kinematics solves for, in the order of its output rows.
+    pub solved_axes: Vec<String>,
+    /// Named machine constants (mm, rad).
+    #[serde(default)]
+    pub constants: BTreeMap<String, f64>,
+    /// Decimals of axis values in programs, if the machine states them.
+    #[serde(default)]
+    pub program_decimals: Option<usize>,
+    /// Programmed axes the machine does not solve but takes from the
+    /// toolpath, which must drive them (a steady rest's U).
+    #[serde(default)]
+    pub driven_axes: Vec<String>,
+    /// Moving bodies other than the tool, placed by their own chains.
+    #[serde(default)]
+    pub bodies: Vec<BodySpec>,
+    /// The tool's chain, tool frame to part frame, when the machine states
+    /// it (the host checks the axes' stated signs against it). Empty if not.
+    #[serde(default)]
+    pub chain: Vec<FactorSpec>,
+    /// The tool frame the chain places.
+    #[serde(default)]
+    pub tool: ToolSpec,
+}
+
+impl MachineInfo {
+    /// The axis called `name`.
+    pub fn axis(&self, name: &str) -> Option<&Axis> {
+        self.axes.iter().find(|a| a.name == name)
+    }
+
+    /// The body called `name`.
+    pub fn body(&self, name: &str) -> Option<&BodySpec> {
+        self.bodies.iter().find(|b| b.name == name)
+    }
+}
+
+/// How a block moves.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum Motion {
+    /// At the machine's rapid traverse.
+    Rapid,
+    /// A straight cut at the block's feed.
+    Linear,
+    /// A thread cut synchronised with the spindle at `lead` mm per turn.
+    Thread {
+        /// Lead (mm per spindle turn).
+        lead: f64,
+    },
+}
+
+/// An axis of a program.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ProgramAxis {
+    /// The address letter.
+    pub name: String,
+    /// `mm` or `deg`.
+    pub unit: String,
+}
+
+/// One block of a program.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Block {
+    /// How the block moves.
+    pub motion: Motion,
+    /// Axis values in program units, in the order of [`AxisProgram::axes`].
+    pub values: Vec<f64>,
+    /// Feed (mm/min) for linear blocks; the lead for thread blocks is in
+    /// the motion; 0 for rapids.
+    pub feed: f64,
+    /// A spindle speed (rpm) set from this block on; `None` keeps the last.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spindle: Option<f64>,
+    /// A comment to print before the block (a pass's name).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub comment: Option<String>,
+}
+
+/// A program for one machine: named axes in program units (mm, degrees)
+/// and blocks.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AxisProgram {
+    /// The program's name (letters, digits, `_`).
+    pub name: String,
+    /// The program number (Fanuc `O` word).
+    pub number: u32,
+    /// The machine's name.
+    pub machine: String,
+    /// The control's dialect.
+    pub control: String,
+    /// The tool's number.
+    pub tool_number: u32,
+    /// The tool's name.
+    pub tool_name: String,
+    /// Spindle speed (rpm).
+    pub spindle_rpm: f64,
+    /// Decimals of axis values, if the machine states them (else the
+    /// dialect's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub decimals: Option<usize>,
+    /// The programmed axes.
+    pub axes: Vec<ProgramAxis>,
+    /// The blocks.
+    pub blocks: Vec<Block>,
+}
+
+impl AxisProgram {
+    /// The values of axis `name` over all blocks, in program units.
+    pub fn column(&self, name: &str) -> Option<Vec<f64>> {
+        let i = self.axes.iter().position(|a| a.name == name)?;
+        Some(self.blocks.iter().map(|b| b.values[i]).collect())
+    }
+}
+
+/// What the host sends a plugin's `post`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PostRequest {
+    /// The dialect (`sinumerik`, `fanuc`, `cld`).
+    pub dialect: String,
+    /// The program.
+    pub program: AxisProgram,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A descriptor of ABI 1.0 (without the fields 1.1 appended) still reads.
+    #[test]
+    fn a_1_0_descriptor_reads_with_defaults() {
+        let text = r#"{"name":"lathe","control":"fanuc","axes":[
+            {"name":"X","kind":"linear","min":-10.0,"max":400.0,"max_feed":8000.0,"programmed":true,
+             "description":"","moves":[0.5,0.0,0.0],"turns":null,"body":null}],
+            "solved_axes":["X"]}"#;
+        let info: MachineInfo = serde_json::from_str(text).unwrap();
+        assert!(info.bodies.is_empty() && info.chain.is_empty());
+        assert_eq!(info.tool, ToolSpec::default());
+        assert_eq!(info.axis("X").unwrap().moves, Some([0.5, 0.0, 0.0]));
+    }
+
+    #[test]
+    fn quantities_and_factors_read_as_numbers_or_names() {
+        let q: Vec<Quantity> = serde_json::from_str(r#"[25.0, "rest_radius"]"#).unwrap();
+        let constants = BTreeMap::from([("rest_radius".to_owned(), 30.0)]);
+        assert_eq!(q[0].resolve(&constants), Ok(25.0));
+        assert_eq!(q[1].resolve(&constants), Ok(30.0));
+        assert!(Quantity::Constant("b".into())
+            .resolve(&constants)
+            .unwrap_err()
+            .contains("'b'"));
+        let f = FactorSpec::constant(FactorKind::Tz, "rest_offset_b");
+        let text = serde_json::to_string(&f).unwrap();
+        assert_eq!(text, r#"{"factor":"tz","constant":"rest_offset_b"}"#);
+        assert_eq!(serde_json::from_str::<FactorSpec>(&text).unwrap(), f);
+    }
+
+    #[test]
+    fn units_round_trip() {
+        let a = Axis {
+            name: "A".into(),
+            kind: AxisKind::Rotary,
+            min: -1.0,
+            max: 1.0,
+            max_feed: 1.0,
+            programmed: true,
+            description: String::new(),
+            moves: None,
+            turns: Some([0.0, 0.0, 1.0]),
+            body: None,
+        };
+        assert!((a.from_user(a.to_user(0.3)) - 0.3).abs() < 1e-15);
+        assert_eq!(a.unit(), "deg");
+    }
+}
