@@ -35,9 +35,22 @@ run_all "$root/target/release/pilgrim" "$root" "$work/new"
 status=0
 for j in "${jobs[@]}"; do
   name=${j%%|*}
-  for f in $(cd "$work/base/$name" && ls) $(cd "$work/new/$name" && ls); do
+  for f in $( (cd "$work/base/$name" && ls; cd "$work/new/$name" && ls) | sort -u); do
     if ! cmp -s "$work/base/$name/$f" "$work/new/$name/$f"; then
-      echo "differs: $name/$f"; status=1
+      status=1
+      case "$f" in
+        *.csv)
+          if python3 -c 'import csv,sys; r=lambda p: list(csv.reader(open(p))); sys.exit(r(sys.argv[1]) != r(sys.argv[2]))' \
+              "$work/base/$name/$f" "$work/new/$name/$f"; then
+            echo "differs: $name/$f (bytes only: the same CSV records)"
+          else
+            echo "differs: $name/$f (records)"
+          fi ;;
+        *.json)
+          echo "differs: $name/$f:"
+          diff "$work/base/$name/$f" "$work/new/$name/$f" | sed 's/^/    /' | head -20 ;;
+        *) echo "differs: $name/$f" ;;
+      esac
     fi
   done
 done

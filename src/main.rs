@@ -59,9 +59,10 @@ enum Command {
         /// Default: the first block of the last pass.
         #[arg(long, value_name = "N")]
         pose_block: Option<usize>,
-        /// Chordal tolerance of the 3-D models (mm).
-        #[arg(long, default_value_t = pilgrim_kernel::mesh::DEFAULT_TOLERANCE)]
-        tolerance: f64,
+        /// Chordal tolerance of the 3-D models (mm); the family's own
+        /// tolerances are parameters (--set).
+        #[arg(long, value_name = "MM", default_value_t = pilgrim_kernel::mesh::DEFAULT_TOLERANCE)]
+        mesh_tolerance: f64,
         /// Write the STL files as ASCII instead of binary.
         #[arg(long)]
         stl_ascii: bool,
@@ -240,7 +241,7 @@ fn main() -> ExitCode {
             machine,
             out,
             pose_block,
-            tolerance,
+            mesh_tolerance,
             stl_ascii,
             gltf,
         } => run::run(
@@ -250,7 +251,7 @@ fn main() -> ExitCode {
                     gltf: *gltf,
                 },
                 pose_block: *pose_block,
-                mesh_tolerance: *tolerance,
+                mesh_tolerance: *mesh_tolerance,
                 script: script.clone(),
                 params: params.clone(),
                 sets: sets.clone(),

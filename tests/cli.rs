@@ -335,7 +335,7 @@ fn bad_input_is_refused_and_nothing_is_written() {
         .collect();
     assert_eq!(leftovers.len(), 2, "{leftovers:?}");
     // A tolerance that is not positive, a pose block beyond the program.
-    let (code, _, err) = pilgrim(&["run", DEMO, "--tolerance", "0", "--out", s(&out)]);
+    let (code, _, err) = pilgrim(&["run", DEMO, "--mesh-tolerance", "0", "--out", s(&out)]);
     assert_eq!(code, 1);
     assert!(err.contains("chordal tolerance must be > 0"), "{err}");
     let (code, _, err) = pilgrim(&["run", DEMO, "--pose-block", "9999", "--out", s(&out)]);

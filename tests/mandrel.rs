@@ -236,7 +236,7 @@ fn bad_mandrel_parameters_are_refused_and_nothing_is_written() {
         (vec!["n=0"], "mandrel n must be > 0, got 0"),
         (vec!["stock=-0.1"], "the stock is not negative"),
         (
-            vec!["n=30", "wheel_r=60", "wheel_w=130"],
+            vec!["n=30", "rounding_r=60", "wheel_w=130"],
             "tool radius 60 mm exceeds the profile's radius of curvature",
         ),
         (vec!["rest_r=140"], "axis U at 1"),
@@ -264,7 +264,7 @@ fn bad_mandrel_parameters_are_refused_and_nothing_is_written() {
         );
     }
     // The wheel too round is refused naming the places, near the law's end.
-    let (_, err) = run(&["n=30", "wheel_r=60", "wheel_w=130"]);
+    let (_, err) = run(&["n=30", "rounding_r=60", "wheel_w=130"]);
     assert!(err.contains("z = 39"), "{err}");
     // U beyond its travel names the block.
     let (_, err) = run(&["rest_r=140"]);

@@ -198,12 +198,11 @@ fn files_only_inside_the_input_directories() {
 fn transforms_in_scripts_follow_the_universal_chain() {
     let src = format!(
         "{HEAD}fn toolpath(p) {{\n\
-           let a = universal([3.0, 4.0, 5.0, 90.0, 1.0, 2.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);\n\
-           let b = transform(\"tx\", 1.0) * transform(\"ty\", 2.0) * transform(\"tz\", 0.5) * transform(\"rz\", 90.0)\n\
-                 * transform(\"tx\", 3.0) * transform(\"ty\", 4.0) * transform(\"tz\", 5.0);\n\
+           let a = universal_deg([3.0, 4.0, 5.0, 90.0, 1.0, 2.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);\n\
+           let b = tx(1.0) * ty(2.0) * tz(0.5) * rz_deg(90.0) * tx(3.0) * ty(4.0) * tz(5.0);\n\
            let r = 8.0; let beta = linspace(0.0, 6.0, 7);\n\
-           let pa = apply(a, cos(beta) * r, sin(beta) * r, filled(7, 2.0));\n\
-           let pb = apply(b, cos(beta) * r, sin(beta) * r, filled(7, 2.0));\n\
+           let pa = a.apply(cos(beta) * r, sin(beta) * r, filled(7, 2.0));\n\
+           let pb = b.apply(cos(beta) * r, sin(beta) * r, [2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0]);\n\
            let tp = new_toolpath(\"t\", end_mill(\"m\", 1, 6.0, 10.0), 1000.0, []);\n\
            tp.add_pass(\"a\", #{{ x: pa.x, y: pa.y, z: pa.z, feed: 100.0 }});\n\
            tp.add_pass(\"b\", #{{ x: pb.x, y: pb.y, z: pb.z, feed: 100.0 }});\n\
@@ -232,14 +231,17 @@ fn transforms_in_scripts_follow_the_universal_chain() {
         }
     }
     let e = family(&format!(
-        "{HEAD}fn toolpath(p) {{ transform(\"rw\", 1.0) }}"
+        "{HEAD}fn toolpath(p) {{ universal_deg([1.0, 2.0]) }}"
     ))
     .unwrap();
     let text = e
         .toolpath(&values(&e, None, &[]).unwrap())
         .unwrap_err()
         .to_string();
-    assert!(text.contains("not 'rw'"), "{text}");
+    assert!(
+        text.contains("universal_deg needs 15 values, got 2"),
+        "{text}"
+    );
 }
 
 /// The segment builder, adaptive spacing and the rest's track from a
@@ -254,11 +256,12 @@ fn mandrel_building_blocks_in_scripts() {
            let law = mandrel_law(38.0, 52.0, 400.0, 0.012, 2.3);\n\
            let part = profile_start(-350.0, 19.0 - 350.0 * 0.006).line_to(0.0, 19.0).law(law)\n\
                         .line_to(500.0, 26.0 + 100.0 * 0.0324).build(0.00001, 0.05);\n\
-           let e = equidistant(part, 20.0, \"outside\");\n\
-           let k = simplify(e.z, e.x, 0.0005);\n\
+           let wheel = wheel_tool(\"w\", 1, 500.0, 20.0, 50.0);\n\
+           let e = equidistant(part, wheel, \"outside\");\n\
+           let k = e.path.simplified(0.0005);\n\
            let stock = profile_start(-700.0, 30.0).cylinder(1600.0).build(0.001, 1.0);\n\
-           let rest = rest_track(stock, k.z, k.x, 20.0, 25.0, -150.0);\n\
-           let tp = new_toolpath(\"m\", wheel_tool(\"w\", 1, 500.0, 20.0, 50.0), 399.0, [\"U\"]);\n\
+           let rest = rest_track(stock, k, wheel, steady_rest(25.0, -150.0, 0.05, 1e-5));\n\
+           let tp = new_toolpath(\"m\", wheel, 399.0, [\"U\"]);\n\
            tp.add_pass(\"finish\", #{{ x: k.x, y: 0.0, z: k.z, feed: 2000.0, aux: #{{ U: rest.centre_x }} }});\n\
            tp\n}}"
     );
@@ -305,4 +308,70 @@ fn mandrel_building_blocks_in_scripts() {
         .unwrap_err()
         .to_string();
     assert!(text.contains("\"out\" or \"in\""), "{text}");
+}
+
+/// The API as a writer guesses it: arrays and Floats alike, typed results
+/// whose misspelt property is an error where it is written, the profile's
+/// value at a z (`x_at`, since `eval` is reserved), the wheel's dimensions
+/// from its tool.
+#[test]
+fn the_api_takes_arrays_and_gives_typed_results() {
+    let src = format!(
+        "{HEAD}fn toolpath(p) {{\n\
+           let a = profile([0.0, 1.0, 2.0], floats([1.0, 2.0, 3.0]));\n\
+           if a.x_at(1.5) != 2.5 {{ throw `x_at ${{a.x_at(1.5)}}`; }}\n\
+           let wheel = wheel_tool(\"w\", 1, 500.0, 20.0, 50.0);\n\
+           if wheel.rounding_radius != 20.0 || wheel.width != 50.0 {{ throw \"tool\"; }}\n\
+           let c = concat([1.0, 2.0], floats([3.0]));\n\
+           if c.len != 3 {{ throw \"concat\"; }}\n\
+           let e = equidistant(a, wheel, \"outside\");\n\
+           e.slop\n\
+         }}"
+    );
+    let fam = family(&src).unwrap();
+    let e = fam
+        .toolpath(&values(&fam, None, &[]).unwrap())
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("t.rhai:10:"), "{e}");
+    assert!(e.contains("Unknown property 'slop'"), "{e}");
+    // A wheel function given another tool says so.
+    let src = format!(
+        "{HEAD}fn toolpath(p) {{\n  let m = end_mill(\"m\", 1, 6.0, 10.0);\n  m.rounding_radius\n}}"
+    );
+    let fam = family(&src).unwrap();
+    let e = fam
+        .toolpath(&values(&fam, None, &[]).unwrap())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("tool 'm' is not a grinding wheel"), "{e}");
+}
+
+/// A table's columns are read by header when asked for: a column of notes
+/// is fine, a misspelt column lists the table's.
+#[test]
+fn tables_are_read_column_by_column() {
+    let dir = std::env::temp_dir().join(format!("pilgrim-table-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("t.csv"),
+        "theta,Hp,note\n0,10,start\n10,9.5,reduction\n20,9,\n",
+    )
+    .unwrap();
+    let access = Access {
+        input_dirs: vec![dir.clone()],
+    };
+    let src = format!(
+        "{HEAD}fn toolpath(p) {{\n  let t = read_table(\"t.csv\");\n  if t.rows != 3 || t[\"Hp\"][1] != 9.5 {{ throw \"read\"; }}\n  t[\"depth\"]\n}}"
+    );
+    let fam = ScriptFamily::from_source(&src, "f.rhai", &Limits::default(), &access).unwrap();
+    let e = fam
+        .toolpath(&values(&fam, None, &[]).unwrap())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("depth") && e.contains("theta") && e.contains("note"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -66,8 +66,8 @@ pub fn export(
         })
         .collect::<Result<Vec<_>, _>>()?;
     let pose = scene::tool_pose(&program, kin, &toolpath.tool, index)?;
-    let tool = scene::tool_mesh(&toolpath.tool, report.tolerance_mm)?;
-    let others = scene::machine_bodies(kin, &program, index, report.tolerance_mm)?;
+    let tool = scene::tool_mesh(&toolpath.tool, report.mesh_tolerance_mm)?;
+    let others = scene::machine_bodies(kin, &program, index, report.mesh_tolerance_mm)?;
     let (files, bodies) = scene::files(&parts, tool, pose, others, formats)?;
     report.pose_block = Some(index + 1);
     report.bodies = bodies;

@@ -185,7 +185,9 @@ pub fn run(
         ("program.cld".into(), cld_text.into_bytes()),
         (
             "report.csv".into(),
-            block_table(&program, &toolpath).into_bytes(),
+            block_table(&program, &toolpath)
+                .map_err(Error::Output)?
+                .into_bytes(),
         ),
     ];
     stage(STAGES[4]);
@@ -241,7 +243,7 @@ pub fn run(
             .collect(),
         checks,
         pose_block,
-        tolerance_mm: tol,
+        mesh_tolerance_mm: tol,
         bodies,
         axis_ranges: axis_ranges(&program),
         verification: verification.clone(),

@@ -56,7 +56,7 @@ pub struct Report {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pose_block: Option<usize>,
     /// Chordal tolerance of the meshes (mm).
-    pub tolerance_mm: f64,
+    pub mesh_tolerance_mm: f64,
     /// The bodies written as STL.
     #[serde(default)]
     pub bodies: Vec<BodyFile>,
@@ -118,29 +118,39 @@ pub fn cycle_time(program: &AxisProgram, info: &MachineInfo) -> Real {
 }
 
 /// `report.csv`: one row per block: block number, pass, motion, axis
-/// values (the program's decimals), feed.
-pub fn block_table(program: &AxisProgram, toolpath: &Toolpath) -> String {
-    let mut out = String::from("block,pass,motion");
-    for a in &program.axes {
-        out += &format!(",{} ({})", a.name, a.unit);
-    }
-    out += ",feed (mm/min)\n";
-    let names = toolpath
-        .passes
-        .iter()
-        .flat_map(|p| std::iter::repeat_n(p.name.as_str(), p.points.len()));
+/// values (the program's decimals), feed; written by the `csv` crate
+/// (RFC 4180, fields quoted where they need it).
+///
+/// # Failures
+/// The writer failing (it writes to memory).
+pub fn block_table(program: &AxisProgram, toolpath: &Toolpath) -> Result<String, String> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header = vec!["block".to_owned(), "pass".into(), "motion".into()];
+    header.extend(
+        program
+            .axes
+            .iter()
+            .map(|a| format!("{} ({})", a.name, a.unit)),
+    );
+    header.push("feed (mm/min)".into());
+    w.write_record(&header).map_err(|e| e.to_string())?;
     let decimals = program.decimals.unwrap_or(3);
-    for (i, (b, pass)) in program.blocks.iter().zip(names).enumerate() {
-        let motion = match b.motion {
-            Motion::Rapid => "rapid",
-            Motion::Linear => "linear",
-            Motion::Thread { .. } => "thread",
-        };
-        out += &format!("{},\"{}\",{motion}", i + 1, pass.replace('"', "'"));
-        for v in &b.values {
-            out += &format!(",{}", fixed(*v, decimals));
+    for (pass, blocks) in toolpath.pass_ranges() {
+        for i in blocks {
+            let Some(b) = program.blocks.get(i) else {
+                break;
+            };
+            let motion = match b.motion {
+                Motion::Rapid => "rapid",
+                Motion::Linear => "linear",
+                Motion::Thread { .. } => "thread",
+            };
+            let mut row = vec![(i + 1).to_string(), pass.name.clone(), motion.to_owned()];
+            row.extend(b.values.iter().map(|v| fixed(*v, decimals)));
+            row.push(fixed(b.feed, 1));
+            w.write_record(&row).map_err(|e| e.to_string())?;
         }
-        out += &format!(",{}\n", fixed(b.feed, 1));
     }
-    out
+    let bytes = w.into_inner().map_err(|e| e.to_string())?;
+    String::from_utf8(bytes).map_err(|e| e.to_string())
 }

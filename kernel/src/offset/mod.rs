@@ -59,6 +59,16 @@ pub struct Equidistant {
     pub side: Side,
 }
 
+impl Equidistant {
+    /// The centres as a polyline (z increasing).
+    pub fn path(&self) -> crate::profile::Polyline {
+        crate::profile::Polyline {
+            z: self.z.clone(),
+            x: self.x.clone(),
+        }
+    }
+}
+
 /// Every node where a tool of `radius` on `side` is rounder than the
 /// profile: the profile is concave seen from the tool and its radius of
 /// curvature is below `radius` (MATH §2.2's shaping condition).

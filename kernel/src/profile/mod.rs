@@ -23,7 +23,7 @@ mod table;
 pub use builder::{Bulge, ProfileBuilder};
 pub use ellipse::EllipseSection;
 pub use law::{uniform_grid, MandrelLaw};
-pub use simplify::simplify_polyline;
+pub use simplify::{simplify_polyline, Polyline};
 pub use smooth::Smoothing;
 pub use table::{read_table, read_table_str, Table, TableError, TableFormat};
 
@@ -407,6 +407,30 @@ impl Profile {
                 }
             })
             .collect())
+    }
+
+    /// The profile with `dx` added where `z_from <= z <= z_to` (a stock
+    /// allowance over a stretch: a blank).
+    ///
+    /// # Failures
+    /// A `dx` or bound that is not finite.
+    pub fn raised(&self, z_from: Real, z_to: Real, dx: Real) -> Result<Profile, ProfileError> {
+        crate::math::finite("raise from z", z_from)?;
+        crate::math::finite("raise to z", z_to)?;
+        crate::math::finite("raise by", dx)?;
+        let x = self
+            .z()
+            .iter()
+            .zip(self.x())
+            .map(|(z, x)| {
+                if (z_from..=z_to).contains(z) {
+                    x + dx
+                } else {
+                    *x
+                }
+            })
+            .collect();
+        Profile::new(self.z().to_vec(), x)
     }
 
     /// The profile resampled at a uniform step of z from its first to its

@@ -129,3 +129,68 @@ mod tests {
         );
     }
 }
+
+/// A polyline in the axial section: points `(z[i], x[i])` in order, z in
+/// any direction (a wheel's centres along a pass, one way or the other).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Polyline {
+    /// The points' z (mm).
+    pub z: Vec<Real>,
+    /// The points' x (mm).
+    pub x: Vec<Real>,
+}
+
+impl Polyline {
+    /// The polyline through `(z[i], x[i])`.
+    ///
+    /// # Failures
+    /// Arrays of different lengths; a value that is not finite.
+    pub fn new(z: Vec<Real>, x: Vec<Real>) -> Result<Self, crate::input::InputError> {
+        if z.len() != x.len() {
+            return Err(crate::input::InputError::LengthMismatch {
+                what: "polyline z and x".into(),
+                left: z.len(),
+                right: x.len(),
+            });
+        }
+        crate::math::all_finite("polyline z", &z)?;
+        crate::math::all_finite("polyline x", &x)?;
+        Ok(Self { z, x })
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.z.len()
+    }
+
+    /// Whether it has no points.
+    pub fn is_empty(&self) -> bool {
+        self.z.is_empty()
+    }
+
+    /// The fewest of its points keeping every dropped one within `tol` of
+    /// the chords ([`simplify_polyline`]).
+    pub fn simplified(&self, tol: Real) -> Self {
+        let keep = simplify_polyline(&self.z, &self.x, tol);
+        Self {
+            z: keep.iter().map(|&i| self.z[i]).collect(),
+            x: keep.iter().map(|&i| self.x[i]).collect(),
+        }
+    }
+
+    /// The same points in reverse order.
+    pub fn reversed(&self) -> Self {
+        Self {
+            z: self.z.iter().rev().copied().collect(),
+            x: self.x.iter().rev().copied().collect(),
+        }
+    }
+
+    /// Every point moved by `dx` in x.
+    pub fn shifted(&self, dx: Real) -> Self {
+        Self {
+            z: self.z.clone(),
+            x: self.x.iter().map(|x| x + dx).collect(),
+        }
+    }
+}

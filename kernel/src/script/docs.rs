@@ -1,7 +1,8 @@
 //! The script API's reference, generated from the doc comments of the
-//! functions registered (rhai's `metadata`).
+//! functions registered (rhai's `metadata`), group by group.
 
-use super::{engine, Access, Limits};
+use super::{register_types, Access, API};
+use rhai::Engine;
 
 /// A signature in the script writer's terms: script type names, no Rust
 /// result wrapper, properties and indexing as they are written.
@@ -16,6 +17,10 @@ fn tidy(signature: &str) -> String {
     }
     for (rust, script) in [
         ("ToolpathHandle", "Toolpath"),
+        ("Polyline", "Path"),
+        ("RestSetup", "SteadyRest"),
+        ("Numbers", "Floats"),
+        ("String", "string"),
         ("Real", "float"),
         ("i64", "int"),
         ("&str", "string"),
@@ -52,10 +57,9 @@ fn tidy(signature: &str) -> String {
     s
 }
 
-/// The reference of every function the kernel gives scripts, as Markdown:
-/// signature and doc comment, sorted by name and signature (stable output).
-pub fn api_reference() -> String {
-    let engine = engine(&Limits::default(), &Access::default());
+/// Signature and doc comment of every function `engine` has, sorted by
+/// name and signature (stable output).
+fn entries(engine: &Engine) -> Vec<(String, String, Vec<String>)> {
     let json = engine.gen_fn_metadata_to_json(false).unwrap_or_default();
     let meta: serde_json::Value = serde_json::from_str(&json).unwrap_or_default();
     let mut entries: Vec<(String, String, Vec<String>)> = meta["functions"]
@@ -80,36 +84,51 @@ pub fn api_reference() -> String {
         .unwrap_or_default();
     entries.sort();
     entries.dedup();
+    entries
+}
+
+/// The reference of every function the kernel gives scripts, as Markdown,
+/// grouped as the API is (numbers, profiles, paths, ...): signature and
+/// doc comment of each.
+pub fn api_reference() -> String {
     let mut out = String::from(
         "# pilgrim script API\n\n\
          Generated from the kernel's doc comments by `pilgrim api-docs`; do not edit.\n\
-         Operators `+ - * /` combine `Floats` elementwise with `Floats` of the same length\n\
-         or with numbers; unary `-` negates. See `scripts/README.md` for the family contract.\n",
+         Where a function takes `Floats`, a plain array of numbers does as well. Operators\n\
+         `+ - * /` combine `Floats` elementwise with `Floats` of the same length or with\n\
+         numbers; unary `-` negates. The naming scheme and the family contract are in\n\
+         `scripts/README.md`.\n",
     );
-    for (name, signature, docs) in entries {
-        if docs.is_empty() && !name.starts_with(|c: char| c.is_alphabetic()) {
-            continue;
-        }
-        out.push_str(&format!("\n## `{}`\n\n", tidy(&signature)));
-        let text: Vec<String> = docs
-            .iter()
-            .flat_map(|d| {
-                d.lines()
-                    .map(|l| {
-                        l.trim_start()
-                            .trim_start_matches("///")
-                            .strip_prefix(' ')
-                            .unwrap_or(l.trim_start().trim_start_matches("///"))
-                            .to_owned()
-                    })
-                    .collect::<Vec<_>>()
-            })
-            .collect();
-        if text.is_empty() {
-            out.push_str("(undocumented)\n");
-        } else {
-            out.push_str(&text.join("\n"));
-            out.push('\n');
+    for group in &API {
+        let mut engine = Engine::new_raw();
+        register_types(&mut engine);
+        (group.register)(&mut engine, &Access::default());
+        out.push_str(&format!("\n## {}\n", group.title));
+        for (name, signature, docs) in entries(&engine) {
+            if docs.is_empty() && !name.starts_with(|c: char| c.is_alphabetic()) {
+                continue;
+            }
+            out.push_str(&format!("\n### `{}`\n\n", tidy(&signature)));
+            let text: Vec<String> = docs
+                .iter()
+                .flat_map(|d| {
+                    d.lines()
+                        .map(|l| {
+                            l.trim_start()
+                                .trim_start_matches("///")
+                                .strip_prefix(' ')
+                                .unwrap_or(l.trim_start().trim_start_matches("///"))
+                                .to_owned()
+                        })
+                        .collect::<Vec<_>>()
+                })
+                .collect();
+            if text.is_empty() {
+                out.push_str("(undocumented)\n");
+            } else {
+                out.push_str(&text.join("\n"));
+                out.push('\n');
+            }
         }
     }
     out

@@ -19,11 +19,16 @@
 //! doc comments, by [`api_reference`] (`docs/script-api.md`). A machine may
 //! be a script too ([`machine_from_script`]).
 
-mod api;
+mod bind_offset;
+mod bind_profile;
+mod bind_table;
+mod bind_toolpath;
+mod bind_transform;
 mod docs;
+mod floats;
 
-pub use api::Floats;
 pub use docs::api_reference;
+pub use floats::Floats;
 
 use crate::family::{Check, FamilyError, PartBody, PartFamily, PartGeometry, VerifyRequest};
 use crate::machine::{Machine, MachineError};
@@ -103,45 +108,100 @@ pub fn engine(limits: &Limits, access: &Access) -> Engine {
     // Scripts print to the error stream, never into outputs.
     e.on_print(|s| eprintln!("{s}"));
     e.on_debug(|s, src, pos| eprintln!("{}:{pos}: {s}", src.unwrap_or("script")));
-    api::register(&mut e);
-    register_files(&mut e, access);
+    register_types(&mut e);
+    for group in API {
+        (group.register)(&mut e, access);
+    }
     e
 }
 
-/// `read_table(path)`, allowed only inside the input directories.
-fn register_files(engine: &mut Engine, access: &Access) {
-    let dirs: Vec<PathBuf> = access
-        .input_dirs
-        .iter()
-        .filter_map(|d| d.canonicalize().ok())
-        .collect();
-    rhai::FuncRegistration::new("read_table")
-        .with_params_info(["path: &str", "Table"])
-        .with_comments([
-            "/// A table (CSV, XLSX, XLS, ODS) from a file inside the input directories",
-            "/// (the script's own, and the parameter file's); a relative path is taken",
-            "/// from the first of them. Returns a map of columns by header: `#{ theta: Floats, ... }`.",
-        ])
-        .register_into_engine(engine, move |path: &str| -> Result<Map, Box<EvalAltResult>> {
-            let p = Path::new(path);
-            let full = if p.is_absolute() {
-                p.to_owned()
-            } else {
-                dirs.first().map(|d| d.join(p)).ok_or("no input directory is open to scripts")?
-            };
-            let canon = full.canonicalize().map_err(|e| format!("{}: {e}", full.display()))?;
-            if !dirs.iter().any(|d| canon.starts_with(d)) {
-                return Err(format!("{} is outside the input directories", full.display()).into());
-            }
-            let table = crate::profile::read_table(&canon).map_err(|e| e.to_string())?;
-            let mut m = Map::new();
-            for (i, h) in table.headers().iter().enumerate() {
-                let col = table.column(&(i + 1).to_string()).map_err(|e| e.to_string())?;
-                m.insert(h.as_str().into(), Dynamic::from(Floats::new(col)));
-            }
-            Ok(m)
-        });
+/// The script types, by the names scripts and the reference use.
+fn register_types(e: &mut Engine) {
+    use crate::offset::rest::{RestSetup, RestTrack};
+    use crate::offset::Equidistant;
+    use crate::profile::{MandrelLaw, Polyline, ProfileBuilder, Smoothing, Table};
+    e.register_type_with_name::<Floats>("Floats")
+        .register_type_with_name::<Profile>("Profile")
+        .register_type_with_name::<MandrelLaw>("MandrelLaw")
+        .register_type_with_name::<ProfileBuilder>("ProfileBuilder")
+        .register_type_with_name::<Smoothing>("Smoothing")
+        .register_type_with_name::<Polyline>("Path")
+        .register_type_with_name::<Equidistant>("Equidistant")
+        .register_type_with_name::<RestSetup>("SteadyRest")
+        .register_type_with_name::<RestTrack>("RestTrack")
+        .register_type_with_name::<crate::tool::Tool>("Tool")
+        .register_type_with_name::<bind_transform::Transform>("Transform")
+        .register_type_with_name::<bind_transform::Points>("Points")
+        .register_type_with_name::<Table>("Table")
+        .register_type_with_name::<bind_toolpath::ToolpathHandle>("Toolpath");
 }
+
+/// A group of the script API: its heading and what it registers.
+struct Group {
+    title: &'static str,
+    register: fn(&mut Engine, &Access),
+}
+
+/// The script API, group by group, as the reference lists it.
+const API: [Group; 9] = [
+    Group {
+        title: "Numbers (`Floats`)",
+        register: |e, _| {
+            e.register_global_module(rhai::exported_module!(floats::floats_api).into());
+            floats::register_arithmetic(e);
+        },
+    },
+    Group {
+        title: "Profiles (`Profile`, `MandrelLaw`, `Smoothing`)",
+        register: |e, _| {
+            e.register_global_module(rhai::exported_module!(bind_profile::profile_api).into());
+        },
+    },
+    Group {
+        title: "Whole parts from segments (`ProfileBuilder`)",
+        register: |e, _| {
+            e.register_global_module(rhai::exported_module!(bind_profile::builder_api).into());
+        },
+    },
+    Group {
+        title: "Paths of tool centres (`Path`)",
+        register: |e, _| {
+            e.register_global_module(rhai::exported_module!(bind_profile::path_api).into());
+        },
+    },
+    Group {
+        title:
+            "Equidistants, envelopes, the steady rest (`Equidistant`, `SteadyRest`, `RestTrack`)",
+        register: |e, _| {
+            e.register_global_module(rhai::exported_module!(bind_offset::offset_api).into());
+        },
+    },
+    Group {
+        title: "Transforms (`Transform`, `Points`)",
+        register: |e, _| {
+            e.register_global_module(rhai::exported_module!(bind_transform::transform_api).into());
+        },
+    },
+    Group {
+        title: "Tools (`Tool`)",
+        register: |e, _| {
+            e.register_global_module(rhai::exported_module!(bind_toolpath::tool_api).into());
+        },
+    },
+    Group {
+        title: "Toolpaths (`Toolpath`)",
+        register: |e, _| {
+            e.register_global_module(rhai::exported_module!(bind_toolpath::toolpath_api).into());
+        },
+    },
+    Group {
+        title: "Tables (`Table`)",
+        register: |e, access| {
+            e.register_global_module(rhai::exported_module!(bind_table::table_api).into());
+            bind_table::register(e, access);
+        },
+    },
+];
 
 /// Where an error happened and what it says, from the innermost error.
 fn locate(file: &str, called: &str, e: &EvalAltResult) -> FamilyError {
@@ -361,7 +421,7 @@ fn param_value(d: &Dynamic) -> Option<ParamValue> {
     } else if d.is_array() {
         let a = d.clone().cast::<rhai::Array>();
         a.iter()
-            .map(api::number)
+            .map(floats::number)
             .collect::<Option<Vec<_>>>()
             .map(ParamValue::List)
     } else {
@@ -425,9 +485,11 @@ impl PartFamily for ScriptFamily {
     /// `fn toolpath(p)`: the toolpath it builds.
     fn toolpath(&self, values: &Params) -> Result<Toolpath, FamilyError> {
         let d = self.call_with_params("toolpath", values)?;
-        let handle = d.try_cast::<api::ToolpathHandle>().ok_or_else(|| {
-            self.contract("fn toolpath(p) must return a toolpath (new_toolpath(...))".into())
-        })?;
+        let handle = d
+            .try_cast::<bind_toolpath::ToolpathHandle>()
+            .ok_or_else(|| {
+                self.contract("fn toolpath(p) must return a toolpath (new_toolpath(...))".into())
+            })?;
         // The script's variables are gone: the handle is the last owner, and
         // the toolpath is moved out rather than copied.
         Ok(std::rc::Rc::try_unwrap(handle)
@@ -471,7 +533,7 @@ impl PartFamily for ScriptFamily {
         let shape =
             || self.contract("fn verify(p) must return #{ profile, from, to, tolerance }".into());
         let m = d.try_cast::<Map>().ok_or_else(shape)?;
-        let num = |k: &str| m.get(k).and_then(api::number).ok_or_else(shape);
+        let num = |k: &str| m.get(k).and_then(floats::number).ok_or_else(shape);
         Ok(Some(VerifyRequest {
             profile: m
                 .get("profile")

@@ -296,6 +296,38 @@ impl Frame {
     }
 }
 
+/// The points `(x[i], y[i], z[i])` mapped by the homogeneous matrix `m`
+/// (`r0 = m r1`, MATH §1), as three arrays.
+///
+/// # Failures
+/// Arrays of different lengths.
+pub fn map_points(
+    m: &Mat4,
+    x: &[Real],
+    y: &[Real],
+    z: &[Real],
+) -> Result<[Vec<Real>; 3], InputError> {
+    if y.len() != x.len() || z.len() != x.len() {
+        return Err(InputError::LengthMismatch {
+            what: "points x, y and z".into(),
+            left: x.len(),
+            right: if y.len() != x.len() { y.len() } else { z.len() },
+        });
+    }
+    let mut out = [
+        Vec::with_capacity(x.len()),
+        Vec::with_capacity(x.len()),
+        Vec::with_capacity(x.len()),
+    ];
+    for i in 0..x.len() {
+        let p = m * nalgebra::Vector4::new(x[i], y[i], z[i], 1.0);
+        out[0].push(p.x);
+        out[1].push(p.y);
+        out[2].push(p.z);
+    }
+    Ok(out)
+}
+
 /// An ordered product of elementary factors, some bound to named axes.
 ///
 /// See the [module docs](self). Build one with [`Chain::builder`], or take

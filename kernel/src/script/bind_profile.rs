@@ -1,0 +1,282 @@
+//! Profiles for scripts: `x(z)` from samples, the mandrel law, whole parts
+//! chained from segments, derivative smoothing, and polylines (`Path`s) of
+//! tool centres.
+
+use super::floats::{err, kernel, numbers, Floats, Numbers};
+use crate::math::Real;
+use crate::profile::{Bulge, MandrelLaw, Polyline, Profile, ProfileBuilder, Smoothing};
+use rhai::plugin::*;
+use rhai::EvalAltResult;
+
+/// Profiles and their generators.
+#[export_module]
+pub mod profile_api {
+    use super::*;
+
+    /// A profile `x(z)` from its samples (z increasing strictly, at least 3).
+    ///
+    /// ```rhai
+    /// let disc = profile([-10.0, -5.0, 0.0], [40.0, 40.0, 40.0]);
+    /// ```
+    #[rhai_fn(return_raw)]
+    pub fn profile(z: Numbers, x: Numbers) -> Result<Profile, Box<EvalAltResult>> {
+        let (z, x) = (numbers(&z, "profile z")?, numbers(&x, "profile x")?);
+        kernel(Profile::new(z.as_ref().clone(), x.as_ref().clone()))
+    }
+
+    /// The profile's abscissae.
+    #[rhai_fn(get = "z", pure)]
+    pub fn profile_z(p: &mut Profile) -> Floats {
+        Floats::new(p.z().to_vec())
+    }
+
+    /// The profile's ordinates.
+    #[rhai_fn(get = "x", pure)]
+    pub fn profile_x(p: &mut Profile) -> Floats {
+        Floats::new(p.x().to_vec())
+    }
+
+    /// Number of nodes.
+    #[rhai_fn(get = "len", pure)]
+    pub fn profile_len(p: &mut Profile) -> i64 {
+        p.len() as i64
+    }
+
+    /// dx/dz at every node (analytic where the generator knows it).
+    #[rhai_fn(pure)]
+    pub fn slopes(p: &mut Profile) -> Floats {
+        Floats::new(p.slopes().into_owned())
+    }
+
+    /// Signed curvature at every node (1/mm; positive: concave seen from +x).
+    #[rhai_fn(pure)]
+    pub fn curvature(p: &mut Profile) -> Floats {
+        Floats::new(p.curvature())
+    }
+
+    /// Radius of curvature at every node (mm).
+    #[rhai_fn(pure)]
+    pub fn curvature_radius(p: &mut Profile) -> Floats {
+        Floats::new(p.curvature_radius())
+    }
+
+    /// Cumulative arc length (mm).
+    #[rhai_fn(pure)]
+    pub fn arc_length(p: &mut Profile) -> Floats {
+        Floats::new(p.arc_length())
+    }
+
+    /// x at `z` (cubic Hermite between nodes).
+    #[rhai_fn(pure, return_raw)]
+    pub fn x_at(p: &mut Profile, z: Real) -> Result<Real, Box<EvalAltResult>> {
+        kernel(p.eval(z))
+    }
+
+    /// The profile at a uniform step of z.
+    #[rhai_fn(pure, return_raw)]
+    pub fn resampled(p: &mut Profile, step: Real) -> Result<Profile, Box<EvalAltResult>> {
+        kernel(p.resample_uniform(step))
+    }
+
+    /// The profile with `dx` added where `z_from <= z <= z_to` (a stock
+    /// allowance over a stretch: the blank).
+    #[rhai_fn(pure, return_raw)]
+    pub fn raised(
+        p: &mut Profile,
+        z_from: Real,
+        z_to: Real,
+        dx: Real,
+    ) -> Result<Profile, Box<EvalAltResult>> {
+        kernel(p.raised(z_from, z_to, dx))
+    }
+
+    /// Three-point smoothing of the derivative (seed 001): `iterations`
+    /// passes, the profile rebuilt from node `anchor`. The result has
+    /// `.profile`, `.max_change` (mm) and `.max_change_z`.
+    #[rhai_fn(pure, return_raw)]
+    pub fn smoothed(
+        p: &mut Profile,
+        iterations: i64,
+        anchor: i64,
+    ) -> Result<Smoothing, Box<EvalAltResult>> {
+        if iterations < 0 || anchor < 0 {
+            return err("smoothed: iterations and anchor must not be negative");
+        }
+        kernel(p.smooth_derivative(iterations as usize, anchor as usize))
+    }
+
+    /// The smoothed profile.
+    #[rhai_fn(get = "profile", pure)]
+    pub fn smoothing_profile(s: &mut Smoothing) -> Profile {
+        s.profile.clone()
+    }
+
+    /// The largest change smoothing made to x (mm).
+    #[rhai_fn(get = "max_change", pure)]
+    pub fn smoothing_change(s: &mut Smoothing) -> Real {
+        s.max_change
+    }
+
+    /// Where (z) the largest change is.
+    #[rhai_fn(get = "max_change_z", pure)]
+    pub fn smoothing_change_z(s: &mut Smoothing) -> Real {
+        s.max_change_z
+    }
+
+    /// The mandrel's working-part law (MATH §2.1): diameters `d_min` at 0
+    /// and `d_max` at `length`, initial taper (diameter change per mm at 0),
+    /// exponent.
+    #[rhai_fn(return_raw)]
+    pub fn mandrel_law(
+        d_min: Real,
+        d_max: Real,
+        length: Real,
+        taper: Real,
+        exponent: Real,
+    ) -> Result<MandrelLaw, Box<EvalAltResult>> {
+        kernel(MandrelLaw::new(d_min, d_max, length, taper, exponent))
+    }
+
+    /// The law's radius x(z).
+    #[rhai_fn(name = "x")]
+    pub fn law_x(law: &mut MandrelLaw, z: Real) -> Real {
+        law.x(z)
+    }
+
+    /// The law's slope dx/dz at z.
+    #[rhai_fn(name = "slope")]
+    pub fn law_slope(law: &mut MandrelLaw, z: Real) -> Real {
+        law.dx(z)
+    }
+
+    /// The law sampled at `step` from `z_start`, with analytic derivatives.
+    #[rhai_fn(name = "profile", return_raw)]
+    pub fn law_profile(
+        law: &mut MandrelLaw,
+        step: Real,
+        z_start: Real,
+    ) -> Result<Profile, Box<EvalAltResult>> {
+        kernel(law.profile(step, z_start))
+    }
+}
+
+/// A whole part profile chained from segments.
+#[export_module]
+pub mod builder_api {
+    use super::*;
+
+    /// Starts a whole part profile at `(z, x)`; chain segments left to right
+    /// along z, then `build`.
+    ///
+    /// ```rhai
+    /// let p = profile_start(-80.0, 18.0).cylinder(40.0).line_to(-30.0, 20.0)
+    ///             .law(mandrel_law(40.0, 48.0, 300.0, 0.01, 2.5)).build(0.001, 1.0);
+    /// ```
+    pub fn profile_start(z: Real, x: Real) -> ProfileBuilder {
+        ProfileBuilder::start(z, x)
+    }
+
+    /// A straight segment (cone or cylinder) to `(z, x)`.
+    #[rhai_fn(name = "line_to")]
+    pub fn line_to(b: ProfileBuilder, z: Real, x: Real) -> ProfileBuilder {
+        b.line_to(z, x)
+    }
+
+    /// A cylinder of `length` at the current radius.
+    #[rhai_fn(name = "cylinder")]
+    pub fn cylinder(b: ProfileBuilder, length: Real) -> ProfileBuilder {
+        b.cylinder(length)
+    }
+
+    /// An arc of `radius` to `(z, x)`, bulging "out" (convex, centre below)
+    /// or "in" (a fillet, centre above).
+    #[rhai_fn(name = "arc_to", return_raw)]
+    pub fn arc_to(
+        b: ProfileBuilder,
+        z: Real,
+        x: Real,
+        radius: Real,
+        bulge: &str,
+    ) -> Result<ProfileBuilder, Box<EvalAltResult>> {
+        let bulge = match bulge {
+            "out" => Bulge::Out,
+            "in" => Bulge::In,
+            other => {
+                return err(format!(
+                    "arc bulge must be \"out\" or \"in\", not \"{other}\""
+                ))
+            }
+        };
+        Ok(b.arc_to(z, x, radius, bulge))
+    }
+
+    /// The mandrel law from the current z (the current x must be d_min / 2).
+    #[rhai_fn(name = "law")]
+    pub fn law(b: ProfileBuilder, law: MandrelLaw) -> ProfileBuilder {
+        b.law(law)
+    }
+
+    /// The profile, chords within `tol` (mm), nodes at most `max_step` apart.
+    #[rhai_fn(name = "build", return_raw)]
+    pub fn build(
+        b: ProfileBuilder,
+        tol: Real,
+        max_step: Real,
+    ) -> Result<Profile, Box<EvalAltResult>> {
+        kernel(b.build(tol, max_step))
+    }
+}
+
+/// Paths: polylines of points `(z, x)` in order, either way along z (a
+/// wheel's centres along a pass).
+#[export_module]
+pub mod path_api {
+    use super::*;
+
+    /// The path through `(z[i], x[i])`.
+    #[rhai_fn(return_raw)]
+    pub fn path(z: Numbers, x: Numbers) -> Result<Polyline, Box<EvalAltResult>> {
+        let (z, x) = (numbers(&z, "path z")?, numbers(&x, "path x")?);
+        kernel(Polyline::new(z.as_ref().clone(), x.as_ref().clone()))
+    }
+
+    /// The points' z.
+    #[rhai_fn(get = "z", pure)]
+    pub fn path_z(p: &mut Polyline) -> Floats {
+        Floats::new(p.z.clone())
+    }
+
+    /// The points' x.
+    #[rhai_fn(get = "x", pure)]
+    pub fn path_x(p: &mut Polyline) -> Floats {
+        Floats::new(p.x.clone())
+    }
+
+    /// Number of points.
+    #[rhai_fn(get = "len", pure)]
+    pub fn path_len(p: &mut Polyline) -> i64 {
+        p.len() as i64
+    }
+
+    /// The fewest of its points keeping every dropped one within `tol` (mm)
+    /// of the chords (greedy longest chords): the adaptive spacing of a
+    /// wheel's moves along its equidistant.
+    #[rhai_fn(pure, return_raw)]
+    pub fn simplified(p: &mut Polyline, tol: Real) -> Result<Polyline, Box<EvalAltResult>> {
+        kernel(crate::math::positive("simplify tolerance", tol))?;
+        Ok(p.simplified(tol))
+    }
+
+    /// The same points in reverse order.
+    #[rhai_fn(name = "reversed", pure)]
+    pub fn path_reversed(p: &mut Polyline) -> Polyline {
+        p.reversed()
+    }
+
+    /// Every point moved by `dx` in x (a stock left on the finished path).
+    #[rhai_fn(pure, return_raw)]
+    pub fn shifted(p: &mut Polyline, dx: Real) -> Result<Polyline, Box<EvalAltResult>> {
+        kernel(crate::math::finite("shift", dx))?;
+        Ok(p.shifted(dx))
+    }
+}

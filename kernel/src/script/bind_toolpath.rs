@@ -1,0 +1,236 @@
+//! Tools and toolpaths for scripts: wheels and cutters, and the toolpath a
+//! family builds pass by pass.
+
+use super::bind_offset::rounding_radius;
+use super::floats::{err, kernel, len_of, number, Column};
+use crate::math::Real;
+use crate::tool::{Tool, ToolShape, Wheel};
+use crate::toolpath::{ClPoint, Motion, Pass, Toolpath};
+use rhai::plugin::*;
+use rhai::{Array, EvalAltResult, Map};
+use std::cell::RefCell;
+use std::rc::Rc;
+
+/// A toolpath under construction, shared by handle.
+pub type ToolpathHandle = Rc<RefCell<Toolpath>>;
+
+/// Tools.
+#[export_module]
+pub mod tool_api {
+    use super::*;
+
+    /// A grinding wheel tool: `diameter`, rounding radius, `width` (mm); the
+    /// toolpath tracks its rounding's centre, the machine programs its lowest point.
+    #[rhai_fn(return_raw)]
+    pub fn wheel_tool(
+        name: &str,
+        number: i64,
+        diameter: Real,
+        rounding_radius: Real,
+        width: Real,
+    ) -> Result<Tool, Box<EvalAltResult>> {
+        let w = kernel(Wheel::new(diameter, rounding_radius, width))?;
+        Ok(Tool::wheel(name, tool_number(number)?, w))
+    }
+
+    /// An end mill tracked at its tip centre.
+    #[rhai_fn(return_raw)]
+    pub fn end_mill(
+        name: &str,
+        number: i64,
+        diameter: Real,
+        length: Real,
+    ) -> Result<Tool, Box<EvalAltResult>> {
+        kernel(Tool::end_mill(name, tool_number(number)?, diameter, length))
+    }
+
+    fn tool_number(n: i64) -> Result<u32, Box<EvalAltResult>> {
+        u32::try_from(n).map_err(|_| format!("tool number {n} is out of range").into())
+    }
+
+    /// The tool's name.
+    #[rhai_fn(get = "name", pure)]
+    pub fn tool_name(t: &mut Tool) -> String {
+        t.name.clone()
+    }
+
+    /// The wheel's rounding radius R_s (mm); an error for another tool.
+    #[rhai_fn(get = "rounding_radius", pure, return_raw)]
+    pub fn tool_rounding(t: &mut Tool) -> Result<Real, Box<EvalAltResult>> {
+        rounding_radius(t)
+    }
+
+    /// The tool's diameter (mm): a wheel's outer diameter, a cutter's.
+    #[rhai_fn(get = "diameter", pure, return_raw)]
+    pub fn tool_diameter(t: &mut Tool) -> Result<Real, Box<EvalAltResult>> {
+        match t.shape {
+            ToolShape::Wheel(w) => Ok(w.diameter),
+            ToolShape::EndMill { diameter, .. } => Ok(diameter),
+            ToolShape::Insert { .. } => err(format!("tool '{}' has no diameter", t.name)),
+        }
+    }
+
+    /// The wheel's width (mm); an error for another tool.
+    #[rhai_fn(get = "width", pure, return_raw)]
+    pub fn tool_width(t: &mut Tool) -> Result<Real, Box<EvalAltResult>> {
+        match t.shape {
+            ToolShape::Wheel(w) => Ok(w.width),
+            _ => err(format!("tool '{}' is not a grinding wheel", t.name)),
+        }
+    }
+}
+
+/// Building toolpaths.
+#[export_module]
+pub mod toolpath_api {
+    use super::*;
+
+    /// A new, empty toolpath for `part` with `tool` at `spindle_rpm`; every point
+    /// will carry the auxiliary values named in `aux_names` (e.g. `["U"]`).
+    #[rhai_fn(return_raw)]
+    pub fn new_toolpath(
+        part: &str,
+        tool: Tool,
+        spindle_rpm: Real,
+        aux_names: Array,
+    ) -> Result<ToolpathHandle, Box<EvalAltResult>> {
+        let names = aux_names
+            .iter()
+            .map(|d| {
+                d.clone()
+                    .into_string()
+                    .map_err(|t| format!("auxiliary names must be strings, not {t}"))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Rc::new(RefCell::new(Toolpath::new(
+            part,
+            tool,
+            spindle_rpm,
+            names,
+        ))))
+    }
+
+    /// Notes a figure about the toolpath for the run's report.
+    #[rhai_fn(name = "note", return_raw)]
+    pub fn note(
+        tp: &mut ToolpathHandle,
+        name: &str,
+        value: Real,
+    ) -> Result<(), Box<EvalAltResult>> {
+        crate::math::finite(&format!("note {name}"), value).map_err(|e| e.to_string())?;
+        tp.borrow_mut().notes.insert(name.to_owned(), value);
+        Ok(())
+    }
+
+    /// Number of points so far.
+    #[rhai_fn(get = "point_count", pure)]
+    pub fn point_count(tp: &mut ToolpathHandle) -> i64 {
+        tp.borrow().point_count() as i64
+    }
+
+    /// Appends a pass. `data` holds columns (Floats, arrays, or one number
+    /// for all points): `x`, `y`, `z` (the tracked point, mm), `feed`
+    /// (mm/min; not for rapids), and optionally `motion` ("linear",
+    /// "rapid", "thread"), `lead` (mm, threads), `i`, `j`, `k` (the tool's
+    /// axis, default 0, 0, 1), `aux` (a map of the toolpath's auxiliary
+    /// names to columns).
+    ///
+    /// ```rhai
+    /// tp.add_pass("contour", #{ x: xs, y: ys, z: -5.0, feed: 600.0 });
+    /// ```
+    #[rhai_fn(return_raw)]
+    pub fn add_pass(
+        tp: &mut ToolpathHandle,
+        name: &str,
+        data: Map,
+    ) -> Result<(), Box<EvalAltResult>> {
+        const KEYS: [&str; 10] = [
+            "x", "y", "z", "feed", "motion", "lead", "i", "j", "k", "aux",
+        ];
+        if let Some(k) = data.keys().find(|k| !KEYS.contains(&k.as_str())) {
+            return err(format!(
+                "add_pass: unknown key '{k}' (keys: {})",
+                KEYS.join(", ")
+            ));
+        }
+        let get = |k: &str| data.get(k).cloned();
+        let n = ["x", "y", "z"]
+            .iter()
+            .find_map(|k| get(k).as_ref().and_then(len_of))
+            .ok_or("add_pass: x, y or z must be an array of the pass's points")?;
+        let col = |k: &str, default: Option<Real>| -> Result<Column, Box<EvalAltResult>> {
+            match (get(k), default) {
+                (Some(d), _) => Column::read(&d, n, k),
+                (None, Some(v)) => Ok(Column::Scalar(v)),
+                (None, None) => err(format!("add_pass: missing '{k}'")),
+            }
+        };
+        let motion_name = match get("motion") {
+            Some(m) => m
+                .into_string()
+                .map_err(|t| format!("add_pass: motion must be a string, not {t}"))?,
+            None => "linear".into(),
+        };
+        let motion = match motion_name.as_str() {
+            "linear" => Motion::Linear,
+            "rapid" => Motion::Rapid,
+            "thread" => {
+                let lead = get("lead")
+                    .as_ref()
+                    .and_then(number)
+                    .ok_or("add_pass: a thread needs a number 'lead'")?;
+                Motion::Thread { lead }
+            }
+            other => {
+                return err(format!(
+                    "add_pass: motion must be linear, rapid or thread, not '{other}'"
+                ))
+            }
+        };
+        let (x, y, z) = (col("x", None)?, col("y", None)?, col("z", None)?);
+        let feed = col("feed", (motion == Motion::Rapid).then_some(0.0))?;
+        let (i, j, k) = (
+            col("i", Some(0.0))?,
+            col("j", Some(0.0))?,
+            col("k", Some(1.0))?,
+        );
+        let mut t = tp.borrow_mut();
+        let aux_map = match get("aux") {
+            Some(a) => a
+                .try_cast::<Map>()
+                .ok_or("add_pass: aux must be a map of columns")?,
+            None => Map::new(),
+        };
+        if let Some(extra) = aux_map
+            .keys()
+            .find(|a| !t.aux_names.iter().any(|n| n == a.as_str()))
+        {
+            return err(format!(
+                "add_pass: '{extra}' is not one of the toolpath's auxiliary names ({})",
+                t.aux_names.join(", ")
+            ));
+        }
+        let aux = t
+            .aux_names
+            .iter()
+            .map(|a| match aux_map.get(a.as_str()) {
+                Some(d) => Column::read(d, n, &format!("aux.{a}")),
+                None => err(format!("add_pass: missing aux.{a}")),
+            })
+            .collect::<Result<Vec<_>, Box<EvalAltResult>>>()?;
+        let points = (0..n)
+            .map(|p| ClPoint {
+                point: [x.at(p), y.at(p), z.at(p)],
+                axis: [i.at(p), j.at(p), k.at(p)],
+                motion,
+                feed: feed.at(p),
+                aux: aux.iter().map(|c| c.at(p)).collect(),
+            })
+            .collect();
+        t.passes.push(Pass {
+            name: name.to_owned(),
+            points,
+        });
+        Ok(())
+    }
+}
