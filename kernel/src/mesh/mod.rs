@@ -6,7 +6,7 @@
 //! (normals outward): [`TriMesh::check_closed`] proves it for any mesh.
 //!
 //! - [`revolve`]: a closed section in the `(z, r)` half-plane turned about Z;
-//!   [`body_of_revolution`] (a [`Profile`](crate::Profile) with end caps),
+//!   [`body_of_revolution`] (a [`Profile`](crate::profile::Profile) with end caps),
 //!   [`wheel`] (a disk with a torus periphery), [`cylinder`];
 //! - [`sweep`]: a closed section carried along a path, its shape changing;
 //! - [`Scene`]: named bodies with poses; STL ([`write_stl`]) and glTF

@@ -280,7 +280,7 @@ pub fn body_of_revolution(profile: &Profile, tol: Real) -> Result<TriMesh, MeshE
 
 /// A grinding wheel: a disk of the wheel's width whose periphery is rounded
 /// with its rounding radius (a torus where the rounding is half the width),
-/// placed in the frame of [`Tool::wheel`](crate::Tool::wheel): its axis
+/// placed in the frame of [`Tool::wheel`](crate::tool::Tool::wheel): its axis
 /// along Z through `(D/2, 0, 0)`, the lowest point of its periphery at the
 /// origin, its mid-plane at z = 0.
 ///
