@@ -69,11 +69,19 @@ enum Command {
         /// Also write the scene as scene.gltf + scene.bin.
         #[arg(long)]
         gltf: bool,
+        /// Wall-clock limit of each call of the family's script (seconds).
+        #[arg(long, value_name = "S", default_value_t = 60.0)]
+        script_seconds: f64,
     },
     /// Re-export a finished run's 3-D scene with the tool at another block.
     Export {
         /// The run's output directory.
         dir: PathBuf,
+        /// The machine, when the run's is not a built-in: a plugin (.so), a
+        /// machine file (.toml) or script (.rhai). pilgrim never opens one
+        /// the run's files name.
+        #[arg(long)]
+        machine: Option<String>,
         /// The block (from 1). Default: the first block of the last pass.
         #[arg(long, value_name = "N")]
         block: Option<usize>,
@@ -191,15 +199,17 @@ fn params(script: &Path) -> Result<String, String> {
         "description".to_owned(),
     )];
     for p in fam.params() {
-        rows.push((
-            p.name.clone(),
-            p.default.to_string(),
-            p.unit.clone(),
-            match &p.machine {
-                Some(m) => format!("{} (default: the machine's constant {m})", p.doc),
-                None => p.doc.clone(),
-            },
-        ));
+        rows.push((p.name.clone(), p.default.to_string(), p.unit.clone(), {
+            let mut d = p.doc.clone();
+            let range = p.range_text();
+            if !range.is_empty() {
+                d += &format!(" ({range})");
+            }
+            if let Some(m) = &p.machine {
+                d += &format!(" (default: the machine's constant {m})");
+            }
+            d
+        }));
     }
     let w0 = rows.iter().map(|r| r.0.len()).max().unwrap_or(0);
     let w1 = rows.iter().map(|r| r.1.len()).max().unwrap_or(0);
@@ -244,6 +254,7 @@ fn main() -> ExitCode {
             mesh_tolerance,
             stl_ascii,
             gltf,
+            script_seconds,
         } => run::run(
             &run::RunArgs {
                 formats: Formats {
@@ -260,6 +271,7 @@ fn main() -> ExitCode {
                     PathBuf::from("out").join(script.file_stem().unwrap_or_else(|| "run".as_ref()))
                 }),
                 quiet: cli.quiet,
+                script_seconds: *script_seconds,
             },
             &catalog,
         )
@@ -271,12 +283,14 @@ fn main() -> ExitCode {
         } => list_machines(&catalog, plugins, files, *only_files),
         Command::Export {
             dir,
+            machine,
             block,
             stl_ascii,
             gltf,
         } => run::export(
             dir,
             &catalog,
+            machine.as_deref(),
             *block,
             Formats {
                 stl_ascii: *stl_ascii,
@@ -289,7 +303,9 @@ fn main() -> ExitCode {
         Command::ApiDocs { out } => {
             let text = pilgrim_kernel::script::api_reference();
             match out {
-                Some(p) => run::write_file(p, text.as_bytes()).map(|_| String::new()),
+                Some(p) => std::fs::write(p, text.as_bytes())
+                    .map(|_| String::new())
+                    .map_err(|e| format!("{}: {e}", p.display())),
                 None => Ok(text),
             }
         }

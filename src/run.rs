@@ -20,6 +20,7 @@ pub struct RunArgs {
     pub machine: Option<String>,
     pub out: PathBuf,
     pub quiet: bool,
+    pub script_seconds: f64,
 }
 
 /// A progress bar over the run's stages (hidden with --quiet).
@@ -53,13 +54,23 @@ pub fn run(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
             dir.to_owned()
         });
     }
-    let family =
-        ScriptFamily::load(&args.script, &Limits::default(), &access).map_err(|e| e.to_string())?;
+    if !(args.script_seconds > 0.0) {
+        return Err(format!(
+            "--script-seconds {} must be > 0",
+            args.script_seconds
+        ));
+    }
+    let limits = Limits {
+        max_seconds: args.script_seconds,
+        ..Limits::default()
+    };
+    let family = ScriptFamily::load(&args.script, &limits, &access).map_err(|e| e.to_string())?;
     let mut sources = Vec::new();
     if let Some(p) = &args.params {
         sources.push(ParamSource::Toml {
             label: p.display().to_string(),
-            text: std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?,
+            text: pilgrim_kernel::files::read_text(p, pilgrim_kernel::files::MAX_TEXT_BYTES)
+                .map_err(|e| e.to_string())?,
         });
     }
     sources.push(ParamSource::Pairs {
@@ -93,7 +104,7 @@ pub fn run(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
     let out = job::run(&family, &machine, &sources, &options, &mut |s| next(s))
         .map_err(|e| e.to_string())?;
     next("writing");
-    write_atomically(&args.out, &out.files)?;
+    pilgrim_kernel::output::write_dir(&args.out, &out.files).map_err(|e| e.to_string())?;
     bar.finish_and_clear();
     Ok(format!(
         "{}; written to {}",
@@ -106,63 +117,16 @@ pub fn run(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
 pub fn export(
     dir: &Path,
     catalog: &Catalog,
+    machine: Option<&str>,
     block: Option<usize>,
     formats: Formats,
 ) -> Result<String, String> {
-    let e = job::export(dir, catalog, block, formats).map_err(|e| e.to_string())?;
-    for (name, bytes) in &e.files {
-        write_file(&dir.join(name), bytes)?;
-    }
+    pilgrim_kernel::output::check_replaceable(dir).map_err(|e| e.to_string())?;
+    let e = job::export(dir, catalog, machine, block, formats).map_err(|e| e.to_string())?;
+    pilgrim_kernel::output::update_dir(dir, &e.files).map_err(|e| e.to_string())?;
     Ok(format!(
         "{}: the scene placed at block {}",
         dir.display(),
         e.block
     ))
-}
-
-/// Writes the files into a temporary directory beside `out`, then swaps it
-/// in: a failure leaves `out` as it was and no half-written file.
-pub fn write_atomically(out: &Path, files: &[(String, Vec<u8>)]) -> Result<(), String> {
-    let parent = match out.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
-        _ => PathBuf::from("."),
-    };
-    let base = out
-        .file_name()
-        .and_then(|n| n.to_str())
-        .ok_or_else(|| format!("{}: not a directory name", out.display()))?;
-    std::fs::create_dir_all(&parent).map_err(|e| format!("{}: {e}", parent.display()))?;
-    let tmp = parent.join(format!(".{base}.tmp-{}", std::process::id()));
-    let old = parent.join(format!(".{base}.old-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&tmp);
-    let result = (|| {
-        std::fs::create_dir(&tmp).map_err(|e| format!("{}: {e}", tmp.display()))?;
-        for (name, text) in files {
-            let p = tmp.join(name);
-            std::fs::write(&p, text).map_err(|e| format!("{}: {e}", p.display()))?;
-        }
-        if out.exists() {
-            std::fs::rename(out, &old).map_err(|e| format!("{}: {e}", out.display()))?;
-        }
-        std::fs::rename(&tmp, out).map_err(|e| {
-            let _ = std::fs::rename(&old, out);
-            format!("{}: {e}", out.display())
-        })?;
-        let _ = std::fs::remove_dir_all(&old);
-        Ok(())
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_dir_all(&tmp);
-    }
-    result
-}
-
-/// Writes one file through a temporary file and a rename.
-pub fn write_file(path: &Path, text: &[u8]) -> Result<(), String> {
-    let tmp = path.with_extension(format!("tmp-{}", std::process::id()));
-    std::fs::write(&tmp, text).map_err(|e| format!("{}: {e}", tmp.display()))?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        format!("{}: {e}", path.display())
-    })
 }

@@ -174,7 +174,19 @@ fn broken_plugins_are_clear_errors() {
     let e = PluginMachine::load("/no/such/libplugin.so")
         .unwrap_err()
         .to_string();
-    assert!(e.contains("/no/such/libplugin.so: cannot load"), "{e}");
+    assert!(e.contains("/no/such/libplugin.so: No such file"), "{e}");
+    // A complete ELF shared object the loader refuses (an executable):
+    // the system's reason is given, not only that it failed.
+    let dir = std::env::temp_dir().join(format!("pilgrim-plugins-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let exe = dir.join("libtrue.so");
+    std::fs::copy("/bin/true", &exe).unwrap();
+    let e = PluginMachine::load(&exe).unwrap_err().to_string();
+    assert!(
+        e.contains("cannot load the library: dlopen failed: "),
+        "{e}"
+    );
+    assert!(e.len() > e.find("dlopen failed: ").unwrap() + 20, "{e}");
 }
 
 /// A plugin whose construction panics is an error naming the panic, and

@@ -6,7 +6,8 @@
 //! The modules, in the order data flows through them (ARCHITECTURE §1;
 //! `docs/architecture.md` says where each stage lives):
 //!
-//! - [`math`], [`input`]: the numbers and the one validation error;
+//! - [`math`], [`input`], [`files`]: the numbers, the one validation error,
+//!   and reading outside files (regular files only, bounded);
 //! - [`transform`]: elementary factors, the [`Chain`] of a machine, the
 //!   universal 15-factor preset of seed 003, forward and inverse kinematics;
 //! - [`machine`]: a machine's description ([`MachineInfo`], the plugin ABI's
@@ -42,12 +43,14 @@
 pub mod catalog;
 pub mod error;
 pub mod family;
+pub mod files;
 pub mod input;
 pub mod job;
 pub mod machine;
 pub mod math;
 pub mod mesh;
 pub mod offset;
+pub mod output;
 pub mod params;
 pub mod plugin;
 pub mod profile;

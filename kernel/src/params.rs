@@ -66,7 +66,13 @@ impl ParamValue {
 
     /// The value of a TOML value, of the same kind as `like`.
     fn from_toml(v: &toml::Value, like: &ParamValue) -> Result<Self, String> {
-        let got = || format!("expected {}, got {v}", like.kind());
+        let got = || {
+            format!(
+                "expected {}, got {}",
+                like.kind(),
+                crate::files::excerpt(&v.to_string())
+            )
+        };
         Ok(match (like, v) {
             (Self::Int(_), toml::Value::Integer(i)) => Self::Int(*i),
             (Self::Float(_), toml::Value::Float(f)) => Self::Float(*f),
@@ -86,7 +92,7 @@ impl ParamValue {
     /// The value of a `NAME=VALUE` text, of the same kind as `like`.
     fn parse(text: &str, like: &ParamValue) -> Result<Self, String> {
         let t = text.trim();
-        let bad = || format!("'{text}' is not {}", like.kind());
+        let bad = || format!("'{}' is not {}", crate::files::excerpt(text), like.kind());
         Ok(match like {
             Self::Int(_) => Self::Int(t.parse().map_err(|_| bad())?),
             Self::Float(_) => Self::Float(t.parse().map_err(|_| bad())?),
@@ -140,6 +146,80 @@ pub struct ParamSpec {
     /// it, if any.
     #[serde(default)]
     pub machine: Option<String>,
+    /// The least value allowed (a number, or each number of a list).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min: Option<f64>,
+    /// The greatest value allowed: the ceiling of a quantity that drives
+    /// work (passes, points), checked before any work.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max: Option<f64>,
+    /// The most values a list may hold.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_len: Option<usize>,
+}
+
+impl ParamSpec {
+    /// A spec with no bounds.
+    pub fn new(name: &str, default: ParamValue, unit: &str, doc: &str) -> Self {
+        Self {
+            name: name.to_owned(),
+            default,
+            unit: unit.to_owned(),
+            doc: doc.to_owned(),
+            machine: None,
+            min: None,
+            max: None,
+            max_len: None,
+        }
+    }
+
+    /// The bounds in words, for listings: `[1, 100]`, `>= 0.0001`, ...
+    pub fn range_text(&self) -> String {
+        let mut parts = vec![];
+        match (self.min, self.max) {
+            (Some(a), Some(b)) => parts.push(format!("[{a}, {b}]")),
+            (Some(a), None) => parts.push(format!(">= {a}")),
+            (None, Some(b)) => parts.push(format!("<= {b}")),
+            (None, None) => {}
+        }
+        if let Some(n) = self.max_len {
+            parts.push(format!("at most {n} values"));
+        }
+        parts.join(", ")
+    }
+
+    /// Checks `value` against the bounds.
+    fn check(&self, value: &ParamValue) -> Result<(), String> {
+        let check_one = |x: f64| -> Result<(), String> {
+            if let Some(max) = self.max {
+                if x > max {
+                    return Err(format!("{x} is above the ceiling {max}"));
+                }
+            }
+            if let Some(min) = self.min {
+                if x < min {
+                    return Err(format!("{x} is below the least value allowed, {min}"));
+                }
+            }
+            Ok(())
+        };
+        match value {
+            ParamValue::Int(i) => check_one(*i as f64),
+            ParamValue::Float(x) => check_one(*x),
+            ParamValue::List(v) => {
+                if let Some(n) = self.max_len {
+                    if v.len() > n {
+                        return Err(format!(
+                            "{} values are more than the ceiling of {n}",
+                            v.len()
+                        ));
+                    }
+                }
+                v.iter().try_for_each(|x| check_one(*x))
+            }
+            ParamValue::Bool(_) | ParamValue::Text(_) => Ok(()),
+        }
+    }
 }
 
 /// Where parameter values come from, in the order they apply (a later
@@ -198,18 +278,21 @@ pub enum ParamError {
 
 /// The values of the parameters `specs`: defaults (a machine constant's
 /// value for a parameter tied to one that `constants` has), then each
-/// source in order.
+/// source in order; then every value against its spec's bounds.
 ///
 /// # Failures
 /// A TOML syntax error; an unknown name (listing the valid ones); a value
 /// of another kind than the default's, or not finite; a machine constant
-/// that is not of its parameter's kind (a whole number, say), naming both.
+/// that is not of its parameter's kind (a whole number, say), naming both;
+/// a value outside its bounds, naming the parameter, where the value came
+/// from, the value and the bound.
 pub fn resolve(
     specs: &[ParamSpec],
     constants: &BTreeMap<String, Real>,
     sources: &[ParamSource],
 ) -> Result<Params, ParamError> {
     let mut values = BTreeMap::new();
+    let mut came_from: BTreeMap<String, String> = BTreeMap::new();
     for s in specs {
         let value = match s
             .machine
@@ -217,13 +300,17 @@ pub fn resolve(
             .and_then(|m| Some((m, constants.get(m)?)))
         {
             Some((m, &x)) => {
+                came_from.insert(s.name.clone(), format!("the machine's constant {m}"));
                 ParamValue::from_constant(x, &s.default).map_err(|message| ParamError::Bad {
                     name: s.name.clone(),
                     source_name: format!("the machine's constant {m}"),
                     message,
                 })?
             }
-            None => s.default.clone(),
+            None => {
+                came_from.insert(s.name.clone(), "its default".into());
+                s.default.clone()
+            }
         };
         values.insert(s.name.clone(), value);
     }
@@ -249,9 +336,25 @@ pub fn resolve(
     for source in sources {
         match source {
             ParamSource::Toml { label, text } => {
-                let table: toml::Table = toml::from_str(text).map_err(|e| ParamError::Source {
-                    source_name: label.clone(),
-                    message: e.to_string().trim().to_owned(),
+                let table: toml::Table = toml::from_str(text).map_err(|e| {
+                    // The place and the parser's words, not its quote of the
+                    // line (which may be a megabyte long).
+                    let at = e.span().map_or(0, |s| s.start).min(text.len());
+                    let before = &text.as_bytes()[..at];
+                    let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+                    let column = at
+                        - before
+                            .iter()
+                            .rposition(|&b| b == b'\n')
+                            .map_or(0, |i| i + 1)
+                        + 1;
+                    ParamError::Source {
+                        source_name: label.clone(),
+                        message: format!(
+                            "line {line}, column {column}: {}",
+                            crate::files::excerpt(e.message().trim())
+                        ),
+                    }
                 })?;
                 for (k, v) in &table {
                     let s = spec(k, label)?;
@@ -259,6 +362,7 @@ pub fn resolve(
                         ParamValue::from_toml(v, &s.default).map_err(|m| bad(k, label, m))?;
                     value.check_finite().map_err(|m| bad(k, label, m))?;
                     values.insert(k.clone(), value);
+                    came_from.insert(k.clone(), label.clone());
                 }
             }
             ParamSource::Pairs { label, pairs } => {
@@ -268,9 +372,14 @@ pub fn resolve(
                         ParamValue::parse(text, &s.default).map_err(|m| bad(k, label, m))?;
                     value.check_finite().map_err(|m| bad(k, label, m))?;
                     values.insert(k.clone(), value);
+                    came_from.insert(k.clone(), label.clone());
                 }
             }
         }
+    }
+    for s in specs {
+        s.check(&values[&s.name])
+            .map_err(|m| bad(&s.name, &came_from[&s.name], m))?;
     }
     Ok(values)
 }
@@ -281,11 +390,8 @@ mod tests {
 
     fn specs() -> Vec<ParamSpec> {
         let spec = |name: &str, default, machine: Option<&str>| ParamSpec {
-            name: name.into(),
-            default,
-            unit: String::new(),
-            doc: String::new(),
             machine: machine.map(str::to_owned),
+            ..ParamSpec::new(name, default, "", "")
         };
         vec![
             spec("n", ParamValue::Int(3), None),
@@ -311,6 +417,13 @@ mod tests {
             },
         ];
         let v = resolve(&specs(), &constants, &sources).unwrap();
+        let mut bounded = specs();
+        bounded[0].max = Some(4.0);
+        let e = resolve(&bounded, &constants, &sources).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "parameter 'n' from p.toml: 5 is above the ceiling 4"
+        );
         assert_eq!(v["n"], ParamValue::Int(5));
         assert_eq!(v["r"], ParamValue::Float(22.5));
         assert_eq!(v["on"], ParamValue::Bool(false), "from the machine");

@@ -2,7 +2,13 @@
 //! `pilgrim-plugin-abi` crate), loaded from shared libraries or compiled
 //! in.
 //!
-//! [`PluginMachine::load`] opens a library and finds its entry
+//! [`PluginMachine::load`] first checks, with the `object` crate's ELF
+//! reader, that the file is a complete shared object for this machine (its
+//! program headers and loaded segments lie inside the file: a truncated
+//! library would otherwise crash the process with SIGBUS when mapped), then
+//! opens it (a bare file name is a path in the working directory, never a
+//! search of the system's library path; a failure gives the system's
+//! reason) and finds its entry
 //! `pilgrim_plugin_<name>` (`<name>`: the file name without `lib` and the
 //! extension, `-` read as `_`); [`PluginMachine::from_entry`] takes the
 //! entry of a plugin compiled into the program. Both then go the same way:
@@ -35,6 +41,14 @@ use std::sync::Arc;
 /// Why a plugin could not be loaded or called.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PluginLoadError {
+    /// The file is not a complete shared object for this machine.
+    #[error("{path}: {message}")]
+    NotLibrary {
+        /// The file.
+        path: String,
+        /// What it is instead.
+        message: String,
+    },
     /// The library could not be opened.
     #[error("{path}: cannot load the library: {message}")]
     Open {
@@ -140,6 +154,66 @@ pub struct PluginMachine {
     abi: (u32, u32),
 }
 
+/// Checks that `path` is a complete ELF shared object of this machine's
+/// class, byte order and architecture: its program headers and every
+/// loaded segment lie inside the file.
+fn check_elf(path: &Path) -> Result<(), String> {
+    use object::elf;
+    use object::read::elf::{FileHeader, ProgramHeader};
+    use object::Endianness;
+    let data =
+        crate::files::read_bytes(path, crate::files::MAX_DATA_BYTES).map_err(|e| e.message)?;
+    let data = data.as_slice();
+    if !data.starts_with(&elf::ELFMAG) {
+        return Err(
+            "not an ELF shared object (pilgrim loads machine plugins built as .so libraries)"
+                .into(),
+        );
+    }
+    let incomplete = |what: &str| {
+        format!("not a complete shared object: {what} (the file is cut short or damaged)")
+    };
+    let header = elf::FileHeader64::<Endianness>::parse(data)
+        .map_err(|_| incomplete("its ELF header cannot be read, or it is not a 64-bit library"))?;
+    let endian = header
+        .endian()
+        .map_err(|_| incomplete("its byte order cannot be read"))?;
+    if (endian == Endianness::Little) != cfg!(target_endian = "little") {
+        return Err("a library for another byte order".into());
+    }
+    let machine = if cfg!(target_arch = "x86_64") {
+        Some(elf::EM_X86_64)
+    } else if cfg!(target_arch = "aarch64") {
+        Some(elf::EM_AARCH64)
+    } else {
+        None
+    };
+    if machine.is_some_and(|m| header.e_machine(endian) != m) {
+        return Err(format!(
+            "a library for another machine (ELF machine {})",
+            header.e_machine(endian)
+        ));
+    }
+    if header.e_type(endian) != elf::ET_DYN {
+        return Err(format!(
+            "not a shared object (ELF type {})",
+            header.e_type(endian)
+        ));
+    }
+    let phdrs = header
+        .program_headers(endian, data)
+        .map_err(|_| incomplete("its program headers lie beyond its end"))?;
+    for ph in phdrs {
+        if ph.p_type(endian) == elf::PT_LOAD {
+            let end = ph.p_offset(endian).checked_add(ph.p_filesz(endian));
+            if end.is_none_or(|e| e > data.len() as u64) {
+                return Err(incomplete("a loaded segment lies beyond its end"));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The entry symbol for a library file: `pilgrim_plugin_<stem>`.
 pub fn entry_symbol(path: &Path) -> String {
     let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("");
@@ -214,13 +288,29 @@ impl PluginMachine {
     /// [`PluginLoadError`]: the library cannot be opened; no entry symbol; a
     /// null table; another ABI major; a missing entry; a bad descriptor.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, PluginLoadError> {
-        let path = path.as_ref();
-        let shown = path.display().to_string();
-        let symbol = entry_symbol(path);
-        // SAFETY: loading runs the library's initialisers; see the module docs.
-        let lib = unsafe { libloading::Library::new(path) }.map_err(|e| PluginLoadError::Open {
+        let given = path.as_ref();
+        let shown = given.display().to_string();
+        // A bare name would make dlopen search the system's library path.
+        let path = if given.components().count() == 1 && !given.is_absolute() {
+            Path::new(".").join(given)
+        } else {
+            given.to_owned()
+        };
+        let symbol = entry_symbol(&path);
+        check_elf(&path).map_err(|message| PluginLoadError::NotLibrary {
             path: shown.clone(),
-            message: e.to_string(),
+            message,
+        })?;
+        // SAFETY: loading runs the library's initialisers; see the module docs.
+        let lib = unsafe { libloading::Library::new(&path) }.map_err(|e| {
+            use std::error::Error as _;
+            PluginLoadError::Open {
+                path: shown.clone(),
+                message: match e.source() {
+                    Some(reason) => format!("{e}: {reason}"),
+                    None => e.to_string(),
+                },
+            }
         })?;
         // Never unloaded: nothing from the library may outlive it.
         let lib: &'static libloading::Library = Box::leak(Box::new(lib));

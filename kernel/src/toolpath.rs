@@ -80,6 +80,10 @@ pub struct Toolpath {
     pub notes: BTreeMap<String, Real>,
 }
 
+/// The most points a toolpath may have (and so blocks a program): 2
+/// million, checked before inverse kinematics.
+pub const MAX_POINTS: usize = 2_000_000;
+
 /// A bad toolpath, named by pass and point.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ToolpathError {
@@ -133,7 +137,8 @@ impl Toolpath {
 
     /// Checks every value: finite coordinates, unit axes, positive feeds on
     /// cutting moves, positive leads, the right number of auxiliary values,
-    /// a positive spindle speed, at least one point.
+    /// a positive spindle speed, at least one point and at most
+    /// [`MAX_POINTS`].
     ///
     /// # Failures
     /// [`ToolpathError`] naming the pass and point.
@@ -146,6 +151,12 @@ impl Toolpath {
         }
         if self.point_count() == 0 {
             return Err(ToolpathError::Whole("no points".into()));
+        }
+        if self.point_count() > MAX_POINTS {
+            return Err(ToolpathError::Whole(format!(
+                "{} points, more than the ceiling of {MAX_POINTS}",
+                self.point_count()
+            )));
         }
         for (i, j, c) in self.points() {
             let err = |message: String| ToolpathError::Point {

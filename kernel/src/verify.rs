@@ -98,6 +98,7 @@ pub struct Deviation {
     /// Where the largest is (z).
     pub at_z: Real,
     /// The block (index from 0) whose move forms the surface there.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub block: Option<usize>,
 }
 

@@ -20,42 +20,69 @@ struct MillCircle {
 
 impl MillCircle {
     fn new() -> Self {
-        let spec = |name: &str, default, unit: &str, doc: &str| ParamSpec {
-            name: name.into(),
-            default,
-            unit: unit.into(),
-            doc: doc.into(),
-            machine: None,
-        };
+        let spec = ParamSpec::new;
         let f = ParamValue::Float;
+        let bounded = |s: ParamSpec, min: Option<f64>, max: f64| ParamSpec {
+            min,
+            max: Some(max),
+            ..s
+        };
         Self {
             specs: vec![
-                spec(
-                    "radius",
-                    f(40.0),
-                    "mm",
-                    "radius of the disc's finished edge",
+                bounded(
+                    spec(
+                        "radius",
+                        f(40.0),
+                        "mm",
+                        "radius of the disc's finished edge",
+                    ),
+                    Some(0.1),
+                    1000.0,
                 ),
-                spec("tool_diameter", f(10.0), "mm", "end mill diameter"),
-                spec(
-                    "depth",
-                    f(5.0),
-                    "mm",
-                    "depth of the contour below the top face (z = 0)",
+                bounded(
+                    spec("tool_diameter", f(10.0), "mm", "end mill diameter"),
+                    Some(0.1),
+                    200.0,
                 ),
-                spec(
-                    "points",
-                    ParamValue::Int(360),
-                    "",
-                    "points round the circle",
+                bounded(
+                    spec(
+                        "depth",
+                        f(5.0),
+                        "mm",
+                        "depth of the contour below the top face (z = 0)",
+                    ),
+                    Some(0.01),
+                    200.0,
                 ),
-                spec("feed", f(600.0), "mm/min", "cutting speed along the edge"),
-                spec("spindle", f(3000.0), "rpm", "spindle speed"),
-                spec(
-                    "clearance",
-                    f(5.0),
-                    "mm",
-                    "height of rapid moves above the top face",
+                bounded(
+                    spec(
+                        "points",
+                        ParamValue::Int(360),
+                        "",
+                        "points round the circle",
+                    ),
+                    None,
+                    1e6,
+                ),
+                bounded(
+                    spec("feed", f(600.0), "mm/min", "cutting speed along the edge"),
+                    None,
+                    20000.0,
+                ),
+                bounded(
+                    spec("spindle", f(3000.0), "rpm", "spindle speed"),
+                    Some(1.0),
+                    30000.0,
+                ),
+                bounded(
+                    spec(
+                        "clearance",
+                        f(5.0),
+                        "mm",
+                        "height of rapid moves above the top face",
+                    ),
+                    Some(0.0),
+                    500.0,
                 ),
                 spec(
                     "turn_table",
@@ -210,6 +237,9 @@ fn a_rust_family_runs_through_the_same_job_as_the_rhai_one() {
     let rhai = ScriptFamily::load(&script, &Limits::default(), &Access::default()).unwrap();
     let (a, b) = (run(&MillCircle::new()), run(&rhai));
     assert_eq!(a.params, b.params);
+    let mut specs = MillCircle::new().params().to_vec();
+    specs.sort_by(|a, b| a.name.cmp(&b.name));
+    assert_eq!(specs, rhai.params());
     assert_eq!(a.toolpath, b.toolpath);
     assert_eq!(a.program, b.program);
     let names = |o: &job::JobOutput| o.files.iter().map(|f| f.0.clone()).collect::<Vec<_>>();

@@ -184,7 +184,7 @@ fn files_only_inside_the_input_directories() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("secret.csv is outside the input directories"),
+        e.contains("../secret.csv: not a readable file inside the input directories"),
         "{e}"
     );
     let e = family("fn params() { #{} }\nimport \"x\" as y;\nfn toolpath(p) {}")

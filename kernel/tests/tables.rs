@@ -1,7 +1,7 @@
 //! Tables from real spreadsheet files: XLSX (written by rust_xlsxwriter), ODS
 //! (assembled as the zip of XML that LibreOffice writes) and CSV.
 
-use pilgrim_kernel::{read_table, TableError};
+use pilgrim_kernel::{read_table, read_table_str, TableError};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -147,4 +147,16 @@ fn csv_file_and_broken_spreadsheet() {
         "{e}"
     );
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A table of more than 10 million cells is refused with the bound named.
+#[test]
+fn tables_are_bounded_in_cells() {
+    let row = "1,".repeat(999) + "1\n";
+    let text = row.repeat(10_001);
+    let e = read_table_str(&text, "big.csv").unwrap_err().to_string();
+    assert!(
+        e.contains("big.csv") && e.contains("more than 10000000 cells"),
+        "{e}"
+    );
 }

@@ -20,20 +20,27 @@ pub struct Exported {
 }
 
 /// The scene of the run in `dir` placed at `block` (from 1; `None`: the
-/// middle of the last cutting pass), the machine reopened from `catalog`.
+/// middle of the last cutting pass).
+///
+/// Nothing in the run's files is trusted: they are read only from `dir`, by
+/// plain names; the machine is the built-in the report names, or the one
+/// the caller names (`machine`, what the user gave on the command line):
+/// a plugin or a machine file named only by the report is never opened.
 ///
 /// # Failures
 /// A file of the run missing or not what the run wrote; a run without 3-D
-/// models; block 0; the machine or the replay failing.
+/// models; a report naming a machine that is not a built-in, with no
+/// `machine` given; block 0; the machine or the replay failing.
 pub fn export(
     dir: &Path,
     catalog: &Catalog,
+    machine: Option<&str>,
     block: Option<usize>,
     formats: Formats,
 ) -> Result<Exported, Error> {
     let read = |name: &str| {
-        std::fs::read_to_string(dir.join(name))
-            .map_err(|e| Error::Read(format!("{}: {e}", dir.join(name).display())))
+        crate::files::read_text(&dir.join(name), crate::files::MAX_DATA_BYTES)
+            .map_err(|e| Error::Read(e.to_string()))
     };
     let parse = |name: &str, e: serde_json::Error| Error::Read(format!("{name}: {e}"));
     let mut report: Report =
@@ -48,7 +55,24 @@ pub fn export(
             dir.display()
         )));
     }
-    let machine = catalog.open(&report.machine_spec)?;
+    let spec = match machine {
+        Some(m) => m.to_owned(),
+        None if catalog
+            .builtin_names()
+            .iter()
+            .any(|n| n.eq_ignore_ascii_case(&report.machine_spec)) =>
+        {
+            report.machine_spec.clone()
+        }
+        None => {
+            return Err(Error::Read(format!(
+                "{}: the run's machine '{}' is not a built-in: name it with --machine (pilgrim loads a plugin or machine file only when the command line names it)",
+                dir.display(),
+                crate::files::excerpt(&report.machine_spec)
+            )))
+        }
+    };
+    let machine = catalog.open(&spec)?;
     let kin = machine.kinematics.as_ref();
     let index = match block {
         Some(0) => return Err(Error::Options("--block counts blocks from 1".into())),
@@ -60,7 +84,19 @@ pub fn export(
         .iter()
         .filter(|b| b.kind == "part")
         .map(|b| {
-            crate::mesh::read_stl(&dir.join(&b.file))
+            // Only the run's own files, by the names the run gives them.
+            if !crate::files::is_plain_name(&b.name) || b.file != format!("{}.stl", b.name) {
+                return Err(Error::Read(format!(
+                    "{}: report.json names the file '{}' for body '{}', which is not a file of this run",
+                    dir.display(),
+                    crate::files::excerpt(&b.file),
+                    crate::files::excerpt(&b.name)
+                )));
+            }
+            let path = dir.join(&b.file);
+            crate::files::check_regular(&path, crate::files::MAX_DATA_BYTES)
+                .map_err(|e| Error::Read(e.to_string()))?;
+            crate::mesh::read_stl(&path)
                 .map(|m| (b.name.clone(), m))
                 .map_err(|e| Error::Read(e.to_string()))
         })
@@ -81,7 +117,7 @@ pub fn export(
                     .any(|b| b.kind == "part" && &b.file == n)
         })
         .collect();
-    all.push(("report.json".into(), super::json(&report)?));
+    all.push(("report.json".into(), super::report_json(&report)?));
     Ok(Exported {
         files: all,
         block: index + 1,

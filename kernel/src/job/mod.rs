@@ -111,6 +111,34 @@ fn json<T: Serialize>(v: &T) -> Result<Vec<u8>, Error> {
         .map_err(|e| Error::Output(e.to_string()))
 }
 
+/// The first place in `v` holding null: where JSON has put a number that
+/// is not finite (NaN or infinite).
+fn null_at(v: &serde_json::Value, path: &str) -> Option<String> {
+    use serde_json::Value;
+    match v {
+        Value::Null => Some(path.to_owned()),
+        Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .find_map(|(i, x)| null_at(x, &format!("{path}[{i}]"))),
+        Value::Object(m) => m
+            .iter()
+            .find_map(|(k, x)| null_at(x, &format!("{path}.{k}"))),
+        _ => None,
+    }
+}
+
+/// The report as JSON, refused if any of its numbers is not finite.
+fn report_json(report: &Report) -> Result<Vec<u8>, Error> {
+    let value = serde_json::to_value(report).map_err(|e| Error::Output(e.to_string()))?;
+    if let Some(at) = null_at(&value, "report") {
+        return Err(Error::Output(format!(
+            "{at} is not a finite number: the run's figures are out of range"
+        )));
+    }
+    json(report)
+}
+
 /// Runs `family` on `machine` with the parameter `sources`; `stage` is
 /// called as each stage begins (for progress).
 ///
@@ -192,6 +220,15 @@ pub fn run(
     ];
     stage(STAGES[4]);
     let parts = family.part(&values)?;
+    if let Some(b) = parts.iter().find(|b| !crate::files::is_plain_name(&b.name)) {
+        return Err(Error::Family(crate::family::FamilyError::Contract {
+            family: family.name().to_owned(),
+            message: format!(
+                "fn part(p): the body name '{}' is not a plain name (letters, digits, _ or -, at most 64): it becomes a file name",
+                crate::files::excerpt(&b.name)
+            ),
+        }));
+    }
     let tol = options.mesh_tolerance;
     let (pose_block, bodies) = if parts.is_empty() {
         (None, vec![])
@@ -269,7 +306,7 @@ pub fn run(
         files.push(("profile.svg".into(), text.into_bytes()));
         report.files.push("profile.svg".into());
     }
-    files.push(("report.json".into(), json(&report)?));
+    files.push(("report.json".into(), report_json(&report)?));
     Ok(JobOutput {
         params: values,
         toolpath,
@@ -278,4 +315,17 @@ pub fn run(
         report,
         files,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A number JSON cannot hold (NaN, infinity) is found, with its place.
+    #[test]
+    fn non_finite_numbers_are_found() {
+        let v = serde_json::json!({"a": 1.0, "notes": {"x": f64::NAN}});
+        assert_eq!(null_at(&v, "report"), Some("report.notes.x".into()));
+        assert_eq!(null_at(&serde_json::json!({"a": [1, 2]}), "r"), None);
+    }
 }

@@ -28,6 +28,7 @@ struct MachineFile {
     program_decimals: Option<Spanned<i64>>,
     #[serde(default)]
     driven_axes: Vec<String>,
+    min_feed: Option<Spanned<Real>>,
 }
 
 #[derive(Deserialize)]
@@ -126,9 +127,11 @@ impl Machine {
     /// An unreadable file, or any error of [`Machine::from_toml_str`].
     pub fn from_file(path: impl AsRef<Path>) -> Result<Machine, MachineError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| MachineError::Io {
-            file: path.display().to_string(),
-            message: e.to_string(),
+        let text = crate::files::read_text(path, crate::files::MAX_TEXT_BYTES).map_err(|e| {
+            MachineError::Io {
+                file: e.file,
+                message: e.message,
+            }
         })?;
         Self::from_toml_str(&text, &path.display().to_string())
     }
@@ -177,7 +180,8 @@ impl Machine {
     /// constants (mm; a `_deg` key is stored in radians without the suffix);
     /// a constant factor may take one (`constant = "rest_offset_b"`).
     /// `driven_axes` lists programmed axes the machine takes from the
-    /// toolpath rather than solving. Every linear axis states `moves` and
+    /// toolpath rather than solving; `min_feed` is the least feed of a
+    /// cutting move (mm/min). Every linear axis states `moves` and
     /// every rotary axis `turns` (the axis the tool turns about, relative to
     /// the part); both are checked against the chain when the file is read.
     ///
@@ -191,7 +195,7 @@ impl Machine {
         let src = Source { name: source, text };
         let file: MachineFile = toml::from_str(text).map_err(|e| {
             let span = e.span().unwrap_or(0..0);
-            src.err(span, e.message().trim().to_owned())
+            src.err(span, crate::files::excerpt(e.message().trim()))
         })?;
         let axes = file
             .axes
@@ -255,6 +259,10 @@ impl Machine {
             bodies,
             chain,
             tool,
+            min_feed: match &file.min_feed {
+                Some(f) => Some(src.finite("min_feed", f)?),
+                None => None,
+            },
         };
         Machine::compile(info).map_err(|e| src.err(span_of(&file, &e), e.message))
     }

@@ -68,15 +68,6 @@ fn invalid(place: Place, message: impl Into<String>) -> Invalid {
     }
 }
 
-/// Whether `name` is a plain name: letters, digits, `_`, `-` (safe as a
-/// file name).
-pub(crate) fn is_plain_name(name: &str) -> bool {
-    !name.is_empty()
-        && name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
-}
-
 fn kind_of(f: SpecFactor) -> FactorKind {
     match f {
         SpecFactor::Tx => FactorKind::Tx,
@@ -279,7 +270,7 @@ fn check_axes(info: &MachineInfo) -> Result<ToolFrame, Invalid> {
 
 /// Checks a body's name and shape.
 fn check_body(info: &MachineInfo, b: &BodySpec) -> Result<(), Invalid> {
-    if !is_plain_name(&b.name) {
+    if !crate::files::is_plain_name(&b.name) {
         return Err(invalid(
             Place::Body(b.name.clone(), "name"),
             format!(

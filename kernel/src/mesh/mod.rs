@@ -27,6 +27,20 @@ pub use sweep::sweep;
 use crate::math::{Mat4, Real};
 use std::collections::HashMap;
 
+/// The most triangles a tessellation makes: 20 million (about 1 GB of
+/// mesh); checked before the mesh is built.
+pub const MAX_TRIANGLES: usize = 20_000_000;
+
+/// An error unless `count` triangles are within [`MAX_TRIANGLES`].
+pub(crate) fn check_triangles(count: usize, tol: Real) -> Result<(), MeshError> {
+    if count > MAX_TRIANGLES {
+        return Err(MeshError::Degenerate(format!(
+            "the mesh would have {count} triangles at a chordal tolerance of {tol} mm, more than the ceiling {MAX_TRIANGLES}: give a coarser tolerance"
+        )));
+    }
+    Ok(())
+}
+
 /// The default chordal tolerance of tessellations (mm).
 pub const DEFAULT_TOLERANCE: Real = 0.01;
 

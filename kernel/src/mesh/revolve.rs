@@ -169,6 +169,8 @@ pub fn revolve(section: &[[Real; 2]], tol: Real) -> Result<TriMesh, MeshError> {
     // point, the programmed one, at angle pi); angles as pi (2k / n) are
     // exact there.
     let na = super::arc_segments(r_max, TAU, tol, 8)?.next_multiple_of(2);
+    // Each section segment makes a band of at most 2 triangles a sector.
+    super::check_triangles(na.saturating_mul(2).saturating_mul(n), tol)?;
     let trig: Vec<(Real, Real)> = (0..na)
         .map(|k| (PI * (2 * k) as Real / na as Real).sin_cos())
         .collect();

@@ -25,7 +25,9 @@ pub use ellipse::EllipseSection;
 pub use law::{uniform_grid, MandrelLaw};
 pub use simplify::{simplify_polyline, Polyline};
 pub use smooth::Smoothing;
-pub use table::{read_table, read_table_str, Table, TableError, TableFormat};
+pub use table::{
+    read_table, read_table_bytes, read_table_str, Table, TableError, TableFormat, MAX_CELLS,
+};
 
 use crate::input::InputError;
 use crate::math::{fixed, Real};

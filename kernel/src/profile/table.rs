@@ -11,11 +11,21 @@
 //! CSV files may use `,`, `;` or tab as the delimiter (detected from the
 //! first line); with `;` or tab, a decimal comma (`12,5`) is accepted.
 //! Lines starting with `#` are comments.
+//!
+//! Bounds: only regular files are read, of at most
+//! [`crate::files::MAX_DATA_BYTES`]; a table holds at most [`MAX_CELLS`]
+//! cells (its rows' widths added up), checked as it is read: an XLSX sheet
+//! is read cell by cell, never as the rectangle its farthest cell spans.
+//! (An XLS sheet is at most 65,536 x 256 cells by its format; an ODS
+//! sheet's repetitions are bounded by the reader.)
 
 use super::{Profile, ProfileError};
 use crate::input::InputError;
 use crate::math::Real;
 use std::path::Path;
+
+/// The most cells a table may hold: 10 million.
+pub const MAX_CELLS: usize = 10_000_000;
 
 /// Errors reading tables; each names the file, and the row and column where
 /// there is one.
@@ -136,24 +146,37 @@ pub struct Table {
 pub fn read_table(path: impl AsRef<Path>) -> Result<Table, TableError> {
     let path = path.as_ref();
     let file = path.display().to_string();
-    let format = TableFormat::of(path).ok_or_else(|| TableError::UnknownFormat {
-        file: file.clone(),
+    format_of(path, &file)?;
+    let bytes = crate::files::read_bytes(path, crate::files::MAX_DATA_BYTES).map_err(|e| {
+        TableError::Read {
+            file: file.clone(),
+            message: e.message,
+        }
+    })?;
+    read_table_bytes(&bytes, &file)
+}
+
+/// The format a file's extension names.
+fn format_of(path: &Path, file: &str) -> Result<TableFormat, TableError> {
+    TableFormat::of(path).ok_or_else(|| TableError::UnknownFormat {
+        file: file.to_owned(),
         extension: path
             .extension()
             .and_then(|e| e.to_str())
             .unwrap_or("")
             .to_owned(),
-    })?;
-    match format {
-        TableFormat::Csv => {
-            let bytes = std::fs::read(path).map_err(|e| TableError::Read {
-                file: file.clone(),
-                message: e.to_string(),
-            })?;
-            let text = String::from_utf8_lossy(&bytes);
-            read_table_str(&text, &file)
-        }
-        TableFormat::Spreadsheet => read_spreadsheet(path, file),
+    })
+}
+
+/// Reads a table from a file's bytes; `file` names it in errors and its
+/// extension gives the format.
+///
+/// # Failures
+/// As [`read_table`], but for reading the file.
+pub fn read_table_bytes(bytes: &[u8], file: &str) -> Result<Table, TableError> {
+    match format_of(Path::new(file), file)? {
+        TableFormat::Csv => read_table_str(&String::from_utf8_lossy(bytes), file),
+        TableFormat::Spreadsheet => read_spreadsheet(bytes, file.to_owned()),
     }
 }
 
@@ -181,11 +204,14 @@ pub fn read_table_str(text: &str, source: &str) -> Result<Table, TableError> {
         .trim(csv::Trim::All)
         .from_reader(text.as_bytes());
     let mut rows = Vec::new();
+    let mut cells_read = 0usize;
     for rec in reader.records() {
         let rec = rec.map_err(|e| TableError::Read {
             file: source.to_owned(),
-            message: e.to_string(),
+            message: crate::files::excerpt(&e.to_string()),
         })?;
+        cells_read += rec.len();
+        check_cells(cells_read, source)?;
         let line = rec.position().map_or(0, |p| p.line() as usize);
         let cells = rec
             .iter()
@@ -210,38 +236,94 @@ pub fn read_table_str(text: &str, source: &str) -> Result<Table, TableError> {
     Table::from_rows(source.to_owned(), rows)
 }
 
-fn read_spreadsheet(path: &Path, file: String) -> Result<Table, TableError> {
-    use calamine::{Data, Reader};
+/// An error once a table has more than [`MAX_CELLS`] cells.
+fn check_cells(n: usize, file: &str) -> Result<(), TableError> {
+    if n > MAX_CELLS {
+        return Err(TableError::Read {
+            file: file.to_owned(),
+            message: format!("the table has more than {MAX_CELLS} cells"),
+        });
+    }
+    Ok(())
+}
+
+/// A spreadsheet cell as the table keeps it.
+fn cell_of(c: &calamine::Data) -> Cell {
+    use calamine::Data;
+    match c {
+        Data::Int(v) => Cell::Number(*v as Real),
+        Data::Float(v) => Cell::Number(*v),
+        Data::Empty => Cell::Empty,
+        Data::String(s) => match s.trim().parse::<Real>() {
+            Ok(v) => Cell::Number(v),
+            Err(_) if s.trim().is_empty() => Cell::Empty,
+            Err(_) => Cell::Text(s.clone()),
+        },
+        other => Cell::Text(other.to_string()),
+    }
+}
+
+/// Rows of `(row, column, cell)` triples, in any order, as the table's rows
+/// (numbered from 1), each as wide as its farthest cell; bounded by
+/// [`MAX_CELLS`] as they are laid out.
+fn rows_of(
+    mut cells: Vec<(u32, u32, Cell)>,
+    file: &str,
+) -> Result<Vec<(usize, Vec<Cell>)>, TableError> {
+    cells.sort_by_key(|c| (c.0, c.1));
+    let mut rows: Vec<(usize, Vec<Cell>)> = Vec::new();
+    let mut total = 0usize;
+    for (r, c, cell) in cells {
+        if cell == Cell::Empty {
+            continue;
+        }
+        if rows.last().is_none_or(|(n, _)| *n != r as usize + 1) {
+            rows.push((r as usize + 1, Vec::new()));
+        }
+        let row = &mut rows.last_mut().expect("pushed above").1;
+        let width = c as usize + 1;
+        total += width.saturating_sub(row.len());
+        check_cells(total, file)?;
+        row.resize(width.max(row.len()), Cell::Empty);
+        row[c as usize] = cell;
+    }
+    Ok(rows)
+}
+
+fn read_spreadsheet(bytes: &[u8], file: String) -> Result<Table, TableError> {
+    use calamine::{Reader, Sheets};
     let read_err = |e: &dyn std::fmt::Display| TableError::Read {
         file: file.clone(),
-        message: e.to_string(),
+        message: crate::files::excerpt(&e.to_string()),
     };
-    let mut book = calamine::open_workbook_auto(path).map_err(|e| read_err(&e))?;
-    let range = book
-        .worksheet_range_at(0)
-        .ok_or_else(|| read_err(&"the workbook has no sheets"))?
+    let mut book = calamine::open_workbook_auto_from_rs(std::io::Cursor::new(bytes))
         .map_err(|e| read_err(&e))?;
-    let (row0, col0) = range.start().unwrap_or((0, 0));
-    let rows = range
-        .rows()
-        .enumerate()
-        .map(|(i, r)| {
-            let mut cells: Vec<Cell> = vec![Cell::Empty; col0 as usize];
-            cells.extend(r.iter().map(|c| match c {
-                Data::Int(v) => Cell::Number(*v as Real),
-                Data::Float(v) => Cell::Number(*v),
-                Data::Empty => Cell::Empty,
-                Data::String(s) => match s.trim().parse::<Real>() {
-                    Ok(v) => Cell::Number(v),
-                    Err(_) if s.trim().is_empty() => Cell::Empty,
-                    Err(_) => Cell::Text(s.clone()),
-                },
-                other => Cell::Text(other.to_string()),
-            }));
-            (row0 as usize + i + 1, cells)
-        })
-        .collect();
-    Table::from_rows(file, rows)
+    let first = book
+        .sheet_names()
+        .first()
+        .cloned()
+        .ok_or_else(|| read_err(&"the workbook has no sheets"))?;
+    let mut cells = Vec::new();
+    if let Sheets::Xlsx(xlsx) = &mut book {
+        // Cell by cell: a far cell must not make a rectangle of cells.
+        let mut reader = xlsx
+            .worksheet_cells_reader(&first)
+            .map_err(|e| read_err(&e))?;
+        while let Some(c) = reader.next_cell().map_err(|e| read_err(&e))? {
+            let (r, col) = c.get_position();
+            let data: calamine::Data = c.get_value().clone().into();
+            cells.push((r, col, cell_of(&data)));
+            check_cells(cells.len(), &file)?;
+        }
+    } else {
+        let range = book.worksheet_range(&first).map_err(|e| read_err(&e))?;
+        check_cells(range.get_size().0.saturating_mul(range.get_size().1), &file)?;
+        for (r, c, d) in range.used_cells() {
+            let (row0, col0) = range.start().unwrap_or((0, 0));
+            cells.push((row0 + r as u32, col0 + c as u32, cell_of(d)));
+        }
+    }
+    Table::from_rows(file.clone(), rows_of(cells, &file)?)
 }
 
 /// Spreadsheet column letters: 0 -> A, 25 -> Z, 26 -> AA.

@@ -17,6 +17,10 @@ use crate::machine::{Axis, MachineError, MachineInfo, MachineKinematics};
 use crate::math::Real;
 use crate::toolpath::{Motion, Toolpath, ToolpathError};
 
+/// The least feed of a cutting block on any machine (mm/min): below it a
+/// move would take longer than a report can say.
+pub const MIN_FEED: Real = 1e-3;
+
 /// Errors making a program from a toolpath; blocks are numbered from 1.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ProgramError {
@@ -70,6 +74,18 @@ pub enum ProgramError {
         max: Real,
         /// mm or deg.
         unit: &'static str,
+    },
+    /// A cutting block slower than the machine's controls accept.
+    #[error("block {block}: feed {feed:e} mm/min is below the minimum feed of machine {machine}, {min} mm/min")]
+    FeedTooLow {
+        /// Block number (from 1).
+        block: usize,
+        /// The feed.
+        feed: Real,
+        /// The machine.
+        machine: String,
+        /// Its least feed.
+        min: Real,
     },
     /// A block faster than an axis can go.
     #[error("block {block}: axis {axis} would move at {speed:.1} {unit}, above its maximum {max} {unit}")]
@@ -265,6 +281,19 @@ pub fn build(
             },
             spindle: (k == 0).then_some(toolpath.spindle_rpm),
             comment: (j == 0).then(|| toolpath.passes[p].name.clone()),
+        });
+    }
+    let min = info.min_feed.unwrap_or(MIN_FEED).max(MIN_FEED);
+    if let Some((i, b)) = blocks
+        .iter()
+        .enumerate()
+        .find(|(_, b)| b.motion != Motion::Rapid && !(b.feed >= min))
+    {
+        return Err(ProgramError::FeedTooLow {
+            block: i + 1,
+            feed: b.feed,
+            machine: info.name.clone(),
+            min,
         });
     }
     let axes_refs: Vec<&Axis> = columns.iter().map(|(a, _)| *a).collect();

@@ -68,13 +68,14 @@ pub(super) fn register(engine: &mut Engine, access: &Access) {
                         .map(|d| d.join(p))
                         .ok_or("no input directory is open to scripts")?
                 };
-                let canon = full
-                    .canonicalize()
-                    .map_err(|e| format!("{}: {e}", full.display()))?;
+                // A missing file and one outside get the same answer: a
+                // script must not learn what lies outside.
+                let refused = || -> Box<EvalAltResult> {
+                    format!("{path}: not a readable file inside the input directories").into()
+                };
+                let canon = full.canonicalize().map_err(|_| refused())?;
                 if !dirs.iter().any(|d| canon.starts_with(d)) {
-                    return Err(
-                        format!("{} is outside the input directories", full.display()).into(),
-                    );
+                    return Err(refused());
                 }
                 kernel(crate::profile::read_table(&canon))
             },

@@ -20,6 +20,9 @@ impl Floats {
     }
 }
 
+/// The most values a `Floats` may hold: 10 million (80 MB).
+pub const MAX_FLOATS: usize = 10_000_000;
+
 /// What a binding declares for a parameter that takes numbers: `Floats`,
 /// an array of numbers, or (where the function says so) one number. The
 /// reference shows it as `Floats`.
@@ -123,8 +126,10 @@ pub mod floats_api {
         if n < 2 {
             return err(format!("linspace needs at least 2 points, got {n}"));
         }
-        if n > 10_000_000 {
-            return err(format!("linspace of {n} points is more than 10 million"));
+        if n > MAX_FLOATS as i64 {
+            return err(format!(
+                "linspace of {n} points is more than the ceiling of {MAX_FLOATS}"
+            ));
         }
         let m = (n - 1) as Real;
         Ok(Floats::new(
@@ -149,8 +154,10 @@ pub mod floats_api {
     /// `n` copies of `value`.
     #[rhai_fn(return_raw)]
     pub fn filled(n: i64, value: Real) -> Result<Floats, Box<EvalAltResult>> {
-        if !(0..=10_000_000).contains(&n) {
-            return err(format!("filled: {n} values is out of range"));
+        if !(0..=MAX_FLOATS as i64).contains(&n) {
+            return err(format!(
+                "filled: {n} values is out of range (0 to the ceiling of {MAX_FLOATS})"
+            ));
         }
         Ok(Floats::new(vec![value; n as usize]))
     }
@@ -161,10 +168,20 @@ pub mod floats_api {
         numbers(&values, "floats").map(Floats)
     }
 
-    /// The numbers as an ordinary array.
-    #[rhai_fn(pure)]
-    pub fn to_array(v: &mut Floats) -> Array {
-        v.0.iter().map(|x| Dynamic::from_float(*x)).collect()
+    /// The numbers as an ordinary array (within the engine's array size).
+    #[rhai_fn(pure, return_raw)]
+    pub fn to_array(
+        ctx: NativeCallContext<'_>,
+        v: &mut Floats,
+    ) -> Result<Array, Box<EvalAltResult>> {
+        let max = ctx.engine().max_array_size();
+        if max > 0 && v.0.len() > max {
+            return err(format!(
+                "to_array: {} values are more than the array size limit of {max}",
+                v.0.len()
+            ));
+        }
+        Ok(v.0.iter().map(|x| Dynamic::from_float(*x)).collect())
     }
 
     /// Number of values.
@@ -245,6 +262,12 @@ pub mod floats_api {
             numbers(&a, "concat's first")?,
             numbers(&b, "concat's second")?,
         );
+        if a.len() + b.len() > MAX_FLOATS {
+            return err(format!(
+                "concat: {} values are more than the ceiling of {MAX_FLOATS}",
+                a.len() + b.len()
+            ));
+        }
         Ok(Floats::new(a.iter().chain(b.iter()).copied().collect()))
     }
 }

@@ -3,7 +3,9 @@
 //! A family is a Rhai script that defines
 //!
 //! - `fn params()`: a map of parameters, each `#{ value, unit, doc }` (the
-//!   default, its unit, a one-line description);
+//!   default, its unit, a one-line description), optionally `min`, `max`
+//!   (bounds; a quantity that drives work has a ceiling) and `max_len` (for
+//!   a list), and `machine` (the machine constant that gives the default);
 //! - `fn toolpath(p)`: the toolpath for the parameter values `p` (a map);
 //! - optionally `fn part(p)` (the part's geometry, for export),
 //!   `fn checks(p)` (an array of `#{ name, ok, detail }`), `fn verify(p)`
@@ -39,7 +41,7 @@ use rhai::{Dynamic, Engine, EvalAltResult, Map, Position, Scope, AST};
 use std::path::{Path, PathBuf};
 
 /// The engine's limits.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Limits {
     /// Operations per call (a runaway loop is stopped here).
     pub max_operations: u64,
@@ -53,12 +55,21 @@ pub struct Limits {
     pub max_string_size: usize,
     /// Entries of a map.
     pub max_map_size: usize,
+    /// Wall-clock seconds per call of a family's function: the operation
+    /// count alone does not bound time (an operation on a large array costs
+    /// in proportion to it).
+    pub max_seconds: f64,
+    /// Megabytes the process may hold while a script runs (its resident
+    /// memory, looked at every few thousand operations; Linux): the size
+    /// limits alone do not bound memory (Rhai 1.27 does not count a map's
+    /// entries added by `m[key] = value`).
+    pub max_memory_mb: u64,
 }
 
 impl Default for Limits {
     /// 50 million operations (a few seconds), 64 calls deep, expressions 64
     /// (32 in functions), 1 million array elements, 1 MB strings, 10,000
-    /// map entries.
+    /// map entries, 60 seconds a call, 4 GB of memory.
     fn default() -> Self {
         Self {
             max_operations: 50_000_000,
@@ -67,8 +78,38 @@ impl Default for Limits {
             max_array_size: 1_000_000,
             max_string_size: 1 << 20,
             max_map_size: 10_000,
+            max_seconds: 60.0,
+            max_memory_mb: 4096,
         }
     }
+}
+
+/// The process's resident memory (MB), where the system tells it (Linux).
+fn resident_mb() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/self/statm").ok()?;
+    let pages: u64 = text.split_whitespace().nth(1)?.parse().ok()?;
+    // SAFETY: sysconf reads a system constant.
+    let page = unsafe { libc::sysconf(libc::_SC_PAGESIZE) };
+    Some(pages * u64::try_from(page).ok()? / (1 << 20))
+}
+
+thread_local! {
+    /// When the running call of a script must stop, and its limit (s).
+    static DEADLINE: std::cell::Cell<Option<(std::time::Instant, f64)>> =
+        const { std::cell::Cell::new(None) };
+}
+
+/// Runs `f` with a wall-clock limit of `seconds` on the script calls in it.
+fn with_deadline<T>(seconds: f64, f: impl FnOnce() -> T) -> T {
+    let limit = std::time::Duration::try_from_secs_f64(seconds.max(0.0))
+        .unwrap_or(std::time::Duration::MAX);
+    let until = std::time::Instant::now()
+        .checked_add(limit)
+        .map(|t| (t, seconds));
+    let before = DEADLINE.with(|d| d.replace(until));
+    let out = f();
+    DEADLINE.with(|d| d.set(before));
+    out
 }
 
 /// Where scripts may read files.
@@ -84,6 +125,7 @@ pub struct ScriptFamily {
     ast: AST,
     file: String,
     specs: Vec<ParamSpec>,
+    max_seconds: f64,
 }
 
 impl std::fmt::Debug for ScriptFamily {
@@ -105,6 +147,23 @@ pub fn engine(limits: &Limits, access: &Access) -> Engine {
         .set_max_string_size(limits.max_string_size)
         .set_max_map_size(limits.max_map_size)
         .set_module_resolver(rhai::module_resolvers::DummyModuleResolver::new());
+    // The wall-clock limit, looked at every 64 operations, and the memory
+    // limit every 4096.
+    let max_mb = limits.max_memory_mb;
+    e.on_progress(move |ops| {
+        if ops % 64 != 0 {
+            return None;
+        }
+        if ops % 4096 == 0 && resident_mb().is_some_and(|mb| mb > max_mb) {
+            return Some(Dynamic::from_int(max_mb as rhai::INT));
+        }
+        DEADLINE.with(|d| match d.get() {
+            Some((until, seconds)) if std::time::Instant::now() > until => {
+                Some(Dynamic::from_float(seconds))
+            }
+            _ => None,
+        })
+    });
     // Scripts print to the error stream, never into outputs.
     e.on_print(|s| eprintln!("{s}"));
     e.on_debug(|s, src, pos| eprintln!("{}:{pos}: {s}", src.unwrap_or("script")));
@@ -221,6 +280,12 @@ fn locate(file: &str, called: &str, e: &EvalAltResult) -> FamilyError {
         inner.position()
     };
     let mut message = match inner {
+        EvalAltResult::ErrorTerminated(token, _) => match token.as_int() {
+            Ok(mb) => format!("the script ran past its memory limit of {mb} MB and was stopped"),
+            Err(_) => format!(
+                "the script ran past its time limit of {token} s and was stopped (an endless loop?)"
+            ),
+        },
         EvalAltResult::ErrorTooManyOperations(_) => {
             "the script ran past its operation limit and was stopped (an endless loop?)".to_owned()
         }
@@ -266,9 +331,11 @@ impl ScriptFamily {
     /// returns something other than a map of `#{value, unit, doc}`.
     pub fn load(path: &Path, limits: &Limits, access: &Access) -> Result<Self, FamilyError> {
         let file = path.display().to_string();
-        let source = std::fs::read_to_string(path).map_err(|e| FamilyError::Io {
-            file: file.clone(),
-            message: e.to_string(),
+        let source = crate::files::read_text(path, crate::files::MAX_TEXT_BYTES).map_err(|e| {
+            FamilyError::Io {
+                file: file.clone(),
+                message: e.message,
+            }
         })?;
         let mut access = access.clone();
         if let Some(dir) = path.parent() {
@@ -302,6 +369,7 @@ impl ScriptFamily {
             ast,
             file: file.to_owned(),
             specs: vec![],
+            max_seconds: limits.max_seconds,
         };
         for (name, arity) in [("params", 0), ("toolpath", 1)] {
             if !fam.has_fn(name, arity) {
@@ -342,13 +410,38 @@ impl ScriptFamily {
                     default.kind()
                 )));
             }
-            fam.specs.push(ParamSpec {
-                name: name.to_string(),
-                default,
-                unit: text("unit"),
-                doc: text("doc"),
+            let bound = |k: &str| -> Result<Option<f64>, FamilyError> {
+                match field(k) {
+                    None => Ok(None),
+                    Some(d) => floats::number(&d).map(Some).ok_or_else(|| {
+                        fam.contract(format!("parameter '{name}': {k} must be a number"))
+                    }),
+                }
+            };
+            let (min, max) = (bound("min")?, bound("max")?);
+            let max_len = match bound("max_len")? {
+                Some(n) if n >= 0.0 && n.fract() == 0.0 => Some(n as usize),
+                Some(_) => {
+                    return Err(fam.contract(format!(
+                        "parameter '{name}': max_len must be a whole number"
+                    )))
+                }
+                None => None,
+            };
+            let spec = ParamSpec {
                 machine,
-            });
+                min,
+                max,
+                max_len,
+                ..ParamSpec::new(&name, default, &text("unit"), &text("doc"))
+            };
+            // The default must be allowed (a family's own mistake).
+            if let Err(e) =
+                crate::params::resolve(std::slice::from_ref(&spec), &Default::default(), &[])
+            {
+                return Err(fam.contract(e.to_string()));
+            }
+            fam.specs.push(spec);
         }
         Ok(fam)
     }
@@ -369,9 +462,11 @@ impl ScriptFamily {
 
     fn call(&self, name: &str, args: impl rhai::FuncArgs) -> Result<Dynamic, FamilyError> {
         let mut scope = Scope::new();
-        self.engine
-            .call_fn::<Dynamic>(&mut scope, &self.ast, name, args)
-            .map_err(|e| locate(&self.file, name, &e))
+        with_deadline(self.max_seconds, || {
+            self.engine
+                .call_fn::<Dynamic>(&mut scope, &self.ast, name, args)
+        })
+        .map_err(|e| locate(&self.file, name, &e))
     }
 
     /// The script's file name.
@@ -560,14 +655,16 @@ pub fn machine_from_script(path: &Path) -> Result<Machine, MachineError> {
         file: shown.clone(),
         message,
     };
-    let source = std::fs::read_to_string(path).map_err(|e| io(e.to_string()))?;
+    let source =
+        crate::files::read_text(path, crate::files::MAX_TEXT_BYTES).map_err(|e| io(e.message))?;
     let engine = engine(&Limits::default(), &Access::default());
     let ast = engine
         .compile(&source)
         .map_err(|e| io(format!("{}: {}", e.position(), e.err_type())))?;
-    let map: Dynamic = engine
-        .call_fn(&mut Scope::new(), &ast, "machine", ())
-        .map_err(|e| io(format!("fn machine(): {e}")))?;
+    let map: Dynamic = with_deadline(Limits::default().max_seconds, || {
+        engine.call_fn(&mut Scope::new(), &ast, "machine", ())
+    })
+    .map_err(|e| io(format!("fn machine(): {e}")))?;
     let value: toml::Value = rhai::serde::from_dynamic(&map)
         .map_err(|e| io(format!("fn machine() must return the machine's table: {e}")))?;
     let text = toml::to_string(&value).map_err(|e| io(e.to_string()))?;

@@ -48,7 +48,7 @@
 //!             name: "lathe".into(), description: String::new(), control: "fanuc".into(),
 //!             axes: vec![axis("X"), axis("Z")], solved_axes: vec!["X".into(), "Z".into()],
 //!             constants: Default::default(), program_decimals: None, driven_axes: vec![],
-//!             bodies: vec![], chain: vec![], tool: Default::default(),
+//!             bodies: vec![], chain: vec![], tool: Default::default(), min_feed: None,
 //!         }
 //!     }
 //!     fn inverse(&self, poses: &[f64], tool: &[f64; 6], out: &mut [f64]) -> Result<(), PluginError> {
@@ -84,7 +84,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 pub const ABI_MAJOR: u32 = 1;
 /// The ABI's minor version: fields appended to the table and to the JSON
 /// types since the major (1.1: the table's `capabilities`; the descriptor's
-/// `driven_axes`, `bodies`, `chain`, `tool`).
+/// `driven_axes`, `bodies`, `chain`, `tool`, `min_feed`).
 pub const ABI_MINOR: u32 = 1;
 
 /// The call succeeded.

@@ -317,6 +317,10 @@ pub struct MachineInfo {
     /// The tool frame the chain places.
     #[serde(default)]
     pub tool: ToolSpec,
+    /// The least feed the machine's controls accept on a cutting move
+    /// (mm/min, or deg/min for a move that only turns), if stated.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_feed: Option<f64>,
 }
 
 impl MachineInfo {

@@ -144,6 +144,8 @@ pub fn describe() -> MachineInfo {
             FactorSpec::axis(FactorKind::Tx, "X"),
         ],
         tool: ToolSpec::default(),
+        // The 840D's feeds below 1 mm/min are not a grinding feed.
+        min_feed: Some(1.0),
     }
 }
 

@@ -1,0 +1,495 @@
+//! Trust (issue 10): no user file is ever lost, nothing reaches outside,
+//! every input is bounded. Each test reproduces a defect found by trying
+//! pilgrim as a hostile or careless user would, from the command line.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+mod common;
+
+fn pilgrim_in(dir: &Path, args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_pilgrim"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn pilgrim(args: &[&str]) -> (i32, String, String) {
+    pilgrim_in(root(), args)
+}
+
+/// Runs pilgrim, killing it after `limit`: `None` if it had to be killed.
+fn pilgrim_within(args: &[&str], limit: Duration) -> Option<(i32, String)> {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_pilgrim"))
+        .current_dir(root())
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            let mut err = String::new();
+            use std::io::Read;
+            child.stderr.take().unwrap().read_to_string(&mut err).ok();
+            return Some((status.code().unwrap_or(-1), err));
+        }
+        if start.elapsed() > limit {
+            child.kill().ok();
+            child.wait().ok();
+            return None;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("pilgrim-trust-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+const DEMO: &str = "scripts/examples/mill_circle.rhai";
+
+/// Every file below `dir` with its bytes, sorted.
+fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut out = vec![];
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            out.extend(snapshot(&p));
+        } else {
+            out.push((p.clone(), std::fs::read(&p).unwrap()));
+        }
+    }
+    out.sort();
+    out
+}
+
+/// `--out` at a directory pilgrim did not write is refused and every file
+/// in it stays; a regular file given as `--out` is refused too; a previous
+/// output is replaced as a whole.
+#[test]
+fn out_never_replaces_what_pilgrim_did_not_write() {
+    let dir = scratch("out");
+    let user = dir.join("d");
+    std::fs::create_dir(&user).unwrap();
+    std::fs::write(user.join("notes.txt"), "x\n").unwrap();
+    let before = snapshot(&dir);
+    let abs_demo = root().join(DEMO);
+    let (code, _, err) = pilgrim(&["run", DEMO, "--out", s(&user), "--quiet"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("was not written by pilgrim") && err.contains("notes.txt"),
+        "{err}"
+    );
+    // --out "$PWD": the user's working directory.
+    let (code, _, err) = pilgrim_in(&user, &["run", s(&abs_demo), "--out", s(&user), "--quiet"]);
+    assert_eq!(code, 1, "{err}");
+    let file = dir.join("f");
+    std::fs::write(&file, "keep me\n").unwrap();
+    let (code, _, err) = pilgrim(&["run", DEMO, "--out", s(&file), "--quiet"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("is not a directory"), "{err}");
+    let mut expected = before.clone();
+    expected.push((file.clone(), b"keep me\n".to_vec()));
+    expected.sort();
+    assert_eq!(snapshot(&dir), expected);
+    // A new directory, then the same run again: replaced as a whole.
+    let out = dir.join("run");
+    for _ in 0..2 {
+        let (code, _, err) = pilgrim(&["run", DEMO, "--out", s(&out), "--quiet"]);
+        assert_eq!(code, 0, "{err}");
+    }
+    assert!(out.join(".pilgrim-output").is_file());
+    // A previous output to which the user added a file is refused, naming it.
+    std::fs::write(out.join("mine.txt"), "mine\n").unwrap();
+    let (code, _, err) = pilgrim(&["run", DEMO, "--out", s(&out), "--quiet"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("mine.txt"), "{err}");
+    assert_eq!(std::fs::read(out.join("mine.txt")).unwrap(), b"mine\n");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Temporary directories of killed runs are cleaned by the next run, but
+/// only when their process is gone.
+#[test]
+fn stale_temporaries_of_dead_runs_are_cleaned() {
+    let dir = scratch("stale");
+    // A process that is gone: a child that has exited.
+    let dead = Command::new("true").spawn().unwrap();
+    let dead_pid = dead.id();
+    let mut dead = dead;
+    dead.wait().unwrap();
+    let stale = dir.join(format!(".out.tmp-{dead_pid}"));
+    std::fs::create_dir(&stale).unwrap();
+    std::fs::write(stale.join(".pilgrim-output"), "").unwrap();
+    std::fs::write(stale.join("part.stl"), "half").unwrap();
+    // One of a live process (this test).
+    let live = dir.join(format!(".out.tmp-{}", std::process::id()));
+    std::fs::create_dir(&live).unwrap();
+    std::fs::write(live.join(".pilgrim-output"), "").unwrap();
+    let out = dir.join("out");
+    let (code, _, err) = pilgrim(&["run", DEMO, "--out", s(&out), "--quiet"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!stale.exists(), "the dead run's temporary is still there");
+    assert!(live.exists(), "a live run's temporary was removed");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A family's body names become file names only when they are plain names.
+#[test]
+fn part_names_cannot_reach_outside() {
+    let dir = scratch("names");
+    let victim = dir.join("victim");
+    for name in [format!("{}/x", dir.display()), "../../victim".to_owned()] {
+        let script = dir.join("f.rhai");
+        std::fs::write(
+            &script,
+            format!(
+                "fn params() {{ #{{}} }}\n\
+                 fn default_machine() {{ \"vertical-mill\" }}\n\
+                 fn toolpath(p) {{ let tp = new_toolpath(\"t\", end_mill(\"m\", 1, 6.0, 10.0), 1000.0, [\"C\"]);\n\
+                   tp.add_pass(\"a\", #{{ x: [50.0], y: [0.0], z: [5.0], motion: \"rapid\", aux: #{{ C: 0.0 }} }}); tp }}\n\
+                 fn part(p) {{ #{{ \"{name}\": profile([-1.0, 0.0, 1.0], [5.0, 5.0, 5.0]) }} }}\n"
+            ),
+        )
+        .unwrap();
+        let out = dir.join("out").join("run");
+        let (code, _, err) = pilgrim(&["run", s(&script), "--out", s(&out), "--quiet"]);
+        assert_eq!(code, 1, "{name}: {err}");
+        assert!(
+            err.contains(&format!("'{name}'")) && err.contains("plain name"),
+            "{err}"
+        );
+        assert!(!dir.join("x.stl").exists() && !victim.with_extension("stl").exists());
+        assert!(!out.exists());
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `export` reads only the run's own files by plain name, and loads a
+/// plugin only when the command line names it.
+#[test]
+fn export_trusts_nothing_in_the_report() {
+    let dir = scratch("export");
+    let out = dir.join("run");
+    let (code, _, err) = pilgrim(&["run", DEMO, "--out", s(&out), "--quiet"]);
+    assert_eq!(code, 0, "{err}");
+    let report_path = out.join("report.json");
+    let original = std::fs::read_to_string(&report_path).unwrap();
+    let mut report: serde_json::Value = serde_json::from_str(&original).unwrap();
+    // A plugin named by the report is not loaded.
+    let lib = common::shared_lib("plugin_fixture");
+    report["machine_spec"] = lib.display().to_string().into();
+    std::fs::write(&report_path, serde_json::to_string(&report).unwrap()).unwrap();
+    let (code, _, err) = pilgrim(&["export", s(&out), "--block", "5"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("--machine"), "{err}");
+    // A body's file outside the directory is not opened.
+    let secret = dir.join("secret.stl");
+    std::fs::copy(out.join("part.stl"), &secret).unwrap();
+    report["machine_spec"] = "vertical-mill".into();
+    report["bodies"][0]["file"] = "../secret.stl".into();
+    std::fs::write(&report_path, serde_json::to_string(&report).unwrap()).unwrap();
+    let (code, _, err) = pilgrim(&["export", s(&out), "--block", "5"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("../secret.stl"), "{err}");
+    // The run's own report exports, with the machine it names by a built-in's name.
+    std::fs::write(&report_path, &original).unwrap();
+    let (code, _, err) = pilgrim(&["export", s(&out), "--block", "5"]);
+    assert_eq!(code, 0, "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `read_table` gives the same answer for a file outside the input
+/// directories whether or not it exists.
+#[test]
+fn outside_files_are_not_told_apart() {
+    let dir = scratch("outside");
+    let inside = dir.join("in");
+    std::fs::create_dir(&inside).unwrap();
+    std::fs::write(dir.join("exists.csv"), "a,b\n1,2\n").unwrap();
+    let mut answers = vec![];
+    for target in ["../exists.csv", "../missing.csv"] {
+        let script = inside.join("f.rhai");
+        std::fs::write(
+            &script,
+            format!(
+                "fn params() {{ #{{}} }}\nfn default_machine() {{ \"vertical-mill\" }}\n\
+                 fn toolpath(p) {{ read_table(\"{target}\") }}\n"
+            ),
+        )
+        .unwrap();
+        let (code, _, err) = pilgrim(&["run", s(&script), "--out", s(&dir.join("o")), "--quiet"]);
+        assert_eq!(code, 1);
+        answers.push(err.replace(target, "FILE"));
+    }
+    assert_eq!(answers[0], answers[1]);
+    assert!(
+        answers[0].contains("not a readable file inside the input directories"),
+        "{}",
+        answers[0]
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A 2 KB spreadsheet with one cell at XFD1048576 is read, not an abort
+/// (the bound on cells itself: `kernel/tests/tables.rs`).
+#[test]
+fn a_far_spreadsheet_cell_is_bounded() {
+    let dir = scratch("xlsx");
+    let path = dir.join("far.xlsx");
+    let mut book = rust_xlsxwriter::Workbook::new();
+    let sheet = book.add_worksheet();
+    sheet.write_number(0, 0, 1.0).unwrap();
+    sheet.write_number(1, 0, 2.0).unwrap();
+    sheet.write_number(1_048_575, 16_383, 3.0).unwrap();
+    book.save(&path).unwrap();
+    let script = dir.join("f.rhai");
+    std::fs::write(
+        &script,
+        "fn params() { #{} }\nfn default_machine() { \"vertical-mill\" }\nfn toolpath(p) { read_table(\"far.xlsx\")[\"A\"] }\n",
+    )
+    .unwrap();
+    let (code, _, err) = pilgrim(&["run", s(&script), "--out", s(&dir.join("o")), "--quiet"]);
+    // Read cell by cell: the far cell is a row of its own, named when the
+    // column it lacks is asked for.
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("far.xlsx, row 1048576, column A: the cell is empty"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A shared library cut short is refused before it is loaded, in every
+/// command that loads one; a failed load says the system's reason; a bare
+/// file name is a path in the working directory, not a library search.
+#[test]
+fn truncated_plugins_do_not_crash_the_host() {
+    let dir = scratch("truncated");
+    let good = std::fs::read(common::shared_lib("grinder_3k152vf20")).unwrap();
+    let cut = dir.join("libgrinder_3k152vf20.so");
+    std::fs::write(&cut, &good[..4096]).unwrap();
+    let out = dir.join("o");
+    for args in [
+        vec!["plugin-check", s(&cut)],
+        vec!["run", DEMO, "--machine", s(&cut), "--out", s(&out)],
+        vec!["machines", "--plugin", s(&cut)],
+    ] {
+        let (code, _, err) = pilgrim(&args);
+        assert_eq!(code, 1, "{args:?}: {err}");
+        assert!(err.contains("not a complete"), "{args:?}: {err}");
+    }
+    // Not ELF at all.
+    let text = dir.join("libtext.so");
+    std::fs::write(&text, "not a library").unwrap();
+    let (code, _, err) = pilgrim(&["plugin-check", s(&text)]);
+    assert_eq!(code, 1);
+    assert!(err.contains("not an ELF"), "{err}");
+    // A bare name is looked up in the working directory only.
+    let (code, _, err) = pilgrim_in(&dir, &["plugin-check", "libc.so.6"]);
+    assert_eq!(code, 1);
+    assert!(err.contains("libc.so.6"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Parameters that drive work have ceilings, checked before the work, and
+/// the error names the parameter, its value and the ceiling; feeds below
+/// the machine's minimum are refused.
+#[test]
+fn parameters_that_drive_work_are_bounded() {
+    let dir = scratch("bounds");
+    let out = dir.join("o");
+    let small = "scripts/examples/mandrel-small.toml";
+    for (sets, params, expected) in [
+        (vec!["passes=99999999999"], None, "passes"),
+        (vec!["tolerance=1e-12"], None, "tolerance"),
+        (vec!["cone_d=-1000000"], Some(small), "cone_d"),
+        (vec!["wheel_d=1e9"], None, "wheel_d"),
+        (vec!["feed=1e-320"], None, "feed"),
+    ] {
+        let mut args = vec!["run", "scripts/mandrel.rhai", "--out", s(&out), "--quiet"];
+        if let Some(p) = params {
+            args.extend(["--params", p]);
+        }
+        for set in &sets {
+            args.extend(["--set", set]);
+        }
+        let Some((code, err)) = pilgrim_within(&args, Duration::from_secs(60)) else {
+            panic!("{sets:?} ran past a minute");
+        };
+        assert_eq!(code, 1, "{sets:?}: {err}");
+        assert!(
+            err.contains(&format!("parameter '{expected}'")) || err.contains("minimum"),
+            "{sets:?}: {err}"
+        );
+        assert!(!out.exists());
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A script cannot pass its limits: memory through Floats, time through
+/// operations that each cost more as an array grows, memory through a map
+/// grown by index (which Rhai 1.27 does not count against its map size).
+#[test]
+fn scripts_are_bounded_in_memory_and_time() {
+    let dir = scratch("rhai");
+    let head = "fn params() { #{} }\nfn default_machine() { \"vertical-mill\" }\n";
+    for (body, expected) in [
+        (
+            "fn toolpath(p) { let v = linspace(0.0, 1.0, 1000); for i in 0..40 { v = concat(v, v); } v }",
+            "ceiling of 10000000",
+        ),
+        (
+            "fn toolpath(p) { let a = []; loop { a.push(1); } }",
+            "limit",
+        ),
+        (
+            "fn toolpath(p) { let m = #{}; for i in 0..100000000 { m[`k${i}`] = i; } m }",
+            "limit",
+        ),
+    ] {
+        let script = dir.join("f.rhai");
+        std::fs::write(&script, format!("{head}{body}\n")).unwrap();
+        let Some((code, err)) = pilgrim_within(
+            &[
+                "run",
+                s(&script),
+                "--out",
+                s(&dir.join("o")),
+                "--quiet",
+                "--script-seconds",
+                "2",
+            ],
+            Duration::from_secs(60),
+        ) else {
+            panic!("{body} was not stopped");
+        };
+        assert_eq!(code, 1, "{body}: {err}");
+        assert!(err.to_lowercase().contains(expected), "{body}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Only regular files are read: a FIFO given as a parameter file or read
+/// as a table is refused, not waited on.
+#[test]
+fn fifos_are_refused() {
+    let dir = scratch("fifo");
+    let fifo = dir.join("p.toml");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let Some((code, err)) = pilgrim_within(
+        &[
+            "run",
+            DEMO,
+            "--params",
+            s(&fifo),
+            "--out",
+            s(&dir.join("o")),
+        ],
+        Duration::from_secs(20),
+    ) else {
+        panic!("the run waited on a FIFO");
+    };
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("not a regular file"), "{err}");
+    let table = dir.join("t.csv");
+    assert!(Command::new("mkfifo")
+        .arg(&table)
+        .status()
+        .unwrap()
+        .success());
+    let script = dir.join("f.rhai");
+    std::fs::write(
+        &script,
+        "fn params() { #{} }\nfn default_machine() { \"vertical-mill\" }\nfn toolpath(p) { read_table(\"t.csv\") }\n",
+    )
+    .unwrap();
+    let Some((code, err)) = pilgrim_within(
+        &["run", s(&script), "--out", s(&dir.join("o"))],
+        Duration::from_secs(20),
+    ) else {
+        panic!("read_table waited on a FIFO");
+    };
+    assert_eq!(code, 1, "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// An error about a 1 MB line quotes a short excerpt of it.
+#[test]
+fn errors_quote_short_excerpts() {
+    let dir = scratch("long");
+    let params = dir.join("p.toml");
+    std::fs::write(&params, format!("radius = {}\n", "9".repeat(1 << 20))).unwrap();
+    let (code, _, err) = pilgrim(&[
+        "run",
+        DEMO,
+        "--params",
+        s(&params),
+        "--out",
+        s(&dir.join("o")),
+    ]);
+    assert_eq!(code, 1);
+    assert!(err.len() < 2000, "{} bytes of error", err.len());
+    let params = dir.join("q.toml");
+    std::fs::write(&params, format!("radius = \"{}\n", "x".repeat(1 << 20))).unwrap();
+    let (code, _, err) = pilgrim(&[
+        "run",
+        DEMO,
+        "--params",
+        s(&params),
+        "--out",
+        s(&dir.join("o")),
+    ]);
+    assert_eq!(code, 1);
+    assert!(err.len() < 2000, "{} bytes of error", err.len());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A run killed part way leaves the previous output or none, never a
+/// half-written one; the same input gives the same bytes.
+#[test]
+fn killed_runs_leave_the_old_output_whole() {
+    let dir = scratch("kill");
+    let out = dir.join("o");
+    let (code, _, err) = pilgrim(&["run", "scripts/mandrel.rhai", "--out", s(&out), "--quiet"]);
+    assert_eq!(code, 0, "{err}");
+    let before = snapshot(&out);
+    for delay_ms in [5u64, 15, 30, 45, 60, 90] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_pilgrim"))
+            .current_dir(root())
+            .args(["run", "scripts/mandrel.rhai", "--out", s(&out), "--quiet"])
+            .spawn()
+            .unwrap();
+        std::thread::sleep(Duration::from_millis(delay_ms));
+        child.kill().ok();
+        child.wait().unwrap();
+        let now = snapshot(&out);
+        // Either untouched, or the whole new output: the same bytes.
+        assert_eq!(now, before, "after a kill at {delay_ms} ms");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
