@@ -13,12 +13,13 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use pilgrim_kernel::catalog::{Catalog, CompiledPlugin};
 use pilgrim_kernel::job::{self, JobOptions};
-use pilgrim_kernel::offset::rest::{after_pass, track, RestSetup};
-use pilgrim_kernel::profile::simplify_polyline;
+use pilgrim_kernel::offset::flat_path;
+use pilgrim_kernel::offset::rest::{track, RestSetup};
+use pilgrim_kernel::offset::surface::{GroundSurface, PassLayer, WheelSection};
 use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
 use pilgrim_kernel::{
-    equidistant, ClPoint, MandrelLaw, Motion, PartFamily, Pass, Profile, ProfileBuilder, Side,
-    Tool, Toolpath, Wheel,
+    equidistant, ClPoint, MandrelLaw, Motion, PartFamily, Pass, ProfileBuilder, Side, Tool,
+    Toolpath, Wheel,
 };
 use std::hint::black_box;
 use std::path::Path;
@@ -49,9 +50,11 @@ fn mandrel_job(c: &mut Criterion) {
     g.finish();
 }
 
-/// The family's default toolpath, step for step as `scripts/mandrel.rhai`.
+/// The family's default toolpath, step for step as `scripts/mandrel.rhai`:
+/// the wheel's path over the ground length, and in each pass the steady
+/// rest's track on the surface the earlier passes left.
 fn native_toolpath() -> Toolpath {
-    let (tol, r_s, stock, passes, over) = (0.001, 20.0, 0.3, 4, 10.0);
+    let (tol, r_s, stock, passes, over, rpm) = (0.001, 20.0, 0.3, 4, 10.0, 399.0);
     let law = MandrelLaw::new(38.0, 52.0, 400.0, 0.012, 2.3).unwrap();
     let x0 = 19.0;
     let part = ProfileBuilder::start(-240.0 - 3.0 - 60.0, 15.0)
@@ -68,31 +71,27 @@ fn native_toolpath() -> Toolpath {
         .line_to(440.0 + over, 26.0 - 0.1 * (40.0 + over))
         .build(tol / 10.0, 0.5)
         .unwrap();
+    let wheel = Wheel::new(500.0, r_s, 40.0).unwrap();
     let e = equidistant(&ground, r_s, Side::Outside).unwrap();
-    let blank_x = part
-        .z()
-        .iter()
-        .zip(part.x())
-        .map(|(z, x)| {
-            if (-over..=440.0).contains(z) {
-                x + stock
-            } else {
-                *x
-            }
-        })
-        .collect();
-    let mut surface = Profile::new(part.z().to_vec(), blank_x).unwrap();
+    let centres = flat_path(&e.z, &e.x, wheel.flat(), Side::Outside).unwrap();
+    let blank = part.raised(-over, 440.0, stock).unwrap();
+    let mut surface = GroundSurface::new(blank);
+    let section = WheelSection {
+        radius: r_s,
+        flat: wheel.flat(),
+    };
+    let finish = (wheel.feed_for_ridge(0.4 * tol) * rpm).min(2000.0);
     let mut tp = Toolpath::new(
         "mandrel",
-        Tool::wheel("wheel", 1, Wheel::new(500.0, r_s, 40.0).unwrap()),
-        399.0,
+        Tool::wheel("wheel", 1, wheel),
+        rpm,
         vec!["U".into()],
     );
     let setup = RestSetup {
         radius: 25.0,
         offset_b: -180.0,
         sample: 0.05,
-        resolution: 1e-5,
+        tolerance: 0.002,
     };
     let pt = |z: f64, x: f64, motion, feed, u: f64| ClPoint {
         point: [x, 0.0, z],
@@ -101,17 +100,15 @@ fn native_toolpath() -> Toolpath {
         feed,
         aux: vec![u],
     };
-    let mut last = (0.0, 0.0, 0.0);
     for j in 1..=passes {
         let h = stock * (1.0 - j as f64 / passes as f64);
-        let ex: Vec<f64> = e.x.iter().map(|x| x + h).collect();
-        let keep = simplify_polyline(&e.z, &ex, tol / 2.0);
-        let (mut cz, mut cx): (Vec<f64>, Vec<f64>) = keep.iter().map(|&i| (e.z[i], ex[i])).unzip();
+        let feed = if h > 0.0 { 2000.0 } else { finish };
+        let mut pass = centres.shifted(h).simplified(tol / 2.0);
         if j % 2 == 0 {
-            cz.reverse();
-            cx.reverse();
+            pass = pass.reversed();
         }
-        let rest = track(&surface, &cz, &cx, r_s, &setup).unwrap();
+        let rest = track(&surface, &pass, section, feed, rpm, &setup).unwrap();
+        let (cz, cx) = (&rest.path.z, &rest.path.x);
         if j == 1 {
             tp.passes.push(Pass {
                 name: "approach".into(),
@@ -121,17 +118,12 @@ fn native_toolpath() -> Toolpath {
         tp.passes.push(Pass {
             name: format!("pass {j}"),
             points: (0..cz.len())
-                .map(|k| pt(cz[k], cx[k], Motion::Linear, 2000.0, rest.centre_x[k]))
+                .map(|k| pt(cz[k], cx[k], Motion::Linear, feed, rest.centre_x[k]))
                 .collect(),
         });
-        surface = after_pass(&surface, &cz, &cx, r_s, 1e-5).unwrap();
-        let n = cz.len() - 1;
-        last = (cz[n], cx[n], rest.centre_x[n]);
+        let layer = PassLayer::new(cz, cx, section, feed, rpm).unwrap();
+        surface = surface.with(layer);
     }
-    tp.passes.push(Pass {
-        name: "retract".into(),
-        points: vec![pt(last.0, last.1 + 2.0, Motion::Rapid, 0.0, last.2)],
-    });
     tp
 }
 
@@ -145,6 +137,12 @@ fn mandrel_rhai_vs_native(c: &mut Criterion) {
     assert_eq!(a.passes.len(), b.passes.len());
     for (pa, pb) in a.passes.iter().zip(&b.passes) {
         assert_eq!(pa.points.len(), pb.points.len(), "{}", pa.name);
+        assert_eq!(
+            pa.points.iter().map(|p| p.feed).collect::<Vec<_>>(),
+            pb.points.iter().map(|p| p.feed).collect::<Vec<_>>(),
+            "{}",
+            pa.name
+        );
         for (x, y) in pa.points.iter().zip(&pb.points) {
             assert_eq!(
                 (x.point, x.aux.clone()),

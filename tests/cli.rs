@@ -139,7 +139,7 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
     for out in [&a, &b] {
         let (code, stdout, err) = pilgrim(&["run", DEMO, "--out", s(out)]);
         assert_eq!(code, 0, "{err}");
-        assert!(stdout.contains("365 blocks for vertical-mill"), "{stdout}");
+        assert!(stdout.contains("368 blocks for vertical-mill"), "{stdout}");
     }
     for f in FILES {
         let (x, y) = (
@@ -155,16 +155,19 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
         "{mpf}"
     );
     assert!(
-        mpf.contains("N40 G0 X45.000 Y0.000 Z5.000 C0.000\n") && mpf.ends_with("M30\n"),
+        mpf.contains(
+            "N5 M8\n; start\nN10 G0 Z50.000\nN20 X45.000 Y0.000 C0.000\n; approach\nN30 Z5.000\n"
+        ) && mpf.ends_with("; end\nN3680 Z50.000\nN3690 M9\nN3700 M5\nN3710 M30\n"),
         "{mpf}"
     );
     let report: serde_json::Value =
         serde_json::from_slice(&std::fs::read(a.join("report.json")).unwrap()).unwrap();
-    assert_eq!(report["blocks"], 365);
+    assert_eq!(report["blocks"], 368);
     assert_eq!(report["parameters"]["radius"]["value"], 40.0);
     // The disc and the cutter, placed at the middle of the last cutting pass
-    // (the contour, blocks 4..=364 at C = 0..=360 deg): block 184, C = 180 deg.
-    assert_eq!(report["pose_block"], 184);
+    // (the contour, blocks 6..=366 at C = 0..=360 deg, after the machine's
+    // two start blocks): block 186, C = 180 deg.
+    assert_eq!(report["pose_block"], 186);
     let disc = pilgrim_kernel::mesh::read_stl(&a.join("part.stl")).unwrap();
     disc.check_closed().unwrap();
     let exact = std::f64::consts::PI * 40.0 * 40.0 * 10.0;
@@ -185,11 +188,11 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
         "{lo:?} {hi:?}"
     );
     leave_for_checkers(&a, "demo");
-    // Export at another block: block 200 is the contour point at C = 196 deg
-    // (block 4 is C = 0).
-    let (code, out, err) = pilgrim(&["export", s(&a), "--block", "200"]);
+    // Export at another block: block 202 is the contour point at C = 196 deg
+    // (block 6 is C = 0).
+    let (code, out, err) = pilgrim(&["export", s(&a), "--block", "202"]);
     assert_eq!(code, 0, "{err}");
-    assert!(out.contains("block 200"), "{out}");
+    assert!(out.contains("block 202"), "{out}");
     let moved = pilgrim_kernel::mesh::read_stl(&a.join("cutter.stl")).unwrap();
     let (lo, hi) = moved.bounds();
     let c = 196f64.to_radians();
@@ -205,7 +208,7 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
     );
     let report: serde_json::Value =
         serde_json::from_slice(&std::fs::read(a.join("report.json")).unwrap()).unwrap();
-    assert_eq!(report["pose_block"], 200);
+    assert_eq!(report["pose_block"], 202);
     leave_for_checkers(&a, "demo-block200");
     // On request: ASCII STL, and .gltf with its .bin.
     let c = dir.join("c");
@@ -245,7 +248,7 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
         s(&a),
     ]);
     assert_eq!(code, 0, "{err}");
-    assert!(out.contains("41 blocks"), "{out}");
+    assert!(out.contains("44 blocks"), "{out}");
     let rhai_machine = dir.join("mill.rhai");
     std::fs::write(
         &rhai_machine,
@@ -302,7 +305,9 @@ fn bad_input_is_refused_and_nothing_is_written() {
     ]);
     assert_eq!(code, 1);
     assert!(
-        err.contains("block 1 (pass 1, point 1): axis X would need 505.0000 mm, outside its travel [-400, 400] mm"),
+        err.contains(
+            "N30 in \"approach\": axis X would need 505.0000 mm, outside its travel [-400, 400] mm"
+        ),
         "{err}"
     );
     // A syntax error names file, line and column.
@@ -341,7 +346,7 @@ fn bad_input_is_refused_and_nothing_is_written() {
     let (code, _, err) = pilgrim(&["run", DEMO, "--pose-block", "9999", "--out", s(&out)]);
     assert_eq!(code, 1);
     assert!(
-        err.contains("block 9999 is beyond the program's 365 blocks"),
+        err.contains("block 9999 is beyond the program's 368 blocks"),
         "{err}"
     );
     let after: Vec<Vec<u8>> = FILES

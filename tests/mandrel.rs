@@ -1,13 +1,9 @@
 //! The mandrel family (seed 000) checked from the program text it writes.
 
-use pilgrim_kernel::offset::rest::after_pass;
-use pilgrim_kernel::offset::{swept_circles, CircleEnvelope};
-use pilgrim_kernel::program::{build, AxisProgram, PostProcessor, SharedPost};
+use pilgrim_kernel::program::{block_label, build, AxisProgram, PostProcessor, SharedPost};
 use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
 use pilgrim_kernel::verify::GrindingCheck;
-use pilgrim_kernel::{
-    drop_circle, MandrelLaw, ParamValue, Params, PartFamily, PartGeometry, Profile, Side, Toolpath,
-};
+use pilgrim_kernel::{MandrelLaw, Params, PartFamily, Profile, Side, Toolpath};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -33,7 +29,7 @@ fn passes_from_text(text: &str) -> Vec<(String, Vec<[f64; 3]>)> {
     let mut at = [f64::NAN; 3];
     for line in text.lines() {
         if let Some(c) = line.strip_prefix("; ") {
-            if c.starts_with("pass ") || c == "approach" || c == "retract" {
+            if c.starts_with("pass ") || ["start", "approach", "end"].contains(&c) {
                 passes.push((c.to_owned(), vec![]));
             }
             continue;
@@ -71,7 +67,9 @@ fn program_text() -> (ScriptFamily, String, AxisProgram) {
 }
 
 /// Every finishing block puts the rounding's centre (Z, X + R_s) at R_s from
-/// the nominal profile, within 0.1 um, read back from the program's text.
+/// the nominal profile, read back from the program's text: the wheel's
+/// blocks within 0.1 um, the blocks the steady rest adds on the wheel's
+/// straight moves between them within the chords' half tolerance (0.5 um).
 #[test]
 fn finishing_blocks_stand_at_r_s_from_the_law() {
     let (_, text, _) = program_text();
@@ -94,7 +92,7 @@ fn finishing_blocks_stand_at_r_s_from_the_law() {
             law.x(z)
         }
     };
-    let mut worst: f64 = 0.0;
+    let (mut worst, mut on): (f64, usize) = (0.0, 0);
     for b in finish {
         let (cz, cx) = (b[0], b[1] + R_S);
         // Nearest point of the profile: a fine search, then golden sections.
@@ -117,67 +115,15 @@ fn finishing_blocks_stand_at_r_s_from_the_law() {
         }
         let dist = d2(0.5 * (a + c)).sqrt();
         worst = worst.max((dist - R_S).abs());
+        on += usize::from((dist - R_S).abs() <= 1e-4);
     }
-    assert!(worst <= 1e-4, "a finishing block is {worst:e} mm off R_s");
+    assert!(
+        worst <= 0.5e-3 + 1e-4,
+        "a finishing block is {worst:e} mm off R_s"
+    );
+    // The rest adds a few blocks to the finish: most are the wheel's.
+    assert!(on * 10 >= finish.len() * 7, "{on} of {}", finish.len());
     assert!(finish.len() > 20);
-}
-
-/// U at every block is the exact drop of the rest's support on the current
-/// surface, simulated independently from the program's text: the blank,
-/// lowered by each earlier pass's swept wheel and by this pass's circles
-/// placed so far; never pressing in, never standing off, within 1 um.
-#[test]
-fn the_rest_rides_the_simulated_surface() {
-    let (fam, text, _) = program_text();
-    let values = params(&fam, &[]);
-    let blank = fam
-        .part(&values)
-        .unwrap()
-        .into_iter()
-        .find(|b| b.name == "blank")
-        .unwrap();
-    let PartGeometry::Revolution(mut surface) = blank.geometry else {
-        panic!("the blank is a body of revolution")
-    };
-    let (r_o, b) = (25.0, -180.0);
-    let mut checked = 0;
-    for (name, blocks) in passes_from_text(&text)
-        .iter()
-        .filter(|p| p.0.starts_with("pass "))
-    {
-        let cz: Vec<f64> = blocks.iter().map(|b| b[0]).collect();
-        let cx: Vec<f64> = blocks.iter().map(|b| b[1] + R_S).collect();
-        let (dz, dx, block_of) = swept_circles(&cz, &cx, R_S, 1e-5).unwrap();
-        for k in (0..blocks.len()).step_by(4) {
-            let z_r = cz[k] + b;
-            let placed: Vec<usize> = (0..dz.len())
-                .filter(|&i| block_of[i] <= k && (dz[i] - z_r).abs() <= r_o + R_S)
-                .collect();
-            let grid: Vec<f64> = (0..=2500)
-                .map(|i| z_r - r_o + 2.0 * r_o * i as f64 / 2500.0)
-                .collect();
-            let mut s = surface.eval_many(&grid).unwrap();
-            if !placed.is_empty() {
-                let (pz, px): (Vec<f64>, Vec<f64>) = placed.iter().map(|&i| (dz[i], dx[i])).unzip();
-                let env = CircleEnvelope::new(&pz, &px, R_S, Side::Outside).unwrap();
-                for (v, e) in s.iter_mut().zip(env.eval_many(&grid)) {
-                    *v = v.min(e);
-                }
-            }
-            let under = Profile::new(grid, s).unwrap();
-            let exact = drop_circle(&under, z_r, r_o, Side::Outside)
-                .unwrap()
-                .centre_x;
-            let u = blocks[k][2];
-            assert!(
-                (u - exact).abs() <= 1e-3,
-                "{name}, block {k}: U {u}, simulated {exact}"
-            );
-            checked += 1;
-        }
-        surface = after_pass(&surface, &cz, &cx, R_S, 1e-5).unwrap();
-    }
-    assert!(checked >= 60, "only {checked} blocks checked");
 }
 
 /// Bad parameters stop the run with a clear message, and nothing is written.
@@ -211,22 +157,7 @@ fn bad_mandrel_parameters_are_refused_and_nothing_is_written() {
     let (code, err) = run(&[]);
     assert_eq!(code, 0, "{err}");
     let before = std::fs::read(out.join("program.mpf")).unwrap();
-    // The rest's roller stands where the pose block's U puts it: its top
-    // on the far side at -(U - R_o), touching the part.
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
-    let block = report["pose_block"].as_u64().unwrap() as usize;
-    let csv = std::fs::read_to_string(out.join("report.csv")).unwrap();
-    let row: Vec<&str> = csv.lines().nth(block).unwrap().rsplit(',').collect();
-    let u: f64 = row[1].parse().unwrap();
-    let rest = pilgrim_kernel::mesh::read_stl(&out.join("rest.stl")).unwrap();
-    rest.check_closed().unwrap();
-    let (_, hi) = rest.bounds();
-    assert!(
-        (hi[0] + (u - 25.0)).abs() < 1e-3,
-        "roller top {} for U {u}",
-        hi[0]
-    );
+    rest_stands_where_u_puts_it(&out, -180.0);
     for (sets, expected) in [
         (
             vec!["d_min=60"],
@@ -251,7 +182,20 @@ fn bad_mandrel_parameters_are_refused_and_nothing_is_written() {
         (vec!["cuts=[0.4,-0.1]"], "no cut is negative"),
         (
             vec!["shank_len=100"],
-            "pass 1: the steady rest's support at block 1 of the pass (z_r = z + B, B = -180.0000 mm) has nothing under it: its centre at z = -190.1200",
+            "pass 1: the steady rest's support at point 1 of the pass (z_r = z + B, B = -180.0000 mm) has nothing under it: its centre at z = -190.1200",
+        ),
+        (
+            vec!["spindle=5000"],
+            "spindle speed S5000 is outside the range of spindle S of machine 3K152VF20, [0, 630] rpm",
+        ),
+        (
+            vec!["tolerance=0.0001"],
+            "a verification tolerance of 0.0001 mm is finer than twice the program's resolution (0.0001 mm steps)",
+        ),
+        (vec!["tolerance=0.000001"], "tolerance"),
+        (
+            vec!["finish_feed=2000"],
+            "verification failed: the finished surface strays",
         ),
     ] {
         let (code, err) = run(&sets);
@@ -266,13 +210,52 @@ fn bad_mandrel_parameters_are_refused_and_nothing_is_written() {
     // The wheel too round is refused naming the places, near the law's end.
     let (_, err) = run(&["n=30", "rounding_r=60", "wheel_w=130"]);
     assert!(err.contains("z = 39"), "{err}");
-    // U beyond its travel names the block.
+    // U beyond its travel names the block as the program numbers it.
     let (_, err) = run(&["rest_r=140"]);
     assert!(
-        err.contains("block ") && err.contains("outside its travel [0, 150] mm"),
+        err.contains("N40 in \"approach\": axis U at ")
+            && err.contains("outside its travel [0, 150] mm"),
+        "{err}"
+    );
+    // A finish whose ridge breaks the tolerance names the pass and its feed.
+    let (_, err) = run(&["finish_feed=2000"]);
+    assert!(
+        err.contains("(pass 4, stock 0.0 um: 5.0125 mm per revolution, a ridge of 0.15766 mm)"),
         "{err}"
     );
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The rest's roller in `out/rest.stl` stands where the pose block's U and
+/// the machine's offset `b` put it: its top on the far side at
+/// -(U - R_o), touching the part, its middle at z = Z + B.
+fn rest_stands_where_u_puts_it(out: &Path, b: f64) {
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    let block = report["pose_block"].as_u64().unwrap() as usize;
+    let mut csv = csv::Reader::from_path(out.join("report.csv")).unwrap();
+    let header = csv.headers().unwrap().clone();
+    let rows: Vec<csv::StringRecord> = csv.records().map(Result::unwrap).collect();
+    assert_eq!(rows.len() as u64, report["blocks"].as_u64().unwrap());
+    let row = &rows[block - 1];
+    let col = |name: &str| header.iter().position(|h| h.starts_with(name)).unwrap();
+    let (z, u): (f64, f64) = (
+        row[col("Z ")].parse().unwrap(),
+        row[col("U ")].parse().unwrap(),
+    );
+    let rest = pilgrim_kernel::mesh::read_stl(&out.join("rest.stl")).unwrap();
+    rest.check_closed().unwrap();
+    let (lo, hi) = rest.bounds();
+    assert!(
+        (hi[0] + (u - 25.0)).abs() < 1e-3,
+        "roller top {} for U {u}",
+        hi[0]
+    );
+    let middle = 0.5 * (lo[2] + hi[2]);
+    assert!(
+        (middle - (z + b)).abs() < 1e-3,
+        "roller at z = {middle}, Z {z} + B {b}"
+    );
 }
 
 /// The family's toolpath and program for `values` on the 3K152VF20, and a
@@ -291,12 +274,15 @@ fn job(
     let v = fam.verification(values).unwrap().unwrap();
     let passes = tp.passes.clone();
     let reference = tp.tool.reference;
+    let pilgrim_kernel::ToolShape::Wheel(wheel) = tp.tool.shape else {
+        panic!("the mandrel's tool is a wheel")
+    };
     let check = move |program: &AxisProgram| {
         pilgrim_kernel::verify::check_grinding(
             program,
             &grinder,
             &reference,
-            R_S,
+            &wheel,
             &passes,
             &v.profile,
             (v.from, v.to),
@@ -328,7 +314,19 @@ fn verification_catches_a_corrupted_block() {
     let x = program.axes.iter().position(|a| a.name == "X").unwrap();
     program.blocks[k].values[x] -= 0.005;
     let e = check(&program).unwrap_err();
-    assert!(e.contains(&format!("where block {} cuts it", k + 1)), "{e}");
+    // The move into the block or the one out of it.
+    let named = |k| {
+        format!(
+            "where {} in \"{}\" cuts it",
+            block_label("sinumerik", k),
+            finish.name
+        )
+    };
+    assert!(
+        e.contains(&named(k)) || e.contains(&named(k + 1)),
+        "{e} (k {k}: {})",
+        named(k)
+    );
     assert!(e.contains("strays -0.00"), "{e}");
 }
 
@@ -440,7 +438,6 @@ fn a_list_of_cuts_sets_the_passes() {
             "pass 3, stock 10.0 um",
             "pass 4, stock 0.0 um",
             "pass 5, stock 0.0 um, spark-out",
-            "retract"
         ]
     );
     // The uniform step's count is for the same five passes (the default
@@ -456,40 +453,43 @@ fn a_list_of_cuts_sets_the_passes() {
     }
 }
 
-/// The rest's parameters follow the machine's constants unless set, and a
-/// machine whose U programs the support's tip gets U = centre - R_o.
+/// The rest's parameters are the machine's constants: they follow the
+/// machine the run uses, and setting one sets the machine's for the whole
+/// run: with `--set rest_b=-150` the chain places the rest's roller at
+/// Z - 150 where U puts it (and U rides the surface there:
+/// `mandrel_fidelity.rs`).
 #[test]
-fn rest_parameters_follow_the_machine() {
+fn rest_parameters_are_the_machines() {
     let fam = family();
-    let default = params(&fam, &[]);
-    let constants: BTreeMap<String, f64> = [
-        ("rest_radius", 30.0),
-        ("rest_offset_b", -180.0),
-        ("rest_programs_centre", 0.0),
-    ]
-    .into_iter()
-    .map(|(k, v)| (k.to_owned(), v))
-    .collect();
+    let constants: BTreeMap<String, f64> = [("rest_radius", 30.0), ("rest_offset_b", -170.0)]
+        .into_iter()
+        .map(|(k, v)| (k.to_owned(), v))
+        .collect();
     let on = params_on(&fam, &constants, &[]);
-    assert_eq!(on["rest_r"], ParamValue::Float(30.0));
-    assert_eq!(on["rest_at_centre"], ParamValue::Bool(false));
+    assert_eq!(on["rest_r"], pilgrim_kernel::ParamValue::Float(30.0));
+    assert_eq!(on["rest_b"], pilgrim_kernel::ParamValue::Float(-170.0));
     let set = params_on(&fam, &constants, &[("rest_r", "25")]);
-    assert_eq!(set["rest_r"], ParamValue::Float(25.0), "--set wins");
-    let (centre, tip) = (fam.toolpath(&default).unwrap(), fam.toolpath(&set).unwrap());
-    let mut n = 0;
-    for (a, b) in centre.passes.iter().zip(&tip.passes) {
-        for (p, q) in a.points.iter().zip(&b.points) {
-            assert_eq!(p.point, q.point);
-            assert!(
-                (p.aux[0] - 25.0 - q.aux[0]).abs() < 1e-12,
-                "{} {}",
-                p.aux[0],
-                q.aux[0]
-            );
-            n += 1;
-        }
-    }
-    assert!(n > 100);
+    assert_eq!(
+        set["rest_r"],
+        pilgrim_kernel::ParamValue::Float(25.0),
+        "--set wins"
+    );
+    let out = std::env::temp_dir().join(format!("pilgrim-rest-b-{}", std::process::id()));
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pilgrim"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args([
+            "run",
+            "scripts/mandrel.rhai",
+            "--set",
+            "rest_b=-150",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    rest_stands_where_u_puts_it(&out, -150.0);
+    std::fs::remove_dir_all(&out).ok();
     // A whole-number parameter cannot follow a fractional constant.
     let bad = ScriptFamily::from_source(
         "fn params() { #{ n: #{ value: 3, machine: \"rest_radius\" } } }\nfn toolpath(p) { () }",

@@ -457,6 +457,37 @@ impl MachineKinematics for PluginMachine {
         &self.info
     }
 
+    /// The plugin with its description's constants set: the host derives
+    /// the bodies' chains from the description, so they follow; a constant
+    /// the plugin's own tool chain uses is refused (its kinematics are its
+    /// own, and the ABI has no call to change them).
+    fn with_constants(
+        &self,
+        overrides: &[(String, f64)],
+    ) -> Result<Box<dyn MachineKinematics>, crate::machine::MachineError> {
+        for (name, _) in overrides {
+            if self
+                .info
+                .chain
+                .iter()
+                .any(|f| f.constant.as_deref() == Some(name))
+            {
+                return Err(crate::machine::MachineError::Description {
+                    machine: self.info.name.clone(),
+                    message: format!(
+                        "the constant '{name}' is part of the plugin's own kinematics and cannot be changed"
+                    ),
+                });
+            }
+        }
+        let info = crate::machine::kinematics_overridden(&self.info, overrides)?;
+        crate::machine::check_description(&info)?;
+        Ok(Box::new(Self {
+            info,
+            ..self.clone()
+        }))
+    }
+
     fn inverse(
         &self,
         poses: &[f64],

@@ -49,10 +49,46 @@ impl Wheel {
         })
     }
 
+    /// The flat of the periphery between the two roundings, in the axial
+    /// section: `width - 2 R_s` (0 for a wheel rounded across its width).
+    pub fn flat(&self) -> Real {
+        (self.width - 2.0 * self.rounding_radius).max(0.0)
+    }
+
+    /// The ridge this wheel leaves on a straight generatrix when its touches
+    /// are `f` mm apart (the feed per revolution, MATH §2.4): the
+    /// rounding's, [`rounding_ridge`]. The flat is not counted: it covers
+    /// the gap between touches only on a surface parallel to the wheel's
+    /// axis; on a slope `s` it stands off the surface by `s` per mm and the
+    /// rounding does the cutting (a mandrel has no such cylinder). The
+    /// verification replays the true section, flat included, everywhere.
+    pub fn ridge(&self, f: Real) -> Real {
+        rounding_ridge(self.rounding_radius, f)
+    }
+
+    /// The largest feed per revolution (mm) whose ridge is at most
+    /// `height` mm: the inverse of [`Self::ridge`].
+    pub fn feed_for_ridge(&self, height: Real) -> Real {
+        let r = self.rounding_radius;
+        let h = height.clamp(0.0, r);
+        2.0 * (r * r - (r - h) * (r - h)).sqrt()
+    }
+
     /// Distance of the rounding's centre circle from the wheel's axis.
     pub fn centre_radius(&self) -> Real {
         0.5 * self.diameter - self.rounding_radius
     }
+}
+
+/// The ridge a rounding of radius `r` leaves between touches `f` mm apart
+/// on a straight generatrix: `r - sqrt(r^2 - (f/2)^2)`, `f^2 / (8 r)` to
+/// first order (`r` once the touches are `2 r` apart or more).
+pub fn rounding_ridge(r: Real, f: Real) -> Real {
+    let half = (f / 2.0).max(0.0);
+    if half >= r {
+        return r;
+    }
+    r - (r * r - half * half).sqrt()
 }
 
 /// The shape of a tool.
@@ -144,5 +180,25 @@ mod tests {
         assert!(Wheel::new(10.0, -1.0, 5.0).is_err());
         let t = Tool::wheel("w", 1, w);
         assert_eq!(t.reference.point.x, 20.0);
+    }
+
+    #[test]
+    fn ridges_and_the_feed_that_holds_them() {
+        let w = Wheel::new(500.0, 20.0, 40.0).unwrap();
+        assert_eq!(w.flat(), 0.0);
+        // The seed's screen: f = 5 mm at R_s = 20: about 157 um.
+        assert!((w.ridge(5.0) - 0.15686).abs() < 1e-5, "{}", w.ridge(5.0));
+        let f = w.feed_for_ridge(0.0005);
+        assert!((w.ridge(f) - 0.0005).abs() < 1e-12);
+        // A flat of 10 mm: the rounding's ridge all the same (on a slope
+        // the flat stands off and the rounding cuts).
+        let flat = Wheel::new(500.0, 15.0, 40.0).unwrap();
+        assert_eq!(flat.flat(), 10.0);
+        assert!((flat.ridge(10.0) - (15.0 - (225.0f64 - 25.0).sqrt())).abs() < 1e-12);
+        assert!(
+            (flat.feed_for_ridge(0.0005) - 2.0 * (15.0f64.powi(2) - 14.9995f64.powi(2)).sqrt())
+                .abs()
+                < 1e-12
+        );
     }
 }

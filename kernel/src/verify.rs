@@ -1,19 +1,24 @@
 //! Verifying a program by replaying it (ARCHITECTURE §1's VERIFY stage).
 //!
-//! A grinding program moves the wheel's rounding centre in straight lines
-//! between blocks. [`SweptWheel`] is the surface the rounding leaves along
-//! those moves, in the part's axial section: the envelope of the circle
-//! placed along each move densely enough that the discretisation itself is
-//! below a stated resolution. [`SweptWheel::deviation`] compares it with the
-//! nominal profile and names the block whose move left the largest error.
+//! [`check_grinding`] reads a grinding program as a control does (its
+//! values as written, [`as_written`]), replays every block through the
+//! machine's forward kinematics, and simulates what the machine makes of
+//! it: the part turning while the wheel moves in straight lines between
+//! blocks, the wheel's true section (flat and roundings) where each of
+//! [`GENERATRICES`] generatrices meets it. Each pass's surface is compared
+//! with the nominal profile, the helical ridge included, and the worst
+//! place is named by z, block and pass.
 
 use crate::input::InputError;
 use crate::machine::{KinematicsError, MachineKinematics};
 use crate::math::{positive, Real};
-use crate::offset::{CircleEnvelope, Side};
+use crate::offset::surface::{touches, GENERATRICES};
+use crate::offset::{CapsuleEnvelope, Side};
 use crate::profile::{Profile, ProfileError};
+use crate::program::pass_blocks;
 use crate::program::{axis_rows, AxisProgram};
-use crate::toolpath::{pass_ranges, Pass};
+use crate::tool::Wheel;
+use crate::toolpath::Pass;
 use crate::transform::ToolFrame;
 use serde::{Deserialize, Serialize};
 
@@ -55,31 +60,38 @@ pub enum VerifyError {
     /// The finished surface strays from the nominal beyond the tolerance.
     #[error(
         "verification failed: the finished surface strays {} mm from the nominal profile at z = {}, \
-         where block {} cuts it (tolerance {tolerance} mm)",
+         where {} cuts it ({pass}: {} mm per revolution, a ridge of {} mm) (tolerance {tolerance} mm)",
         crate::math::fixed(*deviation, 5),
         crate::math::fixed(*z, 3),
-        block.map_or("?".into(), |b| b.to_string())
+        block.as_deref().unwrap_or("an unknown block"),
+        crate::math::fixed(*feed_per_rev, 4),
+        crate::math::fixed(*ridge, 5)
     )]
     Deviation {
         /// The signed deviation (mm; negative: a gouge).
         deviation: Real,
         /// Where (z, mm).
         z: Real,
-        /// The block (from 1) whose move formed the surface there.
-        block: Option<usize>,
+        /// The block whose move formed the surface there, as the program
+        /// names it (`N1130 in "pass 4, ..."`).
+        block: Option<String>,
+        /// The finishing pass.
+        pass: String,
+        /// Its feed per revolution (mm).
+        feed_per_rev: Real,
+        /// The ridge that feed leaves (mm).
+        ridge: Real,
         /// The tolerance (mm).
         tolerance: Real,
     },
-}
-
-/// The surface left by a wheel's rounding moved in straight lines between
-/// centres (mm, axial section).
-#[derive(Debug, Clone)]
-pub struct SweptWheel {
-    envelope: CircleEnvelope,
-    /// For each placed circle, the block whose move placed it.
-    block_of: Vec<usize>,
-    resolution: Real,
+    /// A tolerance finer than the program can carry.
+    #[error("a verification tolerance of {tolerance} mm is finer than twice the program's resolution ({resolution} mm steps): the program cannot hold it")]
+    Resolution {
+        /// The tolerance asked.
+        tolerance: Real,
+        /// The program's smallest step.
+        resolution: Real,
+    },
 }
 
 /// How far a surface strays from the nominal profile over a range.
@@ -97,127 +109,10 @@ pub struct Deviation {
     pub max_abs: Real,
     /// Where the largest is (z).
     pub at_z: Real,
-    /// The block (index from 0) whose move forms the surface there.
+    /// The block (from 1, the program's and `report.csv`'s count) whose
+    /// move forms the surface there.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub block: Option<usize>,
-}
-
-impl SweptWheel {
-    /// The surface left when the rounding (radius `radius`) moves through
-    /// the centres `(z[i], x[i])`, block `i` after block `i - 1`. Circles are
-    /// placed along each move at most `sqrt(8 radius resolution)` apart, so
-    /// the scallops between them stay below `resolution` (mm).
-    ///
-    /// # Failures
-    /// Fewer than one centre, arrays of different lengths, non-finite
-    /// values, a radius or resolution that is not positive, or more than 50
-    /// million circles.
-    pub fn new(
-        z: &[Real],
-        x: &[Real],
-        radius: Real,
-        resolution: Real,
-    ) -> Result<Self, ProfileError> {
-        positive("wheel rounding radius", radius)?;
-        positive("verification resolution", resolution)?;
-        crate::math::all_finite("wheel centre z", z)?;
-        crate::math::all_finite("wheel centre x", x)?;
-        if z.len() != x.len() || z.is_empty() {
-            return Err(crate::input::InputError::LengthMismatch {
-                what: "wheel centres z and x".into(),
-                left: z.len(),
-                right: x.len(),
-            }
-            .into());
-        }
-        let (cz, cx, block_of) = crate::offset::swept_circles(z, x, radius, resolution)?;
-        Ok(Self {
-            envelope: CircleEnvelope::new(&cz, &cx, radius, Side::Outside)?,
-            block_of,
-            resolution,
-        })
-    }
-
-    /// The surface's x at `z` (infinite where the wheel never reached).
-    pub fn eval(&self, z: Real) -> Real {
-        self.envelope.eval(z)
-    }
-
-    /// The block whose move forms the surface at `z`.
-    pub fn block_at(&self, z: Real) -> Option<usize> {
-        self.envelope.source_at(z).map(|i| self.block_of[i])
-    }
-
-    /// The deviation from `nominal` over `[z_from, z_to]`, sampled at `step`
-    /// (and at the nominal's nodes inside the range).
-    ///
-    /// # Tolerance
-    /// The surface is exact to [`Self::new`]'s resolution; between samples a
-    /// deviation can peak by at most the surface's and the profile's
-    /// curvature times `step^2 / 8`.
-    ///
-    /// # Failures
-    /// A range outside the nominal profile; a step that is not positive;
-    /// a place in the range the wheel never reached.
-    pub fn deviation(
-        &self,
-        nominal: &Profile,
-        z_from: Real,
-        z_to: Real,
-        step: Real,
-    ) -> Result<Deviation, ProfileError> {
-        positive("verification step", step)?;
-        let mut zs = crate::profile::uniform_grid(z_from, z_to, step)?;
-        zs.extend(
-            nominal
-                .z()
-                .iter()
-                .copied()
-                .filter(|z| (z_from..=z_to).contains(z)),
-        );
-        zs.sort_by(Real::total_cmp);
-        zs.dedup();
-        let surface = self.envelope.eval_many(&zs);
-        let profile = nominal.eval_many(&zs)?;
-        let mut d = Deviation {
-            max_above: Real::NEG_INFINITY,
-            above_z: z_from,
-            max_below: Real::INFINITY,
-            below_z: z_from,
-            max_abs: 0.0,
-            at_z: z_from,
-            block: None,
-        };
-        for ((&z, &s), &p) in zs.iter().zip(&surface).zip(&profile) {
-            if !s.is_finite() {
-                return Err(ProfileError::OutsideProfile {
-                    what: "the wheel never reached the profile".into(),
-                    z,
-                    z_min: z_from,
-                    z_max: z_to,
-                });
-            }
-            let e = s - p;
-            if e > d.max_above {
-                (d.max_above, d.above_z) = (e, z);
-            }
-            if e < d.max_below {
-                (d.max_below, d.below_z) = (e, z);
-            }
-        }
-        (d.max_abs, d.at_z) = if d.max_above >= -d.max_below {
-            (d.max_above.abs(), d.above_z)
-        } else {
-            (d.max_below.abs(), d.below_z)
-        };
-        d.block = self.block_at(d.at_z);
-        Ok(d)
-    }
-
-    /// The resolution the surface was built to (mm).
-    pub fn resolution(&self) -> Real {
-        self.resolution
-    }
 }
 
 /// The tool's pose at every block of a program, by the machine's forward
@@ -265,49 +160,104 @@ pub struct PassCheck {
     pub name: String,
     /// Its first block (from 1).
     pub first_block: usize,
-    /// Its surface against the nominal (blocks from 1).
+    /// Its cutting feed (mm/min).
+    pub feed_mm_min: Real,
+    /// The spindle speed it ran at (rpm).
+    pub spindle_rpm: Real,
+    /// The feed per revolution of the part, `F / S` (mm).
+    pub feed_per_rev_mm: Real,
+    /// The ridge the wheel leaves at that feed on a straight generatrix
+    /// (mm), `R_s - sqrt(R_s^2 - ((f - flat)/2)^2)`.
+    pub ridge_mm: Real,
+    /// Its surface against the nominal, over every generatrix simulated
+    /// (blocks from 1): ridges included.
     pub deviation: Deviation,
 }
 
-/// A grinding program replayed: each cutting pass's swept surface against
-/// the nominal profile; the last one must hold the tolerance.
+/// A grinding program replayed: each cutting pass's surface against the
+/// nominal profile; the last one must hold the tolerance.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GrindingCheck {
     /// The tolerance held (mm).
     pub tolerance: Real,
+    /// The generatrices each pass was simulated on.
+    pub generatrices: usize,
+    /// The smallest step the program's values carry (mm), which the replay
+    /// reads them at.
+    pub resolution_mm: Real,
     /// Each cutting pass (the last is the finish).
     pub passes: Vec<PassCheck>,
 }
 
-/// Replays a grinding program (a wheel of rounding `rounding_radius` whose
-/// tracked point is its rounding's centre) through the machine, builds each
-/// cutting pass's swept surface in the axial section (radius from the axis,
-/// z), and compares it with `nominal` over `[from, to]`. `passes` are the
-/// toolpath's, whose points became the program's blocks.
+/// The program as a control reads it: every value rounded to the decimals
+/// the program is written with (its own, or its dialect's).
+pub fn as_written(program: &AxisProgram) -> (AxisProgram, Real) {
+    let decimals = program
+        .decimals
+        .or_else(|| crate::program::post::dialect(&program.control).map(|d| d.decimals))
+        .unwrap_or(3);
+    let mut p = program.clone();
+    for b in &mut p.blocks {
+        for v in &mut b.values {
+            *v = crate::math::fixed(*v, decimals).parse().unwrap_or(*v);
+        }
+    }
+    (p, 10f64.powi(-(decimals as i32)))
+}
+
+/// Replays a grinding program as the machine runs it (MATH §2.4): the
+/// values rounded as written, every axis moving in a straight line between
+/// blocks at the block's feed while the part turns at the program's
+/// spindle speed; on each of [`GENERATRICES`] generatrices the wheel's true
+/// section (its flat and roundings; its tracked point is the middle of the
+/// flat) left at the moments it passed under the wheel; each cutting pass's
+/// surface, ridges included, against `nominal` over `[from, to]`, the worst
+/// generatrix counting. `passes` are the toolpath's, whose points became
+/// the program's blocks.
 ///
 /// # Failures
-/// The replay failing; a pass that does not cover the range; the finishing
-/// pass straying more than `tolerance` from the nominal
-/// ([`VerifyError::Deviation`], naming the deviation, its z and the block,
-/// from 1, whose move formed it).
+/// A tolerance finer than twice the program's resolution; the replay
+/// failing; a pass that does not cover the range; the finishing pass
+/// straying more than `tolerance` from the nominal
+/// ([`VerifyError::Deviation`], naming the deviation, its z, the block and
+/// the pass with its feed).
 #[allow(clippy::too_many_arguments)]
 pub fn check_grinding(
     program: &AxisProgram,
     machine: &dyn MachineKinematics,
     tool: &ToolFrame,
-    rounding_radius: Real,
+    wheel: &Wheel,
     passes: &[Pass],
     nominal: &Profile,
     range: (Real, Real),
     tolerance: Real,
 ) -> Result<GrindingCheck, VerifyError> {
     positive("verification tolerance", tolerance)?;
-    let poses = replay(program, machine, tool)?;
+    let (written, resolution) = as_written(program);
+    if tolerance < 2.0 * resolution {
+        return Err(VerifyError::Resolution {
+            tolerance,
+            resolution,
+        });
+    }
+    let poses = replay(&written, machine, tool)?;
+    let info = machine.info();
+    let axes: Vec<Option<&crate::machine::Axis>> =
+        written.axes.iter().map(|a| info.axis(&a.name)).collect();
+    let known: Vec<&crate::machine::Axis> = axes.iter().flatten().copied().collect();
     let mut out = GrindingCheck {
         tolerance,
+        generatrices: GENERATRICES,
+        resolution_mm: resolution,
         passes: Vec::new(),
     };
-    for (pass, blocks) in pass_ranges(passes) {
+    let mut rpm = written.spindle_rpm;
+    for (pass, blocks) in pass_blocks(program, passes) {
+        for b in &written.blocks[blocks.clone()] {
+            if let Some(s) = b.spindle {
+                rpm = s;
+            }
+        }
         if !pass.cuts() {
             continue;
         }
@@ -316,18 +266,122 @@ pub fn check_grinding(
             .clone()
             .map(|b| poses[6 * b].hypot(poses[6 * b + 1]))
             .collect();
-        let swept = SweptWheel::new(&z, &x, rounding_radius, tolerance / 20.0)?;
-        let step = (tolerance * 20.0).clamp(0.005, 0.05);
-        let mut d = swept
-            .deviation(nominal, range.0, range.1, step)
-            .map_err(|source| VerifyError::Pass {
-                pass: pass.name.clone(),
-                source,
-            })?;
-        d.block = d.block.map(|k| blocks.start + k + 1);
+        // The wheel's speed along its (z, x) line: the block's feed over
+        // the control's path (every linear axis of the block).
+        let mut feeds = vec![0.0; z.len()];
+        let mut cutting_feed: Real = 0.0;
+        for (i, k) in blocks.clone().enumerate().skip(1) {
+            let (a, b) = (&written.blocks[k - 1], &written.blocks[k]);
+            let deltas: Vec<Real> = a
+                .values
+                .iter()
+                .zip(&b.values)
+                .zip(&axes)
+                .filter(|(_, ax)| ax.is_some())
+                .map(|((p, q), _)| q - p)
+                .collect();
+            let path = crate::machine::move_length(&known, &deltas);
+            let line = (z[i] - z[i - 1]).hypot(x[i] - x[i - 1]);
+            let f = if b.motion == crate::toolpath::Motion::Rapid {
+                info.axes
+                    .iter()
+                    .filter(|a| a.kind == crate::machine::AxisKind::Linear)
+                    .map(|a| a.max_feed)
+                    .fold(Real::INFINITY, Real::min)
+            } else {
+                cutting_feed = cutting_feed.max(b.feed);
+                b.feed
+            };
+            feeds[i] = if path > 0.0 { f * line / path } else { f };
+        }
+        let t = touches(&z, &x, &feeds, rpm, GENERATRICES)?;
+        // Each generatrix met: the wheel's section at its touches.
+        let met: Vec<usize> = (0..t.z.len()).filter(|&g| !t.z[g].is_empty()).collect();
+        let envs = met
+            .iter()
+            .map(|&g| {
+                CapsuleEnvelope::new(
+                    &t.z[g],
+                    &t.x[g],
+                    wheel.rounding_radius,
+                    wheel.flat(),
+                    Side::Outside,
+                )
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut zs =
+            crate::profile::uniform_grid(range.0, range.1, (tolerance * 20.0).clamp(0.005, 0.05))?;
+        zs.extend(
+            nominal
+                .z()
+                .iter()
+                .copied()
+                .filter(|z| (range.0..=range.1).contains(z)),
+        );
+        for env in &envs {
+            zs.extend(env.kinks(range.0, range.1));
+        }
+        zs.sort_by(Real::total_cmp);
+        zs.dedup();
+        let profile = nominal.eval_many(&zs)?;
+        let mut d = Deviation {
+            max_above: Real::NEG_INFINITY,
+            above_z: range.0,
+            max_below: Real::INFINITY,
+            below_z: range.0,
+            max_abs: 0.0,
+            at_z: range.0,
+            block: None,
+        };
+        // The generatrix of the largest value above and below.
+        let (mut g_above, mut g_below) = (0, 0);
+        for (g, env) in envs.iter().enumerate() {
+            let surface = env.eval_many(&zs);
+            for ((&z, &s), &p) in zs.iter().zip(&surface).zip(&profile) {
+                if !s.is_finite() {
+                    return Err(VerifyError::Pass {
+                        pass: pass.name.clone(),
+                        source: ProfileError::OutsideProfile {
+                            what: format!(
+                                "generatrix {} of {GENERATRICES}: the wheel never reached the profile",
+                                g + 1
+                            ),
+                            z,
+                            z_min: range.0,
+                            z_max: range.1,
+                        },
+                    });
+                }
+                let e = s - p;
+                if e > d.max_above {
+                    (d.max_above, d.above_z, g_above) = (e, z, g);
+                }
+                if e < d.max_below {
+                    (d.max_below, d.below_z, g_below) = (e, z, g);
+                }
+            }
+        }
+        let gen_at = if d.max_above >= -d.max_below {
+            (d.max_abs, d.at_z) = (d.max_above.abs(), d.above_z);
+            g_above
+        } else {
+            (d.max_abs, d.at_z) = (d.max_below.abs(), d.below_z);
+            g_below
+        };
+        let env = &envs[gen_at];
+        // The touch forming the worst place.
+        d.block = env
+            .source_at(d.at_z)
+            .and_then(|i| t.block[met[gen_at]].get(i))
+            .map(|&k| blocks.start + k + 1);
+        let f = if rpm > 0.0 { cutting_feed / rpm } else { 0.0 };
         out.passes.push(PassCheck {
             name: pass.name.clone(),
             first_block: blocks.start + 1,
+            feed_mm_min: cutting_feed,
+            spindle_rpm: rpm,
+            feed_per_rev_mm: f,
+            ridge_mm: wheel.ridge(f),
             deviation: d,
         });
     }
@@ -341,7 +395,10 @@ pub fn check_grinding(
                 d.max_below
             },
             z: d.at_z,
-            block: d.block,
+            block: d.block.map(|b| crate::program::block_name(program, b - 1)),
+            pass: finish.name.clone(),
+            feed_per_rev: finish.feed_per_rev_mm,
+            ridge: finish.ridge_mm,
             tolerance,
         });
     }

@@ -258,7 +258,7 @@ fn a_rust_family_runs_through_the_same_job_as_the_rhai_one() {
     assert_eq!(ra, rb);
     assert!(a
         .summary()
-        .starts_with("mill_circle (Rust): 2 cutting passes (4 in all), 365 blocks"));
+        .starts_with("mill_circle (Rust): 2 cutting passes (4 in all), 368 blocks"));
 }
 
 /// A failed check stops the job, naming the family and the check.

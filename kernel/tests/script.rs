@@ -56,13 +56,16 @@ fn demo_family_runs_to_a_program() {
             .collect::<Vec<_>>(),
         ["X", "Y", "Z", "C"]
     );
-    // Seed 003's example: X stays at R + D/2 = 45 while the table turns.
+    // Seed 003's example: X stays at R + D/2 = 45 while the table turns
+    // (after the machine's two start blocks and the toolpath's three).
+    let lead = pilgrim_kernel::program::start_blocks(&prog.setup) + 3;
+    assert_eq!(lead, 5);
     let x = prog.column("X").unwrap();
     let c = prog.column("C").unwrap();
-    for (k, b) in prog.blocks.iter().enumerate().skip(3).take(361) {
+    for (k, b) in prog.blocks.iter().enumerate().skip(lead).take(361) {
         assert!((x[k] - 45.0).abs() < 1e-6, "block {k}: X {}", x[k]);
         assert!(
-            (c[k] - 360.0 * (k - 3) as f64 / 360.0).abs() < 1e-9,
+            (c[k] - 360.0 * (k - lead) as f64 / 360.0).abs() < 1e-9,
             "block {k}: C {}",
             c[k]
         );
@@ -73,7 +76,7 @@ fn demo_family_runs_to_a_program() {
     let prog = build(&fam.toolpath(&still).unwrap(), &mill, "m").unwrap();
     let (x, y) = (prog.column("X").unwrap(), prog.column("Y").unwrap());
     assert!(prog.column("C").unwrap().iter().all(|c| *c == 0.0));
-    for k in 3..364 {
+    for k in lead..lead + 361 {
         assert!((x[k].hypot(y[k]) - 45.0).abs() < 1e-6);
     }
     let checks = fam.checks(&values(&fam, None, &[]).unwrap()).unwrap();
@@ -249,20 +252,21 @@ fn transforms_in_scripts_follow_the_universal_chain() {
 #[test]
 fn mandrel_building_blocks_in_scripts() {
     use pilgrim_kernel::offset::rest::{track, RestSetup};
-    use pilgrim_kernel::profile::simplify_polyline;
+    use pilgrim_kernel::offset::surface::{GroundSurface, WheelSection};
+    use pilgrim_kernel::profile::{simplify_polyline, Polyline};
     use pilgrim_kernel::{equidistant, MandrelLaw, ProfileBuilder, Side};
     let src = format!(
         "{HEAD}fn toolpath(p) {{\n\
            let law = mandrel_law(38.0, 52.0, 400.0, 0.012, 2.3);\n\
            let part = profile_start(-350.0, 19.0 - 350.0 * 0.006).line_to(0.0, 19.0).law(law)\n\
                         .line_to(500.0, 26.0 + 100.0 * 0.0324).build(0.00001, 0.05);\n\
-           let wheel = wheel_tool(\"w\", 1, 500.0, 20.0, 50.0);\n\
+           let wheel = wheel_tool(\"w\", 1, 500.0, 20.0, 40.0);\n\
            let e = equidistant(part, wheel, \"outside\");\n\
            let k = e.path.simplified(0.0005);\n\
-           let stock = profile_start(-700.0, 30.0).cylinder(1600.0).build(0.001, 1.0);\n\
-           let rest = rest_track(stock, k, wheel, steady_rest(25.0, -150.0, 0.05, 1e-5));\n\
+           let stock = ground_surface(profile_start(-700.0, 30.0).cylinder(1600.0).build(0.001, 1.0));\n\
+           let rest = rest_track(stock, k, wheel, steady_rest(25.0, -150.0, 0.05, 0.002), 2000.0, 399.0);\n\
            let tp = new_toolpath(\"m\", wheel, 399.0, [\"U\"]);\n\
-           tp.add_pass(\"finish\", #{{ x: k.x, y: 0.0, z: k.z, feed: 2000.0, aux: #{{ U: rest.centre_x }} }});\n\
+           tp.add_pass(\"finish\", #{{ x: rest.path.x, y: 0.0, z: rest.path.z, feed: 2000.0, aux: #{{ U: rest.centre_x }} }});\n\
            tp\n}}"
     );
     let fam = family(&src).unwrap();
@@ -277,7 +281,6 @@ fn mandrel_building_blocks_in_scripts() {
     let e = equidistant(&part, 20.0, Side::Outside).unwrap();
     let keep = simplify_polyline(&e.z, &e.x, 0.0005);
     let pass = &tp.passes[0].points;
-    assert_eq!(pass.len(), keep.len());
     assert!(
         keep.len() < e.z.len() / 50,
         "{} of {}",
@@ -293,10 +296,30 @@ fn mandrel_building_blocks_in_scripts() {
         radius: 25.0,
         offset_b: -150.0,
         sample: 0.05,
-        resolution: 1e-5,
+        tolerance: 0.002,
     };
-    let t = track(&stock, &cz, &cx, 20.0, &setup).unwrap();
-    for (c, (u, (z, x))) in pass.iter().zip(t.centre_x.iter().zip(cz.iter().zip(&cx))) {
+    let wheel = WheelSection {
+        radius: 20.0,
+        flat: 0.0,
+    };
+    let path = Polyline::new(cz, cx).unwrap();
+    let t = track(
+        &GroundSurface::new(stock),
+        &path,
+        wheel,
+        2000.0,
+        399.0,
+        &setup,
+    )
+    .unwrap();
+    // The script's pass is the track's path: the wheel's points and those
+    // the rest added on its moves.
+    assert_eq!(pass.len(), t.path.len());
+    assert!(t.path.len() >= keep.len());
+    for (c, (u, (z, x))) in pass
+        .iter()
+        .zip(t.centre_x.iter().zip(t.path.z.iter().zip(&t.path.x)))
+    {
         assert_eq!((c.point[2], c.point[0], c.aux[0]), (*z, *x, *u));
     }
     let e = family(&format!(

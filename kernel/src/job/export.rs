@@ -77,7 +77,7 @@ pub fn export(
     let index = match block {
         Some(0) => return Err(Error::Options("--block counts blocks from 1".into())),
         Some(n) => n - 1,
-        None => scene::default_pose_block(&toolpath.passes),
+        None => scene::default_pose_block(&program, &toolpath.passes),
     };
     let parts = report
         .bodies

@@ -23,7 +23,7 @@ pub use scene::{default_pose_block, BodyFile, Formats, SceneError};
 use crate::catalog::OpenMachine;
 use crate::error::Error;
 use crate::family::{PartFamily, PartGeometry};
-use crate::params::{resolve, ParamSource, Params};
+use crate::params::{resolve, ParamSource, ParamValue, Params};
 use crate::program::post::{dialect, CLD};
 use crate::program::{build, AxisProgram};
 use crate::tool::ToolShape;
@@ -153,10 +153,35 @@ pub fn run(
     options: &JobOptions,
     stage: &mut dyn FnMut(&str),
 ) -> Result<JobOutput, Error> {
-    let kin = machine.kinematics.as_ref();
+    // Parameters tied to machine constants default to this machine's; set
+    // otherwise, they set the machine's for the whole run (its chains, its
+    // bodies, the scene), so that the family and the machine cannot differ.
+    let values = resolve(
+        family.params(),
+        &machine.kinematics.info().constants,
+        sources,
+    )?;
+    let overrides: Vec<(String, f64)> = family
+        .params()
+        .iter()
+        .filter_map(|s| {
+            let c = s.machine.as_ref()?;
+            let have = *machine.kinematics.info().constants.get(c)?;
+            let want = match &values[&s.name] {
+                ParamValue::Bool(b) => f64::from(u8::from(*b)),
+                v => v.as_number()?,
+            };
+            (want != have).then(|| (c.clone(), want))
+        })
+        .collect();
+    let changed;
+    let kin: &dyn crate::machine::MachineKinematics = if overrides.is_empty() {
+        machine.kinematics.as_ref()
+    } else {
+        changed = machine.kinematics.with_constants(&overrides)?;
+        changed.as_ref()
+    };
     let info = kin.info();
-    // Parameters tied to machine constants default to this machine's.
-    let values = resolve(family.params(), &info.constants, sources)?;
     stage(STAGES[0]);
     let checks = family.checks(&values)?;
     let failed: Vec<String> = checks
@@ -188,7 +213,7 @@ pub fn run(
                 &program,
                 kin,
                 &toolpath.tool.reference,
-                w.rounding_radius,
+                &w,
                 &toolpath.passes,
                 &v.profile,
                 (v.from, v.to),
@@ -213,9 +238,7 @@ pub fn run(
         ("program.cld".into(), cld_text.into_bytes()),
         (
             "report.csv".into(),
-            block_table(&program, &toolpath)
-                .map_err(Error::Output)?
-                .into_bytes(),
+            block_table(&program).map_err(Error::Output)?.into_bytes(),
         ),
     ];
     stage(STAGES[4]);
@@ -240,7 +263,7 @@ pub fn run(
         let index = match options.pose_block {
             Some(0) => return Err(Error::Options("--pose-block counts blocks from 1".into())),
             Some(n) => n - 1,
-            None => default_pose_block(&toolpath.passes),
+            None => default_pose_block(&program, &toolpath.passes),
         };
         let pose = scene::tool_pose(&program, kin, &toolpath.tool, index)?;
         let tool = scene::tool_mesh(&toolpath.tool, tol)?;

@@ -6,8 +6,8 @@ use crate::family::Check;
 use crate::machine::{move_length, Axis, MachineInfo};
 use crate::math::{fixed, Real};
 use crate::params::ParamValue;
-use crate::program::AxisProgram;
-use crate::toolpath::{Motion, Toolpath};
+use crate::program::{block_label, AxisProgram};
+use crate::toolpath::Motion;
 use crate::verify::GrindingCheck;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -117,15 +117,23 @@ pub fn cycle_time(program: &AxisProgram, info: &MachineInfo) -> Real {
     minutes
 }
 
-/// `report.csv`: one row per block: block number, pass, motion, axis
-/// values (the program's decimals), feed; written by the `csv` crate
-/// (RFC 4180, fields quoted where they need it).
+/// `report.csv`: one row per block of the program, the start's and the
+/// end's included: block number (from 1), the program's name for it
+/// ([`block_label`]: `N570`), the pass (the last comment at or before it),
+/// motion, axis values (the program's decimals; empty for an axis the
+/// block keeps where it stands), feed; written by the `csv` crate (RFC
+/// 4180, fields quoted where they need it).
 ///
 /// # Failures
 /// The writer failing (it writes to memory).
-pub fn block_table(program: &AxisProgram, toolpath: &Toolpath) -> Result<String, String> {
+pub fn block_table(program: &AxisProgram) -> Result<String, String> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    let mut header = vec!["block".to_owned(), "pass".into(), "motion".into()];
+    let mut header = vec![
+        "block".to_owned(),
+        "label".into(),
+        "pass".into(),
+        "motion".into(),
+    ];
     header.extend(
         program
             .axes
@@ -135,21 +143,31 @@ pub fn block_table(program: &AxisProgram, toolpath: &Toolpath) -> Result<String,
     header.push("feed (mm/min)".into());
     w.write_record(&header).map_err(|e| e.to_string())?;
     let decimals = program.decimals.unwrap_or(3);
-    for (pass, blocks) in toolpath.pass_ranges() {
-        for i in blocks {
-            let Some(b) = program.blocks.get(i) else {
-                break;
-            };
-            let motion = match b.motion {
-                Motion::Rapid => "rapid",
-                Motion::Linear => "linear",
-                Motion::Thread { .. } => "thread",
-            };
-            let mut row = vec![(i + 1).to_string(), pass.name.clone(), motion.to_owned()];
-            row.extend(b.values.iter().map(|v| fixed(*v, decimals)));
-            row.push(fixed(b.feed, 1));
-            w.write_record(&row).map_err(|e| e.to_string())?;
+    let mut pass = "";
+    for (i, b) in program.blocks.iter().enumerate() {
+        if let Some(c) = &b.comment {
+            pass = c;
         }
+        let motion = match b.motion {
+            Motion::Rapid => "rapid",
+            Motion::Linear => "linear",
+            Motion::Thread { .. } => "thread",
+        };
+        let mut row = vec![
+            (i + 1).to_string(),
+            block_label(&program.control, i),
+            pass.to_owned(),
+            motion.to_owned(),
+        ];
+        row.extend(program.axes.iter().zip(&b.values).map(|(a, v)| {
+            if b.keep.contains(&a.name) {
+                String::new()
+            } else {
+                fixed(*v, decimals)
+            }
+        }));
+        row.push(fixed(b.feed, 1));
+        w.write_record(&row).map_err(|e| e.to_string())?;
     }
     let bytes = w.into_inner().map_err(|e| e.to_string())?;
     String::from_utf8(bytes).map_err(|e| e.to_string())

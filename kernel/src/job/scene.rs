@@ -6,9 +6,10 @@ use crate::family::{PartBody, PartGeometry};
 use crate::machine::{bodies_of, BodyShape, MachineKinematics};
 use crate::math::{Mat4, Point3, Vec3};
 use crate::mesh::{self, frame_from_pose, MeshError, Scene, StlFormat, TriMesh};
+use crate::program::pass_blocks;
 use crate::program::{axis_rows, AxisProgram};
 use crate::tool::{Tool, ToolShape};
-use crate::toolpath::{pass_ranges, Pass};
+use crate::toolpath::Pass;
 use serde::{Deserialize, Serialize};
 
 /// A body written to a file, for the report.
@@ -132,12 +133,13 @@ pub fn machine_bodies(
     Ok(out)
 }
 
-/// Block index (from 0) where the scene shows the tool by default: the
-/// middle block of the last pass that cuts (has a move other than a rapid),
-/// the tool at work on the finish; else the first block of the last pass.
-pub fn default_pose_block(passes: &[Pass]) -> usize {
+/// Block index (from 0) of `program`, built from `passes`, where the scene
+/// shows the tool by default: the middle block of the last pass that cuts
+/// (has a move other than a rapid), the tool at work on the finish; else
+/// the first block of the last pass.
+pub fn default_pose_block(program: &AxisProgram, passes: &[Pass]) -> usize {
     let (mut last_start, mut pick) = (0, None);
-    for (p, blocks) in pass_ranges(passes) {
+    for (p, blocks) in pass_blocks(program, passes) {
         if p.cuts() {
             pick = Some(blocks.start + p.points.len() / 2);
         }

@@ -6,8 +6,9 @@
 use crate::machine::{bodies_of, MachineKinematics};
 use crate::math::fixed;
 use crate::profile::Profile;
+use crate::program::pass_blocks;
 use crate::program::{axis_rows, AxisProgram};
-use crate::toolpath::{pass_ranges, Pass, Toolpath};
+use crate::toolpath::{Pass, Toolpath};
 
 /// One line of a panel.
 struct Series {
@@ -81,7 +82,7 @@ pub fn profile_svg(
         };
         let names = body.chain().axis_names();
         let mut series = Vec::new();
-        for (i, (p, blocks)) in pass_ranges(&toolpath.passes)
+        for (i, (p, blocks)) in pass_blocks(program, &toolpath.passes)
             .filter(|(p, _)| p.cuts())
             .enumerate()
         {

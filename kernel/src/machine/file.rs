@@ -4,7 +4,7 @@ use super::info::{Invalid, Place};
 use super::ToolSpec;
 use super::{Axis, AxisKind, BodyShape, BodySpec, FactorSpec, Machine, MachineError, MachineInfo};
 use crate::math::Real;
-use pilgrim_plugin_abi::types::FactorKind;
+use pilgrim_plugin_abi::types::{FactorKind, ProgramSetup};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -29,6 +29,7 @@ struct MachineFile {
     #[serde(default)]
     driven_axes: Vec<String>,
     min_feed: Option<Spanned<Real>>,
+    setup: Option<Spanned<ProgramSetup>>,
 }
 
 #[derive(Deserialize)]
@@ -263,6 +264,11 @@ impl Machine {
                 Some(f) => Some(src.finite("min_feed", f)?),
                 None => None,
             },
+            setup: file
+                .setup
+                .as_ref()
+                .map(|s| s.get_ref().clone())
+                .unwrap_or_default(),
         };
         Machine::compile(info).map_err(|e| src.err(span_of(&file, &e), e.message))
     }
@@ -317,6 +323,7 @@ fn span_of(file: &MachineFile, e: &Invalid) -> Range<usize> {
         }
         Place::Tool => file.tool.as_ref().map_or(0..0, |t| t.point.span()),
         Place::Decimals => file.program_decimals.as_ref().map_or(0..0, Spanned::span),
+        Place::Setup => file.setup.as_ref().map_or(0..0, Spanned::span),
     }
 }
 

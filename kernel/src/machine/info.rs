@@ -9,7 +9,7 @@
 use super::{Axis, AxisKind, BodyShape, BodySpec, FactorSpec, Machine, MachineError, MachineInfo};
 use crate::math::{Point3, Real, Vec3};
 use crate::transform::{Chain, FactorKind, ToolFrame};
-use pilgrim_plugin_abi::types::FactorKind as SpecFactor;
+use pilgrim_plugin_abi::types::{FactorKind as SpecFactor, Radial};
 use std::collections::BTreeMap;
 
 /// A moving body other than the tool (a steady rest): its description and
@@ -52,6 +52,8 @@ pub(super) enum Place {
     Tool,
     /// The program decimals.
     Decimals,
+    /// The program's start and end settings.
+    Setup,
 }
 
 /// A wrong value in a description: where, and what.
@@ -415,6 +417,81 @@ fn check_capabilities(info: &MachineInfo) -> Result<(), Invalid> {
     Ok(())
 }
 
+/// Checks the program's start and end settings: a work offset G54 to G59;
+/// a radial axis that is a linear axis whose stated motion (radial, 1 mm
+/// or 0.5 mm per mm) says the same programming; every axis named a
+/// programmed one; a clear position, within travel, for every axis the
+/// start or the end takes clear.
+fn check_setup(info: &MachineInfo) -> Result<(), Invalid> {
+    let s = &info.setup;
+    let bad = |m: String| Err(invalid(Place::Setup, m));
+    if let Some(w) = s.work_offset {
+        if !(1..=6).contains(&w) {
+            return bad(format!(
+                "setup: work_offset = {w} must be 1 to 6 (G54 to G59)"
+            ));
+        }
+    }
+    if let Some(r) = s.radial {
+        let name = if s.radial_axis.is_empty() {
+            "X"
+        } else {
+            &s.radial_axis
+        };
+        let Some(a) = info.axis(name).filter(|a| a.kind == AxisKind::Linear) else {
+            return bad(format!(
+                "setup: the radial axis {name} is not a linear axis of the machine"
+            ));
+        };
+        let (word, per_mm) = match r {
+            Radial::Radius => ("radius", 1.0),
+            Radial::Diameter => ("diameter", 0.5),
+        };
+        if let Some(m) = a.moves {
+            if (m[0].abs() - per_mm).abs() > 1e-9 || m[1] != 0.0 || m[2] != 0.0 {
+                return bad(format!(
+                    "setup: radial = \"{word}\" says 1 mm of {name} moves the tool {per_mm} mm from the part's axis, but the axis states moves = [{}, {}, {}]",
+                    m[0], m[1], m[2]
+                ));
+            }
+        }
+    }
+    let named = s
+        .start_clear
+        .iter()
+        .map(|a| (a, true))
+        .chain(s.approach.iter().flatten().map(|a| (a, false)))
+        .chain(s.retract.iter().flatten().map(|a| (a, true)))
+        .chain(s.clear.keys().map(|a| (a, false)));
+    for (name, needs_clear) in named {
+        let Some(axis) = info.axis(name).filter(|a| a.is_programmed()) else {
+            return bad(format!(
+                "setup: '{name}' is not a programmed axis of the machine"
+            ));
+        };
+        match s.clear.get(name) {
+            None if needs_clear => {
+                return bad(format!(
+                    "setup: axis {name} is taken clear but has no clear position"
+                ))
+            }
+            Some(&v) => {
+                let internal = axis.from_user(v);
+                if !(internal >= axis.min && internal <= axis.max) {
+                    return bad(format!(
+                        "setup: the clear position of {name}, {v}, is outside its travel [{}, {}] {}",
+                        axis.to_user(axis.min),
+                        axis.to_user(axis.max),
+                        axis.unit()
+                    ));
+                }
+            }
+            None => {}
+        }
+    }
+    Ok(())
+}
+
 fn described(info: &MachineInfo, e: Invalid) -> MachineError {
     MachineError::Description {
         machine: info.name.clone(),
@@ -445,6 +522,7 @@ pub fn check_description(info: &MachineInfo) -> Result<(), MachineError> {
     }
     check_axes(info)
         .and_then(|_| check_capabilities(info))
+        .and_then(|_| check_setup(info))
         .and_then(|_| compile_bodies(info).map(|_| ()))
         .map_err(|e| described(info, e))
 }
@@ -457,6 +535,7 @@ impl Machine {
         let chain = compile_chain(&info, None, &info.chain)?;
         let bodies = compile_bodies(&info)?;
         check_capabilities(&info)?;
+        check_setup(&info)?;
         let machine = Machine {
             info,
             chain,

@@ -83,6 +83,45 @@ pub trait MachineKinematics {
         tool: &ToolFrame,
         out: &mut Vec<Real>,
     ) -> Result<(), KinematicsError>;
+
+    /// The same machine with some of its named constants set otherwise
+    /// (`name`, value in kernel units): everything the host derives from
+    /// the description (bodies' chains and shapes) follows. Machines that
+    /// cannot follow a constant in their own kinematics refuse it.
+    ///
+    /// # Failures
+    /// A constant the machine does not have; one its kinematics cannot
+    /// follow; a description that no longer holds.
+    fn with_constants(
+        &self,
+        overrides: &[(String, Real)],
+    ) -> Result<Box<dyn MachineKinematics>, MachineError> {
+        let _ = overrides;
+        Err(MachineError::Description {
+            machine: self.info().name.clone(),
+            message: "its constants cannot be changed".into(),
+        })
+    }
+}
+
+/// `info` with the constants `overrides` set, each checked to exist.
+pub(crate) fn overridden(
+    info: &MachineInfo,
+    overrides: &[(String, Real)],
+) -> Result<MachineInfo, MachineError> {
+    let mut info = info.clone();
+    for (name, v) in overrides {
+        match info.constants.get_mut(name) {
+            Some(c) => *c = *v,
+            None => {
+                return Err(MachineError::Description {
+                    machine: info.name.clone(),
+                    message: format!("no machine constant '{name}'"),
+                })
+            }
+        }
+    }
+    Ok(info)
 }
 
 /// Any [`Machine`] as [`MachineKinematics`]: its chain, numerical inverse
@@ -258,6 +297,19 @@ pub fn batch_rows(values: &[Real], width: usize, what: &str) -> Result<usize, Ki
 impl MachineKinematics for ChainMachine {
     fn info(&self) -> &MachineInfo {
         self.machine.info()
+    }
+
+    /// The machine rebuilt from its description with the constants set:
+    /// its chains follow.
+    fn with_constants(
+        &self,
+        overrides: &[(String, Real)],
+    ) -> Result<Box<dyn MachineKinematics>, MachineError> {
+        let info = overridden(self.machine.info(), overrides)?;
+        Ok(Box::new(ChainMachine {
+            machine: Machine::from_info(info)?,
+            options: self.options,
+        }))
     }
 
     fn inverse(

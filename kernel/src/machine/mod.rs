@@ -27,6 +27,7 @@ mod kinematics;
 
 pub use builtin::{BUILTIN_MACHINES, BUILTIN_SOURCES};
 pub use info::{bodies_of, check_description, Body};
+pub(crate) use kinematics::overridden as kinematics_overridden;
 pub use kinematics::{batch_rows, ChainMachine, KinematicsError, MachineKinematics};
 pub use pilgrim_plugin_abi::types::{
     Axis, AxisKind, BodyShape, BodySpec, FactorSpec, MachineInfo, Quantity, ToolSpec,

@@ -119,6 +119,23 @@ impl CircleEnvelope {
         self.radius
     }
 
+    /// The side the circles stand on.
+    pub fn side(&self) -> Side {
+        self.side
+    }
+
+    /// The z in `[a, b]` where one circle takes over from another (the
+    /// envelope's cusps), in order.
+    pub fn breakpoints(&self, a: Real, b: Real) -> Vec<Real> {
+        let lo = self.pieces.partition_point(|p| p.0 < a);
+        let hi = self.pieces.partition_point(|p| p.0 <= b);
+        self.pieces[lo..hi]
+            .iter()
+            .map(|p| p.0)
+            .filter(|z| z.is_finite())
+            .collect()
+    }
+
     /// How many circles appear on the envelope.
     pub fn piece_count(&self) -> usize {
         self.pieces.len()
@@ -159,7 +176,7 @@ impl CircleEnvelope {
         if !zs.windows(2).all(|w| w[0] <= w[1]) {
             return zs.iter().map(|&z| self.eval(z)).collect();
         }
-        let mut k = 0;
+        let mut k = zs.first().map_or(0, |&z| self.piece_at(z));
         zs.iter()
             .map(|&z| {
                 while k + 1 < self.pieces.len() && self.pieces[k + 1].0 <= z {

@@ -10,10 +10,13 @@
 //! exactly on the sampled data and are the independent check of every
 //! offset.
 
+mod capsule;
 mod drop;
 mod envelope;
 pub mod rest;
+pub mod surface;
 
+pub use capsule::{flat_path, CapsuleEnvelope};
 pub use drop::{drop_circle, Drop};
 pub use envelope::{swept_circles, CircleEnvelope, SweptCircles};
 

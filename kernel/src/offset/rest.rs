@@ -23,9 +23,11 @@
 //! (the edge of the current pass) the seed's model has no such bound: that
 //! is why the exact model is the default.
 
+pub use super::surface::WheelSection;
+use super::surface::{GroundSurface, PassLayer};
 use super::{drop_circle, Drop, Side};
 use crate::math::{finite, positive, Real};
-use crate::profile::{Profile, ProfileError};
+use crate::profile::{Polyline, Profile, ProfileError};
 use serde::{Deserialize, Serialize};
 
 /// Which model of the rest to use.
@@ -100,26 +102,38 @@ pub fn seed_error_bound(max_curvature: Real, max_sin_slope: Real, h: Real, r_o: 
     0.5 * k * (reach + h) * (reach + 2.0 * h) + 0.125 * k * h * h
 }
 
-/// The steady rest along one pass: for each block, the support's centre x
-/// on the current surface (the exact drop), the contact point, and the
-/// seed's formula on the same surface.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// The steady rest along one pass: the pass's path with the blocks the
+/// rest needs added; at each block the support's centre x on the current
+/// surface (the exact drop), the contact point, and the seed's formula on
+/// the same surface; and how far the control's straight line of U between
+/// blocks stands off the surface or presses into it.
+#[derive(Debug, Clone, PartialEq)]
 pub struct RestTrack {
-    /// The support centre's x at each block (exact model).
+    /// The wheel's path: the pass's points and, on its moves, the points
+    /// added for the rest (same line, same feed).
+    pub path: Polyline,
+    /// The support centre's x at each point of the path (exact model).
     pub centre_x: Vec<Real>,
-    /// The contact point's z at each block.
+    /// The contact point's z at each point.
     pub contact_z: Vec<Real>,
-    /// The contact point's x at each block.
+    /// The contact point's x at each point.
     pub contact_x: Vec<Real>,
-    /// The support centre's x by the seed's formula.
+    /// The support centre's x by the seed's formula at each point.
     pub seed_centre_x: Vec<Real>,
     /// The largest |seed - exact| over the pass (mm).
     pub max_model_difference: Real,
-    /// The block where it is (from 0).
+    /// The point where it is (from 0).
     pub max_difference_block: usize,
+    /// The largest amount U, moving in a straight line between points,
+    /// stands off the surface (above the exact drop, mm, >= 0).
+    pub max_gap: Real,
+    /// The largest amount it presses into the surface (mm, >= 0).
+    pub max_press: Real,
+    /// Points the rest added to the pass.
+    pub added: usize,
 }
 
-/// What the rest rides on during a pass.
+/// What the rest rides on during a pass, and how closely its U follows.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RestSetup {
     /// The support's radius R_o (mm).
@@ -128,101 +142,216 @@ pub struct RestSetup {
     pub offset_b: Real,
     /// Spacing of the surface samples under the support (mm).
     pub sample: Real,
-    /// Resolution of the wheel's swept surface (mm), as in [`swept_circles`](super::swept_circles).
-    pub resolution: Real,
+    /// How far the straight line of U between blocks may stray from the
+    /// exact drop (mm): blocks are added until it holds.
+    pub tolerance: Real,
 }
 
-/// The steady rest's track along a pass whose wheel rounding (radius
-/// `wheel_radius`) moves through the centres `(z[k], x[k])` in order (a
-/// pass runs one way along z), over a workpiece whose surface before the
-/// pass is `previous`. At block k the rest at `z_r = z[k] + B` rides the
-/// current surface: the previous surface where the wheel has not been, the
-/// surface the wheel has left where it has, their minimum where the
-/// support's reach straddles both (MATH §2.3). The surface under the
-/// support is sampled at `setup.sample` and the exact drop taken on it.
+/// Along each move the straight line of U is checked against the exact
+/// drop at least this often (mm of the wheel's travel along z).
+pub const REST_CHECK_STEP: Real = 1.0;
+
+/// Each move is checked at this many places at least.
+pub const MIN_REST_CHECKS: usize = 4;
+
+/// A kink of U (the support's contact jumping between features of the
+/// surface) is located to this much of the wheel's travel (mm): a kink
+/// inside a move this short bends U's line by at most a quarter of it times
+/// the change of slope (below 0.3 um).
+pub const KINK_WIDTH: Real = 1e-3;
+
+/// The largest number of rest points a pass may get.
+const MAX_REST_POINTS: usize = 200_000;
+
+/// The steady rest along a pass (MATH §2.3, §2.4): the wheel's reference
+/// moves along `path` (one way along z) at `feed` (mm/min) while the part
+/// turns at `rpm`, over a part whose surface before the pass is `before`.
+/// At each moment the rest at `z_r = z + B` rides the current surface: the
+/// crests of the ridges already left by earlier passes and by this one as
+/// far as the wheel has come ([`PassLayer`]: the wheel's section swept
+/// along the path, raised by the pass's ridge). U is the exact drop of the
+/// support on that surface (sampled `setup.sample` mm apart under the
+/// support) at every block, and at [`MIN_REST_CHECKS`] or more places a
+/// move, at most [`REST_CHECK_STEP`] apart; where the control's straight
+/// line of U between two blocks strays more than `setup.tolerance` from
+/// the exact drop, a block is added on the wheel's line at the worst
+/// place, or, where the support's contact jumps from one feature of the
+/// surface to another (a kink of U), a block either side of the kink,
+/// until it holds.
 ///
 /// # Failures
-/// Bad numbers; centres of different lengths or fewer than one; a rest
-/// position whose support misses the previous surface altogether.
+/// Bad numbers; a rest position whose support misses the part altogether
+/// (naming the point and z); more than 200,000 rest points in a pass.
 pub fn track(
-    previous: &Profile,
-    z: &[Real],
-    x: &[Real],
-    wheel_radius: Real,
+    before: &GroundSurface,
+    path: &Polyline,
+    wheel: WheelSection,
+    feed: Real,
+    rpm: Real,
     setup: &RestSetup,
 ) -> Result<RestTrack, ProfileError> {
     positive("rest support radius R_o", setup.radius)?;
     positive("rest surface sample", setup.sample)?;
+    positive("rest tolerance", setup.tolerance)?;
     finite("rest offset B", setup.offset_b)?;
-    let (cz, cx, block_of) = super::swept_circles(z, x, wheel_radius, setup.resolution)?;
-    let full = super::CircleEnvelope::new(&cz, &cx, wheel_radius, Side::Outside)?;
-    // The last circle placed by each block (where the wheel stands then).
-    let mut last_of_block = vec![0usize; z.len()];
-    for (i, &b) in block_of.iter().enumerate() {
-        last_of_block[b] = i;
+    if path.is_empty() {
+        return Err(crate::input::InputError::TooFew {
+            what: "pass points".into(),
+            got: 0,
+            min: 1,
+        }
+        .into());
     }
-    let increasing = z.last() >= z.first();
-    let reach = setup.radius + wheel_radius;
-    let (lo_prev, hi_prev) = previous.z_range();
-    let slopes = previous.slopes();
-    let prev_at = |zq: Real| crate::profile::hermite(previous.z(), previous.x(), &slopes, zq);
-    let mut out = RestTrack {
-        centre_x: Vec::with_capacity(z.len()),
-        contact_z: Vec::with_capacity(z.len()),
-        contact_x: Vec::with_capacity(z.len()),
-        seed_centre_x: Vec::with_capacity(z.len()),
-        max_model_difference: 0.0,
-        max_difference_block: 0,
-    };
-    for k in 0..z.len() {
-        let z_r = z[k] + setup.offset_b;
-        let (a, b) = (
-            (z_r - setup.radius).max(lo_prev),
-            (z_r + setup.radius).min(hi_prev),
-        );
+    let layer = PassLayer::new(&path.z, &path.x, wheel, feed, rpm)?;
+    let mut time = vec![0.0; path.len()];
+    for k in 1..path.len() {
+        time[k] = time[k - 1] + (path.z[k] - path.z[k - 1]).hypot(path.x[k] - path.x[k - 1]) / feed;
+    }
+    let (lo, hi) = before.z_range();
+    // The exact drop with the wheel at `(z, time)`, and the seed's formula
+    // there if asked.
+    let at = |z: Real, time: Real, k: usize, seed: bool| -> Result<(Drop, Real), ProfileError> {
+        let z_r = z + setup.offset_b;
+        let (a, b) = ((z_r - setup.radius).max(lo), (z_r + setup.radius).min(hi));
         if a >= b {
             return Err(ProfileError::OutsideProfile {
                 what: format!(
-                    "the steady rest's support at block {} of the pass (z_r = z + B, B = {} mm) has nothing under it: its centre",
+                    "the steady rest's support at point {} of the pass (z_r = z + B, B = {} mm) has nothing under it: its centre",
                     k + 1,
                     crate::math::fixed(setup.offset_b, 4)
                 ),
                 z: z_r,
-                z_min: lo_prev,
-                z_max: hi_prev,
+                z_min: lo,
+                z_max: hi,
             });
         }
-        // Circles whose reach meets the support's: a run of the pass.
-        let near = if increasing {
-            cz.partition_point(|&c| c < z_r - reach)..cz.partition_point(|&c| c <= z_r + reach)
-        } else {
-            cz.partition_point(|&c| c > z_r + reach)..cz.partition_point(|&c| c >= z_r - reach)
-        };
-        // Of those, the ones the wheel has placed by now: none, all (the
-        // pass's whole envelope serves), or the first few.
-        let now = last_of_block[k];
-        let partial;
-        let cut = if near.is_empty() || near.start > now {
-            None
-        } else if near.end - 1 <= now {
-            Some(&full)
-        } else {
-            let (pz, px): (Vec<Real>, Vec<Real>) =
-                (near.start..=now).map(|i| (cz[i], cx[i])).unzip();
-            partial = super::CircleEnvelope::new(&pz, &px, wheel_radius, Side::Outside)?;
-            Some(&partial)
-        };
-        let grid = crate::profile::uniform_grid(a, b, setup.sample)?;
-        let surface: Vec<Real> = grid
-            .iter()
-            .map(|&g| match cut {
-                Some(env) => prev_at(g).min(env.eval(g)),
-                None => prev_at(g),
-            })
-            .collect();
-        let window = Profile::new(grid, surface)?;
+        let part = layer.by_time(time, a, b)?;
+        let window = before.window(a, b, setup.sample, part.as_ref())?;
         let d = super::drop_circle(&window, z_r, setup.radius, Side::Outside)?;
-        let seed = seed_u(&window, z_r.clamp(a, b), setup.radius)?;
+        if !seed {
+            return Ok((d, Real::NAN));
+        }
+        // The seed's formula reads the surface as an array at an even step.
+        let grid = crate::profile::uniform_grid(a, b, setup.sample)?;
+        let even = Profile::new(grid.clone(), before.eval_many(&grid, part.as_ref()))?;
+        let seed = seed_u(&even, z_r.clamp(a, b), setup.radius)?;
+        Ok((d, seed))
+    };
+    // Exact U at every point, then at samples along each move, adding the
+    // worst sample as a point where the straight line strays.
+    let mut pts: Vec<(Real, Real, Real)> = path
+        .z
+        .iter()
+        .zip(&path.x)
+        .zip(&time)
+        .map(|((&z, &x), &tm)| (z, x, tm))
+        .collect();
+    let mut drops: Vec<(Drop, Real)> = pts
+        .iter()
+        .enumerate()
+        .map(|(k, p)| at(p.0, p.2, k, true))
+        .collect::<Result<_, _>>()?;
+    let (mut max_gap, mut max_press) = (0.0 as Real, 0.0 as Real);
+    let mut k = 1;
+    let original = pts.len();
+    while k < pts.len() {
+        let (a, b) = (pts[k - 1], pts[k]);
+        let (ua, ub) = (drops[k - 1].0.centre_x, drops[k].0.centre_x);
+        let n = ((b.0 - a.0).abs() / REST_CHECK_STEP)
+            .ceil()
+            .max(MIN_REST_CHECKS as Real) as usize;
+        let mut worst: Option<(Real, Real)> = None;
+        let (mut gap, mut press) = (0.0 as Real, 0.0 as Real);
+        let mut contact = drops[k - 1].0.contact_z;
+        let mut kink: Option<(Real, Real)> = None;
+        let at_s = |s: Real| at(a.0 + s * (b.0 - a.0), a.2 + s * (b.2 - a.2), k, false);
+        for i in 1..=n {
+            let s = i as Real / n as Real;
+            let d = if i == n { drops[k].0 } else { at_s(s)?.0 };
+            // The support's contact jumping from one feature of the
+            // surface to another (a corner, a step, where a pass's cut
+            // begins) is a kink in U: found to within KINK_WIDTH and made
+            // a block, so the straight lines either side follow smooth arcs.
+            let dz = (b.0 - a.0).abs() / n as Real;
+            if kink.is_none() && dz > KINK_WIDTH && (d.contact_z - contact).abs() > 2.0 * dz + 1e-3
+            {
+                let (mut lo, mut hi) = ((i - 1) as Real / n as Real, s);
+                let from = contact;
+                while (hi - lo) * (b.0 - a.0).abs() > KINK_WIDTH {
+                    let m = 0.5 * (lo + hi);
+                    if (at_s(m)?.0.contact_z - from).abs()
+                        > 2.0 * (m - lo) * (b.0 - a.0).abs() + 1e-3
+                    {
+                        hi = m;
+                    } else {
+                        lo = m;
+                    }
+                }
+                kink = Some((lo, hi));
+            }
+            contact = d.contact_z;
+            if i == n {
+                break;
+            }
+            let (exact, line) = (d.centre_x, ua + s * (ub - ua));
+            gap = gap.max(line - exact);
+            press = press.max(exact - line);
+            let dev = (line - exact).abs();
+            if dev > setup.tolerance && worst.is_none_or(|w| dev > w.0) {
+                worst = Some((dev, s));
+            }
+        }
+        // Where the line strays: a kink in the move gets a block either
+        // side of it (the short move between them has no room to stray),
+        // else a block goes at the worst place.
+        let add: Vec<Real> = match (kink, worst) {
+            (Some((lo, hi)), Some(_)) => [lo, hi]
+                .into_iter()
+                .filter(|s| *s > 0.0 && *s < 1.0)
+                .collect(),
+            (_, w) => w.map(|w| w.1).into_iter().collect(),
+        };
+        if add.is_empty() {
+            max_gap = max_gap.max(gap);
+            max_press = max_press.max(press);
+            k += 1;
+            continue;
+        }
+        if pts.len() >= original + MAX_REST_POINTS {
+            return Err(crate::input::InputError::out_of_range(
+                "points the steady rest adds to a pass",
+                pts.len() as Real,
+                format!("at most {MAX_REST_POINTS}: a coarser rest tolerance"),
+            )
+            .into());
+        }
+        for (j, s) in add.into_iter().enumerate() {
+            let p = (
+                a.0 + s * (b.0 - a.0),
+                a.1 + s * (b.1 - a.1),
+                a.2 + s * (b.2 - a.2),
+            );
+            let d = at(p.0, p.2, k + j, true)?;
+            pts.insert(k + j, p);
+            drops.insert(k + j, d);
+        }
+    }
+    let mut out = RestTrack {
+        path: Polyline {
+            z: pts.iter().map(|p| p.0).collect(),
+            x: pts.iter().map(|p| p.1).collect(),
+        },
+        centre_x: Vec::with_capacity(pts.len()),
+        contact_z: Vec::with_capacity(pts.len()),
+        contact_x: Vec::with_capacity(pts.len()),
+        seed_centre_x: Vec::with_capacity(pts.len()),
+        max_model_difference: 0.0,
+        max_difference_block: 0,
+        max_gap,
+        max_press,
+        added: pts.len() - original,
+    };
+    for (k, (d, seed)) in drops.iter().enumerate() {
         if (seed - d.centre_x).abs() > out.max_model_difference {
             out.max_model_difference = (seed - d.centre_x).abs();
             out.max_difference_block = k;
@@ -230,33 +359,7 @@ pub fn track(
         out.centre_x.push(d.centre_x);
         out.contact_z.push(d.contact_z);
         out.contact_x.push(d.contact_x);
-        out.seed_centre_x.push(seed);
+        out.seed_centre_x.push(*seed);
     }
     Ok(out)
-}
-
-/// The surface after a pass: the lower of `previous` and the surface the
-/// wheel's rounding (radius `wheel_radius`) leaves moving through
-/// `(z[k], x[k])`, at `previous`'s nodes (the pass's own scallops, below
-/// `resolution`, are what lies between).
-///
-/// # Failures
-/// As [`swept_circles`](super::swept_circles) and [`Profile::new`].
-pub fn after_pass(
-    previous: &Profile,
-    z: &[Real],
-    x: &[Real],
-    wheel_radius: Real,
-    resolution: Real,
-) -> Result<Profile, ProfileError> {
-    let (cz, cx, _) = super::swept_circles(z, x, wheel_radius, resolution)?;
-    let env = super::CircleEnvelope::new(&cz, &cx, wheel_radius, Side::Outside)?;
-    let cut = env.eval_many(previous.z());
-    let xs = previous
-        .x()
-        .iter()
-        .zip(cut)
-        .map(|(p, c)| p.min(c))
-        .collect();
-    Profile::new(previous.z().to_vec(), xs)
 }

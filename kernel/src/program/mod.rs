@@ -10,32 +10,30 @@
 
 pub mod post;
 
-pub use pilgrim_plugin_abi::types::{AxisProgram, Block, ProgramAxis};
+pub use pilgrim_plugin_abi::types::{AxisProgram, Block, Plane, ProgramAxis, ProgramSetup, Radial};
 pub use post::{post, Dialect, PostError, PostProcessor, SharedPost};
 
-use crate::machine::{Axis, MachineError, MachineInfo, MachineKinematics};
+use crate::machine::{Axis, AxisKind, MachineError, MachineInfo, MachineKinematics};
 use crate::math::Real;
-use crate::toolpath::{Motion, Toolpath, ToolpathError};
+use crate::toolpath::{pass_ranges, Motion, Pass, Toolpath, ToolpathError};
+use std::ops::Range;
 
 /// The least feed of a cutting block on any machine (mm/min): below it a
 /// move would take longer than a report can say.
 pub const MIN_FEED: Real = 1e-3;
 
-/// Errors making a program from a toolpath; blocks are numbered from 1.
+/// Errors making a program from a toolpath. Blocks are named as the
+/// program names them ([`block_name`]: `N570 in "pass 1"`).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ProgramError {
     /// The toolpath itself is bad.
     #[error(transparent)]
     Toolpath(#[from] ToolpathError),
     /// Inverse kinematics failed at a block.
-    #[error("block {block} (pass {pass}, point {point}): {message}")]
+    #[error("{block}: {message}")]
     Kinematics {
-        /// Block number (from 1).
-        block: usize,
-        /// Pass (from 1).
-        pass: usize,
-        /// Point in the pass (from 1).
-        point: usize,
+        /// The block, as the program names it.
+        block: String,
         /// What failed.
         message: String,
     },
@@ -59,11 +57,24 @@ pub enum ProgramError {
         /// Its programmed axes.
         known: String,
     },
+    /// An axis the machine takes from the toolpath that the toolpath does
+    /// not drive.
+    #[error("machine {machine} takes axis {axis} from the toolpath, which does not drive it (its values: {given}): the family must give {axis} at every point")]
+    NotDriven {
+        /// The axis.
+        axis: String,
+        /// The machine.
+        machine: String,
+        /// The auxiliary values the toolpath gives.
+        given: String,
+    },
     /// A block outside an axis's travel.
-    #[error("block {block}: axis {axis} at {value:.4} {unit} is outside its travel [{min}, {max}] {unit}")]
+    #[error(
+        "{block}: axis {axis} at {value:.4} {unit} is outside its travel [{min}, {max}] {unit}"
+    )]
     OutsideTravel {
-        /// Block number (from 1).
-        block: usize,
+        /// The block, as the program names it.
+        block: String,
         /// The axis.
         axis: String,
         /// Its value (mm or deg).
@@ -76,10 +87,10 @@ pub enum ProgramError {
         unit: &'static str,
     },
     /// A cutting block slower than the machine's controls accept.
-    #[error("block {block}: feed {feed:e} mm/min is below the minimum feed of machine {machine}, {min} mm/min")]
+    #[error("{block}: feed {feed:e} mm/min is below the minimum feed of machine {machine}, {min} mm/min")]
     FeedTooLow {
-        /// Block number (from 1).
-        block: usize,
+        /// The block, as the program names it.
+        block: String,
         /// The feed.
         feed: Real,
         /// The machine.
@@ -88,10 +99,12 @@ pub enum ProgramError {
         min: Real,
     },
     /// A block faster than an axis can go.
-    #[error("block {block}: axis {axis} would move at {speed:.1} {unit}, above its maximum {max} {unit}")]
+    #[error(
+        "{block}: axis {axis} would move at {speed:.1} {unit}, above its maximum {max} {unit}"
+    )]
     FeedExceeded {
-        /// Block number (from 1).
-        block: usize,
+        /// The block, as the program names it.
+        block: String,
         /// The axis.
         axis: String,
         /// Speed needed.
@@ -101,12 +114,28 @@ pub enum ProgramError {
         /// mm/min or deg/min.
         unit: &'static str,
     },
+    /// A spindle speed outside the machine's spindle range.
+    #[error("{block}: spindle speed S{rpm} is outside the range of spindle {axis} of machine {machine}, [{min}, {max}] rpm")]
+    Spindle {
+        /// The block, as the program names it.
+        block: String,
+        /// The speed (rpm).
+        rpm: Real,
+        /// The spindle axis.
+        axis: String,
+        /// The machine.
+        machine: String,
+        /// Its least speed.
+        min: Real,
+        /// Its greatest speed.
+        max: Real,
+    },
 }
 
 impl ProgramError {
-    /// A machine limit error, its point index read as a block (from 0), on
-    /// the machine called `machine`.
-    fn from_limit(machine: &str, e: MachineError) -> Self {
+    /// A machine limit error, its point index read as block `index`, named
+    /// by `name`, on the machine called `machine`.
+    fn from_limit(machine: &str, e: MachineError, name: impl Fn(usize) -> String) -> Self {
         match e {
             MachineError::OutsideTravel {
                 point,
@@ -116,7 +145,7 @@ impl ProgramError {
                 max,
                 unit,
             } => Self::OutsideTravel {
-                block: point + 1,
+                block: name(point),
                 axis,
                 value,
                 min,
@@ -130,7 +159,7 @@ impl ProgramError {
                 max,
                 unit,
             } => Self::FeedExceeded {
-                block: point + 1,
+                block: name(point),
                 axis,
                 speed,
                 max,
@@ -144,17 +173,70 @@ impl ProgramError {
     }
 }
 
+/// How many blocks a machine's setup puts before the toolpath's first: the
+/// start's clearing move and each approach group.
+pub fn start_blocks(setup: &ProgramSetup) -> usize {
+    usize::from(!setup.start_clear.is_empty()) + setup.approach.len()
+}
+
+/// Each of `passes` with the blocks (indices from 0) it became in
+/// `program`, which was built from them ([`build`]): after the setup's
+/// start blocks.
+pub fn pass_blocks<'a>(
+    program: &AxisProgram,
+    passes: &'a [Pass],
+) -> impl Iterator<Item = (&'a Pass, Range<usize>)> {
+    let lead = start_blocks(&program.setup);
+    pass_ranges(passes).map(move |(p, r)| (p, r.start + lead..r.end + lead))
+}
+
+/// The number a program in the dialect `control` gives its block `index`
+/// (from 0): `N570` where the dialect numbers blocks (the shared writer's
+/// numbering, [`post::Dialect::numbering`]), else `block 57`.
+pub fn block_label(control: &str, index: usize) -> String {
+    match post::dialect(control).and_then(|d| d.numbering) {
+        Some((first, step)) => format!("N{}", first + step * index as u64),
+        None => format!("block {}", index + 1),
+    }
+}
+
+/// Block `index` (from 0) of `program` as the program names it: its label
+/// ([`block_label`]) and the pass it is in (the last comment at or before
+/// it): `N570 in "pass 1, stock 225.0 um"`.
+pub fn block_name(program: &AxisProgram, index: usize) -> String {
+    name_in(&program.control, &program.blocks, index)
+}
+
+fn name_in(control: &str, blocks: &[Block], index: usize) -> String {
+    let label = block_label(control, index);
+    let pass = blocks
+        .get(..=index.min(blocks.len().saturating_sub(1)))
+        .and_then(|b| b.iter().rev().find_map(|b| b.comment.as_deref()));
+    match pass {
+        Some(p) => format!("{label} in \"{p}\""),
+        None => label,
+    }
+}
+
 /// The program for `toolpath` on `machine`: inverse kinematics of every
 /// point (one batch), auxiliary values mapped to the machine's axes of
 /// the same names (an auxiliary value named like an axis inverse
 /// kinematics solves drives that axis, and the others are solved around
-/// it), values in program units, then travel and feed checks.
-/// Every pass's first block carries the pass's name as a comment.
+/// it), values in program units; the machine's start before the first
+/// point (its axes cleared, then brought in, group by group, as its setup
+/// says: [`ProgramSetup`]) and its end after the last; then every word
+/// checked against the machine: travel, feeds (each axis's and the
+/// least), the spindle's speed. Every pass's first block carries the
+/// pass's name as a comment; the start's and the end's blocks carry
+/// `start` and `end`.
 ///
 /// # Failures
-/// A bad toolpath (named by pass and point); an auxiliary name that is
-/// no programmed axis; inverse kinematics failing at a point; a block
-/// outside travel or too fast for an axis (named by block and axis).
+/// A bad toolpath (named by pass and point); an auxiliary name that is no
+/// programmed axis; an axis the machine takes from the toolpath
+/// ([`MachineInfo::driven_axes`]) that it does not give; inverse kinematics
+/// failing at a point; a block outside travel, too fast for an axis, too
+/// slow for the control, or a spindle speed beyond the spindle's range
+/// (named by block, as the program numbers it, and axis).
 pub fn build(
     toolpath: &Toolpath,
     machine: &dyn MachineKinematics,
@@ -166,6 +248,20 @@ pub fn build(
         machine: info.name.clone(),
         message,
     };
+    for axis in &info.driven_axes {
+        if !toolpath.aux_names.contains(axis) {
+            return Err(ProgramError::NotDriven {
+                axis: axis.clone(),
+                machine: info.name.clone(),
+                given: if toolpath.aux_names.is_empty() {
+                    "none".into()
+                } else {
+                    toolpath.aux_names.join(", ")
+                },
+            });
+        }
+    }
+    let lead = start_blocks(&info.setup);
     let mut poses = Vec::with_capacity(toolpath.point_count() * 6);
     for (_, _, c) in toolpath.points() {
         poses.extend_from_slice(&c.point);
@@ -205,12 +301,14 @@ pub fn build(
         .map_err(|e| {
             match e
                 .index
-                .and_then(|i| toolpath.points().nth(i).map(|(p, q, _)| (i, p, q)))
+                .and_then(|i| toolpath.points().nth(i).map(|(p, _, _)| (i, p)))
             {
-                Some((i, p, q)) => ProgramError::Kinematics {
-                    block: i + 1,
-                    pass: p + 1,
-                    point: q + 1,
+                Some((i, p)) => ProgramError::Kinematics {
+                    block: format!(
+                        "{} in \"{}\"",
+                        block_label(&info.control, lead + i),
+                        toolpath.passes[p].name
+                    ),
                     message: e.message,
                 },
                 None => machine_err(e.message),
@@ -254,23 +352,18 @@ pub fn build(
             columns.push((a, Source::Aux(i)));
         }
     }
-    let mut blocks = Vec::with_capacity(toolpath.point_count());
-    let mut rows_internal = Vec::with_capacity(toolpath.point_count() * columns.len());
+    let mut blocks = Vec::with_capacity(toolpath.point_count() + lead + 4);
     for (k, (p, j, c)) in toolpath.points().enumerate() {
         let row = &solved[k * n_solved..(k + 1) * n_solved];
-        let internal: Vec<Real> = columns
-            .iter()
-            .map(|(_, s)| match s {
-                Source::Solved(i) => row[*i],
-                Source::Aux(i) => aux_internal(info, &toolpath.aux_names[*i], c.aux[*i]),
-            })
-            .collect();
         let values = columns
             .iter()
-            .zip(&internal)
-            .map(|((a, _), v)| a.to_user(*v))
+            .map(|(a, s)| {
+                a.to_user(match s {
+                    Source::Solved(i) => row[*i],
+                    Source::Aux(i) => aux_internal(info, &toolpath.aux_names[*i], c.aux[*i]),
+                })
+            })
             .collect();
-        rows_internal.extend_from_slice(&internal);
         blocks.push(Block {
             motion: c.motion,
             values,
@@ -281,8 +374,13 @@ pub fn build(
             },
             spindle: (k == 0).then_some(toolpath.spindle_rpm),
             comment: (j == 0).then(|| toolpath.passes[p].name.clone()),
+            keep: Vec::new(),
         });
     }
+    let names: Vec<&str> = columns.iter().map(|(a, _)| a.name.as_str()).collect();
+    let blocks = with_start_and_end(blocks, &names, &info.setup);
+    let name_of = |i: usize| name_in(&info.control, &blocks, i);
+    check_spindle(info, &blocks, toolpath.spindle_rpm, &name_of)?;
     let min = info.min_feed.unwrap_or(MIN_FEED).max(MIN_FEED);
     if let Some((i, b)) = blocks
         .iter()
@@ -290,15 +388,24 @@ pub fn build(
         .find(|(_, b)| b.motion != Motion::Rapid && !(b.feed >= min))
     {
         return Err(ProgramError::FeedTooLow {
-            block: i + 1,
+            block: name_of(i),
             feed: b.feed,
             machine: info.name.clone(),
             min,
         });
     }
     let axes_refs: Vec<&Axis> = columns.iter().map(|(a, _)| *a).collect();
+    let rows_internal: Vec<Real> = blocks
+        .iter()
+        .flat_map(|b| {
+            axes_refs
+                .iter()
+                .zip(&b.values)
+                .map(|(a, v)| a.from_user(*v))
+        })
+        .collect();
     crate::machine::check_travel(&axes_refs, &rows_internal)
-        .map_err(|e| ProgramError::from_limit(&info.name, e))?;
+        .map_err(|e| ProgramError::from_limit(&info.name, e, name_of))?;
     // Feed: rapid blocks move at the machine's rapid rate, not checked.
     let feeds: Vec<Real> = blocks
         .iter()
@@ -311,7 +418,7 @@ pub fn build(
         })
         .collect();
     crate::machine::check_feed(&axes_refs, &rows_internal, &feeds)
-        .map_err(|e| ProgramError::from_limit(&info.name, e))?;
+        .map_err(|e| ProgramError::from_limit(&info.name, e, name_of))?;
     Ok(AxisProgram {
         name: program_name(name),
         number: 1,
@@ -329,7 +436,110 @@ pub fn build(
             })
             .collect(),
         blocks,
+        setup: info.setup.clone(),
     })
+}
+
+/// `blocks` (the toolpath's) with the setup's start before them and its end
+/// after them (`axes`: the program's columns). The start: the axes of
+/// `start_clear` to their clear positions, every other axis kept where it
+/// stands; then each approach group to the first block's values, the axes
+/// not yet moved kept. The end: each retract group to its clear positions.
+/// Axes the setup names that the program lacks are left out.
+fn with_start_and_end(blocks: Vec<Block>, axes: &[&str], setup: &ProgramSetup) -> Vec<Block> {
+    let (Some(first), Some(last)) = (blocks.first(), blocks.last()) else {
+        return blocks;
+    };
+    let col = |name: &str| axes.iter().position(|a| *a == name);
+    let rapid = |values: Vec<Real>, keep: Vec<String>| Block {
+        motion: Motion::Rapid,
+        values,
+        feed: 0.0,
+        spindle: None,
+        comment: None,
+        keep,
+    };
+    let mut out = Vec::with_capacity(blocks.len() + start_blocks(setup) + setup.retract.len());
+    let mut moved: Vec<bool> = vec![false; axes.len()];
+    let mut values = first.values.clone();
+    let kept = |moved: &[bool]| -> Vec<String> {
+        axes.iter()
+            .zip(moved)
+            .filter(|(_, m)| !**m)
+            .map(|(a, _)| (*a).to_owned())
+            .collect()
+    };
+    if !setup.start_clear.is_empty() {
+        for a in &setup.start_clear {
+            if let (Some(c), Some(v)) = (col(a), setup.clear.get(a)) {
+                values[c] = *v;
+                moved[c] = true;
+            }
+        }
+        out.push(rapid(values.clone(), kept(&moved)));
+    }
+    for group in &setup.approach {
+        for a in group {
+            if let Some(c) = col(a) {
+                values[c] = first.values[c];
+                moved[c] = true;
+            }
+        }
+        out.push(rapid(values.clone(), kept(&moved)));
+    }
+    if let Some(b) = out.first_mut() {
+        b.comment = Some("start".into());
+        // The start's blocks must not pass a later spindle speed by.
+        b.spindle = first.spindle;
+    }
+    let mut values = last.values.clone();
+    let mut end = Vec::with_capacity(setup.retract.len());
+    for group in &setup.retract {
+        for a in group {
+            if let (Some(c), Some(v)) = (col(a), setup.clear.get(a)) {
+                values[c] = *v;
+            }
+        }
+        end.push(rapid(values.clone(), Vec::new()));
+    }
+    if let Some(b) = end.first_mut() {
+        b.comment = Some("end".into());
+    }
+    out.extend(blocks);
+    out.extend(end);
+    out
+}
+
+/// Every spindle speed the program sets within the machine's spindle (its
+/// first spindle axis), if it has one.
+fn check_spindle(
+    info: &MachineInfo,
+    blocks: &[Block],
+    rpm: Real,
+    name_of: &impl Fn(usize) -> String,
+) -> Result<(), ProgramError> {
+    let Some(s) = info.axes.iter().find(|a| a.kind == AxisKind::Spindle) else {
+        return Ok(());
+    };
+    let speeds = std::iter::once((0, rpm)).chain(
+        blocks
+            .iter()
+            .enumerate()
+            .filter_map(|(i, b)| b.spindle.map(|v| (i, v))),
+    );
+    for (i, v) in speeds {
+        if !(v >= s.min && v <= s.max) {
+            return Err(ProgramError::Spindle {
+                block: name_of(i),
+                rpm: v,
+                axis: s.name.clone(),
+                machine: info.name.clone(),
+                min: s.min,
+                max: s.max,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// An auxiliary value in kernel units: toolpaths give rotary aux values in

@@ -11,11 +11,22 @@
 //!
 //! | dialect | file | numbers | comments | motion |
 //! |---|---|---|---|---|
-//! | `sinumerik` (840D) | `.mpf`, `%_N_<NAME>_MPF` | `N10`, step 10 | `; text` | `G0 G1 G33 K<lead>` |
+//! | `sinumerik` (840D) | `.mpf`, `%_N_<NAME>_MPF` | `N1`.. before the moves, move `i` (from 0) is `N(10 + 10 i)` | `; text` | `G0 G1 G33 K<lead>` |
 //! | `fanuc` (0i) | `.nc`, `%` `O<number>` ... `%` | none (5-digit N would overflow) | `(TEXT)` | `G00 G01 G32 F<lead>` |
 //! | `cld` (APT) | `.cld` | none | `PPRINT/text` | `RAPID`, `FEDRAT/`, `GOTO/` |
+//!
+//! The machine's [`ProgramSetup`] becomes words of the dialect: the work
+//! offset (`G54`..`G59`), the plane (`G17`..`G19`), radius or diameter
+//! programming (`DIAMOF`/`DIAMON` on Sinumerik; a comment on Fanuc, where
+//! it is a parameter of the control), coolant (`M8`/`M9`, `COOLNT/`).
+//! Every block of the program is written, in order, with the number
+//! [`super::block_label`] gives it: a block that moves nothing writes its
+//! first axis again; an axis a block keeps ([`super::Block::keep`]) is not
+//! written (it stays where it stands). The CL file carries every
+//! coordinate of each record: a kept axis reads the value the approach
+//! brings it to.
 
-use super::AxisProgram;
+use super::{AxisProgram, Plane, ProgramSetup, Radial};
 use crate::math::fixed;
 use crate::toolpath::Motion;
 
@@ -50,7 +61,9 @@ pub enum Style {
 
 /// The settings of one output format. Templates may use `{NAME}`,
 /// `{ONUM}` (four digits), `{MACHINE}`, `{TOOL}`, `{TOOL2}` (two digits),
-/// `{TOOLNAME}`, `{S}` (rpm) and `{VERSION}`.
+/// `{TOOLNAME}`, `{S}` (rpm), `{VERSION}`, and the machine's setup:
+/// `{SETUP}` (work offset, plane and radial words), `{COOLANT}` and
+/// `{COOLANT_OFF}`. A line that fills to nothing is left out.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dialect {
     /// The dialect's name, as `--control` and machine files say it.
@@ -63,7 +76,9 @@ pub struct Dialect {
     pub comment: (&'static str, &'static str),
     /// Whether comments are upper-cased (Fanuc).
     pub upper_comments: bool,
-    /// First block number and step, or `None` for no numbers.
+    /// The first move's block number and the step, or `None` for no
+    /// numbers. The preamble's blocks count `1, 2, ..` up to below the
+    /// first; the footer's go on after the last move's.
     pub numbering: Option<(u64, u64)>,
     /// Lines before the program, unnumbered.
     pub header: &'static [&'static str],
@@ -87,6 +102,12 @@ pub struct Dialect {
     pub feed_decimals: usize,
     /// Decimals of leads.
     pub lead_decimals: usize,
+    /// The words of radius and diameter programming, or `None` where the
+    /// control sets it by a parameter: then a comment says which the
+    /// program assumes.
+    pub radial_words: Option<(&'static str, &'static str)>,
+    /// Coolant on and off.
+    pub coolant: (&'static str, &'static str),
 }
 
 /// Siemens Sinumerik 840D part program (`.MPF`).
@@ -103,8 +124,14 @@ pub const SINUMERIK: Dialect = Dialect {
         "; {NAME} for {MACHINE}, written by pilgrim {VERSION}",
         "; tool T{TOOL}: {TOOLNAME}",
     ],
-    preamble: &["G90 G94 G71", "T{TOOL} D1", "S{S} M3"],
-    footer: &["M5", "M30"],
+    preamble: &[
+        "G90 G94 G71",
+        "{SETUP}",
+        "T{TOOL} D1",
+        "S{S} M3",
+        "{COOLANT}",
+    ],
+    footer: &["{COOLANT_OFF}", "M5", "M30"],
     trailer: &[],
     rapid: "G0",
     linear: "G1",
@@ -113,6 +140,8 @@ pub const SINUMERIK: Dialect = Dialect {
     decimals: 3,
     feed_decimals: 1,
     lead_decimals: 4,
+    radial_words: Some(("DIAMOF", "DIAMON")),
+    coolant: ("M8", "M9"),
 };
 
 /// Fanuc 0i (lathe, G-code system A: absolute by axis address, feed per minute).
@@ -129,8 +158,14 @@ pub const FANUC: Dialect = Dialect {
         "({MACHINE}, WRITTEN BY PILGRIM {VERSION})",
         "(TOOL T{TOOL2}: {TOOLNAME})",
     ],
-    preamble: &["G21 G40 G97 G98", "T{TOOL2}{TOOL2}", "S{S} M03"],
-    footer: &["M05", "M30"],
+    preamble: &[
+        "G21 G40 G97 G98",
+        "{SETUP}",
+        "T{TOOL2}{TOOL2}",
+        "S{S} M03",
+        "{COOLANT}",
+    ],
+    footer: &["{COOLANT_OFF}", "M05", "M30"],
     trailer: &["%"],
     rapid: "G00",
     linear: "G01",
@@ -139,6 +174,8 @@ pub const FANUC: Dialect = Dialect {
     decimals: 3,
     feed_decimals: 1,
     lead_decimals: 4,
+    radial_words: None,
+    coolant: ("M08", "M09"),
 };
 
 /// APT-style cutter-location file (ISO 4343 flavour) in machine coordinates.
@@ -156,9 +193,10 @@ pub const CLD: Dialect = Dialect {
         "UNITS/MM",
         "LOADTL/{TOOL}",
         "SPINDL/{S},RPM,CLW",
+        "{COOLANT}",
     ],
     preamble: &[],
-    footer: &["SPINDL/OFF", "FINI"],
+    footer: &["{COOLANT_OFF}", "SPINDL/OFF", "FINI"],
     trailer: &[],
     rapid: "RAPID",
     linear: "",
@@ -167,6 +205,8 @@ pub const CLD: Dialect = Dialect {
     decimals: 3,
     feed_decimals: 3,
     lead_decimals: 4,
+    radial_words: None,
+    coolant: ("COOLNT/ON", "COOLNT/OFF"),
 };
 
 /// Every dialect.
@@ -190,10 +230,10 @@ pub enum PostError {
         name: String,
     },
     /// A block that cannot be written.
-    #[error("block {block}: {message}")]
+    #[error("{block}: {message}")]
     BadBlock {
-        /// Block number (from 1).
-        block: usize,
+        /// The block, as the program names it ([`super::block_name`]).
+        block: String,
         /// What is wrong.
         message: String,
     },
@@ -216,7 +256,8 @@ pub fn post_by_name(program: &AxisProgram, name: &str) -> Result<String, PostErr
 struct Writer<'a> {
     d: &'a Dialect,
     out: String,
-    next: Option<u64>,
+    /// The next block's number and the step to the one after.
+    next: Option<(u64, u64)>,
 }
 
 impl Writer<'_> {
@@ -226,12 +267,19 @@ impl Writer<'_> {
     }
 
     fn block(&mut self, text: &str) {
-        match (self.d.numbering, self.next) {
-            (Some((_, step)), Some(n)) => {
+        match self.next {
+            Some((n, step)) => {
                 self.out.push_str(&format!("N{n} {text}\n"));
-                self.next = Some(n + step);
+                self.next = Some((n + step, step));
             }
-            _ => self.line(text),
+            None => self.line(text),
+        }
+    }
+
+    /// Numbers the blocks from `first` by `step` (if the dialect numbers).
+    fn number_from(&mut self, first: u64, step: u64) {
+        if self.next.is_some() {
+            self.next = Some((first, step));
         }
     }
 
@@ -269,7 +317,11 @@ fn fill(template: &str, p: &AxisProgram, d: &Dialect) -> String {
         }
     };
     let (tool_name, machine) = (text(&p.tool_name), text(&p.machine));
+    let (coolant_on, coolant_off) = if p.setup.coolant { d.coolant } else { ("", "") };
     template
+        .replace("{SETUP}", &setup_words(&p.setup, d).join(" "))
+        .replace("{COOLANT_OFF}", coolant_off)
+        .replace("{COOLANT}", coolant_on)
         .replace("{NAME}", &p.name)
         .replace("{ONUM}", &format!("{:04}", p.number % 10000))
         .replace("{MACHINE}", &machine)
@@ -278,6 +330,56 @@ fn fill(template: &str, p: &AxisProgram, d: &Dialect) -> String {
         .replace("{TOOL}", &p.tool_number.to_string())
         .replace("{S}", &format!("{}", p.spindle_rpm.round() as i64))
         .replace("{VERSION}", crate::VERSION)
+}
+
+/// The words of `setup` in `d`: work offset, plane, radius or diameter
+/// programming where the dialect has words for it.
+fn setup_words(setup: &ProgramSetup, d: &Dialect) -> Vec<String> {
+    if d.style == Style::Apt {
+        return Vec::new();
+    }
+    let mut words = Vec::new();
+    if let Some(n) = setup.work_offset {
+        words.push(format!("G{}", 53 + u16::from(n)));
+    }
+    if let Some(p) = setup.plane {
+        words.push(
+            match p {
+                Plane::Xy => "G17",
+                Plane::Zx => "G18",
+                Plane::Yz => "G19",
+            }
+            .to_owned(),
+        );
+    }
+    if let (Some(r), Some((radius, diameter))) = (setup.radial, d.radial_words) {
+        words.push(
+            match r {
+                Radial::Radius => radius,
+                Radial::Diameter => diameter,
+            }
+            .to_owned(),
+        );
+    }
+    words
+}
+
+/// The comment that says how the radial axis is programmed, where the
+/// dialect has no word for it.
+fn radial_note(setup: &ProgramSetup, d: &Dialect) -> Option<String> {
+    let r = setup.radial?;
+    if d.radial_words.is_some() && d.style == Style::GCode {
+        return None;
+    }
+    let axis = if setup.radial_axis.is_empty() {
+        "X"
+    } else {
+        &setup.radial_axis
+    };
+    Some(match r {
+        Radial::Radius => format!("{axis} on radius"),
+        Radial::Diameter => format!("{axis} on diameter"),
+    })
 }
 
 /// Writes `program` in `dialect`.
@@ -290,7 +392,7 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
     let width = program.axes.len();
     for (i, b) in program.blocks.iter().enumerate() {
         let bad = |message: String| PostError::BadBlock {
-            block: i + 1,
+            block: super::block_name(program, i),
             message,
         };
         if b.values.len() != width {
@@ -309,13 +411,30 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
     let mut w = Writer {
         d,
         out: String::new(),
-        next: d.numbering.map(|n| n.0),
+        next: d.numbering.map(|_| (1, 1)),
     };
     for h in d.header {
-        w.line(&fill(h, program, d));
+        let line = fill(h, program, d);
+        if !line.is_empty() {
+            w.line(&line);
+        }
     }
-    for h in d.preamble {
-        w.block(&fill(h, program, d));
+    if let Some(note) = radial_note(&program.setup, d) {
+        w.comment(&note);
+    }
+    let preamble: Vec<String> = d
+        .preamble
+        .iter()
+        .map(|h| fill(h, program, d))
+        .filter(|l| !l.trim().is_empty())
+        .collect();
+    for line in &preamble {
+        w.block(line);
+    }
+    // The moves' numbers are their indices' (`block_label`); every
+    // dialect's preamble fits below the first (a test checks it).
+    if let Some((first, step)) = d.numbering {
+        w.number_from(first, step);
     }
     let mut last_words: Vec<Option<String>> = vec![None; width];
     let mut last_motion: Option<&str> = None;
@@ -366,18 +485,25 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
                     Motion::Thread { .. } => d.thread,
                 };
                 let mut words = Vec::new();
+                let mut first_written = None;
                 for (k, v) in values.into_iter().enumerate() {
+                    let name = &program.axes[k].name;
+                    if b.keep.contains(name) {
+                        continue;
+                    }
+                    if first_written.is_none() {
+                        first_written = Some(format!("{name}{v}"));
+                    }
                     if last_words[k].as_ref() != Some(&v) {
-                        words.push(format!("{}{v}", program.axes[k].name));
+                        words.push(format!("{name}{v}"));
                         last_words[k] = Some(v);
                     }
                 }
                 if words.is_empty() {
-                    // No axis moves: only a new spindle speed is worth a block.
-                    if let Some(s) = spindle {
-                        w.block(&format!("S{s}"));
-                    }
-                    continue;
+                    // No axis moves: the block is still the program's (its
+                    // number, its place in the report), so its first axis
+                    // is written again.
+                    words.extend(first_written);
                 }
                 if last_motion != Some(motion) {
                     words.insert(0, motion.to_owned());
@@ -404,7 +530,10 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
         }
     }
     for f in d.footer {
-        w.block(&fill(f, program, d));
+        let line = fill(f, program, d);
+        if !line.is_empty() {
+            w.block(&line);
+        }
     }
     for t in d.trailer {
         w.line(&fill(t, program, d));
@@ -428,6 +557,7 @@ mod tests {
             feed,
             spindle: None,
             comment: comment.map(str::to_owned),
+            keep: Vec::new(),
         };
         AxisProgram {
             name: "DEMO".into(),
@@ -447,6 +577,7 @@ mod tests {
                 block(Motion::Thread { lead: 6.35 }, [40.0, -60.0], 0.0, None),
                 block(Motion::Rapid, [50.0, -60.0], 0.0, None),
             ],
+            setup: ProgramSetup::default(),
         }
     }
 
@@ -454,8 +585,8 @@ mod tests {
     fn sinumerik_program() {
         let text = post(&program(), &SINUMERIK).unwrap();
         let expected = "%_N_DEMO_MPF\n;$PATH=/_N_MPF_DIR\n; DEMO for test-lathe, written by pilgrim VERSION\n\
-; tool T3: thread insert (60)\nN10 G90 G94 G71\nN20 T3 D1\nN30 S399 M3\n; pass 1\nN40 G0 X50.000 Z5.000\n\
-N50 G1 X40.000 F100.0\nN60 Z0.000\nN70 G33 Z-60.000 K6.3500\nN80 G0 X50.000\nN90 M5\nN100 M30\n";
+; tool T3: thread insert (60)\nN1 G90 G94 G71\nN2 T3 D1\nN3 S399 M3\n; pass 1\nN10 G0 X50.000 Z5.000\n\
+N20 G1 X40.000 F100.0\nN30 Z0.000\nN40 X40.000\nN50 G33 Z-60.000 K6.3500\nN60 G0 X50.000\nN70 M5\nN80 M30\n";
         assert_eq!(text, expected.replace("VERSION", crate::VERSION));
     }
 
@@ -464,7 +595,7 @@ N50 G1 X40.000 F100.0\nN60 Z0.000\nN70 G33 Z-60.000 K6.3500\nN80 G0 X50.000\nN90
         let text = post(&program(), &FANUC).unwrap();
         let expected = "%\nO0007 (DEMO)\n(TEST-LATHE, WRITTEN BY PILGRIM VERSION)\n(TOOL T03: THREAD INSERT 60)\n\
 G21 G40 G97 G98\nT0303\nS399 M03\n(PASS 1)\nG00 X50.000 Z5.000\nG01 X40.000 F100.0\nZ0.000\n\
-G32 Z-60.000 F6.3500\nG00 X50.000\nM05\nM30\n%\n";
+X40.000\nG32 Z-60.000 F6.3500\nG00 X50.000\nM05\nM30\n%\n";
         assert_eq!(text, expected.replace("VERSION", crate::VERSION));
     }
 
@@ -484,8 +615,8 @@ SPINDL/OFF\nFINI\n";
         p.blocks[0].spindle = Some(399.0); // the preamble's speed: nothing new
         p.blocks[4].spindle = Some(120.0);
         let g = post(&p, &SINUMERIK).unwrap();
-        assert!(g.contains("N40 G0 X50.000 Z5.000\n"), "{g}");
-        assert!(g.contains("N70 G33 Z-60.000 K6.3500 S120\n"), "{g}");
+        assert!(g.contains("N10 G0 X50.000 Z5.000\n"), "{g}");
+        assert!(g.contains("N50 G33 Z-60.000 K6.3500 S120\n"), "{g}");
         let a = post(&p, &CLD).unwrap();
         assert!(
             a.contains("GOTO/40.000,0.000\nSPINDL/120,RPM,CLW\nFEDRAT/6.3500,MMPR\n"),
@@ -499,7 +630,7 @@ SPINDL/OFF\nFINI\n";
         p.decimals = Some(4);
         let g = post(&p, &SINUMERIK).unwrap();
         assert!(
-            g.contains("N40 G0 X50.0000 Z5.0000\n") && g.contains("N60 Z-0.0001\n"),
+            g.contains("N10 G0 X50.0000 Z5.0000\n") && g.contains("N30 Z-0.0001\n"),
             "{g}"
         );
     }
@@ -510,16 +641,75 @@ SPINDL/OFF\nFINI\n";
         p.blocks[2].values[1] = f64::NAN;
         assert_eq!(
             post(&p, &SINUMERIK).unwrap_err().to_string(),
-            "block 3: value NaN is not a finite number"
+            "block 3 in \"pass 1\": value NaN is not a finite number"
         );
         p.blocks[2].values.pop();
         assert!(post(&p, &CLD)
             .unwrap_err()
             .to_string()
-            .contains("block 3: 1 values for 2 axes"));
+            .contains("block 3 in \"pass 1\": 1 values for 2 axes"));
         assert!(post_by_name(&program(), "heidenhain")
             .unwrap_err()
             .to_string()
             .contains("'heidenhain'"));
+    }
+
+    fn with_setup() -> AxisProgram {
+        let mut p = program();
+        p.setup = ProgramSetup {
+            work_offset: Some(1),
+            plane: Some(Plane::Zx),
+            radial: Some(Radial::Radius),
+            coolant: true,
+            ..ProgramSetup::default()
+        };
+        // A start block that moves X only: Z stays where it stands.
+        p.blocks[0].keep = vec!["Z".into()];
+        p
+    }
+
+    #[test]
+    fn the_setup_becomes_words_of_each_dialect() {
+        let g = post(&with_setup(), &SINUMERIK).unwrap();
+        assert!(
+g.contains("N1 G90 G94 G71\nN2 G54 G18 DIAMOF\nN3 T3 D1\nN4 S399 M3\nN5 M8\n; pass 1\nN10 G0 X50.000\nN20 G1 X40.000 Z5.000 F100.0\n"),
+            "{g}"
+        );
+        assert!(
+            g.ends_with("N60 G0 X50.000\nN70 M9\nN80 M5\nN90 M30\n"),
+            "{g}"
+        );
+        let mut d = with_setup();
+        d.setup.radial = Some(Radial::Diameter);
+        assert!(post(&d, &SINUMERIK)
+            .unwrap()
+            .contains("N2 G54 G18 DIAMON\n"));
+        let f = post(&with_setup(), &FANUC).unwrap();
+        assert!(
+            f.contains("(X ON RADIUS)\nG21 G40 G97 G98\nG54 G18\nT0303\nS399 M03\nM08\n"),
+            "{f}"
+        );
+        assert!(f.ends_with("M09\nM05\nM30\n%\n"), "{f}");
+        let a = post(&with_setup(), &CLD).unwrap();
+        assert!(
+            a.contains("SPINDL/399,RPM,CLW\nCOOLNT/ON\nPPRINT/X on radius\n"),
+            "{a}"
+        );
+        assert!(a.ends_with("COOLNT/OFF\nSPINDL/OFF\nFINI\n"), "{a}");
+    }
+
+    #[test]
+    fn every_preamble_fits_below_the_first_move() {
+        let full = with_setup();
+        for d in DIALECTS {
+            if let Some((first, _)) = d.numbering {
+                let blocks = d
+                    .preamble
+                    .iter()
+                    .filter(|l| !fill(l, &full, d).is_empty())
+                    .count() as u64;
+                assert!(blocks < first, "{}: {blocks} blocks", d.name);
+            }
+        }
     }
 }

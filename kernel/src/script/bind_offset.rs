@@ -4,18 +4,33 @@
 use super::floats::{err, kernel, numbers, Floats, Numbers};
 use crate::math::Real;
 use crate::offset::rest::{RestSetup, RestTrack};
+use crate::offset::surface::{GroundSurface, PassLayer, WheelSection};
 use crate::offset::{self, Equidistant, Side};
 use crate::profile::{Polyline, Profile};
 use crate::tool::{Tool, ToolShape};
 use rhai::plugin::*;
 use rhai::EvalAltResult;
 
-/// The rounding radius of a wheel tool.
-pub(super) fn rounding_radius(tool: &Tool) -> Result<Real, Box<EvalAltResult>> {
+/// The wheel of a wheel tool.
+pub(super) fn wheel_of(tool: &Tool) -> Result<crate::tool::Wheel, Box<EvalAltResult>> {
     match tool.shape {
-        ToolShape::Wheel(w) => Ok(w.rounding_radius),
+        ToolShape::Wheel(w) => Ok(w),
         _ => err(format!("tool '{}' is not a grinding wheel", tool.name)),
     }
+}
+
+/// The rounding radius of a wheel tool.
+pub(super) fn rounding_radius(tool: &Tool) -> Result<Real, Box<EvalAltResult>> {
+    wheel_of(tool).map(|w| w.rounding_radius)
+}
+
+/// A wheel tool's section: roundings and flat.
+fn section(tool: &Tool) -> Result<WheelSection, Box<EvalAltResult>> {
+    let w = wheel_of(tool)?;
+    Ok(WheelSection {
+        radius: w.rounding_radius,
+        flat: w.flat(),
+    })
 }
 
 fn to_side(s: &str) -> Result<Side, Box<EvalAltResult>> {
@@ -114,71 +129,140 @@ pub mod offset_api {
         Ok(Floats::new(env.eval_many(&at)))
     }
 
+    /// The path of the wheel's reference (the middle of its flat; the
+    /// rounding's centre for a wheel rounded across its width) over the
+    /// profile from outside: the roundings' equidistant, dilated by the
+    /// flat, so that no part of the wheel's true section cuts into the
+    /// profile. Refuses a wheel rounder than the profile, naming every z.
+    #[rhai_fn(return_raw)]
+    pub fn wheel_path(p: Profile, wheel: Tool) -> Result<Polyline, Box<EvalAltResult>> {
+        let w = wheel_of(&wheel)?;
+        let e = kernel(offset::equidistant(&p, w.rounding_radius, Side::Outside))?;
+        kernel(offset::flat_path(&e.z, &e.x, w.flat(), Side::Outside))
+    }
+
+    /// The ridge (mm) the wheel leaves on a straight generatrix at a feed
+    /// of `feed_per_rev` mm per revolution of the part (MATH §2.4).
+    #[rhai_fn(return_raw)]
+    pub fn ridge_height(wheel: Tool, feed_per_rev: Real) -> Result<Real, Box<EvalAltResult>> {
+        kernel(crate::math::finite("feed per revolution", feed_per_rev))?;
+        Ok(wheel_of(&wheel)?.ridge(feed_per_rev))
+    }
+
+    /// The largest feed per revolution (mm) whose ridge is at most
+    /// `height` mm.
+    #[rhai_fn(return_raw)]
+    pub fn ridge_feed(wheel: Tool, height: Real) -> Result<Real, Box<EvalAltResult>> {
+        kernel(crate::math::positive("ridge height", height))?;
+        Ok(wheel_of(&wheel)?.feed_for_ridge(height))
+    }
+
+    /// The surface of a part about to be ground: the blank, taken as the
+    /// polyline through its nodes (a step stays a step).
+    pub fn ground_surface(blank: Profile) -> GroundSurface {
+        GroundSurface::new(blank)
+    }
+
+    /// The surface after a pass of the wheel along `centres` at `feed`
+    /// (mm/min) while the part turns at `spindle_rpm`: on each generatrix
+    /// the wheel's true section where it met it, the ridges' crests as one
+    /// surface of revolution.
+    #[rhai_fn(return_raw)]
+    pub fn cut(
+        surface: GroundSurface,
+        centres: Polyline,
+        wheel: Tool,
+        feed: Real,
+        spindle_rpm: Real,
+    ) -> Result<GroundSurface, Box<EvalAltResult>> {
+        let layer = PassLayer::new(&centres.z, &centres.x, section(&wheel)?, feed, spindle_rpm);
+        Ok(surface.with(kernel(layer)?))
+    }
+
+    /// The surface at `z`.
+    #[rhai_fn(pure)]
+    pub fn surface_x(s: &mut GroundSurface, z: Real) -> Real {
+        s.eval_many(&[z], None)[0]
+    }
+
     /// A steady rest (MATH §2.3): its support, a circle of
     /// `support_radius` in the axial section, stands at `offset` along z
     /// from the wheel (z_r = z + offset). Its track samples the surface
-    /// under the support every `sample` mm, and the wheel's swept surface
-    /// to `resolution` mm.
+    /// under the support every `sample` mm, and adds blocks until the
+    /// control's straight line of U between blocks stays within
+    /// `tolerance` mm of the support's exact drop.
     #[rhai_fn(return_raw)]
     pub fn steady_rest(
         support_radius: Real,
         offset: Real,
         sample: Real,
-        resolution: Real,
+        tolerance: Real,
     ) -> Result<RestSetup, Box<EvalAltResult>> {
         kernel(crate::math::positive("rest support radius", support_radius))?;
         kernel(crate::math::finite("rest offset", offset))?;
         kernel(crate::math::positive("rest surface sample", sample))?;
-        kernel(crate::math::positive("rest resolution", resolution))?;
+        kernel(crate::math::positive("rest tolerance", tolerance))?;
         Ok(RestSetup {
             radius: support_radius,
             offset_b: offset,
             sample,
-            resolution,
+            tolerance,
         })
     }
 
-    /// The steady rest along a pass (MATH §2.3): the wheel's rounding
-    /// centre moves along `centres` (one way along z) over a workpiece whose
-    /// surface before the pass is `previous`. The result has, per block,
-    /// `.centre_x`, `.contact_z`, `.contact_x` (the exact drop on the current
-    /// surface) and `.seed_centre_x` (the seed's formula on it), and
-    /// `.max_model_difference` (mm) with `.max_difference_block` (from 0).
+    /// The steady rest along a pass (MATH §2.3): the wheel moves along
+    /// `centres` (one way along z) at `feed` mm/min, the part turning at
+    /// `spindle_rpm`, over `surface`. The result's `.path` is the pass with
+    /// the blocks the rest needs added (on the wheel's line); per point of
+    /// it `.centre_x`, `.contact_z`, `.contact_x` (the exact drop on the
+    /// current surface) and `.seed_centre_x` (the seed's formula on it);
+    /// `.max_model_difference` (mm) with `.max_difference_block` (from 0);
+    /// `.max_gap` and `.max_press` (mm): how far U's straight line between
+    /// blocks stands off the surface or presses into it; `.added`.
     #[rhai_fn(return_raw)]
     pub fn rest_track(
-        previous: Profile,
+        surface: GroundSurface,
         centres: Polyline,
         wheel: Tool,
         rest: RestSetup,
+        feed: Real,
+        spindle_rpm: Real,
     ) -> Result<RestTrack, Box<EvalAltResult>> {
         kernel(offset::rest::track(
-            &previous,
-            &centres.z,
-            &centres.x,
-            rounding_radius(&wheel)?,
+            &surface,
+            &centres,
+            section(&wheel)?,
+            feed,
+            spindle_rpm,
             &rest,
         ))
     }
 
-    /// The support centre's x at each block (exact model).
+    /// The pass with the rest's blocks added.
+    #[rhai_fn(get = "path", pure)]
+    pub fn track_path(t: &mut RestTrack) -> Polyline {
+        t.path.clone()
+    }
+
+    /// The support centre's x at each point (exact model).
     #[rhai_fn(get = "centre_x", pure)]
     pub fn track_centre_x(t: &mut RestTrack) -> Floats {
         Floats::new(t.centre_x.clone())
     }
 
-    /// The contact point's z at each block.
+    /// The contact point's z at each point.
     #[rhai_fn(get = "contact_z", pure)]
     pub fn track_contact_z(t: &mut RestTrack) -> Floats {
         Floats::new(t.contact_z.clone())
     }
 
-    /// The contact point's x at each block.
+    /// The contact point's x at each point.
     #[rhai_fn(get = "contact_x", pure)]
     pub fn track_contact_x(t: &mut RestTrack) -> Floats {
         Floats::new(t.contact_x.clone())
     }
 
-    /// The support centre's x by the seed's formula at each block.
+    /// The support centre's x by the seed's formula at each point.
     #[rhai_fn(get = "seed_centre_x", pure)]
     pub fn track_seed_centre_x(t: &mut RestTrack) -> Floats {
         Floats::new(t.seed_centre_x.clone())
@@ -190,29 +274,29 @@ pub mod offset_api {
         t.max_model_difference
     }
 
-    /// The block (from 0) where it is.
+    /// The point (from 0) where it is.
     #[rhai_fn(get = "max_difference_block", pure)]
     pub fn track_difference_block(t: &mut RestTrack) -> i64 {
         t.max_difference_block as i64
     }
 
-    /// The surface after a pass: the lower of `previous` and what the
-    /// wheel's rounding leaves moving along `centres`, at `previous`'s
-    /// nodes, the swept surface exact to `resolution` (mm).
-    #[rhai_fn(return_raw)]
-    pub fn cut(
-        previous: Profile,
-        centres: Polyline,
-        wheel: Tool,
-        resolution: Real,
-    ) -> Result<Profile, Box<EvalAltResult>> {
-        kernel(offset::rest::after_pass(
-            &previous,
-            &centres.z,
-            &centres.x,
-            rounding_radius(&wheel)?,
-            resolution,
-        ))
+    /// How far U's straight line between blocks stands off the surface at
+    /// most (mm).
+    #[rhai_fn(get = "max_gap", pure)]
+    pub fn track_gap(t: &mut RestTrack) -> Real {
+        t.max_gap
+    }
+
+    /// How far it presses into the surface at most (mm).
+    #[rhai_fn(get = "max_press", pure)]
+    pub fn track_press(t: &mut RestTrack) -> Real {
+        t.max_press
+    }
+
+    /// Points the rest added to the pass.
+    #[rhai_fn(get = "added", pure)]
+    pub fn track_added(t: &mut RestTrack) -> i64 {
+        t.added as i64
     }
 
     /// The steady rest's support centre x at `at_z` on `surface` by the

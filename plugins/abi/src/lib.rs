@@ -49,6 +49,7 @@
 //!             axes: vec![axis("X"), axis("Z")], solved_axes: vec!["X".into(), "Z".into()],
 //!             constants: Default::default(), program_decimals: None, driven_axes: vec![],
 //!             bodies: vec![], chain: vec![], tool: Default::default(), min_feed: None,
+//!             setup: Default::default(),
 //!         }
 //!     }
 //!     fn inverse(&self, poses: &[f64], tool: &[f64; 6], out: &mut [f64]) -> Result<(), PluginError> {
@@ -84,8 +85,9 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 pub const ABI_MAJOR: u32 = 1;
 /// The ABI's minor version: fields appended to the table and to the JSON
 /// types since the major (1.1: the table's `capabilities`; the descriptor's
-/// `driven_axes`, `bodies`, `chain`, `tool`, `min_feed`).
-pub const ABI_MINOR: u32 = 1;
+/// `driven_axes`, `bodies`, `chain`, `tool`, `min_feed`; 1.2: the
+/// descriptor's and the program's `setup`, a block's `keep`).
+pub const ABI_MINOR: u32 = 2;
 
 /// The call succeeded.
 pub const STATUS_OK: i32 = 0;

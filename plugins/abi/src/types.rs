@@ -321,6 +321,71 @@ pub struct MachineInfo {
     /// (mm/min, or deg/min for a move that only turns), if stated.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_feed: Option<f64>,
+    /// Since 1.2: how every program on the machine starts and ends.
+    #[serde(default)]
+    pub setup: ProgramSetup,
+}
+
+/// A working plane (G17, G18, G19).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Plane {
+    /// X-Y (G17).
+    Xy,
+    /// Z-X (G18), the plane of a lathe or a cylindrical grinder.
+    Zx,
+    /// Y-Z (G19).
+    Yz,
+}
+
+/// How a radial axis is programmed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Radial {
+    /// The value is the distance from the part's axis (Sinumerik `DIAMOF`).
+    Radius,
+    /// The value is twice it (Sinumerik `DIAMON`; a Fanuc lathe's parameter).
+    Diameter,
+}
+
+/// How every program on a machine starts and ends (since 1.2): settings of
+/// the machine that the writer turns into its dialect's words, and the safe
+/// order of the first and last moves, which the host turns into blocks.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProgramSetup {
+    /// The work offset: 1 is G54, ... 6 is G59. `None`: none written.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub work_offset: Option<u8>,
+    /// The working plane. `None`: none written.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plane: Option<Plane>,
+    /// The radial axis (the one named in `radial_axis`) and how it is
+    /// programmed; the host checks it against the axis's stated motion.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radial: Option<Radial>,
+    /// The name of the radial axis (`X` if empty).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub radial_axis: String,
+    /// Coolant on after the spindle starts and off at the end (M8, M9).
+    #[serde(default)]
+    pub coolant: bool,
+    /// Clear positions of axes (program units): where the start and the
+    /// end take them out of the way.
+    #[serde(default)]
+    pub clear: BTreeMap<String, f64>,
+    /// The start's first move: these axes to their clear positions,
+    /// together, from wherever they stand.
+    #[serde(default)]
+    pub start_clear: Vec<String>,
+    /// Then these groups of axes, one group after the other, to the first
+    /// block's position; the first block brings the remaining axes.
+    #[serde(default)]
+    pub approach: Vec<Vec<String>>,
+    /// After the last block, these groups of axes, one after the other, to
+    /// their clear positions.
+    #[serde(default)]
+    pub retract: Vec<Vec<String>>,
 }
 
 impl MachineInfo {
@@ -375,6 +440,11 @@ pub struct Block {
     /// A comment to print before the block (a pass's name).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub comment: Option<String>,
+    /// Since 1.2: axes this block leaves where they stand (not written):
+    /// at the start, an axis not yet moved, whose place nobody knows. Its
+    /// value here is the one it takes next.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub keep: Vec<String>,
 }
 
 /// A program for one machine: named axes in program units (mm, degrees)
@@ -403,6 +473,11 @@ pub struct AxisProgram {
     pub axes: Vec<ProgramAxis>,
     /// The blocks.
     pub blocks: Vec<Block>,
+    /// Since 1.2: the machine's start and end settings (work offset,
+    /// plane, radial programming, coolant); its safe first and last moves
+    /// are blocks already.
+    #[serde(default)]
+    pub setup: ProgramSetup,
 }
 
 impl AxisProgram {

@@ -29,7 +29,8 @@
 //! library's); built as a cdylib it is `libgrinder_3k152vf20.so`.
 
 use pilgrim_plugin_abi::types::{
-    Axis, AxisKind, BodyShape, BodySpec, FactorKind, FactorSpec, MachineInfo, Quantity, ToolSpec,
+    Axis, AxisKind, BodyShape, BodySpec, FactorKind, FactorSpec, MachineInfo, Plane, ProgramSetup,
+    Quantity, Radial, ToolSpec,
 };
 use pilgrim_plugin_abi::{export_plugin, Plugin, PluginError};
 
@@ -52,6 +53,29 @@ fn linear(name: &str, min: f64, max: f64, max_feed: f64, moves: [f64; 3], what: 
         moves: Some(moves),
         turns: None,
         body: None,
+    }
+}
+
+/// How a program starts and ends on the 3K152VF20: work offset G54, the
+/// ZX plane, X in radius (the wheel's radial position, not a diameter),
+/// coolant on while grinding. At the start the wheel (X) and the rest (U)
+/// go to their clear positions first, then Z moves to the first block's
+/// position and X comes in; U is brought in by the first block, after the
+/// wheel. At the end the wheel backs off, then the rest.
+fn setup() -> ProgramSetup {
+    let group = |axes: &[&str]| axes.iter().map(|a| (*a).to_owned()).collect::<Vec<_>>();
+    ProgramSetup {
+        work_offset: Some(1),
+        plane: Some(Plane::Zx),
+        radial: Some(Radial::Radius),
+        radial_axis: "X".into(),
+        coolant: true,
+        clear: [("X".to_owned(), 100.0), ("U".to_owned(), 150.0)]
+            .into_iter()
+            .collect(),
+        start_clear: group(&["X", "U"]),
+        approach: vec![group(&["Z"]), group(&["X"])],
+        retract: vec![group(&["X"]), group(&["U"])],
     }
 }
 
@@ -108,10 +132,8 @@ pub fn describe() -> MachineInfo {
             // z_r = z_k + B (mm): the rest stands 180 mm before the wheel along Z.
             ("rest_offset_b".to_owned(), -180.0),
             // Radius R_o of the rest's support in the axial section (mm).
+            // U programs the support's centre (the seed, MATH §2.3).
             ("rest_radius".to_owned(), 25.0),
-            // What U programs: 1 = the support's centre, 0 = its contact
-            // point (MATH §5; the seed: the centre).
-            ("rest_programs_centre".to_owned(), 1.0),
         ]
         .into_iter()
         .collect(),
@@ -120,6 +142,7 @@ pub fn describe() -> MachineInfo {
         // coarser than the tolerance.
         program_decimals: Some(4),
         driven_axes: vec!["U".into()],
+        setup: setup(),
         bodies: vec![BodySpec {
             name: "rest".into(),
             description: "steady rest support (circle of radius rest_radius in the axial section)"
