@@ -1,0 +1,220 @@
+//! The roll and its groove in 3-D (MATH §3.1).
+
+use crate::input::InputError;
+use crate::math::{Real, Vec3};
+use crate::profile::{EllipseSection, Profile, ProfileError};
+
+/// Why a groove cannot be built from its tables.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GrooveError {
+    /// A table that is not a profile (too short, theta not increasing, a
+    /// value not finite).
+    #[error("groove table {table}: {source}")]
+    Table {
+        /// `Hp` or `B`.
+        table: &'static str,
+        /// What is wrong.
+        source: ProfileError,
+    },
+    /// The two tables at different angles.
+    #[error("the groove tables Hp and B must be at the same angles: row {row} has theta = {hp_theta} deg in Hp, {b_theta} deg in B")]
+    DifferentTheta {
+        /// Row (from 1).
+        row: usize,
+        /// The angle in Hp's table (deg).
+        hp_theta: Real,
+        /// The angle in B's table (deg).
+        b_theta: Real,
+    },
+    /// The tables of different lengths.
+    #[error("the groove tables Hp and B must have the same rows: {hp} in Hp, {b} in B")]
+    DifferentRows {
+        /// Rows of Hp.
+        hp: usize,
+        /// Rows of B.
+        b: usize,
+    },
+    /// A depth or width that is not positive, or a depth through the roll.
+    #[error(
+        "groove table {table}, row {row} (theta = {theta} deg): {table} = {value} mm {expected}"
+    )]
+    Value {
+        /// `Hp` or `B`.
+        table: &'static str,
+        /// Row (from 1).
+        row: usize,
+        /// The angle (deg).
+        theta: Real,
+        /// The value (mm).
+        value: Real,
+        /// What it must be.
+        expected: String,
+    },
+    /// A query outside the tables or a bad number.
+    #[error(transparent)]
+    Query(#[from] ProfileError),
+    /// A bad roll radius.
+    #[error(transparent)]
+    Input(#[from] InputError),
+}
+
+/// A roll of radius `R_d` whose groove, in the section through the roll's
+/// axis at angle `theta`, is half an ellipse centred on the periphery:
+/// `B(theta) / 2` wide along the axis, `Hp(theta)` deep (tables, Hermite
+/// interpolated between rows). The point at polar angle `psi` of the
+/// section (from the depth direction, positive toward +Z) is at axial
+/// position `x_A`, radius `R_d - z_A`, angle `theta`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Groove {
+    r_d: Real,
+    hp: Profile,
+    b: Profile,
+}
+
+/// Step of the numerical derivatives of the surface (rad).
+const DIFF_STEP: Real = 1e-6;
+
+impl Groove {
+    /// The groove of a roll of radius `r_d` (mm) from its tables: angles
+    /// `theta_deg` (degrees, increasing), depths `hp` and widths `b` (mm).
+    ///
+    /// # Failures
+    /// Fewer than 2 rows, angles not increasing, tables of different rows
+    /// or angles, a depth or width not positive, a depth at or beyond the
+    /// roll's radius (each named by table, row and angle).
+    pub fn new(
+        r_d: Real,
+        theta_deg: (&[Real], &[Real]),
+        hp: &[Real],
+        b: &[Real],
+    ) -> Result<Self, GrooveError> {
+        crate::math::positive("roll radius R_d", r_d)?;
+        let (ht, bt) = theta_deg;
+        if ht.len() != bt.len() || hp.len() != b.len() || ht.len() != hp.len() {
+            return Err(GrooveError::DifferentRows {
+                hp: ht.len().min(hp.len()),
+                b: bt.len().min(b.len()),
+            });
+        }
+        if let Some(i) = (0..ht.len()).find(|&i| ht[i] != bt[i]) {
+            return Err(GrooveError::DifferentTheta {
+                row: i + 1,
+                hp_theta: ht[i],
+                b_theta: bt[i],
+            });
+        }
+        for (table, values) in [("Hp", hp), ("B", b)] {
+            for (i, &v) in values.iter().enumerate() {
+                let expected = if !(v > 0.0 && v.is_finite()) {
+                    Some("must be a positive number".to_owned())
+                } else if table == "Hp" && v >= r_d {
+                    Some(format!(
+                        "must be less than the roll's radius R_d = {r_d} mm"
+                    ))
+                } else {
+                    None
+                };
+                if let Some(expected) = expected {
+                    return Err(GrooveError::Value {
+                        table,
+                        row: i + 1,
+                        theta: ht[i],
+                        value: v,
+                        expected,
+                    });
+                }
+            }
+        }
+        let theta: Vec<Real> = ht.iter().map(|t| t.to_radians()).collect();
+        let profile = |table, x: &[Real]| {
+            Profile::new(theta.clone(), x.to_vec())
+                .map_err(|source| GrooveError::Table { table, source })
+        };
+        Ok(Self {
+            r_d,
+            hp: profile("Hp", hp)?,
+            b: profile("B", b)?,
+        })
+    }
+
+    /// The roll's radius (mm).
+    pub fn roll_radius(&self) -> Real {
+        self.r_d
+    }
+
+    /// The range of theta the tables cover (rad).
+    pub fn theta_range(&self) -> (Real, Real) {
+        self.hp.z_range()
+    }
+
+    /// The depth table (theta in rad).
+    pub fn depth(&self) -> &Profile {
+        &self.hp
+    }
+
+    /// The width table (theta in rad).
+    pub fn width(&self) -> &Profile {
+        &self.b
+    }
+
+    /// The section at `theta` (rad).
+    ///
+    /// # Failures
+    /// `theta` outside the tables.
+    pub fn section(&self, theta: Real) -> Result<EllipseSection, GrooveError> {
+        let hp = self.hp.eval(theta)?;
+        let b = self.b.eval(theta)?;
+        Ok(EllipseSection::new(b / 2.0, hp)?)
+    }
+
+    /// The groove's point at `(theta, psi)` (rad) in the roll's frame.
+    ///
+    /// # Failures
+    /// `theta` outside the tables.
+    pub fn point(&self, theta: Real, psi: Real) -> Result<Vec3, GrooveError> {
+        let (x_a, z_a) = self.section(theta)?.point(psi);
+        let rho = self.r_d - z_a;
+        Ok(Vec3::new(rho * theta.cos(), rho * theta.sin(), x_a))
+    }
+
+    /// The groove's unit normal at `(theta, psi)`, out of the roll's
+    /// material into the groove's open space (toward a wheel in it), from
+    /// the surface's partial derivatives (central differences of 1e-6 rad,
+    /// one-sided at the tables' ends).
+    ///
+    /// # Failures
+    /// `theta` outside the tables.
+    pub fn normal(&self, theta: Real, psi: Real) -> Result<Vec3, GrooveError> {
+        let (lo, hi) = self.theta_range();
+        let (t0, t1) = ((theta - DIFF_STEP).max(lo), (theta + DIFF_STEP).min(hi));
+        let d_theta = (self.point(t1, psi)? - self.point(t0, psi)?) / (t1 - t0);
+        let d_psi = (self.point(theta, psi + DIFF_STEP)? - self.point(theta, psi - DIFF_STEP)?)
+            / (2.0 * DIFF_STEP);
+        let n = d_theta.cross(&d_psi).normalize();
+        // The section's centre (on the periphery) is on the open side.
+        let centre = Vec3::new(self.r_d * theta.cos(), self.r_d * theta.sin(), 0.0);
+        let p = self.point(theta, psi)?;
+        Ok(if n.dot(&(centre - p)) >= 0.0 { n } else { -n })
+    }
+
+    /// The smallest radius of curvature of the groove's sections, over the
+    /// tables' rows and the midpoints between them, with the theta where
+    /// it is (rad): the largest a wheel's rounding may be.
+    pub fn min_curvature_radius(&self) -> Result<(Real, Real), GrooveError> {
+        let z = self.hp.z();
+        let mut best = (Real::INFINITY, z[0]);
+        for i in 0..z.len() {
+            let mut at = vec![z[i]];
+            if i + 1 < z.len() {
+                at.push(0.5 * (z[i] + z[i + 1]));
+            }
+            for t in at {
+                let r = self.section(t)?.min_curvature_radius();
+                if r < best.0 {
+                    best = (r, t);
+                }
+            }
+        }
+        Ok(best)
+    }
+}

@@ -1,0 +1,23 @@
+//! The caliber's geometry (seed 001, MATH §3): the groove of a cold-pilger
+//! roll as a surface in 3-D, the scallop between passes, and the wheel's
+//! pose on the groove, by the seed's model and exactly.
+//!
+//! - [`Groove`]: the roll of radius `R_d` with its groove, half an ellipse
+//!   in each section (`B(theta)/2` wide, `Hp(theta)` deep, from tables),
+//!   its points and normals in the roll's frame;
+//! - [`scallop_height`] and [`step_for_scallop`]: the cusp two neighbouring
+//!   passes leave, and its inverse (MATH §3.3);
+//! - [`seed_pose`]: the seed's wheel centre and corrections (MATH §3.4);
+//!   [`TorusWheel`] and [`exact_pose`]: the torus touching the groove at a
+//!   point with its normal, and the distance of any point from it.
+//!
+//! The roll's frame: Z along the roll's axis, the section at `theta = 0` in
+//! the XZ plane, `theta` turning right-handed about +Z (ARCHITECTURE §3).
+
+mod groove;
+mod pose;
+mod scallop;
+
+pub use groove::{Groove, GrooveError};
+pub use pose::{exact_pose, seed_pose, SeedPose, TorusWheel};
+pub use scallop::{scallop_height, step_for_scallop};
