@@ -17,10 +17,20 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// The machine plugins compiled into the program.
-const COMPILED_PLUGINS: [CompiledPlugin; 1] = [CompiledPlugin {
-    symbol: "pilgrim_plugin_grinder_3k152vf20",
-    entry: grinder_3k152vf20::pilgrim_plugin_grinder_3k152vf20,
-}];
+const COMPILED_PLUGINS: [CompiledPlugin; 3] = [
+    CompiledPlugin {
+        symbol: "pilgrim_plugin_grinder_3k152vf20",
+        entry: grinder_3k152vf20::pilgrim_plugin_grinder_3k152vf20,
+    },
+    CompiledPlugin {
+        symbol: "pilgrim_plugin_lz_250",
+        entry: lz_250::pilgrim_plugin_lz_250,
+    },
+    CompiledPlugin {
+        symbol: "pilgrim_plugin_mannesmann",
+        entry: mannesmann::pilgrim_plugin_mannesmann,
+    },
+];
 
 /// CAM for special grinders and lathes: cold-pilger mandrels and calibers,
 /// worm threads.

@@ -275,3 +275,56 @@ fn rest_beyond_travel_names_the_block() {
         )
     );
 }
+
+/// The caliber grinders load from their shared libraries as they are
+/// compiled in: the same description, the same axes for the same poses.
+#[test]
+fn caliber_grinders_load_as_compiled_in() {
+    use pilgrim_kernel::machine::MachineKinematics;
+    use pilgrim_kernel::math::{Point3, Vec3};
+    use pilgrim_kernel::transform::ToolFrame;
+    for (lib, compiled) in [
+        (
+            "lz_250",
+            PluginMachine::from_entry(
+                "LZ-250",
+                "pilgrim_plugin_lz_250",
+                lz_250::pilgrim_plugin_lz_250,
+            )
+            .unwrap(),
+        ),
+        (
+            "mannesmann",
+            PluginMachine::from_entry(
+                "Mannesmann",
+                "pilgrim_plugin_mannesmann",
+                mannesmann::pilgrim_plugin_mannesmann,
+            )
+            .unwrap(),
+        ),
+    ] {
+        let loaded = PluginMachine::load(common::shared_lib(lib)).unwrap();
+        assert_eq!(loaded.info(), compiled.info());
+        let tool = ToolFrame {
+            point: Point3::origin(),
+            axis: Vec3::z(),
+        };
+        let poses: Vec<f64> = (0..20)
+            .flat_map(|i| {
+                let t = 0.1 * i as f64;
+                [
+                    150.0 * t.cos(),
+                    150.0 * t.sin(),
+                    5.0 * t,
+                    0.0,
+                    -0.1 * t.cos(),
+                    1.0,
+                ]
+            })
+            .collect();
+        let (mut a, mut b) = (vec![], vec![]);
+        loaded.inverse(&poses, &tool, &mut a).unwrap();
+        compiled.inverse(&poses, &tool, &mut b).unwrap();
+        assert_eq!(a, b, "{lib}");
+    }
+}

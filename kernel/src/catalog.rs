@@ -137,13 +137,17 @@ impl Catalog {
         Ok(Self { plugins })
     }
 
-    /// The built-ins' names: the compiled-in plugins, then the data machines.
+    /// The built-ins' names: the compiled-in plugins, then the data
+    /// machines a plugin of the same name does not stand for (a name opens
+    /// the plugin first).
     pub fn builtin_names(&self) -> Vec<String> {
-        self.plugins
-            .iter()
-            .map(|p| p.info().name.clone())
-            .chain(BUILTIN_MACHINES.iter().map(|s| (*s).to_owned()))
-            .collect()
+        let mut names: Vec<String> = self.plugins.iter().map(|p| p.info().name.clone()).collect();
+        for m in BUILTIN_MACHINES {
+            if !names.iter().any(|n| n.eq_ignore_ascii_case(m)) {
+                names.push(m.to_owned());
+            }
+        }
+        names
     }
 
     /// Opens `spec`: `*.so`/`*.dylib`/`*.dll` (a plugin), `*.toml` (a

@@ -28,6 +28,10 @@ pub fn shared_lib(name: &str) -> PathBuf {
             "pilgrim-grinder-3k152vf20",
             "-p",
             "pilgrim-plugin-fixture",
+            "-p",
+            "pilgrim-lz-250",
+            "-p",
+            "pilgrim-mannesmann",
         ])
         .current_dir(env!("CARGO_MANIFEST_DIR"));
         if dir.file_name().is_some_and(|n| n == "release") {

@@ -1,0 +1,230 @@
+//! The LZ-250 caliber grinder (seed 001, MATH §3.5) as a pilgrim machine
+//! plugin: the roll turns (A = theta) and moves along its axis (X) and
+//! radially (Z); the wheel swivels (B = epsilon) about the radial axis.
+//! Four controlled axes; a Sinumerik control (the host's writer posts its
+//! programs). Its kinematics ([`CaliberKinematics`]) serve the Mannesmann
+//! grinder too, which adds the cross axis Y.
+//!
+//! The part frame: Z along the roll's axis, X radial, the groove's section
+//! at theta = 0 in the XZ plane. The chain, tool frame to part frame:
+//! `Rz(-A) Tz(X) Tx(Z) [Ty(Y)] Rx(B)`. Signs (the host checks them against
+//! the chain whenever it loads the plugin):
+//!
+//! - `A` +1 deg turns the roll +1 deg about its axis (right-handed), so the
+//!   wheel turns -1 deg about +Z relative to the roll;
+//! - `X` +1 mm moves the wheel +1 mm along the roll's axis relative to it;
+//! - `Z` +1 mm moves the wheel's centre 1 mm away from the roll's axis;
+//! - `Y` (Mannesmann) +1 mm moves the wheel +1 mm along +Y, tangent to the
+//!   roll at the wheel;
+//! - `B` +1 deg swivels the wheel +1 deg about the radial axis.
+//!
+//! The tool frame's origin is the wheel's centre, its axis the wheel's
+//! axis (parallel to the roll's at B = 0).
+//!
+//! Inverse kinematics are closed-form. A wheel pose has five freedoms (a
+//! torus is symmetric about its axis); the Mannesmann's five axes reach
+//! every pose whose axis is not radial: A turns the roll until the wheel's
+//! axis has no radial part, B swivels it, X, Z and Y place the centre. The
+//! LZ-250 has no Y: A turns the roll until the tracked point lies in the
+//! plane of the roll's axis and the radius, so the point is placed exactly,
+//! and B swivels the wheel's axis as near the asked one as the machine
+//! allows: the radial part of the axis it cannot give (the angle between
+//! the two is [`CaliberKinematics::axis_error`]). The family asks for
+//! reachable poses; the verification says what any difference costs.
+
+pub mod kinematics;
+
+pub use kinematics::CaliberKinematics;
+
+use pilgrim_plugin_abi::types::{
+    Axis, AxisKind, FactorKind, FactorSpec, MachineInfo, Plane, ProgramSetup, Radial, ToolSpec,
+};
+use pilgrim_plugin_abi::{export_plugin, Plugin, PluginError};
+
+/// The machine's name.
+pub const NAME: &str = "LZ-250";
+
+/// A linear axis of a caliber grinder.
+pub fn linear(name: &str, min: f64, max: f64, max_feed: f64, moves: [f64; 3], what: &str) -> Axis {
+    Axis {
+        name: name.into(),
+        kind: AxisKind::Linear,
+        min,
+        max,
+        max_feed,
+        programmed: true,
+        description: what.into(),
+        moves: Some(moves),
+        turns: None,
+        body: None,
+    }
+}
+
+/// A rotary axis (limits in degrees, feed in deg/min; held in rad).
+pub fn rotary(name: &str, deg: f64, feed_deg: f64, turns: [f64; 3], what: &str) -> Axis {
+    Axis {
+        name: name.into(),
+        kind: AxisKind::Rotary,
+        min: -deg.to_radians(),
+        max: deg.to_radians(),
+        max_feed: feed_deg.to_radians(),
+        programmed: true,
+        description: what.into(),
+        moves: None,
+        turns: Some(turns),
+        body: None,
+    }
+}
+
+/// The axes and chain of a caliber grinder, with the cross axis Y if
+/// `cross`: the one definition both machines' descriptions use.
+pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInfo {
+    let mut axes = vec![
+        linear(
+            "X",
+            -150.0,
+            150.0,
+            3000.0,
+            [0.0, 0.0, 1.0],
+            "along the roll's axis (wheel relative to roll)",
+        ),
+        linear(
+            "Z",
+            0.0,
+            600.0,
+            2000.0,
+            [1.0, 0.0, 0.0],
+            "radial: the wheel centre's distance from the roll's axis",
+        ),
+    ];
+    if cross {
+        axes.push(linear(
+            "Y",
+            -60.0,
+            60.0,
+            2000.0,
+            [0.0, 1.0, 0.0],
+            "across: perpendicular to the roll's axis and radius",
+        ));
+    }
+    axes.push(rotary(
+        "A",
+        370.0,
+        3600.0,
+        [0.0, 0.0, -1.0],
+        "roll turn theta about its axis",
+    ));
+    axes.push(rotary(
+        "B",
+        45.0,
+        1800.0,
+        [1.0, 0.0, 0.0],
+        "wheel swivel epsilon about the radial axis",
+    ));
+    axes.push(Axis {
+        name: "S".into(),
+        kind: AxisKind::Spindle,
+        min: 0.0,
+        max: 3000.0,
+        max_feed: 3000.0,
+        programmed: false,
+        description: "wheel spindle".into(),
+        moves: None,
+        turns: None,
+        body: None,
+    });
+    let solved: Vec<String> = axes
+        .iter()
+        .filter(|a| a.kind != AxisKind::Spindle)
+        .map(|a| a.name.clone())
+        .collect();
+    let mut chain = vec![
+        FactorSpec {
+            scale: -1.0,
+            ..FactorSpec::axis(FactorKind::Rz, "A")
+        },
+        FactorSpec::axis(FactorKind::Tz, "X"),
+        FactorSpec::axis(FactorKind::Tx, "Z"),
+    ];
+    if cross {
+        chain.push(FactorSpec::axis(FactorKind::Ty, "Y"));
+    }
+    chain.push(FactorSpec::axis(FactorKind::Rx, "B"));
+    let mut approach = vec!["X".to_owned()];
+    if cross {
+        approach.push("Y".into());
+    }
+    approach.extend(["A".to_owned(), "B".to_owned()]);
+    MachineInfo {
+        name: name.into(),
+        description: description.into(),
+        control: "sinumerik".into(),
+        axes,
+        solved_axes: solved,
+        constants: Default::default(),
+        program_decimals: None,
+        driven_axes: vec![],
+        bodies: vec![],
+        chain,
+        tool: ToolSpec::default(),
+        min_feed: Some(1.0),
+        // G54, the ZX plane, Z (the wheel's radial position) in radius,
+        // coolant; the wheel backs off to Z 600 first, then the roll, the
+        // table (and the cross slide) and the swivel come to the start; at
+        // the end the wheel backs off again.
+        setup: ProgramSetup {
+            work_offset: Some(1),
+            plane: Some(Plane::Zx),
+            radial: Some(Radial::Radius),
+            radial_axis: "Z".into(),
+            coolant: true,
+            clear: [("Z".to_owned(), 600.0)].into_iter().collect(),
+            start_clear: vec!["Z".into()],
+            approach: vec![approach],
+            retract: vec![vec!["Z".into()]],
+        },
+    }
+}
+
+/// The LZ-250's description.
+pub fn describe() -> MachineInfo {
+    caliber_grinder(
+        NAME,
+        "LZ-250 caliber grinder: roll turn A, axial X, radial Z, wheel swivel B",
+        false,
+    )
+}
+
+/// The LZ-250.
+#[derive(Debug, Clone, Default)]
+pub struct Lz250;
+
+impl Plugin for Lz250 {
+    fn describe(&self) -> MachineInfo {
+        describe()
+    }
+
+    /// Rows of `[X, Z, A, B]`.
+    fn inverse(&self, poses: &[f64], tool: &[f64; 6], out: &mut [f64]) -> Result<(), PluginError> {
+        CaliberKinematics { cross: false }.inverse(poses, tool, out)
+    }
+
+    fn forward(&self, axes: &[f64], tool: &[f64; 6], out: &mut [f64]) -> Result<(), PluginError> {
+        CaliberKinematics { cross: false }.forward(axes, tool, out)
+    }
+}
+
+export_plugin!(pilgrim_plugin_lz_250, Lz250);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pilgrim_kernel::machine::Machine;
+
+    /// The plugin describes the machine the kernel's machine file does:
+    /// one machine, whichever way it is opened.
+    #[test]
+    fn the_plugin_is_the_machine_file() {
+        assert_eq!(Machine::builtin(NAME).unwrap().info(), &describe());
+    }
+}
