@@ -277,3 +277,69 @@ fn smoothing_keeps_smooth_tables_and_removes_a_planted_dent() {
         "{s:?}"
     );
 }
+
+/// The example groove (`scripts/examples/caliber-groove.csv`, with a notes
+/// column) reads into a groove: its depth falls from the hollow's radius
+/// through the reduction zone to the tube's, constant over the sizing
+/// section, and its sections are rounder than a 10 mm wheel rounding.
+#[test]
+fn the_example_groove_reads_from_its_table() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../scripts/examples/caliber-groove.csv");
+    let t = pilgrim_kernel::read_table(&path).unwrap();
+    let g =
+        Groove::from_tables(150.0, (&t, "theta_deg", "Hp_mm"), (&t, "theta_deg", "B_mm")).unwrap();
+    let hp = |deg: f64| g.depth().eval(deg.to_radians()).unwrap();
+    assert!((hp(20.0) - 24.0).abs() < 1e-9 && (hp(200.0) - 14.1).abs() < 1e-9);
+    assert!((hp(225.0) - 14.1).abs() < 1e-9, "the sizing section");
+    assert!(hp(100.0) < hp(60.0) && hp(60.0) < hp(30.0));
+    let (r_min, at) = g.min_curvature_radius().unwrap();
+    assert!(
+        r_min > 10.0 && r_min < 14.1,
+        "{r_min} at {} deg",
+        at.to_degrees()
+    );
+}
+
+/// Bad table files are refused naming the file, the row as the file
+/// numbers it, and the column.
+#[test]
+fn bad_table_files_are_named() {
+    let read = |text: &str| pilgrim_kernel::read_table_str(text, "g.csv").unwrap();
+    let build = |t: &pilgrim_kernel::Table| {
+        Groove::from_tables(150.0, (t, "theta", "Hp"), (t, "theta", "B"))
+            .unwrap_err()
+            .to_string()
+    };
+    let e = build(&read("theta,Hp,B\n0,20,40\n10,-1,40\n20,20,40\n"));
+    assert_eq!(
+        e,
+        "g.csv: row 3, column B (Hp): Hp = -1 mm at theta = 10 deg must be a positive number"
+    );
+    let e = build(&read("theta,Hp,B\n0,20,40\n20,20,40\n10,20,40\n"));
+    assert!(
+        e.contains("g.csv") && e.contains("row 4") && e.contains("theta"),
+        "{e}"
+    );
+    let e = build(&read("theta,Hp,B\n0,20,40\n10,,40\n20,20,40\n"));
+    assert!(
+        e.contains("g.csv") && e.contains("row 3") && e.contains("Hp"),
+        "{e}"
+    );
+    let e = build(&read("theta,Hp,B\n0,20,40\n10,deep,40\n20,20,40\n"));
+    assert!(
+        e.contains("g.csv") && e.contains("row 3") && e.contains("deep"),
+        "{e}"
+    );
+    let (h, b) = (
+        pilgrim_kernel::read_table_str("theta,Hp\n0,20\n10,20\n20,20\n", "hp.csv").unwrap(),
+        pilgrim_kernel::read_table_str("theta,B\n0,40\n15,40\n20,40\n", "b.csv").unwrap(),
+    );
+    let e = Groove::from_tables(150.0, (&h, "theta", "Hp"), (&b, "theta", "B"))
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        e,
+        "hp.csv: row 3: theta = 10 deg, but b.csv row 3 gives B at theta = 15 deg: the tables of Hp and B must be at the same angles"
+    );
+}

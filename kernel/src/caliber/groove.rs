@@ -2,7 +2,7 @@
 
 use crate::input::InputError;
 use crate::math::{Real, Vec3};
-use crate::profile::{EllipseSection, Profile, ProfileError};
+use crate::profile::{EllipseSection, Profile, ProfileError, Table};
 
 /// Why a groove cannot be built from its tables.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -50,6 +50,18 @@ pub enum GrooveError {
         /// What it must be.
         expected: String,
     },
+    /// A table file's cell or row that cannot be a groove's, named by file,
+    /// row (as the file numbers it) and column.
+    #[error("{file}: {message}")]
+    File {
+        /// The table's file.
+        file: String,
+        /// What is wrong, and where.
+        message: String,
+    },
+    /// A table that cannot be read as numbers.
+    #[error(transparent)]
+    Read(#[from] crate::profile::TableError),
     /// A query outside the tables or a bad number.
     #[error(transparent)]
     Query(#[from] ProfileError),
@@ -134,6 +146,74 @@ impl Groove {
             r_d,
             hp: profile("Hp", hp)?,
             b: profile("B", b)?,
+        })
+    }
+
+    /// The groove from table files: `hp` and `b` are each a table with the
+    /// names of its angle column (degrees) and value column (mm), which
+    /// may be the same table (columns of notes are left alone). Errors
+    /// name the file, the row as the file numbers it and the column.
+    ///
+    /// # Failures
+    /// A missing, empty or non-numeric cell; angles not increasing; the
+    /// tables at different angles; a depth or width not positive; a depth
+    /// through the roll.
+    pub fn from_tables(
+        r_d: Real,
+        hp: (&Table, &str, &str),
+        b: (&Table, &str, &str),
+    ) -> Result<Self, GrooveError> {
+        let read = |(t, theta, value): (&Table, &str, &str)| -> Result<_, GrooveError> {
+            // Through the table's profile: angles increasing, named by row.
+            t.profile(theta, value)?;
+            Ok((t.column(theta)?, t.column(value)?))
+        };
+        let ((ht, hv), (bt, bv)) = (read(hp)?, read(b)?);
+        let place = |which: &str, row: usize| {
+            let (t, _, col) = if which == "Hp" { hp } else { b };
+            let label = t
+                .column_index(col)
+                .map(|c| t.column_label(c))
+                .unwrap_or_else(|_| col.to_owned());
+            (t.source().to_owned(), t.row_number(row - 1), label)
+        };
+        Self::new(r_d, (&ht, &bt), &hv, &bv).map_err(|e| match e {
+            GrooveError::Value {
+                table,
+                row,
+                theta,
+                value,
+                expected,
+            } => {
+                let (file, row, col) = place(table, row);
+                GrooveError::File {
+                    file,
+                    message: format!(
+                        "row {row}, column {col}: {table} = {value} mm at theta = {theta} deg {expected}"
+                    ),
+                }
+            }
+            GrooveError::DifferentTheta {
+                row,
+                hp_theta,
+                b_theta,
+            } => {
+                let ((hf, hr, _), (bf, br, _)) = (place("Hp", row), place("B", row));
+                GrooveError::File {
+                    file: hf,
+                    message: format!(
+                        "row {hr}: theta = {hp_theta} deg, but {bf} row {br} gives B at theta = {b_theta} deg: the tables of Hp and B must be at the same angles"
+                    ),
+                }
+            }
+            GrooveError::DifferentRows { hp: h, b: n } => GrooveError::File {
+                file: hp.0.source().to_owned(),
+                message: format!(
+                    "{h} rows of Hp, but {} has {n} rows of B: the tables must be at the same angles",
+                    b.0.source()
+                ),
+            },
+            other => other,
         })
     }
 

@@ -397,7 +397,7 @@ impl Table {
     }
 
     /// `B (Hp)`: the column's letter, and its header if it has one.
-    fn label(&self, col: usize) -> String {
+    pub fn column_label(&self, col: usize) -> String {
         match self.headers.get(col).filter(|h| !h.is_empty()) {
             Some(h) => format!("{} ({h})", column_letter(col)),
             None => column_letter(col),
@@ -428,7 +428,7 @@ impl Table {
             file: self.source.clone(),
             column: name.to_owned(),
             available: (0..width)
-                .map(|i| self.label(i))
+                .map(|i| self.column_label(i))
                 .collect::<Vec<_>>()
                 .join(", "),
         })
@@ -449,19 +449,19 @@ impl Table {
                     Cell::Number(v) => Err(TableError::BadValue {
                         file: self.source.clone(),
                         row: *row,
-                        column: self.label(col),
+                        column: self.column_label(col),
                         message: format!("{v} is not a finite number"),
                     }),
                     Cell::Text(t) => Err(TableError::NotNumber {
                         file: self.source.clone(),
                         row: *row,
-                        column: self.label(col),
+                        column: self.column_label(col),
                         text: t.clone(),
                     }),
                     Cell::Empty => Err(TableError::MissingCell {
                         file: self.source.clone(),
                         row: *row,
-                        column: self.label(col),
+                        column: self.column_label(col),
                     }),
                 },
             )
@@ -483,7 +483,7 @@ impl Table {
             }) => TableError::BadValue {
                 file: self.source.clone(),
                 row: self.row_number(index),
-                column: self.label(zc),
+                column: self.column_label(zc),
                 message: format!("{value} does not increase on the row before ({prev})"),
             },
             other => TableError::Read {
