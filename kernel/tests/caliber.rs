@@ -343,3 +343,27 @@ fn bad_table_files_are_named() {
         "hp.csv: row 3: theta = 10 deg, but b.csv row 3 gives B at theta = 15 deg: the tables of Hp and B must be at the same angles"
     );
 }
+
+/// Passes across the groove: evenly spread, no more than dpsi apart, the
+/// scallop of that step in the widest section (the inverse gives the step
+/// back); a rounding as round as the groove's tightest section is refused
+/// naming where that is.
+#[test]
+fn passes_are_spread_across_the_groove() {
+    let g = reduction_groove();
+    let (psi, rz) = g.pass_angles(10.0, 1f64.to_radians(), 1.4).unwrap();
+    assert!((psi[0] + 1.4).abs() < 1e-12 && (psi[psi.len() - 1] - 1.4).abs() < 1e-12);
+    let step = psi[1] - psi[0];
+    assert!(step <= 1f64.to_radians() + 1e-12);
+    assert!(psi.windows(2).all(|w| (w[1] - w[0] - step).abs() < 1e-12));
+    // The widest section: B/2 = 2.1 x 24 / 2 = 25.2 mm.
+    let back = step_for_scallop(25.2, 10.0, rz).unwrap();
+    assert!((back - step).abs() < 1e-7);
+    let e = g.pass_angles(14.0, 0.02, 1.4).unwrap_err().to_string();
+    // b^2/a = 14.1 / 1.05 on the sizing section, at the edge (the
+    // interpolation between rows dips 0.2 um below it beside 120 deg).
+    assert!(
+        e.contains("tightest curvature radius 13.428") && e.contains("deg, psi = 90 deg"),
+        "{e}"
+    );
+}

@@ -217,6 +217,81 @@ impl Groove {
         })
     }
 
+    /// Where the section at `theta` is most curved: `0` (the bottom) when
+    /// the groove is deeper than half its width, else `pi/2` (the edge).
+    ///
+    /// # Failures
+    /// `theta` outside the tables.
+    pub fn tightest_psi(&self, theta: Real) -> Result<Real, GrooveError> {
+        let s = self.section(theta)?;
+        Ok(if s.b > s.a {
+            0.0
+        } else {
+            std::f64::consts::FRAC_PI_2
+        })
+    }
+
+    /// The pass angles `psi` (rad) of a wheel's rounding `r_k` across the
+    /// groove, symmetric about its middle out to `psi_max`, `dpsi` apart at
+    /// most (the passes spread evenly), with the scallop the step leaves in
+    /// the widest section (MATH §3.3: the section circle the groove's
+    /// largest profile radius, `max(B/2, Hp)` over the tables).
+    ///
+    /// # Failures
+    /// `r_k` not smaller than every section's curvature radius (named by
+    /// theta and psi); `dpsi` or `psi_max` out of range; more than 10,000
+    /// passes.
+    pub fn pass_angles(
+        &self,
+        r_k: Real,
+        dpsi: Real,
+        psi_max: Real,
+    ) -> Result<(Vec<Real>, Real), GrooveError> {
+        crate::math::positive("wheel rounding radius r_k", r_k)?;
+        crate::math::positive("pass step dpsi", dpsi)?;
+        if !(psi_max > 0.0 && psi_max <= std::f64::consts::FRAC_PI_2) {
+            return Err(InputError::out_of_range(
+                "largest pass angle psi_max (rad)",
+                psi_max,
+                "(0, pi/2]",
+            )
+            .into());
+        }
+        let (r_min, at) = self.min_curvature_radius()?;
+        if r_k >= r_min {
+            return Err(InputError::out_of_range(
+                "wheel rounding radius r_k (mm)",
+                r_k,
+                format!(
+                    "smaller than the groove's tightest curvature radius {r_min:.4} mm, at theta = {:.3} deg, psi = {:.0} deg",
+                    at.to_degrees(),
+                    self.tightest_psi(at)?.to_degrees()
+                ),
+            )
+            .into());
+        }
+        let n = (2.0 * psi_max / dpsi).ceil();
+        if n > 10_000.0 {
+            return Err(InputError::out_of_range(
+                "passes across the groove",
+                n,
+                "at most 10000: a larger step",
+            )
+            .into());
+        }
+        let n = n as usize;
+        let step = 2.0 * psi_max / n as Real;
+        let widest = self
+            .hp
+            .x()
+            .iter()
+            .zip(self.b.x())
+            .map(|(h, b)| h.max(b / 2.0))
+            .fold(0.0, Real::max);
+        let rz = super::scallop_height(widest, r_k, step)?;
+        Ok(((0..=n).map(|i| -psi_max + step * i as Real).collect(), rz))
+    }
+
     /// The roll's radius (mm).
     pub fn roll_radius(&self) -> Real {
         self.r_d
@@ -279,7 +354,9 @@ impl Groove {
 
     /// The smallest radius of curvature of the groove's sections, over the
     /// tables' rows and the midpoints between them, with the theta where
-    /// it is (rad): the largest a wheel's rounding may be.
+    /// it is (rad): the largest a wheel's rounding may be. In a section it
+    /// is at the bottom (`psi = 0`, `a^2 / b`) or at the edge (`psi = 90
+    /// deg`, `b^2 / a`): [`Self::tightest_psi`] says which.
     pub fn min_curvature_radius(&self) -> Result<(Real, Real), GrooveError> {
         let z = self.hp.z();
         let mut best = (Real::INFINITY, z[0]);
