@@ -223,8 +223,10 @@ fn bad_input_is_refused() {
     assert!(e.contains("half the width"), "{e}");
     let w = Wheel::new(500.0, 20.0, 50.0).unwrap();
     assert!(wheel(&w, 0.0).is_err());
-    // A sweep whose end section cannot be fanned.
-    let star = |z: f64| -> Vec<[f64; 3]> {
+    // A section no point sees whole (a deep notch) makes a solid: its caps
+    // are ear-clipped, its volume the section's area (100 - 81 = 19 mm^2)
+    // times 5.
+    let notched = |z: f64| -> Vec<[f64; 3]> {
         vec![
             [0.0, 0.0, z],
             [10.0, 0.0, z],
@@ -234,8 +236,20 @@ fn bad_input_is_refused() {
             [0.0, 10.0, z],
         ]
     };
-    let e = sweep(&[star(0.0), star(5.0)]).unwrap_err().to_string();
-    assert!(e.contains("star-shaped"), "{e}");
+    let m = sweep(&[notched(0.0), notched(5.0)]).unwrap();
+    m.check_closed().unwrap();
+    assert!((m.volume() - 19.0 * 5.0).abs() < 1e-9, "{}", m.volume());
+    // A section that crosses itself is refused.
+    let bow = |z: f64| {
+        vec![
+            [0.0, 0.0, z],
+            [10.0, 10.0, z],
+            [10.0, 0.0, z],
+            [0.0, 10.0, z],
+        ]
+    };
+    let e = sweep(&[bow(0.0), bow(5.0)]).unwrap_err().to_string();
+    assert!(e.contains("section 0"), "{e}");
 }
 
 /// The meshes in a scene written as .glb, read back by the gltf crate, and

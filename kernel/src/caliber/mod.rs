@@ -9,7 +9,8 @@
 //!   passes leave, and its inverse (MATH §3.3);
 //! - [`seed_pose`]: the seed's wheel centre and corrections (MATH §3.4);
 //!   [`TorusWheel`] and [`exact_pose`]: the torus touching the groove at a
-//!   point with its normal, and the distance of any point from it.
+//!   point with its normal, and the distance of any point from it;
+//! - [`caliber_solid`]: the roll's sector with its groove as a closed mesh.
 //!
 //! The roll's frame: Z along the roll's axis, the section at `theta = 0` in
 //! the XZ plane, `theta` turning right-handed about +Z (ARCHITECTURE §3).
@@ -17,7 +18,9 @@
 mod groove;
 mod pose;
 mod scallop;
+mod solid;
 
 pub use groove::{Groove, GrooveError};
 pub use pose::{exact_pose, seed_pose, SeedPose, TorusWheel};
 pub use scallop::{scallop_height, step_for_scallop};
+pub use solid::{caliber_solid, SolidError};

@@ -5,16 +5,17 @@ use crate::math::Real;
 
 /// The solid bounded by a sequence of closed sections (rings of the same
 /// number of points, the section's shape may change along the path), with
-/// flat caps on the first and last rings. Each cap is fanned from its
-/// centroid, so the end sections must be star-shaped about it. The
-/// sections' sampling is the caller's (keep it within the chordal
-/// tolerance wanted). Either winding of the rings is accepted: the mesh is
-/// oriented outward.
+/// flat caps on the first and last rings. Each cap is triangulated in its
+/// section's plane by ear clipping (`earcutr`, a port of Mapbox's earcut),
+/// so an end section may be any simple polygon (a roll's rim with a groove
+/// cut in it). The sections' sampling is the caller's (keep it within the
+/// chordal tolerance wanted). Either winding of the rings is accepted: the
+/// mesh is oriented outward.
 ///
 /// # Failures
 /// Fewer than 2 rings or 3 points a ring, rings of different sizes, a value
-/// not finite; a degenerate face or an end section that is not star-shaped
-/// about its centroid (named by ring).
+/// not finite; a degenerate face or an end section that is not a simple
+/// plane polygon (named by ring).
 ///
 /// ```
 /// use pilgrim_kernel::mesh::sweep;
@@ -64,41 +65,61 @@ pub fn sweep(rings: &[Vec<[Real; 3]>]) -> Result<TriMesh, MeshError> {
         }
     }
     let side_count = mesh.triangles.len();
-    // Caps, fanned from their centroids, on vertices of their own (flat shading).
+    // Caps, on vertices of their own (flat shading): each section
+    // triangulated in its plane, the triangles wound as the ring (the
+    // first cap) or against it (the last), as the sides are.
     for (j, first) in [(0, true), (rings.len() - 1, false)] {
         let r = &rings[j];
-        let c = r
-            .iter()
-            .fold([0.0; 3], |s, p| [s[0] + p[0], s[1] + p[1], s[2] + p[2]]);
-        let c = [c[0] / m as Real, c[1] / m as Real, c[2] / m as Real];
-        let base = mesh.positions.len() as u32;
-        mesh.positions.push(c);
-        mesh.positions.extend_from_slice(r);
-        for k in 0..m32 {
-            let k1 = (k + 1) % m32;
-            let (p, q) = (base + 1 + k, base + 1 + k1);
-            mesh.triangles
-                .push(if first { [base, p, q] } else { [base, q, p] });
+        // The ring's plane: Newell's normal, and two axes in it.
+        let mut n = [0.0; 3];
+        for k in 0..m {
+            let (p, q) = (r[k], r[(k + 1) % m]);
+            n[0] += (p[1] - q[1]) * (p[2] + q[2]);
+            n[1] += (p[2] - q[2]) * (p[0] + q[0]);
+            n[2] += (p[0] - q[0]) * (p[1] + q[1]);
         }
-        let caps = &mesh.triangles[mesh.triangles.len() - m..];
-        let normals: Vec<[Real; 3]> = caps
+        let area2 = dot(n, n).sqrt();
+        if !(area2 > 0.0) {
+            return Err(MeshError::Degenerate(format!(
+                "section {j} encloses no area: its cap cannot be made"
+            )));
+        }
+        let n = normalize(n);
+        let u = normalize(sub(r[1], r[0]));
+        let u = if dot(u, u) > 0.0 {
+            u
+        } else {
+            normalize(sub(r[2], r[0]))
+        };
+        let v = cross(n, u);
+        let flat: Vec<Real> = r
             .iter()
-            .map(|t| {
-                let (a, b, c) = (
-                    mesh.positions[t[0] as usize],
-                    mesh.positions[t[1] as usize],
-                    mesh.positions[t[2] as usize],
-                );
-                cross(sub(b, a), sub(c, a))
+            .flat_map(|p| {
+                let d = sub(*p, r[0]);
+                [dot(d, u), dot(d, v)]
             })
             .collect();
-        let avg = normals
-            .iter()
-            .fold([0.0; 3], |s, n| [s[0] + n[0], s[1] + n[1], s[2] + n[2]]);
-        if normals.iter().any(|n| dot(*n, avg) <= 0.0) {
+        let tris = earcutr::earcut(&flat, &[], 2).map_err(|e| {
+            MeshError::Degenerate(format!("section {j} cannot be triangulated: {e:?}"))
+        })?;
+        // A simple polygon's triangles cover exactly its area.
+        let covered: Real = tris
+            .chunks_exact(3)
+            .map(|t| dot(cross(sub(r[t[1]], r[t[0]]), sub(r[t[2]], r[t[0]])), n).abs())
+            .sum();
+        if tris.len() != 3 * (m - 2) || (covered - area2).abs() > 1e-9 * area2 {
             return Err(MeshError::Degenerate(format!(
-                "section {j} is not star-shaped about its centroid: its cap cannot be fanned"
+                "section {j} is not a simple polygon: its cap cannot be made"
             )));
+        }
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend_from_slice(r);
+        for t in tris.chunks_exact(3) {
+            let (a, b, c) = (t[0], t[1], t[2]);
+            let along = dot(cross(sub(r[b], r[a]), sub(r[c], r[a])), n) > 0.0;
+            let (b, c) = if along == first { (b, c) } else { (c, b) };
+            mesh.triangles
+                .push([base + a as u32, base + b as u32, base + c as u32]);
         }
     }
     // Orient outward.
