@@ -66,6 +66,49 @@ pub struct Axis {
 }
 
 impl Axis {
+    /// A programmed linear axis: travel `[min, max]` (mm), `max_feed`
+    /// (mm/min), the tool's motion relative to the part for +1 mm
+    /// (`moves`), and what it is.
+    pub fn linear(
+        name: &str,
+        min: f64,
+        max: f64,
+        max_feed: f64,
+        moves: [f64; 3],
+        what: &str,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            kind: AxisKind::Linear,
+            min,
+            max,
+            max_feed,
+            programmed: true,
+            description: what.into(),
+            moves: Some(moves),
+            turns: None,
+            body: None,
+        }
+    }
+
+    /// A programmed rotary axis of travel `[-deg, deg]` and `feed_deg`
+    /// deg/min (held in rad), turning the tool relative to the part about
+    /// `turns` for +1 deg.
+    pub fn rotary_deg(name: &str, deg: f64, feed_deg: f64, turns: [f64; 3], what: &str) -> Self {
+        Self {
+            name: name.into(),
+            kind: AxisKind::Rotary,
+            min: -deg.to_radians(),
+            max: deg.to_radians(),
+            max_feed: feed_deg.to_radians(),
+            programmed: true,
+            description: what.into(),
+            moves: None,
+            turns: Some(turns),
+            body: None,
+        }
+    }
+
     /// A value in file/program units (mm, deg) from kernel units (mm, rad).
     pub fn to_user(&self, v: f64) -> f64 {
         if self.kind == AxisKind::Rotary {

@@ -41,21 +41,6 @@ const POSE_TOL: f64 = 1e-9;
 /// The machine's name.
 pub const NAME: &str = "3K152VF20";
 
-fn linear(name: &str, min: f64, max: f64, max_feed: f64, moves: [f64; 3], what: &str) -> Axis {
-    Axis {
-        name: name.into(),
-        kind: AxisKind::Linear,
-        min,
-        max,
-        max_feed,
-        programmed: true,
-        description: what.into(),
-        moves: Some(moves),
-        turns: None,
-        body: None,
-    }
-}
-
 /// How a program starts and ends on the 3K152VF20: work offset G54, the
 /// ZX plane, X in radius (the wheel's radial position, not a diameter),
 /// coolant on while grinding. At the start the wheel (X) and the rest (U)
@@ -81,7 +66,7 @@ fn setup() -> ProgramSetup {
 
 /// The 3K152VF20's description: axes, chains, constants, capabilities.
 pub fn describe() -> MachineInfo {
-    let mut u = linear(
+    let mut u = Axis::linear(
         "U",
         0.0,
         150.0,
@@ -97,7 +82,7 @@ pub fn describe() -> MachineInfo {
                 .into(),
         control: "sinumerik".into(),
         axes: vec![
-            linear(
+            Axis::linear(
                 "Z",
                 -20.0,
                 1050.0,
@@ -105,7 +90,7 @@ pub fn describe() -> MachineInfo {
                 [0.0, 0.0, 1.0],
                 "table, along the part's axis (wheel relative to part)",
             ),
-            linear(
+            Axis::linear(
                 "X",
                 -5.0,
                 220.0,

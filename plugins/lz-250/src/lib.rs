@@ -44,43 +44,11 @@ use pilgrim_plugin_abi::{export_plugin, Plugin, PluginError};
 /// The machine's name.
 pub const NAME: &str = "LZ-250";
 
-/// A linear axis of a caliber grinder.
-pub fn linear(name: &str, min: f64, max: f64, max_feed: f64, moves: [f64; 3], what: &str) -> Axis {
-    Axis {
-        name: name.into(),
-        kind: AxisKind::Linear,
-        min,
-        max,
-        max_feed,
-        programmed: true,
-        description: what.into(),
-        moves: Some(moves),
-        turns: None,
-        body: None,
-    }
-}
-
-/// A rotary axis (limits in degrees, feed in deg/min; held in rad).
-pub fn rotary(name: &str, deg: f64, feed_deg: f64, turns: [f64; 3], what: &str) -> Axis {
-    Axis {
-        name: name.into(),
-        kind: AxisKind::Rotary,
-        min: -deg.to_radians(),
-        max: deg.to_radians(),
-        max_feed: feed_deg.to_radians(),
-        programmed: true,
-        description: what.into(),
-        moves: None,
-        turns: Some(turns),
-        body: None,
-    }
-}
-
 /// The axes and chain of a caliber grinder, with the cross axis Y if
 /// `cross`: the one definition both machines' descriptions use.
 pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInfo {
     let mut axes = vec![
-        linear(
+        Axis::linear(
             "X",
             -150.0,
             150.0,
@@ -88,7 +56,7 @@ pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInf
             [0.0, 0.0, 1.0],
             "along the roll's axis (wheel relative to roll)",
         ),
-        linear(
+        Axis::linear(
             "Z",
             0.0,
             600.0,
@@ -98,7 +66,7 @@ pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInf
         ),
     ];
     if cross {
-        axes.push(linear(
+        axes.push(Axis::linear(
             "Y",
             -60.0,
             60.0,
@@ -107,14 +75,14 @@ pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInf
             "across: perpendicular to the roll's axis and radius",
         ));
     }
-    axes.push(rotary(
+    axes.push(Axis::rotary_deg(
         "A",
         370.0,
         3600.0,
         [0.0, 0.0, -1.0],
         "roll turn theta about its axis",
     ));
-    axes.push(rotary(
+    axes.push(Axis::rotary_deg(
         "B",
         45.0,
         1800.0,
