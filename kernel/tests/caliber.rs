@@ -413,3 +413,54 @@ fn the_caliber_solid_is_closed_and_holds_its_volume() {
     )
     .unwrap();
 }
+
+/// The caliber's geometry from a script: the example table read, the
+/// groove, the pass angles and the seed's pose give what the kernel does.
+#[test]
+fn scripts_reach_the_caliber_geometry() {
+    use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
+    let examples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scripts/examples");
+    let src = format!(
+        "fn params() {{ #{{}} }}\n\
+         fn toolpath(p) {{ () }}\n\
+         fn probe(p) {{\n\
+           let g = groove(150.0, read_table(\"{}\"), \"theta_deg\", \"Hp_mm\", \"B_mm\");\n\
+           let passes = g.pass_angles(10.0, 0.02, 1.4);\n\
+           let s = g.seed_pose(0.5, 0.3, 150.0, 10.0);\n\
+           [g.min_curvature_radius, passes.psi.len, passes.scallop, s.x_k, s.mu, g.point(0.5, 0.3)[2]]\n\
+         }}",
+        examples.join("caliber-groove.csv").display()
+    );
+    let access = Access {
+        input_dirs: vec![examples.clone()],
+    };
+    let fam = ScriptFamily::from_source(&src, "probe.rhai", &Limits::default(), &access).unwrap();
+    let values = pilgrim_kernel::params::resolve(
+        pilgrim_kernel::PartFamily::params(&fam),
+        &Default::default(),
+        &[],
+    )
+    .unwrap();
+    let got: Vec<f64> = fam
+        .call_with_params("probe", &values)
+        .unwrap()
+        .into_array()
+        .unwrap()
+        .into_iter()
+        .map(|d| d.as_float().unwrap_or_else(|_| d.as_int().unwrap() as f64))
+        .collect();
+    let t = pilgrim_kernel::read_table(examples.join("caliber-groove.csv")).unwrap();
+    let g =
+        Groove::from_tables(150.0, (&t, "theta_deg", "Hp_mm"), (&t, "theta_deg", "B_mm")).unwrap();
+    let (psi, rz) = g.pass_angles(10.0, 0.02, 1.4).unwrap();
+    let s = seed_pose(&g, 0.5, 0.3, 150.0, 10.0).unwrap();
+    let want = [
+        g.min_curvature_radius().unwrap().0,
+        psi.len() as f64,
+        rz,
+        s.x_k,
+        s.mu,
+        g.point(0.5, 0.3).unwrap().z,
+    ];
+    assert_eq!(got, want);
+}

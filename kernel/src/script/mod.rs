@@ -21,6 +21,7 @@
 //! doc comments, by [`api_reference`] (`docs/script-api.md`). A machine may
 //! be a script too ([`machine_from_script`]).
 
+mod bind_caliber;
 mod bind_offset;
 mod bind_profile;
 mod bind_table;
@@ -193,7 +194,9 @@ fn register_types(e: &mut Engine) {
         .register_type_with_name::<bind_transform::Transform>("Transform")
         .register_type_with_name::<bind_transform::Points>("Points")
         .register_type_with_name::<Table>("Table")
-        .register_type_with_name::<bind_toolpath::ToolpathHandle>("Toolpath");
+        .register_type_with_name::<bind_toolpath::ToolpathHandle>("Toolpath")
+        .register_type_with_name::<crate::caliber::Groove>("Groove")
+        .register_type_with_name::<crate::caliber::SeedPose>("SeedPose");
 }
 
 /// A group of the script API: its heading and what it registers.
@@ -203,7 +206,7 @@ struct Group {
 }
 
 /// The script API, group by group, as the reference lists it.
-const API: [Group; 9] = [
+const API: [Group; 10] = [
     Group {
         title: "Numbers (`Floats`)",
         register: |e, _| {
@@ -234,6 +237,12 @@ const API: [Group; 9] = [
             "Equidistants, envelopes, the steady rest (`Equidistant`, `SteadyRest`, `RestTrack`)",
         register: |e, _| {
             e.register_global_module(rhai::exported_module!(bind_offset::offset_api).into());
+        },
+    },
+    Group {
+        title: "Calibers: the groove, passes, the seed's pose (`Groove`, `SeedPose`)",
+        register: |e, _| {
+            e.register_global_module(rhai::exported_module!(bind_caliber::caliber_api).into());
         },
     },
     Group {
