@@ -1,35 +1,15 @@
 //! The `pilgrim` program, run as a user runs it.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn pilgrim(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_pilgrim"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-/// A fresh scratch directory for one test.
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("pilgrim-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 mod common;
 use common::shared_lib as lib;
+use common::{pilgrim, s};
+
+/// A fresh scratch directory for one test.
+fn scratch(name: &str) -> PathBuf {
+    common::scratch("cli", name)
+}
 
 /// The TOML text of the built-in data machine `name`.
 fn builtin_source(name: &str) -> &'static str {

@@ -104,16 +104,7 @@ fn finishing_blocks_stand_at_r_s_from_the_law() {
                 best = z;
             }
         }
-        let (mut a, mut c) = (best - 0.01, best + 0.01);
-        for _ in 0..100 {
-            let (m1, m2) = (a + 0.382 * (c - a), a + 0.618 * (c - a));
-            if d2(m1) < d2(m2) {
-                c = m2;
-            } else {
-                a = m1;
-            }
-        }
-        let dist = d2(0.5 * (a + c)).sqrt();
+        let dist = d2(common::golden_min(d2, best - 0.01, best + 0.01, 100)).sqrt();
         worst = worst.max((dist - R_S).abs());
         on += usize::from((dist - R_S).abs() <= 1e-4);
     }

@@ -10,7 +10,7 @@
 
 use pilgrim_kernel::program::{build, PostProcessor, SharedPost};
 use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
-use pilgrim_kernel::{ParamSource, Params, PartFamily, PartGeometry};
+use pilgrim_kernel::{Params, PartFamily, PartGeometry};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -25,24 +25,7 @@ fn family() -> ScriptFamily {
 /// The family's parameters: its defaults, then the TOML file `file` of
 /// `scripts/examples/` (if any), then `sets`.
 fn params(fam: &ScriptFamily, file: Option<&str>, sets: &[(&str, &str)]) -> Params {
-    let mut sources = Vec::new();
-    if let Some(f) = file {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("scripts/examples")
-            .join(f);
-        sources.push(ParamSource::Toml {
-            label: f.into(),
-            text: std::fs::read_to_string(path).unwrap(),
-        });
-    }
-    sources.push(ParamSource::Pairs {
-        label: "--set".into(),
-        pairs: sets
-            .iter()
-            .map(|(k, v)| ((*k).to_owned(), (*v).to_owned()))
-            .collect(),
-    });
-    pilgrim_kernel::params::resolve(fam.params(), &BTreeMap::new(), &sources).unwrap()
+    common::params_from(fam, &BTreeMap::new(), file, sets)
 }
 
 fn float(p: &Params, name: &str) -> f64 {
@@ -247,16 +230,8 @@ fn drop(surface: &dyn Fn(f64) -> f64, zr: f64, ro: f64, lo: f64, hi: f64) -> f64
         if !local || v[i] < best - 0.05 {
             continue;
         }
-        let (mut l, mut r) = (zs[i.saturating_sub(1)], zs[(i + 1).min(n)]);
-        for _ in 0..60 {
-            let (m1, m2) = (l + 0.382 * (r - l), l + 0.618 * (r - l));
-            if g(m1) < g(m2) {
-                l = m1;
-            } else {
-                r = m2;
-            }
-        }
-        out = out.max(g(0.5 * (l + r)));
+        let (l, r) = (zs[i.saturating_sub(1)], zs[(i + 1).min(n)]);
+        out = out.max(g(common::golden_min(|z| -g(z), l, r, 60)));
     }
     out
 }
@@ -440,15 +415,7 @@ fn verified(
         (v.from, v.to),
         tolerance.unwrap_or(v.tolerance),
     )
-    .unwrap_or_else(|e| {
-        let text = SharedPost.post(&program, "sinumerik").unwrap();
-        let lines: Vec<&str> = text.lines().collect();
-        let p4 = lines
-            .iter()
-            .position(|l| l.starts_with("; pass 4"))
-            .unwrap();
-        panic!("{e}\n{}", lines[p4 - 8..p4 + 14].join("\n"))
-    });
+    .unwrap();
     (
         check,
         SharedPost.post(&program, "sinumerik").unwrap(),

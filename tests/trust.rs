@@ -7,29 +7,8 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 mod common;
+use common::{pilgrim, pilgrim_in, root, s};
 
-fn pilgrim_in(dir: &Path, args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_pilgrim"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn pilgrim(args: &[&str]) -> (i32, String, String) {
-    pilgrim_in(root(), args)
-}
-
-/// Runs pilgrim, killing it after `limit`: `None` if it had to be killed.
 fn pilgrim_within(args: &[&str], limit: Duration) -> Option<(i32, String)> {
     let mut child = Command::new(env!("CARGO_BIN_EXE_pilgrim"))
         .current_dir(root())
@@ -56,14 +35,7 @@ fn pilgrim_within(args: &[&str], limit: Duration) -> Option<(i32, String)> {
 }
 
 fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("pilgrim-trust-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
+    common::scratch("trust", name)
 }
 
 const DEMO: &str = "scripts/examples/mill_circle.rhai";
@@ -442,30 +414,23 @@ fn fifos_are_refused() {
 #[test]
 fn errors_quote_short_excerpts() {
     let dir = scratch("long");
-    let params = dir.join("p.toml");
-    std::fs::write(&params, format!("radius = {}\n", "9".repeat(1 << 20))).unwrap();
-    let (code, _, err) = pilgrim(&[
-        "run",
-        DEMO,
-        "--params",
-        s(&params),
-        "--out",
-        s(&dir.join("o")),
-    ]);
-    assert_eq!(code, 1);
-    assert!(err.len() < 2000, "{} bytes of error", err.len());
-    let params = dir.join("q.toml");
-    std::fs::write(&params, format!("radius = \"{}\n", "x".repeat(1 << 20))).unwrap();
-    let (code, _, err) = pilgrim(&[
-        "run",
-        DEMO,
-        "--params",
-        s(&params),
-        "--out",
-        s(&dir.join("o")),
-    ]);
-    assert_eq!(code, 1);
-    assert!(err.len() < 2000, "{} bytes of error", err.len());
+    for (name, text) in [
+        ("p.toml", format!("radius = {}\n", "9".repeat(1 << 20))),
+        ("q.toml", format!("radius = \"{}\n", "x".repeat(1 << 20))),
+    ] {
+        let params = dir.join(name);
+        std::fs::write(&params, text).unwrap();
+        let (code, _, err) = pilgrim(&[
+            "run",
+            DEMO,
+            "--params",
+            s(&params),
+            "--out",
+            s(&dir.join("o")),
+        ]);
+        assert_eq!(code, 1);
+        assert!(err.len() < 2000, "{name}: {} bytes of error", err.len());
+    }
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -1,6 +1,7 @@
 //! Shared by the integration tests: the plugins' shared libraries.
 
 use std::path::{Path, PathBuf};
+use std::process::Command;
 use std::sync::OnceLock;
 
 /// The directory of this build's artifacts (target/<profile>).
@@ -72,16 +73,90 @@ pub fn params_on(
     constants: &std::collections::BTreeMap<String, f64>,
     sets: &[(&str, &str)],
 ) -> pilgrim_kernel::Params {
-    pilgrim_kernel::params::resolve(
-        family.params(),
-        constants,
-        &[pilgrim_kernel::ParamSource::Pairs {
-            label: "--set".into(),
-            pairs: sets
-                .iter()
-                .map(|(k, v)| ((*k).to_owned(), (*v).to_owned()))
-                .collect(),
-        }],
+    params_from(family, constants, None, sets)
+}
+
+/// The `pilgrim` program run in `dir` with `args`: exit code, stdout,
+/// stderr.
+#[allow(dead_code)]
+pub fn pilgrim_in(dir: &Path, args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_pilgrim"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
     )
-    .unwrap()
+}
+
+/// The repository's root (where `pilgrim` runs in the README's commands).
+#[allow(dead_code)]
+pub fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// `pilgrim` run in the repository's root.
+#[allow(dead_code)]
+pub fn pilgrim(args: &[&str]) -> (i32, String, String) {
+    pilgrim_in(root(), args)
+}
+
+/// A fresh scratch directory `pilgrim-<suite>-<pid>-<name>` for one test.
+#[allow(dead_code)]
+pub fn scratch(suite: &str, name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("pilgrim-{suite}-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A path as the text an argument takes.
+#[allow(dead_code)]
+pub fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// The family's parameters: its defaults, then the TOML file `file` of
+/// `scripts/examples/` (if any), then `NAME=VALUE` pairs, on a machine
+/// with `constants`.
+#[allow(dead_code)]
+pub fn params_from(
+    family: &dyn pilgrim_kernel::PartFamily,
+    constants: &std::collections::BTreeMap<String, f64>,
+    file: Option<&str>,
+    sets: &[(&str, &str)],
+) -> pilgrim_kernel::Params {
+    let mut sources = Vec::new();
+    if let Some(f) = file {
+        sources.push(pilgrim_kernel::ParamSource::Toml {
+            label: f.into(),
+            text: std::fs::read_to_string(root().join("scripts/examples").join(f)).unwrap(),
+        });
+    }
+    sources.push(pilgrim_kernel::ParamSource::Pairs {
+        label: "--set".into(),
+        pairs: sets
+            .iter()
+            .map(|(k, v)| ((*k).to_owned(), (*v).to_owned()))
+            .collect(),
+    });
+    pilgrim_kernel::params::resolve(family.params(), constants, &sources).unwrap()
+}
+
+/// Where the function `f`, unimodal on `[a, b]`, is smallest, to within
+/// `(b - a) 0.618^iterations` (golden sections).
+#[allow(dead_code)]
+pub fn golden_min(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64, iterations: usize) -> f64 {
+    for _ in 0..iterations {
+        let (m1, m2) = (a + 0.382 * (b - a), a + 0.618 * (b - a));
+        if f(m1) < f(m2) {
+            b = m2;
+        } else {
+            a = m1;
+        }
+    }
+    0.5 * (a + b)
 }

@@ -340,8 +340,7 @@ impl Groove {
     /// # Failures
     /// `theta` outside the tables.
     pub fn normal(&self, theta: Real, psi: Real) -> Result<Vec3, GrooveError> {
-        let (lo, hi) = self.theta_range();
-        let (t0, t1) = ((theta - DIFF_STEP).max(lo), (theta + DIFF_STEP).min(hi));
+        let (t0, t1) = self.theta_pair(theta);
         let d_theta = (self.point(t1, psi)? - self.point(t0, psi)?) / (t1 - t0);
         let d_psi = (self.point(theta, psi + DIFF_STEP)? - self.point(theta, psi - DIFF_STEP)?)
             / (2.0 * DIFF_STEP);
@@ -350,6 +349,13 @@ impl Groove {
         let centre = Vec3::new(self.r_d * theta.cos(), self.r_d * theta.sin(), 0.0);
         let p = self.point(theta, psi)?;
         Ok(if n.dot(&(centre - p)) >= 0.0 { n } else { -n })
+    }
+
+    /// The angles either side of `theta` that derivatives along theta are
+    /// taken between: `theta -+ 1e-6 rad`, one-sided at the tables' ends.
+    pub(super) fn theta_pair(&self, theta: Real) -> (Real, Real) {
+        let (lo, hi) = self.theta_range();
+        ((theta - DIFF_STEP).max(lo), (theta + DIFF_STEP).min(hi))
     }
 
     /// The smallest radius of curvature of the groove's sections, over the

@@ -116,7 +116,8 @@ pub struct SeedPose {
 /// The seed's pose of a wheel (largest radius `r_k0`, rounding `r_k`) on
 /// the pass at `psi` of `groove`, at `theta` (MATH §3.4 with its
 /// corrections: `psi_1` in S001-8, the `+` of the law of cosines in
-/// S001-9). Derivatives along theta are central differences of 1e-6 rad.
+/// S001-9). Derivatives along theta are central differences of 1e-6 rad
+/// (one-sided at the tables' ends), as the groove's normal's.
 ///
 /// # Failures
 /// `theta` outside the tables; radii not positive.
@@ -133,9 +134,7 @@ pub fn seed_pose(
     let (x_a, z_a) = section.point(psi);
     let psi_1 = section.normal_angle(psi);
     let r_d = groove.roll_radius();
-    let (lo, hi) = groove.theta_range();
-    let h = 1e-6;
-    let (t0, t1) = ((theta - h).max(lo), (theta + h).min(hi));
+    let (t0, t1) = groove.theta_pair(theta);
     let at = |t: Real| -> Result<(Real, Real), GrooveError> {
         let (x, z) = groove.section(t)?.point(psi);
         Ok((x, r_d - z))

@@ -156,33 +156,43 @@ pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInf
 
 /// The LZ-250's description.
 pub fn describe() -> MachineInfo {
-    caliber_grinder(
-        NAME,
-        "LZ-250 caliber grinder: roll turn A, axial X, radial Z, wheel swivel B",
-        false,
-    )
+    CaliberGrinder::<false>.describe()
 }
 
-/// The LZ-250.
-#[derive(Debug, Clone, Default)]
-pub struct Lz250;
+/// A caliber grinder as a plugin: the LZ-250 (`CROSS = false`) or, with
+/// the cross axis Y, the Mannesmann (`CROSS = true`, exported by the
+/// `mannesmann` crate).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct CaliberGrinder<const CROSS: bool>;
 
-impl Plugin for Lz250 {
+impl<const CROSS: bool> Plugin for CaliberGrinder<CROSS> {
     fn describe(&self) -> MachineInfo {
-        describe()
+        if CROSS {
+            caliber_grinder(
+                "Mannesmann",
+                "Mannesmann caliber grinder: roll turn A, axial X, radial Z, cross Y, wheel swivel B",
+                true,
+            )
+        } else {
+            caliber_grinder(
+                NAME,
+                "LZ-250 caliber grinder: roll turn A, axial X, radial Z, wheel swivel B",
+                false,
+            )
+        }
     }
 
-    /// Rows of `[X, Z, A, B]`.
+    /// Rows of `[X, Z, A, B]`, or `[X, Z, Y, A, B]` with the cross axis.
     fn inverse(&self, poses: &[f64], tool: &[f64; 6], out: &mut [f64]) -> Result<(), PluginError> {
-        CaliberKinematics { cross: false }.inverse(poses, tool, out)
+        CaliberKinematics { cross: CROSS }.inverse(poses, tool, out)
     }
 
     fn forward(&self, axes: &[f64], tool: &[f64; 6], out: &mut [f64]) -> Result<(), PluginError> {
-        CaliberKinematics { cross: false }.forward(axes, tool, out)
+        CaliberKinematics { cross: CROSS }.forward(axes, tool, out)
     }
 }
 
-export_plugin!(pilgrim_plugin_lz_250, Lz250);
+export_plugin!(pilgrim_plugin_lz_250, CaliberGrinder<false>);
 
 #[cfg(test)]
 mod tests {
