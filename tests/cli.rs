@@ -93,25 +93,6 @@ const FILES: [&str; 8] = [
     "scene.glb",
 ];
 
-/// Leaves a run's models for the external checkers of `.ci/run`.
-fn leave_for_checkers(dir: &Path, tag: &str) {
-    let exe = std::env::current_exe().unwrap();
-    let check = exe.ancestors().nth(3).unwrap().join("mesh-check");
-    std::fs::create_dir_all(&check).unwrap();
-    for f in [
-        "part.stl",
-        "blank.stl",
-        "cutter.stl",
-        "wheel.stl",
-        "rest.stl",
-        "scene.glb",
-    ] {
-        if dir.join(f).exists() {
-            std::fs::copy(dir.join(f), check.join(format!("{tag}-{f}"))).unwrap();
-        }
-    }
-}
-
 #[test]
 fn demo_writes_every_file_and_the_same_bytes_twice() {
     let dir = scratch("demo");
@@ -167,7 +148,7 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
             && (0.5 * (lo[1] + hi[1])).abs() < 1e-3,
         "{lo:?} {hi:?}"
     );
-    leave_for_checkers(&a, "demo");
+    common::leave_for_checkers(&a, "demo");
     // Export at another block: block 202 is the contour point at C = 196 deg
     // (block 6 is C = 0).
     let (code, out, err) = pilgrim(&["export", s(&a), "--block", "202"]);
@@ -189,7 +170,7 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
     let report: serde_json::Value =
         serde_json::from_slice(&std::fs::read(a.join("report.json")).unwrap()).unwrap();
     assert_eq!(report["pose_block"], 202);
-    leave_for_checkers(&a, "demo-block200");
+    common::leave_for_checkers(&a, "demo-block200");
     // On request: ASCII STL, and .gltf with its .bin.
     let c = dir.join("c");
     let (code, _, err) = pilgrim(&["run", DEMO, "--stl-ascii", "--gltf", "--out", s(&c)]);
@@ -407,7 +388,7 @@ fn every_script_runs_with_its_defaults() {
         assert_eq!(code, 0, "{}: {err}", script.display());
         assert!(out.join("report.json").exists());
         let stem = script.file_stem().unwrap().to_str().unwrap();
-        leave_for_checkers(&out, &format!("script-{stem}"));
+        common::leave_for_checkers(&out, &format!("script-{stem}"));
     }
 }
 

@@ -262,7 +262,12 @@ fn job(
     let tp = fam.toolpath(values).unwrap();
     let grinder = grinder();
     let program = build(&tp, &grinder, "mandrel").unwrap();
-    let v = fam.verification(values).unwrap().unwrap();
+    let v = fam
+        .verification(values)
+        .unwrap()
+        .unwrap()
+        .into_profile()
+        .unwrap();
     let passes = tp.passes.clone();
     let reference = tp.tool.reference;
     let pilgrim_kernel::ToolShape::Wheel(wheel) = tp.tool.shape else {

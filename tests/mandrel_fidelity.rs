@@ -401,7 +401,12 @@ fn verified(
     let tp = fam.toolpath(&values).unwrap();
     let machine = grinder();
     let program = build(&tp, &machine, "mandrel").unwrap();
-    let v = fam.verification(&values).unwrap().unwrap();
+    let v = fam
+        .verification(&values)
+        .unwrap()
+        .unwrap()
+        .into_profile()
+        .unwrap();
     let pilgrim_kernel::ToolShape::Wheel(wheel) = tp.tool.shape else {
         panic!("a wheel")
     };

@@ -36,6 +36,25 @@ pub struct VerifyRequest {
     pub tolerance: f64,
 }
 
+/// What a family's finished part must be, for the job's replay.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Verification {
+    /// A body of revolution ground by a wheel: the axial section.
+    Profile(VerifyRequest),
+    /// A caliber's groove ground by a torus wheel, replayed in 3-D.
+    Groove(Box<crate::caliber::GrooveRequest>),
+}
+
+impl Verification {
+    /// The axial-section request, if this is one.
+    pub fn into_profile(self) -> Option<VerifyRequest> {
+        match self {
+            Self::Profile(v) => Some(v),
+            Self::Groove(_) => None,
+        }
+    }
+}
+
 /// The geometry of one of a part's bodies.
 #[derive(Debug, Clone, PartialEq)]
 pub enum PartGeometry {
@@ -164,7 +183,7 @@ pub trait PartFamily {
     ///
     /// # Failures
     /// The family's own.
-    fn verification(&self, p: &Params) -> Result<Option<VerifyRequest>, FamilyError> {
+    fn verification(&self, p: &Params) -> Result<Option<Verification>, FamilyError> {
         let _ = p;
         Ok(None)
     }

@@ -64,7 +64,7 @@ pub mod verify;
 
 pub use catalog::{Catalog, OpenMachine};
 pub use error::Error;
-pub use family::{Check, PartBody, PartFamily, PartGeometry, VerifyRequest};
+pub use family::{Check, PartBody, PartFamily, PartGeometry, Verification, VerifyRequest};
 pub use input::InputError;
 pub use machine::{
     Axis, AxisKind, ChainMachine, Machine, MachineError, MachineInfo, MachineKinematics,

@@ -206,6 +206,16 @@ pub fn floor_index(xs: &[Real], x: Real) -> Option<usize> {
     n.checked_sub(1)
 }
 
+/// The angle `t` (rad) in `(-pi, pi]`.
+pub fn wrap_angle(t: Real) -> Real {
+    let w = t.rem_euclid(std::f64::consts::TAU);
+    if w > std::f64::consts::PI {
+        w - std::f64::consts::TAU
+    } else {
+        w
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

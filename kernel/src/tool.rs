@@ -124,6 +124,29 @@ pub struct Tool {
     pub shape: ToolShape,
     /// The tracked point and axis in the tool's frame.
     pub reference: ToolFrame,
+    /// Where a wheel's frame has its origin (how its solid is placed).
+    #[serde(default, skip_serializing_if = "WheelOrigin::is_periphery")]
+    pub origin: WheelOrigin,
+}
+
+/// Where a wheel's own frame has its origin: the machine's programmed point
+/// on the wheel (the tool frame of its chain).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WheelOrigin {
+    /// The lowest point of the periphery, the wheel's axis along +Z at
+    /// `x = diameter / 2` (the 3K152VF20: the seed programs that point).
+    #[default]
+    Periphery,
+    /// The wheel's centre, its axis along +Z (the caliber grinders).
+    Centre,
+}
+
+impl WheelOrigin {
+    /// Whether this is the default, [`Self::Periphery`].
+    pub fn is_periphery(&self) -> bool {
+        *self == Self::Periphery
+    }
 }
 
 impl Tool {
@@ -139,6 +162,19 @@ impl Tool {
                 point: Point3::new(wheel.rounding_radius, 0.0, 0.0),
                 axis: Vec3::z(),
             },
+            origin: WheelOrigin::Periphery,
+        }
+    }
+
+    /// A wheel whose programmed and tracked point is its centre, its axis
+    /// along +Z (the caliber grinders' tool frame, MATH §3.5).
+    pub fn wheel_at_centre(name: &str, number: u32, wheel: Wheel) -> Self {
+        Self {
+            name: name.to_owned(),
+            number,
+            shape: ToolShape::Wheel(wheel),
+            reference: ToolFrame::default(),
+            origin: WheelOrigin::Centre,
         }
     }
 
@@ -159,6 +195,7 @@ impl Tool {
             number,
             shape: ToolShape::EndMill { diameter, length },
             reference: ToolFrame::default(),
+            origin: WheelOrigin::Periphery,
         })
     }
 }

@@ -29,7 +29,9 @@ pub struct ClPoint {
     pub axis: [Real; 3],
     /// How the point is reached.
     pub motion: Motion,
-    /// Feed (mm/min) of the move to this point (ignored for rapids).
+    /// Feed (mm/min) of the move to this point: the tracked point's speed
+    /// relative to the part (ignored for rapids). A program's F is the
+    /// control's reading of it (the same unless a rotary axis moves).
     pub feed: Real,
     /// Auxiliary values, in the order of [`Toolpath::aux_names`].
     #[serde(default)]
@@ -78,6 +80,32 @@ pub struct Toolpath {
     /// Figures the family reports about the toolpath (name to number).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub notes: BTreeMap<String, Real>,
+    /// Tables the family reports (name to columns of equal length).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub tables: BTreeMap<String, BTreeMap<String, Vec<Real>>>,
+    /// Charts the run draws from the tables.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub plots: Vec<PlotSpec>,
+}
+
+/// A chart a run draws (`<file>.svg`) from one of the toolpath's tables:
+/// the columns `y` against the column `x`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlotSpec {
+    /// The file's name without `.svg` (a plain name).
+    pub file: String,
+    /// The chart's title.
+    pub title: String,
+    /// The table.
+    pub table: String,
+    /// The column along the horizontal axis.
+    pub x: String,
+    /// The columns drawn, each a line with its name in the legend.
+    pub y: Vec<String>,
+    /// The horizontal axis's label (with its unit).
+    pub x_label: String,
+    /// The vertical axis's label (with its unit).
+    pub y_label: String,
 }
 
 /// The most points a toolpath may have (and so blocks a program): 2
@@ -114,6 +142,8 @@ impl Toolpath {
             aux_names,
             passes: Vec::new(),
             notes: BTreeMap::new(),
+            tables: BTreeMap::new(),
+            plots: Vec::new(),
         }
     }
 

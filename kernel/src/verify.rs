@@ -31,6 +31,9 @@ pub enum VerifyError {
     /// A surface that cannot be built or compared.
     #[error(transparent)]
     Profile(#[from] ProfileError),
+    /// The groove cannot be evaluated where the replay measures it.
+    #[error(transparent)]
+    GrooveGeometry(#[from] crate::caliber::GrooveError),
     /// The program cannot be replayed on the machine: a block beyond it,
     /// an axis it lacks.
     #[error("{0}")]
@@ -81,6 +84,26 @@ pub enum VerifyError {
         feed_per_rev: Real,
         /// The ridge that feed leaves (mm).
         ridge: Real,
+        /// The tolerance (mm).
+        tolerance: Real,
+    },
+    /// The finished groove strays from the nominal beyond the tolerance.
+    #[error(
+        "verification failed: the finished groove strays {} mm from the nominal at theta = {} deg, psi = {} deg, \
+         where {block} leaves it (tolerance {tolerance} mm; positive: material left, negative: a gouge)",
+        crate::math::fixed(*deviation, 5),
+        crate::math::fixed(*theta_deg, 3),
+        crate::math::fixed(*psi_deg, 3)
+    )]
+    Groove {
+        /// The signed deviation (mm).
+        deviation: Real,
+        /// Where: theta (deg).
+        theta_deg: Real,
+        /// Where: psi (deg).
+        psi_deg: Real,
+        /// The block whose wheel is nearest there, as the program names it.
+        block: String,
         /// The tolerance (mm).
         tolerance: Real,
     },
@@ -280,7 +303,7 @@ pub fn check_grinding(
                 .filter(|(_, ax)| ax.is_some())
                 .map(|((p, q), _)| q - p)
                 .collect();
-            let path = crate::machine::move_length(&known, &deltas);
+            let path = crate::machine::feed_length(&known, &deltas, &info.setup.feed_group);
             let line = (z[i] - z[i - 1]).hypot(x[i] - x[i - 1]);
             let f = if b.motion == crate::toolpath::Motion::Rapid {
                 info.axes

@@ -138,8 +138,10 @@ impl Groove {
             }
         }
         let theta: Vec<Real> = ht.iter().map(|t| t.to_radians()).collect();
+        // Evaluated point by point: the Hermite slopes estimated once.
         let profile = |table, x: &[Real]| {
             Profile::new(theta.clone(), x.to_vec())
+                .map(Profile::with_slopes_kept)
                 .map_err(|source| GrooveError::Table { table, source })
         };
         Ok(Self {
@@ -290,6 +292,54 @@ impl Groove {
             .fold(0.0, Real::max);
         let rz = super::scallop_height(widest, r_k, step)?;
         Ok(((0..=n).map(|i| -psi_max + step * i as Real).collect(), rz))
+    }
+
+    /// The node (row, from 0) in the middle of the sizing section: the
+    /// longest run of rows of one depth (the groove that sizes the tube),
+    /// the smoothing's default anchor (MATH §3.2: its length shrinks
+    /// least); the middle row if no two rows have one depth.
+    pub fn sizing_middle(&self) -> usize {
+        let x = self.hp.x();
+        let (mut best, mut start) = ((0, 0), 0);
+        for i in 1..=x.len() {
+            if i == x.len() || (x[i] - x[i - 1]).abs() > 1e-9 {
+                if i - 1 - start > best.1 - best.0 {
+                    best = (start, i - 1);
+                }
+                start = i;
+            }
+        }
+        if best.1 > best.0 {
+            (best.0 + best.1) / 2
+        } else {
+            x.len() / 2
+        }
+    }
+
+    /// The groove with both tables smoothed (MATH §3.2,
+    /// [`Profile::smooth_derivative`]): `iterations` of the three-point
+    /// rule on the first differences, rebuilt from the row `anchor`; with
+    /// what smoothing did to Hp and to B.
+    ///
+    /// # Failures
+    /// An anchor beyond the tables; a rebuilt depth or width that is not
+    /// positive (named as the tables' errors are).
+    pub fn smoothed(
+        &self,
+        iterations: usize,
+        anchor: usize,
+    ) -> Result<(Self, crate::profile::Smoothing, crate::profile::Smoothing), GrooveError> {
+        let hp = self.hp.smooth_derivative(iterations, anchor)?;
+        let b = self.b.smooth_derivative(iterations, anchor)?;
+        let deg: Vec<Real> = self.hp.z().iter().map(|t| t.to_degrees()).collect();
+        let g = Self::new(self.r_d, (&deg, &deg), hp.profile.x(), b.profile.x())?;
+        // The same angles exactly (not through degrees and back).
+        let g = Self {
+            hp: Profile::new(self.hp.z().to_vec(), g.hp.x().to_vec())?.with_slopes_kept(),
+            b: Profile::new(self.b.z().to_vec(), g.b.x().to_vec())?.with_slopes_kept(),
+            ..g
+        };
+        Ok((g, hp, b))
     }
 
     /// The roll's radius (mm).

@@ -10,17 +10,28 @@
 //! - [`seed_pose`]: the seed's wheel centre and corrections (MATH §3.4);
 //!   [`TorusWheel`] and [`exact_pose`]: the torus touching the groove at a
 //!   point with its normal, and the distance of any point from it;
+//! - [`pass_poses`]: a pass's exact poses at a uniform step of the roll's
+//!   turn, within what the machine reaches ([`SwivelPlane`]);
+//! - [`check_groove`]: the program replayed in 3-D against the groove, and
+//!   the [`contact_patch`] at a block;
 //! - [`caliber_solid`]: the roll's sector with its groove as a closed mesh.
 //!
 //! The roll's frame: Z along the roll's axis, the section at `theta = 0` in
 //! the XZ plane, `theta` turning right-handed about +Z (ARCHITECTURE §3).
 
+mod check;
 mod groove;
+mod pass;
 mod pose;
 mod scallop;
 mod solid;
 
+pub use check::{
+    check_groove, contact_patch, wheel_distance, ContactPatch, GrooveCheck, GroovePlace,
+    GrooveRequest, NEIGHBOUR_PASSES,
+};
 pub use groove::{Groove, GrooveError};
+pub use pass::{pass_poses, pose_at, PassPose, SwivelPlane, MAX_PASS_BLOCKS};
 pub use pose::{exact_pose, seed_pose, SeedPose, TorusWheel};
 pub use scallop::{scallop_height, step_for_scallop};
 pub use solid::{caliber_solid, SolidError};

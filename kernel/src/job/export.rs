@@ -104,7 +104,7 @@ pub fn export(
     let pose = scene::tool_pose(&program, kin, &toolpath.tool, index)?;
     let tool = scene::tool_mesh(&toolpath.tool, report.mesh_tolerance_mm)?;
     let others = scene::machine_bodies(kin, &program, index, report.mesh_tolerance_mm)?;
-    let (files, bodies) = scene::files(&parts, tool, pose, others, formats)?;
+    let (files, bodies) = scene::files(&parts, tool, pose, others, vec![], formats)?;
     report.pose_block = Some(index + 1);
     report.bodies = bodies;
     let mut all: Vec<(String, Vec<u8>)> = files

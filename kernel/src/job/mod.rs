@@ -11,6 +11,7 @@
 //! (the `pilgrim` program writes them atomically). [`export`] places a
 //! finished run's tool at another block.
 
+mod chart;
 mod export;
 mod report;
 mod scene;
@@ -22,7 +23,7 @@ pub use scene::{default_pose_block, BodyFile, Formats, SceneError};
 
 use crate::catalog::OpenMachine;
 use crate::error::Error;
-use crate::family::{PartFamily, PartGeometry};
+use crate::family::{PartFamily, PartGeometry, Verification};
 use crate::params::{resolve, ParamSource, ParamValue, Params};
 use crate::program::post::{dialect, CLD};
 use crate::program::{build, AxisProgram};
@@ -76,6 +77,8 @@ pub struct JobOutput {
     pub program: AxisProgram,
     /// The program replayed against the nominal, if the family asked.
     pub verification: Option<GrindingCheck>,
+    /// The caliber program replayed in 3-D, if the family asked.
+    pub groove: Option<crate::caliber::GrooveCheck>,
     /// The report.
     pub report: Report,
     /// Every file's name and bytes, in the order they were made.
@@ -96,6 +99,16 @@ impl JobOutput {
                     ", finish within {} mm of nominal",
                     crate::math::fixed(p.deviation.max_abs, 5)
                 )
+            })
+            .or_else(|| {
+                self.groove.as_ref().map(|g| {
+                    format!(
+                        ", groove within {} mm of nominal (material left {} mm, gouge {} mm)",
+                        crate::math::fixed(g.max_abs_mm, 5),
+                        crate::math::fixed(g.max_left.mm, 5),
+                        crate::math::fixed(g.max_gouge.mm, 5)
+                    )
+                })
             })
             .unwrap_or_default();
         format!(
@@ -199,7 +212,28 @@ pub fn run(
     let toolpath = family.toolpath(&values)?;
     stage(STAGES[2]);
     let program = build(&toolpath, kin, &options.program_name)?;
-    let nominal = family.verification(&values)?;
+    let requested = family.verification(&values)?;
+    let pose_index = match options.pose_block {
+        Some(0) => return Err(Error::Options("--pose-block counts blocks from 1".into())),
+        Some(n) => n - 1,
+        None => default_pose_block(&program, &toolpath.passes),
+    };
+    let (nominal, groove_request) = match requested {
+        None => (None, None),
+        Some(Verification::Profile(v)) => (Some(v), None),
+        Some(Verification::Groove(g)) => (None, Some(g)),
+    };
+    let groove = match &groove_request {
+        None => None,
+        Some(g) => Some(crate::caliber::check_groove(
+            &program,
+            kin,
+            &toolpath.tool.reference,
+            &toolpath.passes,
+            g,
+            Some(pose_index),
+        )?),
+    };
     let verification = match &nominal {
         None => None,
         Some(v) => {
@@ -260,15 +294,29 @@ pub fn run(
             family: family.name().to_owned(),
             source,
         })?;
-        let index = match options.pose_block {
-            Some(0) => return Err(Error::Options("--pose-block counts blocks from 1".into())),
-            Some(n) => n - 1,
-            None => default_pose_block(&program, &toolpath.passes),
-        };
+        let index = pose_index;
         let pose = scene::tool_pose(&program, kin, &toolpath.tool, index)?;
         let tool = scene::tool_mesh(&toolpath.tool, tol)?;
         let others = scene::machine_bodies(kin, &program, index, tol)?;
-        let (mesh_files, bodies) = scene::files(&meshes, tool, pose, others, options.formats)?;
+        let overlays = match &groove_request {
+            Some(g) => {
+                let (_, patch) = crate::caliber::contact_patch(
+                    &crate::verify::as_written(&program).0,
+                    kin,
+                    &toolpath.tool.reference,
+                    g,
+                    index,
+                )?;
+                vec![(
+                    "contact_patch".to_owned(),
+                    patch,
+                    crate::math::Mat4::identity(),
+                )]
+            }
+            None => vec![],
+        };
+        let (mesh_files, bodies) =
+            scene::files(&meshes, tool, pose, others, overlays, options.formats)?;
         files.extend(mesh_files);
         (Some(index + 1), bodies)
     };
@@ -307,8 +355,27 @@ pub fn run(
         bodies,
         axis_ranges: axis_ranges(&program),
         verification: verification.clone(),
+        groove_verification: groove.clone(),
         notes: toolpath.notes.clone(),
+        tables: toolpath.tables.clone(),
     };
+    for plot in &toolpath.plots {
+        let text = chart::chart_svg(&toolpath, plot).map_err(|message| {
+            Error::Family(crate::family::FamilyError::Contract {
+                family: family.name().to_owned(),
+                message,
+            })
+        })?;
+        let name = format!("{}.svg", plot.file);
+        if files.iter().any(|f| f.0 == name) || name == "profile.svg" {
+            return Err(Error::Family(crate::family::FamilyError::Contract {
+                family: family.name().to_owned(),
+                message: format!("plot {}: a file of that name is written already", plot.file),
+            }));
+        }
+        files.push((name.clone(), text.into_bytes()));
+        report.files.push(name);
+    }
     if let (Some(v), ToolShape::Wheel(w)) = (&nominal, toolpath.tool.shape) {
         let profiles: Vec<(String, crate::profile::Profile)> = parts
             .iter()
@@ -335,6 +402,7 @@ pub fn run(
         toolpath,
         program,
         verification,
+        groove,
         report,
         files,
     })

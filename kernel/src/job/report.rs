@@ -3,7 +3,7 @@
 
 use super::scene::BodyFile;
 use crate::family::Check;
-use crate::machine::{move_length, Axis, MachineInfo};
+use crate::machine::{feed_length, Axis, MachineInfo};
 use crate::math::{fixed, Real};
 use crate::params::ParamValue;
 use crate::program::{block_label, AxisProgram};
@@ -66,9 +66,16 @@ pub struct Report {
     /// The program replayed against the nominal part (families that ask).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub verification: Option<GrindingCheck>,
+    /// The caliber program replayed in 3-D against the groove (families
+    /// that ask).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub groove_verification: Option<crate::caliber::GrooveCheck>,
     /// Figures the family noted.
     #[serde(default)]
     pub notes: BTreeMap<String, f64>,
+    /// Tables the family reported (name to columns).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub tables: BTreeMap<String, BTreeMap<String, Vec<f64>>>,
 }
 
 /// Each programmed axis's range over the program: `[min, max]` in program
@@ -87,15 +94,23 @@ pub fn axis_ranges(program: &AxisProgram) -> BTreeMap<String, [f64; 2]> {
 }
 
 /// Minutes of cutting and rapid moves: a feed move lasts its length
-/// ([`move_length`], the model the feed checks use) over its feed; a rapid
+/// ([`feed_length`], the model the feed checks use) over its feed; a rapid
 /// as long as its slowest axis at that axis's maximum speed.
 pub fn cycle_time(program: &AxisProgram, info: &MachineInfo) -> Real {
     let axes: Vec<Option<&Axis>> = program.axes.iter().map(|a| info.axis(&a.name)).collect();
     let known: Vec<&Axis> = axes.iter().flatten().copied().collect();
     let mut minutes = 0.0;
-    for w in program.blocks.windows(2) {
-        let (a, b) = (&w[0], &w[1]);
-        let deltas: Vec<Real> = a.values.iter().zip(&b.values).map(|(x, y)| y - x).collect();
+    // As the control reads the program: its values as written.
+    let scale = 10f64.powi(crate::program::written_decimals(info) as i32);
+    let w = |v: &Real| (v * scale).round() / scale;
+    for pair in program.blocks.windows(2) {
+        let (a, b) = (&pair[0], &pair[1]);
+        let deltas: Vec<Real> = a
+            .values
+            .iter()
+            .zip(&b.values)
+            .map(|(x, y)| w(y) - w(x))
+            .collect();
         minutes += match b.motion {
             Motion::Rapid => axes
                 .iter()
@@ -109,7 +124,7 @@ pub fn cycle_time(program: &AxisProgram, info: &MachineInfo) -> Real {
                     .filter(|(ax, _)| ax.is_some())
                     .map(|(_, d)| *d)
                     .collect();
-                move_length(&known, &known_deltas) / b.feed
+                feed_length(&known, &known_deltas, &info.setup.feed_group) / b.feed
             }
             _ => 0.0,
         };

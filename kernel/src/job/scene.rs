@@ -8,7 +8,7 @@ use crate::math::{Mat4, Point3, Vec3};
 use crate::mesh::{self, frame_from_pose, MeshError, Scene, StlFormat, TriMesh};
 use crate::program::pass_blocks;
 use crate::program::{axis_rows, AxisProgram};
-use crate::tool::{Tool, ToolShape};
+use crate::tool::{Tool, ToolShape, WheelOrigin};
 use crate::toolpath::Pass;
 use serde::{Deserialize, Serialize};
 
@@ -30,6 +30,7 @@ pub struct BodyFile {
 const PART_COLOR: [f32; 4] = [0.72, 0.72, 0.76, 1.0];
 const TOOL_COLOR: [f32; 4] = [0.25, 0.42, 0.85, 1.0];
 const MACHINE_COLOR: [f32; 4] = [0.85, 0.55, 0.2, 1.0];
+const OVERLAY_COLOR: [f32; 4] = [0.9, 0.1, 0.1, 1.0];
 
 /// Why the scene could not be made.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -78,7 +79,18 @@ pub fn part_meshes(parts: &[PartBody], tol: f64) -> Result<Vec<(String, TriMesh)
 /// The tool's mesh failing.
 pub fn tool_mesh(tool: &Tool, tol: f64) -> Result<Option<(TriMesh, &'static str)>, SceneError> {
     Ok(match tool.shape {
-        ToolShape::Wheel(w) => Some((mesh::wheel(&w, tol).map_err(mesh_err("wheel"))?, "wheel")),
+        ToolShape::Wheel(w) => {
+            let m = mesh::wheel(&w, tol).map_err(mesh_err("wheel"))?;
+            let m = match tool.origin {
+                WheelOrigin::Periphery => m,
+                WheelOrigin::Centre => m.transformed(&Mat4::new_translation(&Vec3::new(
+                    -0.5 * w.diameter,
+                    0.0,
+                    0.0,
+                ))),
+            };
+            Some((m, "wheel"))
+        }
         ToolShape::EndMill { diameter, length } => Some((
             mesh::cylinder(diameter / 2.0, length, tol).map_err(mesh_err("cutter"))?,
             "cutter",
@@ -182,7 +194,8 @@ pub type Files = Vec<(String, Vec<u8>)>;
 
 /// The files of the scene: each part body's STL, the tool's STL placed at
 /// the block, the machine's bodies' STLs, and `scene.glb`; with the bodies'
-/// records.
+/// records. `overlays` are surfaces shown in the scene only (a contact
+/// patch: open meshes, no STL).
 ///
 /// # Failures
 /// A mesh that is not closed, or a writer failing.
@@ -191,6 +204,7 @@ pub fn files(
     tool: Option<(TriMesh, &'static str)>,
     tool_pose: Mat4,
     others: Vec<Placed>,
+    overlays: Vec<Placed>,
     formats: Formats,
 ) -> Result<(Files, Vec<BodyFile>), SceneError> {
     let mut scene = Scene::new();
@@ -231,6 +245,9 @@ pub fn files(
     for (name, m, pose) in others {
         stl(&name, "machine", &m.transformed(&pose), &mut out)?;
         scene.add(&name, m, pose, MACHINE_COLOR);
+    }
+    for (name, m, pose) in overlays {
+        scene.add(&name, m, pose, OVERLAY_COLOR);
     }
     let mut glb = Vec::new();
     mesh::write_glb(&scene, &mut glb).map_err(mesh_err("scene"))?;

@@ -462,7 +462,8 @@ fn check_setup(info: &MachineInfo) -> Result<(), Invalid> {
         .map(|a| (a, true))
         .chain(s.approach.iter().flatten().map(|a| (a, false)))
         .chain(s.retract.iter().flatten().map(|a| (a, true)))
-        .chain(s.clear.keys().map(|a| (a, false)));
+        .chain(s.clear.keys().map(|a| (a, false)))
+        .chain(s.feed_group.iter().map(|a| (a, false)));
     for (name, needs_clear) in named {
         let Some(axis) = info.axis(name).filter(|a| a.is_programmed()) else {
             return bad(format!(

@@ -363,6 +363,26 @@ pub const LINEAR_RESOLUTION: Real = 1e-4;
 /// deg/min). `deltas` are the axes' changes in program units (mm, deg), one
 /// per axis of `axes`.
 pub fn move_length(axes: &[&Axis], deltas: &[Real]) -> Real {
+    feed_length(axes, deltas, &[])
+}
+
+/// [`move_length`] on a control whose feed is the path of the axes
+/// `group` (Sinumerik `FGROUP`, [`ProgramSetup::feed_group`]): their path
+/// (mm and degrees summed alike, as the control does without `FGREF`)
+/// where one of them moves, else [`move_length`]'s.
+pub fn feed_length(axes: &[&Axis], deltas: &[Real], group: &[String]) -> Real {
+    if !group.is_empty() {
+        let g = axes
+            .iter()
+            .zip(deltas)
+            .filter(|(a, _)| group.contains(&a.name))
+            .map(|(_, d)| d * d)
+            .sum::<Real>()
+            .sqrt();
+        if g > 1e-9 {
+            return g;
+        }
+    }
     let length_of = |kind: AxisKind| -> Real {
         axes.iter()
             .zip(deltas)
@@ -390,6 +410,20 @@ pub fn move_length(axes: &[&Axis], deltas: &[Real]) -> Real {
 /// [`MachineError::FeedExceeded`] naming the first offending point and axis;
 /// a feed that is not positive; a ragged batch.
 pub fn check_feed(axes: &[&Axis], rows: &[Real], feeds: &[Real]) -> Result<(), MachineError> {
+    check_feed_grouped(axes, rows, feeds, &[])
+}
+
+/// [`check_feed`] on a control whose feed is the path of `group`
+/// ([`feed_length`]).
+///
+/// # Failures
+/// As [`check_feed`].
+pub fn check_feed_grouped(
+    axes: &[&Axis],
+    rows: &[Real],
+    feeds: &[Real],
+    group: &[String],
+) -> Result<(), MachineError> {
     let n = check_rows(axes, rows)?;
     let w = axes.len();
     if feeds.len() != n {
@@ -412,7 +446,7 @@ pub fn check_feed(axes: &[&Axis], rows: &[Real], feeds: &[Real]) -> Result<(), M
         }
         let user_delta = |i: usize| axes[i].to_user(a1[i]) - axes[i].to_user(a0[i]);
         let deltas: Vec<Real> = (0..w).map(user_delta).collect();
-        let path = move_length(axes, &deltas);
+        let path = feed_length(axes, &deltas, group);
         if path == 0.0 {
             continue;
         }
@@ -440,6 +474,28 @@ pub fn check_feed(axes: &[&Axis], rows: &[Real], feeds: &[Real]) -> Result<(), M
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The feed's length: the linear path, the turn of a move that only
+    /// turns, and with a feed group (FGROUP(A)) the group's motion where
+    /// it moves, the linear path where it does not.
+    #[test]
+    fn feed_lengths_follow_the_control() {
+        let m = Machine::builtin("LZ-250").unwrap();
+        let axes: Vec<&Axis> = ["X", "Z", "A", "B"]
+            .iter()
+            .map(|n| m.info().axis(n).unwrap())
+            .collect();
+        assert_eq!(move_length(&axes, &[3.0, 4.0, 10.0, 1.0]), 5.0);
+        assert_eq!(move_length(&axes, &[0.0, 0.0, 3.0, 4.0]), 5.0);
+        let group = vec!["A".to_owned()];
+        assert_eq!(feed_length(&axes, &[3.0, 4.0, 2.0, 1.0], &group), 2.0);
+        assert_eq!(feed_length(&axes, &[3.0, 4.0, 0.0, 1.0], &group), 5.0);
+        assert_eq!(
+            m.info().setup.feed_group,
+            group,
+            "the caliber grinders' F is the roll's turn"
+        );
+    }
 
     #[test]
     fn travel_and_feed_errors_name_point_and_axis() {

@@ -227,6 +227,17 @@ impl Profile {
         Ok(p)
     }
 
+    /// The profile with its estimated node slopes ([`Self::slopes`]) kept,
+    /// so that evaluating it does not estimate them again each time: the
+    /// same curve, for profiles evaluated point by point (a groove's
+    /// tables).
+    pub fn with_slopes_kept(mut self) -> Self {
+        if self.dx.is_none() {
+            self.dx = Some(self.slopes().into_owned());
+        }
+        self
+    }
+
     /// Number of nodes (at least [`MIN_POINTS`]).
     pub fn len(&self) -> usize {
         self.z.len()

@@ -218,6 +218,53 @@ fn name_in(control: &str, blocks: &[Block], index: usize) -> String {
     }
 }
 
+/// The decimals a program for `info` writes its axis values with.
+pub fn written_decimals(info: &MachineInfo) -> usize {
+    info.program_decimals
+        .or_else(|| post::dialect(&info.control).map(|d| d.decimals))
+        .unwrap_or(3)
+}
+
+/// Where a cutting block turns a rotary axis, its feed becomes the
+/// control's: the toolpath's feed is the tracked point's speed relative to
+/// the part, while a control (Sinumerik, Fanuc, G94) reads F as the path
+/// feed of the linear axes, in deg/min on a move that only turns, or of
+/// the machine's feed group ([`crate::machine::feed_length`]), over the
+/// values as written. The block's F is set so that the
+/// move takes the time the tracked point needs at the toolpath's feed over
+/// the chord between the two points; blocks that turn nothing keep their
+/// feed. `blocks` are the toolpath's, one per point, in order.
+fn rotary_feeds(blocks: &mut [Block], axes: &[&Axis], toolpath: &Toolpath, info: &MachineInfo) {
+    let scale = 10f64.powi(written_decimals(info) as i32);
+    let written = |v: Real| (v * scale).round() / scale;
+    let points: Vec<&crate::toolpath::ClPoint> = toolpath.points().map(|(_, _, c)| c).collect();
+    for k in 1..blocks.len().min(points.len()) {
+        if blocks[k].motion != Motion::Linear {
+            continue;
+        }
+        let deltas: Vec<Real> = blocks[k]
+            .values
+            .iter()
+            .zip(&blocks[k - 1].values)
+            .map(|(b, a)| written(*b) - written(*a))
+            .collect();
+        let turns = axes
+            .iter()
+            .zip(&deltas)
+            .any(|(a, d)| a.kind == AxisKind::Rotary && d.abs() > 1e-12);
+        let (p, q) = (points[k - 1].point, points[k].point);
+        let chord = ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2) + (q[2] - p[2]).powi(2)).sqrt();
+        if !turns || !(chord > 0.0) {
+            continue;
+        }
+        let minutes = chord / blocks[k].feed;
+        let length = crate::machine::feed_length(axes, &deltas, &info.setup.feed_group);
+        if length > 0.0 {
+            blocks[k].feed = length / minutes;
+        }
+    }
+}
+
 /// The program for `toolpath` on `machine`: inverse kinematics of every
 /// point (one batch), auxiliary values mapped to the machine's axes of
 /// the same names (an auxiliary value named like an axis inverse
@@ -225,7 +272,8 @@ fn name_in(control: &str, blocks: &[Block], index: usize) -> String {
 /// it), values in program units; the machine's start before the first
 /// point (its axes cleared, then brought in, group by group, as its setup
 /// says: [`ProgramSetup`]) and its end after the last; then every word
-/// checked against the machine: travel, feeds (each axis's and the
+/// checked against the machine: travel, feeds ([`rotary_feeds`] where a
+/// rotary axis moves) (each axis's and the
 /// least), the spindle's speed. Every pass's first block carries the
 /// pass's name as a comment; the start's and the end's blocks carry
 /// `start` and `end`.
@@ -377,6 +425,8 @@ pub fn build(
             keep: Vec::new(),
         });
     }
+    let col_axes: Vec<&Axis> = columns.iter().map(|(a, _)| *a).collect();
+    rotary_feeds(&mut blocks, &col_axes, toolpath, info);
     let names: Vec<&str> = columns.iter().map(|(a, _)| a.name.as_str()).collect();
     let blocks = with_start_and_end(blocks, &names, &info.setup);
     let name_of = |i: usize| name_in(&info.control, &blocks, i);
@@ -395,15 +445,19 @@ pub fn build(
         });
     }
     let axes_refs: Vec<&Axis> = columns.iter().map(|(a, _)| *a).collect();
-    let rows_internal: Vec<Real> = blocks
-        .iter()
-        .flat_map(|b| {
-            axes_refs
-                .iter()
-                .zip(&b.values)
-                .map(|(a, v)| a.from_user(*v))
-        })
-        .collect();
+    // Rows in kernel units, each value first mapped by `f`.
+    let rows = |f: &dyn Fn(Real) -> Real| -> Vec<Real> {
+        blocks
+            .iter()
+            .flat_map(|b| {
+                axes_refs
+                    .iter()
+                    .zip(&b.values)
+                    .map(|(a, v)| a.from_user(f(*v)))
+            })
+            .collect()
+    };
+    let rows_internal = rows(&|v| v);
     crate::machine::check_travel(&axes_refs, &rows_internal)
         .map_err(|e| ProgramError::from_limit(&info.name, e, name_of))?;
     // Feed: rapid blocks move at the machine's rapid rate, not checked.
@@ -417,7 +471,10 @@ pub fn build(
             }
         })
         .collect();
-    crate::machine::check_feed(&axes_refs, &rows_internal, &feeds)
+    // Speeds as the control runs the program: its values as written.
+    let scale = 10f64.powi(written_decimals(info) as i32);
+    let rows_written = rows(&|v| (v * scale).round() / scale);
+    crate::machine::check_feed_grouped(&axes_refs, &rows_written, &feeds, &info.setup.feed_group)
         .map_err(|e| ProgramError::from_limit(&info.name, e, name_of))?;
     Ok(AxisProgram {
         name: program_name(name),

@@ -108,6 +108,9 @@ pub struct Dialect {
     pub radial_words: Option<(&'static str, &'static str)>,
     /// Coolant on and off.
     pub coolant: (&'static str, &'static str),
+    /// The instruction naming the axes the feed is the path of
+    /// ([`ProgramSetup::feed_group`]: `FGROUP` on Sinumerik), or `None`.
+    pub feed_group: Option<&'static str>,
 }
 
 /// Siemens Sinumerik 840D part program (`.MPF`).
@@ -142,6 +145,7 @@ pub const SINUMERIK: Dialect = Dialect {
     lead_decimals: 4,
     radial_words: Some(("DIAMOF", "DIAMON")),
     coolant: ("M8", "M9"),
+    feed_group: Some("FGROUP"),
 };
 
 /// Fanuc 0i (lathe, G-code system A: absolute by axis address, feed per minute).
@@ -176,6 +180,7 @@ pub const FANUC: Dialect = Dialect {
     lead_decimals: 4,
     radial_words: None,
     coolant: ("M08", "M09"),
+    feed_group: None,
 };
 
 /// APT-style cutter-location file (ISO 4343 flavour) in machine coordinates.
@@ -207,6 +212,7 @@ pub const CLD: Dialect = Dialect {
     lead_decimals: 4,
     radial_words: None,
     coolant: ("COOLNT/ON", "COOLNT/OFF"),
+    feed_group: None,
 };
 
 /// Every dialect.
@@ -351,6 +357,9 @@ fn setup_words(setup: &ProgramSetup, d: &Dialect) -> Vec<String> {
             }
             .to_owned(),
         );
+    }
+    if let (false, Some(word)) = (setup.feed_group.is_empty(), d.feed_group) {
+        words.push(format!("{word}({})", setup.feed_group.join(",")));
     }
     if let (Some(r), Some((radius, diameter))) = (setup.radial, d.radial_words) {
         words.push(

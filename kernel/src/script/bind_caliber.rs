@@ -6,7 +6,9 @@
 use super::floats::{kernel, Floats};
 use crate::caliber::{self, Groove, SeedPose};
 use crate::math::Real;
-use crate::profile::Table;
+use crate::mesh::TriMesh;
+use crate::profile::{Smoothing, Table};
+use crate::tool::{Tool, Wheel};
 use rhai::plugin::*;
 use rhai::{Array, EvalAltResult};
 
@@ -31,6 +33,175 @@ pub mod caliber_api {
             (&table, theta, depth),
             (&table, theta, width),
         ))
+    }
+
+    /// The node (row, from 0) in the middle of the sizing section (the
+    /// longest run of one depth): the smoothing's default anchor.
+    #[rhai_fn(get = "sizing_middle", pure)]
+    pub fn sizing_middle(g: &mut Groove) -> i64 {
+        g.sizing_middle() as i64
+    }
+
+    /// The groove with both tables smoothed (MATH §3.2): `iterations` of
+    /// the three-point rule (0: none, reported all the same), rebuilt from
+    /// row `anchor` (from 0). `#{ groove, hp, b }`: `hp` and `b` are the
+    /// smoothings (`.max_change`, `.max_change_z`, `.d1_before`,
+    /// `.d1_after`, `.d2_before`, `.d2_after`).
+    #[rhai_fn(pure, return_raw)]
+    pub fn smoothed(
+        g: &mut Groove,
+        iterations: i64,
+        anchor: i64,
+    ) -> Result<rhai::Map, Box<EvalAltResult>> {
+        if !(0..=10_000).contains(&iterations) || anchor < 0 {
+            return Err(format!(
+                "smoothed: iterations = {iterations} must be from 0 to 10000, anchor = {anchor} not negative"
+            )
+            .into());
+        }
+        let (groove, hp, b) = kernel(g.smoothed(iterations as usize, anchor as usize))?;
+        let mut m = rhai::Map::new();
+        m.insert("groove".into(), Dynamic::from(groove));
+        m.insert("hp".into(), Dynamic::from(hp));
+        m.insert("b".into(), Dynamic::from(b));
+        Ok(m)
+    }
+
+    /// The first differences before smoothing (one per interval).
+    #[rhai_fn(get = "d1_before", pure)]
+    pub fn d1_before(s: &mut Smoothing) -> Floats {
+        Floats::new(s.d1_before.clone())
+    }
+    /// The first differences after smoothing.
+    #[rhai_fn(get = "d1_after", pure)]
+    pub fn d1_after(s: &mut Smoothing) -> Floats {
+        Floats::new(s.d1_after.clone())
+    }
+    /// The second differences before smoothing (one per interior row).
+    #[rhai_fn(get = "d2_before", pure)]
+    pub fn d2_before(s: &mut Smoothing) -> Floats {
+        Floats::new(s.d2_before.clone())
+    }
+    /// The second differences after smoothing.
+    #[rhai_fn(get = "d2_after", pure)]
+    pub fn d2_after(s: &mut Smoothing) -> Floats {
+        Floats::new(s.d2_after.clone())
+    }
+
+    /// The depth table Hp(theta) as a profile (theta in rad, mm).
+    #[rhai_fn(get = "depth", pure)]
+    pub fn depth(g: &mut Groove) -> crate::profile::Profile {
+        g.depth().clone()
+    }
+
+    /// The width table B(theta) as a profile (theta in rad, mm).
+    #[rhai_fn(get = "width", pure)]
+    pub fn width(g: &mut Groove) -> crate::profile::Profile {
+        g.width().clone()
+    }
+
+    /// The tables' angles (deg), one per row.
+    #[rhai_fn(get = "theta_deg", pure)]
+    pub fn theta_deg(g: &mut Groove) -> Floats {
+        Floats::new(g.depth().z().iter().map(|t| t.to_degrees()).collect())
+    }
+
+    /// A wheel for the caliber grinders: largest radius `r_k0`, rounded
+    /// across its width by `r_k` (a torus: the width is `2 r_k`), tracked
+    /// at its centre with its axis along +Z (the machines' tool frame).
+    #[rhai_fn(return_raw)]
+    pub fn caliber_wheel(
+        name: &str,
+        number: i64,
+        r_k0: Real,
+        r_k: Real,
+    ) -> Result<Tool, Box<EvalAltResult>> {
+        let number =
+            u32::try_from(number).map_err(|_| format!("tool number {number} is out of range"))?;
+        let w = kernel(Wheel::new(2.0 * r_k0, r_k, 2.0 * r_k))?;
+        Ok(Tool::wheel_at_centre(name, number, w))
+    }
+
+    /// The pass at `psi` (rad) along the whole groove, for a wheel of
+    /// largest radius `r_k0` and rounding `r_k`, at a uniform `step` (rad)
+    /// of the roll's turn: the exact pose at every block, the wheel's plane
+    /// along the contact's trajectory, its axis square to the radius
+    /// through the contact (`cross`: a machine with the cross axis Y) or
+    /// through its centre (a 4-axis machine). Columns: `x`, `y`, `z` (the
+    /// wheel's centre), `i`, `j`, `k` (its axis), `theta` (the contact's,
+    /// rad), `turn` (rad), `seed_centre` (mm) and `seed_axis` (rad), how
+    /// far the seed's model is from each pose.
+    #[rhai_fn(pure, return_raw)]
+    pub fn pass(
+        g: &mut Groove,
+        psi: Real,
+        step: Real,
+        r_k0: Real,
+        r_k: Real,
+        cross: bool,
+    ) -> Result<rhai::Map, Box<EvalAltResult>> {
+        let plane = if cross {
+            caliber::SwivelPlane::Contact
+        } else {
+            caliber::SwivelPlane::Wheel
+        };
+        let poses = kernel(caliber::pass_poses(g, psi, step, r_k0, r_k, plane))?;
+        Ok(super::pass_map(&poses))
+    }
+
+    /// [`pass`] for every angle of `psis` (rad), computed on two threads:
+    /// an array of the passes' maps, in the order of `psis`.
+    #[rhai_fn(pure, return_raw)]
+    pub fn passes(
+        g: &mut Groove,
+        psis: Floats,
+        step: Real,
+        r_k0: Real,
+        r_k: Real,
+        cross: bool,
+    ) -> Result<Array, Box<EvalAltResult>> {
+        let plane = if cross {
+            caliber::SwivelPlane::Contact
+        } else {
+            caliber::SwivelPlane::Wheel
+        };
+        let psis: Vec<Real> = psis.0.to_vec();
+        let g: &Groove = g;
+        let run = |list: &[Real]| -> Result<Vec<Vec<caliber::PassPose>>, String> {
+            list.iter()
+                .map(|&psi| {
+                    caliber::pass_poses(g, psi, step, r_k0, r_k, plane).map_err(|e| e.to_string())
+                })
+                .collect()
+        };
+        let half = psis.len() / 2;
+        let (a, b) = std::thread::scope(|s| {
+            let h = s.spawn(|| run(&psis[half..]));
+            let a = run(&psis[..half]);
+            (
+                a,
+                h.join()
+                    .unwrap_or_else(|_| Err("a pass's thread failed".into())),
+            )
+        });
+        Ok(a?
+            .into_iter()
+            .chain(b?)
+            .map(|p| Dynamic::from(super::pass_map(&p)))
+            .collect())
+    }
+
+    /// The roll's sector with its groove as a closed solid (for
+    /// `caliber.stl`): the rim `width` wide from radius `hub` to the
+    /// periphery, chords within `tol` (mm).
+    #[rhai_fn(pure, return_raw)]
+    pub fn caliber_solid(
+        g: &mut Groove,
+        width: Real,
+        hub: Real,
+        tol: Real,
+    ) -> Result<TriMesh, Box<EvalAltResult>> {
+        kernel(caliber::caliber_solid(g, width, hub, tol))
     }
 
     /// The groove's point `[x, y, z]` at `(theta, psi)` in the roll's frame.
@@ -162,4 +333,24 @@ pub mod caliber_api {
     pub fn dtheta_1(p: &mut SeedPose) -> Real {
         p.dtheta_1
     }
+}
+
+/// A pass's poses as the map of columns `pass` returns.
+fn pass_map(poses: &[caliber::PassPose]) -> rhai::Map {
+    use rhai::Dynamic;
+    let col = |f: &dyn Fn(&caliber::PassPose) -> Real| {
+        Dynamic::from(Floats::new(poses.iter().map(f).collect()))
+    };
+    let mut m = rhai::Map::new();
+    m.insert("x".into(), col(&|p| p.wheel.centre.x));
+    m.insert("y".into(), col(&|p| p.wheel.centre.y));
+    m.insert("z".into(), col(&|p| p.wheel.centre.z));
+    m.insert("i".into(), col(&|p| p.wheel.axis.x));
+    m.insert("j".into(), col(&|p| p.wheel.axis.y));
+    m.insert("k".into(), col(&|p| p.wheel.axis.z));
+    m.insert("theta".into(), col(&|p| p.theta));
+    m.insert("turn".into(), col(&|p| p.turn));
+    m.insert("seed_centre".into(), col(&|p| p.seed_centre_error));
+    m.insert("seed_axis".into(), col(&|p| p.seed_axis_error));
+    m
 }

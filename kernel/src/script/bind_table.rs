@@ -55,18 +55,25 @@ pub(super) fn register(engine: &mut Engine, access: &Access) {
         .with_comments([
             "/// A table (CSV, XLSX, XLS, ODS) from a file inside the input directories",
             "/// (the script's own, and the parameter file's); a relative path is taken",
-            "/// from the first of them. Its columns are read by header: `t[\"theta\"]`.",
+            "/// from the first of them that holds it. Its columns are read by header:",
+            "/// `t[\"theta\"]`.",
         ])
         .register_into_engine(
             engine,
             move |path: &str| -> Result<Table, Box<EvalAltResult>> {
                 let p = Path::new(path);
+                if dirs.is_empty() {
+                    return Err("no input directory is open to scripts".into());
+                }
                 let full = if p.is_absolute() {
                     p.to_owned()
                 } else {
-                    dirs.first()
+                    // The first directory holding it (a script's own example,
+                    // or a table beside the parameter file that names it).
+                    dirs.iter()
                         .map(|d| d.join(p))
-                        .ok_or("no input directory is open to scripts")?
+                        .find(|f| f.is_file())
+                        .unwrap_or_else(|| dirs[0].join(p))
                 };
                 // A missing file and one outside get the same answer: a
                 // script must not learn what lies outside.

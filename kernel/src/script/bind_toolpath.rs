@@ -122,6 +122,79 @@ pub mod toolpath_api {
         Ok(())
     }
 
+    /// Adds a table for the run's report: `columns` maps names to columns
+    /// of numbers, all of one length.
+    ///
+    /// ```rhai
+    /// tp.table("passes", #{ psi_deg: [-10.0, 0.0, 10.0], blocks: [281, 281, 281] });
+    /// ```
+    #[rhai_fn(name = "table", return_raw)]
+    pub fn table(
+        tp: &mut ToolpathHandle,
+        name: &str,
+        columns: rhai::Map,
+    ) -> Result<(), Box<EvalAltResult>> {
+        let mut t = std::collections::BTreeMap::new();
+        let mut len = None;
+        for (k, v) in columns {
+            let col = crate::script::floats::numbers(&v, &format!("table {name}, column {k}"))?;
+            if let Some(v) = col.iter().find(|v| !v.is_finite()) {
+                return Err(format!("table {name}, column {k}: {v} is not a finite number").into());
+            }
+            if *len.get_or_insert(col.len()) != col.len() {
+                return Err(format!(
+                    "table {name}: column {k} has {} values, another {}",
+                    col.len(),
+                    len.unwrap_or(0)
+                )
+                .into());
+            }
+            t.insert(k.to_string(), col.to_vec());
+        }
+        tp.borrow_mut().tables.insert(name.to_owned(), t);
+        Ok(())
+    }
+
+    /// Asks the run to draw a chart `<file>.svg` from a table: `spec` holds
+    /// `file`, `title`, `table`, `x` (a column), `y` (an array of columns),
+    /// `x_label` and `y_label` (with units).
+    #[rhai_fn(name = "plot", return_raw)]
+    pub fn plot(tp: &mut ToolpathHandle, spec: rhai::Map) -> Result<(), Box<EvalAltResult>> {
+        let text = |k: &str| -> Result<String, Box<EvalAltResult>> {
+            spec.get(k)
+                .and_then(|d| d.clone().into_string().ok())
+                .ok_or_else(|| format!("plot: '{k}' must be a string").into())
+        };
+        let y = spec
+            .get("y")
+            .and_then(|d| d.clone().try_cast::<rhai::Array>())
+            .ok_or("plot: 'y' must be an array of column names")?
+            .into_iter()
+            .map(|d| {
+                d.into_string()
+                    .map_err(|_| "plot: 'y' must hold names".into())
+            })
+            .collect::<Result<Vec<String>, Box<EvalAltResult>>>()?;
+        let file = text("file")?;
+        if !crate::files::is_plain_name(&file) {
+            return Err(format!(
+                "plot: file '{}' is not a plain name",
+                crate::files::excerpt(&file)
+            )
+            .into());
+        }
+        tp.borrow_mut().plots.push(crate::toolpath::PlotSpec {
+            file,
+            title: text("title")?,
+            table: text("table")?,
+            x: text("x")?,
+            y,
+            x_label: text("x_label")?,
+            y_label: text("y_label")?,
+        });
+        Ok(())
+    }
+
     /// Number of points so far.
     #[rhai_fn(get = "point_count", pure)]
     pub fn point_count(tp: &mut ToolpathHandle) -> i64 {

@@ -33,7 +33,9 @@ mod floats;
 pub use docs::api_reference;
 pub use floats::Floats;
 
-use crate::family::{Check, FamilyError, PartBody, PartFamily, PartGeometry, VerifyRequest};
+use crate::family::{
+    Check, FamilyError, PartBody, PartFamily, PartGeometry, Verification, VerifyRequest,
+};
 use crate::machine::{Machine, MachineError};
 use crate::params::{ParamSpec, ParamValue, Params};
 use crate::profile::Profile;
@@ -196,7 +198,8 @@ fn register_types(e: &mut Engine) {
         .register_type_with_name::<Table>("Table")
         .register_type_with_name::<bind_toolpath::ToolpathHandle>("Toolpath")
         .register_type_with_name::<crate::caliber::Groove>("Groove")
-        .register_type_with_name::<crate::caliber::SeedPose>("SeedPose");
+        .register_type_with_name::<crate::caliber::SeedPose>("SeedPose")
+        .register_type_with_name::<crate::mesh::TriMesh>("Solid");
 }
 
 /// A group of the script API: its heading and what it registers.
@@ -609,37 +612,81 @@ impl PartFamily for ScriptFamily {
             return Ok(vec![]);
         }
         let d = self.call_with_params("part", values)?;
-        let shape =
-            || self.contract("fn part(p) must return a profile or a map of named profiles".into());
-        let body = |name: String, p: Profile| PartBody {
-            name,
-            geometry: PartGeometry::Revolution(p),
+        let shape = || {
+            self.contract(
+                "fn part(p) must return a profile or a map of named profiles or solids".into(),
+            )
         };
-        if let Some(p) = d.clone().try_cast::<Profile>() {
-            return Ok(vec![body("part".into(), p)]);
+        let geometry = |v: Dynamic| {
+            if let Some(p) = v.clone().try_cast::<Profile>() {
+                Some(PartGeometry::Revolution(p))
+            } else {
+                v.try_cast::<crate::mesh::TriMesh>().map(PartGeometry::Mesh)
+            }
+        };
+        if let Some(g) = geometry(d.clone()) {
+            return Ok(vec![PartBody {
+                name: "part".into(),
+                geometry: g,
+            }]);
         }
         let map = d.try_cast::<Map>().ok_or_else(shape)?;
         map.into_iter()
             .map(|(k, v)| {
-                v.try_cast::<Profile>()
-                    .map(|p| body(k.to_string(), p))
+                geometry(v)
+                    .map(|geometry| PartBody {
+                        name: k.to_string(),
+                        geometry,
+                    })
                     .ok_or_else(shape)
             })
             .collect()
     }
 
-    /// `fn verify(p)`, if the script has it:
-    /// `#{ profile, from, to, tolerance }`.
-    fn verification(&self, values: &Params) -> Result<Option<VerifyRequest>, FamilyError> {
+    /// `fn verify(p)`, if the script has it: `#{ profile, from, to,
+    /// tolerance }` (a body of revolution) or `#{ groove, psi, r_k0, r_k,
+    /// tolerance, grid_theta, grid_per_step, patch_gap }` (a caliber).
+    fn verification(&self, values: &Params) -> Result<Option<Verification>, FamilyError> {
         if !self.has_fn("verify", 1) {
             return Ok(None);
         }
         let d = self.call_with_params("verify", values)?;
-        let shape =
-            || self.contract("fn verify(p) must return #{ profile, from, to, tolerance }".into());
+        let shape = || {
+            self.contract(
+                "fn verify(p) must return #{ profile, from, to, tolerance } or #{ groove, psi, r_k0, r_k, tolerance, grid_theta, grid_per_step, patch_gap }".into(),
+            )
+        };
         let m = d.try_cast::<Map>().ok_or_else(shape)?;
         let num = |k: &str| m.get(k).and_then(floats::number).ok_or_else(shape);
-        Ok(Some(VerifyRequest {
+        if let Some(g) = m.get("groove") {
+            let groove = g
+                .clone()
+                .try_cast::<crate::caliber::Groove>()
+                .ok_or_else(shape)?;
+            let psi = m
+                .get("psi")
+                .and_then(|d| floats::numbers(d, "psi").ok())
+                .ok_or_else(shape)?;
+            let per = num("grid_per_step")?;
+            if !(1.0..=1000.0).contains(&per) {
+                return Err(self.contract(format!(
+                    "fn verify(p): grid_per_step = {per} must be from 1 to 1000"
+                )));
+            }
+            return Ok(Some(Verification::Groove(Box::new(
+                crate::caliber::GrooveRequest {
+                    groove,
+                    psi: psi.to_vec(),
+                    r_k0: num("r_k0")?,
+                    r_k: num("r_k")?,
+                    tolerance: num("tolerance")?,
+                    grid_theta: num("grid_theta")?,
+                    grid_per_step: per as usize,
+                    patch_gap: num("patch_gap")?,
+                },
+            ))));
+        }
+        Ok(Some(Verification::Profile(VerifyRequest {
             profile: m
                 .get("profile")
                 .and_then(|p| p.clone().try_cast::<Profile>())
@@ -647,7 +694,7 @@ impl PartFamily for ScriptFamily {
             from: num("from")?,
             to: num("to")?,
             tolerance: num("tolerance")?,
-        }))
+        })))
     }
 }
 

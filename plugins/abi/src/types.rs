@@ -429,6 +429,14 @@ pub struct ProgramSetup {
     /// their clear positions.
     #[serde(default)]
     pub retract: Vec<Vec<String>>,
+    /// The axes whose path the feed F is (Sinumerik `FGROUP`; ABI 1.3):
+    /// empty, the linear axes (a move that only turns: its rotary axes,
+    /// F in deg/min). A caliber grinder's is the roll's turn `A`, the
+    /// leading coordinate: F in deg/min of the roll, the other axes
+    /// following; a block that does not turn it reads F as the linear
+    /// axes' path feed.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub feed_group: Vec<String>,
 }
 
 impl MachineInfo {

@@ -61,6 +61,7 @@ fn setup() -> ProgramSetup {
         start_clear: group(&["X", "U"]),
         approach: vec![group(&["Z"]), group(&["X"])],
         retract: vec![group(&["X"]), group(&["U"])],
+        feed_group: vec![],
     }
 }
 

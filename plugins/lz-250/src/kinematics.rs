@@ -31,6 +31,14 @@ fn wrap(t: f64) -> f64 {
     }
 }
 
+/// Below this sine of the angle between the wheel's axis and the roll's
+/// (0.2 arcsec), the Mannesmann takes the axis as the roll's: any roll
+/// turn then gives it, and the one that brings the wheel's centre into the
+/// plane of the roll's axis is taken (Y = 0), as the LZ-250 does. Above
+/// it the axis fixes the turn; a turn read off an axis a rounding error
+/// away from the roll's would swing from block to block.
+const AXIAL: f64 = 1e-6;
+
 /// The caliber grinders' kinematics: the LZ-250's four axes, or with
 /// `cross` the Mannesmann's five. Rows are the solved axes in the
 /// descriptions' order: `[X, Z, A, B]` or `[X, Z, Y, A, B]` (mm, rad).
@@ -82,7 +90,7 @@ impl CaliberKinematics {
             }
             Ok(wrap((c / rho).asin() - p[1].atan2(p[0])))
         };
-        let (turn, b) = if self.cross && a[0].hypot(a[1]) > 1e-12 {
+        let (turn, b) = if self.cross && a[0].hypot(a[1]) > AXIAL {
             // a.x cos A - a.y sin A = t.x: A = +-acos(t.x / rho) - phi.
             let rho = a[0].hypot(a[1]);
             let phi = a[1].atan2(a[0]);
@@ -145,7 +153,9 @@ impl CaliberKinematics {
     }
 
     /// Inverse kinematics of rows of 6 (point, axis) into rows of the
-    /// solved axes ([`Self::solve`]).
+    /// solved axes ([`Self::solve`]), the roll's turn continuous from row
+    /// to row (the first in (-180, 180] deg, each next the one nearest
+    /// its predecessor).
     ///
     /// # Failures
     /// A pose that is not a point and a unit axis, or (LZ-250) a point on
@@ -158,6 +168,8 @@ impl CaliberKinematics {
     ) -> Result<(), PluginError> {
         let r = [tool[0], tool[1], tool[2]];
         let t = [tool[3], tool[4], tool[5]];
+        let turn_at = if self.cross { 3 } else { 2 };
+        let mut last: Option<f64> = None;
         for (i, (p, q)) in poses
             .chunks_exact(6)
             .zip(out.chunks_exact_mut(self.width()))
@@ -167,6 +179,12 @@ impl CaliberKinematics {
                 .solve([p[0], p[1], p[2]], [p[3], p[4], p[5]], r, t)
                 .map_err(|m| PluginError::at(i, m))?;
             q.copy_from_slice(&row);
+            // The roll turns on: each turn the one nearest the last (a
+            // groove may run past half a turn), not wrapped.
+            if let Some(prev) = last {
+                q[turn_at] = prev + wrap(q[turn_at] - prev);
+            }
+            last = Some(q[turn_at]);
         }
         Ok(())
     }

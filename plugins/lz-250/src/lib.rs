@@ -137,7 +137,7 @@ pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInf
         tool: ToolSpec::default(),
         min_feed: Some(1.0),
         // G54, the ZX plane, Z (the wheel's radial position) in radius,
-        // coolant; the wheel backs off to Z 600 first, then the roll, the
+        // coolant, F the roll's turn in deg/min; the wheel backs off to Z 600 first, then the roll, the
         // table (and the cross slide) and the swivel come to the start; at
         // the end the wheel backs off again.
         setup: ProgramSetup {
@@ -150,6 +150,8 @@ pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInf
             start_clear: vec!["Z".into()],
             approach: vec![approach],
             retract: vec![vec!["Z".into()]],
+            // F is the roll's turn in deg/min (FGROUP(A)).
+            feed_group: vec!["A".into()],
         },
     }
 }

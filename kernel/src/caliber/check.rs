@@ -1,0 +1,609 @@
+//! The caliber program replayed in 3-D (issue 12): the torus swept along
+//! the moves the machine makes, measured against the groove's surface over
+//! a grid of `(theta, psi)`, and the contact patch at one block.
+//!
+//! The replay reads the program as written ([`crate::verify::as_written`]),
+//! moves every solved axis in a straight line between blocks as the
+//! control interpolates, and places the wheel by the machine's forward
+//! kinematics at sub-steps of each move, as many as keep the sampling
+//! error below a stated resolution: between two samples no point of the
+//! wheel moves more than `s`, and a distance that is smallest between
+//! samples is missed by at most `s^2 / (8 r_k)` (the distance to the
+//! rounding curves at `1 / r_k` along the motion), reported as
+//! [`GrooveCheck::sampling_resolution_mm`].
+//!
+//! At each grid point the figure is the signed distance from the nominal
+//! groove to the nearest wheel surface over the samples of the passes
+//! around it (positive: material left, the scallops between passes and
+//! between blocks; negative: a gouge), the passes within
+//! [`NEIGHBOUR_PASSES`] of it across the groove. Every block's wheel is
+//! also measured across the whole section at its own theta, so that a
+//! wheel cutting the groove away from its contact (across it) is seen.
+
+use super::groove::Groove;
+use super::pose::TorusWheel;
+use crate::machine::MachineKinematics;
+use crate::math::{Real, Vec3};
+use crate::mesh::TriMesh;
+use crate::program::{axis_rows, block_name, pass_blocks, AxisProgram};
+use crate::toolpath::Pass;
+use crate::transform::ToolFrame;
+use crate::verify::{as_written, VerifyError};
+use serde::{Deserialize, Serialize};
+
+/// How many passes either side of a grid point (across the groove) its
+/// distance is measured against along the whole groove.
+pub const NEIGHBOUR_PASSES: usize = 2;
+
+/// The sampling resolution is the tolerance over this: what the sampling
+/// of the moves may miss is a tenth of what the groove may deviate.
+pub const SAMPLING_SHARE: Real = 10.0;
+
+/// The most grid points a verification may measure.
+pub const MAX_GRID_POINTS: usize = 20_000_000;
+
+/// The most wheel samples a replay may place.
+pub const MAX_SAMPLES: usize = 20_000_000;
+
+/// What a caliber job asks the replay to hold.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GrooveRequest {
+    /// The nominal groove.
+    pub groove: Groove,
+    /// The pass angle psi (rad) of each cutting pass, in order.
+    pub psi: Vec<Real>,
+    /// The wheel's largest radius `R_k0` (mm).
+    pub r_k0: Real,
+    /// Its rounding `r_k` (mm).
+    pub r_k: Real,
+    /// The deviation the finished groove must hold (mm).
+    pub tolerance: Real,
+    /// The grid's step along theta (rad).
+    pub grid_theta: Real,
+    /// Grid points across the groove per pass step (>= 1).
+    pub grid_per_step: usize,
+    /// The distance from the wheel within which the groove is the contact
+    /// patch (mm).
+    pub patch_gap: Real,
+}
+
+/// A place on the groove with the block whose wheel made the figure there.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GroovePlace {
+    /// The figure (mm).
+    pub mm: Real,
+    /// Theta (deg).
+    pub theta_deg: Real,
+    /// Psi (deg).
+    pub psi_deg: Real,
+    /// The block, as the program names it.
+    pub block: String,
+}
+
+/// The region of the groove within a small distance of the wheel at one
+/// block (MATH §3.6: what the seed reads off the CAD model).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ContactPatch {
+    /// The block (from 1).
+    pub block: usize,
+    /// The distance that counts as contact (mm).
+    pub gap_mm: Real,
+    /// Its size along the groove (mm, on the surface).
+    pub along_mm: Real,
+    /// Its size across the groove (mm, on the section).
+    pub across_mm: Real,
+    /// Its middle: theta (deg).
+    pub theta_deg: Real,
+    /// Its middle: psi (deg).
+    pub psi_deg: Real,
+    /// The deepest the wheel reaches into the nominal there (mm, <= 0 if
+    /// it does).
+    pub least_distance_mm: Real,
+    /// Grid points in the patch.
+    pub points: usize,
+}
+
+/// The replayed caliber program against the nominal groove.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GrooveCheck {
+    /// The tolerance held (mm).
+    pub tolerance: Real,
+    /// The program's smallest step (mm), which the replay reads it at.
+    pub resolution_mm: Real,
+    /// The most the sampling of the moves may miss (mm).
+    pub sampling_resolution_mm: Real,
+    /// Wheel positions replayed (blocks and sub-steps).
+    pub samples: usize,
+    /// Grid points along theta.
+    pub grid_theta: usize,
+    /// Grid points across the groove.
+    pub grid_psi: usize,
+    /// The grid's step along theta (deg).
+    pub grid_theta_step_deg: Real,
+    /// The psi range measured (deg), the outermost passes'.
+    pub psi_range_deg: [Real; 2],
+    /// The most material left (mm, >= 0) and where.
+    pub max_left: GroovePlace,
+    /// The deepest gouge (mm, <= 0; 0 if none) and where.
+    pub max_gouge: GroovePlace,
+    /// The larger of the two in size (mm).
+    pub max_abs_mm: Real,
+    /// The contact patch at the scene's block.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub patch: Option<ContactPatch>,
+}
+
+/// The signed distance from `q` to the wheel `w` (a torus with the disc
+/// inside its centre circle: the wheel's body, rounded across its width).
+#[inline]
+pub fn wheel_distance(w: &TorusWheel, q: &Vec3) -> Real {
+    let v = q - w.centre;
+    let h = v.dot(&w.axis);
+    let rho = (v - h * w.axis).norm();
+    if rho <= w.major {
+        h.abs() - w.minor
+    } else {
+        let r = rho - w.major;
+        (r * r + h * h).sqrt() - w.minor
+    }
+}
+
+/// The middle of the groove's range of theta (rad): angles about the
+/// roll's axis are taken within half a turn of it.
+fn groove_middle(g: &Groove) -> Real {
+    let (lo, hi) = g.theta_range();
+    0.5 * (lo + hi)
+}
+
+/// One replayed wheel position.
+#[derive(Debug, Clone, Copy)]
+struct Sample {
+    wheel: TorusWheel,
+    /// The block (from 0) whose move it is on.
+    block: usize,
+    /// The wheel centre's angle about the roll's axis (rad).
+    turn: Real,
+}
+
+/// The wheel at every sub-step of every move of the cutting passes,
+/// grouped by pass and sorted by turn, with the sampling resolution.
+fn samples(
+    program: &AxisProgram,
+    machine: &dyn MachineKinematics,
+    tool: &ToolFrame,
+    passes: &[Pass],
+    req: &GrooveRequest,
+) -> Result<(Vec<Vec<Sample>>, Real, usize), VerifyError> {
+    let info = machine.info();
+    let n = program.blocks.len();
+    let rows = axis_rows(program, info, &info.solved_axes, 0..n).map_err(VerifyError::Replay)?;
+    let width = info.solved_axes.len();
+    let mut poses = Vec::new();
+    machine
+        .forward(&rows, tool, &mut poses)
+        .map_err(|source| VerifyError::Kinematics {
+            first: 1,
+            last: n,
+            source,
+        })?;
+    let at = |pose: &[Real]| TorusWheel {
+        centre: Vec3::new(pose[0], pose[1], pose[2]),
+        axis: Vec3::new(pose[3], pose[4], pose[5]).normalize(),
+        major: req.r_k0 - req.r_k,
+        minor: req.r_k,
+    };
+    // Between samples no point of the wheel moves more than `step`.
+    let target = req.tolerance / SAMPLING_SHARE;
+    let step = (8.0 * req.r_k * target).sqrt();
+    let mut out = Vec::new();
+    let mut worst: Real = 0.0;
+    let mut count = 0;
+    for (_, blocks) in pass_blocks(program, passes).filter(|(p, _)| p.cuts()) {
+        let mut rows_sub: Vec<Real> = Vec::new();
+        let mut owner = Vec::new();
+        for k in blocks.start.max(1)..blocks.end {
+            let (a, b) = (at(&poses[6 * (k - 1)..6 * k]), at(&poses[6 * k..6 * k + 6]));
+            let turned = a.axis.dot(&b.axis).clamp(-1.0, 1.0).acos();
+            let moved = (b.centre - a.centre).norm() + req.r_k0 * turned;
+            let subs = ((moved / step).ceil() as usize).max(1);
+            worst = worst.max(moved / subs as Real);
+            count += subs;
+            if count > MAX_SAMPLES {
+                return Err(VerifyError::Replay(format!(
+                    "more than {MAX_SAMPLES} wheel positions to replay: a coarser tolerance or fewer blocks"
+                )));
+            }
+            let (ra, rb) = (
+                &rows[(k - 1) * width..k * width],
+                &rows[k * width..(k + 1) * width],
+            );
+            for s in 1..=subs {
+                let t = s as Real / subs as Real;
+                rows_sub.extend(ra.iter().zip(rb).map(|(x, y)| x + (y - x) * t));
+                owner.push(k);
+            }
+        }
+        let mut sub_poses = Vec::new();
+        machine
+            .forward(&rows_sub, tool, &mut sub_poses)
+            .map_err(|source| VerifyError::Kinematics {
+                first: blocks.start + 1,
+                last: blocks.end,
+                source,
+            })?;
+        let mut list: Vec<Sample> = sub_poses
+            .chunks_exact(6)
+            .zip(owner)
+            .map(|(p, block)| Sample {
+                wheel: at(p),
+                block,
+                turn: p[1].atan2(p[0]),
+            })
+            .collect();
+        // Unwrapped from the first (taken within half a turn of the
+        // groove's middle), then in order of turn.
+        let mid = groove_middle(&req.groove);
+        let mut prev = list
+            .first()
+            .map_or(0.0, |s| mid + crate::math::wrap_angle(s.turn - mid));
+        for s in &mut list {
+            s.turn = prev + crate::math::wrap_angle(s.turn - prev);
+            prev = s.turn;
+        }
+        list.sort_by(|a, b| a.turn.total_cmp(&b.turn));
+        out.push(list);
+    }
+    Ok((out, worst * worst / (8.0 * req.r_k), count))
+}
+
+/// The least distance from `q` over `list` (sorted by turn), searched
+/// from the sample nearest `theta` downhill: the distance along a pass is
+/// smooth and has one minimum near the contact.
+fn nearest(list: &[Sample], q: &Vec3, theta: Real) -> (Real, usize) {
+    if list.is_empty() {
+        return (Real::INFINITY, 0);
+    }
+    let mut i = list.partition_point(|s| s.turn < theta).min(list.len() - 1);
+    let d = |i: usize| wheel_distance(&list[i].wheel, q);
+    let mut best = d(i);
+    for stride in [64usize, 8, 1] {
+        loop {
+            let mut moved = false;
+            for j in [i.checked_sub(stride), Some(i + stride)]
+                .into_iter()
+                .flatten()
+            {
+                if j < list.len() {
+                    let v = d(j);
+                    if v < best {
+                        (best, i, moved) = (v, j, true);
+                        break;
+                    }
+                }
+            }
+            if !moved {
+                break;
+            }
+        }
+    }
+    (best, list[i].block)
+}
+
+/// Replays `program` on `machine` (the tool tracked at `tool`) and
+/// measures the groove of `req` against the swept wheel; `passes` are the
+/// toolpath's, `req.psi` one per cutting pass. The contact patch is taken
+/// at block `patch_block` (from 0) if given.
+///
+/// # Failures
+/// A tolerance finer than twice the program's resolution; the replay
+/// failing; too large a grid; the finished groove straying more than the
+/// tolerance ([`VerifyError::Groove`], naming the block, theta and psi).
+pub fn check_groove(
+    program: &AxisProgram,
+    machine: &dyn MachineKinematics,
+    tool: &ToolFrame,
+    passes: &[Pass],
+    req: &GrooveRequest,
+    patch_block: Option<usize>,
+) -> Result<GrooveCheck, VerifyError> {
+    crate::math::positive("verification tolerance", req.tolerance)?;
+    crate::math::positive("verification grid step along theta", req.grid_theta)?;
+    let (written, resolution) = as_written(program);
+    if req.tolerance < 2.0 * resolution {
+        return Err(VerifyError::Resolution {
+            tolerance: req.tolerance,
+            resolution,
+        });
+    }
+    let (lists, sampling, count) = samples(&written, machine, tool, passes, req)?;
+    if lists.len() != req.psi.len() || lists.is_empty() {
+        return Err(VerifyError::Replay(format!(
+            "{} cutting passes for {} pass angles",
+            lists.len(),
+            req.psi.len()
+        )));
+    }
+    // The grid: theta over the tables, psi over the passes (sorted), each
+    // pass step divided.
+    let (lo, hi) = req.groove.theta_range();
+    let n_theta = ((hi - lo) / req.grid_theta).ceil() as usize + 1;
+    let mut order: Vec<usize> = (0..req.psi.len()).collect();
+    order.sort_by(|&a, &b| req.psi[a].total_cmp(&req.psi[b]));
+    let per = req.grid_per_step.max(1);
+    let mut psi_grid: Vec<(Real, usize)> = Vec::new(); // (psi, index in `order`)
+    for (k, w) in order.windows(2).enumerate() {
+        let (a, b) = (req.psi[w[0]], req.psi[w[1]]);
+        for s in 0..per {
+            psi_grid.push((a + (b - a) * s as Real / per as Real, k));
+        }
+    }
+    psi_grid.push((req.psi[*order.last().expect("passes")], order.len() - 1));
+    if n_theta.saturating_mul(psi_grid.len()) > MAX_GRID_POINTS {
+        return Err(VerifyError::Replay(format!(
+            "a grid of {n_theta} x {} points is more than {MAX_GRID_POINTS}: a coarser grid",
+            psi_grid.len()
+        )));
+    }
+    let thetas: Vec<Real> = (0..n_theta)
+        .map(|i| (lo + req.grid_theta * i as Real).min(hi))
+        .collect();
+    // The groove's points, row by row of theta.
+    let mut points = Vec::with_capacity(n_theta * psi_grid.len());
+    for &t in &thetas {
+        for &(psi, _) in &psi_grid {
+            points.push(req.groove.point(t, psi)?);
+        }
+    }
+    let np = psi_grid.len();
+    // Each point against the passes around it; two threads share rows.
+    let measure = |rows: std::ops::Range<usize>| -> Vec<(Real, usize)> {
+        let mut out = Vec::with_capacity(rows.len() * np);
+        for i in rows {
+            for (j, &(_, k)) in psi_grid.iter().enumerate() {
+                let q = &points[i * np + j];
+                let from = k.saturating_sub(NEIGHBOUR_PASSES);
+                let to = (k + NEIGHBOUR_PASSES + 1).min(order.len() - 1);
+                let mut best = (Real::INFINITY, 0);
+                for &pass in &order[from..=to] {
+                    let got = nearest(&lists[pass], q, thetas[i]);
+                    if got.0 < best.0 {
+                        best = got;
+                    }
+                }
+                out.push(best);
+            }
+        }
+        out
+    };
+    let half = n_theta / 2;
+    let mut dist = std::thread::scope(|s| {
+        let h = s.spawn(|| measure(half..n_theta));
+        let mut a = measure(0..half);
+        a.extend(h.join().expect("the measuring thread does not panic"));
+        a
+    });
+    // Each block's wheel across the whole section at its own theta; the
+    // two threads take the two halves of the rows again.
+    let across = |rows: std::ops::Range<usize>, dist: &mut [(Real, usize)]| {
+        for list in &lists {
+            for (idx, s) in list.iter().enumerate() {
+                if idx + 1 < list.len() && list[idx + 1].block == s.block {
+                    continue; // one sample per block: its last, at the block
+                }
+                let i = ((s.turn - lo) / req.grid_theta).round();
+                if !(i >= rows.start as Real && i < rows.end as Real) {
+                    continue;
+                }
+                let i = i as usize;
+                for j in 0..np {
+                    let d = wheel_distance(&s.wheel, &points[i * np + j]);
+                    let at = &mut dist[(i - rows.start) * np + j];
+                    if d < at.0 {
+                        *at = (d, s.block);
+                    }
+                }
+            }
+        }
+    };
+    {
+        let (first, second) = dist.split_at_mut(half * np);
+        std::thread::scope(|s| {
+            s.spawn(|| across(half..n_theta, second));
+            across(0..half, first);
+        });
+    }
+    let place = |idx: usize| {
+        let (i, j) = (idx / np, idx % np);
+        GroovePlace {
+            mm: dist[idx].0,
+            theta_deg: thetas[i].to_degrees(),
+            psi_deg: psi_grid[j].0.to_degrees(),
+            block: block_name(program, dist[idx].1),
+        }
+    };
+    let (mut left, mut gouge) = (0, 0);
+    for (idx, d) in dist.iter().enumerate() {
+        if d.0 > dist[left].0 {
+            left = idx;
+        }
+        if d.0 < dist[gouge].0 {
+            gouge = idx;
+        }
+    }
+    let max_left = place(left);
+    let mut max_gouge = place(gouge);
+    if max_gouge.mm > 0.0 {
+        max_gouge.mm = 0.0;
+    }
+    let max_abs = max_left.mm.max(-max_gouge.mm);
+    let patch = match patch_block {
+        Some(b) => Some(contact_patch(&written, machine, tool, req, b)?.0),
+        None => None,
+    };
+    let check = GrooveCheck {
+        tolerance: req.tolerance,
+        resolution_mm: resolution,
+        sampling_resolution_mm: sampling,
+        samples: count,
+        grid_theta: n_theta,
+        grid_psi: np,
+        grid_theta_step_deg: req.grid_theta.to_degrees(),
+        psi_range_deg: [psi_grid[0].0.to_degrees(), psi_grid[np - 1].0.to_degrees()],
+        max_left,
+        max_gouge,
+        max_abs_mm: max_abs,
+        patch,
+    };
+    if max_abs > req.tolerance {
+        let worst = if check.max_left.mm >= -check.max_gouge.mm {
+            &check.max_left
+        } else {
+            &check.max_gouge
+        };
+        return Err(VerifyError::Groove {
+            deviation: worst.mm,
+            theta_deg: worst.theta_deg,
+            psi_deg: worst.psi_deg,
+            block: worst.block.clone(),
+            tolerance: req.tolerance,
+        });
+    }
+    Ok(check)
+}
+
+/// The contact patch at block `block` (from 0) of `program` (as written):
+/// the groove points within `req.patch_gap` of the wheel on a fine grid of
+/// `(theta, psi)` round the contact (widened until the patch is inside
+/// it), its sizes along and across the groove, its middle, and its cells
+/// as a mesh (lifted 1 um off the groove along its normal, to show over
+/// it).
+///
+/// # Failures
+/// The block beyond the program; the replay failing; no groove point
+/// within the gap (the wheel does not touch the groove at that block).
+pub fn contact_patch(
+    program: &AxisProgram,
+    machine: &dyn MachineKinematics,
+    tool: &ToolFrame,
+    req: &GrooveRequest,
+    block: usize,
+) -> Result<(ContactPatch, TriMesh), VerifyError> {
+    crate::math::positive("contact patch gap", req.patch_gap)?;
+    let pose = crate::verify::replay_blocks(program, machine, tool, block..block + 1)?;
+    let wheel = TorusWheel {
+        centre: Vec3::new(pose[0], pose[1], pose[2]),
+        axis: Vec3::new(pose[3], pose[4], pose[5]).normalize(),
+        major: req.r_k0 - req.r_k,
+        minor: req.r_k,
+    };
+    let g = &req.groove;
+    let (lo, hi) = g.theta_range();
+    // The contact: the groove point nearest the wheel, near the wheel's
+    // turn, over psi.
+    let mid = groove_middle(g);
+    let turn = mid + crate::math::wrap_angle(wheel.centre.y.atan2(wheel.centre.x) - mid);
+    let mut best = (Real::INFINITY, turn.clamp(lo, hi), 0.0);
+    for i in 0..=60 {
+        for j in 0..=180 {
+            let t = (turn + (i as Real - 30.0) * 0.2f64.to_radians()).clamp(lo, hi);
+            let psi = (j as Real - 90.0).to_radians();
+            let d = wheel_distance(&wheel, &g.point(t, psi)?);
+            if d < best.0 {
+                best = (d, t, psi);
+            }
+        }
+    }
+    let (mut w_theta, mut w_psi) = (2f64.to_radians(), 10f64.to_radians());
+    const N: usize = 200;
+    loop {
+        let ts: Vec<Real> = (0..=N)
+            .map(|i| (best.1 - w_theta + 2.0 * w_theta * i as Real / N as Real).clamp(lo, hi))
+            .collect();
+        let ps: Vec<Real> = (0..=N)
+            .map(|j| best.2 - w_psi + 2.0 * w_psi * j as Real / N as Real)
+            .collect();
+        let mut inside = vec![false; (N + 1) * (N + 1)];
+        let mut least = Real::INFINITY;
+        let (mut i0, mut i1, mut j0, mut j1) = (N, 0, N, 0);
+        for (i, &t) in ts.iter().enumerate() {
+            for (j, &p) in ps.iter().enumerate() {
+                let d = wheel_distance(&wheel, &g.point(t, p)?);
+                least = least.min(d);
+                if d <= req.patch_gap {
+                    inside[i * (N + 1) + j] = true;
+                    (i0, i1, j0, j1) = (i0.min(i), i1.max(i), j0.min(j), j1.max(j));
+                }
+            }
+        }
+        if i0 > i1 {
+            return Err(VerifyError::Replay(format!(
+                "the wheel at {} is {} mm from the groove at its nearest: no contact patch within {} mm",
+                block_name(program, block),
+                crate::math::fixed(best.0, 4),
+                req.patch_gap
+            )));
+        }
+        let at_edge = |a: usize, b: usize| a == 0 || b == N;
+        let theta_edge = at_edge(i0, i1) && ts[0] > lo && ts[N] < hi;
+        let psi_edge = at_edge(j0, j1);
+        if (theta_edge || psi_edge) && w_theta < 30f64.to_radians() {
+            if theta_edge {
+                w_theta *= 2.0;
+            }
+            if psi_edge {
+                w_psi = (w_psi * 2.0).min(std::f64::consts::FRAC_PI_2);
+            }
+            continue;
+        }
+        let (tm, pm) = (0.5 * (ts[i0] + ts[i1]), 0.5 * (ps[j0] + ps[j1]));
+        // Sizes on the surface: along theta at the middle psi, across psi
+        // at the middle theta.
+        let arc = |pts: &[Vec3]| pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum::<Real>();
+        let along: Vec<Vec3> = ts[i0..=i1]
+            .iter()
+            .map(|&t| g.point(t, pm))
+            .collect::<Result<_, _>>()?;
+        let across: Vec<Vec3> = ps[j0..=j1]
+            .iter()
+            .map(|&p| g.point(tm, p))
+            .collect::<Result<_, _>>()?;
+        let mut mesh = TriMesh::default();
+        let mut index = std::collections::BTreeMap::new();
+        for i in i0..i1 {
+            for j in j0..j1 {
+                let cell = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)];
+                if !cell.iter().all(|&(a, b)| inside[a * (N + 1) + b]) {
+                    continue;
+                }
+                let mut ids = [0u32; 4];
+                for (c, &(a, b)) in cell.iter().enumerate() {
+                    ids[c] = match index.get(&(a, b)) {
+                        Some(&id) => id,
+                        None => {
+                            let n = g.normal(ts[a], ps[b])?;
+                            let p = g.point(ts[a], ps[b])? + 0.001 * n;
+                            mesh.positions.push([p.x, p.y, p.z]);
+                            mesh.normals.push([n.x, n.y, n.z]);
+                            let id = (mesh.positions.len() - 1) as u32;
+                            index.insert((a, b), id);
+                            id
+                        }
+                    };
+                }
+                mesh.triangles.push([ids[0], ids[2], ids[1]]);
+                mesh.triangles.push([ids[0], ids[3], ids[2]]);
+            }
+        }
+        let patch = ContactPatch {
+            block: block + 1,
+            gap_mm: req.patch_gap,
+            along_mm: arc(&along),
+            across_mm: arc(&across),
+            theta_deg: tm.to_degrees(),
+            psi_deg: pm.to_degrees(),
+            least_distance_mm: least,
+            points: inside.iter().filter(|&&b| b).count(),
+        };
+        return Ok((patch, mesh));
+    }
+}

@@ -1,0 +1,153 @@
+//! Charts of a run's tables ([`crate::toolpath::PlotSpec`]) as SVG, drawn
+//! with plotters: axes with ticks and units, a grid, the legend outside
+//! the data (below the chart).
+
+use crate::toolpath::{PlotSpec, Toolpath};
+use plotters::prelude::*;
+
+/// Line colours, in order (the legend's).
+const COLOURS: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+];
+
+/// The chart `spec` from `toolpath`'s tables as SVG text.
+///
+/// # Failures
+/// A table or column the toolpath does not have; no finite values.
+pub fn chart_svg(toolpath: &Toolpath, spec: &PlotSpec) -> Result<String, String> {
+    let table = toolpath
+        .tables
+        .get(&spec.table)
+        .ok_or_else(|| format!("plot {}: no table '{}'", spec.file, spec.table))?;
+    let column = |name: &str| {
+        table.get(name).ok_or_else(|| {
+            format!(
+                "plot {}: table '{}' has no column '{name}'",
+                spec.file, spec.table
+            )
+        })
+    };
+    let xs = column(&spec.x)?;
+    let series = spec
+        .y
+        .iter()
+        .map(|n| Ok((n.as_str(), column(n)?)))
+        .collect::<Result<Vec<_>, String>>()?;
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for (_, ys) in &series {
+        for (x, y) in xs.iter().zip(ys.iter()) {
+            (x0, x1, y0, y1) = (x0.min(*x), x1.max(*x), y0.min(*y), y1.max(*y));
+        }
+    }
+    if !(x0.is_finite() && y0.is_finite()) {
+        return Err(format!("plot {}: nothing to draw", spec.file));
+    }
+    if x1 - x0 < 1e-12 {
+        x1 = x0 + 1.0;
+    }
+    let pad = ((y1 - y0) * 0.05).max(1e-9 * y1.abs().max(1.0));
+    let (y0, y1) = (y0 - pad, y1 + pad);
+    let legend_rows = series.len().div_ceil(3) as u32;
+    let mut svg = String::new();
+    {
+        let root =
+            SVGBackend::with_string(&mut svg, (1000, 560 + 24 * legend_rows)).into_drawing_area();
+        let e = |e: DrawingAreaErrorKind<_>| format!("plot {}: {e:?}", spec.file);
+        root.fill(&WHITE).map_err(e)?;
+        let (top, bottom) = root.split_vertically(560);
+        let mut chart = ChartBuilder::on(&top)
+            .caption(&spec.title, ("sans-serif", 22))
+            .margin(16)
+            .x_label_area_size(48)
+            .y_label_area_size(90)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(e)?;
+        chart
+            .configure_mesh()
+            .x_desc(spec.x_label.as_str())
+            .y_desc(spec.y_label.as_str())
+            .label_style(("sans-serif", 15))
+            .axis_desc_style(("sans-serif", 17))
+            .draw()
+            .map_err(e)?;
+        for (k, (_, ys)) in series.iter().enumerate() {
+            let c = COLOURS[k % COLOURS.len()];
+            chart
+                .draw_series(LineSeries::new(
+                    xs.iter().zip(ys.iter()).map(|(x, y)| (*x, *y)),
+                    c.stroke_width(2),
+                ))
+                .map_err(e)?;
+        }
+        // The legend below the chart, three to a row: never over the data.
+        for (k, (name, _)) in series.iter().enumerate() {
+            let c = COLOURS[k % COLOURS.len()];
+            let (x, y) = (110 + 300 * (k as i32 % 3), 12 + 24 * (k as i32 / 3));
+            bottom
+                .draw(&PathElement::new(
+                    vec![(x, y), (x + 30, y)],
+                    c.stroke_width(3),
+                ))
+                .map_err(e)?;
+            bottom
+                .draw(&Text::new(
+                    name.to_string(),
+                    (x + 38, y - 8),
+                    ("sans-serif", 16),
+                ))
+                .map_err(e)?;
+        }
+        root.present().map_err(e)?;
+    }
+    Ok(svg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tool::{Tool, Wheel};
+
+    /// A chart names its lines and axes; a missing column is named.
+    #[test]
+    fn charts_draw_their_tables() {
+        let mut tp = Toolpath::new(
+            "t",
+            Tool::wheel("w", 1, Wheel::new(200.0, 8.0, 16.0).unwrap()),
+            100.0,
+            vec![],
+        );
+        tp.tables.insert(
+            "d".into(),
+            [
+                ("x".to_owned(), vec![0.0, 1.0, 2.0]),
+                ("before".to_owned(), vec![0.0, 2.0, 1.0]),
+            ]
+            .into_iter()
+            .collect(),
+        );
+        let mut spec = PlotSpec {
+            file: "f".into(),
+            title: "Derivative".into(),
+            table: "d".into(),
+            x: "x".into(),
+            y: vec!["before".into()],
+            x_label: "theta, deg".into(),
+            y_label: "mm/deg".into(),
+        };
+        let svg = chart_svg(&tp, &spec).unwrap();
+        assert!(svg.contains("<svg") && svg.contains("before") && svg.contains("theta, deg"));
+        spec.y.push("after".into());
+        let e = chart_svg(&tp, &spec).unwrap_err();
+        assert!(e.contains("no column 'after'"), "{e}");
+    }
+}

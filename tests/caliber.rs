@@ -1,0 +1,397 @@
+//! The caliber job end to end (issue 12): the default run on the
+//! Mannesmann replayed from `program.mpf` by a simulation of its own, the
+//! LZ-250's figure, a corrupted block named by the verification, and bad
+//! input refused with no output.
+
+mod common;
+
+use common::{pilgrim, pilgrim_in, root, s, scratch};
+use lz_250::CaliberKinematics;
+use pilgrim_kernel::caliber::{check_groove, Groove};
+use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
+use pilgrim_kernel::{PartFamily, Verification};
+use std::path::Path;
+
+const SCRIPT: &str = "scripts/caliber.rhai";
+
+/// A wheel placed: its centre and axis.
+type Wheel = ([f64; 3], [f64; 3]);
+
+fn scratch_dir(name: &str) -> std::path::PathBuf {
+    scratch("caliber", name)
+}
+
+/// The value of address `a` in a block's words (`X12.5`).
+fn word(line: &str, a: char) -> Option<f64> {
+    line.split_whitespace()
+        .find(|w| w.starts_with(a) && w[1..].parse::<f64>().is_ok())
+        .map(|w| w[1..].parse().unwrap())
+}
+
+/// The moves of a Sinumerik program as a control reads them: each block's
+/// pass (counted by the pass comments, from 0) and its axes
+/// `[X, Z, Y, A, B]` (modal: a word left out keeps its value), the feed
+/// moves of the passes only.
+fn moves(mpf: &str) -> Vec<(usize, [f64; 5])> {
+    let mut at = [f64::NAN; 5];
+    let mut pass: Option<usize> = None;
+    let mut out = Vec::new();
+    for line in mpf.lines() {
+        let (code, comment) = line.split_once(';').unwrap_or((line, ""));
+        if comment.trim_start().starts_with("pass ") {
+            pass = Some(pass.map_or(0, |p| p + 1));
+        }
+        if comment.trim() == "end" {
+            pass = None;
+        }
+        for (i, a) in ['X', 'Z', 'Y', 'A', 'B'].into_iter().enumerate() {
+            if let Some(v) = word(code, a) {
+                at[i] = v;
+            }
+        }
+        if let Some(p) = pass {
+            if word(code, 'N').is_some() && !code.contains("G0") {
+                out.push((p, at));
+            }
+        }
+    }
+    out
+}
+
+/// The wheel's signed distance (torus with its disc), written here from
+/// the geometry, not the kernel's.
+fn distance(c: [f64; 3], w: [f64; 3], r_k0: f64, r_k: f64, q: [f64; 3]) -> f64 {
+    let v = [q[0] - c[0], q[1] - c[1], q[2] - c[2]];
+    let h = v[0] * w[0] + v[1] * w[1] + v[2] * w[2];
+    let r = [v[0] - h * w[0], v[1] - h * w[1], v[2] - h * w[2]];
+    let rho = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+    if rho <= r_k0 - r_k {
+        h.abs() - r_k
+    } else {
+        ((rho - (r_k0 - r_k)).powi(2) + h * h).sqrt() - r_k
+    }
+}
+
+fn report(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap()
+}
+
+/// The groove the run ground: the example table, smoothed as the family
+/// does (5 iterations from the middle of the sizing section).
+fn groove() -> Groove {
+    let t = pilgrim_kernel::profile::read_table(root().join("scripts/examples/caliber-groove.csv"))
+        .unwrap();
+    let g =
+        Groove::from_tables(150.0, (&t, "theta_deg", "Hp_mm"), (&t, "theta_deg", "B_mm")).unwrap();
+    g.smoothed(5, g.sizing_middle()).unwrap().0
+}
+
+/// The default job on the Mannesmann: every file, and the finish replayed
+/// from `program.mpf` by this test's own simulation (the plugin's closed
+/// form, the blocks read as written, each move in 8 straight steps, the
+/// torus's distance written above) within the tolerance at every point of a
+/// grid between the passes (where the scallops are) and on them.
+#[test]
+fn the_default_job_holds_its_tolerance_read_back_from_the_program() {
+    let dir = scratch_dir("default");
+    let out = dir.join("out");
+    let (code, stdout, err) = pilgrim(&["run", SCRIPT, "--out", s(&out)]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        stdout.contains("Mannesmann") && stdout.contains("groove within"),
+        "{stdout}"
+    );
+    for f in [
+        "program.mpf",
+        "program.cld",
+        "program.json",
+        "toolpath.json",
+        "report.json",
+        "report.csv",
+        "caliber.stl",
+        "wheel.stl",
+        "scene.glb",
+        "smoothing_d1.svg",
+        "smoothing_d2.svg",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let r = report(&out);
+    let v = &r["groove_verification"];
+    let tol = v["tolerance"].as_f64().unwrap();
+    assert_eq!(tol, 0.01);
+    assert!(v["max_abs_mm"].as_f64().unwrap() <= tol);
+    // The contact patch is reported with a size and is in the scene.
+    let patch = &v["patch"];
+    assert!(
+        patch["along_mm"].as_f64().unwrap() > 0.1 && patch["across_mm"].as_f64().unwrap() > 0.1,
+        "{patch}"
+    );
+    let doc = gltf::Gltf::from_slice(&std::fs::read(out.join("scene.glb")).unwrap()).unwrap();
+    let names: Vec<String> = doc
+        .nodes()
+        .filter_map(|n| n.name().map(str::to_owned))
+        .collect();
+    assert!(
+        names.iter().any(|n| n == "contact_patch") && names.iter().any(|n| n == "caliber"),
+        "{names:?}"
+    );
+    // Per-pass seed-vs-exact table, and the smoothing's figures.
+    let passes = r["tables"]["passes"]["psi_deg"].as_array().unwrap().len();
+    assert_eq!(passes, r["cutting_passes"].as_u64().unwrap() as usize);
+    assert!(r["notes"]["smoothing_hp_max_change_mm"].as_f64().unwrap() > 0.0);
+
+    // The replay of this test's own.
+    let mpf = std::fs::read_to_string(out.join("program.mpf")).unwrap();
+    assert!(mpf.contains("FGROUP(A)"), "the roll's turn leads the feed");
+    let blocks = moves(&mpf);
+    assert!(blocks.len() > 40_000, "{}", blocks.len());
+    assert!(blocks.iter().all(|b| b.1.iter().all(|v| v.is_finite())));
+    let k = CaliberKinematics { cross: true };
+    let pose = |row: &[f64; 5]| {
+        let q = [
+            row[0],
+            row[1],
+            row[2],
+            row[3].to_radians(),
+            row[4].to_radians(),
+        ];
+        k.pose(&q, [0.0; 3], [0.0, 0.0, 1.0])
+    };
+    // Samples along every move (8 straight steps, as the control moves
+    // the axes), by pass and by whole degree of the wheel centre's angle.
+    let n_pass = blocks.last().unwrap().0 + 1;
+    let mut buckets: Vec<Vec<Vec<Wheel>>> = vec![vec![Vec::new(); 360]; n_pass];
+    for w in blocks.windows(2) {
+        for s in 1..=8 {
+            let t = s as f64 / 8.0;
+            let mut row = [0.0; 5];
+            for i in 0..5 {
+                row[i] = w[0].1[i] + (w[1].1[i] - w[0].1[i]) * t;
+            }
+            let p = pose(&row);
+            let deg = p[1].atan2(p[0]).to_degrees().rem_euclid(360.0) as usize % 360;
+            buckets[w[1].0][deg].push(([p[0], p[1], p[2]], [p[3], p[4], p[5]]));
+        }
+    }
+    let g = groove();
+    let psis: Vec<f64> = r["tables"]["passes"]["psi_deg"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap().to_radians())
+        .collect();
+    assert_eq!(psis.len(), n_pass);
+    let mut worst: f64 = 0.0;
+    for step in 0..=56 {
+        let ti = (step as f64 * 5.0).to_radians();
+        for j in 0..psis.len() - 1 {
+            for psi in [psis[j], 0.5 * (psis[j] + psis[j + 1])] {
+                let q = g.point(ti, psi).unwrap();
+                let q = [q.x, q.y, q.z];
+                let mut d = f64::INFINITY;
+                for pass in j.saturating_sub(1)..(j + 3).min(n_pass) {
+                    for off in -4i64..=4 {
+                        let b = (step as i64 * 5 + off).rem_euclid(360) as usize;
+                        for s in &buckets[pass][b] {
+                            d = d.min(distance(s.0, s.1, 125.0, 8.0, q));
+                        }
+                    }
+                }
+                worst = worst.max(d.abs());
+            }
+        }
+    }
+    eprintln!("replay of program.mpf by the test: largest |distance| {worst:.6} mm");
+    assert!(
+        worst <= tol,
+        "the replay from program.mpf strays {worst} mm"
+    );
+    assert!(
+        worst > 1e-4,
+        "a replay that finds nothing at all is suspect: {worst}"
+    );
+    common::leave_for_checkers(&out, "caliber");
+}
+
+/// The LZ-250 reaches the same exact poses with its four axes (its figure
+/// reported); asked for the Mannesmann's swivel about the contact's radius,
+/// which it cannot give, it does its best and the replay refuses the gouge
+/// that costs, naming the block, and writes nothing.
+#[test]
+fn the_four_axis_machine_reports_its_figure_and_refuses_what_it_cannot_do() {
+    let dir = scratch_dir("lz250");
+    let out = dir.join("out");
+    let (code, _, err) = pilgrim(&["run", SCRIPT, "--machine", "LZ-250", "--out", s(&out)]);
+    assert_eq!(code, 0, "{err}");
+    let r = report(&out);
+    assert_eq!(r["machine"], "LZ-250");
+    assert!(r["groove_verification"]["max_abs_mm"].as_f64().unwrap() <= 0.01);
+    let mpf = std::fs::read_to_string(out.join("program.mpf")).unwrap();
+    assert!(
+        !mpf.lines()
+            .any(|l| l.split(';').next().unwrap().contains(" Y")),
+        "no Y on the LZ-250"
+    );
+    let bad = dir.join("bad");
+    let (code, _, err) = pilgrim(&[
+        "run",
+        SCRIPT,
+        "--machine",
+        "LZ-250",
+        "--set",
+        "cross_axis=true",
+        "--out",
+        s(&bad),
+    ]);
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("verification failed") && err.contains(" in \"pass "),
+        "{err}"
+    );
+    assert!(!bad.exists());
+}
+
+/// A block moved 0.05 mm off its place in the program: the replay names
+/// it (on a coarse job, for time).
+#[test]
+fn a_corrupted_block_is_named() {
+    let fam =
+        ScriptFamily::load(&root().join(SCRIPT), &Limits::default(), &Access::default()).unwrap();
+    let machine = pilgrim_kernel::plugin::PluginMachine::from_entry(
+        "Mannesmann",
+        "pilgrim_plugin_mannesmann",
+        mannesmann::pilgrim_plugin_mannesmann,
+    )
+    .unwrap();
+    let values = common::params_from(
+        &fam,
+        &Default::default(),
+        None,
+        &[
+            ("theta_step_deg", "3"),
+            ("dpsi_deg", "4"),
+            ("verify_theta_deg", "1.5"),
+            ("tolerance", "0.5"),
+            ("psi_max_deg", "60"),
+        ],
+    );
+    let tp = fam.toolpath(&values).unwrap();
+    let mut program = pilgrim_kernel::program::build(&tp, &machine, "caliber").unwrap();
+    let Some(Verification::Groove(req)) = fam.verification(&values).unwrap() else {
+        panic!("the caliber asks for the groove's replay")
+    };
+    let check = |p: &pilgrim_kernel::program::AxisProgram| {
+        check_groove(p, &machine, &tp.tool.reference, &tp.passes, &req, None)
+    };
+    let clean = check(&program).unwrap();
+    assert!(clean.max_abs_mm < 0.5, "{clean:?}");
+    // Block 1000: Z (the wheel's radial position) 0.8 mm in: a gouge.
+    let z = program.axes.iter().position(|a| a.name == "Z").unwrap();
+    program.blocks[999].values[z] -= 0.8;
+    let e = check(&program).unwrap_err().to_string();
+    let name = pilgrim_kernel::program::block_name(&program, 999);
+    assert!(
+        e.contains("gouge") && e.contains(&name),
+        "{e} (expected {name})"
+    );
+}
+
+/// Bad input: each a clear error naming the value and where it is, and no
+/// output.
+#[test]
+fn bad_input_is_refused_with_no_output() {
+    let dir = scratch_dir("bad");
+    let good = std::fs::read_to_string(root().join("scripts/examples/caliber-groove.csv")).unwrap();
+    let rows: Vec<&str> = good.lines().collect();
+    let header = rows
+        .iter()
+        .position(|l| l.starts_with("theta_deg"))
+        .unwrap();
+    let with = |row: usize, col: usize, value: &str| {
+        let mut lines: Vec<String> = rows.iter().map(|l| l.to_string()).collect();
+        let mut cells: Vec<String> = lines[header + row].split(',').map(str::to_owned).collect();
+        cells[col] = value.to_owned();
+        lines[header + row] = cells.join(",");
+        lines.join("\n") + "\n"
+    };
+    let file_row = |row: usize| header + row + 1; // as the file numbers it
+    let cases: Vec<(&str, String, Vec<String>, Vec<String>)> = vec![
+        (
+            "theta",
+            with(5, 0, "3"),
+            vec![],
+            vec!["theta".into(), format!("row {}", file_row(5))],
+        ),
+        (
+            "blank",
+            with(7, 1, ""),
+            vec![],
+            vec![format!("row {}", file_row(7)), "Hp_mm".into()],
+        ),
+        (
+            "text",
+            with(9, 2, "wide"),
+            vec![],
+            vec![format!("row {}", file_row(9)), "B_mm".into(), "wide".into()],
+        ),
+        (
+            "depth",
+            with(11, 1, "-2"),
+            vec![],
+            vec![
+                format!("row {}", file_row(11)),
+                "Hp".into(),
+                "positive".into(),
+            ],
+        ),
+        (
+            "width",
+            with(12, 2, "0"),
+            vec![],
+            vec![
+                format!("row {}", file_row(12)),
+                "B".into(),
+                "positive".into(),
+            ],
+        ),
+        (
+            "rounding",
+            good.clone(),
+            vec!["rounding_r=15".into()],
+            vec!["r_k".into(), "theta".into(), "psi".into()],
+        ),
+        (
+            "travel",
+            good.clone(),
+            vec!["roll_r=500".into()],
+            vec!["N".into(), "travel".into()],
+        ),
+    ];
+    for (name, table, sets, expect) in cases {
+        let case = dir.join(name);
+        std::fs::create_dir_all(&case).unwrap();
+        std::fs::write(case.join("groove.csv"), table).unwrap();
+        std::fs::write(case.join("p.toml"), "table = \"groove.csv\"\n").unwrap();
+        let out = case.join("out");
+        let mut args = vec![
+            "run".to_owned(),
+            root().join(SCRIPT).to_str().unwrap().to_owned(),
+            "--params".into(),
+            "p.toml".into(),
+            "--out".into(),
+            s(&out).to_owned(),
+        ];
+        for kv in &sets {
+            args.push("--set".into());
+            args.push(kv.clone());
+        }
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (code, _, err) = pilgrim_in(&case, &args);
+        assert_ne!(code, 0, "{name}: accepted");
+        for e in &expect {
+            assert!(err.contains(e.as_str()), "{name}: '{e}' not in: {err}");
+        }
+        assert!(!out.exists(), "{name}: output written");
+    }
+}
