@@ -368,10 +368,24 @@ fn bad_input_is_refused_with_no_output() {
             vec!["N".into(), "travel".into()],
         ),
     ];
+    // Widths from a second table whose row 20 is at another angle.
+    let other = with(20, 0, "39.5");
+    let mut cases = cases;
+    cases.push((
+        "two",
+        good.clone(),
+        vec!["width_table=width.csv".into()],
+        vec![
+            "width.csv".into(),
+            format!("row {}", file_row(20)),
+            "same angles".into(),
+        ],
+    ));
     for (name, table, sets, expect) in cases {
         let case = dir.join(name);
         std::fs::create_dir_all(&case).unwrap();
         std::fs::write(case.join("groove.csv"), table).unwrap();
+        std::fs::write(case.join("width.csv"), &other).unwrap();
         std::fs::write(case.join("p.toml"), "table = \"groove.csv\"\n").unwrap();
         let out = case.join("out");
         let mut args = vec![

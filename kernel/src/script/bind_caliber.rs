@@ -204,6 +204,26 @@ pub mod caliber_api {
         kernel(caliber::caliber_solid(g, width, hub, tol))
     }
 
+    /// The groove from two tables: Hp from `depth_table`, B from
+    /// `width_table`, each with its column of theta (deg) named `theta`;
+    /// the two must give the same angles (an error names the rows that
+    /// differ).
+    #[rhai_fn(name = "groove", return_raw)]
+    pub fn groove_two(
+        roll_radius: Real,
+        depth_table: Table,
+        width_table: Table,
+        theta: &str,
+        depth: &str,
+        width: &str,
+    ) -> Result<Groove, Box<EvalAltResult>> {
+        kernel(Groove::from_tables(
+            roll_radius,
+            (&depth_table, theta, depth),
+            (&width_table, theta, width),
+        ))
+    }
+
     /// The groove's point `[x, y, z]` at `(theta, psi)` in the roll's frame.
     #[rhai_fn(pure, return_raw)]
     pub fn point(g: &mut Groove, theta: Real, psi: Real) -> Result<Array, Box<EvalAltResult>> {
