@@ -66,7 +66,7 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
         /// The block (from 1) to place the tool at in the 3-D models.
-        /// Default: the first block of the last pass.
+        /// Default: the middle block of the last cutting pass.
         #[arg(long, value_name = "N")]
         pose_block: Option<usize>,
         /// Chordal tolerance of the 3-D models (mm); the family's own
@@ -92,7 +92,8 @@ enum Command {
         /// the run's files name.
         #[arg(long)]
         machine: Option<String>,
-        /// The block (from 1). Default: the first block of the last pass.
+        /// The block (from 1). Default: the middle block of the last
+        /// cutting pass.
         #[arg(long, value_name = "N")]
         block: Option<usize>,
         /// Write the STL files as ASCII instead of binary.
