@@ -28,11 +28,7 @@ pub mod caliber_api {
         depth: &str,
         width: &str,
     ) -> Result<Groove, Box<EvalAltResult>> {
-        kernel(Groove::from_tables(
-            roll_radius,
-            (&table, theta, depth),
-            (&table, theta, width),
-        ))
+        groove_two(roll_radius, table.clone(), table, theta, depth, width)
     }
 
     /// The node (row, from 0) in the middle of the sizing section (the
@@ -140,11 +136,7 @@ pub mod caliber_api {
         r_k: Real,
         cross: bool,
     ) -> Result<rhai::Map, Box<EvalAltResult>> {
-        let plane = if cross {
-            caliber::SwivelPlane::Contact
-        } else {
-            caliber::SwivelPlane::Wheel
-        };
+        let plane = super::swivel_plane(cross);
         let poses = kernel(caliber::pass_poses(g, psi, step, r_k0, r_k, plane))?;
         Ok(super::pass_map(&poses))
     }
@@ -160,11 +152,7 @@ pub mod caliber_api {
         r_k: Real,
         cross: bool,
     ) -> Result<Array, Box<EvalAltResult>> {
-        let plane = if cross {
-            caliber::SwivelPlane::Contact
-        } else {
-            caliber::SwivelPlane::Wheel
-        };
+        let plane = super::swivel_plane(cross);
         let psis: Vec<Real> = psis.0.to_vec();
         let g: &Groove = g;
         let run = |list: &[Real]| -> Result<Vec<Vec<caliber::PassPose>>, String> {
@@ -373,4 +361,14 @@ fn pass_map(poses: &[caliber::PassPose]) -> rhai::Map {
     m.insert("seed_centre".into(), col(&|p| p.seed_centre_error));
     m.insert("seed_axis".into(), col(&|p| p.seed_axis_error));
     m
+}
+
+/// The plane a caliber wheel's axis keeps: the contact's with the cross
+/// axis, the wheel centre's without.
+fn swivel_plane(cross: bool) -> caliber::SwivelPlane {
+    if cross {
+        caliber::SwivelPlane::Contact
+    } else {
+        caliber::SwivelPlane::Wheel
+    }
 }
