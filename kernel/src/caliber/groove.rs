@@ -138,10 +138,8 @@ impl Groove {
             }
         }
         let theta: Vec<Real> = ht.iter().map(|t| t.to_radians()).collect();
-        // Evaluated point by point: the Hermite slopes estimated once.
         let profile = |table, x: &[Real]| {
             Profile::new(theta.clone(), x.to_vec())
-                .map(Profile::with_slopes_kept)
                 .map_err(|source| GrooveError::Table { table, source })
         };
         Ok(Self {
@@ -335,8 +333,8 @@ impl Groove {
         let g = Self::new(self.r_d, (&deg, &deg), hp.profile.x(), b.profile.x())?;
         // The same angles exactly (not through degrees and back).
         let g = Self {
-            hp: Profile::new(self.hp.z().to_vec(), g.hp.x().to_vec())?.with_slopes_kept(),
-            b: Profile::new(self.b.z().to_vec(), g.b.x().to_vec())?.with_slopes_kept(),
+            hp: Profile::new(self.hp.z().to_vec(), g.hp.x().to_vec())?,
+            b: Profile::new(self.b.z().to_vec(), g.b.x().to_vec())?,
             ..g
         };
         Ok((g, hp, b))

@@ -146,6 +146,21 @@ pub struct Profile {
     dx: Option<Vec<Real>>,
     /// Analytic d2x/dz2 at the nodes, when known (may be infinite at a kink).
     d2x: Option<Vec<Real>>,
+    /// The estimated slopes, made on first use (evaluating point by point
+    /// must not estimate them again each time: that is O(nodes) a call).
+    #[serde(skip)]
+    estimated: SlopeCache,
+}
+
+/// A profile's estimated node slopes, computed once; not part of what the
+/// profile is (equal profiles are equal whether or not it is filled).
+#[derive(Debug, Clone, Default)]
+struct SlopeCache(std::sync::OnceLock<Vec<Real>>);
+
+impl PartialEq for SlopeCache {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 /// Validates an abscissa array: finite, long enough, strictly increasing.
@@ -195,6 +210,7 @@ impl Profile {
             x,
             dx: None,
             d2x: None,
+            estimated: SlopeCache::default(),
         })
     }
 
@@ -225,17 +241,6 @@ impl Profile {
         p.dx = Some(dx);
         p.d2x = Some(d2x);
         Ok(p)
-    }
-
-    /// The profile with its estimated node slopes ([`Self::slopes`]) kept,
-    /// so that evaluating it does not estimate them again each time: the
-    /// same curve, for profiles evaluated point by point (a groove's
-    /// tables).
-    pub fn with_slopes_kept(mut self) -> Self {
-        if self.dx.is_none() {
-            self.dx = Some(self.slopes().into_owned());
-        }
-        self
     }
 
     /// Number of nodes (at least [`MIN_POINTS`]).
@@ -305,6 +310,11 @@ impl Profile {
         if let Some(d) = &self.dx {
             return Cow::Borrowed(d);
         }
+        Cow::Borrowed(self.estimated.0.get_or_init(|| self.estimate_slopes()))
+    }
+
+    /// The three-point estimate of the slopes ([`Self::slopes`]).
+    fn estimate_slopes(&self) -> Vec<Real> {
         let (z, x) = (&self.z, &self.x);
         let n = z.len();
         let mut out = vec![0.0; n];
@@ -320,7 +330,7 @@ impl Profile {
             out[i] = parabola(i, i - 1, i, i + 1);
         }
         out[n - 1] = parabola(n - 1, n - 3, n - 2, n - 1);
-        Cow::Owned(out)
+        out
     }
 
     /// d2x/dz2 at every node: analytic if known, else the second divided
@@ -500,6 +510,7 @@ impl Profile {
             x,
             dx: None,
             d2x: None,
+            estimated: SlopeCache::default(),
         }
     }
 }
