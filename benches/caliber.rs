@@ -71,7 +71,6 @@ fn caliber_verify(c: &mut Criterion) {
             &out.toolpath.tool.reference,
             &out.toolpath.passes,
             &req,
-            None,
         )
         .unwrap()
     };

@@ -282,7 +282,7 @@ fn a_corrupted_block_is_named() {
         panic!("the caliber asks for the groove's replay")
     };
     let check = |p: &pilgrim_kernel::program::AxisProgram| {
-        check_groove(p, &machine, &tp.tool.reference, &tp.passes, &req, None)
+        check_groove(p, &machine, &tp.tool.reference, &tp.passes, &req)
     };
     let clean = check(&program).unwrap();
     assert!(clean.max_abs_mm < 0.5, "{clean:?}");

@@ -128,7 +128,7 @@ pub struct GrooveCheck {
     pub max_gouge: GroovePlace,
     /// The larger of the two in size (mm).
     pub max_abs_mm: Real,
-    /// The contact patch at the scene's block.
+    /// The contact patch at the scene's block (set by the job).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub patch: Option<ContactPatch>,
 }
@@ -291,8 +291,8 @@ fn nearest(list: &[Sample], q: &Vec3, theta: Real) -> (Real, usize) {
 
 /// Replays `program` on `machine` (the tool tracked at `tool`) and
 /// measures the groove of `req` against the swept wheel; `passes` are the
-/// toolpath's, `req.psi` one per cutting pass. The contact patch is taken
-/// at block `patch_block` (from 0) if given.
+/// toolpath's, `req.psi` one per cutting pass. The check's `patch` is
+/// left for the caller ([`contact_patch`], at the block it shows).
 ///
 /// # Failures
 /// A tolerance finer than twice the program's resolution; the replay
@@ -304,7 +304,6 @@ pub fn check_groove(
     tool: &ToolFrame,
     passes: &[Pass],
     req: &GrooveRequest,
-    patch_block: Option<usize>,
 ) -> Result<GrooveCheck, VerifyError> {
     crate::math::positive("verification tolerance", req.tolerance)?;
     crate::math::positive("verification grid step along theta", req.grid_theta)?;
@@ -436,10 +435,6 @@ pub fn check_groove(
         max_gouge.mm = 0.0;
     }
     let max_abs = max_left.mm.max(-max_gouge.mm);
-    let patch = match patch_block {
-        Some(b) => Some(contact_patch(&written, machine, tool, req, b)?.0),
-        None => None,
-    };
     let check = GrooveCheck {
         tolerance: req.tolerance,
         resolution_mm: resolution,
@@ -452,7 +447,7 @@ pub fn check_groove(
         max_left,
         max_gouge,
         max_abs_mm: max_abs,
-        patch,
+        patch: None,
     };
     if max_abs > req.tolerance {
         let worst = if check.max_left.mm >= -check.max_gouge.mm {
@@ -479,15 +474,15 @@ pub fn check_groove(
 /// it).
 ///
 /// # Failures
-/// The block beyond the program; the replay failing; no groove point
-/// within the gap (the wheel does not touch the groove at that block).
+/// The block beyond the program; the replay failing. `None`: no groove
+/// point within the gap (the wheel does not touch the groove there).
 pub fn contact_patch(
     program: &AxisProgram,
     machine: &dyn MachineKinematics,
     tool: &ToolFrame,
     req: &GrooveRequest,
     block: usize,
-) -> Result<(ContactPatch, TriMesh), VerifyError> {
+) -> Result<Option<(ContactPatch, TriMesh)>, VerifyError> {
     crate::math::positive("contact patch gap", req.patch_gap)?;
     let pose = crate::verify::replay_blocks(program, machine, tool, block..block + 1)?;
     let wheel = TorusWheel {
@@ -536,12 +531,7 @@ pub fn contact_patch(
             }
         }
         if i0 > i1 {
-            return Err(VerifyError::Replay(format!(
-                "the wheel at {} is {} mm from the groove at its nearest: no contact patch within {} mm",
-                block_name(program, block),
-                crate::math::fixed(best.0, 4),
-                req.patch_gap
-            )));
+            return Ok(None); // the wheel does not touch the groove here
         }
         let at_edge = |a: usize, b: usize| a == 0 || b == N;
         let theta_edge = at_edge(i0, i1) && ts[0] > lo && ts[N] < hi;
@@ -604,6 +594,6 @@ pub fn contact_patch(
             least_distance_mm: least,
             points: inside.iter().filter(|&&b| b).count(),
         };
-        return Ok((patch, mesh));
+        return Ok(Some((patch, mesh)));
     }
 }

@@ -223,16 +223,31 @@ pub fn run(
         Some(Verification::Profile(v)) => (Some(v), None),
         Some(Verification::Groove(g)) => (None, Some(g)),
     };
-    let groove = match &groove_request {
-        None => None,
-        Some(g) => Some(crate::caliber::check_groove(
-            &program,
-            kin,
-            &toolpath.tool.reference,
-            &toolpath.passes,
-            g,
-            Some(pose_index),
-        )?),
+    // The caliber's replay, and its contact patch at the pose block (in
+    // the report, and its mesh in the scene).
+    let (groove, patch_mesh) = match &groove_request {
+        None => (None, None),
+        Some(g) => {
+            let mut check = crate::caliber::check_groove(
+                &program,
+                kin,
+                &toolpath.tool.reference,
+                &toolpath.passes,
+                g,
+            )?;
+            let patch = crate::caliber::contact_patch(
+                &crate::verify::as_written(&program).0,
+                kin,
+                &toolpath.tool.reference,
+                g,
+                pose_index,
+            )?;
+            let mesh = patch.map(|(p, m)| {
+                check.patch = Some(p);
+                m
+            });
+            (Some(check), mesh)
+        }
     };
     let verification = match &nominal {
         None => None,
@@ -298,23 +313,10 @@ pub fn run(
         let pose = scene::tool_pose(&program, kin, &toolpath.tool, index)?;
         let tool = scene::tool_mesh(&toolpath.tool, tol)?;
         let others = scene::machine_bodies(kin, &program, index, tol)?;
-        let overlays = match &groove_request {
-            Some(g) => {
-                let (_, patch) = crate::caliber::contact_patch(
-                    &crate::verify::as_written(&program).0,
-                    kin,
-                    &toolpath.tool.reference,
-                    g,
-                    index,
-                )?;
-                vec![(
-                    "contact_patch".to_owned(),
-                    patch,
-                    crate::math::Mat4::identity(),
-                )]
-            }
-            None => vec![],
-        };
+        let overlays = patch_mesh
+            .map(|m| ("contact_patch".to_owned(), m, crate::math::Mat4::identity()))
+            .into_iter()
+            .collect();
         let (mesh_files, bodies) =
             scene::files(&meshes, tool, pose, others, overlays, options.formats)?;
         files.extend(mesh_files);
