@@ -215,14 +215,11 @@ pub struct GrindingCheck {
 /// The program as a control reads it: every value rounded to the decimals
 /// the program is written with (its own, or its dialect's).
 pub fn as_written(program: &AxisProgram) -> (AxisProgram, Real) {
-    let decimals = program
-        .decimals
-        .or_else(|| crate::program::post::dialect(&program.control).map(|d| d.decimals))
-        .unwrap_or(3);
+    let decimals = crate::program::written_decimals(program.decimals, &program.control);
     let mut p = program.clone();
     for b in &mut p.blocks {
         for v in &mut b.values {
-            *v = crate::math::fixed(*v, decimals).parse().unwrap_or(*v);
+            *v = crate::program::written(*v, decimals);
         }
     }
     (p, 10f64.powi(-(decimals as i32)))

@@ -101,8 +101,8 @@ pub fn cycle_time(program: &AxisProgram, info: &MachineInfo) -> Real {
     let known: Vec<&Axis> = axes.iter().flatten().copied().collect();
     let mut minutes = 0.0;
     // As the control reads the program: its values as written.
-    let scale = 10f64.powi(crate::program::written_decimals(info) as i32);
-    let w = |v: &Real| (v * scale).round() / scale;
+    let decimals = crate::program::written_decimals(program.decimals, &program.control);
+    let w = |v: &Real| crate::program::written(*v, decimals);
     for pair in program.blocks.windows(2) {
         let (a, b) = (&pair[0], &pair[1]);
         let deltas: Vec<Real> = a

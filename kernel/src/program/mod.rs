@@ -218,11 +218,30 @@ fn name_in(control: &str, blocks: &[Block], index: usize) -> String {
     }
 }
 
-/// The decimals a program for `info` writes its axis values with.
-pub fn written_decimals(info: &MachineInfo) -> usize {
-    info.program_decimals
-        .or_else(|| post::dialect(&info.control).map(|d| d.decimals))
+/// The decimals a program writes its axis values with: its own
+/// (`decimals`, the machine's), else its dialect's (`control`), else 3.
+pub fn written_decimals(decimals: Option<usize>, control: &str) -> usize {
+    decimals
+        .or_else(|| post::dialect(control).map(|d| d.decimals))
         .unwrap_or(3)
+}
+
+/// `v` as a program with `decimals` writes it and a control reads it back:
+/// the one rounding every reader of a program's values uses (replays,
+/// feed checks, cycle times, feeds over rotary moves).
+///
+/// The same number as formatting and parsing (`fixed`), faster: away from
+/// a tie, `round(v 10^d) / 10^d` is the nearest double to the decimal the
+/// file holds (an exact integer over an exact power of ten, divided once);
+/// within 1e-6 of a tie, or beyond 2^52, the text decides.
+pub fn written(v: Real, decimals: usize) -> Real {
+    let scale = 10f64.powi(decimals.min(22) as i32);
+    let t = v * scale;
+    if t.abs() < 4.5e15 && (t.fract().abs() - 0.5).abs() > 1e-6 {
+        t.round() / scale + 0.0
+    } else {
+        crate::math::fixed(v, decimals).parse().unwrap_or(v)
+    }
 }
 
 /// Where a cutting block turns a rotary axis, its feed becomes the
@@ -235,8 +254,7 @@ pub fn written_decimals(info: &MachineInfo) -> usize {
 /// the chord between the two points; blocks that turn nothing keep their
 /// feed. `blocks` are the toolpath's, one per point, in order.
 fn rotary_feeds(blocks: &mut [Block], axes: &[&Axis], toolpath: &Toolpath, info: &MachineInfo) {
-    let scale = 10f64.powi(written_decimals(info) as i32);
-    let written = |v: Real| (v * scale).round() / scale;
+    let decimals = written_decimals(info.program_decimals, &info.control);
     let points: Vec<&crate::toolpath::ClPoint> = toolpath.points().map(|(_, _, c)| c).collect();
     for k in 1..blocks.len().min(points.len()) {
         if blocks[k].motion != Motion::Linear {
@@ -246,7 +264,7 @@ fn rotary_feeds(blocks: &mut [Block], axes: &[&Axis], toolpath: &Toolpath, info:
             .values
             .iter()
             .zip(&blocks[k - 1].values)
-            .map(|(b, a)| written(*b) - written(*a))
+            .map(|(b, a)| written(*b, decimals) - written(*a, decimals))
             .collect();
         let turns = axes
             .iter()
@@ -472,8 +490,8 @@ pub fn build(
         })
         .collect();
     // Speeds as the control runs the program: its values as written.
-    let scale = 10f64.powi(written_decimals(info) as i32);
-    let rows_written = rows(&|v| (v * scale).round() / scale);
+    let decimals = written_decimals(info.program_decimals, &info.control);
+    let rows_written = rows(&|v| written(v, decimals));
     crate::machine::check_feed_grouped(&axes_refs, &rows_written, &feeds, &info.setup.feed_group)
         .map_err(|e| ProgramError::from_limit(&info.name, e, name_of))?;
     Ok(AxisProgram {
@@ -663,4 +681,78 @@ pub fn program_name(name: &str) -> String {
     }
     s.truncate(24);
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The caliber grinders' F: the roll's turn in deg/min where the turn
+    /// is written, the linear path's where it is not. A turn of 0.0003 deg
+    /// the program writes as none, with 1.3 mm of X: the feed check reads
+    /// the program as written (it had read the unwritten turn and found X
+    /// at 3.4 m/min); a whole degree: F is the turn's, at the chord's time.
+    #[test]
+    fn rotary_feeds_follow_the_program_as_written() {
+        use crate::machine::{ChainMachine, Machine};
+        use crate::toolpath::{ClPoint, Pass};
+        let lz = ChainMachine::new(Machine::builtin("LZ-250").unwrap());
+        let wheel = crate::tool::Wheel::new(250.0, 8.0, 16.0).unwrap();
+        let at = |deg: Real, z: Real| {
+            let t = deg.to_radians();
+            ClPoint {
+                point: [250.0 * t.cos(), 250.0 * t.sin(), z],
+                axis: [0.0, 0.0, 1.0],
+                motion: Motion::Linear,
+                feed: 1500.0,
+                aux: vec![],
+            }
+        };
+        let mut tp = Toolpath::new(
+            "t",
+            crate::tool::Tool::wheel_at_centre("w", 1, wheel),
+            2000.0,
+            vec![],
+        );
+        tp.passes.push(Pass {
+            name: "p".into(),
+            points: vec![at(10.0, 0.0), at(10.0003, 1.3), at(11.0003, 1.3)],
+        });
+        let p = build(&tp, &lz, "t").unwrap();
+        let n = p.blocks.len();
+        let (unwritten, turn) = (&p.blocks[n - 3], &p.blocks[n - 2]);
+        assert_eq!(
+            unwritten.feed, 1500.0,
+            "no turn as written: the linear path's feed"
+        );
+        // 1 deg at 250 mm: 4.363 mm at 1500 mm/min, so 1 deg in 0.00291 min.
+        let chord = 2.0 * 250.0 * 0.5f64.to_radians().sin();
+        assert!((turn.feed - 1500.0 / chord).abs() < 1e-6, "{}", turn.feed);
+    }
+
+    /// The fast rounding is the text's, near-ties and negative zeros
+    /// included.
+    #[test]
+    fn written_values_are_the_files() {
+        let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
+        for i in 0..200_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let v = match i % 4 {
+                0 => (x as f64 / u64::MAX as f64 - 0.5) * 2000.0,
+                1 => (x % 2_000_000) as f64 / 2000.0 - 500.0,
+                2 => -((x % 1000) as f64) * 1e-7,
+                _ => (x % 100_000) as f64 * 0.001 + 0.0005,
+            };
+            for d in [1, 3, 4] {
+                let text: Real = crate::math::fixed(v, d).parse().unwrap();
+                assert_eq!(
+                    written(v, d).to_bits(),
+                    text.to_bits(),
+                    "{v} at {d} decimals"
+                );
+            }
+        }
+    }
 }
