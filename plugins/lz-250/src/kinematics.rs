@@ -305,6 +305,46 @@ mod tests {
         assert_eq!((p[0], p[2]), (100.0, 5.0));
     }
 
+    /// A groove runs past half a turn: along a pass round 300 deg of the
+    /// roll the turn A runs on continuously (it had jumped by 360 deg at
+    /// 180, which the feed check read as a turn at 115,830 deg/min).
+    #[test]
+    fn the_roll_turns_on_past_half_a_turn() {
+        for cross in [false, true] {
+            let k = CaliberKinematics { cross };
+            let poses: Vec<f64> = (0..=300)
+                .flat_map(|d| {
+                    let t = (d as f64).to_radians();
+                    let w = [-0.1 * t.sin(), 0.1 * t.cos(), 1.0];
+                    let n = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
+                    [
+                        250.0 * t.cos(),
+                        250.0 * t.sin(),
+                        5.0,
+                        w[0] / n,
+                        w[1] / n,
+                        w[2] / n,
+                    ]
+                })
+                .collect();
+            let width = k.width();
+            let mut out = vec![0.0; 301 * width];
+            k.inverse(&poses, &[0.0, 0.0, 0.0, 0.0, 0.0, 1.0], &mut out)
+                .unwrap();
+            let turn = width - 2;
+            for r in out.chunks(width).collect::<Vec<_>>().windows(2) {
+                assert!(
+                    (r[1][turn] - r[0][turn]).abs() < 2f64.to_radians(),
+                    "{cross}: {r:?}"
+                );
+            }
+            assert!(
+                (out[300 * width + turn] + 300f64.to_radians()).abs() < 1e-9,
+                "A = -theta"
+            );
+        }
+    }
+
     /// A pose whose axis has a radial part: the Mannesmann reaches it (the
     /// roll turns, Y places the centre); the LZ-250 places the point
     /// exactly and the axis as near as it can, the difference the radial
