@@ -63,12 +63,16 @@ fn caliber_verify(c: &mut Criterion) {
     let Some(Verification::Groove(req)) = family.verification(&out.params).unwrap() else {
         panic!("the caliber asks for the groove's replay")
     };
+    let pilgrim_kernel::ToolShape::Wheel(wheel) = out.toolpath.tool.shape else {
+        panic!("the caliber's tool is a wheel")
+    };
     let kin = machine.kinematics.as_ref();
     let replay = || {
         check_groove(
             &out.program,
             kin,
             &out.toolpath.tool.reference,
+            &wheel,
             &out.toolpath.passes,
             &req,
         )

@@ -281,8 +281,11 @@ fn a_corrupted_block_is_named() {
     let Some(Verification::Groove(req)) = fam.verification(&values).unwrap() else {
         panic!("the caliber asks for the groove's replay")
     };
+    let pilgrim_kernel::ToolShape::Wheel(wheel) = tp.tool.shape else {
+        panic!("the caliber's tool is a wheel")
+    };
     let check = |p: &pilgrim_kernel::program::AxisProgram| {
-        check_groove(p, &machine, &tp.tool.reference, &tp.passes, &req)
+        check_groove(p, &machine, &tp.tool.reference, &wheel, &tp.passes, &req)
     };
     let clean = check(&program).unwrap();
     assert!(clean.max_abs_mm < 0.5, "{clean:?}");

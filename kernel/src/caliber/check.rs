@@ -26,6 +26,7 @@ use crate::machine::MachineKinematics;
 use crate::math::{Real, Vec3};
 use crate::mesh::TriMesh;
 use crate::program::{axis_rows, block_name, pass_blocks, AxisProgram};
+use crate::tool::Wheel;
 use crate::toolpath::Pass;
 use crate::transform::ToolFrame;
 use crate::verify::{as_written, VerifyError};
@@ -52,10 +53,6 @@ pub struct GrooveRequest {
     pub groove: Groove,
     /// The pass angle psi (rad) of each cutting pass, in order.
     pub psi: Vec<Real>,
-    /// The wheel's largest radius `R_k0` (mm).
-    pub r_k0: Real,
-    /// Its rounding `r_k` (mm).
-    pub r_k: Real,
     /// The deviation the finished groove must hold (mm).
     pub tolerance: Real,
     /// The grid's step along theta (rad).
@@ -148,6 +145,17 @@ pub fn wheel_distance(w: &TorusWheel, q: &Vec3) -> Real {
     }
 }
 
+/// The wheel (a full-radius wheel: a torus of its diameter and rounding)
+/// at a replayed pose, a row of 6 (centre, axis).
+fn placed(pose: &[Real], wheel: &Wheel) -> TorusWheel {
+    TorusWheel {
+        centre: Vec3::new(pose[0], pose[1], pose[2]),
+        axis: Vec3::new(pose[3], pose[4], pose[5]).normalize(),
+        major: wheel.centre_radius(),
+        minor: wheel.rounding_radius,
+    }
+}
+
 /// The middle of the groove's range of theta (rad): angles about the
 /// roll's axis are taken within half a turn of it.
 fn groove_middle(g: &Groove) -> Real {
@@ -171,6 +179,7 @@ fn samples(
     program: &AxisProgram,
     machine: &dyn MachineKinematics,
     tool: &ToolFrame,
+    wheel: &Wheel,
     passes: &[Pass],
     req: &GrooveRequest,
 ) -> Result<(Vec<Vec<Sample>>, Real, usize), VerifyError> {
@@ -178,23 +187,12 @@ fn samples(
     let n = program.blocks.len();
     let rows = axis_rows(program, info, &info.solved_axes, 0..n).map_err(VerifyError::Replay)?;
     let width = info.solved_axes.len();
-    let mut poses = Vec::new();
-    machine
-        .forward(&rows, tool, &mut poses)
-        .map_err(|source| VerifyError::Kinematics {
-            first: 1,
-            last: n,
-            source,
-        })?;
-    let at = |pose: &[Real]| TorusWheel {
-        centre: Vec3::new(pose[0], pose[1], pose[2]),
-        axis: Vec3::new(pose[3], pose[4], pose[5]).normalize(),
-        major: req.r_k0 - req.r_k,
-        minor: req.r_k,
-    };
+    let poses = crate::verify::replay(program, machine, tool)?;
+    let at = |pose: &[Real]| placed(pose, wheel);
+    let (r_k0, r_k) = (0.5 * wheel.diameter, wheel.rounding_radius);
     // Between samples no point of the wheel moves more than `step`.
     let target = req.tolerance / SAMPLING_SHARE;
-    let step = (8.0 * req.r_k * target).sqrt();
+    let step = (8.0 * r_k * target).sqrt();
     let mut out = Vec::new();
     let mut worst: Real = 0.0;
     let mut count = 0;
@@ -204,7 +202,7 @@ fn samples(
         for k in blocks.start.max(1)..blocks.end {
             let (a, b) = (at(&poses[6 * (k - 1)..6 * k]), at(&poses[6 * k..6 * k + 6]));
             let turned = a.axis.dot(&b.axis).clamp(-1.0, 1.0).acos();
-            let moved = (b.centre - a.centre).norm() + req.r_k0 * turned;
+            let moved = (b.centre - a.centre).norm() + r_k0 * turned;
             let subs = ((moved / step).ceil() as usize).max(1);
             worst = worst.max(moved / subs as Real);
             count += subs;
@@ -253,7 +251,7 @@ fn samples(
         list.sort_by(|a, b| a.turn.total_cmp(&b.turn));
         out.push(list);
     }
-    Ok((out, worst * worst / (8.0 * req.r_k), count))
+    Ok((out, worst * worst / (8.0 * r_k), count))
 }
 
 /// The least distance from `q` over `list` (sorted by turn), searched
@@ -289,8 +287,8 @@ fn nearest(list: &[Sample], q: &Vec3, theta: Real) -> (Real, usize) {
     (best, list[i].block)
 }
 
-/// Replays `program` on `machine` (the tool tracked at `tool`) and
-/// measures the groove of `req` against the swept wheel; `passes` are the
+/// Replays `program` on `machine` (the tool tracked at `tool`, a
+/// full-radius `wheel`: the toolpath's own) and measures the groove of `req` against the swept wheel; `passes` are the
 /// toolpath's, `req.psi` one per cutting pass. The check's `patch` is
 /// left for the caller ([`contact_patch`], at the block it shows).
 ///
@@ -302,6 +300,7 @@ pub fn check_groove(
     program: &AxisProgram,
     machine: &dyn MachineKinematics,
     tool: &ToolFrame,
+    wheel: &Wheel,
     passes: &[Pass],
     req: &GrooveRequest,
 ) -> Result<GrooveCheck, VerifyError> {
@@ -314,7 +313,7 @@ pub fn check_groove(
             resolution,
         });
     }
-    let (lists, sampling, count) = samples(&written, machine, tool, passes, req)?;
+    let (lists, sampling, count) = samples(&written, machine, tool, wheel, passes, req)?;
     if lists.len() != req.psi.len() || lists.is_empty() {
         return Err(VerifyError::Replay(format!(
             "{} cutting passes for {} pass angles",
@@ -480,17 +479,13 @@ pub fn contact_patch(
     program: &AxisProgram,
     machine: &dyn MachineKinematics,
     tool: &ToolFrame,
+    wheel: &Wheel,
     req: &GrooveRequest,
     block: usize,
 ) -> Result<Option<(ContactPatch, TriMesh)>, VerifyError> {
     crate::math::positive("contact patch gap", req.patch_gap)?;
     let pose = crate::verify::replay_blocks(program, machine, tool, block..block + 1)?;
-    let wheel = TorusWheel {
-        centre: Vec3::new(pose[0], pose[1], pose[2]),
-        axis: Vec3::new(pose[3], pose[4], pose[5]).normalize(),
-        major: req.r_k0 - req.r_k,
-        minor: req.r_k,
-    };
+    let wheel = placed(&pose, wheel);
     let g = &req.groove;
     let (lo, hi) = g.theta_range();
     // The contact: the groove point nearest the wheel, near the wheel's

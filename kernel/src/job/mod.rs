@@ -218,6 +218,12 @@ pub fn run(
         Some(n) => n - 1,
         None => default_pose_block(&program, &toolpath.passes),
     };
+    let needs_wheel = || {
+        Error::Family(crate::family::FamilyError::Contract {
+            family: family.name().to_owned(),
+            message: "fn verify(p) needs a grinding wheel".into(),
+        })
+    };
     let (nominal, groove_request) = match requested {
         None => (None, None),
         Some(Verification::Profile(v)) => (Some(v), None),
@@ -228,10 +234,14 @@ pub fn run(
     let (groove, patch_mesh) = match &groove_request {
         None => (None, None),
         Some(g) => {
+            let ToolShape::Wheel(wheel) = toolpath.tool.shape else {
+                return Err(needs_wheel());
+            };
             let mut check = crate::caliber::check_groove(
                 &program,
                 kin,
                 &toolpath.tool.reference,
+                &wheel,
                 &toolpath.passes,
                 g,
             )?;
@@ -239,6 +249,7 @@ pub fn run(
                 &crate::verify::as_written(&program).0,
                 kin,
                 &toolpath.tool.reference,
+                &wheel,
                 g,
                 pose_index,
             )?;
@@ -253,10 +264,7 @@ pub fn run(
         None => None,
         Some(v) => {
             let ToolShape::Wheel(w) = toolpath.tool.shape else {
-                return Err(Error::Family(crate::family::FamilyError::Contract {
-                    family: family.name().to_owned(),
-                    message: "fn verify(p) needs a grinding wheel".into(),
-                }));
+                return Err(needs_wheel());
             };
             Some(check_grinding(
                 &program,

@@ -644,7 +644,7 @@ impl PartFamily for ScriptFamily {
     }
 
     /// `fn verify(p)`, if the script has it: `#{ profile, from, to,
-    /// tolerance }` (a body of revolution) or `#{ groove, psi, r_k0, r_k,
+    /// tolerance }` (a body of revolution) or `#{ groove, psi,
     /// tolerance, grid_theta, grid_per_step, patch_gap }` (a caliber).
     fn verification(&self, values: &Params) -> Result<Option<Verification>, FamilyError> {
         if !self.has_fn("verify", 1) {
@@ -653,7 +653,7 @@ impl PartFamily for ScriptFamily {
         let d = self.call_with_params("verify", values)?;
         let shape = || {
             self.contract(
-                "fn verify(p) must return #{ profile, from, to, tolerance } or #{ groove, psi, r_k0, r_k, tolerance, grid_theta, grid_per_step, patch_gap }".into(),
+                "fn verify(p) must return #{ profile, from, to, tolerance } or #{ groove, psi, tolerance, grid_theta, grid_per_step, patch_gap }".into(),
             )
         };
         let m = d.try_cast::<Map>().ok_or_else(shape)?;
@@ -677,8 +677,6 @@ impl PartFamily for ScriptFamily {
                 crate::caliber::GrooveRequest {
                     groove,
                     psi: psi.to_vec(),
-                    r_k0: num("r_k0")?,
-                    r_k: num("r_k")?,
                     tolerance: num("tolerance")?,
                     grid_theta: num("grid_theta")?,
                     grid_per_step: per as usize,
