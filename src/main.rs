@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// The machine plugins compiled into the program.
-const COMPILED_PLUGINS: [CompiledPlugin; 3] = [
+const COMPILED_PLUGINS: [CompiledPlugin; 4] = [
     CompiledPlugin {
         symbol: "pilgrim_plugin_grinder_3k152vf20",
         entry: grinder_3k152vf20::pilgrim_plugin_grinder_3k152vf20,
@@ -29,6 +29,10 @@ const COMPILED_PLUGINS: [CompiledPlugin; 3] = [
     CompiledPlugin {
         symbol: "pilgrim_plugin_mannesmann",
         entry: mannesmann::pilgrim_plugin_mannesmann,
+    },
+    CompiledPlugin {
+        symbol: "pilgrim_plugin_fanuc_0i_tc",
+        entry: fanuc_0i_tc::pilgrim_plugin_fanuc_0i_tc,
     },
 ];
 
@@ -82,6 +86,10 @@ enum Command {
         /// Wall-clock limit of each call of the family's script (seconds).
         #[arg(long, value_name = "S", default_value_t = 60.0)]
         script_seconds: f64,
+        /// Write a whole program numbered N (Fanuc: `%`, `O` number, the
+        /// tool call) instead of the block to paste after the tool call.
+        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=9999))]
+        program_number: Option<u32>,
     },
     /// Re-export a finished run's 3-D scene with the tool at another block.
     Export {
@@ -266,6 +274,7 @@ fn main() -> ExitCode {
             stl_ascii,
             gltf,
             script_seconds,
+            program_number,
         } => run::run(
             &run::RunArgs {
                 formats: Formats {
@@ -283,6 +292,7 @@ fn main() -> ExitCode {
                 }),
                 quiet: cli.quiet,
                 script_seconds: *script_seconds,
+                program_number: *program_number,
             },
             &catalog,
         )

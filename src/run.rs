@@ -21,6 +21,7 @@ pub struct RunArgs {
     pub out: PathBuf,
     pub quiet: bool,
     pub script_seconds: f64,
+    pub program_number: Option<u32>,
 }
 
 /// A progress bar over the run's stages (hidden with --quiet).
@@ -100,6 +101,7 @@ pub fn run(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
         pose_block: args.pose_block,
         mesh_tolerance: args.mesh_tolerance,
         formats: args.formats,
+        program_number: args.program_number,
     };
     let out = job::run(&family, &machine, &sources, &options, &mut |s| next(s))
         .map_err(|e| e.to_string())?;

@@ -232,6 +232,8 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
         "--out",
         s(&b),
         "--quiet",
+        "--program-number",
+        "1",
     ]);
     assert_eq!(code, 0, "{err}");
     assert!(out.is_empty());

@@ -61,6 +61,7 @@ pub mod tool;
 pub mod toolpath;
 pub mod transform;
 pub mod verify;
+pub mod worm;
 
 pub use catalog::{Catalog, OpenMachine};
 pub use error::Error;

@@ -212,9 +212,14 @@ impl Toolpath {
             if c.motion != Motion::Rapid && !feed_ok {
                 return Err(err(format!("feed {} mm/min is not positive", c.feed)));
             }
-            if let Motion::Thread { lead } = c.motion {
+            if let Motion::Thread { lead, start_deg } = c.motion {
                 if !(lead.is_finite() && lead > 0.0) {
                     return Err(err(format!("thread lead {lead} is not positive")));
+                }
+                if !(0.0..360.0).contains(&start_deg) {
+                    return Err(err(format!(
+                        "thread start angle {start_deg} deg is not in [0, 360)"
+                    )));
                 }
             }
             if c.aux.len() != self.aux_names.len() {

@@ -107,6 +107,10 @@ pub enum VerifyError {
         /// The tolerance (mm).
         tolerance: Real,
     },
+    /// The worm's simulated cut fails a check (the message names the block,
+    /// or the start and flank, and the tolerance).
+    #[error("verification failed: {0}")]
+    Worm(String),
     /// A tolerance finer than the program can carry.
     #[error("a verification tolerance of {tolerance} mm is finer than twice the program's resolution ({resolution} mm steps): the program cannot hold it")]
     Resolution {

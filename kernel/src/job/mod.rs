@@ -44,6 +44,10 @@ pub struct JobOptions {
     pub mesh_tolerance: f64,
     /// Which 3-D files to write.
     pub formats: Formats,
+    /// The program's number (Fanuc `O`): `Some` writes a whole program;
+    /// `None` the block to paste after the tool call, where the dialect
+    /// tells them apart (Fanuc).
+    pub program_number: Option<u32>,
 }
 
 impl Default for JobOptions {
@@ -53,6 +57,7 @@ impl Default for JobOptions {
             pose_block: None,
             mesh_tolerance: crate::mesh::DEFAULT_TOLERANCE,
             formats: Formats::default(),
+            program_number: None,
         }
     }
 }
@@ -211,7 +216,8 @@ pub fn run(
     stage(STAGES[1]);
     let toolpath = family.toolpath(&values)?;
     stage(STAGES[2]);
-    let program = build(&toolpath, kin, &options.program_name)?;
+    let mut program = build(&toolpath, kin, &options.program_name)?;
+    program.number = options.program_number.unwrap_or(0);
     let requested = family.verification(&values)?;
     let pose_index = match options.pose_block {
         Some(0) => return Err(Error::Options("--pose-block counts blocks from 1".into())),

@@ -207,7 +207,7 @@ pub fn block_name(program: &AxisProgram, index: usize) -> String {
     name_in(&program.control, &program.blocks, index)
 }
 
-fn name_in(control: &str, blocks: &[Block], index: usize) -> String {
+pub(crate) fn name_in(control: &str, blocks: &[Block], index: usize) -> String {
     let label = block_label(control, index);
     let pass = blocks
         .get(..=index.min(blocks.len().saturating_sub(1)))
@@ -436,7 +436,7 @@ pub fn build(
             feed: match c.motion {
                 Motion::Rapid => 0.0,
                 Motion::Linear => c.feed,
-                Motion::Thread { lead } => lead * toolpath.spindle_rpm,
+                Motion::Thread { lead, .. } => lead * toolpath.spindle_rpm,
             },
             spindle: (k == 0).then_some(toolpath.spindle_rpm),
             comment: (j == 0).then(|| toolpath.passes[p].name.clone()),
@@ -496,7 +496,8 @@ pub fn build(
         .map_err(|e| ProgramError::from_limit(&info.name, e, name_of))?;
     Ok(AxisProgram {
         name: program_name(name),
-        number: 1,
+        // A block to paste after the tool call until the caller numbers it.
+        number: 0,
         machine: info.name.clone(),
         control: info.control.clone(),
         tool_number: toolpath.tool.number,

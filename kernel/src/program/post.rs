@@ -11,8 +11,9 @@
 //!
 //! | dialect | file | numbers | comments | motion |
 //! |---|---|---|---|---|
-//! | `sinumerik` (840D) | `.mpf`, `%_N_<NAME>_MPF` | `N1`.. before the moves, move `i` (from 0) is `N(10 + 10 i)` | `; text` | `G0 G1 G33 K<lead>` |
-//! | `fanuc` (0i) | `.nc`, `%` `O<number>` ... `%` | none (5-digit N would overflow) | `(TEXT)` | `G00 G01 G32 F<lead>` |
+//! | `sinumerik` (840D) | `.mpf`, `%_N_<NAME>_MPF` | `N1`.. before the moves, move `i` (from 0) is `N(10 + 10 i)` | `; text` | `G0 G1 G33 K<lead> SF=<start>` |
+//! | `fanuc` (0i) | `.nc`, `%` `O<number>` ... `%` (number 0: a block to paste after the tool call) | none (5-digit N would overflow) | `(TEXT)` | `G00 G01 G32 F<lead> Q<start, 0.001 deg>` |
+//! | `linuxcnc` | `.ngc`, `%` ... `%` | as Sinumerik | `(text)` | `G0 G1 G33 K<lead>` |
 //! | `cld` (APT) | `.cld` | none | `PPRINT/text` | `RAPID`, `FEDRAT/`, `GOTO/` |
 //!
 //! The machine's [`ProgramSetup`] becomes words of the dialect: the work
@@ -111,6 +112,24 @@ pub struct Dialect {
     /// The instruction naming the axes the feed is the path of
     /// ([`ProgramSetup::feed_group`]: `FGROUP` on Sinumerik), or `None`.
     pub feed_group: Option<&'static str>,
+    /// How a thread block's start angle is written, or `None` where the
+    /// control has no word for it (then a program with one is refused,
+    /// and a multi-start thread shifts its starts along Z instead).
+    pub thread_start: Option<ThreadStart>,
+}
+
+/// The word of a thread block's spindle start angle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ThreadStart {
+    /// The address (`Q`, `SF=`).
+    pub address: &'static str,
+    /// Units per degree (Fanuc's Q counts 0.001 deg, no decimal point).
+    pub scale: f64,
+    /// Decimals written.
+    pub decimals: usize,
+    /// Whether the word stays in force (Sinumerik's SF) or holds for its
+    /// block only (Fanuc's Q, 0 when absent).
+    pub modal: bool,
 }
 
 /// Siemens Sinumerik 840D part program (`.MPF`).
@@ -146,9 +165,18 @@ pub const SINUMERIK: Dialect = Dialect {
     radial_words: Some(("DIAMOF", "DIAMON")),
     coolant: ("M8", "M9"),
     feed_group: Some("FGROUP"),
+    thread_start: Some(ThreadStart {
+        address: "SF=",
+        scale: 1.0,
+        decimals: 3,
+        modal: true,
+    }),
 };
 
-/// Fanuc 0i (lathe, G-code system A: absolute by axis address, feed per minute).
+/// Fanuc 0i (lathe, G-code system A: absolute by axis address, feed per
+/// minute). A program numbered 0 is the seed's block to paste after the
+/// tool call (no `%`, no `O` number, no T word); a numbered one is a whole
+/// program.
 pub const FANUC: Dialect = Dialect {
     name: "fanuc",
     extension: "nc",
@@ -157,20 +185,21 @@ pub const FANUC: Dialect = Dialect {
     upper_comments: true,
     numbering: None,
     header: &[
-        "%",
-        "O{ONUM} ({NAME})",
+        "{WHOLE}%",
+        "{WHOLE}O{ONUM} ({NAME})",
         "({MACHINE}, WRITTEN BY PILGRIM {VERSION})",
-        "(TOOL T{TOOL2}: {TOOLNAME})",
+        "{BLOCK}(TO FOLLOW THE CALL OF TOOL T{TOOL2}: {TOOLNAME})",
+        "{WHOLE}(TOOL T{TOOL2}: {TOOLNAME})",
     ],
     preamble: &[
         "G21 G40 G97 G98",
         "{SETUP}",
-        "T{TOOL2}{TOOL2}",
+        "{WHOLE}T{TOOL2}{TOOL2}",
         "S{S} M03",
         "{COOLANT}",
     ],
     footer: &["{COOLANT_OFF}", "M05", "M30"],
-    trailer: &["%"],
+    trailer: &["{WHOLE}%"],
     rapid: "G00",
     linear: "G01",
     thread: "G32",
@@ -181,6 +210,44 @@ pub const FANUC: Dialect = Dialect {
     radial_words: None,
     coolant: ("M08", "M09"),
     feed_group: None,
+    thread_start: Some(ThreadStart {
+        address: "Q",
+        scale: 1000.0,
+        decimals: 0,
+        modal: false,
+    }),
+};
+
+/// LinuxCNC (lathe configuration): `%`-framed, spindle-synchronised `G33`
+/// moves with `K` the distance per turn, `G7`/`G8` diameter or radius
+/// mode. G33 starts at the spindle's index: no start angle (a multi-start
+/// thread shifts its starts along Z).
+pub const LINUXCNC: Dialect = Dialect {
+    name: "linuxcnc",
+    extension: "ngc",
+    style: Style::GCode,
+    comment: ("(", ")"),
+    upper_comments: false,
+    numbering: Some((10, 10)),
+    header: &[
+        "%",
+        "({NAME} for {MACHINE}, written by pilgrim {VERSION})",
+        "(tool T{TOOL}: {TOOLNAME})",
+    ],
+    preamble: &["G21 G40 G90 G94 G97", "{SETUP}", "S{S} M3", "{COOLANT}"],
+    footer: &["{COOLANT_OFF}", "M5", "M2"],
+    trailer: &["%"],
+    rapid: "G0",
+    linear: "G1",
+    thread: "G33",
+    lead: "K",
+    decimals: 3,
+    feed_decimals: 1,
+    lead_decimals: 4,
+    radial_words: Some(("G8", "G7")),
+    coolant: ("M8", "M9"),
+    feed_group: None,
+    thread_start: None,
 };
 
 /// APT-style cutter-location file (ISO 4343 flavour) in machine coordinates.
@@ -213,10 +280,11 @@ pub const CLD: Dialect = Dialect {
     radial_words: None,
     coolant: ("COOLNT/ON", "COOLNT/OFF"),
     feed_group: None,
+    thread_start: None,
 };
 
 /// Every dialect.
-pub const DIALECTS: [&Dialect; 3] = [&SINUMERIK, &FANUC, &CLD];
+pub const DIALECTS: [&Dialect; 4] = [&SINUMERIK, &FANUC, &LINUXCNC, &CLD];
 
 /// The dialect called `name`.
 pub fn dialect(name: &str) -> Option<&'static Dialect> {
@@ -230,7 +298,7 @@ pub fn dialect(name: &str) -> Option<&'static Dialect> {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PostError {
     /// No dialect of that name.
-    #[error("no post-processor dialect '{name}' (dialects: sinumerik, fanuc, cld)")]
+    #[error("no post-processor dialect '{name}' (dialects: sinumerik, fanuc, linuxcnc, cld)")]
     UnknownDialect {
         /// The name asked for.
         name: String,
@@ -308,7 +376,9 @@ impl Writer<'_> {
 }
 
 /// A template filled in for `p`; names are upper-cased and freed of
-/// parentheses where the dialect's comments need it.
+/// parentheses where the dialect's comments need it. A template starting
+/// `{WHOLE}` is for a whole program only (`p.number` > 0), one starting
+/// `{BLOCK}` for a block to paste only (number 0).
 fn fill(template: &str, p: &AxisProgram, d: &Dialect) -> String {
     let text = |s: &str| {
         let s = if d.upper_comments {
@@ -323,6 +393,16 @@ fn fill(template: &str, p: &AxisProgram, d: &Dialect) -> String {
         }
     };
     let (tool_name, machine) = (text(&p.tool_name), text(&p.machine));
+    let template = match (
+        template.strip_prefix("{WHOLE}"),
+        template.strip_prefix("{BLOCK}"),
+    ) {
+        (Some(t), _) if p.number > 0 => t,
+        (Some(_), _) => return String::new(),
+        (_, Some(t)) if p.number == 0 => t,
+        (_, Some(_)) => return String::new(),
+        _ => template,
+    };
     let (coolant_on, coolant_off) = if p.setup.coolant { d.coolant } else { ("", "") };
     template
         .replace("{SETUP}", &setup_words(&p.setup, d).join(" "))
@@ -450,7 +530,8 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
     let mut last_feed: Option<String> = None;
     // The preamble started the spindle at the program's speed.
     let mut last_spindle = program.spindle_rpm.round() as i64;
-    for b in &program.blocks {
+    let mut last_start: Option<String> = None;
+    for (k, b) in program.blocks.iter().enumerate() {
         if let Some(c) = &b.comment {
             w.comment(c);
         }
@@ -477,11 +558,14 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
                             last_feed = Some(f);
                         }
                     }
-                    Motion::Thread { lead } => {
+                    Motion::Thread { lead, start_deg } => {
                         let f = format!("FEDRAT/{},MMPR", fixed(lead, d.lead_decimals));
                         if last_feed.as_ref() != Some(&f) {
                             w.line(&f);
                             last_feed = Some(f);
+                        }
+                        if start_deg != 0.0 {
+                            w.comment(&format!("thread start {} deg", fixed(start_deg, 3)));
                         }
                     }
                 }
@@ -521,7 +605,7 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
                 let feed = match b.motion {
                     Motion::Rapid => None,
                     Motion::Linear => Some(format!("F{}", fixed(b.feed, d.feed_decimals))),
-                    Motion::Thread { lead } => {
+                    Motion::Thread { lead, .. } => {
                         Some(format!("{}{}", d.lead, fixed(lead, d.lead_decimals)))
                     }
                 };
@@ -529,6 +613,35 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
                     if last_feed.as_ref() != Some(&f) {
                         words.push(f.clone());
                         last_feed = Some(f);
+                    }
+                }
+                if let Motion::Thread { start_deg, .. } = b.motion {
+                    match d.thread_start {
+                        Some(t) => {
+                            let v = fixed(start_deg * t.scale, t.decimals);
+                            let word = format!("{}{v}", t.address);
+                            // A modal word stands at 0 until written.
+                            let due = if t.modal {
+                                let zero = format!("{}{}", t.address, fixed(0.0, t.decimals));
+                                *last_start.get_or_insert(zero) != word
+                            } else {
+                                start_deg != 0.0
+                            };
+                            if due {
+                                words.push(word.clone());
+                                last_start = Some(word);
+                            }
+                        }
+                        None if start_deg != 0.0 => {
+                            return Err(PostError::BadBlock {
+                                block: super::name_in(d.name, &program.blocks, k),
+                                message: format!(
+                                    "a thread start angle of {start_deg} deg, which {} cannot write (its thread starts at the spindle's index): shift the starts along Z instead",
+                                    d.name
+                                ),
+                            })
+                        }
+                        None => {}
                     }
                 }
                 if let Some(s) = spindle {
@@ -583,7 +696,15 @@ mod tests {
                 block(Motion::Linear, [40.0, 5.0], 100.0, None),
                 block(Motion::Linear, [40.0, -0.0001], 100.0, None),
                 block(Motion::Linear, [40.0, -0.0001], 100.0, None),
-                block(Motion::Thread { lead: 6.35 }, [40.0, -60.0], 0.0, None),
+                block(
+                    Motion::Thread {
+                        lead: 6.35,
+                        start_deg: 0.0,
+                    },
+                    [40.0, -60.0],
+                    0.0,
+                    None,
+                ),
                 block(Motion::Rapid, [50.0, -60.0], 0.0, None),
             ],
             setup: ProgramSetup::default(),
@@ -631,6 +752,48 @@ SPINDL/OFF\nFINI\n";
             a.contains("GOTO/40.000,0.000\nSPINDL/120,RPM,CLW\nFEDRAT/6.3500,MMPR\n"),
             "{a}"
         );
+    }
+
+    /// A numbered Fanuc program is whole; number 0 is the block to paste
+    /// after the tool call. A thread's start angle is Fanuc's Q (0.001 deg,
+    /// its block only), Sinumerik's SF= (modal); LinuxCNC has no word for
+    /// it and refuses, naming the block.
+    #[test]
+    fn thread_starts_and_program_kinds() {
+        let mut p = program();
+        p.number = 0;
+        p.blocks[4].motion = Motion::Thread {
+            lead: 6.35,
+            start_deg: 180.0,
+        };
+        p.blocks.push(p.blocks[4].clone());
+        let f = post(&p, &FANUC).unwrap();
+        assert!(
+            !f.contains('%') && !f.contains("O00") && !f.contains("T0303"),
+            "{f}"
+        );
+        assert!(
+            f.contains("(TO FOLLOW THE CALL OF TOOL T03: THREAD INSERT 60)\n"),
+            "{f}"
+        );
+        assert!(f.contains("G32 Z-60.000 F6.3500 Q180000\n"), "{f}");
+        assert!(f.contains("\nG32 X40.000 Q180000\n"), "{f}");
+        let g = post(&p, &SINUMERIK).unwrap();
+        assert!(g.contains("N50 G33 Z-60.000 K6.3500 SF=180.000\n"), "{g}");
+        assert!(g.contains("N70 G33 X40.000\n"), "{g}");
+        let e = post(&p, &LINUXCNC).unwrap_err().to_string();
+        assert!(e.contains("N50") && e.contains("start angle of 180"), "{e}");
+        p.blocks[4].motion = Motion::Thread {
+            lead: 6.35,
+            start_deg: 0.0,
+        };
+        p.blocks.pop();
+        let l = post(&p, &LINUXCNC).unwrap();
+        assert!(
+            l.starts_with("%\n(DEMO for test-lathe") && l.ends_with("M2\n%\n"),
+            "{l}"
+        );
+        assert!(l.contains("N50 G33 Z-60.000 K6.3500\n"), "{l}");
     }
 
     #[test]

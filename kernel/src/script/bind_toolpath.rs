@@ -204,7 +204,9 @@ pub mod toolpath_api {
     /// Appends a pass. `data` holds columns (Floats, arrays, or one number
     /// for all points): `x`, `y`, `z` (the tracked point, mm), `feed`
     /// (mm/min; not for rapids), and optionally `motion` ("linear",
-    /// "rapid", "thread"), `lead` (mm, threads), `i`, `j`, `k` (the tool's
+    /// "rapid", "thread"; one for all points, or an array of one per
+    /// point), `lead` (mm, threads), `start` (deg, the spindle's angle a
+    /// thread starts at), `i`, `j`, `k` (the tool's
     /// axis, default 0, 0, 1), `aux` (a map of the toolpath's auxiliary
     /// names to columns).
     ///
@@ -217,8 +219,8 @@ pub mod toolpath_api {
         name: &str,
         data: Map,
     ) -> Result<(), Box<EvalAltResult>> {
-        const KEYS: [&str; 10] = [
-            "x", "y", "z", "feed", "motion", "lead", "i", "j", "k", "aux",
+        const KEYS: [&str; 11] = [
+            "x", "y", "z", "feed", "motion", "lead", "start", "i", "j", "k", "aux",
         ];
         if let Some(k) = data.keys().find(|k| !KEYS.contains(&k.as_str())) {
             return err(format!(
@@ -238,30 +240,57 @@ pub mod toolpath_api {
                 (None, None) => err(format!("add_pass: missing '{k}'")),
             }
         };
-        let motion_name = match get("motion") {
-            Some(m) => m
-                .into_string()
-                .map_err(|t| format!("add_pass: motion must be a string, not {t}"))?,
-            None => "linear".into(),
+        let thread = || -> Result<Motion, Box<EvalAltResult>> {
+            let lead = get("lead")
+                .as_ref()
+                .and_then(number)
+                .ok_or("add_pass: a thread needs a number 'lead'")?;
+            let start_deg = match get("start") {
+                Some(s) => number(&s).ok_or("add_pass: 'start' must be a number (deg)")?,
+                None => 0.0,
+            };
+            Ok(Motion::Thread { lead, start_deg })
         };
-        let motion = match motion_name.as_str() {
-            "linear" => Motion::Linear,
-            "rapid" => Motion::Rapid,
-            "thread" => {
-                let lead = get("lead")
-                    .as_ref()
-                    .and_then(number)
-                    .ok_or("add_pass: a thread needs a number 'lead'")?;
-                Motion::Thread { lead }
-            }
-            other => {
-                return err(format!(
+        let motion_of = |name: &str| -> Result<Motion, Box<EvalAltResult>> {
+            match name {
+                "linear" => Ok(Motion::Linear),
+                "rapid" => Ok(Motion::Rapid),
+                "thread" => thread(),
+                other => err(format!(
                     "add_pass: motion must be linear, rapid or thread, not '{other}'"
-                ))
+                )),
             }
         };
+        let motions: Vec<Motion> = match get("motion") {
+            None => vec![Motion::Linear; n],
+            Some(m) if m.is_array() => {
+                let a = m.cast::<Array>();
+                if a.len() != n {
+                    return err(format!(
+                        "add_pass: motion has {} entries for {n} points",
+                        a.len()
+                    ));
+                }
+                a.into_iter()
+                    .map(|v| {
+                        v.into_string()
+                            .map_err(|t| {
+                                format!("add_pass: a motion must be a string, not {t}").into()
+                            })
+                            .and_then(|s| motion_of(&s))
+                    })
+                    .collect::<Result<_, Box<EvalAltResult>>>()?
+            }
+            Some(m) => {
+                let name = m
+                    .into_string()
+                    .map_err(|t| format!("add_pass: motion must be a string, not {t}"))?;
+                vec![motion_of(&name)?; n]
+            }
+        };
+        let all_rapid = motions.iter().all(|m| *m == Motion::Rapid);
         let (x, y, z) = (col("x", None)?, col("y", None)?, col("z", None)?);
-        let feed = col("feed", (motion == Motion::Rapid).then_some(0.0))?;
+        let feed = col("feed", all_rapid.then_some(0.0))?;
         let (i, j, k) = (
             col("i", Some(0.0))?,
             col("j", Some(0.0))?,
@@ -295,7 +324,7 @@ pub mod toolpath_api {
             .map(|p| ClPoint {
                 point: [x.at(p), y.at(p), z.at(p)],
                 axis: [i.at(p), j.at(p), k.at(p)],
-                motion,
+                motion: motions[p],
                 feed: feed.at(p),
                 aux: aux.iter().map(|c| c.at(p)).collect(),
             })

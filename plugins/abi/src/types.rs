@@ -463,6 +463,12 @@ pub enum Motion {
     Thread {
         /// Lead (mm per spindle turn).
         lead: f64,
+        /// Since 1.4: the spindle's angle (deg) at which the cut starts,
+        /// after the spindle's one-turn mark (Fanuc `Q`, Sinumerik `SF`):
+        /// a multi-start thread's starts differ by `360 / z1`. 0 when
+        /// absent.
+        #[serde(default, skip_serializing_if = "is_zero")]
+        start_deg: f64,
     },
 }
 

@@ -1,0 +1,178 @@
+//! The thread cutter: a lathe tool whose section in the worm's axial
+//! plane is a trapezoid, its tip `tip_width` wide with both corners
+//! rounded by the nose radius, its flanks at their own angles from the
+//! radial direction. A full-profile cutter has the worm's half-angle on
+//! both flanks and the root's space as its tip; a narrower "universal"
+//! one reaches the flanks by the axial offset `a_1z` (MATH §4.4).
+
+use crate::input::InputError;
+use crate::math::{positive, Real};
+use serde::{Deserialize, Serialize};
+
+/// How far a nose arc's chords may stray from it (mm) in the section.
+pub const ARC_TOLERANCE: Real = 2e-4;
+
+/// A thread cutter's section. Its tracked point is the middle of its tip,
+/// its `z` along the worm's axis and `r` radial, away from the axis.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ThreadCutter {
+    /// Width of the tip between the flanks' lines (mm).
+    pub tip_width: Real,
+    /// Radius of the two tip corners (mm).
+    pub nose_radius: Real,
+    /// Angle of the left flank (towards -z) from the radial direction (rad).
+    pub left_angle: Real,
+    /// Angle of the right flank (rad).
+    pub right_angle: Real,
+    /// Height of the cutting profile above the tip (mm).
+    pub height: Real,
+}
+
+impl ThreadCutter {
+    /// A cutter from its sizes.
+    ///
+    /// # Failures
+    /// A size not positive and finite (the nose radius may be 0); a flank
+    /// angle beyond 45 degrees; nose radii that do not fit on the tip.
+    pub fn new(
+        tip_width: Real,
+        nose_radius: Real,
+        left_angle: Real,
+        right_angle: Real,
+        height: Real,
+    ) -> Result<Self, InputError> {
+        positive("cutter tip width", tip_width)?;
+        crate::math::finite("cutter nose radius", nose_radius)?;
+        if nose_radius < 0.0 {
+            return Err(InputError::out_of_range(
+                "cutter nose radius",
+                nose_radius,
+                "0 or more",
+            ));
+        }
+        for (what, a) in [
+            ("cutter left flank angle", left_angle),
+            ("cutter right flank angle", right_angle),
+        ] {
+            crate::math::finite(what, a)?;
+            if !(0.0..=std::f64::consts::FRAC_PI_4).contains(&a) {
+                return Err(InputError::out_of_range(
+                    format!("{what} (deg)"),
+                    a.to_degrees(),
+                    "from 0 to 45",
+                ));
+            }
+        }
+        positive("cutter height", height)?;
+        let c = Self {
+            tip_width,
+            nose_radius,
+            left_angle,
+            right_angle,
+            height,
+        };
+        let need = c.inset(left_angle) + c.inset(right_angle);
+        if need > tip_width {
+            return Err(InputError::out_of_range(
+                "cutter nose radius",
+                nose_radius,
+                format!(
+                    "small enough that both corners fit on the {tip_width} mm tip (they need {need:.4} mm)"
+                ),
+            ));
+        }
+        Ok(c)
+    }
+
+    /// How far a corner's arc starts inside the tip's end: `r (1 - sin a) / cos a`.
+    fn inset(&self, angle: Real) -> Real {
+        self.nose_radius * (1.0 - angle.sin()) / angle.cos()
+    }
+
+    /// The width between the flanks' lines at `r` above the tip.
+    pub fn width_at(&self, r: Real) -> Real {
+        self.tip_width + r * (self.left_angle.tan() + self.right_angle.tan())
+    }
+
+    /// The section as a closed polygon `(z, r)` about the tracked point,
+    /// counter-clockwise, up to `top` above the tip (the profile's straight
+    /// flanks carried on past `height` if `top` is higher): down the left
+    /// flank, round the left corner, along the tip, round the right
+    /// corner, up the right flank. Arcs within [`ARC_TOLERANCE`].
+    pub fn section(&self, top: Real) -> Vec<[Real; 2]> {
+        let w = self.tip_width / 2.0;
+        let r = self.nose_radius;
+        let mut pts = vec![[w + top * self.right_angle.tan(), top]];
+        let arc = |centre: [Real; 2], from: Real, to: Real, pts: &mut Vec<[Real; 2]>| {
+            let step = if r > ARC_TOLERANCE {
+                2.0 * (1.0 - ARC_TOLERANCE / r).acos()
+            } else {
+                Real::INFINITY
+            };
+            let n = (((from - to).abs() / step).ceil() as usize).clamp(1, 256);
+            for k in 0..=n {
+                let t = from + (to - from) * k as Real / n as Real;
+                pts.push([centre[0] + r * t.cos(), centre[1] + r * t.sin()]);
+            }
+        };
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        if r > 0.0 {
+            arc(
+                [w - self.inset(self.right_angle), r],
+                -self.right_angle,
+                -half_pi,
+                &mut pts,
+            );
+            arc(
+                [-(w - self.inset(self.left_angle)), r],
+                -half_pi,
+                -std::f64::consts::PI + self.left_angle,
+                &mut pts,
+            );
+        } else {
+            pts.push([w, 0.0]);
+            pts.push([-w, 0.0]);
+        }
+        pts.push([-w - top * self.left_angle.tan(), top]);
+        // Built clockwise (down the right flank): turned round.
+        pts.reverse();
+        pts
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The section's corners are tangent to the tip and the flanks, its
+    /// area that of the trapezoid less the corners'.
+    #[test]
+    fn the_section_is_the_rounded_trapezoid() {
+        let a = 20f64.to_radians();
+        let c = ThreadCutter::new(3.0, 0.5, a, a, 12.0).unwrap();
+        let s = c.section(10.0);
+        let area: f64 = (0..s.len())
+            .map(|i| {
+                let (p, q) = (s[i], s[(i + 1) % s.len()]);
+                p[0] * q[1] - q[0] * p[1]
+            })
+            .sum::<f64>()
+            / 2.0;
+        let trapezoid = 0.5 * (3.0 + c.width_at(10.0)) * 10.0;
+        // A corner of interior angle 90 + a rounded by r loses
+        // r^2 (tan(phi/2) - phi/2), phi = 90 - a its turning angle.
+        let phi = std::f64::consts::FRAC_PI_2 - a;
+        let corner = 0.25 * ((phi / 2.0).tan() - phi / 2.0);
+        assert!(area > 0.0, "counter-clockwise");
+        assert!((area - (trapezoid - 2.0 * corner)).abs() < 5e-4, "{area}");
+        // The lowest points are on the tip line, the flank points on their lines.
+        assert!(s.iter().all(|p| p[1] >= -1e-12));
+        for p in &s {
+            if p[1] > 0.5 {
+                assert!((p[0].abs() - (1.5 + p[1] * a.tan())).abs() < 1e-9, "{p:?}");
+            }
+        }
+        // A nose radius that does not fit is refused.
+        assert!(ThreadCutter::new(0.5, 0.5, a, a, 5.0).is_err());
+    }
+}

@@ -1,0 +1,36 @@
+//! Worm threads cut in many passes on a CNC lathe (seed 004, MATH §4, with
+//! the corrections of issue 13).
+//!
+//! - [`WormSizes`]: the cylindrical worm with a ZA profile and its derived
+//!   sizes (standard practice, not the seed's words);
+//! - [`approach_length`], [`runout_length`] and their lead errors: the
+//!   acceleration and deceleration lengths S1, S2 (Fanuc's exact form);
+//! - [`ThreadCutter`]: the cutter's section, full-profile or universal;
+//! - [`roughing_depths`], [`plan`]: the roughing law of decreasing infeed
+//!   with its minimum depth, alternating flanks, finishing, the universal
+//!   cutter's axial offset [`axial_offset`], every start;
+//! - [`simulate`]: the program replayed in the axial section, pass by
+//!   pass, with polygon booleans: chips, flank loads, the finished profile
+//!   against the nominal;
+//! - [`worm_solid`]: the finished worm as a closed mesh.
+//!
+//! The part frame: Z along the worm's axis, the thread from z = 0 (the
+//! face towards the tailstock) to z = -b1, cut towards the chuck (-Z); X
+//! radial. The thread is right-handed.
+
+mod cutter;
+mod plan;
+mod servo;
+mod simulate;
+mod sizes;
+mod solid;
+
+pub use cutter::{ThreadCutter, ARC_TOLERANCE};
+pub use plan::{
+    axial_offset, plan, rational_passes, roughing_depths, Flank, FlankOrder, PassKind,
+    PlanSettings, PlannedPass, MAX_PASSES,
+};
+pub use servo::{approach_error, approach_length, runout_error, runout_length};
+pub use simulate::{simulate, SimulatedPass, StartProfile, WormCheck, WormRequest, WormTolerances};
+pub use sizes::WormSizes;
+pub use solid::{worm_solid, MAX_AROUND};

@@ -1,0 +1,533 @@
+//! The cut simulated pass by pass (issue 13 §2): the axis program, as
+//! written, replayed in the worm's axial section. Every thread block cuts
+//! the section at one place: the cutter's tip at the block's X, at the Z
+//! where the helix it cuts crosses the section at part angle 0 (its start
+//! Z shifted by the start angle's share of the lead). The cutter's section
+//! (nose radii included) is subtracted from the blank's with a polygon
+//! boolean crate (`geo`, whose `BooleanOps` is the `i_overlay` engine), not
+//! hand-written clipping. From the simulation alone: each pass's chip
+//! area and its share on each flank, any cut beyond the nominal space
+//! (named by block), and the finished profile against the nominal ZA
+//! axial profile: flank angles and form, thickness at the pitch line,
+//! root and tip diameters, each start's position.
+//!
+//! The section is periodic along the axis with the lead: one lead is
+//! simulated, from the middle of the thread before start 0's space, the
+//! cutter placed with its copies one lead either side. What the model
+//! leaves out: the servo's lag (the same on every pass at one spindle
+//! speed, so it shifts the whole thread, not one pass), the approach and
+//! run-out (checked to cover the thread's length), the cutter's clearance
+//! angles and the lead angle's effect on the section (a ZA worm is cut with
+//! the cutter in the axial plane), deflection and wear.
+
+use super::{ThreadCutter, WormSizes};
+use crate::machine::MachineKinematics;
+use crate::math::Real;
+use crate::program::{block_name, AxisProgram};
+use crate::toolpath::Motion;
+use crate::transform::ToolFrame;
+use crate::verify::{as_written, replay, VerifyError};
+use geo::{Area, BooleanOps, Coord, LineString, MultiPolygon, Polygon};
+use serde::Serialize;
+
+/// What the finished worm must hold.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct WormTolerances {
+    /// Flank form and any cut beyond the nominal (mm, normal to the flank).
+    pub form: Real,
+    /// Axial thickness at the pitch line (mm).
+    pub thickness: Real,
+    /// Root and tip diameters (mm).
+    pub diameter: Real,
+    /// Each start's place along the axis, and the lead's error over the
+    /// thread's length (mm).
+    pub position: Real,
+    /// Flank angles (rad).
+    pub flank_angle: Real,
+}
+
+/// What the family asks the simulation to check.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WormRequest {
+    /// The worm.
+    pub sizes: WormSizes,
+    /// The thread's length: from z = 0 to z = -length (mm).
+    pub length: Real,
+    /// Where start 0's space is centred in the section at part angle 0
+    /// (z, mm; any z the same modulo the lead).
+    pub space_centre: Real,
+    /// The tolerances.
+    pub tolerances: WormTolerances,
+}
+
+/// One thread block as simulated.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SimulatedPass {
+    /// The block (from 1, the program's and `report.csv`'s count).
+    pub block: usize,
+    /// The block as the program names it (number and pass).
+    pub name: String,
+    /// The start it cut (from 0), by where it is.
+    pub start: u32,
+    /// X as written (diameter of the cutter's tip, mm).
+    pub x: Real,
+    /// Its axial offset from the start's nominal space centre (mm).
+    pub offset: Real,
+    /// The chip's area (mm^2).
+    pub chip_area: Real,
+    /// The chip's area on the cutter's left of its tip's centre (mm^2):
+    /// the load on the left edge.
+    pub left_area: Real,
+    /// On its right (mm^2).
+    pub right_area: Real,
+    /// The deepest cut beyond the nominal space (mm; 0 where none).
+    pub gouge: Real,
+}
+
+/// The finished profile at one start's space.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StartProfile {
+    /// The start (from 0).
+    pub start: u32,
+    /// The space's centre at the pitch line, less the nominal (mm).
+    pub position_error: Real,
+    /// The axial thickness at the pitch line of the thread after this
+    /// space (mm).
+    pub thickness: Real,
+    /// The left flank's angle from the radial (deg), fitted.
+    pub left_angle_deg: Real,
+    /// The right flank's (deg).
+    pub right_angle_deg: Real,
+    /// The left flank's largest deviation from the nominal, normal to it
+    /// (mm; positive: material left, negative: cut too deep).
+    pub left_form: Real,
+    /// The right flank's (mm).
+    pub right_form: Real,
+    /// The diameter at the space's centre (mm).
+    pub root_diameter: Real,
+    /// The diameter at the middle of the thread after it (mm).
+    pub tip_diameter: Real,
+}
+
+/// The simulation's result.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WormCheck {
+    /// Every thread block, in order.
+    pub passes: Vec<SimulatedPass>,
+    /// The finished profile at each start.
+    pub starts: Vec<StartProfile>,
+    /// The nominal area of the spaces in one lead of the section (mm^2).
+    pub space_area: Real,
+    /// The simulated chips' areas summed (mm^2).
+    pub removed_area: Real,
+    /// The programmed lead's error accumulated over the thread (mm).
+    pub lead_error: Real,
+    /// The loads summed over all passes: left edge, right edge (mm^2).
+    pub flank_loads: [Real; 2],
+    /// The tolerances checked.
+    pub tolerances: WormTolerances,
+    /// Each pass's chip as polygons `(z, r)` (for the pass-by-pass view).
+    #[serde(skip)]
+    pub chips: Vec<Vec<Vec<[Real; 2]>>>,
+    /// The finished section over one lead (from `window.0`).
+    #[serde(skip)]
+    pub section: MultiPolygon<Real>,
+    /// The lead's window of the section: its first z and the lead.
+    #[serde(skip)]
+    pub window: (Real, Real),
+}
+
+impl WormCheck {
+    /// The finished worm's radius at `z` in the section at part angle 0
+    /// (the section repeats with the lead): the highest material there.
+    pub fn radius_at(&self, z: Real) -> Real {
+        let (w0, lead) = self.window;
+        let z = w0 + (z - w0).rem_euclid(lead);
+        vertical_top(&self.section, z).unwrap_or(0.0)
+    }
+}
+
+fn poly(points: &[[Real; 2]]) -> Polygon<Real> {
+    Polygon::new(
+        LineString::from(points.iter().map(|p| (p[0], p[1])).collect::<Vec<_>>()),
+        vec![],
+    )
+}
+
+fn rect(z0: Real, z1: Real, r0: Real, r1: Real) -> Polygon<Real> {
+    poly(&[[z0, r0], [z1, r0], [z1, r1], [z0, r1]])
+}
+
+/// Every edge of a multipolygon's rings.
+fn edges(m: &MultiPolygon<Real>) -> impl Iterator<Item = (Coord<Real>, Coord<Real>)> + '_ {
+    m.0.iter()
+        .flat_map(|p| std::iter::once(p.exterior()).chain(p.interiors()))
+        .flat_map(|ring| ring.lines().map(|l| (l.start, l.end)))
+}
+
+/// The z where the material's boundary crosses the radius `r`, sorted.
+fn crossings_at(m: &MultiPolygon<Real>, r: Real) -> Vec<Real> {
+    let mut out: Vec<Real> = edges(m)
+        .filter(|(a, b)| (a.y <= r) != (b.y <= r))
+        .map(|(a, b)| a.x + (r - a.y) / (b.y - a.y) * (b.x - a.x))
+        .collect();
+    out.sort_by(Real::total_cmp);
+    out
+}
+
+/// The highest material at `z`.
+fn vertical_top(m: &MultiPolygon<Real>, z: Real) -> Option<Real> {
+    edges(m)
+        .filter(|(a, b)| (a.x <= z) != (b.x <= z))
+        .map(|(a, b)| a.y + (z - a.x) / (b.x - a.x) * (b.y - a.y))
+        .max_by(Real::total_cmp)
+}
+
+/// The space around `c` at radius `r`: the material's boundary just left
+/// and just right of it, if `c` is in a space there.
+fn space_edges(m: &MultiPolygon<Real>, r: Real, c: Real) -> Option<(Real, Real)> {
+    let x = crossings_at(m, r);
+    let i = x.iter().position(|z| *z > c)?;
+    // Crossings alternate into and out of material from the left: an even
+    // count to the left of c means c is outside the material.
+    (i % 2 == 0 && i > 0).then(|| (x[i - 1], x[i]))
+}
+
+fn segment_distance(p: [Real; 2], a: [Real; 2], b: [Real; 2]) -> Real {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let l2 = dx * dx + dy * dy;
+    let t = if l2 > 0.0 {
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    ((p[0] - a[0] - t * dx).powi(2) + (p[1] - a[1] - t * dy).powi(2)).sqrt()
+}
+
+/// The nominal spaces of one lead's window (and one either side), each a
+/// trapezoid from the root to above the tip.
+fn nominal_spaces(w: &WormSizes, c0: Real) -> Vec<[[Real; 2]; 4]> {
+    let top = w.tip_radius() + 2.0;
+    let (bottom, upper) = (w.root_space() / 2.0, w.space_at(top) / 2.0);
+    (-1..=i64::from(w.starts))
+        .map(|k| {
+            let c = c0 + k as Real * w.axial_pitch();
+            [
+                [c - bottom, w.root_radius()],
+                [c + bottom, w.root_radius()],
+                [c + upper, top],
+                [c - upper, top],
+            ]
+        })
+        .collect()
+}
+
+/// Replays `program` (as written) on `machine` and simulates the cut of
+/// `cutter` (tracked at `tool`) in the worm's axial section; see the
+/// module's docs.
+///
+/// # Failures
+/// The replay failing; a thread block that tapers (X changes), whose lead
+/// is not the worm's within the position tolerance over the thread, or
+/// that does not run over the whole thread; a move other than a thread
+/// that crosses the blank; any cut deeper than the form tolerance beyond
+/// the nominal space (named by block); the finished profile beyond a
+/// tolerance (named by start and flank). Each a [`VerifyError::Worm`].
+pub fn simulate(
+    program: &AxisProgram,
+    machine: &dyn MachineKinematics,
+    tool: &ToolFrame,
+    cutter: &ThreadCutter,
+    req: &WormRequest,
+) -> Result<WormCheck, VerifyError> {
+    let w = &req.sizes;
+    let tol = &req.tolerances;
+    let fail = |m: String| VerifyError::Worm(m);
+    let (written, _) = as_written(program);
+    let poses = replay(&written, machine, tool)?;
+    let at = |i: usize| (poses[6 * i], poses[6 * i + 2]);
+    let lead = w.lead();
+    let (px, z1) = (w.axial_pitch(), w.starts);
+    let (r_a, r_f) = (w.tip_radius(), w.root_radius());
+    let r_core = r_f - (2.0f64).min(r_f / 2.0);
+    let c0 = req.space_centre;
+    let w0 = c0 - px / 2.0;
+    let mut material = MultiPolygon::new(vec![rect(w0, w0 + lead, r_core, r_a)]);
+    let spaces = nominal_spaces(w, c0);
+    let nominal = MultiPolygon::new(spaces.iter().map(|s| poly(s)).collect());
+    let mut passes = Vec::new();
+    let mut chips = Vec::new();
+    let mut lead_error: Real = 0.0;
+    let x_axis = written.axes.iter().position(|a| a.name == "X");
+    for i in 1..written.blocks.len() {
+        let b = &written.blocks[i];
+        let name = || block_name(&written, i);
+        let ((r0, z0), (r1, z1e)) = (at(i - 1), at(i));
+        let Motion::Thread { lead: l, start_deg } = b.motion else {
+            // Any other move must keep clear of the blank.
+            let low = r0.min(r1);
+            if low < r_a - 1e-9 {
+                let half = cutter.width_at(r_a - low) / 2.0;
+                let (lo, hi) = (z0.min(z1e), z0.max(z1e));
+                if hi > -req.length - half && lo < half {
+                    return Err(fail(format!(
+                        "{}: a move that is not a thread block crosses the blank (tip at diameter {:.3}, z from {:.3} to {:.3}; the worm runs from z = {:.3} to 0 at diameter {:.3})",
+                        name(), 2.0 * low, z0, z1e, -req.length, 2.0 * r_a
+                    )));
+                }
+            }
+            continue;
+        };
+        if (r1 - r0).abs() > 1e-9 {
+            return Err(fail(format!(
+                "{}: a thread block that changes X (from {:.4} to {:.4}) cuts a taper, not a worm",
+                name(),
+                2.0 * r0,
+                2.0 * r1
+            )));
+        }
+        let err_len = (l - lead).abs() * req.length / lead;
+        lead_error = lead_error.max(err_len);
+        if err_len > tol.position {
+            return Err(fail(format!(
+                "{}: lead {l} mm is not the worm's {lead:.6} mm: {err_len:.4} mm out over the thread's {} mm (tolerance {} mm)",
+                name(), req.length, tol.position
+            )));
+        }
+        if z0.min(z1e) > -req.length || z0.max(z1e) < 0.0 {
+            return Err(fail(format!(
+                "{}: the thread block runs from z = {z0:.3} to {z1e:.3}, not over the whole thread (z from {:.3} to 0)",
+                name(),
+                -req.length
+            )));
+        }
+        let dir = (z1e - z0).signum();
+        let z_sec = z0 - dir * l * start_deg / 360.0;
+        let k_raw = ((z_sec - c0) / px).round();
+        let start = (k_raw as i64).rem_euclid(i64::from(z1)) as u32;
+        let offset = z_sec - (c0 + k_raw * px);
+        let zw = w0 + (z_sec - w0).rem_euclid(lead);
+        let section = cutter.section(r_a + 1.0 - r1);
+        let placed = |dz: Real| -> Polygon<Real> {
+            poly(
+                &section
+                    .iter()
+                    .map(|p| [p[0] + zw + dz, p[1] + r1])
+                    .collect::<Vec<_>>(),
+            )
+        };
+        let cutter_mp = MultiPolygon::new(vec![placed(-lead), placed(0.0), placed(lead)]);
+        let chip = material.intersection(&cutter_mp);
+        let chip_area = chip.unsigned_area();
+        let left_side = MultiPolygon::new(
+            [-lead, 0.0, lead]
+                .iter()
+                .map(|dz| rect(zw + dz - lead / 2.0, zw + dz, r_core - 1.0, r_a + 2.0))
+                .collect(),
+        );
+        let left_area = chip.intersection(&left_side).unsigned_area();
+        let beyond = chip.difference(&nominal);
+        let mut gouge: Real = 0.0;
+        let mut worst = [0.0; 2];
+        if beyond.unsigned_area() > 1e-12 {
+            for (p, _) in edges(&beyond) {
+                let q = [p.x, p.y];
+                let d = spaces
+                    .iter()
+                    .map(|s| {
+                        (0..4)
+                            .map(|j| segment_distance(q, s[j], s[(j + 1) % 4]))
+                            .fold(Real::INFINITY, Real::min)
+                    })
+                    .fold(Real::INFINITY, Real::min);
+                if d > gouge {
+                    gouge = d;
+                    worst = q;
+                }
+            }
+        }
+        let x = x_axis.map(|k| b.values[k]).unwrap_or(2.0 * r1);
+        if gouge > tol.form {
+            return Err(fail(format!(
+                "{}: the cutter cuts {:.4} mm beyond the nominal thread space (at z = {:.3} in the section, diameter {:.3}; X{x:.3}, offset {offset:.4} mm from start {}'s space; tolerance {} mm)",
+                name(), gouge, worst[0], 2.0 * worst[1], start + 1, tol.form
+            )));
+        }
+        chips.push(
+            chip.0
+                .iter()
+                .map(|p| p.exterior().coords().map(|c| [c.x, c.y]).collect())
+                .collect(),
+        );
+        material = material.difference(&cutter_mp);
+        passes.push(SimulatedPass {
+            block: i + 1,
+            name: name(),
+            start,
+            x,
+            offset,
+            chip_area,
+            left_area,
+            right_area: chip_area - left_area,
+            gouge,
+        });
+    }
+    if passes.is_empty() {
+        return Err(VerifyError::NoCuttingPass);
+    }
+    let starts = measure(&material, w, c0, cutter, tol)?;
+    Ok(WormCheck {
+        removed_area: passes.iter().map(|p| p.chip_area).sum(),
+        flank_loads: [
+            passes.iter().map(|p| p.left_area).sum(),
+            passes.iter().map(|p| p.right_area).sum(),
+        ],
+        passes,
+        starts,
+        space_area: Real::from(z1) * w.space_area(),
+        lead_error,
+        tolerances: *tol,
+        chips,
+        section: material,
+        window: (w0, lead),
+    })
+}
+
+/// The least-squares slope `b` of `z = a + b r`.
+fn slope(samples: &[(Real, Real)]) -> Real {
+    let n = samples.len() as Real;
+    let (mr, mz) = samples
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (r, z)| (a + r / n, b + z / n));
+    let (mut sxy, mut sxx) = (0.0, 0.0);
+    for (r, z) in samples {
+        sxy += (r - mr) * (z - mz);
+        sxx += (r - mr) * (r - mr);
+    }
+    sxy / sxx
+}
+
+/// The finished profile at every start, checked against the nominal.
+fn measure(
+    m: &MultiPolygon<Real>,
+    w: &WormSizes,
+    c0: Real,
+    cutter: &ThreadCutter,
+    tol: &WormTolerances,
+) -> Result<Vec<StartProfile>, VerifyError> {
+    let fail = |m: String| VerifyError::Worm(m);
+    let (px, r_a, r_f, r1) = (
+        w.axial_pitch(),
+        w.tip_radius(),
+        w.root_radius(),
+        w.pitch_radius(),
+    );
+    // The flanks are measured clear of the root's fillet and the tip's edge.
+    let r_lo = r_f + 2.0 * cutter.nose_radius + 0.1 * w.module;
+    let r_hi = r_a - 0.1 * w.module;
+    let samples = 21;
+    let mut out = Vec::new();
+    for k in 0..w.starts {
+        let c = c0 + Real::from(k) * px;
+        let space = |r: Real| {
+            space_edges(m, r, c).ok_or_else(|| {
+                fail(format!(
+                    "start {}: no space cut at diameter {:.3} (the thread's space is not there)",
+                    k + 1,
+                    2.0 * r
+                ))
+            })
+        };
+        let (mut left, mut right) = (Vec::new(), Vec::new());
+        let (mut left_form, mut right_form): (Real, Real) = (0.0, 0.0);
+        let mut worst_at = [0.0; 2];
+        for j in 0..samples {
+            let r = r_lo + (r_hi - r_lo) * j as Real / (samples - 1) as Real;
+            let (zl, zr) = space(r)?;
+            left.push((r, zl));
+            right.push((r, zr));
+            let half = w.space_at(r) / 2.0;
+            let dl = (zl - (c - half)) * w.alpha.cos();
+            let dr = ((c + half) - zr) * w.alpha.cos();
+            if dl.abs() > left_form.abs() {
+                left_form = dl;
+                worst_at[0] = r;
+            }
+            if dr.abs() > right_form.abs() {
+                right_form = dr;
+                worst_at[1] = r;
+            }
+        }
+        let (zl, zr) = space(r1)?;
+        // The space after the last start's is start 0's, one lead on.
+        let next = if k + 1 == w.starts {
+            space_edges(m, r1, c0).map(|(a, _)| a + w.lead())
+        } else {
+            space_edges(m, r1, c + px).map(|(a, _)| a)
+        }
+        .ok_or_else(|| {
+            fail(format!(
+                "start {}: no space after it at the pitch line",
+                k + 1
+            ))
+        })?;
+        let p = StartProfile {
+            start: k,
+            position_error: 0.5 * (zl + zr) - c,
+            thickness: next - zr,
+            left_angle_deg: (-slope(&left)).atan().to_degrees(),
+            right_angle_deg: slope(&right).atan().to_degrees(),
+            left_form,
+            right_form,
+            root_diameter: 2.0 * vertical_top(m, c).unwrap_or(0.0),
+            tip_diameter: 2.0 * vertical_top(m, c + px / 2.0).unwrap_or(0.0),
+        };
+        let s = k + 1;
+        let alpha = w.alpha.to_degrees();
+        for (flank, form, r) in [
+            ("left", p.left_form, worst_at[0]),
+            ("right", p.right_form, worst_at[1]),
+        ] {
+            if form.abs() > tol.form {
+                return Err(fail(format!(
+                    "start {s}, {flank} flank: {} {:.4} mm from the nominal ZA flank at diameter {:.3} (tolerance {} mm)",
+                    if form > 0.0 { "material left" } else { "cut too deep" },
+                    form.abs(), 2.0 * r, tol.form
+                )));
+            }
+        }
+        for (flank, a) in [("left", p.left_angle_deg), ("right", p.right_angle_deg)] {
+            if (a - alpha).abs() > tol.flank_angle.to_degrees() {
+                return Err(fail(format!(
+                    "start {s}, {flank} flank: angle {a:.4} deg, nominal {alpha:.4} deg (tolerance {:.4} deg)",
+                    tol.flank_angle.to_degrees()
+                )));
+            }
+        }
+        if (p.thickness - w.thickness).abs() > tol.thickness {
+            return Err(fail(format!(
+                "start {s}: axial thickness at the pitch line {:.4} mm, nominal {:.4} mm (tolerance {} mm)",
+                p.thickness, w.thickness, tol.thickness
+            )));
+        }
+        for (what, d, nominal) in [
+            ("root diameter", p.root_diameter, w.root_diameter()),
+            ("tip diameter", p.tip_diameter, w.tip_diameter()),
+        ] {
+            if (d - nominal).abs() > tol.diameter {
+                return Err(fail(format!(
+                    "start {s}: {what} {d:.4} mm, nominal {nominal:.4} mm (tolerance {} mm)",
+                    tol.diameter
+                )));
+            }
+        }
+        if p.position_error.abs() > tol.position {
+            return Err(fail(format!(
+                "start {s}: its space is {:.4} mm from its place (tolerance {} mm)",
+                p.position_error, tol.position
+            )));
+        }
+        out.push(p);
+    }
+    Ok(out)
+}

@@ -1,0 +1,214 @@
+//! The worm's sizes (MATH §4.1): standard cylindrical-worm practice, not
+//! the seed's words (the seed names the inputs only).
+
+use crate::input::InputError;
+use crate::math::{positive, Real};
+use serde::Serialize;
+use std::f64::consts::PI;
+
+/// A cylindrical worm with a ZA profile (straight flanks in the axial
+/// section) and the sizes derived from its module, starts and pitch
+/// diameter. All lengths in mm, angles in radians.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct WormSizes {
+    /// Module m.
+    pub module: Real,
+    /// Number of starts z1.
+    pub starts: u32,
+    /// Pitch diameter d1.
+    pub pitch_diameter: Real,
+    /// Radial clearance factor c*.
+    pub clearance: Real,
+    /// Profile half-angle alpha in the axial section.
+    pub alpha: Real,
+    /// Axial thickness of the thread at the pitch line, S_a1 (in the axial
+    /// section the thread is a rack: its chord at the pitch line is its
+    /// axial thickness). `p_x / 2` unless thinned for backlash.
+    pub thickness: Real,
+}
+
+impl WormSizes {
+    /// The worm of module `m`, `z1` starts, pitch diameter `d1`, clearance
+    /// factor `c`, half-angle `alpha` and pitch-line thickness `s_a1`
+    /// (`None`: half the axial pitch).
+    ///
+    /// # Failures
+    /// A value that is not positive and finite (`c` may be 0); `z1` of 0;
+    /// a half-angle beyond 45 degrees; a root at or below the axis; a
+    /// thickness that leaves no space between the threads.
+    pub fn new(
+        m: Real,
+        z1: i64,
+        d1: Real,
+        c: Real,
+        alpha: Real,
+        s_a1: Option<Real>,
+    ) -> Result<Self, InputError> {
+        positive("module m", m)?;
+        if z1 <= 0 || z1 > 100 {
+            return Err(InputError::out_of_range(
+                "number of starts z1",
+                z1 as f64,
+                "from 1 to 100",
+            ));
+        }
+        positive("pitch diameter d1", d1)?;
+        crate::math::finite("clearance factor c*", c)?;
+        if !(0.0..=1.0).contains(&c) {
+            return Err(InputError::out_of_range(
+                "clearance factor c*",
+                c,
+                "from 0 to 1",
+            ));
+        }
+        positive("profile half-angle", alpha)?;
+        if alpha > PI / 4.0 {
+            return Err(InputError::out_of_range(
+                "profile half-angle (deg)",
+                alpha.to_degrees(),
+                "at most 45",
+            ));
+        }
+        let mut w = Self {
+            module: m,
+            starts: z1 as u32,
+            pitch_diameter: d1,
+            clearance: c,
+            alpha,
+            thickness: PI * m / 2.0,
+        };
+        if let Some(s) = s_a1 {
+            positive("thread thickness S_a1", s)?;
+            w.thickness = s;
+        }
+        if w.root_diameter() <= 0.0 {
+            return Err(InputError::out_of_range(
+                "pitch diameter d1",
+                d1,
+                format!(
+                    "above 2 (1 + c*) m = {} so that the root stays off the axis",
+                    2.0 * (1.0 + c) * m
+                ),
+            ));
+        }
+        if !(w.root_space() > 0.0) {
+            return Err(InputError::out_of_range(
+                "thread thickness S_a1",
+                w.thickness,
+                format!(
+                    "below {:.4} mm, so that a space remains at the root",
+                    w.axial_pitch() - 2.0 * (w.pitch_radius() - w.root_radius()) * alpha.tan()
+                ),
+            ));
+        }
+        Ok(w)
+    }
+
+    /// Axial pitch `p_x = pi m`.
+    pub fn axial_pitch(&self) -> Real {
+        PI * self.module
+    }
+
+    /// Lead `P_z = z1 p_x`.
+    pub fn lead(&self) -> Real {
+        Real::from(self.starts) * self.axial_pitch()
+    }
+
+    /// Thread height `h1 = (2 + c*) m`.
+    pub fn height(&self) -> Real {
+        (2.0 + self.clearance) * self.module
+    }
+
+    /// Tip diameter `d_a1 = d1 + 2 m` (the blank's).
+    pub fn tip_diameter(&self) -> Real {
+        self.pitch_diameter + 2.0 * self.module
+    }
+
+    /// Root diameter `d_f1 = d1 - 2 (1 + c*) m`.
+    pub fn root_diameter(&self) -> Real {
+        self.pitch_diameter - 2.0 * (1.0 + self.clearance) * self.module
+    }
+
+    /// Pitch radius.
+    pub fn pitch_radius(&self) -> Real {
+        self.pitch_diameter / 2.0
+    }
+
+    /// Tip radius.
+    pub fn tip_radius(&self) -> Real {
+        self.tip_diameter() / 2.0
+    }
+
+    /// Root radius.
+    pub fn root_radius(&self) -> Real {
+        self.root_diameter() / 2.0
+    }
+
+    /// Lead angle `gamma = atan(z1 m / d1)`.
+    pub fn lead_angle(&self) -> Real {
+        (Real::from(self.starts) * self.module / self.pitch_diameter).atan()
+    }
+
+    /// Width of the space between threads along the axis at radius `r`:
+    /// `p_x - S_a1` at the pitch line, narrower by `2 tan(alpha)` per mm
+    /// towards the root.
+    pub fn space_at(&self, r: Real) -> Real {
+        self.axial_pitch() - self.thickness - 2.0 * (self.pitch_radius() - r) * self.alpha.tan()
+    }
+
+    /// Width of the space at the root: the widest tip a cutter may have.
+    pub fn root_space(&self) -> Real {
+        self.space_at(self.root_radius())
+    }
+
+    /// Area of one thread space in the axial section, between root and
+    /// tip (a trapezoid).
+    pub fn space_area(&self) -> Real {
+        0.5 * (self.root_space() + self.space_at(self.tip_radius())) * self.height()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// m = 5, z1 = 2, d1 = 50, c* = 0.2, alpha = 20 deg, computed by hand.
+    #[test]
+    fn sizes_of_a_two_start_module_5_worm() {
+        let w = WormSizes::new(5.0, 2, 50.0, 0.2, 20f64.to_radians(), None).unwrap();
+        assert!((w.axial_pitch() - 15.707_963).abs() < 1e-6);
+        assert!((w.lead() - 31.415_927).abs() < 1e-6);
+        assert!((w.height() - 11.0).abs() < 1e-12);
+        assert!((w.tip_diameter() - 60.0).abs() < 1e-12);
+        assert!((w.root_diameter() - 38.0).abs() < 1e-12);
+        assert!((w.thickness - 7.853_982).abs() < 1e-6);
+        // gamma = atan(10 / 50) = 11.3099 deg.
+        assert!((w.lead_angle().to_degrees() - 11.309_932).abs() < 1e-6);
+        // Space at the root: 7.853982 - 2 * 6 * tan 20 = 7.853982 - 4.367643.
+        assert!((w.root_space() - 3.486_339).abs() < 1e-6);
+        // At the tip: 7.853982 + 2 * 5 * tan 20 = 7.853982 + 3.639702.
+        assert!((w.space_at(30.0) - 11.493_684).abs() < 1e-6);
+        assert!((w.space_area() - 82.390_125).abs() < 1e-5);
+    }
+
+    #[test]
+    fn bad_sizes_are_named() {
+        let a = 20f64.to_radians();
+        let e = WormSizes::new(5.0, 0, 50.0, 0.2, a, None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("z1"), "{e}");
+        let e = WormSizes::new(-1.0, 1, 50.0, 0.2, a, None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("module m"), "{e}");
+        let e = WormSizes::new(5.0, 1, 10.0, 0.2, a, None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("pitch diameter d1"), "{e}");
+        let e = WormSizes::new(5.0, 1, 50.0, 0.2, a, Some(15.0))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("S_a1"), "{e}");
+    }
+}

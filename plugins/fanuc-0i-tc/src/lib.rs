@@ -1,0 +1,224 @@
+//! A two-axis CNC lathe with a Fanuc 0i-TC control (seed 004, MATH §4) as
+//! a pilgrim machine plugin: cross slide X on diameter, carriage Z, main
+//! spindle; worm threads cut in many passes with single thread blocks
+//! (G32). The host's writer posts its programs in the `fanuc` dialect.
+//!
+//! Its description ([`describe`]) is the one definition of the machine;
+//! the kernel's data file `kernel/machines/fanuc-0i-tc.toml` says the same
+//! (a test holds them equal). Part frame: Z along the spindle's axis, X
+//! radial (ARCHITECTURE §3). Signs:
+//!
+//! - `X` on diameter: +1 mm moves the tool 0.5 mm away from the axis;
+//! - `Z` +1 mm moves the tool +1 mm along the axis, away from the chuck.
+//!
+//! The tool frame's origin is the tool's tracked point (a thread cutter's
+//! tip centre), its axis the part's. The kinematics are closed-form: the
+//! tool moves in the axial section, `X = 2 (x - r_x)`, `Z = z - r_z`.
+//!
+//! Its constant `servo_time_constant` (s) is the carriage's servo time
+//! constant T, which sets a thread's acceleration and deceleration lengths
+//! (MATH §4.2); its Z axis's `max_feed` bounds lead x rpm of a thread.
+
+use pilgrim_plugin_abi::types::{
+    Axis, AxisKind, FactorKind, FactorSpec, MachineInfo, Plane, ProgramSetup, Radial, ToolSpec,
+};
+use pilgrim_plugin_abi::{export_plugin, Plugin, PluginError};
+
+/// How far off the axial section (y) or off the part's axis direction a
+/// pose may be and still be the lathe's.
+const POSE_TOL: f64 = 1e-9;
+
+/// The machine's name.
+pub const NAME: &str = "fanuc-0i-tc";
+
+/// How a program starts and ends: G54, the ZX plane, X on diameter (a
+/// parameter of the control: the program says so in a comment), coolant
+/// on; X clears to diameter 300 first, then Z comes to the start; at the
+/// end X backs off.
+fn setup() -> ProgramSetup {
+    ProgramSetup {
+        work_offset: Some(1),
+        plane: Some(Plane::Zx),
+        radial: Some(Radial::Diameter),
+        radial_axis: "X".into(),
+        coolant: true,
+        clear: [("X".to_owned(), 300.0)].into_iter().collect(),
+        start_clear: vec!["X".into()],
+        approach: vec![vec!["Z".into()]],
+        retract: vec![vec!["X".into()]],
+        feed_group: vec![],
+    }
+}
+
+/// The lathe's description: axes, chain, constants.
+pub fn describe() -> MachineInfo {
+    // X in program units, on diameter: travel and feed in diameter.
+    let x = Axis::linear(
+        "X",
+        -10.0,
+        400.0,
+        12000.0,
+        [0.5, 0.0, 0.0],
+        "cross slide, on diameter",
+    );
+    let mut tx = FactorSpec::axis(FactorKind::Tx, "X");
+    tx.scale = 0.5;
+    MachineInfo {
+        name: NAME.into(),
+        description: "two-axis CNC lathe, Fanuc 0i-TC, X on diameter".into(),
+        control: "fanuc".into(),
+        axes: vec![
+            x,
+            Axis::linear(
+                "Z",
+                -750.0,
+                150.0,
+                10000.0,
+                [0.0, 0.0, 1.0],
+                "carriage, along the spindle's axis (program zero at the part's face)",
+            ),
+            Axis {
+                name: "S".into(),
+                kind: AxisKind::Spindle,
+                min: 0.0,
+                max: 3500.0,
+                max_feed: 3500.0,
+                programmed: false,
+                description: "main spindle".into(),
+                moves: None,
+                turns: None,
+                body: None,
+            },
+        ],
+        solved_axes: vec!["X".into(), "Z".into()],
+        constants: [
+            // The carriage's servo time constant T (s), usually 0.033 s.
+            ("servo_time_constant".to_owned(), 0.033),
+        ]
+        .into_iter()
+        .collect(),
+        program_decimals: None,
+        driven_axes: vec![],
+        setup: setup(),
+        bodies: vec![],
+        chain: vec![FactorSpec::axis(FactorKind::Tz, "Z"), tx],
+        tool: ToolSpec::default(),
+        min_feed: Some(1.0),
+    }
+}
+
+/// The Fanuc lathe.
+#[derive(Debug, Clone, Default)]
+pub struct Lathe;
+
+impl Plugin for Lathe {
+    fn describe(&self) -> MachineInfo {
+        describe()
+    }
+
+    /// Rows of `[X, Z]` (the solved axes' order), X on diameter.
+    fn inverse(&self, poses: &[f64], tool: &[f64; 6], out: &mut [f64]) -> Result<(), PluginError> {
+        for (i, (p, q)) in poses
+            .chunks_exact(6)
+            .zip(out.chunks_exact_mut(2))
+            .enumerate()
+        {
+            if (p[1] - tool[1]).abs() > POSE_TOL {
+                return Err(PluginError::at(
+                    i,
+                    format!(
+                        "the point is {:.6} mm off the axial section (y must be {})",
+                        p[1] - tool[1],
+                        tool[1]
+                    ),
+                ));
+            }
+            let tilt =
+                ((p[3] - tool[3]).powi(2) + (p[4] - tool[4]).powi(2) + (p[5] - tool[5]).powi(2))
+                    .sqrt();
+            if tilt > POSE_TOL {
+                return Err(PluginError::at(
+                    i,
+                    format!(
+                        "the tool's axis ({:.6}, {:.6}, {:.6}) must stay the part's ({}, {}, {}): a lathe does not swivel",
+                        p[3], p[4], p[5], tool[3], tool[4], tool[5]
+                    ),
+                ));
+            }
+            q[0] = 2.0 * (p[0] - tool[0]);
+            q[1] = p[2] - tool[2];
+        }
+        Ok(())
+    }
+
+    fn forward(&self, axes: &[f64], tool: &[f64; 6], out: &mut [f64]) -> Result<(), PluginError> {
+        for (q, p) in axes.chunks_exact(2).zip(out.chunks_exact_mut(6)) {
+            p.copy_from_slice(&[
+                0.5 * q[0] + tool[0],
+                tool[1],
+                q[1] + tool[2],
+                tool[3],
+                tool[4],
+                tool[5],
+            ]);
+        }
+        Ok(())
+    }
+}
+
+export_plugin!(pilgrim_plugin_fanuc_0i_tc, Lathe);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pilgrim_kernel::machine::{ChainMachine, Machine, MachineKinematics};
+    use pilgrim_kernel::math::{Point3, Vec3};
+    use pilgrim_kernel::transform::ToolFrame;
+
+    /// The plugin describes the machine the kernel's machine file does.
+    #[test]
+    fn the_plugin_is_the_machine_file() {
+        assert_eq!(Machine::builtin(NAME).unwrap().info(), &describe());
+    }
+
+    /// The closed form agrees with the description's chain solved
+    /// numerically, both ways; X is twice the radius.
+    #[test]
+    fn closed_form_matches_the_chain() {
+        let chain = ChainMachine::new(Machine::from_info(describe()).unwrap());
+        let tool = ToolFrame {
+            point: Point3::new(0.0, 0.0, 0.0),
+            axis: Vec3::z(),
+        };
+        let t6 = [0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+        let poses: Vec<f64> = (0..20)
+            .flat_map(|i| {
+                [
+                    19.0 + 0.5 * i as f64,
+                    0.0,
+                    5.0 - 3.0 * i as f64,
+                    0.0,
+                    0.0,
+                    1.0,
+                ]
+            })
+            .collect();
+        let mut a = vec![0.0; 40];
+        Lathe.inverse(&poses, &t6, &mut a).unwrap();
+        let mut b = vec![];
+        chain.inverse(&poses, &tool, &mut b).unwrap();
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x - y).abs() < 1e-7, "{x} vs {y}");
+        }
+        assert_eq!(a[0], 38.0);
+        let mut back = vec![0.0; 120];
+        Lathe.forward(&a, &t6, &mut back).unwrap();
+        for (x, y) in back.iter().zip(&poses) {
+            assert!((x - y).abs() < 1e-12);
+        }
+        let mut bad = poses.clone();
+        bad[6 * 3 + 1] = 0.5;
+        let e = Lathe.inverse(&bad, &t6, &mut a).unwrap_err();
+        assert_eq!(e.row, Some(3));
+    }
+}
