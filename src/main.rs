@@ -90,6 +90,10 @@ enum Command {
         /// tool call) instead of the block to paste after the tool call.
         #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=9999))]
         program_number: Option<u32>,
+        /// Also write the program in this dialect (repeatable): `linuxcnc`
+        /// (`program.ngc`), `sinumerik`, `fanuc`.
+        #[arg(long = "post", value_name = "DIALECT")]
+        also_post: Vec<String>,
     },
     /// Re-export a finished run's 3-D scene with the tool at another block.
     Export {
@@ -275,6 +279,7 @@ fn main() -> ExitCode {
             gltf,
             script_seconds,
             program_number,
+            also_post,
         } => run::run(
             &run::RunArgs {
                 formats: Formats {
@@ -293,6 +298,7 @@ fn main() -> ExitCode {
                 quiet: cli.quiet,
                 script_seconds: *script_seconds,
                 program_number: *program_number,
+                also_post: also_post.clone(),
             },
             &catalog,
         )

@@ -22,6 +22,7 @@ pub struct RunArgs {
     pub quiet: bool,
     pub script_seconds: f64,
     pub program_number: Option<u32>,
+    pub also_post: Vec<String>,
 }
 
 /// A progress bar over the run's stages (hidden with --quiet).
@@ -102,17 +103,18 @@ pub fn run(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
         mesh_tolerance: args.mesh_tolerance,
         formats: args.formats,
         program_number: args.program_number,
+        also_post: args.also_post.clone(),
     };
     let out = job::run(&family, &machine, &sources, &options, &mut |s| next(s))
         .map_err(|e| e.to_string())?;
     next("writing");
     pilgrim_kernel::output::write_dir(&args.out, &out.files).map_err(|e| e.to_string())?;
     bar.finish_and_clear();
-    Ok(format!(
-        "{}; written to {}",
-        out.summary(),
-        args.out.display()
-    ))
+    let mut said = format!("{}; written to {}", out.summary(), args.out.display());
+    for w in &out.report.warnings {
+        said += &format!("\nwarning: {w}");
+    }
+    Ok(said)
 }
 
 /// `pilgrim export DIR --block N`: the run's scene placed at another block.

@@ -43,6 +43,8 @@ pub enum Verification {
     Profile(VerifyRequest),
     /// A caliber's groove ground by a torus wheel, replayed in 3-D.
     Groove(Box<crate::caliber::GrooveRequest>),
+    /// A worm's thread cut in passes, simulated in the axial section.
+    Worm(Box<crate::worm::WormRequest>),
 }
 
 impl Verification {
@@ -50,7 +52,7 @@ impl Verification {
     pub fn into_profile(self) -> Option<VerifyRequest> {
         match self {
             Self::Profile(v) => Some(v),
-            Self::Groove(_) => None,
+            Self::Groove(_) | Self::Worm(_) => None,
         }
     }
 }

@@ -109,6 +109,8 @@ pub enum ToolShape {
         /// Nose radius (mm).
         nose_radius: Real,
     },
+    /// A thread cutter: its section in the axial plane.
+    ThreadCutter(crate::worm::ThreadCutter),
 }
 
 /// A tool: its shape, the number the control calls it by, and the
@@ -175,6 +177,19 @@ impl Tool {
             shape: ToolShape::Wheel(wheel),
             reference: ToolFrame::default(),
             origin: WheelOrigin::Centre,
+        }
+    }
+
+    /// A thread cutter tracked at its tip's centre (the tool frame's
+    /// origin), its section in the tool frame's XZ plane (X radial, Z
+    /// along the part's axis).
+    pub fn thread_cutter(name: &str, number: u32, cutter: crate::worm::ThreadCutter) -> Self {
+        Self {
+            name: name.to_owned(),
+            number,
+            shape: ToolShape::ThreadCutter(cutter),
+            reference: ToolFrame::default(),
+            origin: WheelOrigin::Periphery,
         }
     }
 

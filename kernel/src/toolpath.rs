@@ -86,6 +86,9 @@ pub struct Toolpath {
     /// Charts the run draws from the tables.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub plots: Vec<PlotSpec>,
+    /// What the family warns of (the run goes on).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 /// A chart a run draws (`<file>.svg`) from one of the toolpath's tables:
@@ -144,6 +147,7 @@ impl Toolpath {
             notes: BTreeMap::new(),
             tables: BTreeMap::new(),
             plots: Vec::new(),
+            warnings: Vec::new(),
         }
     }
 

@@ -16,6 +16,7 @@ mod export;
 mod report;
 mod scene;
 mod svg;
+mod worm_files;
 
 pub use export::{export, Exported};
 pub use report::{axis_ranges, block_table, cycle_time, Report, ReportParam};
@@ -44,6 +45,9 @@ pub struct JobOptions {
     pub mesh_tolerance: f64,
     /// Which 3-D files to write.
     pub formats: Formats,
+    /// Dialects to write the program in besides the control's and the CL
+    /// file (`linuxcnc`: `program.ngc`).
+    pub also_post: Vec<String>,
     /// The program's number (Fanuc `O`): `Some` writes a whole program;
     /// `None` the block to paste after the tool call, where the dialect
     /// tells them apart (Fanuc).
@@ -57,6 +61,7 @@ impl Default for JobOptions {
             pose_block: None,
             mesh_tolerance: crate::mesh::DEFAULT_TOLERANCE,
             formats: Formats::default(),
+            also_post: Vec::new(),
             program_number: None,
         }
     }
@@ -84,6 +89,8 @@ pub struct JobOutput {
     pub verification: Option<GrindingCheck>,
     /// The caliber program replayed in 3-D, if the family asked.
     pub groove: Option<crate::caliber::GrooveCheck>,
+    /// The worm's cut simulated, if the family asked.
+    pub worm: Option<crate::worm::WormCheck>,
     /// The report.
     pub report: Report,
     /// Every file's name and bytes, in the order they were made.
@@ -112,6 +119,21 @@ impl JobOutput {
                         crate::math::fixed(g.max_abs_mm, 5),
                         crate::math::fixed(g.max_left.mm, 5),
                         crate::math::fixed(g.max_gouge.mm, 5)
+                    )
+                })
+            })
+            .or_else(|| {
+                self.worm.as_ref().map(|w| {
+                    let form = w
+                        .starts
+                        .iter()
+                        .map(|s| s.left_form.abs().max(s.right_form.abs()))
+                        .fold(0.0, f64::max);
+                    format!(
+                        ", thread within tolerance (flank form {} mm; chips {:.2} of {:.2} mm^2 of space)",
+                        crate::math::fixed(form, 4),
+                        w.removed_area,
+                        w.space_area
                     )
                 })
             })
@@ -230,10 +252,30 @@ pub fn run(
             message: "fn verify(p) needs a grinding wheel".into(),
         })
     };
-    let (nominal, groove_request) = match requested {
-        None => (None, None),
-        Some(Verification::Profile(v)) => (Some(v), None),
-        Some(Verification::Groove(g)) => (None, Some(g)),
+    let (nominal, groove_request, worm_request) = match requested {
+        None => (None, None, None),
+        Some(Verification::Profile(v)) => (Some(v), None, None),
+        Some(Verification::Groove(g)) => (None, Some(g), None),
+        Some(Verification::Worm(w)) => (None, None, Some(w)),
+    };
+    // The worm's cut, simulated pass by pass from the program as written.
+    let worm = match &worm_request {
+        None => None,
+        Some(r) => {
+            let ToolShape::ThreadCutter(c) = toolpath.tool.shape else {
+                return Err(Error::Family(crate::family::FamilyError::Contract {
+                    family: family.name().to_owned(),
+                    message: "fn verify(p) of a worm needs a thread cutter".into(),
+                }));
+            };
+            Some(crate::worm::simulate(
+                &program,
+                kin,
+                &toolpath.tool.reference,
+                &c,
+                r,
+            )?)
+        }
     };
     // The caliber's replay, and its contact patch at the pose block (in
     // the report, and its mesh in the scene).
@@ -291,6 +333,17 @@ pub fn run(
     })?;
     let control_text = machine.post.post(&program, control.name)?;
     let cld_text = machine.post.post(&program, CLD.name)?;
+    let mut extra = Vec::new();
+    for name in &options.also_post {
+        let d = dialect(name).ok_or_else(|| {
+            Error::Post(crate::program::PostError::UnknownDialect { name: name.clone() })
+        })?;
+        if d.name == control.name || d.name == CLD.name {
+            continue;
+        }
+        let text = machine.post.post(&program, d.name)?;
+        extra.push((format!("program.{}", d.extension), text.into_bytes()));
+    }
     let mut files: Vec<(String, Vec<u8>)> = vec![
         ("toolpath.json".into(), json(&toolpath)?),
         ("program.json".into(), json(&program)?),
@@ -299,13 +352,14 @@ pub fn run(
             control_text.into_bytes(),
         ),
         ("program.cld".into(), cld_text.into_bytes()),
-        (
-            "report.csv".into(),
-            block_table(&program).map_err(Error::Output)?.into_bytes(),
-        ),
     ];
+    files.extend(extra);
+    files.extend([(
+        "report.csv".into(),
+        block_table(&program).map_err(Error::Output)?.into_bytes(),
+    )]);
     stage(STAGES[4]);
-    let parts = family.part(&values)?;
+    let mut parts = family.part(&values)?;
     if let Some(b) = parts.iter().find(|b| !crate::files::is_plain_name(&b.name)) {
         return Err(Error::Family(crate::family::FamilyError::Contract {
             family: family.name().to_owned(),
@@ -316,6 +370,19 @@ pub fn run(
         }));
     }
     let tol = options.mesh_tolerance;
+    // The finished worm: the simulated section swept along the helix.
+    if let (Some(w), Some(r)) = (&worm, &worm_request) {
+        let mesh = crate::worm::worm_solid(w, r.length, tol).map_err(|source| {
+            Error::Scene(SceneError::Mesh {
+                body: "worm".into(),
+                source,
+            })
+        })?;
+        parts.push(crate::family::PartBody {
+            name: "worm".into(),
+            geometry: PartGeometry::Mesh(mesh),
+        });
+    }
     let (pose_block, bodies) = if parts.is_empty() {
         (None, vec![])
     } else {
@@ -372,18 +439,55 @@ pub fn run(
         axis_ranges: axis_ranges(&program),
         verification: verification.clone(),
         groove_verification: groove.clone(),
+        worm_verification: worm.clone(),
+        warnings: toolpath.warnings.clone(),
         notes: toolpath.notes.clone(),
         tables: toolpath.tables.clone(),
     };
+    if let Some(w) = &worm {
+        // The simulated areas beside the plan's, row for row, where the
+        // family's "passes" table has one row per thread block.
+        if let Some(t) = report.tables.get_mut("passes") {
+            if t.values().all(|c| c.len() == w.passes.len()) && !t.is_empty() {
+                t.insert(
+                    "simulated_area".into(),
+                    w.passes.iter().map(|p| p.chip_area).collect(),
+                );
+                t.insert(
+                    "left_area".into(),
+                    w.passes.iter().map(|p| p.left_area).collect(),
+                );
+                t.insert(
+                    "right_area".into(),
+                    w.passes.iter().map(|p| p.right_area).collect(),
+                );
+                t.insert(
+                    "block".into(),
+                    w.passes.iter().map(|p| p.block as f64).collect(),
+                );
+            }
+        }
+        let table =
+            worm_files::worm_pass_table(w, report.tables.get("passes")).map_err(Error::Output)?;
+        files.push(("passes.csv".into(), table.into_bytes()));
+        report.files.push("passes.csv".into());
+        let svg = worm_files::worm_passes_svg(w).map_err(Error::Output)?;
+        files.push(("passes.svg".into(), svg.into_bytes()));
+        report.files.push("passes.svg".into());
+    }
+    let charted = Toolpath {
+        tables: report.tables.clone(),
+        ..toolpath.clone()
+    };
     for plot in &toolpath.plots {
-        let text = chart::chart_svg(&toolpath, plot).map_err(|message| {
+        let text = chart::chart_svg(&charted, plot).map_err(|message| {
             Error::Family(crate::family::FamilyError::Contract {
                 family: family.name().to_owned(),
                 message,
             })
         })?;
         let name = format!("{}.svg", plot.file);
-        if files.iter().any(|f| f.0 == name) || name == "profile.svg" {
+        if files.iter().any(|f| f.0 == name) || name == "profile.svg" || name == "passes.svg" {
             return Err(Error::Family(crate::family::FamilyError::Contract {
                 family: family.name().to_owned(),
                 message: format!("plot {}: a file of that name is written already", plot.file),
@@ -419,6 +523,7 @@ pub fn run(
         program,
         verification,
         groove,
+        worm,
         report,
         files,
     })

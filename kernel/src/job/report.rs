@@ -70,6 +70,13 @@ pub struct Report {
     /// that ask).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub groove_verification: Option<crate::caliber::GrooveCheck>,
+    /// The worm's cut simulated pass by pass (families that ask; written,
+    /// not read back).
+    #[serde(default, skip_serializing_if = "Option::is_none", skip_deserializing)]
+    pub worm_verification: Option<crate::worm::WormCheck>,
+    /// What the family warned of.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
     /// Figures the family noted.
     #[serde(default)]
     pub notes: BTreeMap<String, f64>,

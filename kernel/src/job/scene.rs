@@ -73,6 +73,10 @@ pub fn part_meshes(parts: &[PartBody], tol: f64) -> Result<Vec<(String, TriMesh)
         .collect()
 }
 
+/// The thickness of a thread cutter's blade in the 3-D models (mm): the
+/// cutter's section is its cutting edge; the blade only shows it.
+pub const CUTTER_BLADE: f64 = 6.0;
+
 /// The tool's solid in its own frame and the file name it is written as.
 ///
 /// # Failures
@@ -96,6 +100,21 @@ pub fn tool_mesh(tool: &Tool, tol: f64) -> Result<Option<(TriMesh, &'static str)
             "cutter",
         )),
         ToolShape::Insert { .. } => None,
+        ToolShape::ThreadCutter(c) => {
+            // The section in the tool frame's XZ plane (X radial from the
+            // tip, Z along the part), a blade CUTTER_BLADE mm thick.
+            let half = CUTTER_BLADE / 2.0;
+            let ring = |y: f64| -> Vec<[f64; 3]> {
+                c.section(c.height)
+                    .iter()
+                    .map(|p| [p[1], y, p[0]])
+                    .collect()
+            };
+            Some((
+                mesh::sweep(&[ring(-half), ring(half)]).map_err(mesh_err("cutter"))?,
+                "cutter",
+            ))
+        }
     })
 }
 

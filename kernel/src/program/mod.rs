@@ -114,6 +114,23 @@ pub enum ProgramError {
         /// mm/min or deg/min.
         unit: &'static str,
     },
+    /// A thread block whose lead times the spindle's speed is beyond the
+    /// feed of the axis that carries it.
+    #[error("{block}: a thread of lead {lead} mm at {rpm} rpm needs axis {axis} at {speed:.1} mm/min, above its maximum {max} mm/min: lower the spindle speed")]
+    ThreadTooFast {
+        /// The block, as the program names it.
+        block: String,
+        /// The lead (mm).
+        lead: Real,
+        /// The spindle speed (rpm).
+        rpm: Real,
+        /// The axis.
+        axis: String,
+        /// Speed needed (mm/min).
+        speed: Real,
+        /// The axis's maximum (mm/min).
+        max: Real,
+    },
     /// A spindle speed outside the machine's spindle range.
     #[error("{block}: spindle speed S{rpm} is outside the range of spindle {axis} of machine {machine}, [{min}, {max}] rpm")]
     Spindle {
@@ -493,7 +510,29 @@ pub fn build(
     let decimals = written_decimals(info.program_decimals, &info.control);
     let rows_written = rows(&|v| written(v, decimals));
     crate::machine::check_feed_grouped(&axes_refs, &rows_written, &feeds, &info.setup.feed_group)
-        .map_err(|e| ProgramError::from_limit(&info.name, e, name_of))?;
+        .map_err(|e| {
+        // A thread's feed is the lead times the spindle's speed.
+        if let MachineError::FeedExceeded {
+            point,
+            axis,
+            speed,
+            max,
+            ..
+        } = &e
+        {
+            if let Some(Motion::Thread { lead, .. }) = blocks.get(*point).map(|b| b.motion) {
+                return ProgramError::ThreadTooFast {
+                    block: name_of(*point),
+                    lead,
+                    rpm: toolpath.spindle_rpm,
+                    axis: axis.clone(),
+                    speed: *speed,
+                    max: *max,
+                };
+            }
+        }
+        ProgramError::from_limit(&info.name, e, name_of)
+    })?;
     Ok(AxisProgram {
         name: program_name(name),
         // A block to paste after the tool call until the caller numbers it.

@@ -112,6 +112,9 @@ pub struct Dialect {
     /// The instruction naming the axes the feed is the path of
     /// ([`ProgramSetup::feed_group`]: `FGROUP` on Sinumerik), or `None`.
     pub feed_group: Option<&'static str>,
+    /// Whether every thread block writes its lead (LinuxCNC: `K` is not
+    /// modal for G33) or only where it changes.
+    pub lead_every_block: bool,
     /// How a thread block's start angle is written, or `None` where the
     /// control has no word for it (then a program with one is refused,
     /// and a multi-start thread shifts its starts along Z instead).
@@ -165,6 +168,7 @@ pub const SINUMERIK: Dialect = Dialect {
     radial_words: Some(("DIAMOF", "DIAMON")),
     coolant: ("M8", "M9"),
     feed_group: Some("FGROUP"),
+    lead_every_block: false,
     thread_start: Some(ThreadStart {
         address: "SF=",
         scale: 1.0,
@@ -210,6 +214,7 @@ pub const FANUC: Dialect = Dialect {
     radial_words: None,
     coolant: ("M08", "M09"),
     feed_group: None,
+    lead_every_block: false,
     thread_start: Some(ThreadStart {
         address: "Q",
         scale: 1000.0,
@@ -247,6 +252,7 @@ pub const LINUXCNC: Dialect = Dialect {
     radial_words: Some(("G8", "G7")),
     coolant: ("M8", "M9"),
     feed_group: None,
+    lead_every_block: true,
     thread_start: None,
 };
 
@@ -280,6 +286,7 @@ pub const CLD: Dialect = Dialect {
     radial_words: None,
     coolant: ("COOLNT/ON", "COOLNT/OFF"),
     feed_group: None,
+    lead_every_block: false,
     thread_start: None,
 };
 
@@ -610,7 +617,8 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
                     }
                 };
                 if let Some(f) = feed {
-                    if last_feed.as_ref() != Some(&f) {
+                    let every = d.lead_every_block && matches!(b.motion, Motion::Thread { .. });
+                    if every || last_feed.as_ref() != Some(&f) {
                         words.push(f.clone());
                         last_feed = Some(f);
                     }

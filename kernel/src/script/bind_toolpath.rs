@@ -66,7 +66,9 @@ pub mod tool_api {
         match t.shape {
             ToolShape::Wheel(w) => Ok(w.diameter),
             ToolShape::EndMill { diameter, .. } => Ok(diameter),
-            ToolShape::Insert { .. } => err(format!("tool '{}' has no diameter", t.name)),
+            ToolShape::Insert { .. } | ToolShape::ThreadCutter(_) => {
+                err(format!("tool '{}' has no diameter", t.name))
+            }
         }
     }
 
@@ -193,6 +195,12 @@ pub mod toolpath_api {
             y_label: text("y_label")?,
         });
         Ok(())
+    }
+
+    /// Adds a warning: the run goes on, and says it (the report's
+    /// `warnings`, the summary).
+    pub fn warn(tp: &mut ToolpathHandle, text: &str) {
+        tp.borrow_mut().warnings.push(text.to_owned());
     }
 
     /// Number of points so far.

@@ -116,6 +116,17 @@ pub(super) fn len_of(d: &Dynamic) -> Option<usize> {
 pub mod floats_api {
     use super::*;
 
+    /// `x` with `decimals` decimals (0 to 12), as programs and reports
+    /// write numbers (never `-0.000`).
+    ///
+    /// ```rhai
+    /// fixed(2.0 / 3.0, 3) // "0.667"
+    /// ```
+    #[rhai_fn(name = "fixed")]
+    pub fn fixed_text(x: Real, decimals: i64) -> String {
+        crate::math::fixed(x, decimals.clamp(0, 12) as usize)
+    }
+
     /// `n` numbers evenly spaced from `a` to `b` (both included).
     ///
     /// ```rhai

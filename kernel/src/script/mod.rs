@@ -27,6 +27,7 @@ mod bind_profile;
 mod bind_table;
 mod bind_toolpath;
 mod bind_transform;
+mod bind_worm;
 mod docs;
 mod floats;
 
@@ -199,7 +200,8 @@ fn register_types(e: &mut Engine) {
         .register_type_with_name::<bind_toolpath::ToolpathHandle>("Toolpath")
         .register_type_with_name::<crate::caliber::Groove>("Groove")
         .register_type_with_name::<crate::caliber::SeedPose>("SeedPose")
-        .register_type_with_name::<crate::mesh::TriMesh>("Solid");
+        .register_type_with_name::<crate::mesh::TriMesh>("Solid")
+        .register_type_with_name::<crate::worm::WormSizes>("Worm");
 }
 
 /// A group of the script API: its heading and what it registers.
@@ -209,7 +211,7 @@ struct Group {
 }
 
 /// The script API, group by group, as the reference lists it.
-const API: [Group; 10] = [
+const API: [Group; 11] = [
     Group {
         title: "Numbers (`Floats`)",
         register: |e, _| {
@@ -246,6 +248,12 @@ const API: [Group; 10] = [
         title: "Calibers: the groove, passes, the seed's pose (`Groove`, `SeedPose`)",
         register: |e, _| {
             e.register_global_module(rhai::exported_module!(bind_caliber::caliber_api).into());
+        },
+    },
+    Group {
+        title: "Worm threads: sizes, cutter, S1 and S2, passes (`Worm`)",
+        register: |e, _| {
+            e.register_global_module(rhai::exported_module!(bind_worm::worm_api).into());
         },
     },
     Group {
@@ -644,8 +652,9 @@ impl PartFamily for ScriptFamily {
     }
 
     /// `fn verify(p)`, if the script has it: `#{ profile, from, to,
-    /// tolerance }` (a body of revolution) or `#{ groove, psi,
-    /// tolerance, grid_theta, grid_per_step, patch_gap }` (a caliber).
+    /// tolerance }` (a body of revolution), `#{ groove, psi,
+    /// tolerance, grid_theta, grid_per_step, patch_gap }` (a caliber) or
+    /// `#{ worm, length, space_centre, tolerance }` (a worm thread).
     fn verification(&self, values: &Params) -> Result<Option<Verification>, FamilyError> {
         if !self.has_fn("verify", 1) {
             return Ok(None);
@@ -653,11 +662,42 @@ impl PartFamily for ScriptFamily {
         let d = self.call_with_params("verify", values)?;
         let shape = || {
             self.contract(
-                "fn verify(p) must return #{ profile, from, to, tolerance } or #{ groove, psi, tolerance, grid_theta, grid_per_step, patch_gap }".into(),
+                "fn verify(p) must return #{ profile, from, to, tolerance }, #{ groove, psi, tolerance, grid_theta, grid_per_step, patch_gap } or #{ worm, length, space_centre, tolerance: #{ form, thickness, diameter, position, flank_angle_deg } }".into(),
             )
         };
         let m = d.try_cast::<Map>().ok_or_else(shape)?;
         let num = |k: &str| m.get(k).and_then(floats::number).ok_or_else(shape);
+        if let Some(w) = m.get("worm") {
+            let sizes = w
+                .clone()
+                .try_cast::<crate::worm::WormSizes>()
+                .ok_or_else(shape)?;
+            let t = m
+                .get("tolerance")
+                .and_then(|t| t.clone().try_cast::<Map>())
+                .ok_or_else(shape)?;
+            let tnum = |k: &str| {
+                t.get(k).and_then(floats::number).ok_or_else(|| {
+                    self.contract(format!(
+                        "fn verify(p): tolerance.{k} must be a number (tolerance: form, thickness, diameter, position, flank_angle_deg)"
+                    ))
+                })
+            };
+            return Ok(Some(Verification::Worm(Box::new(
+                crate::worm::WormRequest {
+                    sizes,
+                    length: num("length")?,
+                    space_centre: num("space_centre")?,
+                    tolerances: crate::worm::WormTolerances {
+                        form: tnum("form")?,
+                        thickness: tnum("thickness")?,
+                        diameter: tnum("diameter")?,
+                        position: tnum("position")?,
+                        flank_angle: tnum("flank_angle_deg")?.to_radians(),
+                    },
+                },
+            ))));
+        }
         if let Some(g) = m.get("groove") {
             let groove = g
                 .clone()

@@ -264,9 +264,13 @@ pub fn simulate(
         let name = || block_name(&written, i);
         let ((r0, z0), (r1, z1e)) = (at(i - 1), at(i));
         let Motion::Thread { lead: l, start_deg } = b.motion else {
-            // Any other move must keep clear of the blank.
+            // Any other move must keep clear of the blank, but for the
+            // retract straight out of the groove a thread block just cut.
             let low = r0.min(r1);
-            if low < r_a - 1e-9 {
+            let out_of_groove = matches!(written.blocks[i - 1].motion, Motion::Thread { .. })
+                && z0 == z1e
+                && r1 >= r0;
+            if low < r_a - 1e-9 && !out_of_groove {
                 let half = cutter.width_at(r_a - low) / 2.0;
                 let (lo, hi) = (z0.min(z1e), z0.max(z1e));
                 if hi > -req.length - half && lo < half {
@@ -480,7 +484,9 @@ fn measure(
             left_form,
             right_form,
             root_diameter: 2.0 * vertical_top(m, c).unwrap_or(0.0),
-            tip_diameter: 2.0 * vertical_top(m, c + px / 2.0).unwrap_or(0.0),
+            // The thread's middle (the last start's at the window's end:
+            // 1 um inside it).
+            tip_diameter: 2.0 * vertical_top(m, c + px / 2.0 - 1e-3).unwrap_or(0.0),
         };
         let s = k + 1;
         let alpha = w.alpha.to_degrees();

@@ -1,0 +1,254 @@
+//! Worm threads for scripts (MATH §4): the worm's sizes, the thread
+//! cutter, the acceleration and deceleration lengths, the plan of passes.
+//! Angles are degrees here (as a process sheet gives them); lengths mm.
+
+use super::floats::{kernel, number, Floats};
+use crate::math::Real;
+use crate::tool::{Tool, ToolShape};
+use crate::worm::{self, FlankOrder, PlanSettings, ThreadCutter, WormSizes};
+use rhai::plugin::*;
+use rhai::{Array, EvalAltResult, Map};
+
+fn cutter_of(tool: &Tool) -> Result<ThreadCutter, Box<EvalAltResult>> {
+    match tool.shape {
+        ToolShape::ThreadCutter(c) => Ok(c),
+        _ => Err(format!("tool '{}' is not a thread cutter", tool.name).into()),
+    }
+}
+
+/// The worm's sizes, the cutter, S1 and S2, the plan.
+#[export_module]
+pub mod worm_api {
+    use super::*;
+
+    /// A cylindrical ZA worm: module `m`, `z1` starts, pitch diameter
+    /// `d1`, clearance factor `c` (c*), profile half-angle `alpha_deg`,
+    /// thread thickness at the pitch line `s_a1` (0: half the axial pitch).
+    #[rhai_fn(return_raw)]
+    pub fn worm(
+        m: Real,
+        z1: i64,
+        d1: Real,
+        c: Real,
+        alpha_deg: Real,
+        s_a1: Real,
+    ) -> Result<WormSizes, Box<EvalAltResult>> {
+        kernel(WormSizes::new(
+            m,
+            z1,
+            d1,
+            c,
+            alpha_deg.to_radians(),
+            (s_a1 != 0.0).then_some(s_a1),
+        ))
+    }
+
+    /// Axial pitch `p_x = pi m` (mm).
+    #[rhai_fn(get = "axial_pitch", pure)]
+    pub fn axial_pitch(w: &mut WormSizes) -> Real {
+        w.axial_pitch()
+    }
+    /// Lead `P_z = z1 p_x` (mm).
+    #[rhai_fn(get = "lead", pure)]
+    pub fn lead(w: &mut WormSizes) -> Real {
+        w.lead()
+    }
+    /// Number of starts.
+    #[rhai_fn(get = "starts", pure)]
+    pub fn starts(w: &mut WormSizes) -> i64 {
+        i64::from(w.starts)
+    }
+    /// Thread height `h1 = (2 + c*) m` (mm).
+    #[rhai_fn(get = "height", pure)]
+    pub fn height(w: &mut WormSizes) -> Real {
+        w.height()
+    }
+    /// Tip diameter `d_a1` (mm): the blank's.
+    #[rhai_fn(get = "tip_diameter", pure)]
+    pub fn tip_diameter(w: &mut WormSizes) -> Real {
+        w.tip_diameter()
+    }
+    /// Root diameter `d_f1` (mm).
+    #[rhai_fn(get = "root_diameter", pure)]
+    pub fn root_diameter(w: &mut WormSizes) -> Real {
+        w.root_diameter()
+    }
+    /// Thread thickness at the pitch line `S_a1` (mm).
+    #[rhai_fn(get = "thickness", pure)]
+    pub fn thickness(w: &mut WormSizes) -> Real {
+        w.thickness
+    }
+    /// The space's width at the root (mm): the widest cutter tip.
+    #[rhai_fn(get = "root_space", pure)]
+    pub fn root_space(w: &mut WormSizes) -> Real {
+        w.root_space()
+    }
+    /// The lead angle (deg).
+    #[rhai_fn(get = "lead_angle_deg", pure)]
+    pub fn lead_angle_deg(w: &mut WormSizes) -> Real {
+        w.lead_angle().to_degrees()
+    }
+    /// The profile half-angle (deg).
+    #[rhai_fn(get = "alpha_deg", pure)]
+    pub fn alpha_deg(w: &mut WormSizes) -> Real {
+        w.alpha.to_degrees()
+    }
+    /// One space's area in the axial section (mm^2).
+    #[rhai_fn(get = "space_area", pure)]
+    pub fn space_area(w: &mut WormSizes) -> Real {
+        w.space_area()
+    }
+
+    /// A thread cutter (tool `number`): tip width and nose radius (mm),
+    /// flank angles from the radial (deg), profile height (mm); tracked
+    /// at its tip's centre.
+    #[rhai_fn(return_raw)]
+    pub fn thread_cutter(
+        name: &str,
+        number: i64,
+        tip_width: Real,
+        nose_radius: Real,
+        left_deg: Real,
+        right_deg: Real,
+        height: Real,
+    ) -> Result<Tool, Box<EvalAltResult>> {
+        let c = kernel(ThreadCutter::new(
+            tip_width,
+            nose_radius,
+            left_deg.to_radians(),
+            right_deg.to_radians(),
+            height,
+        ))?;
+        let number = u32::try_from(number)
+            .map_err(|_| format!("thread_cutter: tool number {number} is not 0 or more"))?;
+        Ok(Tool::thread_cutter(name, number, c))
+    }
+
+    /// The cutter's width at `r` above its tip (mm).
+    #[rhai_fn(return_raw)]
+    pub fn cutter_width(tool: Tool, r: Real) -> Result<Real, Box<EvalAltResult>> {
+        Ok(cutter_of(&tool)?.width_at(r))
+    }
+
+    /// The universal cutter's axial offset to each flank, `a_1z` (mm).
+    #[rhai_fn(pure, return_raw)]
+    pub fn axial_offset(w: &mut WormSizes, tool: Tool) -> Result<Real, Box<EvalAltResult>> {
+        Ok(worm::axial_offset(w, &cutter_of(&tool)?))
+    }
+
+    /// The approach S1 = T V (-1 - ln a + a) (mm): servo time constant
+    /// `t` (s), feed velocity `v` (mm/s), lead error ratio `a`.
+    pub fn approach_length(t: Real, v: Real, a: Real) -> Real {
+        worm::approach_length(t, v, a)
+    }
+    /// The run-out S2 = T V (mm).
+    pub fn runout_length(t: Real, v: Real) -> Real {
+        worm::runout_length(t, v)
+    }
+    /// The lead error ratio at the thread's start with an approach of
+    /// `length` mm.
+    pub fn approach_error(t: Real, v: Real, length: Real) -> Real {
+        worm::approach_error(t, v, length)
+    }
+    /// The lead error ratio at the thread's end with a run-out of
+    /// `length` mm.
+    pub fn runout_error(t: Real, v: Real, length: Real) -> Real {
+        worm::runout_error(t, v, length)
+    }
+
+    /// The passes, in the order cut, for `tool` (a thread cutter), with
+    /// `settings`: `roughing_passes` (0: the rational number), `min_depth`,
+    /// `finish_depth`, `finish_passes`, `order` ("alternating", "left",
+    /// "right", "radial"), `axial_step`, `by_depth` (every start at each
+    /// depth before the next). Columns: `kind` ("rough", "finish",
+    /// "side"), `start` (from 0), `depth`, `cumulative`, `offset`, `flank`
+    /// (-1 left, 0 radial, 1 right), `planned_area`.
+    #[rhai_fn(pure, return_raw)]
+    pub fn plan(w: &mut WormSizes, tool: Tool, settings: Map) -> Result<Map, Box<EvalAltResult>> {
+        const KEYS: [&str; 7] = [
+            "roughing_passes",
+            "min_depth",
+            "finish_depth",
+            "finish_passes",
+            "order",
+            "axial_step",
+            "by_depth",
+        ];
+        if let Some(k) = settings.keys().find(|k| !KEYS.contains(&k.as_str())) {
+            return Err(format!(
+                "plan: unknown setting '{k}' (settings: {})",
+                KEYS.join(", ")
+            )
+            .into());
+        }
+        let num = |k: &str| -> Result<Real, Box<EvalAltResult>> {
+            settings
+                .get(k)
+                .and_then(number)
+                .ok_or_else(|| format!("plan: '{k}' must be a number").into())
+        };
+        let count = |k: &str| -> Result<usize, Box<EvalAltResult>> {
+            let v = num(k)?;
+            if !(0.0..=worm::MAX_PASSES as Real).contains(&v) || v.fract() != 0.0 {
+                return Err(format!(
+                    "plan: {k} = {v} must be a whole number from 0 to {}",
+                    worm::MAX_PASSES
+                )
+                .into());
+            }
+            Ok(v as usize)
+        };
+        let order = settings
+            .get("order")
+            .and_then(|d| d.clone().into_string().ok())
+            .ok_or("plan: 'order' must be a string")?;
+        let by_depth = settings
+            .get("by_depth")
+            .and_then(|d| d.as_bool().ok())
+            .ok_or("plan: 'by_depth' must be true or false")?;
+        let n = count("roughing_passes")?;
+        let s = PlanSettings {
+            roughing_passes: (n > 0).then_some(n),
+            min_depth: num("min_depth")?,
+            finish_depth: num("finish_depth")?,
+            finish_passes: count("finish_passes")?,
+            order: FlankOrder::parse(&order).map_err(|e| format!("plan: {e}"))?,
+            axial_step: num("axial_step")?,
+            starts_by_depth: by_depth,
+        };
+        let passes = kernel(worm::plan(w, &cutter_of(&tool)?, &s))?;
+        let col = |f: &dyn Fn(&worm::PlannedPass) -> Real| {
+            Dynamic::from(Floats::new(passes.iter().map(f).collect()))
+        };
+        let mut m = Map::new();
+        m.insert(
+            "kind".into(),
+            Dynamic::from(
+                passes
+                    .iter()
+                    .map(|p| {
+                        Dynamic::from(match p.kind {
+                            worm::PassKind::Rough => "rough",
+                            worm::PassKind::Finish => "finish",
+                            worm::PassKind::Side => "side",
+                        })
+                    })
+                    .collect::<Array>(),
+            ),
+        );
+        m.insert("start".into(), col(&|p| Real::from(p.start)));
+        m.insert("depth".into(), col(&|p| p.depth));
+        m.insert("cumulative".into(), col(&|p| p.cumulative));
+        m.insert("offset".into(), col(&|p| p.offset));
+        m.insert(
+            "flank".into(),
+            col(&|p| match p.flank {
+                worm::Flank::Left => -1.0,
+                worm::Flank::Radial => 0.0,
+                worm::Flank::Right => 1.0,
+            }),
+        );
+        m.insert("planned_area".into(), col(&|p| p.planned_area));
+        Ok(m)
+    }
+}

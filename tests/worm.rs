@@ -1,0 +1,420 @@
+//! The worm job end to end (issue 13): the default two-start worm and a
+//! three-start one simulated pass by pass from `program.nc` as a control
+//! reads it, a corrupted pass named by the simulation, the LinuxCNC
+//! program read by LinuxCNC's own interpreter, and bad input refused with
+//! no output.
+
+mod common;
+
+use common::{pilgrim, s, scratch};
+use pilgrim_kernel::plugin::PluginMachine;
+use pilgrim_kernel::program::{AxisProgram, Block, ProgramAxis};
+use pilgrim_kernel::tool::{Tool, ToolShape};
+use pilgrim_kernel::worm::{simulate, WormCheck, WormRequest, WormSizes, WormTolerances};
+use pilgrim_kernel::Motion;
+use std::path::Path;
+
+const SCRIPT: &str = "scripts/worm.rhai";
+
+fn lathe() -> PluginMachine {
+    PluginMachine::from_entry(
+        "fanuc-0i-tc",
+        "pilgrim_plugin_fanuc_0i_tc",
+        fanuc_0i_tc::pilgrim_plugin_fanuc_0i_tc,
+    )
+    .unwrap()
+}
+
+fn report(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap()
+}
+
+/// The value of address `a` in a block's words (`X12.5`).
+fn word(code: &str, a: char) -> Option<f64> {
+    code.split_whitespace()
+        .find(|w| w.starts_with(a) && w[1..].parse::<f64>().is_ok())
+        .map(|w| w[1..].parse().unwrap())
+}
+
+/// A Fanuc program (`program.nc`) read as the control reads it, from the
+/// first pass on: modal G00/G01/G32, X, Z and F; Q (0.001 deg) for its
+/// block only; each pass's comment on its first block.
+fn read_nc(nc: &str, rpm: f64) -> AxisProgram {
+    let (mut g, mut x, mut z, mut f) = (0, f64::NAN, f64::NAN, 0.0);
+    let mut comment: Option<String> = None;
+    let mut in_passes = false;
+    let mut blocks = Vec::new();
+    for line in nc.lines() {
+        let (code, note) = match line.split_once('(') {
+            Some((c, n)) => (c, Some(n.trim_end_matches(')').to_owned())),
+            None => (line, None),
+        };
+        if let Some(n) = note {
+            if n.starts_with("PASS ") {
+                in_passes = true;
+                comment = Some(n.to_lowercase());
+            } else if n == "END" {
+                in_passes = false;
+            }
+        }
+        for w in code.split_whitespace() {
+            match w {
+                "G00" => g = 0,
+                "G01" => g = 1,
+                "G32" => g = 32,
+                _ => {}
+            }
+        }
+        let (nx, nz) = (word(code, 'X'), word(code, 'Z'));
+        x = nx.unwrap_or(x);
+        z = nz.unwrap_or(z);
+        f = word(code, 'F').unwrap_or(f);
+        if !in_passes || (nx.is_none() && nz.is_none()) {
+            continue;
+        }
+        let motion = match g {
+            0 => Motion::Rapid,
+            1 => Motion::Linear,
+            _ => Motion::Thread {
+                lead: f,
+                start_deg: word(code, 'Q').unwrap_or(0.0) / 1000.0,
+            },
+        };
+        blocks.push(Block {
+            motion,
+            values: vec![x, z],
+            feed: if g == 32 { f * rpm } else { f },
+            spindle: None,
+            comment: comment.take(),
+            keep: vec![],
+        });
+    }
+    let axis = |n: &str| ProgramAxis {
+        name: n.into(),
+        unit: "mm".into(),
+    };
+    AxisProgram {
+        name: "WORM".into(),
+        number: 0,
+        machine: "fanuc-0i-tc".into(),
+        control: "fanuc".into(),
+        tool_number: 1,
+        tool_name: "thread cutter".into(),
+        spindle_rpm: rpm,
+        decimals: None,
+        axes: vec![axis("X"), axis("Z")],
+        blocks,
+        setup: Default::default(),
+    }
+}
+
+/// The run's cutter, as its toolpath.json says.
+fn cutter(dir: &Path) -> pilgrim_kernel::worm::ThreadCutter {
+    let tp: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("toolpath.json")).unwrap()).unwrap();
+    let tool: Tool = serde_json::from_value(tp["tool"].clone()).unwrap();
+    match tool.shape {
+        ToolShape::ThreadCutter(c) => c,
+        other => panic!("not a thread cutter: {other:?}"),
+    }
+}
+
+/// The run in `dir` simulated again from its `program.nc`.
+fn simulate_nc(
+    dir: &Path,
+    nc: &str,
+    m: f64,
+    z1: i64,
+    d1: f64,
+    b1: f64,
+) -> Result<WormCheck, String> {
+    let r = report(dir);
+    let rpm = r["parameters"]["spindle"]["value"].as_f64().unwrap();
+    let program = read_nc(nc, rpm);
+    let req = WormRequest {
+        sizes: WormSizes::new(m, z1, d1, 0.2, 20f64.to_radians(), None).unwrap(),
+        length: b1,
+        space_centre: r["notes"]["space_centre_mm"].as_f64().unwrap(),
+        tolerances: WormTolerances {
+            form: 0.01,
+            thickness: 0.02,
+            diameter: 0.02,
+            position: 0.01,
+            flank_angle: 0.05f64.to_radians(),
+        },
+    };
+    simulate(&program, &lathe(), &Default::default(), &cutter(dir), &req).map_err(|e| e.to_string())
+}
+
+/// The simulation read back from the program: every chip summed is the
+/// thread spaces' area (less the root's fillets the nose radius leaves);
+/// the profile within its tolerances at every start; alternating flanks
+/// share the load.
+fn holds(check: &WormCheck, z1: usize, nose: f64) {
+    // Each space keeps at most two fillets of r^2 (tan(phi/2) - phi/2),
+    // phi = 70 deg, where the nose radius turns the root's corners (the
+    // last roughing passes on the flanks take part of them).
+    let phi = 70f64.to_radians();
+    let fillets = 2.0 * z1 as f64 * nose * nose * ((phi / 2.0).tan() - phi / 2.0);
+    let left = check.space_area - check.removed_area;
+    assert!(
+        left > 0.0 && left <= fillets + 1e-9,
+        "space {} mm^2, removed {} mm^2: {left} left, fillets {fillets}",
+        check.space_area,
+        check.removed_area
+    );
+    assert_eq!(check.starts.len(), z1);
+    for s in &check.starts {
+        assert!(
+            s.left_form.abs() < 0.002 && s.right_form.abs() < 0.002,
+            "{s:?}"
+        );
+        assert!(
+            (s.left_angle_deg - 20.0).abs() < 0.01 && (s.right_angle_deg - 20.0).abs() < 0.01,
+            "{s:?}"
+        );
+        assert!(s.position_error.abs() < 0.001, "{s:?}");
+    }
+    let [l, r] = check.flank_loads;
+    assert!(l / r > 0.9 && l / r < 1.1, "left {l} mm^2, right {r} mm^2");
+}
+
+#[test]
+fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
+    let dir = scratch("worm", "default");
+    let out = dir.join("out");
+    let (code, stdout, err) = pilgrim(&["run", SCRIPT, "--out", s(&out)]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("thread within tolerance"), "{stdout}");
+    let nc = std::fs::read_to_string(out.join("program.nc")).unwrap();
+    // The block to paste after the tool call: G97 before any thread, G32
+    // with F the lead, the second start by the spindle's start angle.
+    assert!(!nc.contains("O0") && !nc.contains("T0101"), "{nc}");
+    let g97 = nc.find("G97").unwrap();
+    assert!(g97 < nc.find("G32").unwrap());
+    assert!(
+        nc.contains("G32 Z-68.431 F31.4159\n") && nc.contains("Q180000"),
+        "{nc}"
+    );
+    assert!(nc.trim_end().ends_with("M30"), "{nc}");
+    let check = simulate_nc(&out, &nc, 5.0, 2, 50.0, 60.0).unwrap();
+    holds(&check, 2, 0.3);
+    // The run's own simulation says the same.
+    let r = report(&out);
+    let w = &r["worm_verification"];
+    assert_eq!(w["passes"].as_array().unwrap().len(), check.passes.len());
+    assert!((w["removed_area"].as_f64().unwrap() - check.removed_area).abs() < 1e-6);
+    // S1 and S2 are the minimums of Fanuc's exact form at 100 rpm.
+    let v = 31.415_926_5 * 100.0 / 60.0;
+    let s1 = r["notes"]["s1_mm"].as_f64().unwrap();
+    assert!(
+        (s1 - 0.033 * v * (-1.0 - 0.01f64.ln() + 0.01)).abs() < 1e-6,
+        "{s1}"
+    );
+    // Every pass's planned and simulated areas in passes.csv; the law's
+    // equal areas are not what a flat-tipped cutter cuts.
+    let csv = std::fs::read_to_string(out.join("passes.csv")).unwrap();
+    assert_eq!(csv.lines().count(), check.passes.len() + 1);
+    assert!(
+        csv.starts_with("block,name,start,x_mm,offset_mm,chip_area_mm2"),
+        "{csv}"
+    );
+    for f in [
+        "passes.svg",
+        "chip_area.svg",
+        "worm.stl",
+        "cutter.stl",
+        "scene.glb",
+    ] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+    common::leave_for_checkers(&out, "worm");
+}
+
+#[test]
+fn a_three_start_worm_cut_each_start_completely_holds_its_profile() {
+    let dir = scratch("worm", "three");
+    let out = dir.join("out");
+    let (code, _, err) = pilgrim(&[
+        "run",
+        SCRIPT,
+        "--out",
+        s(&out),
+        "--set",
+        "z1=3",
+        "--set",
+        "m=4",
+        "--set",
+        "d1=60",
+        "--set",
+        "starts_by_depth=false",
+        "--set",
+        "b1=40",
+        "--set",
+        "spindle=60",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let nc = std::fs::read_to_string(out.join("program.nc")).unwrap();
+    assert!(nc.contains("Q120000") && nc.contains("Q240000"), "{nc}");
+    let check = simulate_nc(&out, &nc, 4.0, 3, 60.0, 40.0).unwrap();
+    holds(&check, 3, 0.3);
+    // Each start completely: the first third of the passes cut start 1.
+    let third = check.passes.len() / 3;
+    assert!(check.passes[..third].iter().all(|p| p.start == 0));
+    assert!(check.passes[2 * third..].iter().all(|p| p.start == 2));
+}
+
+/// One pass 0.2 mm deeper on diameter in the program: the simulation
+/// names it.
+#[test]
+fn a_corrupted_pass_is_named() {
+    let dir = scratch("worm", "corrupt");
+    let out = dir.join("out");
+    let (code, _, err) = pilgrim(&["run", SCRIPT, "--out", s(&out), "--quiet"]);
+    assert_eq!(code, 0, "{err}");
+    let nc = std::fs::read_to_string(out.join("program.nc")).unwrap();
+    let lines: Vec<&str> = nc.lines().collect();
+    let at = lines
+        .iter()
+        .position(|l| l.starts_with("(PASS 60,"))
+        .unwrap();
+    // The pass's infeed: its block that brings X in to depth (before G32).
+    let g32 = at
+        + lines[at..]
+            .iter()
+            .position(|l| l.starts_with("G32"))
+            .unwrap();
+    let infeed = g32 - 1;
+    let x = word(lines[infeed], 'X').unwrap();
+    let mut bad: Vec<String> = lines.iter().map(|l| (*l).to_owned()).collect();
+    bad[infeed] = format!("X{:.3}", x - 0.2);
+    let e = simulate_nc(&out, &(bad.join("\n") + "\n"), 5.0, 2, 50.0, 60.0).unwrap_err();
+    assert!(
+        e.contains("\"pass 60, start") && e.contains("beyond the nominal thread space"),
+        "{e}"
+    );
+}
+
+/// LinuxCNC's own interpreter reads the LinuxCNC program with no error,
+/// and every synchronised move has the lead and the place the axis
+/// program says.
+#[test]
+fn linuxcnc_reads_the_program_and_its_moves_match() {
+    let dir = scratch("worm", "linuxcnc");
+    let out = dir.join("out");
+    let (code, _, err) = pilgrim(&[
+        "run",
+        SCRIPT,
+        "--out",
+        s(&out),
+        "--quiet",
+        "--set",
+        "start_shift=z",
+        "--post",
+        "linuxcnc",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let canon = dir.join("canon.txt");
+    let run = std::process::Command::new("rs274")
+        .arg("-g")
+        .arg(out.join("program.ngc"))
+        .arg(&canon)
+        .stdin(std::process::Stdio::null())
+        .output()
+        .expect("rs274 (Debian linuxcnc-uspace; .ci/run installs it) must be on PATH");
+    let said = format!(
+        "{}{}",
+        String::from_utf8_lossy(&run.stdout),
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(
+        said.lines()
+            .all(|l| l.trim().is_empty() || l.trim() == "executing"),
+        "rs274 said: {said}"
+    );
+    let canon = std::fs::read_to_string(&canon).unwrap();
+    assert!(canon.contains("PROGRAM_END()"), "{canon}");
+    let program: AxisProgram =
+        serde_json::from_str(&std::fs::read_to_string(out.join("program.json")).unwrap()).unwrap();
+    let threads: Vec<&Block> = program
+        .blocks
+        .iter()
+        .filter(|b| matches!(b.motion, Motion::Thread { .. }))
+        .collect();
+    // Each START_SPEED_FEED_SYNC(lead, ...) then the move STRAIGHT_FEED(x, y, z, ...).
+    let lines: Vec<&str> = canon.lines().collect();
+    let args = |l: &str| -> Vec<f64> {
+        let inner = &l[l.find('(').unwrap() + 1..l.rfind(')').unwrap()];
+        inner
+            .split(',')
+            .map(|v| v.trim().parse().unwrap())
+            .collect()
+    };
+    let mut synced = 0;
+    for (k, l) in lines.iter().enumerate() {
+        if !l.contains("START_SPEED_FEED_SYNC(") {
+            continue;
+        }
+        let lead = args(l)[0];
+        let mv = args(lines[k + 1]);
+        assert!(lines[k + 1].contains("STRAIGHT_FEED("), "{}", lines[k + 1]);
+        let b = threads[synced];
+        let want = match b.motion {
+            Motion::Thread { lead, .. } => lead,
+            _ => f64::NAN,
+        };
+        assert!((lead - want).abs() < 1e-4, "lead {lead} vs {want}");
+        // X on diameter in the program, the radius in canonical form.
+        assert!(
+            (mv[0] - b.values[0] / 2.0).abs() < 1e-3,
+            "{mv:?} vs {:?}",
+            b.values
+        );
+        assert!(
+            (mv[2] - b.values[1]).abs() < 1e-3,
+            "{mv:?} vs {:?}",
+            b.values
+        );
+        synced += 1;
+    }
+    assert_eq!(synced, threads.len());
+    assert!(synced > 50, "{synced}");
+}
+
+/// Bad input: each a clear message, and no output for the errors; S1
+/// below its minimum a warning naming the lead error.
+#[test]
+fn bad_input_is_refused_with_no_output() {
+    let dir = scratch("worm", "bad");
+    for (set, says) in [
+        ("z1=0", "z1"),
+        ("m=-1", "m"),
+        ("tip_width=5", "the cutter's tip fits the space at the root"),
+        ("a_min=20", "a_min"),
+        ("spindle=400", "a thread of lead 31.41"),
+    ] {
+        let out = dir.join(set.replace('=', "_"));
+        let (code, _, err) = pilgrim(&["run", SCRIPT, "--out", s(&out), "--quiet", "--set", set]);
+        assert_ne!(code, 0, "{set}");
+        assert!(err.contains(says), "{set}: {err}");
+        assert!(!out.exists(), "{set}: output written");
+    }
+    assert!(pilgrim(&[
+        "run",
+        SCRIPT,
+        "--out",
+        s(&dir.join("x")),
+        "--quiet",
+        "--set",
+        "spindle=400"
+    ])
+    .2
+    .contains("needs axis Z at 12566.4 mm/min, above its maximum 10000 mm/min"));
+    let out = dir.join("short_s1");
+    let (code, stdout, err) = pilgrim(&["run", SCRIPT, "--out", s(&out), "--set", "s1=5"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        stdout.contains("warning: S1 = 5.000 mm is below its minimum 6.247 mm: the lead is"),
+        "{stdout}"
+    );
+}
