@@ -327,4 +327,22 @@ fn caliber_grinders_load_as_compiled_in() {
         compiled.inverse(&poses, &tool, &mut b).unwrap();
         assert_eq!(a, b, "{lib}");
     }
+    // The lathe: poses in the axial section.
+    let loaded = PluginMachine::load(common::shared_lib("fanuc_0i_tc")).unwrap();
+    let compiled = PluginMachine::from_entry(
+        "fanuc-0i-tc",
+        "pilgrim_plugin_fanuc_0i_tc",
+        fanuc_0i_tc::pilgrim_plugin_fanuc_0i_tc,
+    )
+    .unwrap();
+    assert_eq!(loaded.info(), compiled.info());
+    let tool = ToolFrame::default();
+    let poses: Vec<f64> = (0..20)
+        .flat_map(|i| [20.0 + i as f64, 0.0, 5.0 - 4.0 * i as f64, 0.0, 0.0, 1.0])
+        .collect();
+    let (mut a, mut b) = (vec![], vec![]);
+    loaded.inverse(&poses, &tool, &mut a).unwrap();
+    compiled.inverse(&poses, &tool, &mut b).unwrap();
+    assert_eq!(a, b, "fanuc_0i_tc");
+    assert_eq!(a[0], 40.0);
 }

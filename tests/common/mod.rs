@@ -33,6 +33,8 @@ pub fn shared_lib(name: &str) -> PathBuf {
             "pilgrim-lz-250",
             "-p",
             "pilgrim-mannesmann",
+            "-p",
+            "pilgrim-fanuc-0i-tc",
         ])
         .current_dir(env!("CARGO_MANIFEST_DIR"));
         if dir.file_name().is_some_and(|n| n == "release") {
@@ -170,6 +172,7 @@ pub fn leave_for_checkers(dir: &Path, tag: &str) {
     for f in [
         "part.stl",
         "caliber.stl",
+        "worm.stl",
         "blank.stl",
         "cutter.stl",
         "wheel.stl",
@@ -179,5 +182,22 @@ pub fn leave_for_checkers(dir: &Path, tag: &str) {
         if dir.join(f).exists() {
             std::fs::copy(dir.join(f), check.join(format!("{tag}-{f}"))).unwrap();
         }
+    }
+}
+
+/// Leaves a run's LinuxCNC program and its axis program for `.ci/run`'s
+/// check with LinuxCNC's own `rs274` interpreter (`.ci/rs274_check.py`).
+#[allow(dead_code)]
+pub fn leave_for_rs274(dir: &Path, tag: &str) {
+    let exe = std::env::current_exe().unwrap();
+    let check = exe
+        .ancestors()
+        .nth(3)
+        .unwrap()
+        .join("linuxcnc-check")
+        .join(tag);
+    std::fs::create_dir_all(&check).unwrap();
+    for f in ["program.ngc", "program.json"] {
+        std::fs::copy(dir.join(f), check.join(f)).unwrap();
     }
 }

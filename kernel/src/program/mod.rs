@@ -116,7 +116,7 @@ pub enum ProgramError {
     },
     /// A thread block whose lead times the spindle's speed is beyond the
     /// feed of the axis that carries it.
-    #[error("{block}: a thread of lead {lead} mm at {rpm} rpm needs axis {axis} at {speed:.1} mm/min, above its maximum {max} mm/min: lower the spindle speed")]
+    #[error("{block}: a thread of lead {lead:.4} mm at {rpm} rpm needs axis {axis} at {speed:.1} mm/min, above its maximum {max} mm/min: lower the spindle speed")]
     ThreadTooFast {
         /// The block, as the program names it.
         block: String,

@@ -14,9 +14,10 @@ pub const MAX_PASSES: usize = 20_000;
 
 /// The cumulative depths of the roughing passes (mm, increasing, the last
 /// `h_r`): the law `D_i = h_r sqrt(i / n)` (equal chip areas for a sharp V
-/// tool), each pass at least `a_min` deep. A pass the law makes thinner is
-/// raised to `a_min` and the passes go on until `h_r` is reached; a pass
-/// after which less than `a_min` would remain takes the rest. With `n` of
+/// tool). A pass the law makes thinner than `a_min` is raised to `a_min`
+/// and the passes go on until `h_r` is reached; the last pass is what
+/// remains, no deeper than `a_min` once the raising began (the seed's
+/// condition; it may be thinner). With `n` of
 /// `None` the seed's rational number of passes: the least `n` whose law
 /// makes the last pass no deeper than `a_min`.
 ///
@@ -50,7 +51,11 @@ pub fn roughing_depths(h_r: Real, n: Option<usize>, a_min: Real) -> Result<Vec<R
     let mut i = 1;
     while d < h_r {
         let a = law(i).max(a_min);
-        d = if h_r - (d + a) < a_min { h_r } else { d + a };
+        d = (d + a).min(h_r);
+        // Within rounding of the depth: the depth.
+        if h_r - d < 1e-9 {
+            d = h_r;
+        }
         out.push(d);
         i += 1;
     }
@@ -320,7 +325,10 @@ mod tests {
         let cuts: Vec<f64> = std::iter::once(d[0])
             .chain(d.windows(2).map(|w| w[1] - w[0]))
             .collect();
-        assert!(cuts.iter().all(|a| *a >= a_min - 1e-12), "{cuts:?}");
+        let (last, before) = cuts.split_last().unwrap();
+        assert!(before.iter().all(|a| *a >= a_min - 1e-12), "{cuts:?}");
+        // The seed's condition: the last pass no deeper than a_min.
+        assert!(*last > 0.0 && *last <= a_min + 1e-12, "{last}");
         assert_eq!(*d.last().unwrap(), h);
         // Fewer passes than n: the thin ones were raised.
         assert!(d.len() < n, "{}", d.len());

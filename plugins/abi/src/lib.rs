@@ -239,6 +239,46 @@ impl PluginError {
     }
 }
 
+/// Checks that pose `row` (point and axis, 6 values) keeps a machine that
+/// moves its tool in the part's axial section (the XZ plane through the
+/// tool's reference) with the tool's axis the part's (a cylindrical
+/// grinder, a lathe): y and the axis as the `tool` reference has them,
+/// within `tol`. `tool_name` names the tool in the message.
+///
+/// # Failures
+/// The point off the section, or the axis turned, named by row.
+pub fn check_axial_section(
+    row: usize,
+    pose: &[f64],
+    tool: &[f64; 6],
+    tol: f64,
+    tool_name: &str,
+) -> Result<(), PluginError> {
+    if (pose[1] - tool[1]).abs() > tol {
+        return Err(PluginError::at(
+            row,
+            format!(
+                "the point is {:.6} mm off the axial section the {tool_name} moves in (y must be {})",
+                pose[1] - tool[1],
+                tool[1]
+            ),
+        ));
+    }
+    let tilt =
+        ((pose[3] - tool[3]).powi(2) + (pose[4] - tool[4]).powi(2) + (pose[5] - tool[5]).powi(2))
+            .sqrt();
+    if tilt > tol {
+        return Err(PluginError::at(
+            row,
+            format!(
+                "the {tool_name}'s axis ({:.6}, {:.6}, {:.6}) must stay parallel to the part's ({}, {}, {})",
+                pose[3], pose[4], pose[5], tool[3], tool[4], tool[5]
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// What a Rust plugin implements; [`export_plugin!`] makes the C entry
 /// points from it. Slices are the batches described at [`InverseFn`] and
 /// [`ForwardFn`], already checked for length against the descriptor's

@@ -22,7 +22,7 @@
 use pilgrim_plugin_abi::types::{
     Axis, AxisKind, FactorKind, FactorSpec, MachineInfo, Plane, ProgramSetup, Radial, ToolSpec,
 };
-use pilgrim_plugin_abi::{export_plugin, Plugin, PluginError};
+use pilgrim_plugin_abi::{check_axial_section, export_plugin, Plugin, PluginError};
 
 /// How far off the axial section (y) or off the part's axis direction a
 /// pose may be and still be the lathe's.
@@ -123,28 +123,7 @@ impl Plugin for Lathe {
             .zip(out.chunks_exact_mut(2))
             .enumerate()
         {
-            if (p[1] - tool[1]).abs() > POSE_TOL {
-                return Err(PluginError::at(
-                    i,
-                    format!(
-                        "the point is {:.6} mm off the axial section (y must be {})",
-                        p[1] - tool[1],
-                        tool[1]
-                    ),
-                ));
-            }
-            let tilt =
-                ((p[3] - tool[3]).powi(2) + (p[4] - tool[4]).powi(2) + (p[5] - tool[5]).powi(2))
-                    .sqrt();
-            if tilt > POSE_TOL {
-                return Err(PluginError::at(
-                    i,
-                    format!(
-                        "the tool's axis ({:.6}, {:.6}, {:.6}) must stay the part's ({}, {}, {}): a lathe does not swivel",
-                        p[3], p[4], p[5], tool[3], tool[4], tool[5]
-                    ),
-                ));
-            }
+            check_axial_section(i, p, tool, POSE_TOL, "tool")?;
             q[0] = 2.0 * (p[0] - tool[0]);
             q[1] = p[2] - tool[2];
         }

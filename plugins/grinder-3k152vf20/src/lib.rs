@@ -32,7 +32,7 @@ use pilgrim_plugin_abi::types::{
     Axis, AxisKind, BodyShape, BodySpec, FactorKind, FactorSpec, MachineInfo, Plane, ProgramSetup,
     Quantity, Radial, ToolSpec,
 };
-use pilgrim_plugin_abi::{export_plugin, Plugin, PluginError};
+use pilgrim_plugin_abi::{check_axial_section, export_plugin, Plugin, PluginError};
 
 /// How far off the axial section (y) or off the part's axis direction a
 /// pose may be and still be the grinder's.
@@ -174,28 +174,7 @@ impl Plugin for Grinder {
             .zip(out.chunks_exact_mut(2))
             .enumerate()
         {
-            if (p[1] - tool[1]).abs() > POSE_TOL {
-                return Err(PluginError::at(
-                    i,
-                    format!(
-                        "the point is {:.6} mm off the wheel's plane (y must be {})",
-                        p[1] - tool[1],
-                        tool[1]
-                    ),
-                ));
-            }
-            let tilt =
-                ((p[3] - tool[3]).powi(2) + (p[4] - tool[4]).powi(2) + (p[5] - tool[5]).powi(2))
-                    .sqrt();
-            if tilt > POSE_TOL {
-                return Err(PluginError::at(
-                    i,
-                    format!(
-                        "the wheel's axis ({:.6}, {:.6}, {:.6}) must stay parallel to the part's ({}, {}, {})",
-                        p[3], p[4], p[5], tool[3], tool[4], tool[5]
-                    ),
-                ));
-            }
+            check_axial_section(i, p, tool, POSE_TOL, "wheel")?;
             q[0] = p[2] - tool[2];
             q[1] = p[0] - tool[0];
         }
@@ -264,7 +243,11 @@ mod tests {
         bad[6 * 7 + 1] = 0.5;
         let e = g.inverse(&bad, &tool, &mut a).unwrap_err();
         assert_eq!(e.index, Some(7));
-        assert!(e.message.contains("off the wheel's plane"), "{e}");
+        assert!(
+            e.message
+                .contains("off the axial section the wheel moves in"),
+            "{e}"
+        );
     }
 
     /// The rest's chain: at Z + B along the axis, U from the axis on the far

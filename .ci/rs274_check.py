@@ -1,0 +1,84 @@
+"""LinuxCNC's own interpreter on every program the tests left.
+
+For each directory under the given root holding program.ngc and
+program.json (tests/common `leave_for_rs274`): `rs274 -g` reads the
+program; it must say nothing but "executing", its canonical output must
+end the program, and every spindle-synchronised move
+(START_SPEED_FEED_SYNC then STRAIGHT_FEED) must have the lead and the
+place (X as a radius: the program is on diameter, G7) of the axis
+program's thread blocks, in order, within the program's 0.001 mm.
+"""
+import json
+import pathlib
+import subprocess
+import sys
+import tempfile
+
+
+def args(line):
+    inner = line[line.index("(") + 1 : line.rindex(")")]
+    return [float(v) for v in inner.split(",")]
+
+
+def check(d):
+    program = json.loads((d / "program.json").read_text())
+    threads = [b for b in program["blocks"] if b["motion"]["type"] == "thread"]
+    with tempfile.TemporaryDirectory() as tmp:
+        canon_path = pathlib.Path(tmp) / "canon.txt"
+        run = subprocess.run(
+            ["rs274", "-g", str(d / "program.ngc"), str(canon_path)],
+            stdin=subprocess.DEVNULL,
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+        said = [l for l in (run.stdout + run.stderr).splitlines() if l.strip() not in ("", "executing")]
+        if said:
+            return f"rs274 said: {said[:5]}"
+        canon = canon_path.read_text().splitlines()
+    if not any("PROGRAM_END()" in l for l in canon):
+        return "no PROGRAM_END in the canonical output"
+    synced = 0
+    for k, line in enumerate(canon):
+        if "START_SPEED_FEED_SYNC(" not in line:
+            continue
+        if synced >= len(threads):
+            return f"more synchronised moves than thread blocks ({len(threads)})"
+        move = canon[k + 1]
+        if "STRAIGHT_FEED(" not in move:
+            return f"synchronised move is not a straight feed: {move}"
+        lead = args(line)[0]
+        x, _, z = args(move)[:3]
+        b = threads[synced]
+        want_lead = b["motion"]["lead"]
+        want_x, want_z = b["values"][0] / 2.0, b["values"][1]
+        if abs(lead - want_lead) > 1e-4 or abs(x - want_x) > 1e-3 or abs(z - want_z) > 1e-3:
+            return (
+                f"synchronised move {synced + 1}: lead {lead}, x {x}, z {z}; "
+                f"the axis program says lead {want_lead}, x {want_x}, z {want_z}"
+            )
+        synced += 1
+    if synced != len(threads):
+        return f"{synced} synchronised moves for {len(threads)} thread blocks"
+    return None
+
+
+def main():
+    root = pathlib.Path(sys.argv[1])
+    dirs = sorted(p.parent for p in root.glob("*/program.ngc"))
+    if not dirs:
+        print(f"rs274: no programs under {root}")
+        return 1
+    failed = 0
+    for d in dirs:
+        problem = check(d)
+        if problem:
+            failed += 1
+            print(f"FAIL  rs274 {d.name}: {problem}")
+        else:
+            print(f"ok    rs274 {d.name}: every synchronised move as the axis program says")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
