@@ -202,6 +202,26 @@ fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
     assert!(nc.trim_end().ends_with("M30"), "{nc}");
     let check = simulate_nc(&out, &nc, 5.0, 2, 50.0, 60.0).unwrap();
     holds(&check, 2, 5.0, 0.3);
+    // The finished worm's solid: closed, and its volume the section's swept
+    // along the helix, pi b1 / L * integral of r(u)^2 over a lead (for any
+    // length: every section across the axis meets a whole lead of it).
+    let solid = pilgrim_kernel::worm::worm_solid(&check, 60.0, 0.01).unwrap();
+    solid.check_closed().unwrap();
+    let (w0, lead) = check.window;
+    let n = 200_000;
+    let integral: f64 = (0..n)
+        .map(|i| check.radius_at(w0 + lead * (i as f64 + 0.5) / n as f64).powi(2))
+        .sum::<f64>()
+        * lead
+        / n as f64;
+    let want = std::f64::consts::PI * 60.0 / lead * integral;
+    assert!(
+        // The chords round the axis (within 0.01 mm of the tip circle:
+        // 122 of them) lose (2 pi / 122)^2 / 6 = 4.4e-4 of the area.
+        (solid.volume() - want).abs() < 1e-3 * want && solid.volume() < want,
+        "{} vs {want}",
+        solid.volume()
+    );
     // The run's own simulation says the same.
     let r = report(&out);
     let w = &r["worm_verification"];

@@ -4,11 +4,12 @@
 //! z = -length to 0, with flat ends.
 //!
 //! The rings are sections across the axis; a ring's points are `n` angles
-//! round the axis, the rings `lead / n` apart, so that the sweep's
+//! round the axis, the rings evenly spaced from -length to 0 as near
+//! `lead / n` apart as a whole number of them allows, so that the sweep's
 //! diagonals (ring j point k to ring j + 1 point k + 1) run along the
-//! helices and the profile is sampled every `lead / n` along it; `n` is
-//! set by the chordal tolerance at the tip. The end rings are at exactly 0
-//! and -length.
+//! helices (within a small fraction of the spacing) and the profile is
+//! sampled every `lead / n` along them; `n` is set by the chordal
+//! tolerance at the tip.
 
 use super::WormCheck;
 use crate::math::Real;
@@ -34,14 +35,13 @@ pub fn worm_solid(check: &WormCheck, length: Real, tol: Real) -> Result<TriMesh,
         .fold(0.0, Real::max);
     let step = 2.0 * (1.0 - (tol / r_tip).min(1.0)).acos();
     let n = ((TAU / step).ceil() as usize).clamp(24, MAX_AROUND);
-    let dz = lead / n as Real;
-    // Ring heights: multiples of dz down from 0, then -length.
-    let mut zs: Vec<Real> = (0..)
-        .map(|j| -(j as Real) * dz)
-        .take_while(|z| *z > -length + 1e-9)
+    // Rings evenly from -length to 0, as near lead / n apart as a whole
+    // number of them allows: each quad's diagonal then strays from its
+    // helix by at most a (2 rings)-th of a ring's spacing.
+    let rings_between = ((length * n as Real / lead).round() as usize).max(1);
+    let zs: Vec<Real> = (0..=rings_between)
+        .map(|j| -length + length * j as Real / rings_between as Real)
         .collect();
-    zs.push(-length);
-    zs.reverse();
     let rings: Vec<Vec<[Real; 3]>> = zs
         .iter()
         .map(|&z| {
