@@ -12,7 +12,7 @@ use pilgrim_kernel::program::{AxisProgram, Block, ProgramAxis};
 use pilgrim_kernel::tool::{Tool, ToolShape};
 use pilgrim_kernel::worm::{simulate, WormCheck, WormRequest, WormSizes, WormTolerances};
 use pilgrim_kernel::Motion;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 const SCRIPT: &str = "scripts/worm.rhai";
 
@@ -23,6 +23,19 @@ fn lathe() -> PluginMachine {
         fanuc_0i_tc::pilgrim_plugin_fanuc_0i_tc,
     )
     .unwrap()
+}
+
+/// The worm job run into a fresh `out` under a scratch directory called
+/// `name`, quietly, with `args` after it (`--set k=v`, `--post d`): the
+/// scratch directory and `out`, the run having succeeded.
+fn run_worm(name: &str, args: &[&str]) -> (PathBuf, PathBuf) {
+    let dir = scratch("worm", name);
+    let out = dir.join("out");
+    let mut all = vec!["run", SCRIPT, "--out", s(&out), "--quiet"];
+    all.extend(args);
+    let (code, _, err) = pilgrim(&all);
+    assert_eq!(code, 0, "{err}");
+    (dir, out)
 }
 
 fn report(dir: &Path) -> serde_json::Value {
@@ -210,7 +223,11 @@ fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
     let (w0, lead) = check.window;
     let n = 200_000;
     let integral: f64 = (0..n)
-        .map(|i| check.radius_at(w0 + lead * (i as f64 + 0.5) / n as f64).powi(2))
+        .map(|i| {
+            check
+                .radius_at(w0 + lead * (i as f64 + 0.5) / n as f64)
+                .powi(2)
+        })
         .sum::<f64>()
         * lead
         / n as f64;
@@ -256,27 +273,23 @@ fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
 
 #[test]
 fn a_three_start_worm_cut_each_start_completely_holds_its_profile() {
-    let dir = scratch("worm", "three");
-    let out = dir.join("out");
-    let (code, _, err) = pilgrim(&[
-        "run",
-        SCRIPT,
-        "--out",
-        s(&out),
-        "--set",
-        "z1=3",
-        "--set",
-        "m=4",
-        "--set",
-        "d1=60",
-        "--set",
-        "starts_by_depth=false",
-        "--set",
-        "b1=40",
-        "--set",
-        "spindle=60",
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let (_, out) = run_worm(
+        "three",
+        &[
+            "--set",
+            "z1=3",
+            "--set",
+            "m=4",
+            "--set",
+            "d1=60",
+            "--set",
+            "starts_by_depth=false",
+            "--set",
+            "b1=40",
+            "--set",
+            "spindle=60",
+        ],
+    );
     let nc = std::fs::read_to_string(out.join("program.nc")).unwrap();
     assert!(nc.contains("Q120000") && nc.contains("Q240000"), "{nc}");
     let check = simulate_nc(&out, &nc, 4.0, 3, 60.0, 40.0).unwrap();
@@ -292,22 +305,17 @@ fn a_three_start_worm_cut_each_start_completely_holds_its_profile() {
 /// on the finishing passes, it holds the same profile.
 #[test]
 fn a_one_start_worm_with_a_universal_cutter_holds_its_profile() {
-    let dir = scratch("worm", "one");
-    let out = dir.join("out");
-    let (code, _, err) = pilgrim(&[
-        "run",
-        SCRIPT,
-        "--out",
-        s(&out),
-        "--quiet",
-        "--set",
-        "z1=1",
-        "--set",
-        "tip_width=2.486",
-        "--set",
-        "axial_step=0.2",
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let (_, out) = run_worm(
+        "one",
+        &[
+            "--set",
+            "z1=1",
+            "--set",
+            "tip_width=2.486",
+            "--set",
+            "axial_step=0.2",
+        ],
+    );
     let r = report(&out);
     let a1z = r["notes"]["axial_offset_a1z_mm"].as_f64().unwrap();
     assert!((a1z - 0.5).abs() < 1e-3, "{a1z}");
@@ -328,10 +336,7 @@ fn a_one_start_worm_with_a_universal_cutter_holds_its_profile() {
 /// names it.
 #[test]
 fn a_corrupted_pass_is_named() {
-    let dir = scratch("worm", "corrupt");
-    let out = dir.join("out");
-    let (code, _, err) = pilgrim(&["run", SCRIPT, "--out", s(&out), "--quiet"]);
-    assert_eq!(code, 0, "{err}");
+    let (_, out) = run_worm("corrupt", &[]);
     let nc = std::fs::read_to_string(out.join("program.nc")).unwrap();
     let lines: Vec<&str> = nc.lines().collect();
     let at = lines
@@ -362,20 +367,10 @@ fn a_corrupted_pass_is_named() {
 /// axis program (`.ci/rs274_check.py`).
 #[test]
 fn the_linuxcnc_program_is_left_for_its_interpreter() {
-    let dir = scratch("worm", "linuxcnc");
-    let out = dir.join("out");
-    let (code, _, err) = pilgrim(&[
-        "run",
-        SCRIPT,
-        "--out",
-        s(&out),
-        "--quiet",
-        "--set",
-        "start_shift=z",
-        "--post",
+    let (dir, out) = run_worm(
         "linuxcnc",
-    ]);
-    assert_eq!(code, 0, "{err}");
+        &["--set", "start_shift=z", "--post", "linuxcnc"],
+    );
     let ngc = std::fs::read_to_string(out.join("program.ngc")).unwrap();
     assert!(ngc.starts_with("%\n") && ngc.ends_with("M2\n%\n"), "{ngc}");
     assert!(ngc.contains(" G7\n"), "{ngc}");
