@@ -268,6 +268,15 @@ fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
     ] {
         assert!(out.join(f).is_file(), "{f}");
     }
+    // Deterministic: a second run writes the same bytes, file by file.
+    let (_, again) = run_worm("default-again", &[]);
+    for e in std::fs::read_dir(&out).unwrap().flatten() {
+        let name = e.file_name();
+        assert!(
+            std::fs::read(e.path()).unwrap() == std::fs::read(again.join(&name)).unwrap(),
+            "{name:?} differs between two runs"
+        );
+    }
     common::leave_for_checkers(&out, "worm");
 }
 
