@@ -433,6 +433,16 @@ fn bad_input_is_refused_with_no_output() {
             "minimum depth of cut a_min = 5 is out of range: at most the roughing depth 2.1000 mm",
         ),
         ("spindle=400", "a thread of lead 31.4159 mm at 400 rpm"),
+        // A fine thread 700 mm long: its solid would be too large.
+        (
+            "m=0.1 b1=700 z1=1 nose_r=0.01 a_min=0.01 finish_depth=0.01 tol_angle_deg=1",
+            "worm: the mesh would have 55900544 triangles",
+        ),
+        // Its flanks, 0.2 mm high, cannot hold 0.05 deg at 0.001 mm steps.
+        (
+            "m=0.1 z1=1 nose_r=0.01 a_min=0.01 finish_depth=0.01",
+            "left flank: angle",
+        ),
     ] {
         let out = dir.join(set.replace(['=', ' '], "_"));
         let mut args = vec!["run", SCRIPT, "--out", s(&out), "--quiet"];

@@ -145,6 +145,22 @@ impl WormCheck {
         let z = w0 + (z - w0).rem_euclid(lead);
         vertical_top(&self.section, z).unwrap_or(0.0)
     }
+
+    /// The finished section's outline over one lead from `window.0`, as
+    /// `(z, r)` at each of its corners: the outline is straight between
+    /// them, so interpolating these is [`Self::radius_at`] exactly, and
+    /// cheaply.
+    pub fn outline(&self) -> Vec<[Real; 2]> {
+        let (w0, lead) = self.window;
+        let mut zs: Vec<Real> = edges(&self.section)
+            .map(|(a, _)| a.x)
+            .filter(|z| *z > w0 && *z < w0 + lead)
+            .chain([w0 + 1e-9, w0 + lead - 1e-9])
+            .collect();
+        zs.sort_by(Real::total_cmp);
+        zs.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+        zs.iter().map(|&z| [z, self.radius_at(z)]).collect()
+    }
 }
 
 fn poly(points: &[[Real; 2]]) -> Polygon<Real> {

@@ -29,16 +29,34 @@ pub fn worm_solid(check: &WormCheck, length: Real, tol: Real) -> Result<TriMesh,
         .map_err(|e| MeshError::Degenerate(e.to_string()))?;
     crate::math::positive("mesh tolerance", tol)
         .map_err(|e| MeshError::Degenerate(e.to_string()))?;
-    let lead = check.window.1;
-    let r_tip = (0..64)
-        .map(|i| check.radius_at(check.window.0 + lead * i as Real / 64.0))
-        .fold(0.0, Real::max);
+    let (w0, lead) = check.window;
+    let outline = check.outline();
+    let r_tip = outline.iter().map(|p| p[1]).fold(0.0, Real::max);
+    // The outline between its corners, repeated with the lead.
+    let radius = |z: Real| -> Real {
+        let u = w0 + (z - w0).rem_euclid(lead);
+        let k = outline
+            .partition_point(|p| p[0] < u)
+            .clamp(1, outline.len() - 1);
+        let (a, b) = (outline[k - 1], outline[k]);
+        let t = if b[0] > a[0] {
+            ((u - a[0]) / (b[0] - a[0])).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        a[1] + t * (b[1] - a[1])
+    };
+    if outline.len() < 2 || !(r_tip > 0.0) {
+        return Err(MeshError::Degenerate("the worm's section is empty".into()));
+    }
     let step = 2.0 * (1.0 - (tol / r_tip).min(1.0)).acos();
     let n = ((TAU / step).ceil() as usize).clamp(24, MAX_AROUND);
     // Rings evenly from -length to 0, as near lead / n apart as a whole
     // number of them allows: each quad's diagonal then strays from its
     // helix by at most a (2 rings)-th of a ring's spacing.
-    let rings_between = ((length * n as Real / lead).round() as usize).max(1);
+    let rings = (length * n as Real / lead).round();
+    crate::mesh::check_triangles((2.0 * n as Real * (rings + 1.0)).min(1e18) as usize, tol)?;
+    let rings_between = (rings as usize).max(1);
     let zs: Vec<Real> = (0..=rings_between)
         .map(|j| -length + length * j as Real / rings_between as Real)
         .collect();
@@ -48,7 +66,7 @@ pub fn worm_solid(check: &WormCheck, length: Real, tol: Real) -> Result<TriMesh,
             (0..n)
                 .map(|k| {
                     let phi = TAU * k as Real / n as Real;
-                    let r = check.radius_at(z - lead * phi / TAU);
+                    let r = radius(z - lead * phi / TAU);
                     [r * phi.cos(), r * phi.sin(), z]
                 })
                 .collect()
