@@ -220,6 +220,15 @@ fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
     // length: every section across the axis meets a whole lead of it).
     let solid = pilgrim_kernel::worm::worm_solid(&check, 60.0, 0.01).unwrap();
     solid.check_closed().unwrap();
+    // Every vertex between the root's and the tip's circles (the axis's
+    // points of the flat ends aside).
+    for p in &solid.positions {
+        let r = p[0].hypot(p[1]);
+        assert!(
+            r < 1e-9 || (19.0 - 1e-6..=30.0 + 1e-6).contains(&r),
+            "{p:?}: r = {r}"
+        );
+    }
     let (w0, lead) = check.window;
     let n = 200_000;
     let integral: f64 = (0..n)
@@ -268,6 +277,35 @@ fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
     ] {
         assert!(out.join(f).is_file(), "{f}");
     }
+    // The run's own worm.stl (f32 binary STL): the same radii and volume.
+    let stl = std::fs::read(out.join("worm.stl")).unwrap();
+    let facets = u32::from_le_bytes(stl[80..84].try_into().unwrap()) as usize;
+    assert_eq!(stl.len(), 84 + 50 * facets);
+    let mut volume = 0.0;
+    for f in 0..facets {
+        let at = |k: usize| -> [f64; 3] {
+            let o = 84 + 50 * f + 12 + 12 * k;
+            let c = |j: usize| {
+                f32::from_le_bytes(stl[o + 4 * j..o + 4 * j + 4].try_into().unwrap()) as f64
+            };
+            [c(0), c(1), c(2)]
+        };
+        let (a, b, c) = (at(0), at(1), at(2));
+        for p in [a, b, c] {
+            let r = p[0].hypot(p[1]);
+            assert!(
+                (19.0 - 1e-4..=30.0 + 1e-4).contains(&r),
+                "worm.stl facet {f}: r = {r}"
+            );
+        }
+        volume += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+            + a[2] * (b[0] * c[1] - b[1] * c[0]))
+            / 6.0;
+    }
+    assert!(
+        (volume - want).abs() < 1e-3 * want,
+        "worm.stl: {volume} vs {want}"
+    );
     // Deterministic: a second run writes the same bytes, file by file.
     let (_, again) = run_worm("default-again", &[]);
     for e in std::fs::read_dir(&out).unwrap().flatten() {

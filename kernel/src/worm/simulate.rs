@@ -147,18 +147,20 @@ impl WormCheck {
     }
 
     /// The finished section's outline over one lead from `window.0`, as
-    /// `(z, r)` at each of its corners: the outline is straight between
-    /// them, so interpolating these is [`Self::radius_at`] exactly, and
-    /// cheaply.
+    /// `(z, r)` just either side of each of its corners (1 nm off, where
+    /// a vertical ray meets edges, not corners): the outline is straight
+    /// between them, so interpolating these is [`Self::radius_at`], and
+    /// cheap.
     pub fn outline(&self) -> Vec<[Real; 2]> {
+        const SIDE: Real = 1e-6;
         let (w0, lead) = self.window;
         let mut zs: Vec<Real> = edges(&self.section)
-            .map(|(a, _)| a.x)
+            .flat_map(|(a, _)| [a.x - SIDE, a.x + SIDE])
+            .chain([w0 + SIDE, w0 + lead - SIDE])
             .filter(|z| *z > w0 && *z < w0 + lead)
-            .chain([w0 + 1e-9, w0 + lead - 1e-9])
             .collect();
         zs.sort_by(Real::total_cmp);
-        zs.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+        zs.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
         zs.iter().map(|&z| [z, self.radius_at(z)]).collect()
     }
 }
