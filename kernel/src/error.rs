@@ -60,6 +60,10 @@ pub enum Error {
     /// A program that cannot be written.
     #[error(transparent)]
     Post(#[from] PostError),
+    /// A written program that fails its lint (read back, it is not what
+    /// the axis program says, or not what its dialect allows).
+    #[error(transparent)]
+    Lint(#[from] crate::program::lint::LintError),
     /// A machine whose control has no dialect.
     #[error("machine {machine}: unknown control '{control}'")]
     UnknownControl {

@@ -333,6 +333,9 @@ pub fn run(
     })?;
     let control_text = machine.post.post(&program, control.name)?;
     let cld_text = machine.post.post(&program, CLD.name)?;
+    // Every program read back before anything is written.
+    crate::program::lint::lint(&control_text, &program, control, &info.axes)?;
+    crate::program::lint::lint(&cld_text, &program, &CLD, &info.axes)?;
     let mut extra = Vec::new();
     for name in &options.also_post {
         let d = dialect(name).ok_or_else(|| {
@@ -342,6 +345,7 @@ pub fn run(
             continue;
         }
         let text = machine.post.post(&program, d.name)?;
+        crate::program::lint::lint(&text, &program, d, &info.axes)?;
         extra.push((format!("program.{}", d.extension), text.into_bytes()));
     }
     let mut files: Vec<(String, Vec<u8>)> = vec![

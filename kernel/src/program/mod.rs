@@ -8,6 +8,7 @@
 //! and axis), and written as text by a [`PostProcessor`]: the shared writer
 //! in a control's dialect ([`post`]), or a plugin's own.
 
+pub mod lint;
 pub mod post;
 
 pub use pilgrim_plugin_abi::types::{AxisProgram, Block, Plane, ProgramAxis, ProgramSetup, Radial};
