@@ -305,6 +305,23 @@ fn verification_catches_a_corrupted_block() {
         "{:?}",
         ok.passes[0]
     );
+    // The curves drawn (deviation.svg, finish.svg) hold each pass's
+    // extremes exactly, ridges and all.
+    for p in &ok.passes {
+        let low = p.along_z.iter().map(|b| b[1]).fold(f64::INFINITY, f64::min);
+        let high = p
+            .along_z
+            .iter()
+            .map(|b| b[2])
+            .fold(f64::NEG_INFINITY, f64::max);
+        assert_eq!(
+            (low, high),
+            (p.deviation.max_below, p.deviation.max_above),
+            "{}",
+            p.name
+        );
+        assert!(p.along_z.len() <= pilgrim_kernel::verify::PROFILE_BUCKETS);
+    }
     // Block 40 of the finishing pass goes 5 um too deep.
     let k = finish.first_block - 1 + 40;
     let x = program.axes.iter().position(|a| a.name == "X").unwrap();
@@ -354,6 +371,14 @@ fn example_parameter_files_run() {
         assert!(stdout.contains("finish within 0.000"), "{f}: {stdout}");
         let svg = std::fs::read_to_string(out.join("profile.svg")).unwrap();
         assert!(svg.starts_with("<svg ") && svg.ends_with("</svg>\n"), "{f}");
+        // Each pass's deviation, and the finish against the tolerance band.
+        let dev = std::fs::read_to_string(out.join("deviation.svg")).unwrap();
+        let fin = std::fs::read_to_string(out.join("finish.svg")).unwrap();
+        assert!(
+            dev.contains("pass 1, stock") && dev.contains("surface minus nominal, um"),
+            "{f}"
+        );
+        assert!(fin.contains("tolerance +-1.0 um"), "{f}");
         // Blank, part, wheel centre; the rest's track in each pass; the
         // curvature (far below the wheel's limit, so no limit line).
         assert_eq!(

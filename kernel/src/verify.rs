@@ -199,6 +199,42 @@ pub struct PassCheck {
     /// Its surface against the nominal, over every generatrix simulated
     /// (blocks from 1): ridges included.
     pub deviation: Deviation,
+    /// Its surface minus the nominal along z, for drawing: `[z, lowest,
+    /// highest]` over the generatrices, in at most [`PROFILE_BUCKETS`]
+    /// stretches of z (each the extremes within it, so no ridge is lost).
+    #[serde(skip)]
+    pub along_z: Vec<[Real; 3]>,
+}
+
+/// The most stretches of z a pass's deviation is kept in for drawing.
+pub const PROFILE_BUCKETS: usize = 1500;
+
+/// `values` (`z`, per generatrix lowest and highest) in at most `n`
+/// stretches of equal length in z, each its middle and the extremes in it.
+fn bucketed(zs: &[Real], lo: &[Real], hi: &[Real], n: usize) -> Vec<[Real; 3]> {
+    let (Some(&z0), Some(&z1)) = (zs.first(), zs.last()) else {
+        return Vec::new();
+    };
+    let width = ((z1 - z0) / n as Real).max(Real::MIN_POSITIVE);
+    let mut out: Vec<[Real; 3]> = Vec::new();
+    let mut current: Option<(usize, [Real; 3])> = None;
+    for ((&z, &l), &h) in zs.iter().zip(lo).zip(hi) {
+        let k = (((z - z0) / width) as usize).min(n - 1);
+        match &mut current {
+            Some((c, b)) if *c == k => {
+                b[1] = b[1].min(l);
+                b[2] = b[2].max(h);
+            }
+            _ => {
+                if let Some((_, b)) = current.take() {
+                    out.push(b);
+                }
+                current = Some((k, [z0 + (k as Real + 0.5) * width, l, h]));
+            }
+        }
+    }
+    out.extend(current.map(|(_, b)| b));
+    out
 }
 
 /// A grinding program replayed: each cutting pass's surface against the
@@ -359,9 +395,11 @@ pub fn check_grinding(
         };
         // The generatrix of the largest value above and below.
         let (mut g_above, mut g_below) = (0, 0);
+        let mut lo = vec![Real::INFINITY; zs.len()];
+        let mut hi = vec![Real::NEG_INFINITY; zs.len()];
         for (g, env) in envs.iter().enumerate() {
             let surface = env.eval_many(&zs);
-            for ((&z, &s), &p) in zs.iter().zip(&surface).zip(&profile) {
+            for (i, ((&z, &s), &p)) in zs.iter().zip(&surface).zip(&profile).enumerate() {
                 if !s.is_finite() {
                     return Err(VerifyError::Pass {
                         pass: pass.name.clone(),
@@ -377,6 +415,7 @@ pub fn check_grinding(
                     });
                 }
                 let e = s - p;
+                (lo[i], hi[i]) = (lo[i].min(e), hi[i].max(e));
                 if e > d.max_above {
                     (d.max_above, d.above_z, g_above) = (e, z, g);
                 }
@@ -407,6 +446,7 @@ pub fn check_grinding(
             feed_per_rev_mm: f,
             ridge_mm: wheel.ridge(f),
             deviation: d,
+            along_z: bucketed(&zs, &lo, &hi, PROFILE_BUCKETS),
         });
     }
     let finish = out.passes.last().ok_or(VerifyError::NoCuttingPass)?;
@@ -427,4 +467,24 @@ pub fn check_grinding(
         });
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Drawing stretches keep each stretch's extremes: the ridges survive.
+    #[test]
+    fn stretches_keep_the_extremes() {
+        let zs: Vec<f64> = (0..10_000).map(|i| i as f64 * 0.01).collect();
+        let lo: Vec<f64> = zs.iter().map(|z| (z * 7.0).sin()).collect();
+        let hi: Vec<f64> = lo.iter().map(|v| v + 0.5).collect();
+        let b = bucketed(&zs, &lo, &hi, 100);
+        assert_eq!(b.len(), 100);
+        let min = b.iter().map(|x| x[1]).fold(f64::INFINITY, f64::min);
+        let max = b.iter().map(|x| x[2]).fold(f64::NEG_INFINITY, f64::max);
+        assert_eq!(min, lo.iter().copied().fold(f64::INFINITY, f64::min));
+        assert_eq!(max, hi.iter().copied().fold(f64::NEG_INFINITY, f64::max));
+        assert!(b.windows(2).all(|w| w[1][0] > w[0][0]));
+    }
 }

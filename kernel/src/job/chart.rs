@@ -6,7 +6,7 @@ use crate::toolpath::{PlotSpec, Toolpath};
 use plotters::prelude::*;
 
 /// Line colours, in order (the legend's).
-const COLOURS: [RGBColor; 6] = [
+pub(super) const COLOURS: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
@@ -14,6 +14,16 @@ const COLOURS: [RGBColor; 6] = [
     RGBColor(148, 103, 189),
     RGBColor(140, 86, 75),
 ];
+
+/// The decimals the ticks of an axis spanning `range` need: one more than
+/// the place of a tenth of the range (the ticks' spacing), at least 0.
+pub(super) fn tick_decimals(range: f64) -> usize {
+    let step = (range / 10.0).abs();
+    if !(step > 0.0) {
+        return 1;
+    }
+    (1.0 - step.log10().floor()).clamp(0.0, 9.0) as usize
+}
 
 /// The chart `spec` from `toolpath`'s tables as SVG text.
 ///
@@ -76,6 +86,9 @@ pub fn chart_svg(toolpath: &Toolpath, spec: &PlotSpec) -> Result<String, String>
             .configure_mesh()
             .x_desc(spec.x_label.as_str())
             .y_desc(spec.y_label.as_str())
+            // One number of decimals an axis, never "-0.0".
+            .x_label_formatter(&|v| crate::math::fixed(*v, tick_decimals(x1 - x0)))
+            .y_label_formatter(&|v| crate::math::fixed(*v, tick_decimals(y1 - y0)))
             .label_style(("sans-serif", 15))
             .axis_desc_style(("sans-serif", 17))
             .draw()

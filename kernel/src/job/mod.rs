@@ -12,6 +12,7 @@
 //! finished run's tool at another block.
 
 mod chart;
+mod deviation;
 mod export;
 mod report;
 mod scene;
@@ -491,7 +492,8 @@ pub fn run(
             })
         })?;
         let name = format!("{}.svg", plot.file);
-        if files.iter().any(|f| f.0 == name) || name == "profile.svg" || name == "passes.svg" {
+        let reserved = ["profile.svg", "passes.svg", "deviation.svg", "finish.svg"];
+        if files.iter().any(|f| f.0 == name) || reserved.contains(&name.as_str()) {
             return Err(Error::Family(crate::family::FamilyError::Contract {
                 family: family.name().to_owned(),
                 message: format!("plot {}: a file of that name is written already", plot.file),
@@ -519,6 +521,12 @@ pub fn run(
         .map_err(|e| Error::Scene(SceneError::Place(e)))?;
         files.push(("profile.svg".into(), text.into_bytes()));
         report.files.push("profile.svg".into());
+    }
+    if let Some(v) = &verification {
+        for (name, text) in deviation::deviation_svgs(v).map_err(Error::Output)? {
+            files.push((name.clone(), text.into_bytes()));
+            report.files.push(name);
+        }
     }
     files.push(("report.json".into(), report_json(&report)?));
     Ok(JobOutput {
