@@ -25,6 +25,34 @@ pub(super) fn tick_decimals(range: f64) -> usize {
     (1.0 - step.log10().floor()).clamp(0.0, 9.0) as usize
 }
 
+/// A legend in `area` (below a chart: never over the data): each item a
+/// line of its colour and its name, `layout.2` to a row starting at
+/// `layout.0` and `layout.1` apart (pixels), in text of `size`.
+pub(super) fn legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    items: &[(String, RGBColor)],
+    layout: (i32, i32, usize),
+    size: u32,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let (left, width, per_row) = layout;
+    for (k, (name, c)) in items.iter().enumerate() {
+        let (x, y) = (
+            left + width * (k % per_row) as i32,
+            12 + 24 * (k / per_row) as i32,
+        );
+        area.draw(&PathElement::new(
+            vec![(x, y), (x + 30, y)],
+            c.stroke_width(3),
+        ))?;
+        area.draw(&Text::new(
+            name.clone(),
+            (x + 38, y - 8),
+            ("sans-serif", size),
+        ))?;
+    }
+    Ok(())
+}
+
 /// The chart `spec` from `toolpath`'s tables as SVG text.
 ///
 /// # Failures
@@ -102,24 +130,12 @@ pub fn chart_svg(toolpath: &Toolpath, spec: &PlotSpec) -> Result<String, String>
                 ))
                 .map_err(e)?;
         }
-        // The legend below the chart, three to a row: never over the data.
-        for (k, (name, _)) in series.iter().enumerate() {
-            let c = COLOURS[k % COLOURS.len()];
-            let (x, y) = (110 + 300 * (k as i32 % 3), 12 + 24 * (k as i32 / 3));
-            bottom
-                .draw(&PathElement::new(
-                    vec![(x, y), (x + 30, y)],
-                    c.stroke_width(3),
-                ))
-                .map_err(e)?;
-            bottom
-                .draw(&Text::new(
-                    name.to_string(),
-                    (x + 38, y - 8),
-                    ("sans-serif", 16),
-                ))
-                .map_err(e)?;
-        }
+        let items: Vec<(String, RGBColor)> = series
+            .iter()
+            .enumerate()
+            .map(|(k, (name, _))| (name.to_string(), COLOURS[k % COLOURS.len()]))
+            .collect();
+        legend(&bottom, &items, (110, 300, 3), 16).map_err(e)?;
         root.present().map_err(e)?;
     }
     Ok(svg)

@@ -88,23 +88,7 @@ fn draw(passes: &[&PassCheck], title: &str, band: Option<f64>) -> Result<String,
             }
             legend.push((format!("tolerance +-{:.1} um", 1e3 * t), grey));
         }
-        // The legend below the chart, two to a row: never over the data.
-        for (k, (name, c)) in legend.iter().enumerate() {
-            let (x, y) = (60 + 520 * (k as i32 % 2), 12 + 24 * (k as i32 / 2));
-            bottom
-                .draw(&PathElement::new(
-                    vec![(x, y), (x + 30, y)],
-                    c.stroke_width(3),
-                ))
-                .map_err(e)?;
-            bottom
-                .draw(&Text::new(
-                    name.clone(),
-                    (x + 38, y - 8),
-                    ("sans-serif", 14),
-                ))
-                .map_err(e)?;
-        }
+        super::chart::legend(&bottom, &legend, (60, 520, 2), 14).map_err(e)?;
         root.present().map_err(e)?;
     }
     Ok(svg)

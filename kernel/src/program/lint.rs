@@ -581,48 +581,9 @@ fn lint_apt(text: &str, program: &AxisProgram, d: &Dialect) -> Result<Linted, Li
 mod tests {
     use super::*;
     use crate::program::post::{post, CLD, FANUC, LINUXCNC, SINUMERIK};
-    use crate::program::{Block, ProgramAxis, ProgramSetup};
 
     fn program() -> AxisProgram {
-        let axis = |n: &str| ProgramAxis {
-            name: n.into(),
-            unit: "mm".into(),
-        };
-        let block = |motion, v: [f64; 2], feed, comment: Option<&str>| Block {
-            motion,
-            values: v.to_vec(),
-            feed,
-            spindle: None,
-            comment: comment.map(str::to_owned),
-            keep: Vec::new(),
-        };
-        AxisProgram {
-            name: "DEMO".into(),
-            number: 7,
-            machine: "test-lathe".into(),
-            control: "fanuc".into(),
-            tool_number: 3,
-            tool_name: "thread insert".into(),
-            spindle_rpm: 399.4,
-            decimals: None,
-            axes: vec![axis("X"), axis("Z")],
-            blocks: vec![
-                block(Motion::Rapid, [50.0, 5.0], 0.0, Some("pass 1")),
-                block(Motion::Linear, [40.0, 5.0], 100.0, None),
-                block(Motion::Linear, [40.0, -0.0001], 100.0, None),
-                block(
-                    Motion::Thread {
-                        lead: 6.35,
-                        start_deg: 0.0,
-                    },
-                    [40.0, -60.0],
-                    0.0,
-                    None,
-                ),
-                block(Motion::Rapid, [50.0, -60.0], 0.0, None),
-            ],
-            setup: ProgramSetup::default(),
-        }
+        crate::program::test_program()
     }
 
     fn axes() -> Vec<Axis> {
@@ -639,7 +600,7 @@ mod tests {
         for d in [&SINUMERIK, &FANUC, &LINUXCNC, &CLD] {
             let text = post(&p, d).unwrap();
             let l = lint(&text, &p, d, &axes()).unwrap_or_else(|e| panic!("{e}\n{text}"));
-            assert_eq!(l.moves, 5, "{}", d.name);
+            assert_eq!(l.moves, 6, "{}", d.name);
         }
         let mut block = p.clone();
         block.number = 0;
@@ -670,17 +631,17 @@ mod tests {
             &FANUC,
             "G32 Z-60.000",
             "G32 Z-60.100",
-            &["block 4", "Z-60.1 read back"],
+            &["block 5", "Z-60.1 read back"],
         );
         case(
             &CLD,
             "GOTO/40.000,-60.000",
             "GOTO/40.000,-60.010",
-            &["block 4", "Z = -60.01"],
+            &["block 5", "Z = -60.01"],
         );
         // Numbering out of order, a block without its number.
-        case(&SINUMERIK, "N40 G33", "N25 G33", &["N25", "out of order"]);
-        case(&LINUXCNC, "N40 G33", "G33", &["line", "without its number"]);
+        case(&SINUMERIK, "N50 G33", "N25 G33", &["N25", "out of order"]);
+        case(&LINUXCNC, "N50 G33", "G33", &["line", "without its number"]);
         // A word the dialect does not have.
         case(
             &FANUC,
@@ -702,12 +663,12 @@ mod tests {
             "N3 S399\n",
             &["N20", "spindle stopped"],
         );
-        case(&LINUXCNC, " K6.3500", "", &["N40", "without its lead K"]);
+        case(&LINUXCNC, " K6.3500", "", &["N50", "without its lead K"]);
         case(
             &LINUXCNC,
             "G21 G40 G90 G94 G97",
             "G21 G40 G90 G94",
-            &["N40", "G97"],
+            &["N50", "G97"],
         );
         // Travel, and the end.
         case(
@@ -724,7 +685,7 @@ mod tests {
             &CLD,
             "GOTO/50.000,-60.000\n",
             "",
-            &["4 GOTO records", "5 blocks"],
+            &["5 GOTO records", "6 blocks"],
         );
     }
 }

@@ -724,6 +724,52 @@ pub fn program_name(name: &str) -> String {
     s
 }
 
+/// A small lathe program of every motion (the post-processor's and the
+/// lint's tests).
+#[cfg(test)]
+pub(crate) fn test_program() -> AxisProgram {
+    let axis = |n: &str| ProgramAxis {
+        name: n.into(),
+        unit: "mm".into(),
+    };
+    let block = |motion, v: [f64; 2], feed, comment: Option<&str>| Block {
+        motion,
+        values: v.to_vec(),
+        feed,
+        spindle: None,
+        comment: comment.map(str::to_owned),
+        keep: Vec::new(),
+    };
+    AxisProgram {
+        name: "DEMO".into(),
+        number: 7,
+        machine: "test-lathe".into(),
+        control: "fanuc".into(),
+        tool_number: 3,
+        tool_name: "thread insert (60)".into(),
+        spindle_rpm: 399.4,
+        decimals: None,
+        axes: vec![axis("X"), axis("Z")],
+        blocks: vec![
+            block(Motion::Rapid, [50.0, 5.0], 0.0, Some("pass 1")),
+            block(Motion::Linear, [40.0, 5.0], 100.0, None),
+            block(Motion::Linear, [40.0, -0.0001], 100.0, None),
+            block(Motion::Linear, [40.0, -0.0001], 100.0, None),
+            block(
+                Motion::Thread {
+                    lead: 6.35,
+                    start_deg: 0.0,
+                },
+                [40.0, -60.0],
+                0.0,
+                None,
+            ),
+            block(Motion::Rapid, [50.0, -60.0], 0.0, None),
+        ],
+        setup: ProgramSetup::default(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
