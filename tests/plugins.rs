@@ -346,3 +346,43 @@ fn caliber_grinders_load_as_compiled_in() {
     assert_eq!(a, b, "fanuc_0i_tc");
     assert_eq!(a[0], 40.0);
 }
+
+/// A plugin that posts its own programs is held to them: what it writes
+/// is linted like the kernel's, and a program that is not the axis
+/// program fails the run, naming the place, with nothing written.
+#[test]
+fn a_plugins_own_program_is_linted() {
+    let dir = common::scratch("plugins", "own-post");
+    let script = dir.join("lathe.rhai");
+    std::fs::write(
+        &script,
+        r#"
+fn params() { #{} }
+fn toolpath(p) {
+    let tool = thread_cutter("cutter", 1, 2.0, 0.1, 20.0, 20.0, 5.0);
+    let tp = new_toolpath("turn", tool, 200.0, []);
+    tp.add_pass("cut", #{ x: [30.0, 25.0, 25.0], y: 0.0, z: [5.0, 5.0, -20.0], feed: 100.0 });
+    tp
+}
+"#,
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let (code, _, err) = common::pilgrim(&[
+        "run",
+        common::s(&script),
+        "--machine",
+        common::s(&fixture_as("panics")),
+        "--out",
+        common::s(&out),
+        "--quiet",
+    ]);
+    assert_ne!(code, 0);
+    // The fixture posts "%\n(3 BLOCKS IN FANUC)\n%\n": no moves, no end.
+    assert!(
+        err.contains("lint of the fanuc program")
+            && err.contains("0 moves read back, the axis program has"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
