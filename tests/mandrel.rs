@@ -379,13 +379,25 @@ fn example_parameter_files_run() {
             "{f}"
         );
         assert!(fin.contains("tolerance +-1.0 um"), "{f}");
-        // Blank, part, wheel centre; the rest's track in each pass; the
-        // curvature (far below the wheel's limit, so no limit line).
+        // Three panels (plotters charts): blank, part and the wheel
+        // centre's path; the rest's track in each pass; the curvature (far
+        // below the wheel's limit, so no limit line). Legends name them.
+        // (plotters writes a text's content on its own line.)
+        assert_eq!(svg.matches(">\nz, mm\n</text>").count(), 3, "{f}");
+        for name in [
+            ">\nblank\n<",
+            ">\npart\n<",
+            ">\nwheel centre, pass ",
+            ">\nR_s x curvature\n<",
+        ] {
+            assert!(svg.contains(name), "{f}: {name}");
+        }
         assert_eq!(
-            svg.matches("<polyline").count(),
-            3 + if f.contains("small") { 5 } else { 6 } + 1,
+            svg.matches(", stock ").count(),
+            if f.contains("small") { 5 } else { 6 } + 1,
             "{f}"
         );
+        assert!(!svg.contains("the wheel's limit\n<"), "{f}");
         std::fs::remove_dir_all(&out).ok();
     }
 }

@@ -26,7 +26,7 @@ pub(super) fn tick_decimals(range: f64) -> usize {
 }
 
 /// A legend in `area` (below a chart: never over the data): each item a
-/// line of its colour and its name, `layout.2` to a row starting at
+/// swatch of its colour and its name, `layout.2` to a row starting at
 /// `layout.0` and `layout.1` apart (pixels), in text of `size`.
 pub(super) fn legend<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
@@ -40,10 +40,8 @@ pub(super) fn legend<DB: DrawingBackend>(
             left + width * (k % per_row) as i32,
             12 + 24 * (k / per_row) as i32,
         );
-        area.draw(&PathElement::new(
-            vec![(x, y), (x + 30, y)],
-            c.stroke_width(3),
-        ))?;
+        // A swatch, not a line: the chart's lines are its data alone.
+        area.draw(&Rectangle::new([(x, y - 2), (x + 30, y + 2)], c.filled()))?;
         area.draw(&Text::new(
             name.clone(),
             (x + 38, y - 8),

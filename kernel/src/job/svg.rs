@@ -1,7 +1,7 @@
 //! `profile.svg`: a grinding job's profile, the wheel's path, the track of
 //! each moving body the toolpath drives (the steady rest) and the
-//! curvature, as panels of line plots (hand-written SVG, fixed decimals:
-//! the same job gives the same bytes).
+//! curvature, as panels of line plots drawn with plotters (the same job
+//! gives the same bytes).
 
 use crate::machine::{bodies_of, MachineKinematics};
 use crate::math::fixed;
@@ -13,7 +13,7 @@ use crate::toolpath::{Pass, Toolpath};
 /// One line of a panel.
 struct Series {
     name: String,
-    color: &'static str,
+    color: plotters::style::RGBColor,
     points: Vec<(f64, f64)>,
 }
 
@@ -24,7 +24,12 @@ struct Panel {
     series: Vec<Series>,
 }
 
-const COLORS: [&str; 4] = ["#444444", "#d08000", "#2a6fd8", "#2a9d4b"];
+const COLORS: [plotters::style::RGBColor; 4] = [
+    plotters::style::RGBColor(0x44, 0x44, 0x44),
+    plotters::style::RGBColor(0xd0, 0x80, 0x00),
+    plotters::style::RGBColor(0x2a, 0x6f, 0xd8),
+    plotters::style::RGBColor(0x2a, 0x9d, 0x4b),
+];
 
 /// `profile.svg`: the part's profiles and the wheel centre's path on the
 /// finishing pass; for each machine body moved by an axis the toolpath
@@ -130,7 +135,7 @@ pub fn profile_svg(
     if top >= 0.25 {
         series.push(Series {
             name: "the wheel's limit".into(),
-            color: "#cc2222",
+            color: plotters::style::RGBColor(0xcc, 0x22, 0x22),
             points: vec![(z[0], 1.0), (z[z.len() - 1], 1.0)],
         });
     }
@@ -142,96 +147,90 @@ pub fn profile_svg(
         y_label: "R_s x curvature".into(),
         series,
     });
-    Ok(render(&panels))
+    render(&panels)
 }
 
-const W: f64 = 900.0;
-const H: f64 = 220.0;
-const M: f64 = 60.0;
-
-/// The SVG of the panels, stacked, over the z range of all their points.
-fn render(panels: &[Panel]) -> String {
+/// The panels as SVG, stacked, sharing the z range of all their points,
+/// each a plotters chart (axes with ticks and units, a grid, the legend
+/// below the data).
+fn render(panels: &[Panel]) -> Result<String, String> {
+    use plotters::prelude::*;
     let all = || {
         panels
             .iter()
             .flat_map(|p| p.series.iter().flat_map(|s| s.points.iter()))
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
     };
     let (z0, z1) = all().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
         (a.min(p.0), b.max(p.0))
     });
-    let height = panels.len() as f64 * (H + M) + M;
-    let mut out = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" viewBox=\"0 0 {} {}\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n",
-        W + 2.0 * M,
-        height,
-        W + 2.0 * M,
-        height
-    );
-    for (k, panel) in panels.iter().enumerate() {
-        let top = M + k as f64 * (H + M);
-        let pts = || {
-            panel
-                .series
-                .iter()
-                .flat_map(|s| s.points.iter())
-                .filter(|p| p.1.is_finite())
-        };
-        let (y0, y1) = pts().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
-            (a.min(p.1), b.max(p.1))
-        });
-        let (y0, y1) = if y1 > y0 {
-            (y0, y1)
-        } else {
-            (y0 - 1.0, y0 + 1.0)
-        };
-        let sx = |z: f64| M + (z - z0) / (z1 - z0).max(1e-12) * W;
-        let sy = |y: f64| top + H - (y - y0) / (y1 - y0) * H;
-        out += &format!(
-            "<text x=\"{M}\" y=\"{}\" font-weight=\"bold\">{}</text>\n<rect x=\"{M}\" y=\"{top}\" width=\"{W}\" height=\"{H}\" fill=\"none\" stroke=\"#888\"/>\n",
-            top - 8.0,
-            xml(&panel.title)
-        );
-        out += &format!(
-            "<text x=\"4\" y=\"{}\">{}</text>\n<text x=\"4\" y=\"{}\">{}</text>\n<text x=\"4\" y=\"{}\" fill=\"#555\">{}</text>\n",
-            top + 12.0,
-            fixed(y1, 4),
-            top + H,
-            fixed(y0, 4),
-            top + H / 2.0,
-            xml(&panel.y_label)
-        );
-        out += &format!(
-            "<text x=\"{M}\" y=\"{}\">z = {} mm</text>\n<text x=\"{}\" y=\"{}\" text-anchor=\"end\">{} mm</text>\n",
-            top + H + 14.0,
-            fixed(z0, 1),
-            M + W,
-            top + H + 14.0,
-            fixed(z1, 1)
-        );
-        for (i, s) in panel.series.iter().enumerate() {
-            let path: Vec<String> = s
-                .points
-                .iter()
-                .filter(|p| p.1.is_finite())
-                .map(|p| format!("{},{}", fixed(sx(p.0), 2), fixed(sy(p.1), 2)))
-                .collect();
-            out += &format!(
-                "<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"1.2\" points=\"{}\"/>\n<text x=\"{}\" y=\"{}\" fill=\"{}\">{}</text>\n",
-                s.color,
-                path.join(" "),
-                M + W - 200.0,
-                top + 16.0 + 14.0 * i as f64,
-                s.color,
-                xml(&s.name)
-            );
-        }
+    if !z0.is_finite() {
+        return Err("profile.svg: nothing to draw".into());
     }
-    out += "</svg>\n";
-    out
-}
-
-fn xml(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
+    let z1 = if z1 > z0 { z1 } else { z0 + 1.0 };
+    const CHART: u32 = 300;
+    let rows: Vec<u32> = panels
+        .iter()
+        .map(|p| p.series.len().div_ceil(3) as u32)
+        .collect();
+    let height: u32 = rows.iter().map(|r| CHART + 24 * r + 8).sum();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (1100, height)).into_drawing_area();
+        let e = |e: DrawingAreaErrorKind<_>| format!("profile.svg: {e:?}");
+        root.fill(&WHITE).map_err(e)?;
+        let mut rest = root;
+        for (panel, r) in panels.iter().zip(&rows) {
+            let (area, below) = rest.split_vertically(CHART + 24 * r + 8);
+            rest = below;
+            let (top, legend_area) = area.split_vertically(CHART);
+            let pts = || {
+                panel
+                    .series
+                    .iter()
+                    .flat_map(|s| s.points.iter())
+                    .filter(|p| p.1.is_finite())
+            };
+            let (y0, y1) = pts().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                (a.min(p.1), b.max(p.1))
+            });
+            let (y0, y1) = if y1 > y0 {
+                let pad = 0.05 * (y1 - y0);
+                (y0 - pad, y1 + pad)
+            } else {
+                (y0 - 1.0, y0 + 1.0)
+            };
+            let mut chart = ChartBuilder::on(&top)
+                .caption(&panel.title, ("sans-serif", 18))
+                .margin(12)
+                .x_label_area_size(40)
+                .y_label_area_size(90)
+                .build_cartesian_2d(z0..z1, y0..y1)
+                .map_err(e)?;
+            chart
+                .configure_mesh()
+                .x_desc("z, mm")
+                .y_desc(panel.y_label.as_str())
+                .x_label_formatter(&|v| fixed(*v, super::chart::tick_decimals(z1 - z0)))
+                .y_label_formatter(&|v| fixed(*v, super::chart::tick_decimals(y1 - y0)))
+                .label_style(("sans-serif", 13))
+                .axis_desc_style(("sans-serif", 14))
+                .draw()
+                .map_err(e)?;
+            let mut items = Vec::new();
+            for s in &panel.series {
+                let c = s.color;
+                chart
+                    .draw_series(LineSeries::new(
+                        s.points.iter().copied().filter(|p| p.1.is_finite()),
+                        c.stroke_width(2),
+                    ))
+                    .map_err(e)?;
+                items.push((s.name.clone(), c));
+            }
+            super::chart::legend(&legend_area, &items, (110, 320, 3), 14).map_err(e)?;
+        }
+        rest.present().map_err(e)?;
+    }
+    Ok(svg)
 }
