@@ -1,12 +1,15 @@
 # Imports every STL under $PILGRIM_STL_DIR (default target/mesh-check) into
 # FreeCAD's Mesh workbench and checks that it is a solid: closed, oriented,
-# no non-manifold edges or points. Run: freecadcmd .ci/freecad_check.py
+# no non-manifold edges or points; then every STEP file as an exact solid
+# (below). Run: freecadcmd .ci/freecad_check.py
 # Prints "N passed, M failed" and exits non-zero on any failure.
 import glob
+import json
 import os
 import sys
 
 import Mesh
+import Part
 
 root = os.environ.get("PILGRIM_STL_DIR", "target/mesh-check")
 files = sorted(glob.glob(os.path.join(root, "**", "*.stl"), recursive=True))
@@ -27,6 +30,38 @@ for f in files:
 if not files:
     print("freecad: no STL files found under " + root)
     failed = 1
-print("freecad: %d passed, %d failed" % (len(files) - failed if files else 0, failed))
+
+# Every STEP file: read by OpenCASCADE (Part.read), a valid shape of exactly
+# one closed solid, its volume the one the test that left it found
+# independently (<name>.step.json: volume_mm3 within allowed_mm3).
+steps = sorted(glob.glob(os.path.join(root, "**", "*.step"), recursive=True))
+step_failed = 0
+for f in steps:
+    bad = []
+    try:
+        expected = json.load(open(f + ".json"))
+    except OSError:
+        expected = None
+        bad.append("no expected volume beside it")
+    shape = Part.read(f)
+    if not shape.isValid():
+        bad.append("not valid")
+    if len(shape.Solids) != 1:
+        bad.append("%d solids" % len(shape.Solids))
+    elif not all(s.isClosed() for s in shape.Solids[0].Shells):
+        bad.append("a shell is open")
+    volume = shape.Volume
+    if expected and abs(volume - expected["volume_mm3"]) > expected["allowed_mm3"]:
+        bad.append("volume %.3f, expected %.3f +- %.3f" % (
+            volume, expected["volume_mm3"], expected["allowed_mm3"]))
+    print("%s %s: %d faces, volume %.3f mm^3%s" % (
+        "FAIL" if bad else "ok  ", f, len(shape.Faces), volume,
+        (" (" + ", ".join(bad) + ")") if bad else ""))
+    step_failed += 1 if bad else 0
+if not steps:
+    print("freecad: no STEP files found under " + root)
+    step_failed = 1
+failed += step_failed
+print("freecad: %d passed, %d failed" % (len(files) + len(steps) - failed, failed))
 sys.stdout.flush()
 os._exit(1 if failed else 0)

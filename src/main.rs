@@ -77,6 +77,10 @@ enum Command {
         /// tolerances are parameters (--set).
         #[arg(long, value_name = "MM", default_value_t = pilgrim_kernel::mesh::DEFAULT_TOLERANCE)]
         mesh_tolerance: f64,
+        /// Largest deviation of the STEP solids' B-splines from the
+        /// family's profile (mm).
+        #[arg(long, value_name = "MM", default_value_t = pilgrim_kernel::step::DEFAULT_TOLERANCE)]
+        step_tolerance: f64,
         /// Write the STL files as ASCII instead of binary.
         #[arg(long)]
         stl_ascii: bool,
@@ -275,6 +279,7 @@ fn main() -> ExitCode {
             out,
             pose_block,
             mesh_tolerance,
+            step_tolerance,
             stl_ascii,
             gltf,
             script_seconds,
@@ -288,6 +293,7 @@ fn main() -> ExitCode {
                 },
                 pose_block: *pose_block,
                 mesh_tolerance: *mesh_tolerance,
+                step_tolerance: *step_tolerance,
                 script: script.clone(),
                 params: params.clone(),
                 sets: sets.clone(),

@@ -212,6 +212,13 @@ fn the_default_job_holds_its_tolerance_read_back_from_the_program() {
         "a replay that finds nothing at all is suspect: {worst}"
     );
     common::leave_for_checkers(&out, "caliber");
+    // The wheel as an exact solid: R_k0 125, r_k 8, 16 wide, by Pappus (the
+    // disc less the two corners outside the rounding).
+    let (r, rho, b) = (125.0, 8.0, 16.0);
+    let pi = std::f64::consts::PI;
+    let corner = rho * rho * (1.0 - pi / 4.0);
+    let v = pi * r * r * b - 4.0 * pi * (r - rho + 2.0 * rho / (3.0 * (4.0 - pi))) * corner;
+    common::leave_step_for_freecad(&out, "caliber", "wheel", v, 1e-6 * v);
 }
 
 /// The LZ-250 reaches the same exact poses with its four axes (its figure

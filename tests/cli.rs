@@ -82,7 +82,7 @@ fn machine_file_errors_name_file_and_line() {
     assert_eq!(code, 2);
 }
 
-const FILES: [&str; 8] = [
+const FILES: [&str; 10] = [
     "toolpath.json",
     "program.json",
     "program.mpf",
@@ -91,6 +91,8 @@ const FILES: [&str; 8] = [
     "part.stl",
     "cutter.stl",
     "scene.glb",
+    "part.step",
+    "cutter.step",
 ];
 
 #[test]
@@ -149,6 +151,24 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
         "{lo:?} {hi:?}"
     );
     common::leave_for_checkers(&a, "demo");
+    // The exact solids: the disc and the end mill (a cylinder as deep as
+    // three depths), their volumes exact.
+    let param = |n: &str| report["parameters"][n]["value"].as_f64().unwrap();
+    let cutter =
+        std::f64::consts::PI * (param("tool_diameter") / 2.0).powi(2) * 3.0 * param("depth");
+    for (name, v) in [("part", exact), ("cutter", cutter)] {
+        let solid = report["solids"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|b| b["name"] == name)
+            .unwrap();
+        assert!(
+            (solid["volume_mm3"].as_f64().unwrap() - v).abs() < 1e-3,
+            "{name}"
+        );
+        common::leave_step_for_freecad(&a, "demo", name, v, 1e-6 * v);
+    }
     // Export at another block: block 202 is the contour point at C = 196 deg
     // (block 6 is C = 0).
     let (code, out, err) = pilgrim(&["export", s(&a), "--block", "202"]);
@@ -170,6 +190,11 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
     let report: serde_json::Value =
         serde_json::from_slice(&std::fs::read(a.join("report.json")).unwrap()).unwrap();
     assert_eq!(report["pose_block"], 202);
+    // The cutter's solid moved with it; the part's did not.
+    let step = |d: &std::path::Path, f: &str| std::fs::read(d.join(f)).unwrap();
+    assert_ne!(step(&a, "cutter.step"), step(&b, "cutter.step"));
+    assert_eq!(step(&a, "part.step"), step(&b, "part.step"));
+    assert_eq!(report["solids"].as_array().unwrap().len(), 2);
     common::leave_for_checkers(&a, "demo-block200");
     // On request: ASCII STL, and .gltf with its .bin.
     let c = dir.join("c");

@@ -402,6 +402,67 @@ fn example_parameter_files_run() {
     }
 }
 
+/// The default run's STEP solids are the family's bodies: the part's and
+/// the blank's volumes those of their profiles (pi integral of x^2 by
+/// Simpson, independent of the fit) within the STEP tolerance times the
+/// lateral area, the wheel's by Pappus's theorem; FreeCAD imports them in CI
+/// (`.ci/freecad_check.py`) and checks the same volumes.
+#[test]
+fn step_solids_are_the_family_bodies() {
+    let out = common::scratch("mandrel", "step").join("out");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pilgrim"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["run", "scripts/mandrel.rhai", "-q", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    let tol = report["step_tolerance_mm"].as_f64().unwrap();
+    assert_eq!(tol, 1e-3);
+    let solid = |name: &str| {
+        report["solids"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|s| s["name"] == name)
+            .unwrap_or_else(|| panic!("no solid {name}"))
+            .clone()
+    };
+    let fam = family();
+    let values = params(&fam, &[]);
+    for body in fam.part(&values).unwrap() {
+        let pilgrim_kernel::PartGeometry::Revolution(p) = &body.geometry else {
+            panic!("{} is not a body of revolution", body.name)
+        };
+        let (v, area) = common::revolution_volume_and_area(p);
+        let s = solid(&body.name);
+        let allowed = tol * area;
+        let got = s["volume_mm3"].as_f64().unwrap();
+        assert!(
+            (got - v).abs() <= allowed,
+            "{}: {got} vs {v} +- {allowed}",
+            body.name
+        );
+        assert!(s["deviation_mm"].as_f64().unwrap() <= tol);
+        let text = std::fs::read_to_string(out.join(format!("{}.step", body.name))).unwrap();
+        assert!(text.contains(&format!("PRODUCT('{0}','{0}'", body.name)));
+        common::leave_step_for_freecad(&out, "mandrel", &body.name, v, allowed);
+    }
+    // The wheel: D 500, R_s 20, width 40 (the family's defaults): the
+    // rectangle turned less the two corners outside the rounding.
+    let (r, rho, b) = (250.0, 20.0, 40.0);
+    let pi = std::f64::consts::PI;
+    let corner = rho * rho * (1.0 - pi / 4.0);
+    let centroid = r - rho + 2.0 * rho / (3.0 * (4.0 - pi));
+    let v = pi * r * r * b - 2.0 * 2.0 * pi * centroid * corner;
+    let got = solid("wheel")["volume_mm3"].as_f64().unwrap();
+    assert!((got - v).abs() <= 1e-3, "wheel: {got} vs {v}");
+    common::leave_step_for_freecad(&out, "mandrel", "wheel", v, 1e-6 * v);
+    std::fs::remove_dir_all(out.parent().unwrap()).ok();
+}
+
 /// The report's comparison is fair and the figure holds: the uniform step it
 /// names is the longest that keeps every chord of the wheel's path within
 /// half the tolerance (a fifth longer breaks it, round the end cone's

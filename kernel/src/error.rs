@@ -78,6 +78,9 @@ pub enum Error {
     /// A mesh.
     #[error(transparent)]
     Mesh(#[from] MeshError),
+    /// An exact solid (STEP).
+    #[error(transparent)]
+    Step(#[from] crate::step::StepError),
     /// The 3-D scene.
     #[error(transparent)]
     Scene(#[from] SceneError),

@@ -18,7 +18,8 @@
 //! - [`params`], [`family`]: a part family's parameters and the
 //!   [`PartFamily`] trait;
 //! - [`toolpath`] (CL data), [`program`] (the axis program and its
-//!   post-processors), [`verify`] (the replay), [`mesh`] (3-D models);
+//!   post-processors), [`verify`] (the replay), [`mesh`] (3-D models),
+//!   [`step`] (exact solids for CAD);
 //! - [`script`] (part families in Rhai), [`plugin`] (machine plugins),
 //!   [`catalog`] (machines by name);
 //! - [`job`]: a run as one call; [`Error`]: any stage's error.
@@ -57,6 +58,7 @@ pub mod plugin;
 pub mod profile;
 pub mod program;
 pub mod script;
+pub mod step;
 pub mod tool;
 pub mod toolpath;
 pub mod transform;

@@ -185,6 +185,52 @@ pub fn leave_for_checkers(dir: &Path, tag: &str) {
     }
 }
 
+/// Leaves a run's STEP file `name.step` for `.ci/run`'s FreeCAD check
+/// (`.ci/freecad_check.py`) with the volume it must have: `volume` mm^3
+/// within `allowed`, found by the test independently of the kernel's fit.
+#[allow(dead_code)]
+pub fn leave_step_for_freecad(dir: &Path, tag: &str, name: &str, volume: f64, allowed: f64) {
+    let exe = std::env::current_exe().unwrap();
+    let check = exe.ancestors().nth(3).unwrap().join("mesh-check");
+    std::fs::create_dir_all(&check).unwrap();
+    let file = check.join(format!("{tag}-{name}.step"));
+    std::fs::copy(dir.join(format!("{name}.step")), &file).unwrap();
+    let expected = serde_json::json!({ "volume_mm3": volume, "allowed_mm3": allowed });
+    std::fs::write(
+        check.join(format!("{tag}-{name}.step.json")),
+        expected.to_string(),
+    )
+    .unwrap();
+}
+
+/// The volume of the body of revolution of `profile` and its lateral area
+/// (mm^3, mm^2), by Simpson's rule on 20,000 stretches of the profile's own
+/// curve: a test's oracle for solids made from it.
+#[allow(dead_code)]
+pub fn revolution_volume_and_area(profile: &pilgrim_kernel::Profile) -> (f64, f64) {
+    let m = 20_000;
+    let (a, b) = profile.z_range();
+    let h = (b - a) / m as f64;
+    let zs: Vec<f64> = (0..=m).map(|k| a + h * k as f64).collect();
+    let xs = profile.eval_many(&zs).unwrap();
+    let (mut v, mut area) = (0.0, 0.0);
+    for k in 0..=m {
+        let w = if k == 0 || k == m {
+            1.0
+        } else if k % 2 == 1 {
+            4.0
+        } else {
+            2.0
+        };
+        v += w * xs[k] * xs[k];
+        if k > 0 {
+            area += 0.5 * (xs[k] + xs[k - 1]) * h.hypot(xs[k] - xs[k - 1]);
+        }
+    }
+    let pi = std::f64::consts::PI;
+    (pi * v * h / 3.0, 2.0 * pi * area)
+}
+
 /// Leaves a run's LinuxCNC program and its axis program for `.ci/run`'s
 /// check with LinuxCNC's own `rs274` interpreter (`.ci/rs274_check.py`).
 #[allow(dead_code)]

@@ -13,7 +13,8 @@ use std::path::Path;
 #[derive(Debug, Clone)]
 pub struct Exported {
     /// The files (name, bytes): the tool's and the machine bodies' STLs,
-    /// `scene.glb` (and `.gltf`/`.bin` if asked), `report.json`.
+    /// the tool's STEP, `scene.glb` (and `.gltf`/`.bin` if asked),
+    /// `report.json`.
     pub files: Vec<(String, Vec<u8>)>,
     /// The block (from 1) the scene is placed at.
     pub block: usize,
@@ -117,6 +118,12 @@ pub fn export(
                     .any(|b| b.kind == "part" && &b.file == n)
         })
         .collect();
+    // The tool's exact solid moves with it.
+    let (tool_steps, tool_solids) =
+        super::solids::step_files(&[], &toolpath.tool, &pose, report.step_tolerance_mm)?;
+    report.solids.retain(|s| s.kind != "tool");
+    report.solids.extend(tool_solids);
+    all.extend(tool_steps);
     all.push(("report.json".into(), super::report_json(&report)?));
     Ok(Exported {
         files: all,

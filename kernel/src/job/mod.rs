@@ -16,12 +16,14 @@ mod deviation;
 mod export;
 mod report;
 mod scene;
+mod solids;
 mod svg;
 mod worm_files;
 
 pub use export::{export, Exported};
 pub use report::{axis_ranges, block_table, cycle_time, Report, ReportParam};
 pub use scene::{default_pose_block, BodyFile, Formats, SceneError};
+pub use solids::SolidFile;
 
 use crate::catalog::OpenMachine;
 use crate::error::Error;
@@ -46,6 +48,9 @@ pub struct JobOptions {
     pub mesh_tolerance: f64,
     /// Which 3-D files to write.
     pub formats: Formats,
+    /// Largest deviation of a STEP solid's B-spline from the family's
+    /// profile (mm).
+    pub step_tolerance: f64,
     /// Dialects to write the program in besides the control's and the CL
     /// file (`linuxcnc`: `program.ngc`).
     pub also_post: Vec<String>,
@@ -62,6 +67,7 @@ impl Default for JobOptions {
             pose_block: None,
             mesh_tolerance: crate::mesh::DEFAULT_TOLERANCE,
             formats: Formats::default(),
+            step_tolerance: crate::step::DEFAULT_TOLERANCE,
             also_post: Vec::new(),
             program_number: None,
         }
@@ -388,8 +394,8 @@ pub fn run(
             geometry: PartGeometry::Mesh(mesh),
         });
     }
-    let (pose_block, bodies) = if parts.is_empty() {
-        (None, vec![])
+    let (pose_block, bodies, solids) = if parts.is_empty() {
+        (None, vec![], vec![])
     } else {
         let meshes = scene::part_meshes(&parts, tol).map_err(|source| Error::Part {
             family: family.name().to_owned(),
@@ -406,7 +412,10 @@ pub fn run(
         let (mesh_files, bodies) =
             scene::files(&meshes, tool, pose, others, overlays, options.formats)?;
         files.extend(mesh_files);
-        (Some(index + 1), bodies)
+        let (step_files, solids) =
+            solids::step_files(&parts, &toolpath.tool, &pose, options.step_tolerance)?;
+        files.extend(step_files);
+        (Some(index + 1), bodies, solids)
     };
     let mut report = Report {
         pilgrim: crate::VERSION.into(),
@@ -441,6 +450,8 @@ pub fn run(
         pose_block,
         mesh_tolerance_mm: tol,
         bodies,
+        step_tolerance_mm: options.step_tolerance,
+        solids,
         axis_ranges: axis_ranges(&program),
         verification: verification.clone(),
         groove_verification: groove.clone(),

@@ -60,6 +60,13 @@ pub struct Report {
     /// The bodies written as STL.
     #[serde(default)]
     pub bodies: Vec<BodyFile>,
+    /// Largest deviation of a STEP solid's B-spline from the family's
+    /// profile (mm).
+    #[serde(default)]
+    pub step_tolerance_mm: f64,
+    /// The bodies written as exact solids (STEP).
+    #[serde(default)]
+    pub solids: Vec<super::solids::SolidFile>,
     /// Each programmed axis's range over the program: [min, max] (mm, deg).
     #[serde(default)]
     pub axis_ranges: BTreeMap<String, [f64; 2]>,

@@ -1,0 +1,93 @@
+//! A run's exact solids: each body of revolution of the part and the tool
+//! as a STEP file, beside the meshes (issue 14 §3).
+
+use super::scene::Files;
+use crate::family::{PartBody, PartGeometry};
+use crate::math::{Mat4, Real, Vec3};
+use crate::step::{self, StepError};
+use crate::tool::{Tool, ToolShape, WheelOrigin};
+use serde::{Deserialize, Serialize};
+
+/// One STEP file a run wrote.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SolidFile {
+    /// The body's name.
+    pub name: String,
+    /// `part` or `tool`.
+    pub kind: String,
+    /// Its STEP file.
+    pub file: String,
+    /// The solid's volume from its own section (mm^3).
+    pub volume_mm3: f64,
+    /// The largest deviation of its B-spline from the family's profile
+    /// (mm); 0 for a section of lines and arcs, which is exact.
+    pub deviation_mm: f64,
+    /// Cubic Bezier segments its profile became (0 for lines and arcs).
+    pub segments: usize,
+}
+
+/// The STEP files of the part's bodies of revolution (in the part frame)
+/// and of a wheel or end mill placed at `tool_pose` as its STL is; bodies
+/// given as meshes (the caliber's roll, the worm) and thread cutters have
+/// none.
+///
+/// # Failures
+/// A profile that pinches or a tolerance not positive ([`StepError`]).
+pub fn step_files(
+    parts: &[PartBody],
+    tool: &Tool,
+    tool_pose: &Mat4,
+    tol: Real,
+) -> Result<(Files, Vec<SolidFile>), StepError> {
+    let mut files = Vec::new();
+    let mut solids = Vec::new();
+    let mut add = |name: &str,
+                   kind: &str,
+                   section: &step::Section,
+                   pose: &Mat4,
+                   (dev, segments): (Real, usize)| {
+        let text = step::revolution_step(name, section, pose)?;
+        let file = format!("{name}.step");
+        solids.push(SolidFile {
+            name: name.to_owned(),
+            kind: kind.to_owned(),
+            file: file.clone(),
+            volume_mm3: (section.volume() * 1000.0).round() / 1000.0,
+            deviation_mm: dev,
+            segments,
+        });
+        files.push((file, text.into_bytes()));
+        Ok::<(), StepError>(())
+    };
+    for b in parts {
+        if let PartGeometry::Revolution(p) = &b.geometry {
+            let fit = step::profile_section(&b.name, p, tol)?;
+            add(
+                &b.name,
+                "part",
+                &fit.section,
+                &Mat4::identity(),
+                (fit.deviation, fit.segments),
+            )?;
+        }
+    }
+    match tool.shape {
+        ToolShape::Wheel(w) => {
+            // The wheel's section turns about its own axis, which runs
+            // along Z through (D/2, 0, 0) of the wheel frame.
+            let r = 0.5 * w.diameter;
+            let origin = match tool.origin {
+                WheelOrigin::Periphery => 0.0,
+                WheelOrigin::Centre => -r,
+            };
+            let pose = tool_pose * Mat4::new_translation(&Vec3::new(r + origin, 0.0, 0.0));
+            add("wheel", "tool", &step::wheel_section(&w), &pose, (0.0, 0))?;
+        }
+        ToolShape::EndMill { diameter, length } => {
+            let s = step::cylinder_section(diameter / 2.0, length);
+            add("cutter", "tool", &s, tool_pose, (0.0, 0))?;
+        }
+        ToolShape::Insert { .. } | ToolShape::ThreadCutter(_) => {}
+    }
+    Ok((files, solids))
+}
