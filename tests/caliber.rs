@@ -212,6 +212,11 @@ fn the_default_job_holds_its_tolerance_read_back_from_the_program() {
         "a replay that finds nothing at all is suspect: {worst}"
     );
     common::leave_for_checkers(&out, "caliber");
+    common::check_page(&out, "program.mpf");
+    assert!(std::fs::read_to_string(out.join("report.html"))
+        .unwrap()
+        .contains("Verification: the groove replayed in 3-D"));
+    common::leave_page_for_chromium(&out, "caliber");
     // The wheel as an exact solid: R_k0 125, r_k 8, 16 wide, by Pappus (the
     // disc less the two corners outside the rounding).
     let (r, rho, b) = (125.0, 8.0, 16.0);

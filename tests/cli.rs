@@ -82,7 +82,7 @@ fn machine_file_errors_name_file_and_line() {
     assert_eq!(code, 2);
 }
 
-const FILES: [&str; 10] = [
+const FILES: [&str; 11] = [
     "toolpath.json",
     "program.json",
     "program.mpf",
@@ -93,6 +93,7 @@ const FILES: [&str; 10] = [
     "scene.glb",
     "part.step",
     "cutter.step",
+    "report.html",
 ];
 
 #[test]
@@ -196,6 +197,10 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
     assert_eq!(step(&a, "part.step"), step(&b, "part.step"));
     assert_eq!(report["solids"].as_array().unwrap().len(), 2);
     common::leave_for_checkers(&a, "demo-block200");
+    // The page shows the scene as exported (its data URI is the new
+    // scene.glb).
+    common::check_page(&a, "program.mpf");
+    common::leave_page_for_chromium(&a, "demo-block202");
     // On request: ASCII STL, and .gltf with its .bin.
     let c = dir.join("c");
     let (code, _, err) = pilgrim(&["run", DEMO, "--stl-ascii", "--gltf", "--out", s(&c)]);

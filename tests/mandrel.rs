@@ -406,9 +406,11 @@ fn example_parameter_files_run() {
 /// the blank's volumes those of their profiles (pi integral of x^2 by
 /// Simpson, independent of the fit) within the STEP tolerance times the
 /// lateral area, the wheel's by Pappus's theorem; FreeCAD imports them in CI
-/// (`.ci/freecad_check.py`) and checks the same volumes.
+/// (`.ci/freecad_check.py`) and checks the same volumes. Its report page
+/// shows the run's own figures, plots, program and scene; headless Chromium
+/// opens it in CI (`.ci/page/check.js`).
 #[test]
-fn step_solids_are_the_family_bodies() {
+fn step_solids_and_page_are_the_runs() {
     let out = common::scratch("mandrel", "step").join("out");
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_pilgrim"))
         .current_dir(env!("CARGO_MANIFEST_DIR"))
@@ -460,6 +462,19 @@ fn step_solids_are_the_family_bodies() {
     let got = solid("wheel")["volume_mm3"].as_f64().unwrap();
     assert!((got - v).abs() <= 1e-3, "wheel: {got} vs {v}");
     common::leave_step_for_freecad(&out, "mandrel", "wheel", v, 1e-6 * v);
+    // The page of the same run: its figures are the run's files.
+    common::check_page(&out, "program.mpf");
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let finish = &report["verification"]["passes"][3]["deviation"];
+    assert!(page.contains(&format!(
+        "within <b>{:.5} mm</b> of the nominal; the worst at z = {:.3} mm",
+        finish["max_abs"].as_f64().unwrap(),
+        finish["at_z"].as_f64().unwrap()
+    )));
+    for f in ["profile.svg", "deviation.svg", "finish.svg"] {
+        assert!(page.contains(&format!("alt=\"{f}\"")), "{f}");
+    }
+    common::leave_page_for_chromium(&out, "mandrel");
     std::fs::remove_dir_all(out.parent().unwrap()).ok();
 }
 

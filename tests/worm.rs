@@ -316,6 +316,13 @@ fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
         );
     }
     common::leave_for_checkers(&out, "worm");
+    common::check_page(&out, "program.nc");
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(page.contains("Verification: the thread cut simulated"));
+    for f in ["passes.svg", "chip_area.svg"] {
+        assert!(page.contains(&format!("alt=\"{f}\"")), "{f}");
+    }
+    common::leave_page_for_chromium(&out, "worm");
 }
 
 #[test]

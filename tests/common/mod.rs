@@ -185,6 +185,82 @@ pub fn leave_for_checkers(dir: &Path, tag: &str) {
     }
 }
 
+/// Leaves a run's `report.html` for `.ci/run`'s headless-Chromium check
+/// (`.ci/page/check.js`), which keeps its screenshot beside it.
+#[allow(dead_code)]
+pub fn leave_page_for_chromium(dir: &Path, tag: &str) {
+    let exe = std::env::current_exe().unwrap();
+    let check = exe.ancestors().nth(3).unwrap().join("page-check");
+    std::fs::create_dir_all(&check).unwrap();
+    std::fs::copy(
+        dir.join("report.html"),
+        check.join(format!("{tag}-report.html")),
+    )
+    .unwrap();
+}
+
+/// Checks a run's `report.html` against the run's own files: the summary's
+/// figures, every plot (its data URI decoding to the file's bytes), the
+/// program's first and last lines, the 3-D scene (its data URI decoding to
+/// `scene.glb`), and nothing fetched from anywhere.
+#[allow(dead_code)]
+pub fn check_page(dir: &Path, program_file: &str) {
+    use base64::Engine;
+    let page = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
+    let b64 = base64::engine::general_purpose::STANDARD;
+    // The data URI after `marker`, decoded.
+    let uri = |marker: &str| -> Vec<u8> {
+        let at = page.find(marker).unwrap_or_else(|| panic!("no {marker}")) + marker.len();
+        let end = at + page[at..].find('"').unwrap();
+        b64.decode(&page[at..end]).unwrap()
+    };
+    assert!(page.starts_with("<!DOCTYPE html>"));
+    assert!(page.contains(&format!(
+        "<td>blocks</td><td>{}</td>",
+        report["blocks"].as_u64().unwrap()
+    )));
+    let svgs: Vec<&str> = report["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|f| f.as_str())
+        .filter(|f| f.ends_with(".svg"))
+        .collect();
+    for f in &svgs {
+        let svg = uri(&format!(
+            "<img alt=\"{f}\" src=\"data:image/svg+xml;base64,"
+        ));
+        assert_eq!(svg, std::fs::read(dir.join(f)).unwrap(), "{f}");
+    }
+    assert_eq!(page.matches("<figure>").count(), svgs.len());
+    let glb = uri("src=\"data:model/gltf-binary;base64,");
+    assert_eq!(glb, std::fs::read(dir.join("scene.glb")).unwrap());
+    let program = std::fs::read_to_string(dir.join(program_file)).unwrap();
+    let escape = |l: &str| {
+        l.replace('&', "&amp;")
+            .replace('<', "&lt;")
+            .replace('>', "&gt;")
+    };
+    let (first, last) = (
+        program.lines().next().unwrap(),
+        program.lines().last().unwrap(),
+    );
+    assert!(page.contains(&escape(first)) && page.contains(&escape(last)));
+    for (name, p) in report["parameters"].as_object().unwrap() {
+        assert!(page.contains(&format!("<td>{name}</td>")), "{name}");
+        let unit = p["unit"].as_str().unwrap();
+        assert!(
+            page.contains(&format!("<td>{}</td></tr>", escape(unit))),
+            "{unit}"
+        );
+    }
+    for bad in ["src=\"http", "href=\"http", "<link ", "src=\"//"] {
+        assert!(!page.contains(bad), "the page fetches: {bad}");
+    }
+}
+
 /// Leaves a run's STEP file `name.step` for `.ci/run`'s FreeCAD check
 /// (`.ci/freecad_check.py`) with the volume it must have: `volume` mm^3
 /// within `allowed`, found by the test independently of the kernel's fit.

@@ -14,7 +14,7 @@ use std::path::Path;
 pub struct Exported {
     /// The files (name, bytes): the tool's and the machine bodies' STLs,
     /// the tool's STEP, `scene.glb` (and `.gltf`/`.bin` if asked),
-    /// `report.json`.
+    /// `report.html`, `report.json`.
     pub files: Vec<(String, Vec<u8>)>,
     /// The block (from 1) the scene is placed at.
     pub block: usize,
@@ -124,6 +124,32 @@ pub fn export(
     report.solids.retain(|s| s.kind != "tool");
     report.solids.extend(tool_solids);
     all.extend(tool_steps);
+    // The page shows the new scene, with the run's plots and program.
+    let control = crate::program::post::dialect(&report.control).ok_or_else(|| {
+        Error::Read(format!(
+            "{}: report.json names the control '{}', which pilgrim does not know",
+            dir.display(),
+            crate::files::excerpt(&report.control)
+        ))
+    })?;
+    let program_file = format!("program.{}", control.extension);
+    let mut shown: Vec<(String, Vec<u8>)> = Vec::new();
+    // Only plots the run names by plain names, and its program.
+    let plot = |n: &str| {
+        n.strip_suffix(".svg")
+            .is_some_and(crate::files::is_plain_name)
+    };
+    for name in report
+        .files
+        .iter()
+        .filter(|n| plot(n) || **n == program_file)
+    {
+        shown.push((name.clone(), read(name)?.into_bytes()));
+    }
+    shown.extend(all.iter().filter(|f| f.0 == "scene.glb").cloned());
+    let part_box = scene::bounds_of(parts.iter().map(|(_, m)| m));
+    let html = super::page::page_of(&report, &shown, control.extension, part_box);
+    all.push(("report.html".into(), html.into_bytes()));
     all.push(("report.json".into(), super::report_json(&report)?));
     Ok(Exported {
         files: all,

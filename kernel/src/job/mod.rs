@@ -14,6 +14,7 @@
 mod chart;
 mod deviation;
 mod export;
+mod page;
 mod report;
 mod scene;
 mod solids;
@@ -394,13 +395,15 @@ pub fn run(
             geometry: PartGeometry::Mesh(mesh),
         });
     }
-    let (pose_block, bodies, solids) = if parts.is_empty() {
-        (None, vec![], vec![])
+    let (pose_block, bodies, solids, part_box) = if parts.is_empty() {
+        (None, vec![], vec![], None)
     } else {
         let meshes = scene::part_meshes(&parts, tol).map_err(|source| Error::Part {
             family: family.name().to_owned(),
             source,
         })?;
+        // Where the report page's camera points: the part's middle.
+        let part_box = scene::bounds_of(meshes.iter().map(|(_, m)| m));
         let index = pose_index;
         let pose = scene::tool_pose(&program, kin, &toolpath.tool, index)?;
         let tool = scene::tool_mesh(&toolpath.tool, tol)?;
@@ -415,7 +418,7 @@ pub fn run(
         let (step_files, solids) =
             solids::step_files(&parts, &toolpath.tool, &pose, options.step_tolerance)?;
         files.extend(step_files);
-        (Some(index + 1), bodies, solids)
+        (Some(index + 1), bodies, solids, part_box)
     };
     let mut report = Report {
         pilgrim: crate::VERSION.into(),
@@ -539,6 +542,9 @@ pub fn run(
             report.files.push(name);
         }
     }
+    report.files.push("report.html".into());
+    let html = page::page_of(&report, &files, control.extension, part_box);
+    files.push(("report.html".into(), html.into_bytes()));
     files.push(("report.json".into(), report_json(&report)?));
     Ok(JobOutput {
         params: values,

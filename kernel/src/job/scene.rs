@@ -73,6 +73,16 @@ pub fn part_meshes(parts: &[PartBody], tol: f64) -> Result<Vec<(String, TriMesh)
         .collect()
 }
 
+/// The bounding box of `meshes` together (`None` for none).
+pub fn bounds_of<'a>(meshes: impl Iterator<Item = &'a TriMesh>) -> Option<([f64; 3], [f64; 3])> {
+    meshes.map(TriMesh::bounds).reduce(|a, b| {
+        (
+            std::array::from_fn(|k| a.0[k].min(b.0[k])),
+            std::array::from_fn(|k| a.1[k].max(b.1[k])),
+        )
+    })
+}
+
 /// The thickness of a thread cutter's blade in the 3-D models (mm): the
 /// cutter's section is its cutting edge; the blade only shows it.
 pub const CUTTER_BLADE: f64 = 6.0;

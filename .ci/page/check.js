@@ -1,0 +1,130 @@
+// Opens every report.html under the directory given (default
+// target/page-check) in headless Chromium (Debian's, /usr/bin/chromium, or
+// $CHROMIUM) and checks, for each page:
+// - no console errors, no uncaught exceptions, no network request (the page
+//   must stand alone: everything is inline or a data: URI);
+// - every plot decoded (each <figure> image has a size);
+// - the 3-D view loaded scene.glb and drew it: a screenshot of the viewer,
+//   kept beside the page as <name>.png, with pixels other than the
+//   background over at least 1% of the view and in the middle, where the
+//   camera points (the middle of the part);
+// and that the viewer pilgrim inlines is byte for byte the pinned npm
+// release (package.json).
+// Run: npm ci --prefix .ci/page && node .ci/page/check.js target/page-check
+"use strict";
+const fs = require("fs");
+const path = require("path");
+const puppeteer = require("puppeteer-core");
+const { PNG } = require("pngjs");
+
+const root = process.argv[2] || "target/page-check";
+const chromium = process.env.CHROMIUM || "/usr/bin/chromium";
+// The viewer's background (model-viewer { background: #20262e }).
+const BACKGROUND = [0x20, 0x26, 0x2e];
+
+function pages(dir) {
+  if (!fs.existsSync(dir)) return [];
+  return fs.readdirSync(dir, { withFileTypes: true }).flatMap((e) => {
+    const p = path.join(dir, e.name);
+    if (e.isDirectory()) return pages(p);
+    return e.name.endsWith(".html") ? [p] : [];
+  });
+}
+
+function drawn(png) {
+  const differs = (x, y) => {
+    const i = (png.width * y + x) << 2;
+    return BACKGROUND.some((c, k) => Math.abs(png.data[i + k] - c) > 12);
+  };
+  let all = 0;
+  for (let y = 0; y < png.height; y++) {
+    for (let x = 0; x < png.width; x++) all += differs(x, y) ? 1 : 0;
+  }
+  let centre = 0;
+  const [cx, cy, h] = [png.width >> 1, png.height >> 1, 7];
+  for (let y = cy - h; y <= cy + h; y++) {
+    for (let x = cx - h; x <= cx + h; x++) centre += differs(x, y) ? 1 : 0;
+  }
+  return { share: all / (png.width * png.height), centre: centre / (2 * h + 1) ** 2 };
+}
+
+async function check(browser, file) {
+  const problems = [];
+  const page = await browser.newPage();
+  await page.setViewport({ width: 1200, height: 900 });
+  page.on("console", (m) => {
+    if (m.type() === "error") problems.push("console error: " + m.text());
+  });
+  page.on("pageerror", (e) => problems.push("uncaught: " + e.message));
+  await page.setRequestInterception(true);
+  page.on("request", (r) => {
+    const url = r.url();
+    if (url.startsWith("data:") || url.startsWith("blob:") || url === "file://" + file) {
+      r.continue();
+    } else {
+      problems.push("network request: " + url.slice(0, 120));
+      r.abort();
+    }
+  });
+  await page.goto("file://" + file, { waitUntil: "load" });
+  const figures = await page.$$eval("figure img", (imgs) =>
+    imgs.map((i) => [i.alt, i.naturalWidth > 0 && i.naturalHeight > 0])
+  );
+  for (const [alt, ok] of figures) if (!ok) problems.push("plot not drawn: " + alt);
+  let view = "no 3-D view";
+  if (await page.$("model-viewer")) {
+    await page
+      .waitForFunction(() => document.body.dataset.model, { timeout: 120000 })
+      .catch(() => problems.push("scene.glb never loaded (120 s)"));
+    const state = await page.evaluate(() => document.body.dataset.model);
+    if (state !== "loaded") problems.push("3-D view: " + state);
+    // Let the viewer render a few frames at rest.
+    await page.evaluate(
+      () => new Promise((ok) => requestAnimationFrame(() => requestAnimationFrame(() => setTimeout(ok, 500))))
+    );
+    const shot = file.replace(/\.html$/, ".png");
+    const el = await page.$("model-viewer");
+    await el.screenshot({ path: shot });
+    const d = drawn(PNG.sync.read(fs.readFileSync(shot)));
+    view = `3-D view ${(100 * d.share).toFixed(1)}% drawn, middle ${(100 * d.centre).toFixed(0)}% (${path.basename(shot)})`;
+    if (d.share < 0.01) problems.push("the 3-D view is blank");
+    if (d.centre < 0.5) problems.push("nothing drawn where the camera points");
+  }
+  await page.close();
+  console.log(
+    `${problems.length ? "FAIL" : "ok  "} ${file}: ${figures.length} plots, ${view}` +
+      (problems.length ? "\n     " + problems.join("\n     ") : "")
+  );
+  return problems.length === 0;
+}
+
+(async () => {
+  let failed = 0;
+  const vendored = path.join(__dirname, "../../kernel/assets/model-viewer/model-viewer.min.js");
+  const release = require.resolve("@google/model-viewer/dist/model-viewer.min.js");
+  if (!fs.readFileSync(vendored).equals(fs.readFileSync(release))) {
+    console.log("FAIL kernel/assets/model-viewer/model-viewer.min.js is not the pinned release's");
+    failed++;
+  }
+  const files = pages(root).map((f) => path.resolve(f));
+  if (files.length === 0) {
+    console.log("page: no report.html under " + root);
+    process.exit(1);
+  }
+  const browser = await puppeteer.launch({
+    executablePath: chromium,
+    headless: true,
+    args: ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--ignore-gpu-blocklist"],
+  });
+  for (const f of files) {
+    try {
+      if (!(await check(browser, f))) failed++;
+    } catch (e) {
+      console.log(`FAIL ${f}: ${e.message}`);
+      failed++;
+    }
+  }
+  await browser.close();
+  console.log(`page: ${files.length - failed} passed, ${failed} failed`);
+  process.exit(failed ? 1 : 0);
+})();

@@ -1,0 +1,392 @@
+//! `report.html`: a run on one self-contained page (issue 14 §2).
+//!
+//! Opened from disk with no server and no network: the summary (family,
+//! machine, parameters with units, passes, blocks, cycle time, checks, the
+//! verification's figures and where the worst is), every plot the run drew,
+//! the program's first and last blocks, and the 3-D scene (`scene.glb`, as a
+//! data URI) in `<model-viewer>` (Google's web component over three.js,
+//! orbit and zoom), whose pinned release is inlined from
+//! `kernel/assets/model-viewer/` with its licences.
+//!
+//! The HTML is written here by hand: a few tables and figures need no
+//! template engine, and [`escape`] is the one rule every text obeys.
+
+use super::Report;
+use crate::math::fixed;
+use base64::Engine;
+use std::fmt::Write;
+
+/// `<model-viewer>` 4.4.0 (npm `@google/model-viewer`, Apache-2.0; it
+/// bundles three.js, MIT, and lit, BSD-3-Clause, whose licence headers the
+/// file keeps). CI holds it equal to the npm release (`.ci/page`).
+const MODEL_VIEWER: &str = include_str!("../../assets/model-viewer/model-viewer.min.js");
+
+/// The viewer's name and version, as the page credits it.
+pub const VIEWER: &str = "@google/model-viewer 4.4.0";
+
+/// How many lines of the program the page shows from its start and end.
+const HEAD_LINES: usize = 30;
+const TAIL_LINES: usize = 12;
+
+/// Escapes text for HTML (element content and quoted attributes).
+fn escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// What the page is made of besides the report.
+pub struct PageInputs<'a> {
+    /// The run's report.
+    pub report: &'a Report,
+    /// The plots (file name, SVG text), in the order the run made them.
+    pub plots: Vec<(&'a str, &'a [u8])>,
+    /// The control's program: its file name and text.
+    pub program: (&'a str, &'a str),
+    /// `scene.glb`, and the part's bounding box in the part frame (mm),
+    /// where the camera points.
+    pub scene: Option<(&'a [u8], [f64; 3], [f64; 3])>,
+}
+
+/// A table row of cells (already escaped).
+fn row(out: &mut String, cells: &[String]) {
+    out.push_str("<tr>");
+    for c in cells {
+        let _ = write!(out, "<td>{c}</td>");
+    }
+    out.push_str("</tr>\n");
+}
+
+/// The verification's figures, and where the worst is.
+fn verification(out: &mut String, r: &Report) {
+    if let Some(v) = &r.verification {
+        let _ = write!(
+            out,
+            "<h2>Verification: the program replayed</h2>\n<p>Tolerance {} mm; {} generatrices; values read at {} mm as written.</p>\n",
+            fixed(v.tolerance, 4),
+            v.generatrices,
+            fixed(v.resolution_mm, 4)
+        );
+        if let Some(f) = v.passes.last() {
+            let block = f.deviation.block.map_or_else(String::new, |b| {
+                format!(", {}", escape(&crate::program::block_label(&r.control, b)))
+            });
+            let _ = writeln!(
+                out,
+                "<p class=\"verdict\">Finish ({}) within <b>{} mm</b> of the nominal; the worst at z = {} mm{block}.</p>",
+                escape(&f.name),
+                fixed(f.deviation.max_abs, 5),
+                fixed(f.deviation.at_z, 3)
+            );
+        }
+        out.push_str("<table><tr><th>pass</th><th>feed, mm/min</th><th>feed a rev, mm</th><th>ridge, um</th><th>highest, um (z)</th><th>lowest, um (z)</th></tr>\n");
+        for p in &v.passes {
+            row(
+                out,
+                &[
+                    escape(&p.name),
+                    fixed(p.feed_mm_min, 1),
+                    fixed(p.feed_per_rev_mm, 3),
+                    fixed(p.ridge_mm * 1e3, 2),
+                    format!(
+                        "{} ({})",
+                        fixed(p.deviation.max_above * 1e3, 2),
+                        fixed(p.deviation.above_z, 2)
+                    ),
+                    format!(
+                        "{} ({})",
+                        fixed(p.deviation.max_below * 1e3, 2),
+                        fixed(p.deviation.below_z, 2)
+                    ),
+                ],
+            );
+        }
+        out.push_str("</table>\n");
+    }
+    if let Some(g) = &r.groove_verification {
+        let place = |p: &crate::caliber::GroovePlace| {
+            format!(
+                "{} mm at theta {} deg, psi {} deg ({})",
+                fixed(p.mm, 5),
+                fixed(p.theta_deg, 2),
+                fixed(p.psi_deg, 2),
+                escape(&p.block)
+            )
+        };
+        let _ = write!(
+            out,
+            "<h2>Verification: the groove replayed in 3-D</h2>\n<p class=\"verdict\">Within <b>{} mm</b> of the groove (tolerance {} mm) on {} samples.</p>\n<table>\n",
+            fixed(g.max_abs_mm, 5),
+            fixed(g.tolerance, 4),
+            g.samples
+        );
+        row(out, &["most material left".into(), place(&g.max_left)]);
+        row(out, &["deepest gouge".into(), place(&g.max_gouge)]);
+        out.push_str("</table>\n");
+    }
+    if let Some(w) = &r.worm_verification {
+        let _ = write!(
+            out,
+            "<h2>Verification: the thread cut simulated</h2>\n<p class=\"verdict\">Chips {} of {} mm<sup>2</sup> of space; flank loads {} / {} mm<sup>2</sup>; lead error {} mm.</p>\n",
+            fixed(w.removed_area, 3),
+            fixed(w.space_area, 3),
+            fixed(w.flank_loads[0], 1),
+            fixed(w.flank_loads[1], 1),
+            fixed(w.lead_error, 5)
+        );
+        out.push_str("<table><tr><th>start</th><th>flank angles, deg</th><th>form, um</th><th>thickness, mm</th><th>root / tip, mm</th><th>place, um</th></tr>\n");
+        for s in &w.starts {
+            row(
+                out,
+                &[
+                    s.start.to_string(),
+                    format!(
+                        "{} / {}",
+                        fixed(s.left_angle_deg, 4),
+                        fixed(s.right_angle_deg, 4)
+                    ),
+                    format!(
+                        "{} / {}",
+                        fixed(s.left_form * 1e3, 2),
+                        fixed(s.right_form * 1e3, 2)
+                    ),
+                    fixed(s.thickness, 4),
+                    format!(
+                        "{} / {}",
+                        fixed(s.root_diameter, 3),
+                        fixed(s.tip_diameter, 3)
+                    ),
+                    fixed(s.position_error * 1e3, 2),
+                ],
+            );
+        }
+        out.push_str("</table>\n");
+    }
+}
+
+/// The page's text.
+pub fn report_html(inputs: &PageInputs<'_>) -> String {
+    let r = inputs.report;
+    let b64 = base64::engine::general_purpose::STANDARD;
+    let mut out = String::with_capacity(
+        MODEL_VIEWER.len() + inputs.scene.map_or(0, |s| s.0.len() * 4 / 3) + 200_000,
+    );
+    let title = format!("pilgrim: {} on {}", r.script, r.machine);
+    let _ = write!(
+        out,
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n<style>\n{}</style>\n</head>\n<body>\n<h1>{}</h1>\n",
+        escape(&title),
+        STYLE,
+        escape(&title)
+    );
+    let _ = writeln!(
+        out,
+        "<p class=\"sub\">pilgrim {}; control {}; machine given as {}.</p>",
+        escape(&r.pilgrim),
+        escape(&r.control),
+        escape(&r.machine_spec)
+    );
+    out.push_str("<h2>Summary</h2>\n<table>\n");
+    for (k, v) in [
+        (
+            "passes",
+            format!("{} ({} cutting)", r.passes, r.cutting_passes),
+        ),
+        ("toolpath points", r.points.to_string()),
+        ("blocks", r.blocks.to_string()),
+        ("cycle time", format!("{} min", fixed(r.cycle_time_min, 2))),
+        (
+            "3-D pose",
+            r.pose_block.map_or("none".into(), |b| {
+                format!(
+                    "block {b} ({})",
+                    crate::program::block_label(&r.control, b - 1)
+                )
+            }),
+        ),
+        ("files", r.files.join(", ")),
+    ] {
+        row(&mut out, &[k.into(), escape(&v)]);
+    }
+    out.push_str("</table>\n");
+    verification(&mut out, r);
+    if !r.warnings.is_empty() {
+        out.push_str("<h2>Warnings</h2>\n<ul class=\"warn\">\n");
+        for w in &r.warnings {
+            let _ = writeln!(out, "<li>{}</li>", escape(w));
+        }
+        out.push_str("</ul>\n");
+    }
+    out.push_str("<h2>Checks</h2>\n<table><tr><th>check</th><th></th><th>detail</th></tr>\n");
+    for c in &r.checks {
+        row(
+            &mut out,
+            &[
+                escape(&c.name),
+                if c.ok { "ok" } else { "FAILED" }.into(),
+                escape(&c.detail),
+            ],
+        );
+    }
+    out.push_str("</table>\n");
+    if !inputs.plots.is_empty() {
+        out.push_str("<h2>Plots</h2>\n");
+        for (name, svg) in &inputs.plots {
+            let _ = writeln!(
+                out,
+                "<figure><img alt=\"{0}\" src=\"data:image/svg+xml;base64,{1}\"><figcaption>{0}</figcaption></figure>",
+                escape(name),
+                b64.encode(svg)
+            );
+        }
+    }
+    match inputs.scene {
+        Some((glb, lo, hi)) => {
+            // The scene's root turns the part frame's Z up to glTF's Y up
+            // and scales mm to m: (X, Y, Z) -> (X, Z, -Y) / 1000.
+            let c = [
+                0.5 * (lo[0] + hi[0]),
+                0.5 * (lo[1] + hi[1]),
+                0.5 * (lo[2] + hi[2]),
+            ];
+            let target = format!(
+                "{}m {}m {}m",
+                fixed(c[0] / 1e3, 6),
+                fixed(c[2] / 1e3, 6),
+                fixed(-c[1] / 1e3, 6)
+            );
+            let _ = writeln!(
+                out,
+                "<h2>3-D: part, tool and machine at the pose block</h2>\n<p>Drag to orbit, wheel or pinch to zoom, right-drag to pan; the camera points at the middle of the part. {VIEWER}.</p>\n<model-viewer id=\"scene\" alt=\"the part, the tool and the machine's bodies at the pose block\" src=\"data:model/gltf-binary;base64,{}\" loading=\"eager\" camera-controls interaction-prompt=\"none\" camera-target=\"{target}\" camera-orbit=\"0deg 75deg auto\" shadow-intensity=\"0\"></model-viewer>",
+                b64.encode(glb)
+            );
+        }
+        None => out.push_str(
+            "<h2>3-D</h2>\n<p>No 3-D models: the family has no <code>fn part(p)</code>.</p>\n",
+        ),
+    }
+    let (file, text) = inputs.program;
+    let lines: Vec<&str> = text.lines().collect();
+    let _ = writeln!(
+        out,
+        "<h2>Program: {} ({} lines)</h2>",
+        escape(file),
+        lines.len()
+    );
+    out.push_str("<pre>");
+    if lines.len() <= HEAD_LINES + TAIL_LINES {
+        out.push_str(&escape(text));
+    } else {
+        for l in &lines[..HEAD_LINES] {
+            let _ = writeln!(out, "{}", escape(l));
+        }
+        let _ = writeln!(
+            out,
+            "<span class=\"gap\">... {} lines ...</span>",
+            lines.len() - HEAD_LINES - TAIL_LINES
+        );
+        for l in &lines[lines.len() - TAIL_LINES..] {
+            let _ = writeln!(out, "{}", escape(l));
+        }
+    }
+    out.push_str(
+        "</pre>\n<h2>Parameters</h2>\n<table><tr><th>name</th><th>value</th><th>unit</th></tr>\n",
+    );
+    for (name, p) in &r.parameters {
+        let value = serde_json::to_string(&p.value).unwrap_or_default();
+        row(&mut out, &[escape(name), escape(&value), escape(&p.unit)]);
+    }
+    out.push_str("</table>\n");
+    if !r.notes.is_empty() {
+        out.push_str("<h2>Figures the family noted</h2>\n<table>\n");
+        for (k, v) in &r.notes {
+            row(&mut out, &[escape(k), format!("{v}")]);
+        }
+        out.push_str("</table>\n");
+    }
+    if inputs.scene.is_some() {
+        // The state of the 3-D view for whoever watches the page (and the
+        // headless check): data-model on <body> becomes "loaded" or "error".
+        out.push_str(
+            "<script>\nconst viewer = document.getElementById('scene');\n\
+             viewer.addEventListener('load', () => { document.body.dataset.model = 'loaded'; });\n\
+             viewer.addEventListener('error', (e) => { document.body.dataset.model = 'error'; console.error('scene.glb did not load', e.detail); });\n\
+             </script>\n<script type=\"module\">\n",
+        );
+        // The bundle holds no "</script"; were a release to, this keeps
+        // the element closed where it should be.
+        out.push_str(&MODEL_VIEWER.replace("</script", "<\\/script"));
+        out.push_str("\n</script>\n");
+    }
+    out.push_str("</body>\n</html>\n");
+    out
+}
+
+/// The page of a run from its files (name, bytes): the plots (`.svg`), the
+/// control's program (`program.<extension>`) and `scene.glb`, the camera
+/// on `part_box` (the part's bounding box, mm).
+pub(super) fn page_of(
+    report: &Report,
+    files: &[(String, Vec<u8>)],
+    extension: &str,
+    part_box: Option<([f64; 3], [f64; 3])>,
+) -> String {
+    let find = |name: &str| files.iter().find(|f| f.0 == name).map(|f| f.1.as_slice());
+    let program_file = format!("program.{extension}");
+    report_html(&PageInputs {
+        report,
+        plots: files
+            .iter()
+            .filter(|f| f.0.ends_with(".svg"))
+            .map(|f| (f.0.as_str(), f.1.as_slice()))
+            .collect(),
+        program: (
+            &program_file,
+            std::str::from_utf8(find(&program_file).unwrap_or_default()).unwrap_or_default(),
+        ),
+        scene: find("scene.glb")
+            .zip(part_box)
+            .map(|(glb, (lo, hi))| (glb, lo, hi)),
+    })
+}
+
+/// The page's style: readable on screen and on A4.
+const STYLE: &str = "body { font: 14px/1.45 system-ui, sans-serif; margin: 24px auto; max-width: 1100px; padding: 0 16px; color: #1b1f24; }
+h1 { font-size: 22px; margin-bottom: 2px; }
+h2 { font-size: 17px; margin-top: 28px; border-bottom: 1px solid #ccd; }
+.sub { color: #556; margin-top: 0; }
+.verdict { font-size: 15px; }
+table { border-collapse: collapse; margin: 6px 0; }
+td, th { border: 1px solid #ccd; padding: 3px 8px; text-align: left; vertical-align: top; }
+th { background: #eef0f4; }
+ul.warn li { color: #8a4b00; }
+figure { margin: 12px 0; }
+figure img { max-width: 100%; height: auto; border: 1px solid #ddd; }
+figcaption { color: #556; font-size: 12px; }
+model-viewer { width: 100%; height: 520px; background: #20262e; display: block; }
+pre { background: #f6f7f9; border: 1px solid #dde; padding: 8px; overflow-x: auto; font-size: 12px; }
+.gap { color: #889; }
+@media print { model-viewer { display: none; } body { max-width: none; } }
+";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn text_is_escaped() {
+        assert_eq!(
+            escape("<a href=\"x\">'&'</a>"),
+            "&lt;a href=&quot;x&quot;&gt;&#39;&amp;&#39;&lt;/a&gt;"
+        );
+    }
+}
