@@ -212,6 +212,23 @@ fn the_default_job_holds_its_tolerance_read_back_from_the_program() {
         "a replay that finds nothing at all is suspect: {worst}"
     );
     common::leave_for_checkers(&out, "caliber");
+    // The heat map marks the report's worst places with their figures; the
+    // section draws the wheel's rounding once per cutting pass.
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    let g = &report["groove_verification"];
+    let map = std::fs::read_to_string(out.join("deviation_map.svg")).unwrap();
+    for (key, name) in [("max_left", "most left"), ("max_gouge", "deepest gouge")] {
+        let um = g[key]["mm"].as_f64().unwrap() * 1e3;
+        assert!(map.contains(&format!("{name} {um:.2} um")), "{name} {um}");
+    }
+    let section = std::fs::read_to_string(out.join("section.svg")).unwrap();
+    assert_eq!(
+        section
+            .matches("opacity=\"0.35\" stroke=\"#2A6FD8\"")
+            .count(),
+        report["cutting_passes"].as_u64().unwrap() as usize
+    );
     common::check_page(&out, "program.mpf");
     assert!(std::fs::read_to_string(out.join("report.html"))
         .unwrap()

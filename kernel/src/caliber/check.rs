@@ -128,6 +128,67 @@ pub struct GrooveCheck {
     /// The contact patch at the scene's block (set by the job).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub patch: Option<ContactPatch>,
+    /// The distances over the grid, in cells that keep their extremes
+    /// (for the heat map; not in the report).
+    #[serde(skip)]
+    pub map: DeviationMap,
+}
+
+/// The most cells a [`DeviationMap`] has along theta and across the groove.
+pub const MAP_CELLS: (usize, usize) = (240, 60);
+
+/// Distances from the groove to the swept wheel (mm, + material left, -
+/// gouge) over a grid of theta and psi, each cell the grid points' value of
+/// largest size.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct DeviationMap {
+    /// The cells' edges along theta (deg), one more than the cells.
+    pub theta_deg: Vec<Real>,
+    /// The cells' edges across the groove (deg), one more than the cells.
+    pub psi_deg: Vec<Real>,
+    /// The cells' values, row by row of theta.
+    pub mm: Vec<Real>,
+}
+
+impl DeviationMap {
+    /// The map of `values` (row by row of `thetas`, a value per `psis`)
+    /// in at most [`MAP_CELLS`] cells.
+    fn of(thetas: &[Real], psis: &[Real], values: &[Real]) -> Self {
+        let cells = |n: usize, max: usize| n.clamp(1, max);
+        let (nt, np) = (
+            cells(thetas.len(), MAP_CELLS.0),
+            cells(psis.len(), MAP_CELLS.1),
+        );
+        let bucket = |i: usize, n: usize, of: usize| (i * of / n.max(1)).min(of - 1);
+        let mut mm: Vec<Real> = vec![0.0; nt * np];
+        let mut seen = vec![false; nt * np];
+        for (i, _) in thetas.iter().enumerate() {
+            for (j, _) in psis.iter().enumerate() {
+                let v = values[i * psis.len() + j];
+                let c = bucket(i, thetas.len(), nt) * np + bucket(j, psis.len(), np);
+                if !seen[c] || v.abs() > mm[c].abs() {
+                    mm[c] = v;
+                    seen[c] = true;
+                }
+            }
+        }
+        // Edges halfway between the grid points that start each cell.
+        let edges = |xs: &[Real], n: usize| -> Vec<Real> {
+            let first = |k: usize| (k * xs.len()).div_ceil(n).min(xs.len() - 1);
+            let mut e = vec![xs[0]];
+            for k in 1..n {
+                let i = first(k);
+                e.push(0.5 * (xs[i - 1] + xs[i]));
+            }
+            e.push(xs[xs.len() - 1]);
+            e.iter().map(|r| r.to_degrees()).collect()
+        };
+        Self {
+            theta_deg: edges(thetas, nt),
+            psi_deg: edges(psis, np),
+            mm,
+        }
+    }
 }
 
 /// The signed distance from `q` to the wheel `w` (a torus with the disc
@@ -447,6 +508,11 @@ pub fn check_groove(
         max_gouge,
         max_abs_mm: max_abs,
         patch: None,
+        map: DeviationMap::of(
+            &thetas,
+            &psi_grid.iter().map(|p| p.0).collect::<Vec<_>>(),
+            &dist.iter().map(|d| d.0).collect::<Vec<_>>(),
+        ),
     };
     if max_abs > req.tolerance {
         let worst = if check.max_left.mm >= -check.max_gouge.mm {
@@ -590,5 +656,50 @@ pub fn contact_patch(
             points: inside.iter().filter(|&&b| b).count(),
         };
         return Ok(Some((patch, mesh)));
+    }
+}
+
+#[cfg(test)]
+mod map_tests {
+    use super::*;
+
+    /// A grid larger than the map's cells keeps each cell's value of
+    /// largest size, so the extremes survive; the edges span the grid.
+    #[test]
+    fn the_map_keeps_the_extremes() {
+        let thetas: Vec<Real> = (0..1000).map(|i| (i as Real * 0.2).to_radians()).collect();
+        let psis: Vec<Real> = (0..101)
+            .map(|j| ((j as Real - 50.0) * 1.6).to_radians())
+            .collect();
+        let mut values: Vec<Real> = (0..thetas.len() * psis.len())
+            .map(|k| 1e-3 * ((k % 7) as Real - 3.0) / 10.0)
+            .collect();
+        values[123 * 101 + 17] = 0.0042;
+        values[777 * 101 + 99] = -0.0031;
+        let m = DeviationMap::of(&thetas, &psis, &values);
+        assert_eq!(m.theta_deg.len(), MAP_CELLS.0 + 1);
+        assert_eq!(m.psi_deg.len(), MAP_CELLS.1 + 1);
+        assert_eq!(m.mm.len(), MAP_CELLS.0 * MAP_CELLS.1);
+        let max = m.mm.iter().copied().fold(Real::MIN, Real::max);
+        let min = m.mm.iter().copied().fold(Real::MAX, Real::min);
+        assert_eq!((max, min), (0.0042, -0.0031));
+        assert!(
+            (m.theta_deg[0] - 0.0).abs() < 1e-12 && (m.theta_deg[MAP_CELLS.0] - 199.8).abs() < 1e-9
+        );
+        assert!((m.psi_deg[0] + 80.0).abs() < 1e-9 && (m.psi_deg[MAP_CELLS.1] - 80.0).abs() < 1e-9);
+        assert!(m.theta_deg.windows(2).all(|w| w[1] > w[0]));
+        // The 0.0042 at theta 24.6 deg, psi -52.8 deg lies in the cell
+        // whose edges hold it.
+        let i = m
+            .theta_deg
+            .windows(2)
+            .position(|w| w[0] <= 24.6 && 24.6 <= w[1])
+            .unwrap();
+        let j = m
+            .psi_deg
+            .windows(2)
+            .position(|w| w[0] <= -52.8 && -52.8 <= w[1])
+            .unwrap();
+        assert_eq!(m.mm[i * MAP_CELLS.1 + j], 0.0042);
     }
 }

@@ -14,6 +14,7 @@
 mod chart;
 mod deviation;
 mod export;
+mod groove_plots;
 mod page;
 mod report;
 mod scene;
@@ -506,7 +507,14 @@ pub fn run(
             })
         })?;
         let name = format!("{}.svg", plot.file);
-        let reserved = ["profile.svg", "passes.svg", "deviation.svg", "finish.svg"];
+        let reserved = [
+            "profile.svg",
+            "passes.svg",
+            "deviation.svg",
+            "finish.svg",
+            "deviation_map.svg",
+            "section.svg",
+        ];
         if files.iter().any(|f| f.0 == name) || reserved.contains(&name.as_str()) {
             return Err(Error::Family(crate::family::FamilyError::Contract {
                 family: family.name().to_owned(),
@@ -540,6 +548,17 @@ pub fn run(
         for (name, text) in deviation::deviation_svgs(v).map_err(Error::Output)? {
             files.push((name.clone(), text.into_bytes()));
             report.files.push(name);
+        }
+    }
+    if let (Some(g), Some(req), ToolShape::Wheel(w)) =
+        (&groove, &groove_request, toolpath.tool.shape)
+    {
+        let map = groove_plots::deviation_map_svg(g).map_err(Error::Output)?;
+        let section =
+            groove_plots::section_svg(g, req, w.rounding_radius).map_err(Error::Output)?;
+        for (name, text) in [("deviation_map.svg", map), ("section.svg", section)] {
+            files.push((name.into(), text.into_bytes()));
+            report.files.push(name.into());
         }
     }
     report.files.push("report.html".into());
