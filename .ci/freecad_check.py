@@ -54,6 +54,18 @@ for f in steps:
     if expected and abs(volume - expected["volume_mm3"]) > expected["allowed_mm3"]:
         bad.append("volume %.3f, expected %.3f +- %.3f" % (
             volume, expected["volume_mm3"], expected["allowed_mm3"]))
+    # Where the run's STL of the same body lies, the solid lies: their
+    # bounding boxes agree within the mesh's chords (0.05 mm).
+    stl = f[:-len(".step")] + ".stl"
+    if os.path.exists(stl):
+        box = shape.optimalBoundingBox()
+        mesh_box = Mesh.Mesh(stl).BoundBox
+        worst = max(abs(a - b) for a, b in zip(
+            (box.XMin, box.YMin, box.ZMin, box.XMax, box.YMax, box.ZMax),
+            (mesh_box.XMin, mesh_box.YMin, mesh_box.ZMin,
+             mesh_box.XMax, mesh_box.YMax, mesh_box.ZMax)))
+        if worst > 0.05:
+            bad.append("%.3f mm away from %s" % (worst, os.path.basename(stl)))
     print("%s %s: %d faces, volume %.3f mm^3%s" % (
         "FAIL" if bad else "ok  ", f, len(shape.Faces), volume,
         (" (" + ", ".join(bad) + ")") if bad else ""))

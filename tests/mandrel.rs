@@ -462,6 +462,7 @@ fn step_solids_and_page_are_the_runs() {
     let got = solid("wheel")["volume_mm3"].as_f64().unwrap();
     assert!((got - v).abs() <= 1e-3, "wheel: {got} vs {v}");
     common::leave_step_for_freecad(&out, "mandrel", "wheel", v, 1e-6 * v);
+    common::leave_for_checkers(&out, "mandrel");
     // The page of the same run: its figures are the run's files.
     common::check_page(&out, "program.mpf");
     let page = std::fs::read_to_string(out.join("report.html")).unwrap();
