@@ -463,6 +463,35 @@ fn step_solids_and_page_are_the_runs() {
     assert!((got - v).abs() <= 1e-3, "wheel: {got} vs {v}");
     common::leave_step_for_freecad(&out, "mandrel", "wheel", v, 1e-6 * v);
     common::leave_for_checkers(&out, "mandrel");
+    // The rest's stand-off between blocks, charted per pass on a 1 mm
+    // grid, keeps the extremes the report notes.
+    let gaps = report["tables"]["rest_gap"].as_object().unwrap();
+    let (mut hi, mut lo) = (f64::MIN, f64::MAX);
+    for (name, col) in gaps.iter().filter(|(n, _)| n.starts_with("pass ")) {
+        for v in col.as_array().unwrap() {
+            let v = v.as_f64().unwrap();
+            (hi, lo) = (hi.max(v), lo.min(v));
+        }
+        assert_eq!(
+            col.as_array().unwrap().len(),
+            gaps["z_mm"].as_array().unwrap().len(),
+            "{name}"
+        );
+    }
+    let note = |n: &str| report["notes"][n].as_f64().unwrap() * 1e3;
+    assert!(
+        (hi - note("rest_max_gap_between_blocks_mm")).abs() < 1e-9,
+        "{hi}"
+    );
+    assert!(
+        (lo + note("rest_max_press_between_blocks_mm")).abs() < 1e-9,
+        "{lo}"
+    );
+    assert!(report["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|f| f == "rest_gap.svg"));
     // The page of the same run: its figures are the run's files.
     common::check_page(&out, "program.mpf");
     let page = std::fs::read_to_string(out.join("report.html")).unwrap();

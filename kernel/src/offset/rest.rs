@@ -131,6 +131,50 @@ pub struct RestTrack {
     pub max_press: Real,
     /// Points the rest added to the pass.
     pub added: usize,
+    /// Where U's straight line between blocks stands: at each place it was
+    /// checked, the support centre's z (`z + B`) and the line's x minus the
+    /// exact drop's (mm; + off the surface, - into it), blocks included (0).
+    pub stand_off: Vec<[Real; 2]>,
+}
+
+impl RestTrack {
+    /// The stand-off on a grid of z (increasing, evenly spaced): at each
+    /// grid point the checked value of largest size within half a step;
+    /// where none lies that close, the straight line between the nearest
+    /// checks either side; 0 beyond the pass's reach.
+    pub fn stand_off_on(&self, grid: &[Real]) -> Vec<Real> {
+        let mut s = self.stand_off.clone();
+        s.sort_by(|a, b| a[0].total_cmp(&b[0]));
+        let n = grid.len();
+        if n == 0 || s.is_empty() {
+            return vec![0.0; n];
+        }
+        let half = if n > 1 {
+            0.5 * (grid[1] - grid[0])
+        } else {
+            Real::INFINITY
+        };
+        grid.iter()
+            .map(|&z| {
+                let from = s.partition_point(|p| p[0] < z - half);
+                let to = s.partition_point(|p| p[0] <= z + half);
+                if from < to {
+                    return s[from..to].iter().map(|p| p[1]).fold(0.0, |a: Real, v| {
+                        if v.abs() > a.abs() {
+                            v
+                        } else {
+                            a
+                        }
+                    });
+                }
+                if from == 0 || from == s.len() {
+                    return 0.0;
+                }
+                let (a, b) = (s[from - 1], s[from]);
+                a[1] + (b[1] - a[1]) * (z - a[0]) / (b[0] - a[0])
+            })
+            .collect()
+    }
 }
 
 /// What the rest rides on during a pass, and how closely its U follows.
@@ -252,6 +296,7 @@ pub fn track(
         .map(|(k, p)| at(p.0, p.2, k, true))
         .collect::<Result<_, _>>()?;
     let (mut max_gap, mut max_press) = (0.0 as Real, 0.0 as Real);
+    let mut stand_off = vec![[pts[0].0 + setup.offset_b, 0.0]];
     let mut k = 1;
     let original = pts.len();
     while k < pts.len() {
@@ -262,6 +307,7 @@ pub fn track(
             .max(MIN_REST_CHECKS as Real) as usize;
         let mut worst: Option<(Real, Real)> = None;
         let (mut gap, mut press) = (0.0 as Real, 0.0 as Real);
+        let mut checked = Vec::with_capacity(n);
         let mut contact = drops[k - 1].0.contact_z;
         let mut kink: Option<(Real, Real)> = None;
         let at_s = |s: Real| at(a.0 + s * (b.0 - a.0), a.2 + s * (b.2 - a.2), k, false);
@@ -294,6 +340,7 @@ pub fn track(
                 break;
             }
             let (exact, line) = (d.centre_x, ua + s * (ub - ua));
+            checked.push([a.0 + s * (b.0 - a.0) + setup.offset_b, line - exact]);
             gap = gap.max(line - exact);
             press = press.max(exact - line);
             let dev = (line - exact).abs();
@@ -314,6 +361,8 @@ pub fn track(
         if add.is_empty() {
             max_gap = max_gap.max(gap);
             max_press = max_press.max(press);
+            stand_off.extend(checked);
+            stand_off.push([b.0 + setup.offset_b, 0.0]);
             k += 1;
             continue;
         }
@@ -350,6 +399,7 @@ pub fn track(
         max_gap,
         max_press,
         added: pts.len() - original,
+        stand_off,
     };
     for (k, (d, seed)) in drops.iter().enumerate() {
         if (seed - d.centre_x).abs() > out.max_model_difference {
@@ -362,4 +412,43 @@ pub fn track(
         out.seed_centre_x.push(*seed);
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod stand_off_tests {
+    use super::*;
+
+    /// The stand-off on a grid keeps the checked extremes within half a
+    /// step, interpolates between checks farther apart than that, and is 0
+    /// beyond them.
+    #[test]
+    fn stand_off_on_a_grid() {
+        let t = RestTrack {
+            path: Polyline {
+                z: vec![],
+                x: vec![],
+            },
+            centre_x: vec![],
+            contact_z: vec![],
+            contact_x: vec![],
+            seed_centre_x: vec![],
+            max_model_difference: 0.0,
+            max_difference_block: 0,
+            max_gap: 0.0,
+            max_press: 0.0,
+            added: 0,
+            stand_off: vec![
+                [10.0, 0.0],
+                [10.3, 0.002],
+                [10.4, -0.003],
+                [12.0, 0.001],
+                [16.0, 0.0],
+            ],
+        };
+        let v = t.stand_off_on(&[9.0, 10.0, 11.0, 12.0, 13.0, 14.0, 17.0]);
+        assert_eq!((v[0], v[1], v[3], v[6]), (0.0, -0.003, 0.001, 0.0));
+        for (got, want) in [(v[2], -0.0015), (v[4], 0.00075), (v[5], 0.0005)] {
+            assert!((got - want).abs() < 1e-15, "{got} {want}");
+        }
+    }
 }

@@ -288,6 +288,21 @@ pub mod offset_api {
     }
 
     /// How far it presses into the surface at most (mm).
+    /// `track.stand_off_on(grid)`: U's straight line between blocks
+    /// minus the exact drop (mm; + off the surface, - into it) at each z
+    /// of `grid` (increasing, evenly spaced; the support centre's z): the
+    /// largest checked value within half a step, else interpolated; 0
+    /// beyond the pass's reach.
+    #[rhai_fn(name = "stand_off_on", pure, return_raw)]
+    pub fn track_stand_off_on(
+        t: &mut RestTrack,
+        grid: Numbers,
+    ) -> Result<Floats, Box<EvalAltResult>> {
+        let grid = numbers(&grid, "stand-off grid")?;
+        kernel(crate::profile::check_abscissa("stand-off grid", &grid))?;
+        Ok(Floats::new(t.stand_off_on(&grid)))
+    }
+
     #[rhai_fn(get = "max_press", pure)]
     pub fn track_press(t: &mut RestTrack) -> Real {
         t.max_press
