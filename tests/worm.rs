@@ -316,6 +316,25 @@ fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
         );
     }
     common::leave_for_checkers(&out, "worm");
+    // The cutter's blade as an exact solid: the rounded trapezoid (tip =
+    // the root space, flanks at alpha 20 deg, 13 mm high, nose 0.3 mm)
+    // 6 mm thick; a corner of turning angle phi = 90 - alpha rounded by r
+    // loses r^2 (tan(phi/2) - phi/2).
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    let tip = report["notes"]["root_space_mm"].as_f64().unwrap();
+    let (a, h, r) = (20f64.to_radians(), 13.0, 0.3);
+    let phi = std::f64::consts::FRAC_PI_2 - a;
+    let area =
+        0.5 * (2.0 * tip + 2.0 * h * a.tan()) * h - 2.0 * r * r * ((phi / 2.0).tan() - phi / 2.0);
+    let v = area * 6.0;
+    let solid = &report["solids"][0];
+    assert_eq!(solid["name"], "cutter");
+    assert!(
+        (solid["volume_mm3"].as_f64().unwrap() - v).abs() < 1e-3,
+        "{solid} vs {v}"
+    );
+    common::leave_step_for_freecad(&out, "worm", "cutter", v, 1e-6 * v);
     common::check_page(&out, "program.nc");
     let page = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(page.contains("Verification: the thread cut simulated"));

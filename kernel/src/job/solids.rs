@@ -27,9 +27,9 @@ pub struct SolidFile {
 }
 
 /// The STEP files of the part's bodies of revolution (in the part frame)
-/// and of a wheel or end mill placed at `tool_pose` as its STL is; bodies
-/// given as meshes (the caliber's roll, the worm) and thread cutters have
-/// none.
+/// and of a wheel, end mill or thread cutter's blade placed at `tool_pose`
+/// as its STL is; bodies given as meshes (the caliber's roll, the worm)
+/// have none.
 ///
 /// # Failures
 /// A profile that pinches or a tolerance not positive ([`StepError`]).
@@ -41,34 +41,31 @@ pub fn step_files(
 ) -> Result<(Files, Vec<SolidFile>), StepError> {
     let mut files = Vec::new();
     let mut solids = Vec::new();
+    // Each solid: its file's text and its volume from its own outline.
     let mut add = |name: &str,
                    kind: &str,
-                   section: &step::Section,
-                   pose: &Mat4,
+                   (text, volume): (Result<String, StepError>, Real),
                    (dev, segments): (Real, usize)| {
-        let text = step::revolution_step(name, section, pose)?;
         let file = format!("{name}.step");
         solids.push(SolidFile {
             name: name.to_owned(),
             kind: kind.to_owned(),
             file: file.clone(),
-            volume_mm3: (section.volume() * 1000.0).round() / 1000.0,
+            volume_mm3: (volume * 1000.0).round() / 1000.0,
             deviation_mm: dev,
             segments,
         });
-        files.push((file, text.into_bytes()));
+        files.push((file, text?.into_bytes()));
         Ok::<(), StepError>(())
+    };
+    let revolution = |name: &str, s: &step::Section, pose: &Mat4| {
+        (step::revolution_step(name, s, pose), s.volume())
     };
     for b in parts {
         if let PartGeometry::Revolution(p) = &b.geometry {
             let fit = step::profile_section(&b.name, p, tol)?;
-            add(
-                &b.name,
-                "part",
-                &fit.section,
-                &Mat4::identity(),
-                (fit.deviation, fit.segments),
-            )?;
+            let solid = revolution(&b.name, &fit.section, &Mat4::identity());
+            add(&b.name, "part", solid, (fit.deviation, fit.segments))?;
         }
     }
     match tool.shape {
@@ -81,13 +78,27 @@ pub fn step_files(
                 WheelOrigin::Centre => -r,
             };
             let pose = tool_pose * Mat4::new_translation(&Vec3::new(r + origin, 0.0, 0.0));
-            add("wheel", "tool", &step::wheel_section(&w), &pose, (0.0, 0))?;
+            let solid = revolution("wheel", &step::wheel_section(&w), &pose);
+            add("wheel", "tool", solid, (0.0, 0))?;
         }
         ToolShape::EndMill { diameter, length } => {
             let s = step::cylinder_section(diameter / 2.0, length);
-            add("cutter", "tool", &s, tool_pose, (0.0, 0))?;
+            add(
+                "cutter",
+                "tool",
+                revolution("cutter", &s, tool_pose),
+                (0.0, 0),
+            )?;
         }
-        ToolShape::Insert { .. } | ToolShape::ThreadCutter(_) => {}
+        ToolShape::ThreadCutter(c) => {
+            // The blade as the STL shows it: the cutting profile up to its
+            // height, CUTTER_BLADE thick.
+            let outline = c.outline(c.height);
+            let blade = super::scene::CUTTER_BLADE;
+            let text = step::prism_step("cutter", &outline, blade, tool_pose);
+            add("cutter", "tool", (text, outline.area() * blade), (0.0, 0))?;
+        }
+        ToolShape::Insert { .. } => {}
     }
     Ok((files, solids))
 }

@@ -94,6 +94,44 @@ impl Section {
         self.points().last().unwrap_or(self.start)
     }
 
+    /// The signed area the section encloses with the straight line from
+    /// its end back to its start (+ counter-clockwise in `(z, r)`), from
+    /// its own curves (Green's theorem).
+    pub fn area(&self) -> Real {
+        let mut sum = 0.0;
+        let mut from = self.start;
+        // z dr - r dz over a straight line, exact from its ends.
+        let line = |a: [Real; 2], b: [Real; 2]| a[0] * b[1] - b[0] * a[1];
+        for p in &self.pieces {
+            match p {
+                Piece::Line(to) => {
+                    sum += line(from, *to);
+                    from = *to;
+                }
+                Piece::Arc { through, to } => {
+                    let (c, rho, a0, sweep) = arc_of(from, *through, *to);
+                    // z dr - r dz round the circle, in closed form.
+                    sum += sweep * rho * rho
+                        + rho
+                            * (c[0] * ((a0 + sweep).sin() - a0.sin())
+                                + c[1] * (a0.cos() - (a0 + sweep).cos()));
+                    from = *to;
+                }
+                Piece::Cubic(pts) => {
+                    for seg in pts.chunks_exact(3) {
+                        let b = [from, seg[0], seg[1], seg[2]];
+                        sum += gauss(|t| {
+                            let (p, d) = bezier_at(&b, t);
+                            p[0] * d[1] - p[1] * d[0]
+                        });
+                        from = seg[2];
+                    }
+                }
+            }
+        }
+        0.5 * (sum + line(from, self.start))
+    }
+
     /// The volume of the solid the section sweeps turning about Z, from the
     /// section's own curves: `pi |integral of r^2 dz|` along it (the end
     /// faces and the axis add nothing). Gauss-Legendre quadrature, exact
@@ -322,19 +360,7 @@ fn wire(s: &Section) -> Wire {
 /// end on it, runs backwards or encloses nothing; a pose that is not rigid.
 pub fn revolution_step(name: &str, section: &Section, pose: &Mat4) -> Result<String, StepError> {
     check(name, section)?;
-    let rot = pose.fixed_view::<3, 3>(0, 0);
-    let rigid = (rot.transpose() * rot - nalgebra::Matrix3::identity()).amax() < 1e-9
-        && pose
-            .row(3)
-            .iter()
-            .zip([0.0, 0.0, 0.0, 1.0])
-            .all(|(a, b)| *a == b);
-    if !rigid || !(rot.determinant() > 0.0) {
-        return Err(StepError::Section {
-            body: name.to_owned(),
-            message: "the pose is not a rigid motion".into(),
-        });
-    }
+    rigid(name, pose)?;
     let mut shell = builder::rsweep(
         &wire(section),
         Point3::new(0.0, 0.0, 0.0),
@@ -366,10 +392,39 @@ pub fn revolution_step(name: &str, section: &Section, pose: &Mat4) -> Result<Str
         body: name.to_owned(),
         message: format!("the swept faces do not close a solid: {e}"),
     })?;
+    write(name, "a solid of revolution", &solid, pose)
+}
+
+/// Refuses a pose that is not a rigid motion.
+fn rigid(name: &str, pose: &Mat4) -> Result<(), StepError> {
+    let rot = pose.fixed_view::<3, 3>(0, 0);
+    let rigid = (rot.transpose() * rot - nalgebra::Matrix3::identity()).amax() < 1e-9
+        && pose
+            .row(3)
+            .iter()
+            .zip([0.0, 0.0, 0.0, 1.0])
+            .all(|(a, b)| *a == b);
+    if !rigid || !(rot.determinant() > 0.0) {
+        return Err(StepError::Section {
+            body: name.to_owned(),
+            message: "the pose is not a rigid motion".into(),
+        });
+    }
+    Ok(())
+}
+
+/// The STEP text of `solid` placed by `pose`, the product named `name`,
+/// the file described as `what`.
+fn write(
+    name: &str,
+    what: &str,
+    solid: &truck_modeling::Solid,
+    pose: &Mat4,
+) -> Result<String, StepError> {
     let m = truck_modeling::Matrix4::from(std::array::from_fn::<[Real; 4], 4, _>(|c| {
         std::array::from_fn(|r| pose[(r, c)])
     }));
-    let placed = builder::transformed(&solid, m);
+    let placed = builder::transformed(solid, m);
     let compressed = placed.compress();
     let body = truck_stepio::out::CompleteStepDisplay::new(
         truck_stepio::out::StepModel::from(&compressed),
@@ -392,11 +447,64 @@ pub fn revolution_step(name: &str, section: &Section, pose: &Mat4) -> Result<Str
         1,
     );
     Ok(format!(
-        "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION(('pilgrim: {name}, a solid of revolution'),'2;1');\n\
+        "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION(('pilgrim: {name}, {what}'),'2;1');\n\
          FILE_NAME('{name}.step','',('pilgrim'),(''),'truck-stepio 0.3','pilgrim {}','');\n\
          FILE_SCHEMA(('{SCHEMA}'));\nENDSEC;\n{data}",
         crate::VERSION
     ))
+}
+
+/// The STEP file of a flat blade: the closed outline `section` (its
+/// start, pieces back to the start) in the XZ plane (`(z, r)` as for a
+/// section of revolution, r along X), `thickness` thick along Y about
+/// y = 0, placed by `pose` (a rigid motion), the product named `name`. Its
+/// volume is the outline's area times the thickness ([`Section::area`]).
+///
+/// # Failures
+/// An outline that does not close, is not finite or encloses nothing; a
+/// thickness not positive; a pose that is not rigid.
+pub fn prism_step(
+    name: &str,
+    section: &Section,
+    thickness: Real,
+    pose: &Mat4,
+) -> Result<String, StepError> {
+    let bad = |message: String| StepError::Section {
+        body: name.to_owned(),
+        message,
+    };
+    crate::math::positive("blade thickness", thickness)?;
+    for p in section.points() {
+        crate::math::all_finite("outline point", &p)?;
+    }
+    let end = section.end();
+    if end != section.start {
+        return Err(bad(format!(
+            "the outline does not close: it ends at (z {}, r {}), not at its start (z {}, r {})",
+            end[0], end[1], section.start[0], section.start[1]
+        )));
+    }
+    let area = section.area();
+    if !(area.abs() > 0.0) {
+        return Err(bad("the outline encloses no area".into()));
+    }
+    rigid(name, pose)?;
+    let mut edges: Vec<truck_modeling::Edge> = wire(section).into_iter().collect();
+    // The last edge ends where the first starts: one vertex, not two.
+    if let (Some(first), Some(last)) = (edges.first().cloned(), edges.pop()) {
+        let curve = last.oriented_curve();
+        edges.push(truck_modeling::Edge::new(
+            last.front(),
+            first.front(),
+            curve,
+        ));
+    }
+    let face = builder::try_attach_plane(&[edges.into()])
+        .map_err(|e| bad(format!("the outline is not a plane face: {e}")))?;
+    let sign = if area > 0.0 { 1.0 } else { -1.0 };
+    let face = builder::translated(&face, Vector3::new(0.0, -sign * thickness / 2.0, 0.0));
+    let solid = builder::tsweep(&face, Vector3::new(0.0, sign * thickness, 0.0));
+    write(name, "a flat blade", &solid, pose)
 }
 
 #[cfg(test)]
@@ -481,6 +589,42 @@ mod tests {
             }
         }
         assert!(used.is_subset(&defined), "{:?}", used.difference(&defined));
+    }
+
+    /// A blade: its file names the product and describes it; an open
+    /// outline is refused.
+    #[test]
+    fn a_blade_is_a_prism_of_its_outline() {
+        let square = Section {
+            start: [0.0, 0.0],
+            pieces: vec![
+                Piece::Line([2.0, 0.0]),
+                Piece::Line([2.0, 3.0]),
+                Piece::Line([0.0, 3.0]),
+                Piece::Line([0.0, 0.0]),
+            ],
+        };
+        assert_near!(square.area(), 6.0, 1e-12);
+        let text = prism_step("cutter", &square, 4.0, &Mat4::identity()).unwrap();
+        assert!(text.contains("PRODUCT('cutter','cutter',''") && text.contains("a flat blade"));
+        let open = Section {
+            start: [0.0, 0.0],
+            pieces: vec![Piece::Line([2.0, 0.0]), Piece::Line([2.0, 3.0])],
+        };
+        let e = prism_step("cutter", &open, 4.0, &Mat4::identity()).unwrap_err();
+        assert!(e.to_string().contains("does not close"), "{e}");
+        // A half disc: straight diameter, arc back.
+        let half = Section {
+            start: [-1.0, 0.0],
+            pieces: vec![
+                Piece::Line([1.0, 0.0]),
+                Piece::Arc {
+                    through: [0.0, 1.0],
+                    to: [-1.0, 0.0],
+                },
+            ],
+        };
+        assert_near!(half.area(), std::f64::consts::FRAC_PI_2, 1e-12);
     }
 
     /// Sections that cannot be solids are refused, naming the body.
