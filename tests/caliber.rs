@@ -241,6 +241,53 @@ fn the_default_job_holds_its_tolerance_read_back_from_the_program() {
     let corner = rho * rho * (1.0 - pi / 4.0);
     let v = pi * r * r * b - 4.0 * pi * (r - rho + 2.0 * rho / (3.0 * (4.0 - pi))) * corner;
     common::leave_step_for_freecad(&out, "caliber", "wheel", v, 1e-6 * v);
+    // The roll's sector as an exact solid: its volume the section's moment
+    // about the axis integrated over theta (Simpson), the groove's half
+    // ellipse in closed form: the rim w (R^2 - hub^2) / 2 less, for the
+    // groove of half-width a and depth h, int (R z - z^2 / 2) dx =
+    // pi R a h / 2 - 2 a h^2 / 3.
+    let g = groove();
+    let (r_d, rim) = (150.0, 15.0);
+    let width = g.width().x().iter().copied().fold(0.0, f64::max) + 2.0 * rim;
+    let hub = r_d - g.depth().x().iter().copied().fold(0.0, f64::max) - rim;
+    let (t0, t1) = g.theta_range();
+    let m = 20_000;
+    let moment = |t: f64| {
+        let (a, h) = (g.width().eval(t).unwrap() / 2.0, g.depth().eval(t).unwrap());
+        width * (r_d * r_d - hub * hub) / 2.0 - (pi * r_d * a * h / 2.0 - 2.0 * a * h * h / 3.0)
+    };
+    let step = (t1 - t0) / m as f64;
+    let v: f64 = (0..=m)
+        .map(|k| {
+            let w = if k == 0 || k == m {
+                1.0
+            } else {
+                [2.0, 4.0][k % 2]
+            };
+            w * moment(t0 + step * k as f64)
+        })
+        .sum::<f64>()
+        * step
+        / 3.0;
+    // Within the tolerance over the whole surface (rim, faces, hub and
+    // the groove at its widest, generously).
+    let area =
+        (t1 - t0) * (r_d * (width + pi * 60.0) + r_d * r_d + hub * width) + r_d * width * 2.0;
+    let solid = report["solids"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["name"] == "caliber")
+        .unwrap();
+    let tol = report["step_tolerance_mm"].as_f64().unwrap();
+    assert!(solid["deviation_mm"].as_f64().unwrap() <= tol, "{solid}");
+    let got = solid["volume_mm3"].as_f64().unwrap();
+    assert!(
+        (got - v).abs() <= tol * area,
+        "{got} vs {v} +- {}",
+        tol * area
+    );
+    common::leave_step_for_freecad(&out, "caliber", "caliber", v, tol * area);
 }
 
 /// The LZ-250 reaches the same exact poses with its four axes (its figure

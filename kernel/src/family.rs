@@ -62,8 +62,46 @@ impl Verification {
 pub enum PartGeometry {
     /// A body of revolution about Z of this profile `x(z)`.
     Revolution(Profile),
-    /// A closed mesh in the part frame (mm).
-    Mesh(TriMesh),
+    /// A body that is not of revolution: its closed mesh in the part frame
+    /// and the exact body it was meshed from (for STEP).
+    Swept(Box<Swept>),
+}
+
+/// A body swept through its sections, meshed and exact.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Swept {
+    /// Its closed mesh in the part frame (mm).
+    pub mesh: TriMesh,
+    /// The body itself.
+    pub body: SweptBody,
+}
+
+/// The bodies swept through their sections that families make.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SweptBody {
+    /// The caliber's roll with its groove.
+    Roll(Box<crate::caliber::Roll>),
+    /// A finished worm.
+    Worm(crate::worm::WormSweep),
+}
+
+impl SweptBody {
+    /// Its sections, as the STEP writer fits them.
+    pub fn sections(&self) -> &dyn crate::step::Sections {
+        match self {
+            Self::Roll(r) => r.as_ref(),
+            Self::Worm(w) => w,
+        }
+    }
+
+    /// How far (mm) its sections already stray from the body they stand
+    /// for (a worm's outline simplified; 0 for the roll).
+    pub fn simplified(&self) -> crate::math::Real {
+        match self {
+            Self::Roll(_) => 0.0,
+            Self::Worm(w) => w.simplified(),
+        }
+    }
 }
 
 /// One named body of the part (`part`, `blank`, ...), for 3-D export.

@@ -14,7 +14,8 @@
 //!   turn, within what the machine reaches ([`SwivelPlane`]);
 //! - [`check_groove`]: the program replayed in 3-D against the groove, and
 //!   the [`contact_patch`] at a block;
-//! - [`caliber_solid`]: the roll's sector with its groove as a closed mesh.
+//! - [`caliber_solid`]: the roll's sector with its groove as a closed mesh;
+//!   [`Roll`]: the same exactly, for STEP.
 //!
 //! The roll's frame: Z along the roll's axis, the section at `theta = 0` in
 //! the XZ plane, `theta` turning right-handed about +Z (ARCHITECTURE §3).
@@ -34,4 +35,4 @@ pub use groove::{Groove, GrooveError};
 pub use pass::{pass_poses, pose_at, PassPose, SwivelPlane, MAX_PASS_BLOCKS};
 pub use pose::{exact_pose, seed_pose, SeedPose, TorusWheel};
 pub use scallop::{scallop_height, step_for_scallop};
-pub use solid::{caliber_solid, SolidError};
+pub use solid::{caliber_solid, Roll, SolidError};

@@ -385,15 +385,23 @@ pub fn run(
     let tol = options.mesh_tolerance;
     // The finished worm: the simulated section swept along the helix.
     if let (Some(w), Some(r)) = (&worm, &worm_request) {
-        let mesh = crate::worm::worm_solid(w, r.length, tol).map_err(|source| {
+        let mesh_error = |source| {
             Error::Scene(SceneError::Mesh {
                 body: "worm".into(),
                 source,
             })
-        })?;
+        };
+        let mesh = crate::worm::worm_solid(w, r.length, tol).map_err(mesh_error)?;
+        // A quarter of the STEP tolerance for merging the outline's points,
+        // the rest for the fit.
+        let body = crate::worm::WormSweep::new(w, r.length, options.step_tolerance / 4.0)
+            .map_err(mesh_error)?;
         parts.push(crate::family::PartBody {
             name: "worm".into(),
-            geometry: PartGeometry::Mesh(mesh),
+            geometry: PartGeometry::Swept(Box::new(crate::family::Swept {
+                mesh,
+                body: crate::family::SweptBody::Worm(body),
+            })),
         });
     }
     let (pose_block, bodies, solids, part_box) = if parts.is_empty() {
@@ -529,7 +537,7 @@ pub fn run(
             .iter()
             .filter_map(|b| match &b.geometry {
                 PartGeometry::Revolution(p) => Some((b.name.clone(), p.clone())),
-                PartGeometry::Mesh(_) => None,
+                PartGeometry::Swept(_) => None,
             })
             .collect();
         let text = svg::profile_svg(

@@ -66,7 +66,7 @@ pub fn part_meshes(parts: &[PartBody], tol: f64) -> Result<Vec<(String, TriMesh)
             let m = match &b.geometry {
                 PartGeometry::Revolution(p) => mesh::body_of_revolution(p, tol)
                     .map_err(mesh_err(&format!("part '{}'", b.name)))?,
-                PartGeometry::Mesh(m) => m.clone(),
+                PartGeometry::Swept(s) => s.mesh.clone(),
             };
             Ok((b.name.clone(), m))
         })

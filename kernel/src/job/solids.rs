@@ -1,5 +1,5 @@
-//! A run's exact solids: each body of revolution of the part and the tool
-//! as a STEP file, beside the meshes (issue 14 §3).
+//! A run's exact solids: each body of the part and the tool as a STEP file,
+//! beside the meshes (issue 14 §3).
 
 use super::scene::Files;
 use crate::family::{PartBody, PartGeometry};
@@ -22,14 +22,15 @@ pub struct SolidFile {
     /// The largest deviation of its B-spline from the family's profile
     /// (mm); 0 for a section of lines and arcs, which is exact.
     pub deviation_mm: f64,
-    /// Cubic Bezier segments its profile became (0 for lines and arcs).
+    /// Cubic Bezier segments its profile became (0 for lines and arcs); for
+    /// a swept body, its faces across a section.
     pub segments: usize,
 }
 
-/// The STEP files of the part's bodies of revolution (in the part frame)
-/// and of a wheel, end mill or thread cutter's blade placed at `tool_pose`
-/// as its STL is; bodies given as meshes (the caliber's roll, the worm)
-/// have none.
+/// The STEP files of the part's bodies (in the part frame: bodies of
+/// revolution from their profiles, the caliber's roll and the worm swept
+/// through their sections) and of a wheel, end mill or thread cutter's
+/// blade placed at `tool_pose` as its STL is.
 ///
 /// # Failures
 /// A profile that pinches or a tolerance not positive ([`StepError`]).
@@ -62,10 +63,29 @@ pub fn step_files(
         (step::revolution_step(name, s, pose), s.volume())
     };
     for b in parts {
-        if let PartGeometry::Revolution(p) = &b.geometry {
-            let fit = step::profile_section(&b.name, p, tol)?;
-            let solid = revolution(&b.name, &fit.section, &Mat4::identity());
-            add(&b.name, "part", solid, (fit.deviation, fit.segments))?;
+        match &b.geometry {
+            PartGeometry::Revolution(p) => {
+                let fit = step::profile_section(&b.name, p, tol)?;
+                let solid = revolution(&b.name, &fit.section, &Mat4::identity());
+                add(&b.name, "part", solid, (fit.deviation, fit.segments))?;
+            }
+            PartGeometry::Swept(s) => {
+                // What the sections already stray by leaves the rest of the
+                // tolerance to the fit.
+                let strayed = s.body.simplified();
+                let fit = step::swept_step(
+                    &b.name,
+                    "a solid swept through its sections",
+                    s.body.sections(),
+                    tol - strayed,
+                )?;
+                add(
+                    &b.name,
+                    "part",
+                    (Ok(fit.text), fit.volume),
+                    (fit.deviation + strayed, fit.faces),
+                )?;
+            }
         }
     }
     match tool.shape {

@@ -5,8 +5,9 @@
 
 use super::floats::{kernel, Floats};
 use crate::caliber::{self, Groove, SeedPose};
+// The Rhai `Solid`: a mesh and the exact body it was meshed from.
+use crate::family::Swept as Solid;
 use crate::math::Real;
-use crate::mesh::TriMesh;
 use crate::profile::{Smoothing, Table};
 use crate::tool::{Tool, Wheel};
 use rhai::plugin::*;
@@ -179,17 +180,22 @@ pub mod caliber_api {
             .collect())
     }
 
-    /// The roll's sector with its groove as a closed solid (for
-    /// `caliber.stl`): the rim `width` wide from radius `hub` to the
-    /// periphery, chords within `tol` (mm).
+    /// The roll's sector with its groove as a closed solid: the rim `width`
+    /// wide from radius `hub` to the periphery, meshed with chords within
+    /// `tol` (mm) for `caliber.stl`, and exact for `caliber.step`.
     #[rhai_fn(pure, return_raw)]
     pub fn caliber_solid(
         g: &mut Groove,
         width: Real,
         hub: Real,
         tol: Real,
-    ) -> Result<TriMesh, Box<EvalAltResult>> {
-        kernel(caliber::caliber_solid(g, width, hub, tol))
+    ) -> Result<Solid, Box<EvalAltResult>> {
+        let mesh = kernel(caliber::caliber_solid(g, width, hub, tol))?;
+        let roll = kernel(caliber::Roll::new(g, width, hub))?;
+        Ok(Solid {
+            mesh,
+            body: crate::family::SweptBody::Roll(Box::new(roll)),
+        })
     }
 
     /// The groove from two tables: Hp from `depth_table`, B from

@@ -200,7 +200,7 @@ fn register_types(e: &mut Engine) {
         .register_type_with_name::<bind_toolpath::ToolpathHandle>("Toolpath")
         .register_type_with_name::<crate::caliber::Groove>("Groove")
         .register_type_with_name::<crate::caliber::SeedPose>("SeedPose")
-        .register_type_with_name::<crate::mesh::TriMesh>("Solid")
+        .register_type_with_name::<crate::family::Swept>("Solid")
         .register_type_with_name::<crate::worm::WormSizes>("Worm");
 }
 
@@ -629,7 +629,8 @@ impl PartFamily for ScriptFamily {
             if let Some(p) = v.clone().try_cast::<Profile>() {
                 Some(PartGeometry::Revolution(p))
             } else {
-                v.try_cast::<crate::mesh::TriMesh>().map(PartGeometry::Mesh)
+                v.try_cast::<crate::family::Swept>()
+                    .map(|s| PartGeometry::Swept(Box::new(s)))
             }
         };
         if let Some(g) = geometry(d.clone()) {

@@ -18,8 +18,10 @@
 //! byte-identical).
 
 mod fit;
+mod sweep;
 
 pub use fit::{profile_section, ProfileFit};
+pub use sweep::{swept_step, Sections, SweptFit, MAX_CONTROL_POINTS};
 
 use crate::math::{Mat4, Real};
 use crate::tool::Wheel;

@@ -33,4 +33,4 @@ pub use plan::{
 pub use servo::{approach_error, approach_length, runout_error, runout_length};
 pub use simulate::{simulate, SimulatedPass, StartProfile, WormCheck, WormRequest, WormTolerances};
 pub use sizes::WormSizes;
-pub use solid::{worm_solid, MAX_AROUND};
+pub use solid::{worm_solid, WormSweep, MAX_AROUND};

@@ -74,3 +74,107 @@ pub fn worm_solid(check: &WormCheck, length: Real, tol: Real) -> Result<TriMesh,
         .collect();
     sweep(&rings)
 }
+
+/// The finished worm exactly, for STEP: the section `outline` (`(z, r)`
+/// over one lead from `window`'s start, straight between its points,
+/// repeated with the lead) swept helically as [`worm_solid`] meshes it,
+/// from z = -length to 0. Its cross-sections are the pieces: piece `k` is
+/// the outline's stretch `k` wound round the axis (at the part's angle
+/// `phi`, the radius is the outline's at `z - lead phi / 2 pi`), and `v`
+/// runs along the axis; the end faces are square to it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WormSweep {
+    /// The outline's points kept (within the simplification's tolerance),
+    /// the first repeated a lead on at the end.
+    points: Vec<[Real; 2]>,
+    lead: Real,
+    length: Real,
+    /// The largest radial distance of a dropped point from the outline
+    /// kept (mm).
+    simplified: Real,
+}
+
+impl WormSweep {
+    /// The worm of `check`'s finished section, `length` long; points of the
+    /// outline within `merge` (mm, radially) of the line between their
+    /// neighbours kept are dropped (the simulation's outline has pairs a
+    /// micrometre apart and long straight runs).
+    ///
+    /// # Failures
+    /// A length or merge distance not positive or an empty section.
+    pub fn new(check: &WormCheck, length: Real, merge: Real) -> Result<Self, MeshError> {
+        let degenerate = |e: crate::input::InputError| MeshError::Degenerate(e.to_string());
+        crate::math::positive("worm length", length).map_err(degenerate)?;
+        crate::math::positive("outline merge distance", merge).map_err(degenerate)?;
+        let (_, lead) = check.window;
+        let mut all = check.outline();
+        if all.len() < 2 || !all.iter().any(|p| p[1] > 0.0) {
+            return Err(MeshError::Degenerate("the worm's section is empty".into()));
+        }
+        all.push([all[0][0] + lead, all[0][1]]);
+        // Greedy: from each point kept, reach as far as every point passed
+        // stays within `merge` of the chord.
+        let off = |a: [Real; 2], b: [Real; 2], p: [Real; 2]| {
+            let t = if b[0] > a[0] {
+                (p[0] - a[0]) / (b[0] - a[0])
+            } else {
+                0.0
+            };
+            (a[1] + t * (b[1] - a[1]) - p[1]).abs()
+        };
+        let (mut points, mut simplified) = (vec![all[0]], 0.0 as Real);
+        let mut from = 0;
+        while from + 1 < all.len() {
+            let mut to = from + 1;
+            while to + 1 < all.len() {
+                let worst = (from + 1..=to)
+                    .map(|i| off(all[from], all[to + 1], all[i]))
+                    .fold(0.0, Real::max);
+                if worst > merge {
+                    break;
+                }
+                to += 1;
+            }
+            simplified = (from + 1..to)
+                .map(|i| off(all[from], all[to], all[i]))
+                .fold(simplified, Real::max);
+            points.push(all[to]);
+            from = to;
+        }
+        Ok(WormSweep {
+            points,
+            lead,
+            length,
+            simplified,
+        })
+    }
+
+    /// The largest radial distance of a dropped outline point from the
+    /// outline kept (mm).
+    pub fn simplified(&self) -> Real {
+        self.simplified
+    }
+}
+
+impl crate::step::Sections for WormSweep {
+    fn pieces(&self) -> usize {
+        self.points.len() - 1
+    }
+
+    fn straight(&self, _: usize) -> bool {
+        false
+    }
+
+    fn point(&self, k: usize, u: Real, v: Real) -> [Real; 3] {
+        let (a, b) = (self.points[k], self.points[k + 1]);
+        let (s, r) = (a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1]));
+        let z = -self.length + v * self.length;
+        let phi = TAU * (z - s) / self.lead;
+        [r * phi.cos(), r * phi.sin(), z]
+    }
+
+    fn along(&self) -> usize {
+        // Eight points a turn to start.
+        (8.0 * self.length / self.lead).ceil() as usize + 1
+    }
+}
