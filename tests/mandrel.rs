@@ -379,6 +379,12 @@ fn example_parameter_files_run() {
             "{f}"
         );
         assert!(fin.contains("tolerance +-1.0 um"), "{f}");
+        // The stock each pass removed, the first from the blank.
+        let stock = std::fs::read_to_string(out.join("stock.svg")).unwrap();
+        assert!(
+            stock.contains("stock removed, um") && stock.contains("pass 1, stock"),
+            "{f}"
+        );
         // Three panels (plotters charts): blank, part and the wheel
         // centre's path; the rest's track in each pass; the curvature (far
         // below the wheel's limit, so no limit line). Legends name them.
@@ -501,7 +507,7 @@ fn step_solids_and_page_are_the_runs() {
         finish["max_abs"].as_f64().unwrap(),
         finish["at_z"].as_f64().unwrap()
     )));
-    for f in ["profile.svg", "deviation.svg", "finish.svg"] {
+    for f in ["profile.svg", "deviation.svg", "finish.svg", "stock.svg"] {
         assert!(page.contains(&format!("alt=\"{f}\"")), "{f}");
     }
     common::leave_page_for_chromium(&out, "mandrel");

@@ -1,8 +1,10 @@
 //! The grinding replay's pictures (issue 14 §1), drawn with plotters:
 //! `deviation.svg`, each cutting pass's surface minus the nominal in um
 //! along z (its lowest and highest over the generatrices, ridges
-//! included), and `finish.svg`, the finishing pass alone against the
-//! tolerance band.
+//! included), `finish.svg`, the finishing pass alone against the
+//! tolerance band, and `stock.svg`, the stock each pass removed along z
+//! (the surface before it minus the surface it left: the blank's for the
+//! first pass).
 
 use super::chart::{tick_decimals, COLOURS};
 use crate::verify::{GrindingCheck, PassCheck};
@@ -10,7 +12,11 @@ use plotters::prelude::*;
 
 /// One chart of `passes`' deviations (um) along z, with the tolerance
 /// band's lines where `band` is given (mm).
-fn draw(passes: &[&PassCheck], title: &str, band: Option<f64>) -> Result<String, String> {
+fn draw(
+    passes: &[&PassCheck],
+    (title, y_desc): (&str, &str),
+    band: Option<f64>,
+) -> Result<String, String> {
     let (mut z0, mut z1, mut y0, mut y1) = (
         f64::INFINITY,
         f64::NEG_INFINITY,
@@ -20,7 +26,7 @@ fn draw(passes: &[&PassCheck], title: &str, band: Option<f64>) -> Result<String,
     for p in passes {
         for b in &p.along_z {
             (z0, z1) = (z0.min(b[0]), z1.max(b[0]));
-            (y0, y1) = (y0.min(1e3 * b[1]), y1.max(1e3 * b[2]));
+            (y0, y1) = (y0.min(1e3 * b[1].min(b[2])), y1.max(1e3 * b[1].max(b[2])));
         }
     }
     if let Some(t) = band {
@@ -51,7 +57,7 @@ fn draw(passes: &[&PassCheck], title: &str, band: Option<f64>) -> Result<String,
         chart
             .configure_mesh()
             .x_desc("z along the part, mm")
-            .y_desc("surface minus nominal, um")
+            .y_desc(y_desc)
             .x_label_formatter(&|v| crate::math::fixed(*v, tick_decimals(z1 - z0)))
             .y_label_formatter(&|v| crate::math::fixed(*v, tick_decimals(y1 - y0)))
             .label_style(("sans-serif", 15))
@@ -94,19 +100,68 @@ fn draw(passes: &[&PassCheck], title: &str, band: Option<f64>) -> Result<String,
     Ok(svg)
 }
 
-/// `deviation.svg` and `finish.svg` of a grinding replay.
+/// The stock each pass removed along z (mm): its `along_z` replaced by
+/// the surface before it minus the surface it left, at the valleys (the
+/// lowest surfaces' difference) and at the ridges' tops (the highest's,
+/// nil where the pass's ridge stands above the surface before it: no
+/// material was there to remove; the replay sweeps each pass's wheel
+/// alone). The surface before the first pass is `start` (the blank minus
+/// the nominal at z, mm); where it is not known (no blank), the first pass
+/// is left out.
+/// Passes are matched stretch by stretch where their stretches lie at the
+/// same z (the replay samples every pass at the same places).
+pub fn removed(passes: &[PassCheck], start: impl Fn(f64) -> Option<f64>) -> Vec<PassCheck> {
+    let mut out = Vec::with_capacity(passes.len());
+    for (k, p) in passes.iter().enumerate() {
+        let before = |i: usize, z: f64| -> Option<(f64, f64)> {
+            if k == 0 {
+                start(z).map(|s| (s, s))
+            } else {
+                let b = passes[k - 1].along_z.get(i)?;
+                ((b[0] - z).abs() < 1e-9).then_some((b[1], b[2]))
+            }
+        };
+        let along: Vec<[f64; 3]> = p
+            .along_z
+            .iter()
+            .enumerate()
+            .filter_map(|(i, b)| {
+                let (lo, hi) = before(i, b[0])?;
+                Some([b[0], lo - b[1], (hi - b[2]).max(0.0)])
+            })
+            .collect();
+        if !along.is_empty() {
+            out.push(PassCheck {
+                along_z: along,
+                ..p.clone()
+            });
+        }
+    }
+    out
+}
+
+/// `deviation.svg`, `finish.svg` and `stock.svg` of a grinding replay,
+/// `start` the blank's surface minus the nominal at z (mm) where there is
+/// a blank.
 ///
 /// # Failures
 /// A replay with no pass drawn; drawing failing.
-pub fn deviation_svgs(check: &GrindingCheck) -> Result<[(String, String); 2], String> {
+pub fn deviation_svgs(
+    check: &GrindingCheck,
+    start: impl Fn(f64) -> Option<f64>,
+) -> Result<[(String, String); 3], String> {
     let all: Vec<&PassCheck> = check.passes.iter().collect();
     let finish = all.last().copied().ok_or("the replay has no pass")?;
+    let stock = removed(&check.passes, start);
     Ok([
         (
             "deviation.svg".into(),
             draw(
                 &all,
-                "Each pass's surface minus the nominal (lowest and highest over the generatrices)",
+                (
+                    "Each pass's surface minus the nominal (lowest and highest over the generatrices)",
+                    "surface minus nominal, um",
+                ),
                 None,
             )?,
         ),
@@ -114,9 +169,77 @@ pub fn deviation_svgs(check: &GrindingCheck) -> Result<[(String, String); 2], St
             "finish.svg".into(),
             draw(
                 &[finish],
-                "The finish against the tolerance (ridges included)",
+                (
+                    "The finish against the tolerance (ridges included)",
+                    "surface minus nominal, um",
+                ),
                 Some(check.tolerance),
             )?,
         ),
+        (
+            "stock.svg".into(),
+            draw(
+                &stock.iter().collect::<Vec<_>>(),
+                (
+                    "The stock each pass removed, at the valleys and at the ridges' tops",
+                    "stock removed, um",
+                ),
+                None,
+            )?,
+        ),
     ])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::verify::Deviation;
+
+    fn pass(name: &str, along_z: Vec<[f64; 3]>) -> PassCheck {
+        let d = Deviation {
+            max_above: 0.0,
+            above_z: 0.0,
+            max_below: 0.0,
+            below_z: 0.0,
+            max_abs: 0.0,
+            at_z: 0.0,
+            block: None,
+        };
+        PassCheck {
+            name: name.into(),
+            first_block: 1,
+            feed_mm_min: 100.0,
+            spindle_rpm: 100.0,
+            feed_per_rev_mm: 1.0,
+            ridge_mm: 0.0,
+            deviation: d,
+            along_z,
+        }
+    }
+
+    /// Each pass removes the surface before it less the one it leaves,
+    /// the first from the blank; stretches at other z are not matched; no
+    /// blank leaves the first pass out.
+    #[test]
+    fn stock_removed_is_the_difference_of_surfaces() {
+        let passes = vec![
+            pass("rough", vec![[0.0, 0.10, 0.12], [1.0, 0.08, 0.11]]),
+            pass("finish", vec![[0.0, -0.001, 0.002], [1.5, 0.0, 0.001]]),
+        ];
+        let got = removed(&passes, |z| Some(0.3 + 0.01 * z));
+        assert_eq!(got.len(), 2);
+        let r = &got[0].along_z;
+        assert!((r[0][1] - 0.2).abs() < 1e-12 && (r[0][2] - 0.18).abs() < 1e-12);
+        assert!((r[1][1] - 0.23).abs() < 1e-12 && (r[1][2] - 0.2).abs() < 1e-12);
+        // The finish: z 0 matched (0.10 - -0.001, 0.12 - 0.002); z 1.5 not.
+        assert_eq!(got[1].along_z.len(), 1);
+        let f = got[1].along_z[0];
+        assert!((f[1] - 0.101).abs() < 1e-12 && (f[2] - 0.118).abs() < 1e-12);
+        // A ridge standing above the blank removed nothing at its top.
+        let tall = vec![pass("rough", vec![[0.0, 0.2, 0.35]])];
+        assert_eq!(removed(&tall, |_| Some(0.3))[0].along_z[0][2], 0.0);
+        let no_blank = removed(&passes, |_| None);
+        assert_eq!(no_blank.len(), 1);
+        assert_eq!(no_blank[0].name, "finish");
+    }
 }

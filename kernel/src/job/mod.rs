@@ -520,6 +520,7 @@ pub fn run(
             "passes.svg",
             "deviation.svg",
             "finish.svg",
+            "stock.svg",
             "deviation_map.svg",
             "section.svg",
         ];
@@ -552,8 +553,15 @@ pub fn run(
         files.push(("profile.svg".into(), text.into_bytes()));
         report.files.push("profile.svg".into());
     }
-    if let Some(v) = &verification {
-        for (name, text) in deviation::deviation_svgs(v).map_err(Error::Output)? {
+    if let (Some(v), Some(n)) = (&verification, &nominal) {
+        // The surface before the first pass: the blank, where the family
+        // gives one.
+        let blank = parts.iter().find_map(|b| match &b.geometry {
+            PartGeometry::Revolution(p) if b.name == "blank" => Some(p),
+            _ => None,
+        });
+        let start = |z: f64| Some(blank?.eval(z).ok()? - n.profile.eval(z).ok()?);
+        for (name, text) in deviation::deviation_svgs(v, start).map_err(Error::Output)? {
             files.push((name.clone(), text.into_bytes()));
             report.files.push(name);
         }
