@@ -273,21 +273,7 @@ fn the_default_job_holds_its_tolerance_read_back_from_the_program() {
     // the groove at its widest, generously).
     let area =
         (t1 - t0) * (r_d * (width + pi * 60.0) + r_d * r_d + hub * width) + r_d * width * 2.0;
-    let solid = report["solids"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|s| s["name"] == "caliber")
-        .unwrap();
-    let tol = report["step_tolerance_mm"].as_f64().unwrap();
-    assert!(solid["deviation_mm"].as_f64().unwrap() <= tol, "{solid}");
-    let got = solid["volume_mm3"].as_f64().unwrap();
-    assert!(
-        (got - v).abs() <= tol * area,
-        "{got} vs {v} +- {}",
-        tol * area
-    );
-    common::leave_step_for_freecad(&out, "caliber", "caliber", v, tol * area);
+    common::check_fitted_solid(&out, "caliber", "caliber", v, area);
 }
 
 /// The LZ-250 reaches the same exact poses with its four axes (its figure

@@ -338,23 +338,13 @@ fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
     // The worm as an exact solid: the volume found above, within the
     // tolerance over its lateral surface (the section's outline over a lead,
     // wound round the tip's circle along 60 mm, an upper bound).
-    let worm = &report["solids"][0];
-    assert_eq!(worm["name"], "worm");
-    let tol = report["step_tolerance_mm"].as_f64().unwrap();
-    assert!(worm["deviation_mm"].as_f64().unwrap() <= tol, "{worm}");
     let outline = check.outline();
     let run: f64 = outline
         .windows(2)
         .map(|p| (p[1][0] - p[0][0]).hypot(p[1][1] - p[0][1]))
         .sum();
     let area = std::f64::consts::TAU * 30.0 * 60.0 * (run + 30.0) / lead;
-    let got = worm["volume_mm3"].as_f64().unwrap();
-    assert!(
-        (got - want).abs() <= tol * area,
-        "{got} vs {want} +- {}",
-        tol * area
-    );
-    common::leave_step_for_freecad(&out, "worm", "worm", want, tol * area);
+    common::check_fitted_solid(&out, "worm", "worm", want, area);
     common::check_page(&out, "program.nc");
     let page = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(page.contains("Verification: the thread cut simulated"));

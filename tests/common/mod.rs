@@ -279,6 +279,32 @@ pub fn leave_step_for_freecad(dir: &Path, tag: &str, name: &str, volume: f64, al
     .unwrap();
 }
 
+/// Checks a run's fitted STEP solid `name` against the volume a test found
+/// independently: `report.json` says it lies within the run's STEP
+/// tolerance of the body, and its volume is `want` within that tolerance
+/// times `area` (an upper bound of the solid's surface); then leaves the
+/// file for FreeCAD with the same figure.
+#[allow(dead_code)]
+pub fn check_fitted_solid(dir: &Path, tag: &str, name: &str, want: f64, area: f64) {
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
+    let solid = report["solids"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["name"] == name)
+        .unwrap_or_else(|| panic!("no solid {name} in report.json"));
+    let tol = report["step_tolerance_mm"].as_f64().unwrap();
+    assert!(solid["deviation_mm"].as_f64().unwrap() <= tol, "{solid}");
+    let got = solid["volume_mm3"].as_f64().unwrap();
+    assert!(
+        (got - want).abs() <= tol * area,
+        "{name}: {got} vs {want} +- {}",
+        tol * area
+    );
+    leave_step_for_freecad(dir, tag, name, want, tol * area);
+}
+
 /// The volume of the body of revolution of `profile` and its lateral area
 /// (mm^3, mm^2), by Simpson's rule on 20,000 stretches of the profile's own
 /// curve: a test's oracle for solids made from it.
