@@ -474,3 +474,17 @@ fn bad_input_is_refused_with_no_output() {
         assert!(!out.exists(), "{name}: output written");
     }
 }
+
+/// A STEP tolerance no fit of the roll can hold (0.1 nm) is refused after
+/// bounded work, naming the body and the option, and nothing is written.
+#[test]
+fn a_step_tolerance_no_fit_can_hold_is_refused() {
+    let out = scratch_dir("step-tolerance").join("out");
+    let (code, _, err) = pilgrim(&["run", SCRIPT, "--out", s(&out), "--step-tolerance", "1e-7"]);
+    assert_ne!(code, 0, "accepted");
+    assert!(
+        err.contains("body 'caliber'") && err.contains("loosen --step-tolerance"),
+        "{err}"
+    );
+    assert!(!out.exists(), "something was written");
+}
