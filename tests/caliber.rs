@@ -257,18 +257,8 @@ fn the_default_job_holds_its_tolerance_read_back_from_the_program() {
         width * (r_d * r_d - hub * hub) / 2.0 - (pi * r_d * a * h / 2.0 - 2.0 * a * h * h / 3.0)
     };
     let step = (t1 - t0) / m as f64;
-    let v: f64 = (0..=m)
-        .map(|k| {
-            let w = if k == 0 || k == m {
-                1.0
-            } else {
-                [2.0, 4.0][k % 2]
-            };
-            w * moment(t0 + step * k as f64)
-        })
-        .sum::<f64>()
-        * step
-        / 3.0;
+    let moments: Vec<f64> = (0..=m).map(|k| moment(t0 + step * k as f64)).collect();
+    let v = pilgrim_kernel::math::simpson(&moments, step);
     // Within the tolerance over the whole surface (rim, faces, hub and
     // the groove at its widest, generously).
     let area =

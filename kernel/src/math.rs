@@ -216,8 +216,40 @@ pub fn wrap_angle(t: Real) -> Real {
     }
 }
 
+/// Simpson's rule over `samples` of a function at an even number of equal
+/// steps `h` (an odd number of samples): exact for cubics. The tests' oracle
+/// for volumes and areas.
+///
+/// # Panics
+/// An even number of samples (or fewer than three): a caller's mistake.
+pub fn simpson(samples: &[Real], h: Real) -> Real {
+    let m = samples.len().saturating_sub(1);
+    assert!(
+        m >= 2 && m.is_multiple_of(2),
+        "Simpson needs an even number of steps, not {m}"
+    );
+    let inner: Real = samples[1..m]
+        .iter()
+        .enumerate()
+        .map(|(k, y)| if k % 2 == 0 { 4.0 * y } else { 2.0 * y })
+        .sum();
+    (samples[0] + inner + samples[m]) * h / 3.0
+}
+
 #[cfg(test)]
 mod tests {
+    /// Simpson is exact for a cubic: int of x^3 - x over [0, 2] = 2.
+    #[test]
+    fn simpson_is_exact_for_cubics() {
+        let ys: Vec<super::Real> = (0..=4)
+            .map(|k| {
+                let x = 0.5 * k as super::Real;
+                x * x * x - x
+            })
+            .collect();
+        assert!((super::simpson(&ys, 0.5) - 2.0).abs() < 1e-14);
+    }
+
     use super::*;
 
     #[test]

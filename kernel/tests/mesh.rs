@@ -1,6 +1,7 @@
 //! Meshes: closed and manifold for every body type over random parameters,
 //! volumes against analytic ones, files that other programs read.
 
+use pilgrim_kernel::math::simpson;
 use pilgrim_kernel::mesh::{
     body_of_revolution, cylinder, revolve, sweep, wheel, write_glb, write_stl, MeshError, Scene,
     StlFormat, TriMesh,
@@ -118,20 +119,13 @@ fn body_of_revolution_volume_within_its_bound() {
         // pi * integral of x^2 (Simpson, fine) and the lateral area.
         let steps = 40_000;
         let h = 400.0 / steps as f64;
-        let (mut v, mut a) = (0.0, 0.0);
-        for i in 0..=steps {
-            let z = i as f64 * h;
-            let w = if i == 0 || i == steps {
-                1.0
-            } else if i % 2 == 1 {
-                4.0
-            } else {
-                2.0
-            };
-            v += w * law.x(z).powi(2);
-            a += w * law.x(z) * (1.0 + law.dx(z).powi(2)).sqrt();
-        }
-        let (v, a) = (PI * v * h / 3.0, 2.0 * PI * a * h / 3.0);
+        let zs: Vec<f64> = (0..=steps).map(|i| i as f64 * h).collect();
+        let squares: Vec<f64> = zs.iter().map(|&z| law.x(z).powi(2)).collect();
+        let bands: Vec<f64> = zs
+            .iter()
+            .map(|&z| law.x(z) * (1.0 + law.dx(z).powi(2)).sqrt())
+            .collect();
+        let (v, a) = (PI * simpson(&squares, h), 2.0 * PI * simpson(&bands, h));
         let r_max = 26.0;
         let n = (2.0 * PI / (2.0 * (1.0 - tol / 2.0 / r_max).acos())).ceil();
         let bound = v * (2.0 * PI / n).powi(2) / 6.0 + tol / 2.0 * a;

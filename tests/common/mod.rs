@@ -315,22 +315,16 @@ pub fn revolution_volume_and_area(profile: &pilgrim_kernel::Profile) -> (f64, f6
     let h = (b - a) / m as f64;
     let zs: Vec<f64> = (0..=m).map(|k| a + h * k as f64).collect();
     let xs = profile.eval_many(&zs).unwrap();
-    let (mut v, mut area) = (0.0, 0.0);
-    for k in 0..=m {
-        let w = if k == 0 || k == m {
-            1.0
-        } else if k % 2 == 1 {
-            4.0
-        } else {
-            2.0
-        };
-        v += w * xs[k] * xs[k];
-        if k > 0 {
-            area += 0.5 * (xs[k] + xs[k - 1]) * h.hypot(xs[k] - xs[k - 1]);
-        }
-    }
+    let squares: Vec<f64> = xs.iter().map(|x| x * x).collect();
+    let area: f64 = xs
+        .windows(2)
+        .map(|p| 0.5 * (p[0] + p[1]) * h.hypot(p[1] - p[0]))
+        .sum();
     let pi = std::f64::consts::PI;
-    (pi * v * h / 3.0, 2.0 * pi * area)
+    (
+        pi * pilgrim_kernel::math::simpson(&squares, h),
+        2.0 * pi * area,
+    )
 }
 
 /// Leaves a run's LinuxCNC program and its axis program for `.ci/run`'s

@@ -188,21 +188,8 @@ mod tests {
         let h = (b - a) / m as Real;
         let zs: Vec<Real> = (0..=m).map(|k| a + h * k as Real).collect();
         let xs = p.eval_many(&zs).unwrap();
-        let simpson: Real = (0..=m)
-            .map(|k| {
-                let w = if k == 0 || k == m {
-                    1.0
-                } else if k % 2 == 1 {
-                    4.0
-                } else {
-                    2.0
-                };
-                w * xs[k] * xs[k]
-            })
-            .sum::<Real>()
-            * h
-            / 3.0;
-        let v = std::f64::consts::PI * simpson;
+        let squares: Vec<Real> = xs.iter().map(|x| x * x).collect();
+        let v = std::f64::consts::PI * crate::math::simpson(&squares, h);
         let lateral = 2.0 * std::f64::consts::PI * 48.0 / 2.0 * (b - a);
         assert!(
             (fit.section.volume() - v).abs() <= 1e-3 * lateral,
