@@ -120,14 +120,15 @@ impl Section {
                     from = *to;
                 }
                 Piece::Cubic(pts) => {
-                    for seg in pts.chunks_exact(3) {
-                        let b = [from, seg[0], seg[1], seg[2]];
-                        sum += gauss(|t| {
-                            let (p, d) = bezier_at(&b, t);
-                            p[0] * d[1] - p[1] * d[0]
-                        });
-                        from = seg[2];
-                    }
+                    sum += beziers(from, pts)
+                        .map(|b| {
+                            gauss(|t| {
+                                let (p, d) = bezier_at(&b, t);
+                                p[0] * d[1] - p[1] * d[0]
+                            })
+                        })
+                        .sum::<Real>();
+                    from = pts.last().copied().unwrap_or(from);
                 }
             }
         }
@@ -166,14 +167,15 @@ impl Section {
                     from = *to;
                 }
                 Piece::Cubic(pts) => {
-                    for seg in pts.chunks_exact(3) {
-                        let b = [from, seg[0], seg[1], seg[2]];
-                        sum += gauss(|t| {
-                            let (p, d) = bezier_at(&b, t);
-                            p[1] * p[1] * d[0]
-                        });
-                        from = seg[2];
-                    }
+                    sum += beziers(from, pts)
+                        .map(|b| {
+                            gauss(|t| {
+                                let (p, d) = bezier_at(&b, t);
+                                p[1] * p[1] * d[0]
+                            })
+                        })
+                        .sum::<Real>();
+                    from = pts.last().copied().unwrap_or(from);
                 }
             }
         }
@@ -199,6 +201,15 @@ fn arc_of(a: [Real; 2], m: [Real; 2], b: [Real; 2]) -> ([Real; 2], Real, Real, R
         -(a0 - a1).rem_euclid(tau)
     };
     ([ux, uy], (ax - ux).hypot(ay - uy), a0, sweep)
+}
+
+/// The Bezier segments of a [`Piece::Cubic`]'s points starting at `from`:
+/// each its four control points.
+fn beziers(from: [Real; 2], pts: &[[Real; 2]]) -> impl Iterator<Item = [[Real; 2]; 4]> + '_ {
+    let starts = std::iter::once(from).chain(pts.iter().skip(2).step_by(3).copied());
+    starts
+        .zip(pts.chunks_exact(3))
+        .map(|(a, seg)| [a, seg[0], seg[1], seg[2]])
 }
 
 /// A cubic Bezier's point and derivative at `t`.
