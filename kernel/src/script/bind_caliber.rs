@@ -190,8 +190,8 @@ pub mod caliber_api {
         hub: Real,
         tol: Real,
     ) -> Result<Solid, Box<EvalAltResult>> {
-        let mesh = kernel(caliber::caliber_solid(g, width, hub, tol))?;
         let roll = kernel(caliber::Roll::new(g, width, hub))?;
+        let mesh = kernel(roll.mesh(tol))?;
         Ok(Solid {
             mesh,
             body: crate::family::SweptBody::Roll(Box::new(roll)),
