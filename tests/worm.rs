@@ -9,6 +9,7 @@ mod common;
 use common::{pilgrim, s, scratch};
 use pilgrim_kernel::plugin::PluginMachine;
 use pilgrim_kernel::program::{AxisProgram, Block, ProgramAxis};
+use pilgrim_kernel::step::Sections;
 use pilgrim_kernel::tool::{Tool, ToolShape};
 use pilgrim_kernel::worm::{simulate, WormCheck, WormRequest, WormSizes, WormTolerances};
 use pilgrim_kernel::Motion;
@@ -230,6 +231,35 @@ fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
         );
     }
     let (w0, lead) = check.window;
+    // The mesh and the exact body for STEP (two samplings of one sweep)
+    // both put at the part's angle phi and height z the section's radius at
+    // z - lead phi / 2 pi: right-handed, as the program cuts it.
+    let on_helix = |p: [f64; 3]| {
+        let (r, phi) = (p[0].hypot(p[1]), p[1].atan2(p[0]));
+        let u = w0 + (p[2] - lead * phi / std::f64::consts::TAU - w0).rem_euclid(lead);
+        (r - check.radius_at(u)).abs()
+    };
+    let worst_mesh = solid
+        .positions
+        .iter()
+        .filter(|p| p[0].hypot(p[1]) > 1e-9)
+        .map(|p| on_helix(*p))
+        .fold(0.0, f64::max);
+    assert!(
+        worst_mesh < 1e-3,
+        "worm.stl strays {worst_mesh} mm from the helix"
+    );
+    let sweep = pilgrim_kernel::worm::WormSweep::new(&check, 60.0, 2.5e-4).unwrap();
+    let mut worst_sweep: f64 = 0.0;
+    for k in 0..sweep.pieces() {
+        for (u, v) in [(0.0, 0.0), (0.37, 0.5), (0.81, 0.93)] {
+            worst_sweep = worst_sweep.max(on_helix(sweep.point(k, u, v)));
+        }
+    }
+    assert!(
+        worst_sweep <= 2.5e-4 + 1e-9,
+        "the STEP body strays {worst_sweep} mm from the helix"
+    );
     let n = 200_000;
     let integral: f64 = (0..n)
         .map(|i| {
