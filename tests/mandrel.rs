@@ -281,6 +281,7 @@ fn job(
             &wheel,
             &passes,
             &v.profile,
+            v.blank.as_deref(),
             (v.from, v.to),
             v.tolerance,
         )
@@ -305,6 +306,27 @@ fn verification_catches_a_corrupted_block() {
         "{:?}",
         ok.passes[0]
     );
+    // Each pass cuts into the surface before it, the blank's first: no
+    // ridge stands above the 0.3 mm of stock, nor above the surface the
+    // pass before left, stretch by stretch (within 0.1 um of sampling).
+    assert!(
+        ok.passes[0].deviation.max_above <= 0.3 + 1e-6,
+        "pass 1 stands {} mm above the nominal: above the blank",
+        ok.passes[0].deviation.max_above
+    );
+    for w in ok.passes.windows(2) {
+        for (a, b) in w[0].along_z.iter().zip(&w[1].along_z) {
+            assert_eq!(a[0], b[0]);
+            assert!(
+                b[2] <= a[2] + 1e-4,
+                "{} at z {}: {} mm above the nominal, over {} left before it",
+                w[1].name,
+                b[0],
+                b[2],
+                a[2]
+            );
+        }
+    }
     // The curves drawn (deviation.svg, finish.svg) hold each pass's
     // extremes exactly, ridges and all.
     for p in &ok.passes {

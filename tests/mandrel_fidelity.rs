@@ -417,6 +417,7 @@ fn verified(
         &wheel,
         &tp.passes,
         &v.profile,
+        v.blank.as_deref(),
         (v.from, v.to),
         tolerance.unwrap_or(v.tolerance),
     )

@@ -34,6 +34,9 @@ pub struct VerifyRequest {
     pub to: f64,
     /// The tolerance (mm).
     pub tolerance: f64,
+    /// The blank's profile, if the family gives it: the surface the first
+    /// pass cuts into.
+    pub blank: Option<Box<Profile>>,
 }
 
 /// What a family's finished part must be, for the job's replay.

@@ -270,10 +270,11 @@ pub fn as_written(program: &AxisProgram) -> (AxisProgram, Real) {
 /// blocks at the block's feed while the part turns at the program's
 /// spindle speed; on each of [`GENERATRICES`] generatrices the wheel's true
 /// section (its flat and roundings; its tracked point is the middle of the
-/// flat) left at the moments it passed under the wheel; each cutting pass's
-/// surface, ridges included, against `nominal` over `[from, to]`, the worst
-/// generatrix counting. `passes` are the toolpath's, whose points became
-/// the program's blocks.
+/// flat) left at the moments it passed under the wheel, cut into the
+/// surface the passes before left on that generatrix (into `blank`, where
+/// given, before the first); each cutting pass's surface, ridges included,
+/// against `nominal` over `[from, to]`, the worst generatrix counting.
+/// `passes` are the toolpath's, whose points became the program's blocks.
 ///
 /// # Failures
 /// A tolerance finer than twice the program's resolution; the replay
@@ -289,6 +290,7 @@ pub fn check_grinding(
     wheel: &Wheel,
     passes: &[Pass],
     nominal: &Profile,
+    blank: Option<&Profile>,
     range: (Real, Real),
     tolerance: Real,
 ) -> Result<GrindingCheck, VerifyError> {
@@ -312,6 +314,10 @@ pub fn check_grinding(
         passes: Vec::new(),
     };
     let mut rpm = written.spindle_rpm;
+    // Each generatrix's earlier sweeps, with the block (from 1) of each of
+    // their touches: the surface a pass cuts into is their lowest.
+    let mut earlier: Vec<Vec<(CapsuleEnvelope, Vec<usize>)>> =
+        (0..GENERATRICES).map(|_| Vec::new()).collect();
     for (pass, blocks) in pass_blocks(program, passes) {
         for b in &written.blocks[blocks.clone()] {
             if let Some(s) = b.spindle {
@@ -378,12 +384,17 @@ pub fn check_grinding(
                 .copied()
                 .filter(|z| (range.0..=range.1).contains(z)),
         );
-        for env in &envs {
+        // Where this pass's ridges and the earlier ones' peak.
+        for env in envs.iter().chain(earlier.iter().flatten().map(|(e, _)| e)) {
             zs.extend(env.kinks(range.0, range.1));
         }
         zs.sort_by(Real::total_cmp);
         zs.dedup();
         let profile = nominal.eval_many(&zs)?;
+        let before = match blank {
+            Some(b) => b.eval_many(&zs)?,
+            None => vec![Real::INFINITY; zs.len()],
+        };
         let mut d = Deviation {
             max_above: Real::NEG_INFINITY,
             above_z: range.0,
@@ -399,6 +410,16 @@ pub fn check_grinding(
         let mut hi = vec![Real::NEG_INFINITY; zs.len()];
         for (g, env) in envs.iter().enumerate() {
             let surface = env.eval_many(&zs);
+            // The surface the pass cut into (not finite where an earlier
+            // sweep never reached: there it does not bound).
+            let mut under = before.clone();
+            for (e, _) in &earlier[met[g]] {
+                for (u, s) in under.iter_mut().zip(e.eval_many(&zs)) {
+                    if s.is_finite() {
+                        *u = u.min(s);
+                    }
+                }
+            }
             for (i, ((&z, &s), &p)) in zs.iter().zip(&surface).zip(&profile).enumerate() {
                 if !s.is_finite() {
                     return Err(VerifyError::Pass {
@@ -414,7 +435,7 @@ pub fn check_grinding(
                         },
                     });
                 }
-                let e = s - p;
+                let e = s.min(under[i]) - p;
                 (lo[i], hi[i]) = (lo[i].min(e), hi[i].max(e));
                 if e > d.max_above {
                     (d.max_above, d.above_z, g_above) = (e, z, g);
@@ -431,12 +452,24 @@ pub fn check_grinding(
             (d.max_abs, d.at_z) = (d.max_below.abs(), d.below_z);
             g_below
         };
-        let env = &envs[gen_at];
-        // The touch forming the worst place.
-        d.block = env
-            .source_at(d.at_z)
-            .and_then(|i| t.block[met[gen_at]].get(i))
-            .map(|&k| blocks.start + k + 1);
+        // The touch forming the worst place: of this pass's sweep or of the
+        // earlier one lowest there (none where the blank is lowest).
+        let g = met[gen_at];
+        let this: Vec<usize> = t.block[g].iter().map(|&k| blocks.start + k + 1).collect();
+        let at = [d.at_z];
+        let lowest = std::iter::once((&envs[gen_at], &this))
+            .chain(earlier[g].iter().map(|(e, b)| (e, b)))
+            .map(|(e, b)| (e.eval_many(&at)[0], e, b))
+            .filter(|(s, _, _)| s.is_finite())
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        let blank_at = blank.map_or(Ok(Real::INFINITY), |b| b.eval(d.at_z))?;
+        d.block = lowest
+            .filter(|(s, _, _)| *s <= blank_at)
+            .and_then(|(_, e, b)| e.source_at(d.at_z).and_then(|i| b.get(i)).copied());
+        for (env, g) in envs.into_iter().zip(&met) {
+            let touched: Vec<usize> = t.block[*g].iter().map(|&k| blocks.start + k + 1).collect();
+            earlier[*g].push((env, touched));
+        }
         let f = if rpm > 0.0 { cutting_feed / rpm } else { 0.0 };
         out.passes.push(PassCheck {
             name: pass.name.clone(),

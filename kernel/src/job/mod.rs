@@ -330,6 +330,7 @@ pub fn run(
                 &w,
                 &toolpath.passes,
                 &v.profile,
+                v.blank.as_deref(),
                 (v.from, v.to),
                 v.tolerance,
             )?)
@@ -554,13 +555,8 @@ pub fn run(
         report.files.push("profile.svg".into());
     }
     if let (Some(v), Some(n)) = (&verification, &nominal) {
-        // The surface before the first pass: the blank, where the family
-        // gives one.
-        let blank = parts.iter().find_map(|b| match &b.geometry {
-            PartGeometry::Revolution(p) if b.name == "blank" => Some(p),
-            _ => None,
-        });
-        let start = |z: f64| Some(blank?.eval(z).ok()? - n.profile.eval(z).ok()?);
+        // The surface before the first pass: the blank the replay cut into.
+        let start = |z: f64| Some(n.blank.as_deref()?.eval(z).ok()? - n.profile.eval(z).ok()?);
         for (name, text) in deviation::deviation_svgs(v, start).map_err(Error::Output)? {
             files.push((name.clone(), text.into_bytes()));
             report.files.push(name);

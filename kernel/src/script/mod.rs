@@ -663,7 +663,7 @@ impl PartFamily for ScriptFamily {
         let d = self.call_with_params("verify", values)?;
         let shape = || {
             self.contract(
-                "fn verify(p) must return #{ profile, from, to, tolerance }, #{ groove, psi, tolerance, grid_theta, grid_per_step, patch_gap } or #{ worm, length, space_centre, tolerance: #{ form, thickness, diameter, position, flank_angle_deg } }".into(),
+                "fn verify(p) must return #{ profile, from, to, tolerance } (and optionally blank, a profile), #{ groove, psi, tolerance, grid_theta, grid_per_step, patch_gap } or #{ worm, length, space_centre, tolerance: #{ form, thickness, diameter, position, flank_angle_deg } }".into(),
             )
         };
         let m = d.try_cast::<Map>().ok_or_else(shape)?;
@@ -733,6 +733,10 @@ impl PartFamily for ScriptFamily {
             from: num("from")?,
             to: num("to")?,
             tolerance: num("tolerance")?,
+            blank: match m.get("blank") {
+                None => None,
+                Some(b) => Some(Box::new(b.clone().try_cast::<Profile>().ok_or_else(shape)?)),
+            },
         })))
     }
 }
