@@ -102,12 +102,10 @@ fn draw(
 
 /// The stock each pass removed along z (mm): its `along_z` replaced by
 /// the surface before it minus the surface it left, at the valleys (the
-/// lowest surfaces' difference) and at the ridges' tops (the highest's,
-/// nil where the pass's ridge stands above the surface before it: no
-/// material was there to remove; the replay sweeps each pass's wheel
-/// alone). The surface before the first pass is `start` (the blank minus
-/// the nominal at z, mm); where it is not known (no blank), the first pass
-/// is left out.
+/// lowest surfaces' difference) and at the ridges' tops (the highest's).
+/// The surface before the first pass is `start` (the blank minus the
+/// nominal at z, mm); where it is not known (no blank), the first pass is
+/// left out.
 /// Passes are matched stretch by stretch where their stretches lie at the
 /// same z (the replay samples every pass at the same places).
 pub fn removed(passes: &[PassCheck], start: impl Fn(f64) -> Option<f64>) -> Vec<PassCheck> {
@@ -127,7 +125,7 @@ pub fn removed(passes: &[PassCheck], start: impl Fn(f64) -> Option<f64>) -> Vec<
             .enumerate()
             .filter_map(|(i, b)| {
                 let (lo, hi) = before(i, b[0])?;
-                Some([b[0], lo - b[1], (hi - b[2]).max(0.0)])
+                Some([b[0], lo - b[1], hi - b[2]])
             })
             .collect();
         if !along.is_empty() {
@@ -235,9 +233,6 @@ mod tests {
         assert_eq!(got[1].along_z.len(), 1);
         let f = got[1].along_z[0];
         assert!((f[1] - 0.101).abs() < 1e-12 && (f[2] - 0.118).abs() < 1e-12);
-        // A ridge standing above the blank removed nothing at its top.
-        let tall = vec![pass("rough", vec![[0.0, 0.2, 0.35]])];
-        assert_eq!(removed(&tall, |_| Some(0.3))[0].along_z[0][2], 0.0);
         let no_blank = removed(&passes, |_| None);
         assert_eq!(no_blank.len(), 1);
         assert_eq!(no_blank[0].name, "finish");
