@@ -120,14 +120,7 @@ impl Section {
                     from = *to;
                 }
                 Piece::Cubic(pts) => {
-                    sum += beziers(from, pts)
-                        .map(|b| {
-                            gauss(|t| {
-                                let (p, d) = bezier_at(&b, t);
-                                p[0] * d[1] - p[1] * d[0]
-                            })
-                        })
-                        .sum::<Real>();
+                    sum += over_beziers(from, pts, |p, d| p[0] * d[1] - p[1] * d[0]);
                     from = pts.last().copied().unwrap_or(from);
                 }
             }
@@ -167,14 +160,7 @@ impl Section {
                     from = *to;
                 }
                 Piece::Cubic(pts) => {
-                    sum += beziers(from, pts)
-                        .map(|b| {
-                            gauss(|t| {
-                                let (p, d) = bezier_at(&b, t);
-                                p[1] * p[1] * d[0]
-                            })
-                        })
-                        .sum::<Real>();
+                    sum += over_beziers(from, pts, |p, d| p[1] * p[1] * d[0]);
                     from = pts.last().copied().unwrap_or(from);
                 }
             }
@@ -210,6 +196,23 @@ fn beziers(from: [Real; 2], pts: &[[Real; 2]]) -> impl Iterator<Item = [[Real; 2
     starts
         .zip(pts.chunks_exact(3))
         .map(|(a, seg)| [a, seg[0], seg[1], seg[2]])
+}
+
+/// The integral of `f(point, derivative)` along a [`Piece::Cubic`]'s
+/// segments from `from`, by Gauss-Legendre on each.
+fn over_beziers(
+    from: [Real; 2],
+    pts: &[[Real; 2]],
+    f: impl Fn([Real; 2], [Real; 2]) -> Real,
+) -> Real {
+    beziers(from, pts)
+        .map(|b| {
+            gauss(|t| {
+                let (p, d) = bezier_at(&b, t);
+                f(p, d)
+            })
+        })
+        .sum()
 }
 
 /// A cubic Bezier's point and derivative at `t`.
