@@ -188,6 +188,65 @@ fn report_json(report: &Report) -> Result<Vec<u8>, Error> {
     json(report)
 }
 
+/// The run's programs, each read back by the lint before it is kept.
+struct Posted {
+    /// The machine's control's dialect.
+    control: &'static crate::program::post::Dialect,
+    /// The program in it.
+    control_text: String,
+    /// The CL file.
+    cld_text: String,
+    /// The other dialects asked for: (file name, bytes).
+    extra: Vec<(String, Vec<u8>)>,
+}
+
+/// Posts `program` in the control's dialect, as a CL file and in the
+/// dialects `also` names, and lints each ([`crate::program::lint`]):
+/// nothing is kept that does not read back as the axis program.
+fn post_all(
+    machine: &OpenMachine,
+    info: &crate::machine::MachineInfo,
+    program: &AxisProgram,
+    also: &[String],
+) -> Result<Posted, Error> {
+    let control = dialect(&info.control).ok_or_else(|| Error::UnknownControl {
+        machine: info.name.clone(),
+        control: info.control.clone(),
+    })?;
+    let control_text = machine.post.post(program, control.name)?;
+    let cld_text = machine.post.post(program, CLD.name)?;
+    crate::program::lint::lint(&control_text, program, control, &info.axes)?;
+    crate::program::lint::lint(&cld_text, program, &CLD, &info.axes)?;
+    let mut extra = Vec::new();
+    for name in also {
+        let d = dialect(name).ok_or_else(|| {
+            Error::Post(crate::program::PostError::UnknownDialect { name: name.clone() })
+        })?;
+        if d.name == control.name || d.name == CLD.name {
+            continue;
+        }
+        let text = machine.post.post(program, d.name)?;
+        crate::program::lint::lint(&text, program, d, &info.axes)?;
+        extra.push((format!("program.{}", d.extension), text.into_bytes()));
+    }
+    Ok(Posted {
+        control,
+        control_text,
+        cld_text,
+        extra,
+    })
+}
+
+/// The run's data files, made of the toolpath and the program alone:
+/// `toolpath.json`, `program.json` and the block table `report.csv`.
+fn data_files(toolpath: &Toolpath, program: &AxisProgram) -> Result<[Vec<u8>; 3], Error> {
+    Ok([
+        json(toolpath)?,
+        json(program)?,
+        block_table(program).map_err(Error::Output)?.into_bytes(),
+    ])
+}
+
 /// Runs `family` on `machine` with the parameter `sources`; `stage` is
 /// called as each stage begins (for progress).
 ///
@@ -337,30 +396,26 @@ pub fn run(
         }
     };
     stage(STAGES[3]);
-    let control = dialect(&info.control).ok_or_else(|| Error::UnknownControl {
-        machine: info.name.clone(),
-        control: info.control.clone(),
-    })?;
-    let control_text = machine.post.post(&program, control.name)?;
-    let cld_text = machine.post.post(&program, CLD.name)?;
-    // Every program read back before anything is written.
-    crate::program::lint::lint(&control_text, &program, control, &info.axes)?;
-    crate::program::lint::lint(&cld_text, &program, &CLD, &info.axes)?;
-    let mut extra = Vec::new();
-    for name in &options.also_post {
-        let d = dialect(name).ok_or_else(|| {
-            Error::Post(crate::program::PostError::UnknownDialect { name: name.clone() })
-        })?;
-        if d.name == control.name || d.name == CLD.name {
-            continue;
-        }
-        let text = machine.post.post(&program, d.name)?;
-        crate::program::lint::lint(&text, &program, d, &info.axes)?;
-        extra.push((format!("program.{}", d.extension), text.into_bytes()));
-    }
+    // The data files need only the toolpath and the program: a second
+    // thread writes them while this one posts and lints.
+    let (data, posted) = std::thread::scope(|s| {
+        let data = s.spawn(|| data_files(&toolpath, &program));
+        let posted = post_all(machine, info, &program, &options.also_post);
+        let data = data
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (data, posted)
+    });
+    let Posted {
+        control,
+        control_text,
+        cld_text,
+        extra,
+    } = posted?;
+    let [toolpath_json, program_json, csv] = data?;
     let mut files: Vec<(String, Vec<u8>)> = vec![
-        ("toolpath.json".into(), json(&toolpath)?),
-        ("program.json".into(), json(&program)?),
+        ("toolpath.json".into(), toolpath_json),
+        ("program.json".into(), program_json),
         (
             format!("program.{}", control.extension),
             control_text.into_bytes(),
@@ -368,10 +423,7 @@ pub fn run(
         ("program.cld".into(), cld_text.into_bytes()),
     ];
     files.extend(extra);
-    files.extend([(
-        "report.csv".into(),
-        block_table(&program).map_err(Error::Output)?.into_bytes(),
-    )]);
+    files.push(("report.csv".into(), csv));
     stage(STAGES[4]);
     let mut parts = family.part(&values)?;
     if let Some(b) = parts.iter().find(|b| !crate::files::is_plain_name(&b.name)) {
