@@ -188,27 +188,22 @@ fn report_json(report: &Report) -> Result<Vec<u8>, Error> {
     json(report)
 }
 
-/// The run's programs, each read back by the lint before it is kept.
-struct Posted {
-    /// The machine's control's dialect.
-    control: &'static crate::program::post::Dialect,
-    /// The program in it.
-    control_text: String,
-    /// The CL file.
-    cld_text: String,
-    /// The other dialects asked for: (file name, bytes).
-    extra: Vec<(String, Vec<u8>)>,
-}
-
 /// Posts `program` in the control's dialect, as a CL file and in the
 /// dialects `also` names, and lints each ([`crate::program::lint`]):
-/// nothing is kept that does not read back as the axis program.
+/// nothing is kept that does not read back as the axis program. The
+/// control's dialect, and the programs as files (name, bytes) in that order.
 fn post_all(
     machine: &OpenMachine,
     info: &crate::machine::MachineInfo,
     program: &AxisProgram,
     also: &[String],
-) -> Result<Posted, Error> {
+) -> Result<
+    (
+        &'static crate::program::post::Dialect,
+        Vec<(String, Vec<u8>)>,
+    ),
+    Error,
+> {
     let control = dialect(&info.control).ok_or_else(|| Error::UnknownControl {
         machine: info.name.clone(),
         control: info.control.clone(),
@@ -217,7 +212,13 @@ fn post_all(
     let cld_text = machine.post.post(program, CLD.name)?;
     crate::program::lint::lint(&control_text, program, control, &info.axes)?;
     crate::program::lint::lint(&cld_text, program, &CLD, &info.axes)?;
-    let mut extra = Vec::new();
+    let mut files = vec![
+        (
+            format!("program.{}", control.extension),
+            control_text.into_bytes(),
+        ),
+        ("program.cld".into(), cld_text.into_bytes()),
+    ];
     for name in also {
         let d = dialect(name).ok_or_else(|| {
             Error::Post(crate::program::PostError::UnknownDialect { name: name.clone() })
@@ -227,14 +228,9 @@ fn post_all(
         }
         let text = machine.post.post(program, d.name)?;
         crate::program::lint::lint(&text, program, d, &info.axes)?;
-        extra.push((format!("program.{}", d.extension), text.into_bytes()));
+        files.push((format!("program.{}", d.extension), text.into_bytes()));
     }
-    Ok(Posted {
-        control,
-        control_text,
-        cld_text,
-        extra,
-    })
+    Ok((control, files))
 }
 
 /// The run's data files, made of the toolpath and the program alone:
@@ -406,23 +402,13 @@ pub fn run(
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
         (data, posted)
     });
-    let Posted {
-        control,
-        control_text,
-        cld_text,
-        extra,
-    } = posted?;
+    let (control, programs) = posted?;
     let [toolpath_json, program_json, csv] = data?;
     let mut files: Vec<(String, Vec<u8>)> = vec![
         ("toolpath.json".into(), toolpath_json),
         ("program.json".into(), program_json),
-        (
-            format!("program.{}", control.extension),
-            control_text.into_bytes(),
-        ),
-        ("program.cld".into(), cld_text.into_bytes()),
     ];
-    files.extend(extra);
+    files.extend(programs);
     files.push(("report.csv".into(), csv));
     stage(STAGES[4]);
     let mut parts = family.part(&values)?;
