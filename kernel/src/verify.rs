@@ -454,11 +454,16 @@ pub fn check_grinding(
         };
         // The touch forming the worst place: of this pass's sweep or of the
         // earlier one lowest there (none where the blank is lowest).
-        let g = met[gen_at];
-        let this: Vec<usize> = t.block[g].iter().map(|&k| blocks.start + k + 1).collect();
+        for (env, g) in envs.into_iter().zip(&met) {
+            let touched: Vec<usize> = t.block[*g].iter().map(|&k| blocks.start + k + 1).collect();
+            earlier[*g].push((env, touched));
+        }
+        let (this, before) = earlier[met[gen_at]]
+            .split_last()
+            .expect("this pass's sweep was just kept");
         let at = [d.at_z];
-        let lowest = std::iter::once((&envs[gen_at], &this))
-            .chain(earlier[g].iter().map(|(e, b)| (e, b)))
+        let lowest = std::iter::once(this)
+            .chain(before)
             .map(|(e, b)| (e.eval_many(&at)[0], e, b))
             .filter(|(s, _, _)| s.is_finite())
             .min_by(|a, b| a.0.total_cmp(&b.0));
@@ -466,10 +471,6 @@ pub fn check_grinding(
         d.block = lowest
             .filter(|(s, _, _)| *s <= blank_at)
             .and_then(|(_, e, b)| e.source_at(d.at_z).and_then(|i| b.get(i)).copied());
-        for (env, g) in envs.into_iter().zip(&met) {
-            let touched: Vec<usize> = t.block[*g].iter().map(|&k| blocks.start + k + 1).collect();
-            earlier[*g].push((env, touched));
-        }
         let f = if rpm > 0.0 { cutting_feed / rpm } else { 0.0 };
         out.passes.push(PassCheck {
             name: pass.name.clone(),
