@@ -41,8 +41,7 @@ impl Roll {
     /// groove's deepest point.
     pub fn new(groove: &Groove, width: Real, hub: Real) -> Result<Self, SolidError> {
         let r_d = groove.roll_radius();
-        let widest = groove.width().x().iter().copied().fold(0.0, Real::max);
-        let deepest = groove.depth().x().iter().copied().fold(0.0, Real::max);
+        let (widest, deepest) = extremes(groove);
         if !(width > widest) {
             return Err(SolidError::Size(format!(
                 "the rim's width {width} mm must exceed the widest groove, {widest} mm"
@@ -75,6 +74,52 @@ impl Roll {
                 let (x, z) = s.point(psi);
                 (x, self.groove.roll_radius() - z)
             })
+    }
+
+    /// The roll as a closed triangle mesh in its frame, sampled so that its
+    /// chords stay within `tol` of the groove and the periphery (each
+    /// section's groove with the same number of points, evenly in psi: the
+    /// widest section sets it).
+    ///
+    /// # Failures
+    /// A tolerance not positive, or more triangles than
+    /// [`crate::mesh::MAX_TRIANGLES`]; a groove that cannot be evaluated.
+    pub fn mesh(&self, tol: Real) -> Result<TriMesh, SolidError> {
+        use crate::step::Sections;
+        crate::math::positive("chordal tolerance", tol).map_err(MeshError::from)?;
+        let groove = &self.groove;
+        let r_d = groove.roll_radius();
+        let (widest, deepest) = extremes(groove);
+        // The groove's arc: chords within tol on its tightest curvature.
+        let (r_min, _) = groove.min_curvature_radius()?;
+        let chord = (8.0 * tol * r_min).sqrt();
+        let arc = std::f64::consts::PI * (widest / 2.0).max(deepest);
+        let n_psi = ((arc / chord).ceil() as usize).max(8);
+        let (t0, t1) = groove.theta_range();
+        let d_theta = (8.0 * tol / r_d).sqrt();
+        let n_theta = (((t1 - t0) / d_theta).ceil() as usize).max(2);
+        crate::mesh::check_triangles(2 * (n_theta + 1) * (n_psi + 6), tol)?;
+        // Each ring: the section's corners and the groove's points, in the
+        // order of the roll's pieces.
+        let rings = (0..=n_theta)
+            .map(|i| {
+                let v = i as Real / n_theta as Real;
+                let mut ring = vec![self.point(0, 0.0, v), self.point(1, 0.0, v)];
+                ring.extend((0..=n_psi).map(|j| self.point(2, j as Real / n_psi as Real, v)));
+                ring.extend([self.point(4, 0.0, v), self.point(5, 0.0, v)]);
+                ring
+            })
+            .collect::<Vec<_>>();
+        if rings.iter().flatten().flatten().any(|c| !c.is_finite()) {
+            // The tables cover every angle of their own range: a section
+            // that cannot be evaluated is the groove's own error.
+            groove.section(t0)?;
+            groove.section(t1)?;
+            return Err(SolidError::Size(
+                "the groove's sections are not finite".into(),
+            ));
+        }
+        Ok(crate::mesh::sweep(&rings)?)
     }
 }
 
@@ -126,51 +171,8 @@ pub fn caliber_solid(
     Roll::new(groove, width, hub)?.mesh(tol)
 }
 
-impl Roll {
-    /// The roll as a closed triangle mesh in its frame, sampled so that its
-    /// chords stay within `tol` of the groove and the periphery (each
-    /// section's groove with the same number of points, evenly in psi: the
-    /// widest section sets it).
-    ///
-    /// # Failures
-    /// A tolerance not positive, or more triangles than
-    /// [`crate::mesh::MAX_TRIANGLES`]; a groove that cannot be evaluated.
-    pub fn mesh(&self, tol: Real) -> Result<TriMesh, SolidError> {
-        use crate::step::Sections;
-        crate::math::positive("chordal tolerance", tol).map_err(MeshError::from)?;
-        let groove = &self.groove;
-        let r_d = groove.roll_radius();
-        let widest = groove.width().x().iter().copied().fold(0.0, Real::max);
-        let deepest = groove.depth().x().iter().copied().fold(0.0, Real::max);
-        // The groove's arc: chords within tol on its tightest curvature.
-        let (r_min, _) = groove.min_curvature_radius()?;
-        let chord = (8.0 * tol * r_min).sqrt();
-        let arc = std::f64::consts::PI * (widest / 2.0).max(deepest);
-        let n_psi = ((arc / chord).ceil() as usize).max(8);
-        let (t0, t1) = groove.theta_range();
-        let d_theta = (8.0 * tol / r_d).sqrt();
-        let n_theta = (((t1 - t0) / d_theta).ceil() as usize).max(2);
-        crate::mesh::check_triangles(2 * (n_theta + 1) * (n_psi + 6), tol)?;
-        // Each ring: the section's corners and the groove's points, in the
-        // order of the roll's pieces.
-        let rings = (0..=n_theta)
-            .map(|i| {
-                let v = i as Real / n_theta as Real;
-                let mut ring = vec![self.point(0, 0.0, v), self.point(1, 0.0, v)];
-                ring.extend((0..=n_psi).map(|j| self.point(2, j as Real / n_psi as Real, v)));
-                ring.extend([self.point(4, 0.0, v), self.point(5, 0.0, v)]);
-                ring
-            })
-            .collect::<Vec<_>>();
-        if rings.iter().flatten().flatten().any(|c| !c.is_finite()) {
-            // The tables cover every angle of their own range: a section
-            // that cannot be evaluated is the groove's own error.
-            groove.section(t0)?;
-            groove.section(t1)?;
-            return Err(SolidError::Size(
-                "the groove's sections are not finite".into(),
-            ));
-        }
-        Ok(crate::mesh::sweep(&rings)?)
-    }
+/// The widest and the deepest the groove is in its tables (mm).
+fn extremes(groove: &Groove) -> (Real, Real) {
+    let max = |t: &crate::profile::Profile| t.x().iter().copied().fold(0.0, Real::max);
+    (max(groove.width()), max(groove.depth()))
 }
