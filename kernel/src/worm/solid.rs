@@ -113,7 +113,11 @@ impl WormSweep {
         }
         all.push([all[0][0] + lead, all[0][1]]);
         // Greedy: from each point kept, reach as far as every point passed
-        // stays within `merge` of the chord.
+        // stays within `merge` of the chord, radially. Written here, not
+        // geo's Ramer-Douglas-Peucker (SimplifyIdx): that bounds the
+        // distance square to the chord, which on the steep flanks lets the
+        // radius at a place stray several times `merge` (0.71 um for 0.25
+        // um on the default worm).
         let off = |a: [Real; 2], b: [Real; 2], p: [Real; 2]| {
             let t = if b[0] > a[0] {
                 (p[0] - a[0]) / (b[0] - a[0])
