@@ -12,7 +12,10 @@
 //! points), so the faces meet exactly and the shell closes. The
 //! interpolation is written here (de Boor's averaged knots and a banded
 //! solve, about 80 lines) because truck-geometry 0.5 fits no B-spline to
-//! points.
+//! points, and curvo's `try_interpolate` fits one curve at a time on its own
+//! chord-length parameters: a tensor-product surface needs the same knots
+//! for every row and column, and one factorization here serves the
+//! thousands of columns of a fit.
 
 use super::{write, StepError};
 use crate::math::Real;
@@ -235,10 +238,7 @@ impl Patch {
             .map(|i| {
                 let f = p as Real / (k[i + p + 1] - k[i + 1]);
                 (0..self.ctrl[i].len())
-                    .map(|j| {
-                        let (a, b) = (self.ctrl[i][j], self.ctrl[i + 1][j]);
-                        [f * (b[0] - a[0]), f * (b[1] - a[1]), f * (b[2] - a[2])]
-                    })
+                    .map(|j| scaled_difference(f, self.ctrl[i][j], self.ctrl[i + 1][j]))
                     .collect()
             })
             .collect();
@@ -259,8 +259,7 @@ impl Patch {
                 (0..row.len() - 1)
                     .map(|j| {
                         let f = p as Real / (knots_v[j + p + 1] - knots_v[j + 1]);
-                        let (a, b) = (row[j], row[j + 1]);
-                        [f * (b[0] - a[0]), f * (b[1] - a[1]), f * (b[2] - a[2])]
+                        scaled_difference(f, row[j], row[j + 1])
                     })
                     .collect()
             })
@@ -270,6 +269,12 @@ impl Patch {
             ctrl,
         }
     }
+}
+
+/// `f (b - a)`: a control point of a B-spline's derivative from two of its
+/// own.
+fn scaled_difference(f: Real, a: [Real; 3], b: [Real; 3]) -> [Real; 3] {
+    [f * (b[0] - a[0]), f * (b[1] - a[1]), f * (b[2] - a[2])]
 }
 
 /// The patches of every piece, `across[k]` points across piece `k` and
