@@ -31,7 +31,7 @@ use crate::catalog::OpenMachine;
 use crate::error::Error;
 use crate::family::{PartFamily, PartGeometry, Verification};
 use crate::params::{resolve, ParamSource, ParamValue, Params};
-use crate::program::post::{dialect, CLD};
+use crate::program::post::{dialect, Dialect, CLD};
 use crate::program::{build, AxisProgram};
 use crate::tool::ToolShape;
 use crate::toolpath::Toolpath;
@@ -197,13 +197,7 @@ fn post_all(
     info: &crate::machine::MachineInfo,
     program: &AxisProgram,
     also: &[String],
-) -> Result<
-    (
-        &'static crate::program::post::Dialect,
-        Vec<(String, Vec<u8>)>,
-    ),
-    Error,
-> {
+) -> Result<(&'static Dialect, scene::Files), Error> {
     let control = dialect(&info.control).ok_or_else(|| Error::UnknownControl {
         machine: info.name.clone(),
         control: info.control.clone(),
