@@ -458,3 +458,202 @@ fn killed_runs_leave_the_old_output_whole() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A lathe (the Fanuc 0i-TC's file) whose control is `control` and whose
+/// name or description is `name` / `description`.
+fn lathe(control: &str, name: &str, description: &str) -> String {
+    let text = pilgrim_kernel::machine::BUILTIN_SOURCES
+        .iter()
+        .find(|(n, _)| *n == "fanuc-0i-tc")
+        .unwrap()
+        .1;
+    // A TOML basic string, control characters as \uXXXX.
+    let quote = |t: &str| {
+        let body: String = t
+            .chars()
+            .map(|c| match c {
+                '"' | '\\' => format!("\\{c}"),
+                c if c.is_control() => format!("\\u{:04X}", u32::from(c)),
+                c => c.to_string(),
+            })
+            .collect();
+        format!("\"{body}\"")
+    };
+    text.replace("name = \"fanuc-0i-tc\"", &format!("name = {}", quote(name)))
+        .replace(
+            "description = \"two-axis CNC lathe, Fanuc 0i-TC, X on diameter\"",
+            &format!("description = {}", quote(description)),
+        )
+        .replace("control = \"fanuc\"", &format!("control = {control:?}"))
+}
+
+/// A turning family whose tool and pass are named by the script's text
+/// `tool` and `pass`, and a parameter `label` that becomes a pass's name.
+fn turning(tool: &str, pass: &str) -> String {
+    format!(
+        "fn params() {{ #{{ label: #{{ value: \"finish\", unit: \"\", doc: \"the last pass's name\" }} }} }}\n\
+         fn toolpath(p) {{\n\
+           let tp = new_toolpath(\"turn\", end_mill({tool}, 1, 10.0, 30.0), 500.0, []);\n\
+           tp.add_pass({pass}, #{{ x: [30.0, 20.0, 20.0], y: 0.0, z: [2.0, 2.0, -40.0], motion: [\"rapid\", \"linear\", \"linear\"], feed: 100.0 }});\n\
+           tp.add_pass(p.label, #{{ x: [19.0, 19.0, 30.0], y: 0.0, z: [-40.0, 2.0, 2.0], motion: [\"linear\", \"linear\", \"rapid\"], feed: 100.0 }});\n\
+           tp\n\
+         }}\n"
+    )
+}
+
+/// Text that would break a comment or a block, through every source that
+/// reaches a program (tool, pass and machine names, a parameter string, a
+/// machine's description), into every dialect (the control's, `--post`
+/// ones, the CL file): each run is refused, naming the source, and writes
+/// nothing. A tool named `T1)`, a line break and `G00 X0 Z0 (` once put an
+/// uncommented rapid to the spindle's axis into `program.nc`.
+#[test]
+fn injected_words_never_reach_a_program() {
+    let dir = scratch("inject");
+    let out = dir.join("o");
+    let clean_script = dir.join("turn.rhai");
+    std::fs::write(&clean_script, turning("\"turning tool\"", "\"rough\"")).unwrap();
+    for control in ["sinumerik", "fanuc", "linuxcnc"] {
+        let machine = dir.join("lathe.toml");
+        let run = |script: &Path, machine: &Path, extra: &[&str]| {
+            let mut args = vec![
+                "run",
+                s(script),
+                "--machine",
+                s(machine),
+                "--out",
+                s(&out),
+                "--quiet",
+                "--post",
+                "linuxcnc",
+                "--post",
+                "fanuc",
+                "--post",
+                "sinumerik",
+            ];
+            args.extend(extra);
+            pilgrim(&args)
+        };
+        std::fs::write(&machine, lathe(control, "my lathe", "a lathe")).unwrap();
+        let (code, _, err) = run(&clean_script, &machine, &[]);
+        assert_eq!(code, 0, "{control}: the clean run: {err}");
+        std::fs::remove_dir_all(&out).unwrap();
+        // Names in the script.
+        for (tool, pass, source, shown) in [
+            (
+                r#""T1)\nG00 X0 Z0 (""#,
+                r#""rough""#,
+                "tool name",
+                r#""T1)\nG00 X0 Z0 (""#,
+            ),
+            (r#""T1) G00 X0 Z0 (""#, r#""rough""#, "tool name", "')'"),
+            (r#""tool""#, r#""rough\rG00 X0""#, "pass name", r#"\r"#),
+            (r#""tool""#, r#""rough; SF=90""#, "pass name", "';'"),
+            (r#""tool""#, r#""MSG, PROBEOPEN x""#, "", ""),
+        ] {
+            let script = dir.join("inject.rhai");
+            std::fs::write(&script, turning(tool, pass)).unwrap();
+            let (code, _, err) = run(&script, &machine, &[]);
+            if source.is_empty() {
+                // Words of no dialect's comment syntax pass as names; the
+                // LinuxCNC writer keeps its comment from acting.
+                assert_eq!(code, 0, "{control}: {pass}: {err}");
+                let ngc = std::fs::read_to_string(out.join("program.ngc")).unwrap();
+                assert!(
+                    ngc.contains("(_MSG, PROBEOPEN x)") && !ngc.contains("(MSG"),
+                    "{ngc}"
+                );
+                std::fs::remove_dir_all(&out).unwrap();
+                continue;
+            }
+            assert_eq!(code, 1, "{control}: {tool} {pass}");
+            assert!(
+                err.contains("inject.rhai") && err.contains(source) && err.contains(shown),
+                "{control}: {err}"
+            );
+            assert!(!out.exists(), "{control}: {tool} {pass}");
+        }
+        // A parameter string that becomes a pass's name.
+        let params = dir.join("p.toml");
+        std::fs::write(&params, "label = \"finish\\nG00 X0 Z0\"\n").unwrap();
+        let (code, _, err) = run(&clean_script, &machine, &["--params", s(&params)]);
+        assert_eq!(code, 1);
+        assert!(
+            err.contains("p.toml") && err.contains("label") && err.contains("U+000A"),
+            "{control}: {err}"
+        );
+        std::fs::write(&params, "label = \"finish) G00 X0 Z0 (\"\n").unwrap();
+        let (code, _, err) = run(&clean_script, &machine, &["--params", s(&params)]);
+        assert_eq!(code, 1);
+        assert!(
+            err.contains("pass name") && err.contains("')'"),
+            "{control}: {err}"
+        );
+        assert!(!out.exists());
+        // The machine's name (a lone carriage return passed all four
+        // lints) and its description.
+        for (name, description, source) in [
+            ("lathe\rG00 X0 Z0", "a lathe", "machine name"),
+            ("lathe) G00 X0 (", "a lathe", "machine name"),
+            ("lathe", "a lathe\u{1b}[2J", "machine description"),
+        ] {
+            std::fs::write(&machine, lathe(control, name, description)).unwrap();
+            let (code, _, err) = run(&clean_script, &machine, &[]);
+            assert_eq!(code, 1, "{control}: {name:?} {description:?}");
+            assert!(
+                err.contains("lathe.toml") && err.contains(source),
+                "{control}: {err}"
+            );
+            assert!(!out.exists());
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A spindle speed a program writes as `S0` is refused, naming the block;
+/// so is one below the spindle's least speed. A speed of 0.3 rpm was
+/// written `S0 M3` and followed by cutting moves.
+#[test]
+fn a_spindle_that_writes_as_zero_is_refused() {
+    let dir = scratch("s0");
+    let out = dir.join("o");
+    let script = dir.join("turn.rhai");
+    std::fs::write(
+        &script,
+        turning("\"tool\"", "\"rough\"").replace(
+            "label: #{",
+            "rpm: #{ value: 500.0, min: 0.0001, max: 5000.0, unit: \"rpm\", doc: \"spindle\" }, label: #{",
+        ).replace("500.0, []", "p.rpm, []"),
+    )
+    .unwrap();
+    let machine = dir.join("lathe.toml");
+    std::fs::write(&machine, lathe("fanuc", "lathe", "a lathe")).unwrap();
+    let run = |rpm: &str| {
+        pilgrim(&[
+            "run",
+            s(&script),
+            "--machine",
+            s(&machine),
+            "--set",
+            &format!("rpm={rpm}"),
+            "--out",
+            s(&out),
+            "--quiet",
+        ])
+    };
+    let (code, _, err) = run("0.3");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("written S0") && err.contains("block 1 in \"start\""),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let (code, _, err) = run("4000");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("S4000") && err.contains("[0, 3500] rpm"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -72,6 +72,16 @@ pub enum InputError {
         /// The accepted range, in words.
         expected: String,
     },
+    /// A name or text refused for what it holds ([`crate::names`]).
+    #[error("{what} {value} {reason}")]
+    BadText {
+        /// What the text is (`tool name`, `machine description`).
+        what: String,
+        /// The text as quoted in messages (escaped, cut short).
+        value: String,
+        /// What is wrong with it.
+        reason: String,
+    },
 }
 
 impl InputError {

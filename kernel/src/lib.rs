@@ -6,8 +6,9 @@
 //! The modules, in the order data flows through them (ARCHITECTURE §1;
 //! `docs/architecture.md` says where each stage lives):
 //!
-//! - [`math`], [`input`], [`files`]: the numbers, the one validation error,
-//!   and reading outside files (regular files only, bounded);
+//! - [`math`], [`input`], [`files`], [`names`]: the numbers, the one
+//!   validation error, reading outside files (regular files only,
+//!   bounded), and the names and texts that come from outside;
 //! - [`transform`]: elementary factors, the [`Chain`] of a machine, the
 //!   universal 15-factor preset of seed 003, forward and inverse kinematics;
 //! - [`machine`]: a machine's description ([`MachineInfo`], the plugin ABI's
@@ -51,6 +52,7 @@ pub mod job;
 pub mod machine;
 pub mod math;
 pub mod mesh;
+pub mod names;
 pub mod offset;
 pub mod output;
 pub mod params;

@@ -108,12 +108,16 @@ impl ParamValue {
         })
     }
 
-    fn check_finite(&self) -> Result<(), String> {
+    /// Numbers finite; text free of control characters
+    /// ([`crate::names::check_text`]: a parameter's text may become a pass's
+    /// name or reach the page and the terminal).
+    fn check_value(&self) -> Result<(), String> {
         match self {
             Self::Float(f) if !f.is_finite() => Err(format!("{f} is not a finite number")),
             Self::List(v) if v.iter().any(|x| !x.is_finite()) => {
                 Err("the list holds a value that is not finite".into())
             }
+            Self::Text(t) => crate::names::check_text("text", t).map_err(|e| e.to_string()),
             _ => Ok(()),
         }
     }
@@ -360,7 +364,7 @@ pub fn resolve(
                     let s = spec(k, label)?;
                     let value =
                         ParamValue::from_toml(v, &s.default).map_err(|m| bad(k, label, m))?;
-                    value.check_finite().map_err(|m| bad(k, label, m))?;
+                    value.check_value().map_err(|m| bad(k, label, m))?;
                     values.insert(k.clone(), value);
                     came_from.insert(k.clone(), label.clone());
                 }
@@ -370,7 +374,7 @@ pub fn resolve(
                     let s = spec(k, label)?;
                     let value =
                         ParamValue::parse(text, &s.default).map_err(|m| bad(k, label, m))?;
-                    value.check_finite().map_err(|m| bad(k, label, m))?;
+                    value.check_value().map_err(|m| bad(k, label, m))?;
                     values.insert(k.clone(), value);
                     came_from.insert(k.clone(), label.clone());
                 }
@@ -378,7 +382,9 @@ pub fn resolve(
         }
     }
     for s in specs {
-        s.check(&values[&s.name])
+        let v = &values[&s.name];
+        v.check_value()
+            .and_then(|_| s.check(v))
             .map_err(|m| bad(&s.name, &came_from[&s.name], m))?;
     }
     Ok(values)

@@ -136,6 +136,36 @@ pub enum ToolpathError {
 }
 
 impl Toolpath {
+    /// Checks the names and texts of [`Self::validate`].
+    fn check_texts(&self) -> Result<(), ToolpathError> {
+        use crate::names::{check_name, check_text};
+        let whole = |e: crate::InputError| ToolpathError::Whole(e.to_string());
+        check_name("tool name", &self.tool.name).map_err(whole)?;
+        check_name("part name", &self.part).map_err(whole)?;
+        for (i, p) in self.passes.iter().enumerate() {
+            check_name("pass name", &p.name)
+                .map_err(|e| ToolpathError::Whole(format!("pass {}: {e}", i + 1)))?;
+        }
+        for k in self.notes.keys() {
+            check_name("note name", k).map_err(whole)?;
+        }
+        for (name, columns) in &self.tables {
+            check_name("table name", name).map_err(whole)?;
+            for c in columns.keys() {
+                check_name("column name", c).map_err(whole)?;
+            }
+        }
+        for w in &self.warnings {
+            check_text("warning", w).map_err(whole)?;
+        }
+        for p in &self.plots {
+            for t in [&p.title, &p.x_label, &p.y_label] {
+                check_text("plot label", t).map_err(whole)?;
+            }
+        }
+        Ok(())
+    }
+
     /// An empty toolpath.
     pub fn new(part: &str, tool: Tool, spindle_rpm: Real, aux_names: Vec<String>) -> Self {
         Self {
@@ -169,7 +199,10 @@ impl Toolpath {
             .flat_map(|(i, p)| p.points.iter().enumerate().map(move |(j, c)| (i, j, c)))
     }
 
-    /// Checks every value: finite coordinates, unit axes, positive feeds on
+    /// Checks every value: its names and texts ([`crate::names`]: the
+    /// tool's, the part's, each pass's, each note's and table's are names,
+    /// which programs and file names may carry; warnings and plot labels
+    /// are texts), finite coordinates, unit axes, positive feeds on
     /// cutting moves, positive leads, the right number of auxiliary values,
     /// a positive spindle speed, at least one point and at most
     /// [`MAX_POINTS`].
@@ -177,6 +210,7 @@ impl Toolpath {
     /// # Failures
     /// [`ToolpathError`] naming the pass and point.
     pub fn validate(&self) -> Result<(), ToolpathError> {
+        self.check_texts()?;
         if !(self.spindle_rpm.is_finite() && self.spindle_rpm > 0.0) {
             return Err(ToolpathError::Whole(format!(
                 "spindle speed {} rpm is not positive",

@@ -282,6 +282,16 @@ pub fn run(
     let info = kin.info();
     stage(STAGES[0]);
     let checks = family.checks(&values)?;
+    for c in &checks {
+        for (what, t) in [("a check's name", &c.name), ("a check's detail", &c.detail)] {
+            crate::names::check_text(what, t).map_err(|e| {
+                Error::Family(crate::family::FamilyError::Contract {
+                    family: family.name().to_owned(),
+                    message: format!("fn checks(p): {e}"),
+                })
+            })?;
+        }
+    }
     let failed: Vec<String> = checks
         .iter()
         .filter(|c| !c.ok)

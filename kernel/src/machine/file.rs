@@ -15,8 +15,7 @@ use toml::Spanned;
 #[serde(deny_unknown_fields)]
 struct MachineFile {
     name: Spanned<String>,
-    #[serde(default)]
-    description: String,
+    description: Option<Spanned<String>>,
     control: Option<String>,
     tool: Option<ToolFile>,
     axes: Vec<AxisFile>,
@@ -250,7 +249,11 @@ impl Machine {
             .collect();
         let info = MachineInfo {
             name: file.name.get_ref().clone(),
-            description: file.description.clone(),
+            description: file
+                .description
+                .as_ref()
+                .map(|d| d.get_ref().clone())
+                .unwrap_or_default(),
             control: file.control.clone().unwrap_or_else(|| "sinumerik".into()),
             axes,
             solved_axes,
@@ -321,6 +324,11 @@ fn span_of(file: &MachineFile, e: &Invalid) -> Range<usize> {
                 _ => at,
             }
         }
+        Place::Name => file.name.span(),
+        Place::Description => file
+            .description
+            .as_ref()
+            .map_or_else(|| file.name.span(), Spanned::span),
         Place::Tool => file.tool.as_ref().map_or(0..0, |t| t.point.span()),
         Place::Decimals => file.program_decimals.as_ref().map_or(0..0, Spanned::span),
         Place::Setup => file.setup.as_ref().map_or(0..0, Spanned::span),

@@ -48,6 +48,10 @@ pub(super) enum Place {
     Factor(Option<String>, usize, &'static str),
     /// A body, at this key (`name`, `shape`).
     Body(String, &'static str),
+    /// The machine's name.
+    Name,
+    /// The machine's description.
+    Description,
     /// The tool frame.
     Tool,
     /// The program decimals.
@@ -173,6 +177,52 @@ fn compile_chain(
     }
     b.build()
         .map_err(|e| invalid(Place::Chain(owner), e.to_string()))
+}
+
+/// The axis letters a machine may name (ISO 841's): the address letters
+/// that no dialect pilgrim writes uses for anything else.
+pub const AXIS_LETTERS: &str = "XYZABCUVW";
+
+/// Checks the names and texts of a description ([`crate::names`]): the
+/// machine's name is a name (programs carry it); its description, its
+/// axes' and bodies' descriptions and labels are texts; an axis's name is
+/// one of [`AXIS_LETTERS`] (a spindle's `S` or `S` and a number).
+fn check_texts(info: &MachineInfo) -> Result<(), Invalid> {
+    use crate::names::{check_name, check_text};
+    check_name("machine name", &info.name).map_err(|e| invalid(Place::Name, e.to_string()))?;
+    check_text("machine description", &info.description)
+        .map_err(|e| invalid(Place::Description, e.to_string()))?;
+    for (i, a) in info.axes.iter().enumerate() {
+        let ok = if a.kind == AxisKind::Spindle {
+            // A spindle is not a word of the program (its speed is S).
+            a.name.starts_with('S') && a.name[1..].bytes().all(|b| b.is_ascii_digit())
+        } else {
+            a.name.len() == 1 && AXIS_LETTERS.contains(a.name.as_str())
+        };
+        if !ok {
+            return Err(invalid(
+                Place::Axis(i, "name"),
+                format!(
+                    "axis name {} must be {} (ISO 841's letters: others are words of the controls)",
+                    crate::names::quoted(&a.name),
+                    if a.kind == AxisKind::Spindle {
+                        "S, or S and a number, for a spindle".to_owned()
+                    } else {
+                        format!("one of the letters {AXIS_LETTERS}")
+                    }
+                ),
+            ));
+        }
+        check_text(&format!("axis {} description", a.name), &a.description)
+            .map_err(|e| invalid(Place::Axis(i, "description"), e.to_string()))?;
+    }
+    for b in &info.bodies {
+        for (what, t) in [("description", &b.description), ("label", &b.label)] {
+            check_text(&format!("body {} {what}", b.name), t)
+                .map_err(|e| invalid(Place::Body(b.name.clone(), "name"), e.to_string()))?;
+        }
+    }
+    Ok(())
 }
 
 /// Checks the description's axes, decimals and tool frame.
@@ -521,7 +571,8 @@ pub fn check_description(info: &MachineInfo) -> Result<(), MachineError> {
     if !info.chain.is_empty() {
         return Machine::from_info(info.clone()).map(|_| ());
     }
-    check_axes(info)
+    check_texts(info)
+        .and_then(|_| check_axes(info))
         .and_then(|_| check_capabilities(info))
         .and_then(|_| check_setup(info))
         .and_then(|_| compile_bodies(info).map(|_| ()))
@@ -532,6 +583,7 @@ impl Machine {
     /// Checks and compiles a description; the one path of machine files and
     /// plugin descriptors.
     pub(super) fn compile(info: MachineInfo) -> Result<Machine, Invalid> {
+        check_texts(&info)?;
         let tool = check_axes(&info)?;
         let chain = compile_chain(&info, None, &info.chain)?;
         let bodies = compile_bodies(&info)?;

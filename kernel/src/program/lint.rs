@@ -21,10 +21,11 @@
 
 use super::post::{Dialect, Style};
 use super::{name_in, AxisProgram};
-use crate::machine::Axis;
+use crate::machine::{Axis, AxisKind};
 use crate::math::Real;
 use crate::toolpath::Motion;
 use gcode::{Code, Value};
+use pilgrim_plugin_abi::types::Radial;
 
 /// A program that fails its lint: which program, where, what.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -101,10 +102,108 @@ struct State {
     feed: bool,
     lead: Option<Real>,
     spindle_on: bool,
+    /// The spindle's speed as written (S), none before the first.
+    speed: Option<Real>,
+    coolant: bool,
     constant_speed: bool,
+    /// Diameter (true) or radius programming, once set.
+    radial: Option<bool>,
+    feed_group: bool,
     start_deg: Real,
     values: Vec<Option<Real>>,
     ended: bool,
+}
+
+/// A word of Sinumerik's own, outside the ISO words the parser reads.
+#[derive(Debug, Clone, PartialEq)]
+enum OwnWord {
+    /// `DIAMON` (true) or `DIAMOF`.
+    Radial(bool),
+    /// `FGROUP(..)` with its list.
+    FeedGroup(String),
+    /// `SF=`, the thread's start angle (deg).
+    StartAngle(Real),
+}
+
+/// Line `i` of a G-code program in `d` as its control reads it: the code
+/// with its comments blanked in place (the same length, so the parser's
+/// spans index the line), after checking that every comment is one the
+/// dialect's comment writer makes ([`super::post::comment_text`]): closed
+/// on its line, nothing but names' characters, nothing LinuxCNC acts on;
+/// and that the line holds no character pilgrim never writes (a control
+/// character such as a lone carriage return, which ends a line on some
+/// controls; anything beyond ASCII).
+fn read_line(d: &Dialect, i: usize, line: &str) -> Result<String, String> {
+    if let Some(c) = line.chars().find(|c| c.is_control() || !c.is_ascii()) {
+        return Err(format!(
+            "the character U+{:04X}, which pilgrim never writes (a carriage return or another control character ends or changes a line on some controls)",
+            u32::from(c)
+        ));
+    }
+    let check = |comment: &str| -> Result<(), String> {
+        if d.name == "sinumerik" && i == 1 && comment == "$PATH=/_N_MPF_DIR" {
+            return Ok(());
+        }
+        let text = comment.strip_prefix(' ').unwrap_or(comment);
+        if let Some(c) = text.chars().find(|c| !crate::names::is_name_char(*c)) {
+            return Err(format!(
+                "'{c}' in the comment '{}', which pilgrim's comments never hold",
+                crate::files::excerpt(comment)
+            ));
+        }
+        if d.upper_comments && text.chars().any(|c| c.is_ascii_lowercase()) {
+            return Err(format!(
+                "lower case in the comment '{}', which the control may refuse",
+                crate::files::excerpt(comment)
+            ));
+        }
+        if super::post::is_active_comment(d, text) {
+            return Err(format!(
+                "the comment '({})' makes LinuxCNC act (a message, a file, a script)",
+                crate::files::excerpt(comment)
+            ));
+        }
+        Ok(())
+    };
+    let mut code = String::with_capacity(line.len());
+    if d.comment.1.is_empty() {
+        // A comment runs from its opening (`;`) to the line's end.
+        let open = d.comment.0.trim_end();
+        let (c, comment) = match line.find(open) {
+            Some(p) => (&line[..p], Some(&line[p + open.len()..])),
+            None => (line, None),
+        };
+        if let Some(comment) = comment {
+            check(comment)?;
+        }
+        code.push_str(c);
+        code.push_str(&" ".repeat(line.len() - c.len()));
+        return Ok(code);
+    }
+    // Parenthesised comments, closed on their line, none inside another.
+    let mut rest = line;
+    while let Some(p) = rest.find(['(', ')', ';']) {
+        code.push_str(&rest[..p]);
+        match rest.as_bytes()[p] {
+            b'(' => {
+                let inner = &rest[p + 1..];
+                let Some(q) = inner.find(')') else {
+                    return Err("a comment '(' that its line does not close".into());
+                };
+                let comment = &inner[..q];
+                if comment.contains('(') {
+                    return Err("a comment inside a comment".into());
+                }
+                check(comment)?;
+                code.push_str(&" ".repeat(q + 2));
+                rest = &inner[q + 1..];
+            }
+            b')' => return Err("')' outside a comment".into()),
+            _ => return Err("';', which pilgrim never writes in this dialect".into()),
+        }
+    }
+    code.push_str(rest);
+    Ok(code)
 }
 
 fn lint_gcode(
@@ -128,48 +227,68 @@ fn lint_gcode(
         .iter()
         .filter_map(|a| a.name.chars().next())
         .collect();
-    let lines: Vec<&str> = text.lines().collect();
-    // Sinumerik's own words out of the way of the ISO parser (kept at
-    // their places: spans stay valid), the start angle read.
+    let lines: Vec<&str> = text.split('\n').collect();
+    if lines.last() != Some(&"") {
+        return Err(fault(
+            at_line(lines.len() - 1),
+            "the program's last line does not end with a line feed".into(),
+        ));
+    }
+    let lines = &lines[..lines.len() - 1];
+    // Each line as its control reads it: comments out of the way of the ISO
+    // parser (blanked in place, so spans stay valid) and checked, the
+    // header's own lines recognised where they stand, Sinumerik's own
+    // words read.
     let mut iso = String::with_capacity(text.len());
-    let mut sf: Vec<Option<Real>> = vec![None; lines.len()];
+    let mut own: Vec<Vec<OwnWord>> = vec![Vec::new(); lines.len()];
+    let mut has_code = vec![false; lines.len()];
+    let framed = d.header.first().is_some_and(|h| *h == "%")
+        || (d.header.first().is_some_and(|h| *h == "{WHOLE}%") && program.number > 0);
     for (i, line) in lines.iter().enumerate() {
-        let mut l = (*line).to_owned();
-        let first = i == 0;
-        let _ = first;
-        if d.name == "sinumerik" {
-            if first && l.starts_with("%_N_") && l.ends_with("_MPF") {
-                l = " ".repeat(l.len());
-            }
-            let code_part = l.split(';').next().unwrap_or("").to_owned();
-            let mut cleaned = code_part.clone();
-            for word in code_part.split_whitespace() {
-                let keyword = matches!(word, "DIAMON" | "DIAMOF")
-                    || (word.starts_with("FGROUP(") && word.ends_with(')'));
-                if let Some(v) = word.strip_prefix("SF=") {
-                    let v: Real = v
-                        .parse()
-                        .map_err(|_| fault(at_line(i), format!("'{word}' is not a start angle")))?;
-                    sf[i] = Some(v);
-                } else if !keyword {
-                    continue;
-                }
-                cleaned = cleaned.replacen(word, &" ".repeat(word.len()), 1);
-            }
-            l = cleaned + &l[code_part.len()..];
-        } else if l == "%" {
+        let mut l = read_line(d, i, line).map_err(|m| fault(at_line(i), m))?;
+        let header_name = format!("%_N_{}_MPF", program.name);
+        let program_number = format!("O{:04}", program.number % 10000);
+        if d.name == "sinumerik" && i == 0 && *line == header_name {
+            l = " ".repeat(line.len());
+        } else if framed && *line == "%" && (i == 0 || i + 1 == lines.len()) {
             l = " ".into();
-        } else if d.name == "fanuc" && first_code(&l).is_some_and(is_program_number) {
+        } else if d.name == "fanuc"
+            && framed
+            && i == 1
+            && first_code(&l).is_some_and(|w| w == program_number)
+        {
             // Fanuc's program number, `O0001`, is not an ISO word.
             let n = l.find('O').unwrap_or(0);
             l.replace_range(n..n + 5, "     ");
+        } else if d.name == "sinumerik" {
+            let code_part = l.clone();
+            for word in code_part.split_whitespace() {
+                let w =
+                    if matches!(word, "DIAMON" | "DIAMOF") {
+                        OwnWord::Radial(word == "DIAMON")
+                    } else if let Some(list) = word
+                        .strip_prefix("FGROUP(")
+                        .and_then(|w| w.strip_suffix(')'))
+                    {
+                        OwnWord::FeedGroup(list.to_owned())
+                    } else if let Some(v) = word.strip_prefix("SF=") {
+                        OwnWord::StartAngle(v.parse().map_err(|_| {
+                            fault(at_line(i), format!("'{word}' is not a start angle"))
+                        })?)
+                    } else {
+                        continue;
+                    };
+                own[i].push(w);
+                l = l.replacen(word, &" ".repeat(word.len()), 1);
+            }
         }
+        has_code[i] = !l.trim().is_empty() || !own[i].is_empty();
         iso.push_str(&l);
         iso.push('\n');
     }
+    let mut consumed = vec![false; lines.len()];
+    let spindle = axes.iter().find(|a| a.kind == AxisKind::Spindle);
     // The framing: % first and last where the dialect frames.
-    let framed = d.header.first().is_some_and(|h| *h == "%")
-        || (d.header.first().is_some_and(|h| *h == "{WHOLE}%") && program.number > 0);
     if framed {
         if lines.first() != Some(&"%") {
             return Err(fault(at_line(0), "the program must open with '%'".into()));
@@ -201,9 +320,16 @@ fn lint_gcode(
     let mut k = 0; // the next move of the axis program
     for block in &parsed.blocks {
         let line = block.span.line;
-        if block.codes.is_empty() && block.word_addresses.is_empty() && block.line_number.is_none()
+        let own_here = own.get_mut(line).map(std::mem::take).unwrap_or_default();
+        if block.codes.is_empty()
+            && block.word_addresses.is_empty()
+            && block.line_number.is_none()
+            && own_here.is_empty()
         {
             continue;
+        }
+        if let Some(c) = consumed.get_mut(line) {
+            *c = true;
         }
         let place = |k: usize| {
             if k < program.blocks.len() {
@@ -237,6 +363,16 @@ fn lint_gcode(
             (None, None) => {}
         }
         // The block's words: codes and their arguments, bare addresses.
+        let mut radial_here: Vec<bool> = Vec::new();
+        let mut feed_group_here: Vec<&str> = Vec::new();
+        let mut sf_here = None;
+        for w in &own_here {
+            match w {
+                OwnWord::Radial(diameter) => radial_here.push(*diameter),
+                OwnWord::FeedGroup(list) => feed_group_here.push(list),
+                OwnWord::StartAngle(v) => sf_here = Some(*v),
+            }
+        }
         let mut words: Vec<(char, &gcode::Argument)> = Vec::new();
         let mut bare: Vec<&gcode::WordAddress> = Vec::new();
         let mut motion_here = None;
@@ -253,6 +389,8 @@ fn lint_gcode(
                     match n {
                         0 | 1 | 32 | 33 => motion_here = Some(n),
                         97 => st.constant_speed = true,
+                        // LinuxCNC's diameter (G7) and radius (G8) modes.
+                        7 | 8 => radial_here.push(n == 7),
                         _ => {}
                     }
                     words.extend(g.args.iter().map(|a| (a.letter, a)));
@@ -268,6 +406,8 @@ fn lint_gcode(
                     match n {
                         3 => st.spindle_on = true,
                         5 => st.spindle_on = false,
+                        8 => st.coolant = true,
+                        9 => st.coolant = false,
                         n if n == end_code(d) => st.ended = true,
                         _ => {}
                     }
@@ -309,10 +449,48 @@ fn lint_gcode(
             }
             read.push((letter, value_at(span, letter)?));
         }
-        if let Some(s) = sf[line] {
+        if let Some(s) = sf_here {
             read.push(('@', s));
         }
+        // The machine's setup words, once, before the first move, and as
+        // the setup says.
+        for diameter in radial_here {
+            let want = program.setup.radial.map(|r| r == Radial::Diameter);
+            if k > 0 || st.radial.is_some() || want != Some(diameter) {
+                return Err(fault(
+                    place(k),
+                    format!(
+                        "{} where the machine's setup {}",
+                        if diameter {
+                            "diameter programming"
+                        } else {
+                            "radius programming"
+                        },
+                        match (want, k > 0 || st.radial.is_some()) {
+                            (_, true) => "set it before the moves, once".to_owned(),
+                            (Some(true), _) => "programs the radial axis on diameter".to_owned(),
+                            (Some(false), _) => "programs the radial axis on radius".to_owned(),
+                            (None, _) => "says nothing of it".to_owned(),
+                        }
+                    ),
+                ));
+            }
+            st.radial = Some(diameter);
+        }
+        for list in feed_group_here {
+            if k > 0 || st.feed_group || list != program.setup.feed_group.join(",") {
+                return Err(fault(
+                    place(k),
+                    format!(
+                        "FGROUP({list}) where the machine's setup groups the feed over ({}), once, before the moves",
+                        program.setup.feed_group.join(",")
+                    ),
+                ));
+            }
+            st.feed_group = true;
+        }
         let mut lead_here = None;
+        let mut s_here = None;
         for (letter, v) in read {
             if let Some(i) = names.iter().position(|n| *n == letter) {
                 axis_here[i] = Some(v);
@@ -321,7 +499,7 @@ fn lint_gcode(
             match letter {
                 'F' if motion_here.or(st.motion).is_some_and(|m| m == 32) => lead_here = Some(v),
                 'F' => st.feed = true,
-                'S' => {}
+                'S' => s_here = Some(v),
                 'D' if d.name == "sinumerik" => {}
                 'Q' if d.name == "fanuc" => st.start_deg = v / 1000.0,
                 '@' => st.start_deg = v,
@@ -341,9 +519,50 @@ fn lint_gcode(
             st.lead = Some(l);
         }
         let moves = axis_here.iter().any(Option::is_some);
+        if let Some(v) = s_here {
+            // The speed the axis program sets here: a move's own where it
+            // changes, the program's before the moves.
+            let want = if moves {
+                program.blocks.get(k).and_then(|b| b.spindle)
+            } else {
+                Some(program.spindle_rpm)
+            }
+            .map(Real::round);
+            if want != Some(v) {
+                return Err(fault(
+                    place(k),
+                    format!(
+                        "S{v} read back, where the axis program sets {}",
+                        want.map_or("no speed".to_owned(), |w| format!("S{w}"))
+                    ),
+                ));
+            }
+            if !(v >= 1.0) {
+                return Err(fault(
+                    place(k),
+                    format!("S{v}: the spindle would stand while the program cuts"),
+                ));
+            }
+            if let Some(a) = spindle.filter(|a| !(v >= a.min && v <= a.max)) {
+                return Err(fault(
+                    place(k),
+                    format!(
+                        "S{v} is outside spindle {}'s range [{}, {}] rpm",
+                        a.name, a.min, a.max
+                    ),
+                ));
+            }
+            st.speed = Some(v);
+        }
         if !moves {
             if motion_here.is_some() {
                 return Err(fault(place(k), "a motion word with no axis".into()));
+            }
+            if sf_here.is_some() {
+                return Err(fault(
+                    place(k),
+                    "SF= outside a thread block, where the writer never puts it".into(),
+                ));
             }
             continue;
         }
@@ -387,6 +606,42 @@ fn lint_gcode(
             return Err(fault(
                 place(k),
                 "a cutting move with the spindle stopped (no M3)".into(),
+            ));
+        }
+        if m != 0 && !st.speed.is_some_and(|v| v >= 1.0) {
+            return Err(fault(
+                place(k),
+                "a cutting move with no spindle speed S written".into(),
+            ));
+        }
+        if m != 0 && program.setup.coolant && !st.coolant {
+            return Err(fault(
+                place(k),
+                format!(
+                    "a cutting move with the coolant off ({} not written), which the machine's setup turns on",
+                    d.coolant.0
+                ),
+            ));
+        }
+        if sf_here.is_some() && !is_thread {
+            return Err(fault(
+                place(k),
+                "SF= outside a thread block, where the writer never puts it".into(),
+            ));
+        }
+        // Radius or diameter and the feed group, where the dialect has
+        // words for them, as the setup says before the first move.
+        let radial_word = d.radial_words.is_some() && d.style == Style::GCode;
+        if radial_word && program.setup.radial.is_some() && st.radial.is_none() {
+            return Err(fault(
+                place(k),
+                "a move before the radial axis's programming (radius or diameter) is set, which the machine's setup states".into(),
+            ));
+        }
+        if d.feed_group.is_some() && !program.setup.feed_group.is_empty() && !st.feed_group {
+            return Err(fault(
+                place(k),
+                "a move before the feed group the machine's setup states".into(),
             ));
         }
         if let Motion::Thread { lead, start_deg } = b.motion {
@@ -454,6 +709,15 @@ fn lint_gcode(
         }
         k += 1;
     }
+    if let Some(i) = (0..lines.len()).find(|&i| has_code[i] && !consumed[i]) {
+        return Err(fault(
+            at_line(i),
+            format!(
+                "'{}' is not a block the lint can account for",
+                crate::files::excerpt(lines[i])
+            ),
+        ));
+    }
     if k != program.blocks.len() {
         return Err(fault(
             at_line(lines.len().saturating_sub(1)),
@@ -480,11 +744,6 @@ fn first_code(line: &str) -> Option<&str> {
     line.split('(').next()?.split_whitespace().next()
 }
 
-/// Whether `word` is a Fanuc program number, `O` and four digits.
-fn is_program_number(word: &str) -> bool {
-    word.len() == 5 && word.starts_with('O') && word[1..].bytes().all(|b| b.is_ascii_digit())
-}
-
 /// The integer part of a G or M number as the crate prints it (`1`, `33`).
 fn number(text: &str) -> u32 {
     text.split('.')
@@ -493,13 +752,14 @@ fn number(text: &str) -> u32 {
         .unwrap_or(u32::MAX)
 }
 
-/// The APT CL file: known records only, one `GOTO/` a block with the
-/// axis program's values, `FINI` last.
+/// The APT CL file: each record one the writer makes, in the form it
+/// makes it (the part's, machine's and tool's names and numbers, text of
+/// names' characters in `PPRINT/`), no character pilgrim never writes;
+/// the spindle turning (at a speed that is not 0) and the coolant on where
+/// the setup says before a cutting `GOTO/`, `RAPID` before exactly the
+/// rapid ones; one `GOTO/` a block with the axis program's values,
+/// `FINI` last.
 fn lint_apt(text: &str, program: &AxisProgram, d: &Dialect) -> Result<Linted, LintError> {
-    const RECORDS: [&str; 11] = [
-        "PARTNO/", "MACHIN/", "PPRINT/", "UNITS/", "LOADTL/", "SPINDL/", "COOLNT/", "RAPID",
-        "FEDRAT/", "GOTO/", "FINI",
-    ];
     let fault = |place: String, message: String| LintError {
         dialect: d.name.to_owned(),
         place,
@@ -507,31 +767,105 @@ fn lint_apt(text: &str, program: &AxisProgram, d: &Dialect) -> Result<Linted, Li
     };
     let decimals = super::written_decimals(program.decimals, d.name);
     let half = 0.5 * 10f64.powi(-(decimals as i32)) + 1e-9;
-    let lines: Vec<&str> = text.lines().collect();
+    let Some(body) = text.strip_suffix('\n') else {
+        return Err(fault(
+            "the last line".into(),
+            "the CL file's last line does not end with a line feed".into(),
+        ));
+    };
+    let lines: Vec<&str> = body.split('\n').collect();
     let mut k = 0;
+    let (mut rapid_next, mut coolant) = (false, false);
+    let mut speed: Option<Real> = None;
+    let written_by = format!("written by pilgrim {}", crate::VERSION);
     for (l, line) in lines.iter().enumerate() {
-        if !RECORDS.iter().any(|r| line.starts_with(r)) {
+        let at = || format!("line {}", l + 1);
+        if let Some(c) = line.chars().find(|c| c.is_control() || !c.is_ascii()) {
             return Err(fault(
-                format!("line {}", l + 1),
-                format!("'{line}' is not a CL record"),
+                at(),
+                format!(
+                    "the character U+{:04X}, which pilgrim never writes",
+                    u32::from(c)
+                ),
             ));
         }
+        let not_record = || {
+            fault(
+                at(),
+                format!(
+                    "'{}' is not a CL record pilgrim writes",
+                    crate::files::excerpt(line)
+                ),
+            )
+        };
+        let (word, arg) = line.split_once('/').unwrap_or((line, ""));
+        match (word, arg) {
+            ("PARTNO", a) if a == program.name => {}
+            ("MACHIN", a) if a == super::post::comment_text(d, &program.machine) => {}
+            ("UNITS", "MM") | ("FINI", "") => {}
+            ("LOADTL", a) if a == program.tool_number.to_string() => {}
+            ("PPRINT", a) => {
+                if a != written_by && !a.chars().all(crate::names::is_name_char) {
+                    return Err(fault(
+                        at(),
+                        format!(
+                            "PPRINT/{}: text no comment of pilgrim's holds",
+                            crate::files::excerpt(a)
+                        ),
+                    ));
+                }
+            }
+            ("COOLNT", "ON") => coolant = true,
+            ("COOLNT", "OFF") => coolant = false,
+            ("SPINDL", "OFF") => speed = None,
+            ("SPINDL", a) => {
+                let v: Real = a
+                    .strip_suffix(",RPM,CLW")
+                    .and_then(|v| v.parse().ok())
+                    .ok_or_else(not_record)?;
+                if !(v >= 1.0) {
+                    return Err(fault(
+                        at(),
+                        format!("SPINDL/{v}: the spindle would stand while the program cuts"),
+                    ));
+                }
+                speed = Some(v);
+            }
+            ("RAPID", "") => rapid_next = true,
+            ("FEDRAT", a) if a.ends_with(",MMPM") || a.ends_with(",MMPR") => {}
+            ("GOTO", _) => {}
+            _ => return Err(not_record()),
+        }
         if *line == "FINI" && l + 1 != lines.len() {
-            return Err(fault(
-                format!("line {}", l + 1),
-                "records after FINI".into(),
-            ));
+            return Err(fault(at(), "records after FINI".into()));
         }
         let Some(values) = line.strip_prefix("GOTO/") else {
             continue;
         };
         let place = name_in(d.name, &program.blocks, k);
         let Some(b) = program.blocks.get(k) else {
-            return Err(fault(
-                format!("line {}", l + 1),
-                "a GOTO beyond the axis program".into(),
-            ));
+            return Err(fault(at(), "a GOTO beyond the axis program".into()));
         };
+        let rapid = std::mem::take(&mut rapid_next);
+        if rapid != (b.motion == Motion::Rapid) {
+            return Err(fault(
+                place,
+                format!(
+                    "{}, where the axis program has a {:?} move",
+                    if rapid { "RAPID" } else { "a feed move" },
+                    b.motion
+                ),
+            ));
+        }
+        if !rapid && speed.is_none() {
+            return Err(fault(place, "a cutting move with the spindle off".into()));
+        }
+        if !rapid && program.setup.coolant && !coolant {
+            return Err(fault(
+                place,
+                "a cutting move with the coolant off (no COOLNT/ON), which the machine's setup turns on".into(),
+            ));
+        }
         let read: Vec<Real> = values
             .split(',')
             .map(|v| v.parse())
@@ -581,6 +915,7 @@ fn lint_apt(text: &str, program: &AxisProgram, d: &Dialect) -> Result<Linted, Li
 mod tests {
     use super::*;
     use crate::program::post::{post, CLD, FANUC, LINUXCNC, SINUMERIK};
+    use crate::program::ProgramSetup;
 
     fn program() -> AxisProgram {
         crate::program::test_program()
@@ -686,6 +1021,184 @@ mod tests {
             "GOTO/50.000,-60.000\n",
             "",
             &["5 GOTO records", "6 blocks"],
+        );
+    }
+
+    /// Text that would break a comment or a block, put straight into an
+    /// axis program (past the checks where names enter): every dialect's
+    /// writer keeps it inside its comments, each comment stays one line, and
+    /// the lint reads the result back.
+    #[test]
+    fn no_text_breaks_a_comment_of_the_writer() {
+        let mut p = program();
+        p.tool_name = "T1)\nG00 X0 Z0 (".into();
+        p.machine = "lathe\rG00 X0; SF=90 %".into();
+        p.blocks[1].comment = Some("MSG, PROBEOPEN /tmp/x".into());
+        p.blocks[2].comment = Some("a;b(c)\r\nG01 Z-99 $x".into());
+        let clean = {
+            let mut c = program();
+            c.blocks[1].comment = Some("x".into());
+            c.blocks[2].comment = Some("y".into());
+            c
+        };
+        for d in [&SINUMERIK, &FANUC, &LINUXCNC, &CLD] {
+            let text = post(&p, d).unwrap();
+            assert_eq!(
+                text.lines().count(),
+                post(&clean, d).unwrap().lines().count(),
+                "{}: a line was added\n{text}",
+                d.name
+            );
+            lint(&text, &p, d, &axes()).unwrap_or_else(|e| panic!("{e}\n{text}"));
+            assert!(
+                !text.contains('\r') && !text.contains("G00 X0 Z0 ("),
+                "{text}"
+            );
+        }
+        let l = post(&p, &LINUXCNC).unwrap();
+        assert!(l.contains("(_MSG, PROBEOPEN /tmp/x)"), "{l}");
+    }
+
+    /// What a hostile text or a hand edit puts into a program, as each
+    /// control would read it: the lint refuses it, naming the line or the
+    /// block. The `gcode` crate reads a `(` comment across lines; Sinumerik's
+    /// own words were blanked and a line left empty by it skipped.
+    #[test]
+    fn injected_lines_and_words_are_refused() {
+        let mut p = program();
+        p.setup = ProgramSetup {
+            radial: Some(Radial::Diameter),
+            radial_axis: "X".into(),
+            coolant: true,
+            ..ProgramSetup::default()
+        };
+        let case = |d: &Dialect, from: &str, to: &str, says: &[&str]| {
+            let text = post(&p, d).unwrap();
+            lint(&text, &p, d, &axes()).unwrap_or_else(|e| panic!("{e}\n{text}"));
+            assert!(text.contains(from), "{}: {from:?} not in\n{text}", d.name);
+            let bad = text.replacen(from, to, 1);
+            let e = lint(&bad, &p, d, &axes())
+                .map(|_| format!("passed:\n{bad}"))
+                .unwrap_or_else(|e| e.to_string());
+            for s in says {
+                assert!(
+                    e.contains(s),
+                    "{}: {from:?} -> {to:?}: '{s}' not in: {e}",
+                    d.name
+                );
+            }
+        };
+        // A comment opened and closed on another line: the rapid between.
+        case(
+            &FANUC,
+            "(TOOL T03: THREAD INSERT 60)\n",
+            "(TOOL T03: T1\nG00 X0 Z0 )\n",
+            &["line 4", "does not close"],
+        );
+        case(
+            &FANUC,
+            "(PASS 1)",
+            "(PASS (1))",
+            &["comment inside a comment"],
+        );
+        case(&FANUC, "(PASS 1)", "(pass 1)", &["lower case"]);
+        case(
+            &FANUC,
+            "G21 G40 G97 G98\n",
+            "G21 G40 G97 G98 ; x\n",
+            &["';'"],
+        );
+        // A lone carriage return passed all four lints.
+        case(&FANUC, "(PASS 1)", "(PASS 1\rG00 X0)", &["U+000D"]);
+        case(&SINUMERIK, "; pass 1", "; pass 1\rN15 G0 X0", &["U+000D"]);
+        case(&LINUXCNC, "(pass 1)", "(pass 1\r)", &["U+000D"]);
+        case(
+            &CLD,
+            "PPRINT/pass 1",
+            "PPRINT/pass 1\rGOTO/0,0",
+            &["U+000D"],
+        );
+        // Sinumerik's own words only where the writer puts them.
+        case(
+            &SINUMERIK,
+            "N1 G90 G94 G71\n",
+            "N1 G90 G94 G71\nSF=90\n",
+            &["line 6"],
+        );
+        case(
+            &SINUMERIK,
+            "N1 G90 G94 G71\n",
+            "N1 G90 G94 G71 SF=90\n",
+            &["SF= outside"],
+        );
+        case(
+            &SINUMERIK,
+            "; tool T3: thread insert 60\n",
+            "; tool T3: thread insert 60\nDIAMOF\n",
+            &["line 5"],
+        );
+        case(
+            &SINUMERIK,
+            "N2 DIAMON",
+            "N2 DIAMOF",
+            &["radius programming", "on diameter"],
+        );
+        case(&SINUMERIK, "N2 DIAMON", "N2", &["N10", "radial axis"]);
+        case(
+            &SINUMERIK,
+            "N20 G1 X40.000",
+            "N20 G1 DIAMOF X40.000",
+            &["N20", "before the moves"],
+        );
+        case(
+            &SINUMERIK,
+            "N2 DIAMON",
+            "N2 DIAMON FGROUP(A)",
+            &["FGROUP(A)"],
+        );
+        case(
+            &SINUMERIK,
+            "; pass 1",
+            "; pass 1 (x)",
+            &["'(' in the comment"],
+        );
+        // LinuxCNC's comments that act; its ';' comments, never written.
+        case(
+            &LINUXCNC,
+            "(pass 1)",
+            "(MSG, hello)",
+            &["makes LinuxCNC act"],
+        );
+        case(
+            &LINUXCNC,
+            "(pass 1)",
+            "(probeopen /tmp/x)",
+            &["makes LinuxCNC act"],
+        );
+        case(&LINUXCNC, "N10 G0", "N10 G0 ;x", &["';'"]);
+        // The spindle's speed and the coolant, as modal state.
+        case(&SINUMERIK, "N4 S399 M3", "N4 S0 M3", &["S0 read back"]);
+        case(&FANUC, "S399 M03", "S400 M03", &["S400 read back", "S399"]);
+        case(&FANUC, "S399 M03", "M03", &["no spindle speed"]);
+        case(&SINUMERIK, "N5 M8\n", "N5 M9\n", &["N20", "coolant off"]);
+        case(&CLD, "COOLNT/ON\n", "", &["block 2", "coolant off"]);
+        case(
+            &CLD,
+            "SPINDL/399,RPM,CLW",
+            "SPINDL/0,RPM,CLW",
+            &["would stand"],
+        );
+        case(
+            &CLD,
+            "MACHIN/test-lathe",
+            "MACHIN/other",
+            &["not a CL record"],
+        );
+        case(
+            &CLD,
+            "RAPID\nGOTO/50.000,-60.000",
+            "GOTO/50.000,-60.000",
+            &["block 6", "a feed move"],
         );
     }
 }

@@ -132,6 +132,15 @@ pub enum ProgramError {
         /// The axis's maximum (mm/min).
         max: Real,
     },
+    /// A spindle speed the program writes as `S0`: the spindle would stand
+    /// while the program cuts.
+    #[error("{block}: spindle speed {rpm} rpm is written S0: the part (or tool) would stand still while the program cuts; give a speed of at least 1 rpm")]
+    SpindleStopped {
+        /// The block, as the program names it.
+        block: String,
+        /// The speed (rpm).
+        rpm: Real,
+    },
     /// A spindle speed outside the machine's spindle range.
     #[error("{block}: spindle speed S{rpm} is outside the range of spindle {axis} of machine {machine}, [{min}, {max}] rpm")]
     Spindle {
@@ -626,24 +635,30 @@ fn with_start_and_end(blocks: Vec<Block>, axes: &[&str], setup: &ProgramSetup) -
     out
 }
 
-/// Every spindle speed the program sets within the machine's spindle (its
-/// first spindle axis), if it has one.
+/// Every spindle speed the program sets: none written as `S0` (programs
+/// write whole rpm), each within the machine's spindle (its first spindle
+/// axis), if it has one.
 fn check_spindle(
     info: &MachineInfo,
     blocks: &[Block],
     rpm: Real,
     name_of: &impl Fn(usize) -> String,
 ) -> Result<(), ProgramError> {
-    let Some(s) = info.axes.iter().find(|a| a.kind == AxisKind::Spindle) else {
-        return Ok(());
-    };
     let speeds = std::iter::once((0, rpm)).chain(
         blocks
             .iter()
             .enumerate()
             .filter_map(|(i, b)| b.spindle.map(|v| (i, v))),
     );
+    let spindle = info.axes.iter().find(|a| a.kind == AxisKind::Spindle);
     for (i, v) in speeds {
+        if !(v.round() >= 1.0) {
+            return Err(ProgramError::SpindleStopped {
+                block: name_of(i),
+                rpm: v,
+            });
+        }
+        let Some(s) = spindle else { continue };
         if !(v >= s.min && v <= s.max) {
             return Err(ProgramError::Spindle {
                 block: name_of(i),
@@ -746,7 +761,7 @@ pub(crate) fn test_program() -> AxisProgram {
         machine: "test-lathe".into(),
         control: "fanuc".into(),
         tool_number: 3,
-        tool_name: "thread insert (60)".into(),
+        tool_name: "thread insert 60".into(),
         spindle_rpm: 399.4,
         decimals: None,
         axes: vec![axis("X"), axis("Z")],

@@ -365,41 +365,64 @@ impl Writer<'_> {
     }
 
     fn comment(&mut self, text: &str) {
-        let closes_with_paren = self.d.comment.1 == ")";
-        let mut t: String = text
-            .chars()
-            .filter(|c| match c {
-                '\n' | '\r' => false,
-                '(' | ')' => !closes_with_paren,
-                _ => true,
-            })
-            .collect();
-        if self.d.upper_comments {
-            t = t.to_uppercase();
-        }
         let (open, close) = self.d.comment;
-        self.line(&format!("{open}{t}{close}"));
+        self.line(&format!("{open}{}{close}", comment_text(self.d, text)));
     }
 }
 
-/// A template filled in for `p`; names are upper-cased and freed of
-/// parentheses where the dialect's comments need it. A template starting
+/// Words LinuxCNC acts on at the start of a comment (`(MSG,..)` shows a
+/// message, `(PROBEOPEN f)` and `(LOGOPEN,f)` open files, `(PY,..)` runs
+/// Python, `(ABORT,..)` stops, `(AXIS,..)` drives the GUI, `(DEBUG,..)`,
+/// `(PRINT,..)` and `(LOG,..)` print): a comment of pilgrim's never
+/// starts with one ([`comment_text`]), and the lint refuses one that does.
+pub const ACTIVE_COMMENTS: [&str; 8] = [
+    "MSG", "DEBUG", "PRINT", "LOG", "PROBE", "ABORT", "PY", "AXIS",
+];
+
+/// Whether a comment's text would make `d`'s control act: it starts (case
+/// and leading spaces aside) with one of [`ACTIVE_COMMENTS`] on LinuxCNC.
+pub fn is_active_comment(d: &Dialect, text: &str) -> bool {
+    d.name == LINUXCNC.name && {
+        let t = text.trim_start().to_ascii_uppercase();
+        ACTIVE_COMMENTS.iter().any(|k| t.starts_with(k))
+    }
+}
+
+/// `text` as a comment of `d` holds it: the one function every comment a
+/// program carries goes through (pass names, the header's machine and
+/// tool names, the writer's own notes). Names are checked where they enter
+/// ([`crate::names`]); this writes them so that no text can close or break
+/// the comment, or the block, whatever it holds: every character outside
+/// the names' set ([`crate::names::is_name_char`]) becomes `_`, upper case
+/// where the control wants it (Fanuc), and a comment LinuxCNC would act on
+/// ([`is_active_comment`]) is prefixed with `_`.
+pub fn comment_text(d: &Dialect, text: &str) -> String {
+    let mut t: String = text
+        .chars()
+        .take(crate::names::MAX_NAME)
+        .map(|c| {
+            if crate::names::is_name_char(c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if d.upper_comments {
+        t = t.to_uppercase();
+    }
+    if is_active_comment(d, &t) {
+        t.insert(0, '_');
+    }
+    t
+}
+
+/// A template filled in for `p`; names go through [`comment_text`] (the
+/// templates put them in comments only). A template starting
 /// `{WHOLE}` is for a whole program only (`p.number` > 0), one starting
 /// `{BLOCK}` for a block to paste only (number 0).
 fn fill(template: &str, p: &AxisProgram, d: &Dialect) -> String {
-    let text = |s: &str| {
-        let s = if d.upper_comments {
-            s.to_uppercase()
-        } else {
-            s.to_owned()
-        };
-        if d.comment.1 == ")" {
-            s.replace(['(', ')'], "")
-        } else {
-            s
-        }
-    };
-    let (tool_name, machine) = (text(&p.tool_name), text(&p.machine));
+    let (tool_name, machine) = (comment_text(d, &p.tool_name), comment_text(d, &p.machine));
     let template = match (
         template.strip_prefix("{WHOLE}"),
         template.strip_prefix("{BLOCK}"),
@@ -683,7 +706,7 @@ mod tests {
     fn sinumerik_program() {
         let text = post(&program(), &SINUMERIK).unwrap();
         let expected = "%_N_DEMO_MPF\n;$PATH=/_N_MPF_DIR\n; DEMO for test-lathe, written by pilgrim VERSION\n\
-; tool T3: thread insert (60)\nN1 G90 G94 G71\nN2 T3 D1\nN3 S399 M3\n; pass 1\nN10 G0 X50.000 Z5.000\n\
+; tool T3: thread insert 60\nN1 G90 G94 G71\nN2 T3 D1\nN3 S399 M3\n; pass 1\nN10 G0 X50.000 Z5.000\n\
 N20 G1 X40.000 F100.0\nN30 Z0.000\nN40 X40.000\nN50 G33 Z-60.000 K6.3500\nN60 G0 X50.000\nN70 M5\nN80 M30\n";
         assert_eq!(text, expected.replace("VERSION", crate::VERSION));
     }

@@ -113,8 +113,7 @@ pub mod caliber_api {
         r_k0: Real,
         r_k: Real,
     ) -> Result<Tool, Box<EvalAltResult>> {
-        let number =
-            u32::try_from(number).map_err(|_| format!("tool number {number} is out of range"))?;
+        let number = crate::script::bind_toolpath::tool_number(name, number)?;
         let w = kernel(Wheel::new(2.0 * r_k0, r_k, 2.0 * r_k))?;
         Ok(Tool::wheel_at_centre(name, number, w))
     }

@@ -14,6 +14,13 @@ use std::rc::Rc;
 /// A toolpath under construction, shared by handle.
 pub type ToolpathHandle = Rc<RefCell<Toolpath>>;
 
+/// A tool's number, its name checked first: the name reaches the program
+/// ([`crate::names::check_name`]).
+pub(super) fn tool_number(name: &str, number: i64) -> Result<u32, Box<EvalAltResult>> {
+    kernel(crate::names::check_name("tool name", name))?;
+    u32::try_from(number).map_err(|_| format!("tool number {number} is out of range").into())
+}
+
 /// Tools.
 #[export_module]
 pub mod tool_api {
@@ -29,8 +36,9 @@ pub mod tool_api {
         rounding_radius: Real,
         width: Real,
     ) -> Result<Tool, Box<EvalAltResult>> {
+        let number = tool_number(name, number)?;
         let w = kernel(Wheel::new(diameter, rounding_radius, width))?;
-        Ok(Tool::wheel(name, tool_number(number)?, w))
+        Ok(Tool::wheel(name, number, w))
     }
 
     /// An end mill tracked at its tip centre.
@@ -41,11 +49,8 @@ pub mod tool_api {
         diameter: Real,
         length: Real,
     ) -> Result<Tool, Box<EvalAltResult>> {
-        kernel(Tool::end_mill(name, tool_number(number)?, diameter, length))
-    }
-
-    fn tool_number(n: i64) -> Result<u32, Box<EvalAltResult>> {
-        u32::try_from(n).map_err(|_| format!("tool number {n} is out of range").into())
+        let number = tool_number(name, number)?;
+        kernel(Tool::end_mill(name, number, diameter, length))
     }
 
     /// The tool's name.
@@ -96,6 +101,7 @@ pub mod toolpath_api {
         spindle_rpm: Real,
         aux_names: Array,
     ) -> Result<ToolpathHandle, Box<EvalAltResult>> {
+        kernel(crate::names::check_name("part name", part))?;
         let names = aux_names
             .iter()
             .map(|d| {
@@ -119,6 +125,7 @@ pub mod toolpath_api {
         name: &str,
         value: Real,
     ) -> Result<(), Box<EvalAltResult>> {
+        kernel(crate::names::check_name("note name", name))?;
         crate::math::finite(&format!("note {name}"), value).map_err(|e| e.to_string())?;
         tp.borrow_mut().notes.insert(name.to_owned(), value);
         Ok(())
@@ -136,9 +143,11 @@ pub mod toolpath_api {
         name: &str,
         columns: rhai::Map,
     ) -> Result<(), Box<EvalAltResult>> {
+        kernel(crate::names::check_name("table name", name))?;
         let mut t = std::collections::BTreeMap::new();
         let mut len = None;
         for (k, v) in columns {
+            kernel(crate::names::check_name("column name", &k))?;
             let col = crate::script::floats::numbers(&v, &format!("table {name}, column {k}"))?;
             if let Some(v) = col.iter().find(|v| !v.is_finite()) {
                 return Err(format!("table {name}, column {k}: {v} is not a finite number").into());
@@ -163,9 +172,12 @@ pub mod toolpath_api {
     #[rhai_fn(name = "plot", return_raw)]
     pub fn plot(tp: &mut ToolpathHandle, spec: rhai::Map) -> Result<(), Box<EvalAltResult>> {
         let text = |k: &str| -> Result<String, Box<EvalAltResult>> {
-            spec.get(k)
+            let t = spec
+                .get(k)
                 .and_then(|d| d.clone().into_string().ok())
-                .ok_or_else(|| format!("plot: '{k}' must be a string").into())
+                .ok_or_else(|| format!("plot: '{k}' must be a string"))?;
+            kernel(crate::names::check_text(&format!("plot {k}"), &t))?;
+            Ok(t)
         };
         let y = spec
             .get("y")
@@ -199,8 +211,11 @@ pub mod toolpath_api {
 
     /// Adds a warning: the run goes on, and says it (the report's
     /// `warnings`, the summary).
-    pub fn warn(tp: &mut ToolpathHandle, text: &str) {
+    #[rhai_fn(return_raw)]
+    pub fn warn(tp: &mut ToolpathHandle, text: &str) -> Result<(), Box<EvalAltResult>> {
+        kernel(crate::names::check_text("warning", text))?;
         tp.borrow_mut().warnings.push(text.to_owned());
+        Ok(())
     }
 
     /// Number of points so far.
@@ -230,6 +245,7 @@ pub mod toolpath_api {
         const KEYS: [&str; 11] = [
             "x", "y", "z", "feed", "motion", "lead", "start", "i", "j", "k", "aux",
         ];
+        kernel(crate::names::check_name("pass name", name))?;
         if let Some(k) = data.keys().find(|k| !KEYS.contains(&k.as_str())) {
             return err(format!(
                 "add_pass: unknown key '{k}' (keys: {})",

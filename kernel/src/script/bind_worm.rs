@@ -112,6 +112,7 @@ pub mod worm_api {
         right_deg: Real,
         height: Real,
     ) -> Result<Tool, Box<EvalAltResult>> {
+        let number = crate::script::bind_toolpath::tool_number(name, number)?;
         let c = kernel(ThreadCutter::new(
             tip_width,
             nose_radius,
@@ -119,8 +120,6 @@ pub mod worm_api {
             right_deg.to_radians(),
             height,
         ))?;
-        let number = u32::try_from(number)
-            .map_err(|_| format!("thread_cutter: tool number {number} is not 0 or more"))?;
         Ok(Tool::thread_cutter(name, number, c))
     }
 

@@ -352,6 +352,15 @@ impl ScriptFamily {
     /// returns something other than a map of `#{value, unit, doc}`.
     pub fn load(path: &Path, limits: &Limits, access: &Access) -> Result<Self, FamilyError> {
         let file = path.display().to_string();
+        // The family's name is its path: the report, the page and the
+        // terminal show it (its program's name keeps only letters, digits
+        // and _).
+        crate::names::check_text("the family's name (its script's path)", &file).map_err(|e| {
+            FamilyError::Io {
+                file: crate::names::quoted(&file),
+                message: e.to_string(),
+            }
+        })?;
         let source = crate::files::read_text(path, crate::files::MAX_TEXT_BYTES).map_err(|e| {
             FamilyError::Io {
                 file: file.clone(),
@@ -449,6 +458,10 @@ impl ScriptFamily {
                 }
                 None => None,
             };
+            for k in ["unit", "doc"] {
+                crate::names::check_text(&format!("parameter '{name}': its {k}"), &text(k))
+                    .map_err(|e| fam.contract(e.to_string()))?;
+            }
             let spec = ParamSpec {
                 machine,
                 min,
