@@ -252,15 +252,37 @@ pub struct GrindingCheck {
     pub passes: Vec<PassCheck>,
 }
 
-/// The program as a control reads it: every value rounded to the decimals
-/// the program is written with (its own, or its dialect's).
+/// The program as a control reads it: every axis value rounded to the
+/// decimals the program is written with (its own, or its dialect's), and
+/// where the dialect is known, every word as it writes it: the feeds and
+/// leads at its decimals, a thread's start angle at its address's
+/// resolution (Fanuc's Q counts 0.001 deg), the spindle's speeds in whole
+/// rpm. The second value is the axis values' resolution.
 pub fn as_written(program: &AxisProgram) -> (AxisProgram, Real) {
     let decimals = crate::program::written_decimals(program.decimals, &program.control);
+    let dialect = crate::program::post::dialect(&program.control);
+    let w = crate::program::written;
     let mut p = program.clone();
     for b in &mut p.blocks {
         for v in &mut b.values {
-            *v = crate::program::written(*v, decimals);
+            *v = w(*v, decimals);
         }
+        let Some(d) = dialect else { continue };
+        b.spindle = b.spindle.map(Real::round);
+        match &mut b.motion {
+            crate::toolpath::Motion::Linear => b.feed = w(b.feed, d.feed_decimals),
+            crate::toolpath::Motion::Thread { lead, start_deg } => {
+                *lead = w(*lead, d.lead_decimals);
+                if let Some(t) = d.thread_start {
+                    *start_deg = w(*start_deg * t.scale, t.decimals) / t.scale;
+                }
+                b.feed = *lead * p.spindle_rpm.round();
+            }
+            crate::toolpath::Motion::Rapid => {}
+        }
+    }
+    if dialect.is_some() {
+        p.spindle_rpm = p.spindle_rpm.round();
     }
     (p, 10f64.powi(-(decimals as i32)))
 }
@@ -506,6 +528,35 @@ pub fn check_grinding(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A Fanuc thread block's lead and start angle, read at F's 0.0001 mm
+    /// and Q's 0.001 deg; a Sinumerik feed at F's 0.1 mm/min; speeds in
+    /// whole rpm.
+    #[test]
+    fn words_are_read_as_written() {
+        let mut p = crate::program::test_program();
+        p.blocks[4].motion = crate::toolpath::Motion::Thread {
+            lead: 10.0 * std::f64::consts::PI,
+            start_deg: 360.0 / 7.0,
+        };
+        p.blocks[1].feed = 100.94;
+        p.blocks[2].spindle = Some(120.6);
+        let (w, resolution) = as_written(&p);
+        assert_eq!(resolution, 1e-3);
+        assert_eq!(
+            w.blocks[4].motion,
+            crate::toolpath::Motion::Thread {
+                lead: 31.4159,
+                start_deg: 51.429
+            }
+        );
+        assert_eq!(
+            (w.blocks[1].feed, w.blocks[2].spindle),
+            (100.9, Some(121.0))
+        );
+        assert_eq!(w.spindle_rpm, 399.0);
+        assert_eq!(w.blocks[2].values[1], -0.0);
+    }
 
     /// Drawing stretches keep each stretch's extremes: the ridges survive.
     #[test]

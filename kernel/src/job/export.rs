@@ -75,11 +75,12 @@ pub fn export(
     };
     let machine = catalog.open(&spec)?;
     let kin = machine.kinematics.as_ref();
-    let index = match block {
+    let place = match block {
         Some(0) => return Err(Error::Options("--block counts blocks from 1".into())),
-        Some(n) => n - 1,
+        Some(n) => scene::PosePlace::at_end(n - 1),
         None => scene::default_pose_block(&program, &toolpath.passes),
     };
+    let index = place.block;
     let parts = report
         .bodies
         .iter()
@@ -102,11 +103,12 @@ pub fn export(
                 .map_err(|e| Error::Read(e.to_string()))
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let pose = scene::tool_pose(&program, kin, &toolpath.tool, index)?;
-    let tool = scene::tool_mesh(&toolpath.tool, report.mesh_tolerance_mm)?;
-    let others = scene::machine_bodies(kin, &program, index, report.mesh_tolerance_mm)?;
-    let (files, bodies) = scene::files(&parts, tool, pose, others, vec![], formats)?;
+    let pose = scene::tool_pose(&program, kin, &toolpath.tool, place)?;
+    let tool = scene::tool_mesh(&toolpath.tool, &pose, report.mesh_tolerance_mm)?;
+    let others = scene::machine_bodies(kin, &program, place, report.mesh_tolerance_mm)?;
+    let (files, bodies) = scene::files(&parts, tool, pose.pose, others, vec![], formats)?;
     report.pose_block = Some(index + 1);
+    report.pose_along = place.along;
     report.bodies = bodies;
     let mut all: Vec<(String, Vec<u8>)> = files
         .into_iter()

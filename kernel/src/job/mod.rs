@@ -24,7 +24,7 @@ mod worm_files;
 
 pub use export::{export, Exported};
 pub use report::{axis_ranges, block_table, cycle_time, Report, ReportParam};
-pub use scene::{default_pose_block, BodyFile, Formats, SceneError};
+pub use scene::{default_pose_block, BodyFile, Formats, PosePlace, SceneError};
 pub use solids::SolidFile;
 
 use crate::catalog::OpenMachine;
@@ -309,11 +309,12 @@ pub fn run(
     let mut program = build(&toolpath, kin, &options.program_name)?;
     program.number = options.program_number.unwrap_or(0);
     let requested = family.verification(&values)?;
-    let pose_index = match options.pose_block {
+    let pose_place = match options.pose_block {
         Some(0) => return Err(Error::Options("--pose-block counts blocks from 1".into())),
-        Some(n) => n - 1,
+        Some(n) => scene::PosePlace::at_end(n - 1),
         None => default_pose_block(&program, &toolpath.passes),
     };
+    let pose_index = pose_place.block;
     let needs_wheel = || {
         Error::Family(crate::family::FamilyError::Contract {
             family: family.name().to_owned(),
@@ -457,15 +458,15 @@ pub fn run(
         // Where the report page's camera points: the part's middle.
         let part_box = scene::bounds_of(meshes.iter().map(|(_, m)| m));
         let index = pose_index;
-        let pose = scene::tool_pose(&program, kin, &toolpath.tool, index)?;
-        let tool = scene::tool_mesh(&toolpath.tool, tol)?;
-        let others = scene::machine_bodies(kin, &program, index, tol)?;
+        let pose = scene::tool_pose(&program, kin, &toolpath.tool, pose_place)?;
+        let tool = scene::tool_mesh(&toolpath.tool, &pose, tol)?;
+        let others = scene::machine_bodies(kin, &program, pose_place, tol)?;
         let overlays = patch_mesh
             .map(|m| ("contact_patch".to_owned(), m, crate::math::Mat4::identity()))
             .into_iter()
             .collect();
         let (mesh_files, bodies) =
-            scene::files(&meshes, tool, pose, others, overlays, options.formats)?;
+            scene::files(&meshes, tool, pose.pose, others, overlays, options.formats)?;
         files.extend(mesh_files);
         let (step_files, solids) =
             solids::step_files(&parts, &toolpath.tool, &pose, options.step_tolerance)?;
@@ -503,6 +504,7 @@ pub fn run(
             .collect(),
         checks,
         pose_block,
+        pose_along: pose_block.map_or(1.0, |_| pose_place.along),
         mesh_tolerance_mm: tol,
         bodies,
         step_tolerance_mm: options.step_tolerance,

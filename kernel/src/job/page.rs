@@ -143,6 +143,21 @@ fn verification(out: &mut String, r: &Report) {
             fixed(w.flank_loads[1], 1),
             fixed(w.lead_error, 5)
         );
+        let worst = |f: fn(&crate::worm::SimulatedPass) -> f64| {
+            w.passes
+                .iter()
+                .max_by(|a, b| f(a).total_cmp(&f(b)))
+                .map_or_else(String::new, |p| {
+                    format!("{}% ({})", fixed(100.0 * f(p), 3), escape(&p.name))
+                })
+        };
+        let _ = writeln!(
+            out,
+            "<p>The lead where each pass's cutting edges meet the worm's face (S1 from the edges): at most {}; where they leave its far end (S2): at most {}; allowed {}%.</p>",
+            worst(|p| p.face_lead_error),
+            worst(|p| p.end_lead_error),
+            fixed(100.0 * w.tolerances.lead, 3)
+        );
         out.push_str("<table><tr><th>start</th><th>flank angles, deg</th><th>form, um</th><th>thickness, mm</th><th>root / tip, mm</th><th>place, um</th></tr>\n");
         for s in &w.starts {
             row(
@@ -208,7 +223,12 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
             "3-D pose",
             r.pose_block.map_or("none".into(), |b| {
                 format!(
-                    "block {b} ({})",
+                    "{}block {b} ({})",
+                    if r.pose_along < 1.0 {
+                        format!("{}% of the way through ", fixed(100.0 * r.pose_along, 0))
+                    } else {
+                        String::new()
+                    },
                     crate::program::block_label(&r.control, b - 1)
                 )
             }),

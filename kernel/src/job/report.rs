@@ -55,6 +55,10 @@ pub struct Report {
     /// The block (from 1) the 3-D scene places the tool at.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pose_block: Option<usize>,
+    /// How far through that block's move the tool stands (1: at its end;
+    /// 0.5: halfway, where the block cuts a thread).
+    #[serde(default = "at_end", skip_serializing_if = "is_at_end")]
+    pub pose_along: f64,
     /// Chordal tolerance of the meshes (mm).
     pub mesh_tolerance_mm: f64,
     /// The bodies written as STL.
@@ -77,9 +81,8 @@ pub struct Report {
     /// that ask).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub groove_verification: Option<crate::caliber::GrooveCheck>,
-    /// The worm's cut simulated pass by pass (families that ask; written,
-    /// not read back).
-    #[serde(default, skip_serializing_if = "Option::is_none", skip_deserializing)]
+    /// The worm's cut simulated pass by pass (families that ask).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub worm_verification: Option<crate::worm::WormCheck>,
     /// What the family warned of.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -90,6 +93,14 @@ pub struct Report {
     /// Tables the family reported (name to columns).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub tables: BTreeMap<String, BTreeMap<String, Vec<f64>>>,
+}
+
+fn at_end() -> f64 {
+    1.0
+}
+
+fn is_at_end(v: &f64) -> bool {
+    *v == 1.0
 }
 
 /// Each programmed axis's range over the program: `[min, max]` in program

@@ -83,15 +83,17 @@ pub fn bounds_of<'a>(meshes: impl Iterator<Item = &'a TriMesh>) -> Option<([f64;
     })
 }
 
-/// The thickness of a thread cutter's blade in the 3-D models (mm): the
-/// cutter's section is its cutting edge; the blade only shows it.
-pub const CUTTER_BLADE: f64 = 6.0;
-
-/// The tool's solid in its own frame and the file name it is written as.
+/// The tool's solid in its own frame, standing `at` (a thread cutter's
+/// blade follows the thread it cuts there: [`crate::worm::ThreadBlade`]),
+/// and the file name it is written as.
 ///
 /// # Failures
 /// The tool's mesh failing.
-pub fn tool_mesh(tool: &Tool, tol: f64) -> Result<Option<(TriMesh, &'static str)>, SceneError> {
+pub fn tool_mesh(
+    tool: &Tool,
+    at: &ToolAt,
+    tol: f64,
+) -> Result<Option<(TriMesh, &'static str)>, SceneError> {
     Ok(match tool.shape {
         ToolShape::Wheel(w) => {
             let m = mesh::wheel(&w, tol).map_err(mesh_err("wheel"))?;
@@ -110,39 +112,36 @@ pub fn tool_mesh(tool: &Tool, tol: f64) -> Result<Option<(TriMesh, &'static str)
             "cutter",
         )),
         ToolShape::Insert { .. } => None,
-        ToolShape::ThreadCutter(c) => {
-            // The section in the tool frame's XZ plane (X radial from the
-            // tip, Z along the part), a blade CUTTER_BLADE mm thick.
-            let half = CUTTER_BLADE / 2.0;
-            let ring = |y: f64| -> Vec<[f64; 3]> {
-                c.section(c.height)
-                    .iter()
-                    .map(|p| [p[1], y, p[0]])
-                    .collect()
-            };
-            Some((
-                mesh::sweep(&[ring(-half), ring(half)]).map_err(mesh_err("cutter"))?,
-                "cutter",
-            ))
-        }
+        ToolShape::ThreadCutter(c) => Some((
+            thread_blade(&c, at).mesh(tol).map_err(mesh_err("cutter"))?,
+            "cutter",
+        )),
     })
+}
+
+/// A thread cutter's blade standing `at`.
+pub fn thread_blade(c: &crate::worm::ThreadCutter, at: &ToolAt) -> crate::worm::ThreadBlade {
+    let tip_radius = at.pose[(0, 3)].hypot(at.pose[(1, 3)]);
+    crate::worm::ThreadBlade::new(c, tip_radius, at.lead, at.pose)
 }
 
 /// A body placed in the part frame: name, mesh in its own frame, pose.
 pub type Placed = (String, TriMesh, Mat4);
 
 /// The machine's other moving bodies that have a shape, placed by their
-/// chains at block `index` (from 0); a body whose chain needs an axis the
-/// program does not drive is left out.
+/// chains at `place`; a body whose chain needs an axis the program does
+/// not drive is left out.
 ///
 /// # Failures
 /// A body's description or mesh failing.
 pub fn machine_bodies(
     machine: &dyn MachineKinematics,
     program: &AxisProgram,
-    index: usize,
+    place: PosePlace,
     tol: f64,
 ) -> Result<Vec<Placed>, SceneError> {
+    let program = &at_place(program, place)?;
+    let index = 0;
     let info = machine.info();
     let bodies = bodies_of(info).map_err(|e| SceneError::Place(e.to_string()))?;
     let mut out = Vec::new();
@@ -174,11 +173,31 @@ pub fn machine_bodies(
     Ok(out)
 }
 
-/// Block index (from 0) of `program`, built from `passes`, where the scene
-/// shows the tool by default: the middle block of the last pass that cuts
-/// (has a move other than a rapid), the tool at work on the finish; else
-/// the first block of the last pass.
-pub fn default_pose_block(program: &AxisProgram, passes: &[Pass]) -> usize {
+/// Where the scene shows the tool and the machine's bodies: `along` of
+/// the way through block `block`'s move (from 0; 1 is the block's end, its
+/// axis values), the axes interpolated in straight lines from the block
+/// before as the control moves them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PosePlace {
+    /// The block (from 0).
+    pub block: usize,
+    /// How far through its move, from 0 (the block before's end) to 1.
+    pub along: f64,
+}
+
+impl PosePlace {
+    /// The end of block `block` (from 0).
+    pub fn at_end(block: usize) -> Self {
+        Self { block, along: 1.0 }
+    }
+}
+
+/// Where the scene shows the tool by default in `program`, built from
+/// `passes`: the middle block of the last pass that cuts (has a move other
+/// than a rapid), the tool at work on the finish, at its end; halfway
+/// through it if it cuts a thread (whose end lies beyond the thread, where
+/// the tool has left the part); else the first block of the last pass.
+pub fn default_pose_block(program: &AxisProgram, passes: &[Pass]) -> PosePlace {
     let (mut last_start, mut pick) = (0, None);
     for (p, blocks) in pass_blocks(program, passes) {
         if p.cuts() {
@@ -186,11 +205,67 @@ pub fn default_pose_block(program: &AxisProgram, passes: &[Pass]) -> usize {
         }
         last_start = blocks.start;
     }
-    pick.unwrap_or(last_start)
+    let block = pick.unwrap_or(last_start);
+    let thread = program
+        .blocks
+        .get(block)
+        .is_some_and(|b| matches!(b.motion, crate::toolpath::Motion::Thread { .. }));
+    PosePlace {
+        block,
+        along: if thread && block > 0 { 0.5 } else { 1.0 },
+    }
 }
 
-/// The rigid motion of the tool at block `index` (from 0): the machine's
-/// forward kinematics of the block's axis values.
+/// `program` with its blocks replaced by the one at `place` (the axes
+/// interpolated between the block before and this one).
+///
+/// # Failures
+/// A block beyond the program.
+fn at_place(program: &AxisProgram, place: PosePlace) -> Result<AxisProgram, SceneError> {
+    let b = program.blocks.get(place.block).ok_or_else(|| {
+        SceneError::Place(format!(
+            "block {} is beyond the program's {} blocks",
+            place.block + 1,
+            program.blocks.len()
+        ))
+    })?;
+    let mut block = b.clone();
+    if place.along < 1.0 {
+        let before = &program.blocks[place.block.saturating_sub(1)];
+        for (v, a) in block.values.iter_mut().zip(&before.values) {
+            *v = a + (*v - a) * place.along;
+        }
+    }
+    Ok(AxisProgram {
+        name: program.name.clone(),
+        number: program.number,
+        machine: program.machine.clone(),
+        control: program.control.clone(),
+        tool_number: program.tool_number,
+        tool_name: program.tool_name.clone(),
+        spindle_rpm: program.spindle_rpm,
+        decimals: program.decimals,
+        axes: program.axes.clone(),
+        blocks: vec![block],
+        setup: program.setup.clone(),
+    })
+}
+
+/// Where the tool stands at a place of the program.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ToolAt {
+    /// Its rigid motion into the part frame.
+    pub pose: Mat4,
+    /// The lead of the thread it cuts there (mm; 0 outside a thread block).
+    pub lead: f64,
+}
+
+/// The tool at `place`, in the part frame: the machine's forward
+/// kinematics of the axis values there; in a thread block, turned about the
+/// part's axis by the angle the spindle has turned the part since the
+/// thread's start (its start angle, then one turn a lead), as the worm's
+/// simulation places each cut ([`crate::worm::simulate`]): the tool stands
+/// in the thread it cuts.
 ///
 /// # Failures
 /// A block beyond the program; the replay failing.
@@ -198,15 +273,39 @@ pub fn tool_pose(
     program: &AxisProgram,
     machine: &dyn MachineKinematics,
     tool: &Tool,
-    index: usize,
-) -> Result<Mat4, SceneError> {
-    let pose = crate::verify::replay_blocks(program, machine, &tool.reference, index..index + 1)
+    place: PosePlace,
+) -> Result<ToolAt, SceneError> {
+    let here = at_place(program, place)?;
+    let pose = crate::verify::replay_blocks(&here, machine, &tool.reference, 0..1)
         .map_err(|e| SceneError::Place(e.to_string()))?;
-    Ok(frame_from_pose(
+    let frame = frame_from_pose(
         &tool.reference,
         Point3::new(pose[0], pose[1], pose[2]),
         Vec3::new(pose[3], pose[4], pose[5]),
-    ))
+    );
+    let b = &here.blocks[0];
+    let flat = ToolAt {
+        pose: frame,
+        lead: 0.0,
+    };
+    let crate::toolpath::Motion::Thread { lead, start_deg } = b.motion else {
+        return Ok(flat);
+    };
+    if place.block == 0 {
+        return Ok(flat);
+    }
+    // Where the block started: its thread's section at part angle 0 is
+    // there, shifted by the start angle's share of the lead.
+    let start = at_place(program, PosePlace::at_end(place.block - 1))?;
+    let from = crate::verify::replay_blocks(&start, machine, &tool.reference, 0..1)
+        .map_err(|e| SceneError::Place(e.to_string()))?;
+    let dir = (pose[2] - from[2]).signum();
+    let z_section = from[2] - dir * lead * start_deg / 360.0;
+    let angle = std::f64::consts::TAU * (pose[2] - z_section) / lead;
+    Ok(ToolAt {
+        pose: Mat4::from_axis_angle(&Vec3::z_axis(), angle) * frame,
+        lead,
+    })
 }
 
 /// Which 3-D files to write beside the default binary STL and `.glb`.

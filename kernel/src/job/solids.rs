@@ -37,9 +37,10 @@ pub struct SolidFile {
 pub fn step_files(
     parts: &[PartBody],
     tool: &Tool,
-    tool_pose: &Mat4,
+    at: &super::scene::ToolAt,
     tol: Real,
 ) -> Result<(Files, Vec<SolidFile>), StepError> {
+    let tool_pose = &at.pose;
     let mut files = Vec::new();
     let mut solids = Vec::new();
     // Each solid: its file's text and its volume from its own outline.
@@ -111,12 +112,15 @@ pub fn step_files(
             )?;
         }
         ToolShape::ThreadCutter(c) => {
-            // The blade as the STL shows it: the cutting profile up to its
-            // height, CUTTER_BLADE thick.
-            let outline = c.outline(c.height);
-            let blade = super::scene::CUTTER_BLADE;
-            let text = step::prism_step("cutter", &outline, blade, tool_pose);
-            add("cutter", "tool", (text, outline.area() * blade), (0.0, 0))?;
+            // The blade as the STL shows it, following the thread it cuts.
+            let blade = super::scene::thread_blade(&c, at);
+            let fit = step::swept_step("cutter", "a thread cutter's blade", &blade, tol)?;
+            add(
+                "cutter",
+                "tool",
+                (Ok(fit.text), fit.volume),
+                (fit.deviation, fit.faces),
+            )?;
         }
         ToolShape::Insert { .. } => {}
     }

@@ -104,7 +104,9 @@ pub fn worm_passes_svg(check: &WormCheck) -> Result<String, String> {
 }
 
 /// `passes.csv`: one row per simulated thread pass (block, its name,
-/// start from 1, X, axial offset, chip area, left and right loads, gouge)
+/// start from 1, X, axial offset, chip area, left and right loads, gouge,
+/// the approach and run-out from the cutting edges with the lead's error
+/// where they meet the thread's ends)
 /// and the plan's columns from `planned` where it has one row per pass.
 ///
 /// # Failures
@@ -135,6 +137,10 @@ pub fn worm_pass_table(
         "left_area_mm2",
         "right_area_mm2",
         "gouge_mm",
+        "approach_mm",
+        "face_lead_error",
+        "runout_mm",
+        "end_lead_error",
     ]
     .iter()
     .map(|s| (*s).to_owned())
@@ -152,6 +158,10 @@ pub fn worm_pass_table(
             crate::math::fixed(p.left_area, 5),
             crate::math::fixed(p.right_area, 5),
             crate::math::fixed(p.gouge, 5),
+            crate::math::fixed(p.approach_mm, 3),
+            crate::math::fixed(p.face_lead_error, 6),
+            crate::math::fixed(p.runout_mm, 3),
+            crate::math::fixed(p.end_lead_error, 6),
         ];
         row.extend(plan.iter().map(|(_, c)| crate::math::fixed(c[i], 5)));
         w.write_record(&row).map_err(|e| e.to_string())?;

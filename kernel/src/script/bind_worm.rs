@@ -129,6 +129,23 @@ pub mod worm_api {
         Ok(cutter_of(&tool)?.width_at(r))
     }
 
+    /// Where the cutter's cutting edges stand at `h` above its tip (mm from
+    /// the tip's centre): `#{ left, right }`, left towards -z. At the
+    /// blank's radius they are what S1 and S2 are measured from.
+    ///
+    /// ```rhai
+    /// let e = cutter_edges(tool, 3.0);
+    /// let leading = z_start - e.left;   // cutting towards -z
+    /// ```
+    #[rhai_fn(return_raw)]
+    pub fn cutter_edges(tool: Tool, h: Real) -> Result<rhai::Map, Box<EvalAltResult>> {
+        let [left, right] = cutter_of(&tool)?.extent_at(h);
+        let mut m = rhai::Map::new();
+        m.insert("left".into(), left.into());
+        m.insert("right".into(), right.into());
+        Ok(m)
+    }
+
     /// The universal cutter's axial offset to each flank, `a_1z` (mm).
     #[rhai_fn(pure, return_raw)]
     pub fn axial_offset(w: &mut WormSizes, tool: Tool) -> Result<Real, Box<EvalAltResult>> {

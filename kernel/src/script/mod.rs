@@ -676,7 +676,7 @@ impl PartFamily for ScriptFamily {
         let d = self.call_with_params("verify", values)?;
         let shape = || {
             self.contract(
-                "fn verify(p) must return #{ profile, from, to, tolerance } (and optionally blank, a profile), #{ groove, psi, tolerance, grid_theta, grid_per_step, patch_gap } or #{ worm, length, space_centre, tolerance: #{ form, thickness, diameter, position, flank_angle_deg } }".into(),
+                "fn verify(p) must return #{ profile, from, to, tolerance } (and optionally blank, a profile), #{ groove, psi, tolerance, grid_theta, grid_per_step, patch_gap } or #{ worm, length, space_centre, tolerance: #{ form, thickness, diameter, position, flank_angle_deg, lead (optional) } }".into(),
             )
         };
         let m = d.try_cast::<Map>().ok_or_else(shape)?;
@@ -708,6 +708,10 @@ impl PartFamily for ScriptFamily {
                         diameter: tnum("diameter")?,
                         position: tnum("position")?,
                         flank_angle: tnum("flank_angle_deg")?.to_radians(),
+                        lead: match t.get("lead") {
+                            None => crate::worm::LEAD_ERROR,
+                            Some(_) => tnum("lead")?,
+                        },
                     },
                 },
             ))));

@@ -128,6 +128,43 @@ impl Section {
         0.5 * (sum + line(from, self.start))
     }
 
+    /// The point `u` (0 to 1) along piece `k` (from 0; the piece after the
+    /// last is the closing line back to the start): by length along a
+    /// line, by angle along an arc, by the curve's parameter across a
+    /// Bezier piece's segments.
+    pub fn point_on(&self, k: usize, u: Real) -> [Real; 2] {
+        let mut from = self.start;
+        for p in &self.pieces[..k.min(self.pieces.len())] {
+            from = match p {
+                Piece::Line(to) | Piece::Arc { to, .. } => *to,
+                Piece::Cubic(pts) => pts.last().copied().unwrap_or(from),
+            };
+        }
+        let lerp =
+            |a: [Real; 2], b: [Real; 2]| [a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1])];
+        match self.pieces.get(k) {
+            None => lerp(from, self.start),
+            Some(Piece::Line(to)) => lerp(from, *to),
+            Some(Piece::Arc { through, to }) => {
+                let (c, rho, a0, sweep) = arc_of(from, *through, *to);
+                let a = a0 + u * sweep;
+                [c[0] + rho * a.cos(), c[1] + rho * a.sin()]
+            }
+            Some(Piece::Cubic(pts)) => {
+                let segments: Vec<[[Real; 2]; 4]> = beziers(from, pts).collect();
+                let n = segments.len().max(1) as Real;
+                let i = ((u * n).floor() as usize).min(segments.len().saturating_sub(1));
+                let t = u * n - i as Real;
+                let Some(b) = segments.get(i) else {
+                    return from;
+                };
+                let m = 1.0 - t;
+                let w = [m * m * m, 3.0 * m * m * t, 3.0 * m * t * t, t * t * t];
+                [0, 1].map(|j| (0..4).map(|q| w[q] * b[q][j]).sum())
+            }
+        }
+    }
+
     /// The volume of the solid the section sweeps turning about Z, from the
     /// section's own curves: `pi |integral of r^2 dz|` along it (the end
     /// faces and the axis add nothing). Gauss-Legendre quadrature, exact

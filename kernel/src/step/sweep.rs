@@ -35,8 +35,9 @@ const MAX_ALONG: usize = 20_000;
 /// running for `u` from 0 to 1 from where piece `k - 1` ends to where piece
 /// `k + 1` starts (the last piece ends where the first starts). The
 /// sections at `v = 0` and `v = 1` must each lie in a plane, and each of
-/// those planes must either contain the Z axis or be square to it (the
-/// volume is found from the lateral faces alone).
+/// those planes must either contain the Z axis or be square to it, or
+/// both be parallel to Z ([`Sections::ends_along_z`]): the volume is found
+/// from the lateral faces alone.
 pub trait Sections {
     /// How many pieces each section has.
     fn pieces(&self) -> usize;
@@ -47,6 +48,14 @@ pub trait Sections {
     fn point(&self, k: usize, u: Real, v: Real) -> [Real; 3];
     /// How many points along the sweep to start from (refined as needed).
     fn along(&self) -> usize;
+    /// Whether the end sections lie in planes parallel to Z (a blade's
+    /// faces): the volume is then the flux of `(0, 0, z)` through the
+    /// lateral faces, which does not cross them; else (the default) of
+    /// `(x, y, 0) / 2`, which does not cross planes containing Z or square
+    /// to it.
+    fn ends_along_z(&self) -> bool {
+        false
+    }
 }
 
 /// What fitting a swept solid found.
@@ -375,9 +384,10 @@ fn deviations(
 
 /// The volume the lateral surfaces enclose: half the flux of (x, y, 0)
 /// through them (through end planes that contain Z or are square to it, the
-/// flux is nil), by 5-point Gauss-Legendre on each knot span (exact for the
-/// integrand's degree).
-fn volume(patches: &[Patch], knots_v: &[Real]) -> Real {
+/// flux is nil), or with `axial` the flux of (0, 0, z) (nil through end
+/// planes parallel to Z), by 5-point Gauss-Legendre on each knot span
+/// (exact for the integrand's degree).
+fn volume(patches: &[Patch], knots_v: &[Real], axial: bool) -> Real {
     const X: [Real; 5] = [
         0.0,
         -0.538_469_310_105_683,
@@ -426,9 +436,16 @@ fn volume(patches: &[Patch], knots_v: &[Real]) -> Real {
                 let p = s.with(bu, *bv, 3);
                 let su = su_net.with(bu_d, *bv, 3);
                 let sv = sv_net.with(bu, *bv_d, 2);
-                // (x, y) . (su x sv)
                 let (nx, ny) = (su[1] * sv[2] - su[2] * sv[1], su[2] * sv[0] - su[0] * sv[2]);
-                sum += wu * wv * (p[0] * nx + p[1] * ny);
+                sum += wu
+                    * wv
+                    * if axial {
+                        // z (su x sv)_z, twice: the field is (0, 0, z).
+                        2.0 * p[2] * (su[0] * sv[1] - su[1] * sv[0])
+                    } else {
+                        // (x, y) . (su x sv)
+                        p[0] * nx + p[1] * ny
+                    };
             }
         }
     }
@@ -506,7 +523,7 @@ pub fn swept_step(
         }
     };
     let knots_v = knots(along, 3);
-    let signed = volume(&ps, &knots_v);
+    let signed = volume(&ps, &knots_v, body.ends_along_z());
     let surfaces: Vec<_> = ps.iter().map(|p| surface(p, &knots_v)).collect();
     let point = |c: [Real; 3]| Point3::new(c[0], c[1], c[2]);
     let curve = |knots: &[Real], pts: Vec<[Real; 3]>| {

@@ -94,6 +94,25 @@ impl ThreadCutter {
         self.tip_width + r * (self.left_angle.tan() + self.right_angle.tan())
     }
 
+    /// How far the section reaches from the tip's centre at `h` above the
+    /// tip, to the left (-z) and to the right: where its cutting edges
+    /// stand at that height (on a flank's line, or on a nose's arc below
+    /// the point where the flank touches it; 0 and 0 below the tip).
+    pub fn extent_at(&self, h: Real) -> [Real; 2] {
+        let r = self.nose_radius;
+        let side = |a: Real| {
+            if !(h > 0.0) {
+                0.0
+            } else if h >= r * (1.0 - a.sin()) {
+                self.tip_width / 2.0 + h * a.tan()
+            } else {
+                let centre = self.tip_width / 2.0 - self.inset(a);
+                centre + (r * r - (r - h) * (r - h)).max(0.0).sqrt()
+            }
+        };
+        [side(self.left_angle), side(self.right_angle)]
+    }
+
     /// The same outline as [`Self::section`] up to `top`, closed along the
     /// top, in exact lines and arcs (the cutter's STEP solid),
     /// counter-clockwise.
@@ -214,5 +233,31 @@ mod tests {
         );
         // A nose radius that does not fit is refused.
         assert!(ThreadCutter::new(0.5, 0.5, a, a, 5.0).is_err());
+    }
+
+    /// The edges' reach at a height is where a horizontal line there
+    /// leaves the section, on the nose arcs and on the flanks, each side
+    /// at its own angle.
+    #[test]
+    fn the_edges_reach_is_the_sections() {
+        let c = ThreadCutter::new(3.0, 0.5, 20f64.to_radians(), 10f64.to_radians(), 12.0).unwrap();
+        let s = c.section(12.0);
+        for h in [0.01, 0.05, 0.1, 0.2, 0.4, 1.0, 5.0, 11.0] {
+            // The section's crossings of the line r = h, from its edges.
+            let mut xs: Vec<f64> = (0..s.len())
+                .filter_map(|i| {
+                    let (p, q) = (s[i], s[(i + 1) % s.len()]);
+                    ((p[1] - h) * (q[1] - h) < 0.0)
+                        .then(|| p[0] + (h - p[1]) / (q[1] - p[1]) * (q[0] - p[0]))
+                })
+                .collect();
+            xs.sort_by(f64::total_cmp);
+            let [l, r] = c.extent_at(h);
+            // The polygon's chords lie within ARC_TOLERANCE inside the arcs.
+            let tol = 2.0 * (2.0 * ARC_TOLERANCE * 0.5).sqrt();
+            assert!((-xs[0] - l).abs() < tol, "{h}: {} vs {l}", -xs[0]);
+            assert!((xs[xs.len() - 1] - r).abs() < tol, "{h}: {} vs {r}", xs[1]);
+        }
+        assert_eq!(c.extent_at(0.0), [0.0, 0.0]);
     }
 }

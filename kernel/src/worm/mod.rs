@@ -18,6 +18,7 @@
 //! face towards the tailstock) to z = -b1, cut towards the chuck (-Z); X
 //! radial. The thread is right-handed.
 
+mod blade;
 mod cutter;
 mod plan;
 mod servo;
@@ -25,12 +26,15 @@ mod simulate;
 mod sizes;
 mod solid;
 
+pub use blade::{ThreadBlade, BLADE_RELIEF_DEG, BLADE_THICKNESS};
 pub use cutter::{ThreadCutter, ARC_TOLERANCE};
 pub use plan::{
     axial_offset, plan, rational_passes, roughing_depths, Flank, FlankOrder, PassKind,
     PlanSettings, PlannedPass, MAX_PASSES,
 };
 pub use servo::{approach_error, approach_length, runout_error, runout_length};
-pub use simulate::{simulate, SimulatedPass, StartProfile, WormCheck, WormRequest, WormTolerances};
+pub use simulate::{
+    simulate, SimulatedPass, StartProfile, WormCheck, WormRequest, WormTolerances, LEAD_ERROR,
+};
 pub use sizes::WormSizes;
 pub use solid::{worm_solid, WormSweep, MAX_AROUND};

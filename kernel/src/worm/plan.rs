@@ -78,6 +78,41 @@ pub fn axial_offset(w: &WormSizes, c: &ThreadCutter) -> Real {
     (w.lead() / Real::from(w.starts) - w.thickness - s_a1r) / 2.0
 }
 
+/// Each side step's planned area, the area it removes: the planned
+/// passes of one start cut in order from the space's section (the blank
+/// from the tip radius down) with polygon booleans, as the simulation cuts
+/// the program ([`super::simulate`]); a side step of a universal cutter
+/// takes only what the passes before it left at the root's corners and on
+/// the flanks, not its width times the depth.
+fn side_step_areas(w: &WormSizes, c: &ThreadCutter, steps: &mut [PlannedPass]) {
+    use geo::{Area, BooleanOps, MultiPolygon};
+    if !steps.iter().any(|p| p.kind == PassKind::Side) {
+        return;
+    }
+    let r_a = w.tip_radius();
+    let deepest = steps.iter().map(|p| p.cumulative).fold(0.0, Real::max);
+    let half = w.axial_pitch() / 2.0;
+    let mut material = MultiPolygon::new(vec![super::simulate::rect(
+        -half,
+        half,
+        r_a - deepest - 1.0,
+        r_a,
+    )]);
+    for p in steps.iter_mut() {
+        let tip = r_a - p.cumulative;
+        let section: Vec<[Real; 2]> = c
+            .section(p.cumulative + 1.0)
+            .iter()
+            .map(|q| [q[0] + p.offset, q[1] + tip])
+            .collect();
+        let cutter = MultiPolygon::new(vec![super::simulate::poly(&section)]);
+        if p.kind == PassKind::Side {
+            p.planned_area = material.intersection(&cutter).unsigned_area();
+        }
+        material = material.difference(&cutter);
+    }
+}
+
 /// Which flanks the roughing passes cut on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -151,8 +186,10 @@ pub struct PlannedPass {
     pub offset: Real,
     /// The flank it cuts on.
     pub flank: Flank,
-    /// The chip area the plan expects (mm^2): a radial infeed of this
-    /// cutter from the last depth, or the axial step times the depth.
+    /// The chip area the plan expects (mm^2): for a roughing or finishing
+    /// pass a radial infeed of this cutter from the last depth (the law's
+    /// area), for a side step the area it removes beside the passes before
+    /// it at its start ([`side_step_areas`]).
     pub planned_area: Real,
 }
 
@@ -280,6 +317,7 @@ pub fn plan(
     if s.finish_passes == 0 {
         side_steps(&mut steps, last);
     }
+    side_step_areas(w, c, &mut steps);
     let z1 = w.starts;
     if steps.len() * z1 as usize > MAX_PASSES {
         return Err(InputError::out_of_range(

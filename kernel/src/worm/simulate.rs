@@ -28,10 +28,10 @@ use crate::toolpath::Motion;
 use crate::transform::ToolFrame;
 use crate::verify::{as_written, replay, VerifyError};
 use geo::{Area, BooleanOps, Coord, LineString, MultiPolygon, Polygon};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// What the finished worm must hold.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct WormTolerances {
     /// Flank form and any cut beyond the nominal (mm, normal to the flank).
     pub form: Real,
@@ -44,7 +44,15 @@ pub struct WormTolerances {
     pub position: Real,
     /// Flank angles (rad).
     pub flank_angle: Real,
+    /// The lead's error allowed where each pass's cutting edges meet the
+    /// worm's face and leave its far end, as a ratio of the lead (MATH
+    /// §4.2's `a`).
+    pub lead: Real,
 }
+
+/// The lead's usual allowed error at a thread's ends, as a ratio (Fanuc's
+/// practice, MATH §4.2): the default of [`WormTolerances::lead`].
+pub const LEAD_ERROR: Real = 0.01;
 
 /// What the family asks the simulation to check.
 #[derive(Debug, Clone, PartialEq)]
@@ -61,7 +69,7 @@ pub struct WormRequest {
 }
 
 /// One thread block as simulated.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SimulatedPass {
     /// The block (from 1, the program's and `report.csv`'s count).
     pub block: usize,
@@ -82,10 +90,20 @@ pub struct SimulatedPass {
     pub right_area: Real,
     /// The deepest cut beyond the nominal space (mm; 0 where none).
     pub gouge: Real,
+    /// How far the carriage travels before the leading cutting edge, at
+    /// the blank's radius, meets the worm's face (mm): the pass's S1.
+    pub approach_mm: Real,
+    /// The lead's error there, as a ratio (the servo model of MATH §4.2).
+    pub face_lead_error: Real,
+    /// How far before the block's end the trailing cutting edge, at the
+    /// blank's radius, leaves the thread's far end (mm): the pass's S2.
+    pub runout_mm: Real,
+    /// The lead's error there, as a ratio.
+    pub end_lead_error: Real,
 }
 
 /// The finished profile at one start's space.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StartProfile {
     /// The start (from 0).
     pub start: u32,
@@ -109,8 +127,9 @@ pub struct StartProfile {
     pub tip_diameter: Real,
 }
 
-/// The simulation's result.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+/// The simulation's result (`report.json`'s `worm_verification`; the
+/// section and chips, for drawing, are not in it).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WormCheck {
     /// Every thread block, in order.
     pub passes: Vec<SimulatedPass>,
@@ -129,8 +148,9 @@ pub struct WormCheck {
     /// Each pass's chip as polygons `(z, r)` (for the pass-by-pass view).
     #[serde(skip)]
     pub chips: Vec<Vec<Vec<[Real; 2]>>>,
-    /// The finished section over one lead (from `window.0`).
-    #[serde(skip)]
+    /// The finished section over one lead (from `window.0`; empty when
+    /// read back from a report).
+    #[serde(skip, default = "no_section")]
     pub section: MultiPolygon<Real>,
     /// The lead's window of the section: its first z and the lead.
     #[serde(skip)]
@@ -165,14 +185,21 @@ impl WormCheck {
     }
 }
 
-fn poly(points: &[[Real; 2]]) -> Polygon<Real> {
+/// The section of a check read back from a report, which does not hold it.
+fn no_section() -> MultiPolygon<Real> {
+    MultiPolygon::new(Vec::new())
+}
+
+/// A polygon of `(z, r)` points.
+pub(super) fn poly(points: &[[Real; 2]]) -> Polygon<Real> {
     Polygon::new(
         LineString::from(points.iter().map(|p| (p[0], p[1])).collect::<Vec<_>>()),
         vec![],
     )
 }
 
-fn rect(z0: Real, z1: Real, r0: Real, r1: Real) -> Polygon<Real> {
+/// The rectangle `[z0, z1] x [r0, r1]`.
+pub(super) fn rect(z0: Real, z1: Real, r0: Real, r1: Real) -> Polygon<Real> {
     poly(&[[z0, r0], [z1, r0], [z1, r1], [z0, r1]])
 }
 
@@ -277,8 +304,26 @@ pub fn simulate(
     let mut chips = Vec::new();
     let mut lead_error: Real = 0.0;
     let x_axis = written.axes.iter().position(|a| a.name == "X");
+    // The carriage's servo (MATH §4.2): the machine's time constant and
+    // the spindle's speed as written.
+    let servo = machine
+        .info()
+        .constants
+        .get("servo_time_constant")
+        .copied()
+        .filter(|t| *t > 0.0)
+        .ok_or_else(|| {
+            fail(format!(
+                "machine {} states no servo_time_constant (s): the lead where the thread starts and ends cannot be checked",
+                machine.info().name
+            ))
+        })?;
+    let mut rpm = written.spindle_rpm;
     for i in 1..written.blocks.len() {
         let b = &written.blocks[i];
+        if let Some(s) = b.spindle {
+            rpm = s;
+        }
         let name = || block_name(&written, i);
         let ((r0, z0), (r1, z1e)) = (at(i - 1), at(i));
         let Motion::Thread { lead: l, start_deg } = b.motion else {
@@ -375,6 +420,43 @@ pub fn simulate(
                 name(), gouge, worst[0], 2.0 * worst[1], start + 1, tol.form
             )));
         }
+        // Where the cutting edges at the blank's radius meet the thread's
+        // near end and leave its far end: the servo's lead error there.
+        let [left, right] = cutter.extent_at(r_a - r1);
+        let (approach_mm, runout_mm) = if dir < 0.0 {
+            (z0 - left, -req.length - (z1e + right))
+        } else {
+            (-req.length - (z0 + right), z1e - left)
+        };
+        let v = l * rpm / 60.0;
+        let face_lead_error = super::approach_error(servo, v, approach_mm);
+        let end_lead_error = super::runout_error(servo, v, runout_mm);
+        for (what, e, length, minimum) in [
+            (
+                "where the leading cutting edge meets the worm's face",
+                face_lead_error,
+                approach_mm,
+                super::approach_length(servo, v, tol.lead),
+            ),
+            (
+                "where the trailing cutting edge leaves the thread's far end",
+                end_lead_error,
+                runout_mm,
+                super::runout_length(servo, v) * (1.0 - tol.lead),
+            ),
+        ] {
+            if e > tol.lead {
+                return Err(fail(format!(
+                    "{}: the lead is {:.2}% off {what} ({:.3} mm from the block's {}; at least {:.3} mm keeps it within the allowed {}%)",
+                    name(),
+                    100.0 * e,
+                    length,
+                    if length == approach_mm { "start" } else { "end" },
+                    minimum,
+                    100.0 * tol.lead
+                )));
+            }
+        }
         chips.push(
             chip.0
                 .iter()
@@ -392,6 +474,10 @@ pub fn simulate(
             left_area,
             right_area: chip_area - left_area,
             gouge,
+            approach_mm,
+            face_lead_error,
+            runout_mm,
+            end_lead_error,
         });
     }
     if passes.is_empty() {
