@@ -40,8 +40,10 @@ fn progress(quiet: bool) -> ProgressBar {
     bar
 }
 
-/// Runs the job; on any error nothing is written and the previous output
-/// directory is left as it was.
+/// Runs the job. A run that fails a check or its verification writes its
+/// diagnostic (report, page, plots, scene; no program) where
+/// [`pilgrim_kernel::output::failed_dir`] says; on any other error nothing
+/// is written and the previous output directory is left as it was.
 pub fn run(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
     let bar = progress(args.quiet);
     let next = |what: &str| {
@@ -107,8 +109,32 @@ pub fn run(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
         program_number: args.program_number,
         also_post: args.also_post.clone(),
     };
-    let out = job::run(&family, &machine, &sources, &options, &mut |s| next(s))
-        .map_err(|e| e.to_string())?;
+    let out = match job::run(&family, &machine, &sources, &options, &mut |s| next(s)) {
+        Ok(out) => out,
+        Err(pilgrim_kernel::Error::Failed(failed)) => {
+            // What failed is written where the user looks, marked FAILED
+            // and with no program; an earlier good output stays.
+            bar.finish_and_clear();
+            let message = failed.report.verdict.message();
+            let dir =
+                pilgrim_kernel::output::write_failed(&args.out, &failed.files).map_err(|e| {
+                    format!("{message}\nthe diagnostic report could not be written: {e}")
+                })?;
+            let kept = if dir != args.out {
+                format!(
+                    "; {} (the last run that succeeded) is as it was",
+                    args.out.display()
+                )
+            } else {
+                String::new()
+            };
+            return Err(format!(
+                "{message}\nthe run FAILED: no program was written; see {}{kept}",
+                dir.join("report.html").display()
+            ));
+        }
+        Err(e) => return Err(e.to_string()),
+    };
     next("writing");
     pilgrim_kernel::output::write_dir(&args.out, &out.files).map_err(|e| e.to_string())?;
     bar.finish_and_clear();

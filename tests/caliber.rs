@@ -301,7 +301,28 @@ fn the_four_axis_machine_reports_its_figure_and_refuses_what_it_cannot_do() {
         err.contains("verification failed") && err.contains(" in \"pass "),
         "{err}"
     );
-    assert!(!bad.exists());
+    // The failed run leaves what it found: the report marked FAILED with
+    // the figure and its place, the heat map and the section, the scene at
+    // the block that gouged; no program.
+    let r: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(bad.join("report.json")).unwrap()).unwrap();
+    assert_eq!(r["verdict"]["status"], "failed");
+    let failure = &r["verdict"]["failures"][0];
+    assert_eq!(r["pose_block"], failure["block_index"]);
+    assert!(failure["message"].as_str().unwrap().contains("gouge"));
+    for f in [
+        "deviation_map.svg",
+        "section.svg",
+        "scene.glb",
+        "report.html",
+    ] {
+        assert!(bad.join(f).is_file(), "{f}");
+    }
+    for f in ["program.mpf", "program.cld"] {
+        assert!(!bad.join(f).exists(), "{f}");
+    }
+    let page = std::fs::read_to_string(bad.join("report.html")).unwrap();
+    assert!(page.contains("FAILED: no program was written"));
 }
 
 /// A block moved 0.05 mm off its place in the program: the replay names
@@ -338,6 +359,7 @@ fn a_corrupted_block_is_named() {
     };
     let check = |p: &pilgrim_kernel::program::AxisProgram| {
         check_groove(p, &machine, &tp.tool.reference, &wheel, &tp.passes, &req)
+            .and_then(|c| c.verified())
     };
     let clean = check(&program).unwrap();
     assert!(clean.max_abs_mm < 0.5, "{clean:?}");

@@ -127,6 +127,10 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
     let report: serde_json::Value =
         serde_json::from_slice(&std::fs::read(a.join("report.json")).unwrap()).unwrap();
     assert_eq!(report["blocks"], 368);
+    // The demo declares no verification, and its page says so first.
+    assert_eq!(report["verdict"]["status"], "not_verified");
+    let page = std::fs::read_to_string(a.join("report.html")).unwrap();
+    assert!(page.contains("<b>NOT VERIFIED: the family declares no verification"));
     assert_eq!(report["parameters"]["radius"]["value"], 40.0);
     // The disc and the cutter, placed at the middle of the last cutting pass
     // (the contour, blocks 6..=366 at C = 0..=360 deg, after the machine's

@@ -214,6 +214,42 @@ fn bad_mandrel_parameters_are_refused_and_nothing_is_written() {
         err.contains("(pass 4, stock 0.0 um: 5.0125 mm per revolution, a ridge of 0.15766 mm)"),
         "{err}"
     );
+    // What failed is written beside the good output, which stays: marked
+    // FAILED, the deviation plots and the scene at the block that left the
+    // worst place, no program; the next good run removes it.
+    let failed = dir.join("out.failed");
+    assert!(
+        err.contains(&format!("see {}", failed.join("report.html").display()))
+            && err.contains("(the last run that succeeded) is as it was"),
+        "{err}"
+    );
+    let r: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(failed.join("report.json")).unwrap()).unwrap();
+    assert_eq!(r["verdict"]["status"], "failed");
+    let at = r["verdict"]["failures"][0]["block_index"].clone();
+    assert!(
+        at.as_u64().is_some() && r["pose_block"] == at,
+        "{}",
+        r["verdict"]
+    );
+    for f in [
+        "deviation.svg",
+        "finish.svg",
+        "profile.svg",
+        "scene.glb",
+        "wheel.stl",
+    ] {
+        assert!(failed.join(f).is_file(), "{f}");
+    }
+    assert!(!failed.join("program.mpf").exists() && !failed.join("program.cld").exists());
+    let page = std::fs::read_to_string(failed.join("report.html")).unwrap();
+    assert!(page.contains("FAILED: no program was written") && page.contains("strays"));
+    let (code, err) = run(&[]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        !failed.exists(),
+        "the stale diagnostic stays beside a good output"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -285,6 +321,7 @@ fn job(
             (v.from, v.to),
             v.tolerance,
         )
+        .and_then(|c| c.verified(program))
         .map_err(|e| e.to_string())
     };
     (tp, program, check)
@@ -451,6 +488,19 @@ fn step_solids_and_page_are_the_runs() {
         serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
     let tol = report["step_tolerance_mm"].as_f64().unwrap();
     assert_eq!(tol, 1e-3);
+    // The page opens with the verdict: passed, the finish as a share of
+    // its tolerance.
+    let verdict = &report["verdict"];
+    assert_eq!(verdict["status"], "passed");
+    let finish = &verdict["figures"][0];
+    let share = finish["value"].as_f64().unwrap().abs() / finish["tolerance"].as_f64().unwrap();
+    assert!(share > 0.5 && share <= 1.0, "{finish}");
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(page.contains("<b>PASSED: every check and figure held</b>"));
+    assert!(
+        page.contains(&format!("{:.1}%", 100.0 * share)),
+        "no share on the page"
+    );
     let solid = |name: &str| {
         report["solids"]
             .as_array()

@@ -349,7 +349,7 @@ fn caliber_grinders_load_as_compiled_in() {
 
 /// A plugin that posts its own programs is held to them: what it writes
 /// is linted like the kernel's, and a program that is not the axis
-/// program fails the run, naming the place, with nothing written.
+/// program fails the run, naming the place, with no program written.
 #[test]
 fn a_plugins_own_program_is_linted() {
     let dir = common::scratch("plugins", "own-post");
@@ -385,5 +385,8 @@ fn toolpath(p) {
             && err.contains("line 1: '%' is not a block the lint can account for"),
         "{err}"
     );
-    assert!(!out.exists());
+    // What failed is in the output, marked FAILED; no program is.
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(page.contains("FAILED") && page.contains("lint of the fanuc program"));
+    assert!(!out.join("program.nc").exists() && !out.join("program.cld").exists());
 }

@@ -158,7 +158,9 @@ fn simulate_nc(
             lead: 0.01,
         },
     };
-    simulate(&program, &lathe(), &Default::default(), &cutter(dir), &req).map_err(|e| e.to_string())
+    simulate(&program, &lathe(), &Default::default(), &cutter(dir), &req)
+        .and_then(|c| c.verified())
+        .map_err(|e| e.to_string())
 }
 
 /// The simulation read back from the program: every chip summed is the
@@ -592,11 +594,18 @@ fn the_linuxcnc_program_is_left_for_its_interpreter() {
     common::leave_for_rs274(&out, "worm");
 }
 
-/// Bad input: each a clear message, and no output for the errors; S1
+/// Bad input: each a clear message; no output for the errors, and for a
+/// failed check or verification the FAILED report and no program; S1
 /// below its minimum a warning naming the lead error.
 #[test]
 fn bad_input_is_refused_with_no_output() {
     let dir = scratch("worm", "bad");
+    // The cases whose run fails a check or its verification: they leave
+    // their diagnostic.
+    let failed = [
+        "tip_width=5",
+        "m=0.1 z1=1 nose_r=0.01 a_min=0.01 finish_depth=0.01",
+    ];
     for (set, says) in [
         ("z1=0", "z1"),
         ("m=-1", "m"),
@@ -627,7 +636,19 @@ fn bad_input_is_refused_with_no_output() {
         let (code, _, err) = pilgrim(&args);
         assert_ne!(code, 0, "{set}");
         assert!(err.contains(says), "{set}: {err}");
-        assert!(!out.exists(), "{set}: output written");
+        if failed.contains(&set) {
+            let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+            assert!(page.contains("FAILED: no program was written"), "{set}");
+            let r = report(&out);
+            assert!(
+                r["verdict"]["failures"][0]["message"].as_str().unwrap().contains(says),
+                "{set}: {}",
+                r["verdict"]
+            );
+            assert!(!out.join("program.nc").exists() && !out.join("program.cld").exists());
+        } else {
+            assert!(!out.exists(), "{set}: output written");
+        }
     }
     assert!(pilgrim(&[
         "run",

@@ -46,14 +46,6 @@ pub enum Error {
     /// The part family's failure (a script's error, with its place).
     #[error(transparent)]
     Family(#[from] FamilyError),
-    /// The family's checks failed.
-    #[error("{family}: checks failed: {failed}")]
-    Checks {
-        /// The family.
-        family: String,
-        /// Each failed check, with its details.
-        failed: String,
-    },
     /// A toolpath that cannot become a program on the machine.
     #[error(transparent)]
     Program(#[from] ProgramError),
@@ -109,4 +101,8 @@ pub enum Error {
     /// An output that cannot be made.
     #[error("{0}")]
     Output(String),
+    /// The run failed a check, a rule of the process or its verification:
+    /// what it found, to write where the user looks (no program).
+    #[error("{}", .0.report.verdict.message())]
+    Failed(Box<crate::job::FailedRun>),
 }

@@ -64,6 +64,7 @@ pub mod step;
 pub mod tool;
 pub mod toolpath;
 pub mod transform;
+pub mod verdict;
 pub mod verify;
 pub mod worm;
 

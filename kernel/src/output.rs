@@ -34,11 +34,20 @@ fn err(path: &Path, message: impl Into<String>) -> OutputError {
     }
 }
 
-/// The marker's text: what wrote the directory, and its files.
-fn marker_text(files: &[&str]) -> String {
+/// What a FAILED run's marker says on its first line.
+const FAILED_RUN: &str = "of a FAILED run (no program)";
+
+/// The marker's text: what wrote the directory (a run, or a failed run),
+/// and its files.
+fn marker_text(files: &[&str], failed: bool) -> String {
     let mut s = format!(
-        "pilgrim {} output directory: the next run to it replaces it as a whole.\n",
-        crate::VERSION
+        "pilgrim {} output directory{}: the next run to it replaces it as a whole.\n",
+        crate::VERSION,
+        if failed {
+            format!(" {FAILED_RUN}")
+        } else {
+            String::new()
+        }
     );
     for f in files {
         s.push_str(f);
@@ -199,13 +208,65 @@ fn exchange(_: &Path, _: &Path) -> std::io::Result<bool> {
     Ok(false)
 }
 
+/// Whether `dir` holds a pilgrim output of a run that succeeded: its
+/// marker is there and does not say the run failed.
+pub fn holds_good_output(dir: &Path) -> bool {
+    std::fs::read_to_string(dir.join(MARKER))
+        .is_ok_and(|m| m.lines().next().is_some_and(|l| !l.contains(FAILED_RUN)))
+}
+
+/// Where a failed run's diagnostic goes when it was asked to write into
+/// `out`: `out` itself, unless `out` holds the output of a run that
+/// succeeded, which stays as it is: then `<out>.failed` beside it. The two
+/// are never confused: a failed run's marker, report and page say FAILED,
+/// and it holds no program.
+pub fn failed_dir(out: &Path) -> PathBuf {
+    if holds_good_output(out) {
+        let mut name = out.file_name().unwrap_or_default().to_os_string();
+        name.push(".failed");
+        out.with_file_name(name)
+    } else {
+        out.to_owned()
+    }
+}
+
+/// Writes a failed run's `files` (its diagnostic: no program) where
+/// [`failed_dir`] says, as [`write_dir`] writes; the directory written.
+///
+/// # Failures
+/// As [`write_dir`].
+pub fn write_failed(out: &Path, files: &[(String, Vec<u8>)]) -> Result<PathBuf, OutputError> {
+    let dir = failed_dir(out);
+    write_marked(&dir, files, true)?;
+    Ok(dir)
+}
+
 /// Writes `files` as the directory `out`, replacing a previous pilgrim
-/// output there. See the [module docs](self).
+/// output there, and removes the diagnostic a failed run left beside it
+/// (`<out>.failed`, if pilgrim wrote it and it says so). See the [module
+/// docs](self).
 ///
 /// # Failures
 /// [`check_replaceable`]'s; a file name that is not a plain name; a write
 /// or rename failing (the target is then as it was).
 pub fn write_dir(out: &Path, files: &[(String, Vec<u8>)]) -> Result<(), OutputError> {
+    write_marked(out, files, false)?;
+    let mut name = out.file_name().unwrap_or_default().to_os_string();
+    name.push(".failed");
+    let stale = out.with_file_name(name);
+    let failed_marker = std::fs::read_to_string(stale.join(MARKER))
+        .is_ok_and(|m| m.lines().next().is_some_and(|l| l.contains(FAILED_RUN)));
+    if failed_marker
+        && std::fs::symlink_metadata(&stale).is_ok_and(|m| m.is_dir())
+        && check_replaceable(&stale).is_ok()
+    {
+        let _ = std::fs::remove_dir_all(&stale);
+    }
+    Ok(())
+}
+
+/// [`write_dir`]'s writing, the marker saying whether the run failed.
+fn write_marked(out: &Path, files: &[(String, Vec<u8>)], failed: bool) -> Result<(), OutputError> {
     let parent = match out.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
         _ => PathBuf::from("."),
@@ -226,7 +287,7 @@ pub fn write_dir(out: &Path, files: &[(String, Vec<u8>)]) -> Result<(), OutputEr
     let result = (|| {
         std::fs::create_dir(&tmp).map_err(|e| err(&tmp, e.to_string()))?;
         let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
-        std::fs::write(tmp.join(MARKER), marker_text(&names))
+        std::fs::write(tmp.join(MARKER), marker_text(&names, failed))
             .map_err(|e| err(&tmp, e.to_string()))?;
         for (name, bytes) in files {
             let p = tmp.join(name);
@@ -286,7 +347,8 @@ pub fn update_dir(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<(), OutputE
     }
     let refs: Vec<&str> = names.iter().map(String::as_str).collect();
     let tmp = dir.join(format!("{MARKER}.tmp-{}", std::process::id()));
-    std::fs::write(&tmp, marker_text(&refs)).map_err(|e| err(&tmp, e.to_string()))?;
+    let failed = !holds_good_output(dir);
+    std::fs::write(&tmp, marker_text(&refs, failed)).map_err(|e| err(&tmp, e.to_string()))?;
     std::fs::rename(&tmp, dir.join(MARKER)).map_err(|e| err(dir, e.to_string()))
 }
 

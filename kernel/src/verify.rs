@@ -20,6 +20,7 @@ use crate::program::{axis_rows, AxisProgram};
 use crate::tool::Wheel;
 use crate::toolpath::Pass;
 use crate::transform::ToolFrame;
+use crate::verdict::{Figure, Finding};
 use serde::{Deserialize, Serialize};
 
 /// Why a program could not be verified, or failed verification.
@@ -300,10 +301,10 @@ pub fn as_written(program: &AxisProgram) -> (AxisProgram, Real) {
 ///
 /// # Failures
 /// A tolerance finer than twice the program's resolution; the replay
-/// failing; a pass that does not cover the range; the finishing pass
-/// straying more than `tolerance` from the nominal
-/// ([`VerifyError::Deviation`], naming the deviation, its z, the block and
-/// the pass with its feed).
+/// failing; a pass that does not cover the range; no cutting pass. The
+/// finishing pass straying more than `tolerance` from the nominal is the
+/// check's own finding ([`GrindingCheck::failure`], naming the deviation,
+/// its z, the block and the pass with its feed).
 #[allow(clippy::too_many_arguments)]
 pub fn check_grinding(
     program: &AxisProgram,
@@ -505,10 +506,20 @@ pub fn check_grinding(
             along_z: bucketed(&zs, &lo, &hi, PROFILE_BUCKETS),
         });
     }
-    let finish = out.passes.last().ok_or(VerifyError::NoCuttingPass)?;
-    let d = finish.deviation;
-    if d.max_abs > tolerance {
-        return Err(VerifyError::Deviation {
+    if out.passes.is_empty() {
+        return Err(VerifyError::NoCuttingPass);
+    }
+    Ok(out)
+}
+
+impl GrindingCheck {
+    /// The finishing pass's failure, if it strays more than the tolerance
+    /// from the nominal ([`VerifyError::Deviation`], its block named as
+    /// `program`, the one replayed, numbers it).
+    pub fn failure(&self, program: &AxisProgram) -> Option<VerifyError> {
+        let finish = self.passes.last()?;
+        let d = finish.deviation;
+        (d.max_abs > self.tolerance).then(|| VerifyError::Deviation {
             deviation: if d.max_above.abs() >= d.max_below.abs() {
                 d.max_above
             } else {
@@ -519,10 +530,54 @@ pub fn check_grinding(
             pass: finish.name.clone(),
             feed_per_rev: finish.feed_per_rev_mm,
             ridge: finish.ridge_mm,
-            tolerance,
-        });
+            tolerance: self.tolerance,
+        })
     }
-    Ok(out)
+
+    /// The check, or its failure as an error.
+    ///
+    /// # Failures
+    /// [`Self::failure`].
+    pub fn verified(self, program: &AxisProgram) -> Result<Self, VerifyError> {
+        match self.failure(program) {
+            Some(e) => Err(e),
+            None => Ok(self),
+        }
+    }
+
+    /// The finish's figure against the tolerance, and its failure.
+    pub fn findings(&self, program: &AxisProgram) -> (Vec<Figure>, Vec<Finding>) {
+        let Some(finish) = self.passes.last() else {
+            return (Vec::new(), Vec::new());
+        };
+        let d = finish.deviation;
+        let value = if d.max_above.abs() >= d.max_below.abs() {
+            d.max_above
+        } else {
+            d.max_below
+        };
+        let block = d.block.map(|b| crate::program::block_name(program, b - 1));
+        let place = format!(
+            "z = {} mm{}",
+            crate::math::fixed(d.at_z, 3),
+            block.as_ref().map_or(String::new(), |b| format!(", {b}"))
+        );
+        let figure = Figure::new(
+            &format!("{}: the surface from the nominal", finish.name),
+            value,
+            self.tolerance,
+            "mm",
+            place,
+        );
+        let failure = self.failure(program).map(|e| {
+            let f = Finding::new("verification", e.to_string());
+            match d.block {
+                Some(b) => f.at(b - 1, crate::program::block_name(program, b - 1)),
+                None => f,
+            }
+        });
+        (vec![figure], failure.into_iter().collect())
+    }
 }
 
 #[cfg(test)]

@@ -281,6 +281,16 @@ fn a_failed_check_stops_the_job() {
     .unwrap_err();
     assert_eq!(
         e.to_string(),
-        "mill_circle (Rust): checks failed: enough points for the circle ()"
+        "mill_circle (Rust): check failed: enough points for the circle ()"
     );
+    // Failure is a state of the product: the report says which check, with
+    // every parameter, marked FAILED, and there is no program.
+    let pilgrim_kernel::Error::Failed(run) = e else {
+        panic!("a failed run")
+    };
+    assert!(run.report.verdict.failed());
+    let names: Vec<&str> = run.files.iter().map(|f| f.0.as_str()).collect();
+    assert_eq!(names, ["report.html", "report.json"]);
+    let page = String::from_utf8(run.files[0].1.clone()).unwrap();
+    assert!(page.contains("FAILED") && page.contains("enough points for the circle"));
 }

@@ -29,6 +29,7 @@ use crate::program::{axis_rows, block_name, pass_blocks, AxisProgram};
 use crate::tool::Wheel;
 use crate::toolpath::Pass;
 use crate::transform::ToolFrame;
+use crate::verdict::{Figure, Finding};
 use crate::verify::{as_written, VerifyError};
 use serde::{Deserialize, Serialize};
 
@@ -75,6 +76,9 @@ pub struct GroovePlace {
     pub psi_deg: Real,
     /// The block, as the program names it.
     pub block: String,
+    /// The block (from 1, the program's and `report.csv`'s count).
+    #[serde(default)]
+    pub block_index: usize,
 }
 
 /// The region of the groove within a small distance of the wheel at one
@@ -355,8 +359,9 @@ fn nearest(list: &[Sample], q: &Vec3, theta: Real) -> (Real, usize) {
 ///
 /// # Failures
 /// A tolerance finer than twice the program's resolution; the replay
-/// failing; too large a grid; the finished groove straying more than the
-/// tolerance ([`VerifyError::Groove`], naming the block, theta and psi).
+/// failing; too large a grid. The finished groove straying more than the
+/// tolerance is the check's own finding ([`GrooveCheck::failure`], naming
+/// the block, theta and psi).
 pub fn check_groove(
     program: &AxisProgram,
     machine: &dyn MachineKinematics,
@@ -478,6 +483,7 @@ pub fn check_groove(
             theta_deg: thetas[i].to_degrees(),
             psi_deg: psi_grid[j].0.to_degrees(),
             block: block_name(program, dist[idx].1),
+            block_index: dist[idx].1 + 1,
         }
     };
     let (mut left, mut gouge) = (0, 0);
@@ -514,21 +520,81 @@ pub fn check_groove(
             &dist.iter().map(|d| d.0).collect::<Vec<_>>(),
         ),
     };
-    if max_abs > req.tolerance {
-        let worst = if check.max_left.mm >= -check.max_gouge.mm {
-            &check.max_left
+    Ok(check)
+}
+
+impl GrooveCheck {
+    /// The larger of the most material left and the deepest gouge.
+    fn worst(&self) -> &GroovePlace {
+        if self.max_left.mm >= -self.max_gouge.mm {
+            &self.max_left
         } else {
-            &check.max_gouge
-        };
-        return Err(VerifyError::Groove {
+            &self.max_gouge
+        }
+    }
+
+    /// The groove's failure, if it strays more than the tolerance from the
+    /// nominal ([`VerifyError::Groove`]).
+    pub fn failure(&self) -> Option<VerifyError> {
+        let worst = self.worst();
+        (self.max_abs_mm > self.tolerance).then(|| VerifyError::Groove {
             deviation: worst.mm,
             theta_deg: worst.theta_deg,
             psi_deg: worst.psi_deg,
             block: worst.block.clone(),
-            tolerance: req.tolerance,
-        });
+            tolerance: self.tolerance,
+        })
     }
-    Ok(check)
+
+    /// The check, or its failure as an error.
+    ///
+    /// # Failures
+    /// [`Self::failure`].
+    pub fn verified(self) -> Result<Self, VerifyError> {
+        match self.failure() {
+            Some(e) => Err(e),
+            None => Ok(self),
+        }
+    }
+
+    /// The most material left and the deepest gouge against the
+    /// tolerance, and the failure.
+    pub fn findings(&self) -> (Vec<Figure>, Vec<Finding>) {
+        let place = |p: &GroovePlace| {
+            format!(
+                "theta {} deg, psi {} deg, {}",
+                crate::math::fixed(p.theta_deg, 2),
+                crate::math::fixed(p.psi_deg, 2),
+                p.block
+            )
+        };
+        let figures = vec![
+            Figure::new(
+                "the groove: most material left",
+                self.max_left.mm,
+                self.tolerance,
+                "mm",
+                place(&self.max_left),
+            ),
+            Figure::new(
+                "the groove: deepest gouge",
+                self.max_gouge.mm,
+                self.tolerance,
+                "mm",
+                place(&self.max_gouge),
+            ),
+        ];
+        let worst = self.worst();
+        let failures = self
+            .failure()
+            .map(|e| {
+                Finding::new("verification", e.to_string())
+                    .at(worst.block_index.saturating_sub(1), worst.block.clone())
+            })
+            .into_iter()
+            .collect();
+        (figures, failures)
+    }
 }
 
 /// The contact patch at block `block` (from 0) of `program` (as written):

@@ -31,10 +31,11 @@ use crate::catalog::OpenMachine;
 use crate::error::Error;
 use crate::family::{PartFamily, PartGeometry, Verification};
 use crate::params::{resolve, ParamSource, ParamValue, Params};
-use crate::program::post::{dialect, Dialect, CLD};
+use crate::program::post::{dialect, CLD};
 use crate::program::{build, AxisProgram};
 use crate::tool::ToolShape;
 use crate::toolpath::Toolpath;
+use crate::verdict::{Finding, Verdict};
 use crate::verify::{check_grinding, GrindingCheck};
 use serde::Serialize;
 
@@ -191,13 +192,13 @@ fn report_json(report: &Report) -> Result<Vec<u8>, Error> {
 /// Posts `program` in the control's dialect, as a CL file and in the
 /// dialects `also` names, and lints each ([`crate::program::lint`]):
 /// nothing is kept that does not read back as the axis program. The
-/// control's dialect, and the programs as files (name, bytes) in that order.
+/// programs as files (name, bytes) in that order.
 fn post_all(
     machine: &OpenMachine,
     info: &crate::machine::MachineInfo,
     program: &AxisProgram,
     also: &[String],
-) -> Result<(&'static Dialect, scene::Files), Error> {
+) -> Result<scene::Files, Error> {
     let control = dialect(&info.control).ok_or_else(|| Error::UnknownControl {
         machine: info.name.clone(),
         control: info.control.clone(),
@@ -224,7 +225,41 @@ fn post_all(
         crate::program::lint::lint(&text, program, d, &info.axes)?;
         files.push((format!("program.{}", d.extension), text.into_bytes()));
     }
-    Ok((control, files))
+    Ok(files)
+}
+
+/// What a failed run leaves to look at: its report marked FAILED (with
+/// the verdict: what failed, where, and every figure), `report.html`, the
+/// plots and the scene at the place it failed, the data files; no program
+/// a control could load. [`Error::Failed`] carries it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FailedRun {
+    /// The report.
+    pub report: Report,
+    /// Every file's name and bytes.
+    pub files: Vec<(String, Vec<u8>)>,
+}
+
+/// The failed run of `report` with the `files` made so far: the page and
+/// `report.json` added.
+fn failed_run(
+    mut report: Report,
+    mut files: Vec<(String, Vec<u8>)>,
+    part_box: Option<([f64; 3], [f64; 3])>,
+) -> Error {
+    report.files = files
+        .iter()
+        .map(|f| f.0.clone())
+        .chain(["report.html".to_owned(), "report.json".to_owned()])
+        .collect();
+    let control = dialect(&report.control).map_or("", |d| d.extension);
+    let html = page::page_of(&report, &files, control, part_box);
+    files.push(("report.html".into(), html.into_bytes()));
+    match report_json(&report) {
+        Ok(json) => files.push(("report.json".into(), json)),
+        Err(e) => return e,
+    }
+    Error::Failed(Box::new(FailedRun { report, files }))
 }
 
 /// The run's data files, made of the toolpath and the program alone:
@@ -292,16 +327,22 @@ pub fn run(
             })?;
         }
     }
-    let failed: Vec<String> = checks
+    let failed: Vec<Finding> = checks
         .iter()
         .filter(|c| !c.ok)
-        .map(|c| format!("{} ({})", c.name, c.detail))
+        .map(|c| {
+            Finding::new(
+                "the family's checks",
+                format!("{}: check failed: {} ({})", family.name(), c.name, c.detail),
+            )
+        })
         .collect();
     if !failed.is_empty() {
-        return Err(Error::Checks {
-            family: family.name().to_owned(),
-            failed: failed.join("; "),
-        });
+        // Nothing to replay or draw: the report says which checks failed,
+        // with every parameter.
+        let mut report = Report::of_run(family, machine, info, &values, checks);
+        report.verdict = Verdict::of(false, failed, Vec::new(), Vec::new());
+        return Err(failed_run(report, Vec::new(), None));
     }
     stage(STAGES[1]);
     let toolpath = family.toolpath(&values)?;
@@ -309,12 +350,10 @@ pub fn run(
     let mut program = build(&toolpath, kin, &options.program_name)?;
     program.number = options.program_number.unwrap_or(0);
     let requested = family.verification(&values)?;
-    let pose_place = match options.pose_block {
-        Some(0) => return Err(Error::Options("--pose-block counts blocks from 1".into())),
-        Some(n) => scene::PosePlace::at_end(n - 1),
-        None => default_pose_block(&program, &toolpath.passes),
-    };
-    let pose_index = pose_place.block;
+    let requested_any = requested.is_some();
+    if options.pose_block == Some(0) {
+        return Err(Error::Options("--pose-block counts blocks from 1".into()));
+    }
     let needs_wheel = || {
         Error::Family(crate::family::FamilyError::Contract {
             family: family.name().to_owned(),
@@ -346,35 +385,21 @@ pub fn run(
             )?)
         }
     };
-    // The caliber's replay, and its contact patch at the pose block (in
-    // the report, and its mesh in the scene).
-    let (groove, patch_mesh) = match &groove_request {
-        None => (None, None),
+    // The caliber's replay.
+    let mut groove = match &groove_request {
+        None => None,
         Some(g) => {
             let ToolShape::Wheel(wheel) = toolpath.tool.shape else {
                 return Err(needs_wheel());
             };
-            let mut check = crate::caliber::check_groove(
+            Some(crate::caliber::check_groove(
                 &program,
                 kin,
                 &toolpath.tool.reference,
                 &wheel,
                 &toolpath.passes,
                 g,
-            )?;
-            let patch = crate::caliber::contact_patch(
-                &crate::verify::as_written(&program).0,
-                kin,
-                &toolpath.tool.reference,
-                &wheel,
-                g,
-                pose_index,
-            )?;
-            let mesh = patch.map(|(p, m)| {
-                check.patch = Some(p);
-                m
-            });
-            (Some(check), mesh)
+            )?)
         }
     };
     let verification = match &nominal {
@@ -396,18 +421,85 @@ pub fn run(
             )?)
         }
     };
+    // What the verification found: its figures, and what failed.
+    let mut figures = Vec::new();
+    let mut failures = Vec::new();
+    for (f, x) in [
+        verification.as_ref().map(|v| v.findings(&program)),
+        groove.as_ref().map(|g| g.findings()),
+        worm.as_ref().map(|w| w.findings()),
+    ]
+    .into_iter()
+    .flatten()
+    {
+        figures.extend(f);
+        failures.extend(x);
+    }
+    let warnings: Vec<Finding> = toolpath
+        .warnings
+        .iter()
+        .map(|w| Finding::new("the family", w.clone()))
+        .collect();
+    // The scene shows the tool where asked; a failed run's, where it
+    // failed; else the middle of the last cutting pass.
+    let pose_place = match (
+        options.pose_block,
+        failures.iter().find_map(|f| f.block_index),
+    ) {
+        (Some(n), _) => scene::PosePlace::at_end(n - 1),
+        (None, Some(b)) => scene::PosePlace::at_end(b - 1),
+        (None, None) => default_pose_block(&program, &toolpath.passes),
+    };
+    let pose_index = pose_place.block;
+    // The caliber's contact patch at the scene's block (in the report, and
+    // its mesh in the scene).
+    let patch_mesh = match (&mut groove, &groove_request, toolpath.tool.shape) {
+        (Some(check), Some(g), ToolShape::Wheel(wheel)) => crate::caliber::contact_patch(
+            &crate::verify::as_written(&program).0,
+            kin,
+            &toolpath.tool.reference,
+            &wheel,
+            g,
+            pose_index,
+        )?
+        .map(|(p, m)| {
+            check.patch = Some(p);
+            m
+        }),
+        _ => None,
+    };
     stage(STAGES[3]);
     // The data files need only the toolpath and the program: a second
-    // thread writes them while this one posts and lints.
+    // thread writes them while this one posts and lints. A run that failed
+    // writes no program a control could load.
+    let failed_already = !failures.is_empty();
     let (data, posted) = std::thread::scope(|s| {
         let data = s.spawn(|| data_files(&toolpath, &program));
-        let posted = post_all(machine, info, &program, &options.also_post);
+        let posted = if failed_already {
+            Ok(Vec::new())
+        } else {
+            post_all(machine, info, &program, &options.also_post)
+        };
         let data = data
             .join()
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
         (data, posted)
     });
-    let (control, programs) = posted?;
+    let programs = match posted {
+        Ok(p) => p,
+        // A program that does not read back as the axis program (a
+        // plugin's own post, a block its dialect cannot write): no
+        // program, the report says why.
+        Err(e @ (Error::Lint(_) | Error::Post(_))) => {
+            failures.push(Finding::new("the program's text", e.to_string()));
+            Vec::new()
+        }
+        Err(e) => return Err(e),
+    };
+    let control = dialect(&info.control).ok_or_else(|| Error::UnknownControl {
+        machine: info.name.clone(),
+        control: info.control.clone(),
+    })?;
     let [toolpath_json, program_json, csv] = data?;
     let mut files: Vec<(String, Vec<u8>)> = vec![
         ("toolpath.json".into(), toolpath_json),
@@ -468,30 +560,19 @@ pub fn run(
         let (mesh_files, bodies) =
             scene::files(&meshes, tool, pose.pose, others, overlays, options.formats)?;
         files.extend(mesh_files);
-        let (step_files, solids) =
-            solids::step_files(&parts, &toolpath.tool, &pose, options.step_tolerance)?;
-        files.extend(step_files);
+        // A failed run's scene shows where it failed; its exact solids,
+        // for checking a program in CAD, would check none.
+        let solids = if failures.is_empty() {
+            let (step_files, solids) =
+                solids::step_files(&parts, &toolpath.tool, &pose, options.step_tolerance)?;
+            files.extend(step_files);
+            solids
+        } else {
+            Vec::new()
+        };
         (Some(index + 1), bodies, solids, part_box)
     };
     let mut report = Report {
-        pilgrim: crate::VERSION.into(),
-        script: family.name().to_owned(),
-        machine: info.name.clone(),
-        machine_spec: machine.spec.clone(),
-        control: info.control.clone(),
-        parameters: family
-            .params()
-            .iter()
-            .map(|s| {
-                (
-                    s.name.clone(),
-                    ReportParam {
-                        value: values[&s.name].clone(),
-                        unit: s.unit.clone(),
-                    },
-                )
-            })
-            .collect(),
         passes: toolpath.passes.len(),
         cutting_passes: toolpath.passes.iter().filter(|p| p.cuts()).count(),
         points: toolpath.point_count(),
@@ -502,7 +583,6 @@ pub fn run(
             .map(|f| f.0.clone())
             .chain(["report.json".to_owned()])
             .collect(),
-        checks,
         pose_block,
         pose_along: pose_block.map_or(1.0, |_| pose_place.along),
         mesh_tolerance_mm: tol,
@@ -516,6 +596,8 @@ pub fn run(
         warnings: toolpath.warnings.clone(),
         notes: toolpath.notes.clone(),
         tables: toolpath.tables.clone(),
+        verdict: Verdict::of(requested_any, failures, warnings, figures),
+        ..Report::of_run(family, machine, info, &values, checks)
     };
     if let Some(w) = &worm {
         // The simulated areas beside the plan's, row for row, where the
@@ -616,6 +698,9 @@ pub fn run(
             files.push((name.into(), text.into_bytes()));
             report.files.push(name.into());
         }
+    }
+    if report.verdict.failed() {
+        return Err(failed_run(report, files, part_box));
     }
     report.files.push("report.html".into());
     let html = page::page_of(&report, &files, control.extension, part_box);

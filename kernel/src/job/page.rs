@@ -188,6 +188,77 @@ fn verification(out: &mut String, r: &Report) {
     }
 }
 
+/// The verdict at the top of the page: passed (each figure as a share of
+/// its tolerance), failed (what, where, and that no program was written)
+/// or not verified (the family declares no verification).
+fn banner(out: &mut String, r: &Report) {
+    use crate::verdict::Status;
+    let v = &r.verdict;
+    let (class, head) = match v.status {
+        Status::Passed => ("passed", "PASSED: every check and figure held"),
+        Status::Failed => ("failed", "FAILED: no program was written"),
+        Status::NotVerified => (
+            "unverified",
+            "NOT VERIFIED: the family declares no verification, so nothing says this program makes the part",
+        ),
+    };
+    let _ = writeln!(
+        out,
+        "<div class=\"banner {class}\" id=\"verdict\"><b>{head}</b>"
+    );
+    if !v.failures.is_empty() {
+        out.push_str("<ul>\n");
+        for f in &v.failures {
+            let _ = writeln!(
+                out,
+                "<li><b>{}</b>{}: {}</li>",
+                escape(&f.rule),
+                f.block
+                    .as_ref()
+                    .map_or(String::new(), |b| format!(" at {}", escape(b))),
+                escape(&f.message)
+            );
+        }
+        out.push_str("</ul>\n");
+    }
+    if !v.figures.is_empty() {
+        out.push_str("<table><tr><th>figure</th><th>value</th><th>tolerance</th><th>of the tolerance</th><th>where</th></tr>\n");
+        for f in &v.figures {
+            row(
+                out,
+                &[
+                    escape(&f.name),
+                    format!("{} {}", fixed(f.value, 5), escape(&f.unit)),
+                    format!("{} {}", fixed(f.tolerance, 5), escape(&f.unit)),
+                    format!(
+                        "{}{}%",
+                        if f.holds() { "" } else { "FAILED " },
+                        fixed(100.0 * f.share(), 1)
+                    ),
+                    escape(&f.place),
+                ],
+            );
+        }
+        out.push_str("</table>\n");
+    }
+    if !v.warnings.is_empty() {
+        out.push_str("<ul class=\"warn\">\n");
+        for w in &v.warnings {
+            let _ = writeln!(
+                out,
+                "<li>warning ({}){}: {}</li>",
+                escape(&w.rule),
+                w.block
+                    .as_ref()
+                    .map_or(String::new(), |b| format!(" at {}", escape(b))),
+                escape(&w.message)
+            );
+        }
+        out.push_str("</ul>\n");
+    }
+    out.push_str("</div>\n");
+}
+
 /// The page's text.
 pub fn report_html(inputs: &PageInputs<'_>) -> String {
     let r = inputs.report;
@@ -195,7 +266,12 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
     let mut out = String::with_capacity(
         MODEL_VIEWER.len() + inputs.scene.map_or(0, |s| s.0.len() * 4 / 3) + 200_000,
     );
-    let title = format!("pilgrim: {} on {}", r.script, r.machine);
+    let title = format!(
+        "pilgrim: {} on {}{}",
+        r.script,
+        r.machine,
+        if r.verdict.failed() { " (FAILED)" } else { "" }
+    );
     let _ = write!(
         out,
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n<style>\n{}</style>\n</head>\n<body>\n<h1>{}</h1>\n",
@@ -210,6 +286,7 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
         escape(&r.control),
         escape(&r.machine_spec)
     );
+    banner(&mut out, r);
     out.push_str("<h2>Summary</h2>\n<table>\n");
     for (k, v) in [
         (
@@ -296,13 +373,17 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
     }
     let (file, text) = inputs.program;
     let lines: Vec<&str> = text.lines().collect();
-    let _ = writeln!(
-        out,
-        "<h2>Program: {} ({} lines)</h2>",
-        escape(file),
-        lines.len()
-    );
-    out.push_str("<pre>");
+    if r.verdict.failed() {
+        out.push_str("<h2>Program</h2>\n<p>None: the run failed, and writes no program a control could load (<code>program.json</code> and <code>report.csv</code> hold the axis program it would have been).</p>\n<pre>");
+    } else {
+        let _ = writeln!(
+            out,
+            "<h2>Program: {} ({} lines)</h2>",
+            escape(file),
+            lines.len()
+        );
+        out.push_str("<pre>");
+    }
     if lines.len() <= HEAD_LINES + TAIL_LINES {
         out.push_str(&escape(text));
     } else {
@@ -385,6 +466,10 @@ h1 { font-size: 22px; margin-bottom: 2px; }
 h2 { font-size: 17px; margin-top: 28px; border-bottom: 1px solid #ccd; }
 .sub { color: #556; margin-top: 0; }
 .verdict { font-size: 15px; }
+.banner { border: 2px solid; border-radius: 6px; padding: 8px 12px; margin: 12px 0; }
+.banner.passed { border-color: #2e7d32; background: #edf7ee; }
+.banner.failed { border-color: #c62828; background: #fdecea; }
+.banner.unverified { border-color: #b26a00; background: #fff4e0; }
 table { border-collapse: collapse; margin: 6px 0; }
 td, th { border: 1px solid #ccd; padding: 3px 8px; text-align: left; vertical-align: top; }
 th { background: #eef0f4; }

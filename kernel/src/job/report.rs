@@ -93,6 +93,66 @@ pub struct Report {
     /// Tables the family reported (name to columns).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub tables: BTreeMap<String, BTreeMap<String, Vec<f64>>>,
+    /// What the run found: passed, failed or not verified, every figure
+    /// against its tolerance, what failed and where, what it warns of.
+    #[serde(default)]
+    pub verdict: crate::verdict::Verdict,
+}
+
+impl Report {
+    /// The report of a run of `family` on `machine` (described by `info`,
+    /// its constants as the run set them) with `values`, its `checks`
+    /// made: what a run knows before its toolpath, the rest empty.
+    pub fn of_run(
+        family: &dyn crate::family::PartFamily,
+        machine: &crate::catalog::OpenMachine,
+        info: &MachineInfo,
+        values: &crate::params::Params,
+        checks: Vec<Check>,
+    ) -> Self {
+        Self {
+            pilgrim: crate::VERSION.into(),
+            script: family.name().to_owned(),
+            machine: info.name.clone(),
+            machine_spec: machine.spec.clone(),
+            control: info.control.clone(),
+            parameters: family
+                .params()
+                .iter()
+                .filter_map(|s| {
+                    let value = values.get(&s.name)?.clone();
+                    Some((
+                        s.name.clone(),
+                        ReportParam {
+                            value,
+                            unit: s.unit.clone(),
+                        },
+                    ))
+                })
+                .collect(),
+            passes: 0,
+            cutting_passes: 0,
+            points: 0,
+            blocks: 0,
+            cycle_time_min: 0.0,
+            files: Vec::new(),
+            checks,
+            pose_block: None,
+            pose_along: 1.0,
+            mesh_tolerance_mm: 0.0,
+            bodies: Vec::new(),
+            step_tolerance_mm: 0.0,
+            solids: Vec::new(),
+            axis_ranges: BTreeMap::new(),
+            verification: None,
+            groove_verification: None,
+            worm_verification: None,
+            warnings: Vec::new(),
+            notes: BTreeMap::new(),
+            tables: BTreeMap::new(),
+            verdict: crate::verdict::Verdict::default(),
+        }
+    }
 }
 
 fn at_end() -> f64 {

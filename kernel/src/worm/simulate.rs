@@ -26,6 +26,7 @@ use crate::math::Real;
 use crate::program::{block_name, AxisProgram};
 use crate::toolpath::Motion;
 use crate::transform::ToolFrame;
+use crate::verdict::{Figure, Finding};
 use crate::verify::{as_written, replay, VerifyError};
 use geo::{Area, BooleanOps, Coord, LineString, MultiPolygon, Polygon};
 use serde::{Deserialize, Serialize};
@@ -155,9 +156,141 @@ pub struct WormCheck {
     /// The lead's window of the section: its first z and the lead.
     #[serde(skip)]
     pub window: (Real, Real),
+    /// What failed, in the order found (the run's verdict holds them).
+    #[serde(skip)]
+    pub failures: Vec<Finding>,
+    /// The nominal thickness at the pitch line, root and tip diameters (mm).
+    #[serde(default)]
+    pub nominal: (Real, Real, Real),
+    /// The nominal flank angle (deg).
+    #[serde(default)]
+    pub nominal_alpha_deg: Real,
 }
 
 impl WormCheck {
+    /// The check, or its first failure as an error.
+    ///
+    /// # Failures
+    /// What the simulation found beyond a tolerance ([`VerifyError::Worm`],
+    /// naming the block or the start and flank).
+    pub fn verified(self) -> Result<Self, VerifyError> {
+        match self.failures.first() {
+            Some(f) => Err(VerifyError::Worm(
+                f.message
+                    .strip_prefix("verification failed: ")
+                    .unwrap_or(&f.message)
+                    .to_owned(),
+            )),
+            None => Ok(self),
+        }
+    }
+
+    /// Each figure the simulation holds to its tolerance, the worst over
+    /// the starts and passes, and what failed.
+    pub fn findings(&self) -> (Vec<Figure>, Vec<Finding>) {
+        let t = &self.tolerances;
+        let worst = |f: &dyn Fn(&StartProfile) -> Real| {
+            self.starts
+                .iter()
+                .map(|s| (f(s), s.start))
+                .max_by(|a, b| a.0.abs().total_cmp(&b.0.abs()))
+        };
+        let mut figures = Vec::new();
+        let mut start_figure = |name: &str, f: &dyn Fn(&StartProfile) -> Real, tol: Real, unit| {
+            if let Some((v, s)) = worst(f) {
+                figures.push(Figure::new(name, v, tol, unit, format!("start {}", s + 1)));
+            }
+        };
+        start_figure(
+            "flank form",
+            &|s| {
+                if s.left_form.abs() >= s.right_form.abs() {
+                    s.left_form
+                } else {
+                    s.right_form
+                }
+            },
+            t.form,
+            "mm",
+        );
+        let alpha = self.nominal_alpha_deg;
+        start_figure(
+            "flank angle",
+            &|s| {
+                let (l, r) = (s.left_angle_deg - alpha, s.right_angle_deg - alpha);
+                if l.abs() >= r.abs() {
+                    l
+                } else {
+                    r
+                }
+            },
+            t.flank_angle.to_degrees(),
+            "deg",
+        );
+        start_figure(
+            "thickness at the pitch line",
+            &|s| s.thickness - self.nominal.0,
+            t.thickness,
+            "mm",
+        );
+        start_figure(
+            "root diameter",
+            &|s| s.root_diameter - self.nominal.1,
+            t.diameter,
+            "mm",
+        );
+        start_figure(
+            "tip diameter",
+            &|s| s.tip_diameter - self.nominal.2,
+            t.diameter,
+            "mm",
+        );
+        start_figure(
+            "each start's place",
+            &|s| s.position_error,
+            t.position,
+            "mm",
+        );
+        figures.push(Figure::new(
+            "the lead over the thread",
+            self.lead_error,
+            t.position,
+            "mm",
+            String::new(),
+        ));
+        let pass = |f: &dyn Fn(&SimulatedPass) -> Real| {
+            self.passes
+                .iter()
+                .max_by(|a, b| f(a).total_cmp(&f(b)))
+                .map(|p| (f(p), p.name.clone()))
+        };
+        for (name, f, tol, unit) in [
+            (
+                "cut beyond the nominal space",
+                &(|p: &SimulatedPass| p.gouge) as &dyn Fn(&SimulatedPass) -> Real,
+                t.form,
+                "mm",
+            ),
+            (
+                "the lead where a pass's edge meets the face",
+                &|p: &SimulatedPass| 100.0 * p.face_lead_error,
+                100.0 * t.lead,
+                "%",
+            ),
+            (
+                "the lead where a pass's edge leaves the far end",
+                &|p: &SimulatedPass| 100.0 * p.end_lead_error,
+                100.0 * t.lead,
+                "%",
+            ),
+        ] {
+            if let Some((v, place)) = pass(f) {
+                figures.push(Figure::new(name, v, tol, unit, place));
+            }
+        }
+        (figures, self.failures.clone())
+    }
+
     /// The finished worm's radius at `z` in the section at part angle 0
     /// (the section repeats with the lead): the highest material there.
     pub fn radius_at(&self, z: Real) -> Real {
@@ -319,6 +452,13 @@ pub fn simulate(
             ))
         })?;
     let mut rpm = written.spindle_rpm;
+    // What fails is found and the simulation goes on, so that a failed run
+    // shows every pass and the profile it leaves.
+    let mut failures: Vec<Finding> = Vec::new();
+    let mut found = |i: usize, m: String| {
+        failures
+            .push(Finding::new("verification", fail(m).to_string()).at(i, block_name(&written, i)));
+    };
     for i in 1..written.blocks.len() {
         let b = &written.blocks[i];
         if let Some(s) = b.spindle {
@@ -337,36 +477,44 @@ pub fn simulate(
                 let half = cutter.width_at(r_a - low) / 2.0;
                 let (lo, hi) = (z0.min(z1e), z0.max(z1e));
                 if hi > -req.length - half && lo < half {
-                    return Err(fail(format!(
+                    found(i, format!(
                         "{}: a move that is not a thread block crosses the blank (tip at diameter {:.3}, z from {:.3} to {:.3}; the worm runs from z = {:.3} to 0 at diameter {:.3})",
                         name(), 2.0 * low, z0, z1e, -req.length, 2.0 * r_a
-                    )));
+                    ));
                 }
             }
             continue;
         };
         if (r1 - r0).abs() > 1e-9 {
-            return Err(fail(format!(
-                "{}: a thread block that changes X (from {:.4} to {:.4}) cuts a taper, not a worm",
-                name(),
-                2.0 * r0,
-                2.0 * r1
-            )));
+            found(
+                i,
+                format!(
+                    "{}: a thread block that changes X (from {:.4} to {:.4}) cuts a taper, not a worm",
+                    name(),
+                    2.0 * r0,
+                    2.0 * r1
+                ),
+            );
+            continue;
         }
         let err_len = (l - lead).abs() * req.length / lead;
         lead_error = lead_error.max(err_len);
         if err_len > tol.position {
-            return Err(fail(format!(
+            found(i, format!(
                 "{}: lead {l} mm is not the worm's {lead:.6} mm: {err_len:.4} mm out over the thread's {} mm (tolerance {} mm)",
                 name(), req.length, tol.position
-            )));
+            ));
         }
         if z0.min(z1e) > -req.length || z0.max(z1e) < 0.0 {
-            return Err(fail(format!(
-                "{}: the thread block runs from z = {z0:.3} to {z1e:.3}, not over the whole thread (z from {:.3} to 0)",
-                name(),
-                -req.length
-            )));
+            found(
+                i,
+                format!(
+                    "{}: the thread block runs from z = {z0:.3} to {z1e:.3}, not over the whole thread (z from {:.3} to 0)",
+                    name(),
+                    -req.length
+                ),
+            );
+            continue;
         }
         let dir = (z1e - z0).signum();
         let z_sec = z0 - dir * l * start_deg / 360.0;
@@ -415,10 +563,10 @@ pub fn simulate(
         }
         let x = x_axis.map(|k| b.values[k]).unwrap_or(2.0 * r1);
         if gouge > tol.form {
-            return Err(fail(format!(
+            found(i, format!(
                 "{}: the cutter cuts {:.4} mm beyond the nominal thread space (at z = {:.3} in the section, diameter {:.3}; X{x:.3}, offset {offset:.4} mm from start {}'s space; tolerance {} mm)",
                 name(), gouge, worst[0], 2.0 * worst[1], start + 1, tol.form
-            )));
+            ));
         }
         // Where the cutting edges at the blank's radius meet the thread's
         // near end and leave its far end: the servo's lead error there.
@@ -446,7 +594,7 @@ pub fn simulate(
             ),
         ] {
             if e > tol.lead {
-                return Err(fail(format!(
+                found(i, format!(
                     "{}: the lead is {:.2}% off {what} ({:.3} mm from the block's {}; at least {:.3} mm keeps it within the allowed {}%)",
                     name(),
                     100.0 * e,
@@ -454,7 +602,7 @@ pub fn simulate(
                     if length == approach_mm { "start" } else { "end" },
                     minimum,
                     100.0 * tol.lead
-                )));
+                ));
             }
         }
         chips.push(
@@ -483,8 +631,12 @@ pub fn simulate(
     if passes.is_empty() {
         return Err(VerifyError::NoCuttingPass);
     }
-    let starts = measure(&material, w, c0, cutter, tol)?;
+    let (starts, unmeasured) = measure(&material, w, c0, cutter, tol);
+    failures.extend(unmeasured);
     Ok(WormCheck {
+        failures,
+        nominal: (w.thickness, w.root_diameter(), w.tip_diameter()),
+        nominal_alpha_deg: w.alpha.to_degrees(),
         removed_area: passes.iter().map(|p| p.chip_area).sum(),
         flank_loads: [
             passes.iter().map(|p| p.left_area).sum(),
@@ -515,15 +667,17 @@ fn slope(samples: &[(Real, Real)]) -> Real {
     sxy / sxx
 }
 
-/// The finished profile at every start, checked against the nominal.
+/// The finished profile at every start, and what of it fails against the
+/// nominal (a start whose space is not there is not measured further).
 fn measure(
     m: &MultiPolygon<Real>,
     w: &WormSizes,
     c0: Real,
     cutter: &ThreadCutter,
     tol: &WormTolerances,
-) -> Result<Vec<StartProfile>, VerifyError> {
-    let fail = |m: String| VerifyError::Worm(m);
+) -> (Vec<StartProfile>, Vec<Finding>) {
+    let mut failures = Vec::new();
+    let fail = |m: String| Finding::new("verification", VerifyError::Worm(m).to_string());
     let (px, r_a, r_f, r1) = (
         w.axial_pitch(),
         w.tip_radius(),
@@ -535,7 +689,7 @@ fn measure(
     let r_hi = r_a - 0.1 * w.module;
     let samples = 21;
     let mut out = Vec::new();
-    for k in 0..w.starts {
+    'starts: for k in 0..w.starts {
         let c = c0 + Real::from(k) * px;
         let space = |r: Real| {
             space_edges(m, r, c).ok_or_else(|| {
@@ -551,7 +705,13 @@ fn measure(
         let mut worst_at = [0.0; 2];
         for j in 0..samples {
             let r = r_lo + (r_hi - r_lo) * j as Real / (samples - 1) as Real;
-            let (zl, zr) = space(r)?;
+            let (zl, zr) = match space(r) {
+                Ok(s) => s,
+                Err(e) => {
+                    failures.push(e);
+                    continue 'starts;
+                }
+            };
             left.push((r, zl));
             right.push((r, zr));
             let half = w.space_at(r) / 2.0;
@@ -566,19 +726,26 @@ fn measure(
                 worst_at[1] = r;
             }
         }
-        let (zl, zr) = space(r1)?;
+        let (zl, zr) = match space(r1) {
+            Ok(s) => s,
+            Err(e) => {
+                failures.push(e);
+                continue 'starts;
+            }
+        };
         // The space after the last start's is start 0's, one lead on.
         let next = if k + 1 == w.starts {
             space_edges(m, r1, c0).map(|(a, _)| a + w.lead())
         } else {
             space_edges(m, r1, c + px).map(|(a, _)| a)
-        }
-        .ok_or_else(|| {
-            fail(format!(
+        };
+        let Some(next) = next else {
+            failures.push(fail(format!(
                 "start {}: no space after it at the pitch line",
                 k + 1
-            ))
-        })?;
+            )));
+            continue 'starts;
+        };
         let p = StartProfile {
             start: k,
             position_error: 0.5 * (zl + zr) - c,
@@ -599,7 +766,7 @@ fn measure(
             ("right", p.right_form, worst_at[1]),
         ] {
             if form.abs() > tol.form {
-                return Err(fail(format!(
+                failures.push(fail(format!(
                     "start {s}, {flank} flank: {} {:.4} mm from the nominal ZA flank at diameter {:.3} (tolerance {} mm)",
                     if form > 0.0 { "material left" } else { "cut too deep" },
                     form.abs(), 2.0 * r, tol.form
@@ -608,14 +775,14 @@ fn measure(
         }
         for (flank, a) in [("left", p.left_angle_deg), ("right", p.right_angle_deg)] {
             if (a - alpha).abs() > tol.flank_angle.to_degrees() {
-                return Err(fail(format!(
+                failures.push(fail(format!(
                     "start {s}, {flank} flank: angle {a:.4} deg, nominal {alpha:.4} deg (tolerance {:.4} deg)",
                     tol.flank_angle.to_degrees()
                 )));
             }
         }
         if (p.thickness - w.thickness).abs() > tol.thickness {
-            return Err(fail(format!(
+            failures.push(fail(format!(
                 "start {s}: axial thickness at the pitch line {:.4} mm, nominal {:.4} mm (tolerance {} mm)",
                 p.thickness, w.thickness, tol.thickness
             )));
@@ -625,19 +792,19 @@ fn measure(
             ("tip diameter", p.tip_diameter, w.tip_diameter()),
         ] {
             if (d - nominal).abs() > tol.diameter {
-                return Err(fail(format!(
+                failures.push(fail(format!(
                     "start {s}: {what} {d:.4} mm, nominal {nominal:.4} mm (tolerance {} mm)",
                     tol.diameter
                 )));
             }
         }
         if p.position_error.abs() > tol.position {
-            return Err(fail(format!(
+            failures.push(fail(format!(
                 "start {s}: its space is {:.4} mm from its place (tolerance {} mm)",
                 p.position_error, tol.position
             )));
         }
         out.push(p);
     }
-    Ok(out)
+    (out, failures)
 }
