@@ -139,8 +139,8 @@ pub fn run(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
     pilgrim_kernel::output::write_dir(&args.out, &out.files).map_err(|e| e.to_string())?;
     bar.finish_and_clear();
     let mut said = format!("{}; written to {}", out.summary(), args.out.display());
-    for w in &out.report.warnings {
-        said += &format!("\nwarning: {w}");
+    for w in &out.report.verdict.warnings {
+        said += &format!("\nwarning: {}", w.message);
     }
     Ok(said)
 }

@@ -164,7 +164,7 @@ fn bad_mandrel_parameters_are_refused_and_nothing_is_written() {
         (vec!["rest_r=140"], "axis U at 1"),
         (
             vec!["d_mn=40"],
-            "unknown parameter 'd_mn' from --set (parameters: cone_d, cone_len, cuts, d_max, d_min",
+            "unknown parameter 'd_mn' from --set (parameters: clearance, cone_d, cone_len, cuts, d_max, d_min",
         ),
         (
             vec!["cuts=[0.15,0.1]"],
@@ -337,9 +337,11 @@ fn verification_catches_a_corrupted_block() {
     let ok = check(&program).unwrap();
     let finish = ok.passes.last().unwrap();
     assert!(finish.deviation.max_abs <= 1e-3, "{finish:?}");
-    // Each earlier pass leaves its stock: the first pass 225 um.
+    // Each earlier pass leaves its stock: the first pass, one of three
+    // equal roughing cuts of the stock less the 20 um finish, 206.7 um.
+    let left = 0.3 - (0.3 - 0.02) / 3.0;
     assert!(
-        (ok.passes[0].deviation.max_below - 0.225).abs() < 1e-3,
+        (ok.passes[0].deviation.max_below - left).abs() < 1e-3,
         "{:?}",
         ok.passes[0]
     );
@@ -725,4 +727,180 @@ fn rest_parameters_are_the_machines() {
         e.to_string().contains("the machine's constant rest_radius"),
         "{e}"
     );
+}
+
+/// The process's rules on `program` (the default mandrel's, changed), the
+/// material the grinding replay cut: the errors' rules and messages.
+fn process_errors(
+    fam: &ScriptFamily,
+    values: &Params,
+    program: &AxisProgram,
+) -> Vec<(String, String)> {
+    let tp = fam.toolpath(values).unwrap();
+    let grinder = grinder();
+    let v = fam
+        .verification(values)
+        .unwrap()
+        .unwrap()
+        .into_profile()
+        .unwrap();
+    let pilgrim_kernel::ToolShape::Wheel(wheel) = tp.tool.shape else {
+        panic!("the mandrel's tool is a wheel")
+    };
+    let (_, stock) = pilgrim_kernel::verify::replay_grinding(
+        program,
+        &grinder,
+        &tp.tool.reference,
+        &wheel,
+        &tp.passes,
+        &v.profile,
+        v.blank.as_deref(),
+        (v.from, v.to),
+        v.tolerance,
+    )
+    .unwrap();
+    let stock = stock.expect("the mandrel gives its blank");
+    use pilgrim_kernel::MachineKinematics;
+    let limits = pilgrim_kernel::process::ProcessLimits::of(grinder.info());
+    pilgrim_kernel::process::check(program, &grinder, &tp.tool.reference, Some(&stock), &limits)
+        .unwrap()
+        .errors
+        .into_iter()
+        .map(|f| (f.rule, f.message))
+        .collect()
+}
+
+/// The process as a machinist checks it, on the default mandrel: the
+/// steady rest comes onto the turning part at its approach feed and the
+/// wheel into the stock at the infeed feed, at the first pass and at
+/// every reversal (the program shows both: `N50 G1 U.. F100.0`, `N60 X..
+/// F2.0`); the same program with the rest brought on at rapid, the
+/// first infeed at the traverse feed, or the wheel's rapid in lowered
+/// into the stock is refused, naming the block. (The default once plunged
+/// 2 mm at `F2000.0` and brought the rest on under G0.)
+#[test]
+fn the_process_meets_the_part_at_its_feeds() {
+    let fam = family();
+    let values = params(&fam, &[]);
+    let (_, program, _) = job(&fam, &values);
+    assert_eq!(process_errors(&fam, &values, &program), vec![]);
+    let text = SharedPost.post(&program, "sinumerik").unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let at = |n: &str| lines.iter().find(|l| l.starts_with(n)).unwrap().to_string();
+    assert!(
+        at("N40 ").starts_with("N40 U") && !at("N40 ").contains("G1"),
+        "{}",
+        at("N40 ")
+    );
+    assert!(
+        at("N50 ").starts_with("N50 G1 U") && at("N50 ").ends_with(" F100.0"),
+        "{}",
+        at("N50 ")
+    );
+    assert!(
+        at("N60 ").starts_with("N60 X") && at("N60 ").ends_with(" F2.0"),
+        "{}",
+        at("N60 ")
+    );
+    // Every reversal into the stock at F2.0 too: each pass's first block.
+    for (i, l) in lines.iter().enumerate() {
+        if l.starts_with("; pass ") {
+            assert!(lines[i + 1].ends_with(" F2.0"), "{}", lines[i + 1]);
+        }
+    }
+    let index = |n: &str| {
+        (0..program.blocks.len())
+            .find(|&k| block_label("sinumerik", k) == n)
+            .unwrap()
+    };
+    let changed = |f: &dyn Fn(&mut AxisProgram)| {
+        let mut p = program.clone();
+        f(&mut p);
+        process_errors(&fam, &values, &p)
+    };
+    // The rest onto the turning part at rapid.
+    let e = changed(&|p| p.blocks[index("N50")].motion = pilgrim_kernel::Motion::Rapid);
+    assert!(
+        e.len() == 1
+            && e[0]
+                .1
+                .starts_with("N50 in \"approach\": rest comes onto the part at rapid"),
+        "{e:?}"
+    );
+    // The wheel into the stock at the traverse feed.
+    let e = changed(&|p| p.blocks[index("N60")].feed = 1200.0);
+    assert!(
+        e.len() == 1
+            && e[0].1.contains("N60 in \"pass 1")
+            && e[0].1.contains(
+                "into the stock at F1200.0 mm/min; the machine's infeed feed is at most 2 mm/min"
+            ),
+        "{e:?}"
+    );
+    // A rapid through the stock: the wheel's rapid in brought down to the
+    // first cut's depth.
+    let x = program.axes.iter().position(|a| a.name == "X").unwrap();
+    let e = changed(&|p| {
+        let deep = p.blocks[index("N60")].values[x];
+        for k in [index("N30"), index("N40"), index("N50")] {
+            p.blocks[k].values[x] = deep;
+        }
+    });
+    assert!(
+        e.iter()
+            .any(|(rule, m)| rule == pilgrim_kernel::process::RAPID
+                && m.starts_with("N30 in \"start\": a rapid into the material")),
+        "{e:?}"
+    );
+}
+
+/// The seed's schedule (four equal cuts of 75 um, roughing at 2000 mm/min)
+/// is refused: its finishing pass takes 75 um, more than the machine's
+/// finishing stock (30 um); and the report warns that its roughing ridges,
+/// 158 um high, stand above their cuts, so that passes 1 to 3 leave the
+/// surface before them untouched at the crests. Nothing said so before.
+#[test]
+fn a_heavy_finish_fails_and_tall_ridges_are_reported() {
+    let out = common::scratch("mandrel", "seed-schedule").join("out");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pilgrim"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["run", "scripts/mandrel.rhai", "-q", "--out"])
+        .arg(&out)
+        .args(["--set", "rough_feed=2000", "--set", "finish_cut=0.075"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("the finishing pass \"pass 4, stock 0.0 um\" takes 0.07")
+            && err.contains("more than the finishing stock 0.03 mm"),
+        "{err}"
+    );
+    let r: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    let warnings: Vec<&str> = r["verdict"]["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|w| w["rule"] == pilgrim_kernel::process::RIDGE)
+        .map(|w| w["message"].as_str().unwrap())
+        .collect();
+    assert_eq!(warnings.len(), 3, "{warnings:?}");
+    assert!(
+        warnings[0].contains("pass \"pass 1, stock 225.0 um\" leaves ridges 0.157")
+            && warnings[0].contains("on a cut of 0.07"),
+        "{warnings:?}"
+    );
+    // With a finishing stock as large as its cut, it runs, and warns.
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pilgrim"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["run", "scripts/mandrel.rhai", "--out"])
+        .arg(&out)
+        .args(["--set", "rough_feed=2000", "--set", "finish_cut=0.075"])
+        .args(["--set", "finish_stock=0.08"])
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(said.contains("warning: N"), "{said}");
 }

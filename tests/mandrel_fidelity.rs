@@ -433,11 +433,15 @@ fn verified(
 /// mm) leaves about f^2 / (8 R_s) = 157 um between its touches; the
 /// replay on the generatrices finds it above the nominal (the highest of 8
 /// generatrices is within h / 4 of the crest), and reports the pass's feed
-/// per revolution from the program's words.
+/// per revolution from the program's words. (Its cut, 0.2 mm, is deeper
+/// than the ridge: the surface before it does not clip the crests.)
 #[test]
 fn the_ridge_of_a_pass_is_f_squared_over_8_r() {
     // Verified to 0.2 mm: the blocks keep the default 1 um.
-    let (check, _, _) = verified(&[("finish_feed", "2000")], Some(0.2));
+    let (check, _, _) = verified(
+        &[("finish_feed", "2000"), ("cuts", "[0.1, 0.2]")],
+        Some(0.2),
+    );
     let finish = check.passes.last().unwrap();
     let f = 2000.0 / 399.0;
     assert!((finish.feed_per_rev_mm - f).abs() < 1e-9, "{finish:?}");

@@ -828,3 +828,66 @@ fn export_keeps_the_verification() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The process's rules on the worm's program: the default passes them (its
+/// rapids go round the blank, 2 mm above the tip, and come in beyond the
+/// face; every finishing pass takes 0.05 mm); a return along the worm
+/// lowered to the root is a rapid through the stock, named by block.
+#[test]
+fn a_rapid_through_the_stock_is_refused() {
+    let (dir, out) = run_worm("rapid", &[]);
+    let program: AxisProgram =
+        serde_json::from_str(&std::fs::read_to_string(out.join("program.json")).unwrap()).unwrap();
+    let r = report(&out);
+    assert_eq!(r["verdict"]["status"], "passed");
+    let req = WormRequest {
+        sizes: WormSizes::new(5.0, 2, 50.0, 0.2, 20f64.to_radians(), None).unwrap(),
+        length: 60.0,
+        space_centre: r["notes"]["space_centre_mm"].as_f64().unwrap(),
+        tolerances: WormTolerances {
+            form: 0.01,
+            thickness: 0.02,
+            diameter: 0.02,
+            position: 0.01,
+            flank_angle: 0.05f64.to_radians(),
+            lead: 0.01,
+        },
+    };
+    let c = cutter(&out);
+    use pilgrim_kernel::MachineKinematics;
+    let errors = |p: &AxisProgram| {
+        let check = simulate(p, &lathe(), &Default::default(), &c, &req).unwrap();
+        let stock = pilgrim_kernel::worm::WormStock::new(&check, &req, &c);
+        let limits = pilgrim_kernel::process::ProcessLimits::of(lathe().info());
+        pilgrim_kernel::process::check(p, &lathe(), &Default::default(), Some(&stock), &limits)
+            .unwrap()
+    };
+    let found = errors(&program);
+    assert!(found.errors.is_empty(), "{:?}", found.errors);
+    // The return to pass 2's start, along the worm at X60 + 4 (2 mm over
+    // the tip), lowered to the root's diameter.
+    let k = program
+        .blocks
+        .iter()
+        .position(|b| {
+            b.comment
+                .as_deref()
+                .is_some_and(|c| c.starts_with("pass 2,"))
+        })
+        .unwrap();
+    let mut low = program.clone();
+    low.blocks[k].values[0] = 38.0;
+    let found = errors(&low);
+    let name = pilgrim_kernel::program::block_name(&program, k);
+    assert!(
+        found
+            .errors
+            .iter()
+            .any(|f| f.rule == pilgrim_kernel::process::RAPID
+                && f.message
+                    .starts_with(&format!("{name}: a rapid into the material"))),
+        "{:?}",
+        found.errors
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -57,6 +57,7 @@ pub mod offset;
 pub mod output;
 pub mod params;
 pub mod plugin;
+pub mod process;
 pub mod profile;
 pub mod program;
 pub mod script;

@@ -48,9 +48,17 @@ pub struct Pass {
 }
 
 impl Pass {
-    /// Whether the pass cuts: has a move other than a rapid.
+    /// Whether the pass cuts: has a move other than a rapid that moves the
+    /// tool (within the pass, or into its first point). A feed move that
+    /// only moves another body (a steady rest coming onto the part) with
+    /// the tool standing does not cut.
     pub fn cuts(&self) -> bool {
-        self.points.iter().any(|p| p.motion != Motion::Rapid)
+        self.points.iter().enumerate().any(|(i, p)| {
+            p.motion != Motion::Rapid
+                && (i == 0
+                    || p.point != self.points[i - 1].point
+                    || p.axis != self.points[i - 1].axis)
+        })
     }
 }
 

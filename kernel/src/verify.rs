@@ -317,6 +317,30 @@ pub fn check_grinding(
     range: (Real, Real),
     tolerance: Real,
 ) -> Result<GrindingCheck, VerifyError> {
+    replay_grinding(
+        program, machine, tool, wheel, passes, nominal, blank, range, tolerance,
+    )
+    .map(|(check, _)| check)
+}
+
+/// [`check_grinding`], and the material as the replay cut it
+/// ([`GroundStock`], for the process's rules) where the family gives the
+/// blank.
+///
+/// # Failures
+/// As [`check_grinding`].
+#[allow(clippy::too_many_arguments)]
+pub fn replay_grinding(
+    program: &AxisProgram,
+    machine: &dyn MachineKinematics,
+    tool: &ToolFrame,
+    wheel: &Wheel,
+    passes: &[Pass],
+    nominal: &Profile,
+    blank: Option<&Profile>,
+    range: (Real, Real),
+    tolerance: Real,
+) -> Result<(GrindingCheck, Option<GroundStock>), VerifyError> {
     positive("verification tolerance", tolerance)?;
     let (written, resolution) = as_written(program);
     if tolerance < 2.0 * resolution {
@@ -341,6 +365,10 @@ pub fn check_grinding(
     // their touches: the surface a pass cuts into is their lowest.
     let mut earlier: Vec<Vec<(CapsuleEnvelope, Vec<usize>)>> =
         (0..GENERATRICES).map(|_| Vec::new()).collect();
+    // Each generatrix's sweeps' cutting passes (from 0), and each cutting
+    // pass's blocks (from 0).
+    let mut ordinals: Vec<Vec<usize>> = vec![Vec::new(); GENERATRICES];
+    let mut cut_blocks: Vec<std::ops::Range<usize>> = Vec::new();
     for (pass, blocks) in pass_blocks(program, passes) {
         for b in &written.blocks[blocks.clone()] {
             if let Some(s) = b.spindle {
@@ -480,7 +508,9 @@ pub fn check_grinding(
         for (env, g) in envs.into_iter().zip(&met) {
             let touched: Vec<usize> = t.block[*g].iter().map(|&k| blocks.start + k + 1).collect();
             earlier[*g].push((env, touched));
+            ordinals[*g].push(cut_blocks.len());
         }
+        cut_blocks.push(blocks.clone());
         let (this, before) = earlier[met[gen_at]]
             .split_last()
             .expect("this pass's sweep was just kept");
@@ -509,7 +539,171 @@ pub fn check_grinding(
     if out.passes.is_empty() {
         return Err(VerifyError::NoCuttingPass);
     }
-    Ok(out)
+    let stock = match blank {
+        Some(b) => Some(GroundStock::new(
+            &out, b, nominal, wheel, &earlier, &ordinals, cut_blocks,
+        )?),
+        None => None,
+    };
+    Ok((out, stock))
+}
+
+/// The spacing of [`GroundStock`]'s grid along z (mm): the wheel's and the
+/// rest's footprints are sampled this finely.
+pub const STOCK_STEP: Real = 0.05;
+
+/// The material of a body of revolution as the grinding replay cut it, for
+/// the process's rules ([`crate::process`]): on a grid along z, the surface
+/// the part has before each cutting pass and after the last (the highest of
+/// the generatrices: what a wheel or a rest meets first), the blank
+/// lowered by each pass's sweep; the wheel's section; what each pass cut.
+#[derive(Debug, Clone)]
+pub struct GroundStock {
+    z0: Real,
+    /// The surfaces' radii on the grid, one row per state: before cutting
+    /// pass 1, 2, ..., after the last (`-inf` where there is no part).
+    states: Vec<Vec<Real>>,
+    /// Each cutting pass's blocks (from 0).
+    blocks: Vec<std::ops::Range<usize>>,
+    wheel: Wheel,
+    passes: Vec<crate::process::PassStock>,
+}
+
+impl GroundStock {
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        check: &GrindingCheck,
+        blank: &Profile,
+        nominal: &Profile,
+        wheel: &Wheel,
+        sweeps: &[Vec<(CapsuleEnvelope, Vec<usize>)>],
+        ordinals: &[Vec<usize>],
+        blocks: Vec<std::ops::Range<usize>>,
+    ) -> Result<Self, VerifyError> {
+        let (z0, z1) = blank.z_range();
+        let n = ((z1 - z0) / STOCK_STEP).ceil() as usize + 1;
+        let zs: Vec<Real> = (0..n)
+            .map(|i| (z0 + i as Real * STOCK_STEP).min(z1))
+            .collect();
+        let under = blank.eval_many(&zs)?;
+        // Each generatrix's sweeps evaluated once.
+        let evaluated: Vec<Vec<Vec<Real>>> = sweeps
+            .iter()
+            .map(|g| g.iter().map(|(e, _)| e.eval_many(&zs)).collect())
+            .collect();
+        let states = (0..=blocks.len())
+            .map(|done| {
+                (0..n)
+                    .map(|i| {
+                        (0..sweeps.len())
+                            .map(|g| {
+                                evaluated[g]
+                                    .iter()
+                                    .zip(&ordinals[g])
+                                    .filter(|(_, p)| **p < done)
+                                    .map(|(v, _)| v[i])
+                                    .filter(|v| v.is_finite())
+                                    .fold(under[i], Real::min)
+                            })
+                            .fold(Real::NEG_INFINITY, Real::max)
+                    })
+                    .collect()
+            })
+            .collect();
+        // What each pass cut: the surfaces' difference at the valleys, the
+        // blank before the first.
+        let mut passes = Vec::new();
+        for (k, p) in check.passes.iter().enumerate() {
+            let mut cut: Real = 0.0;
+            for (i, b) in p.along_z.iter().enumerate() {
+                let before = if k == 0 {
+                    blank
+                        .eval(b[0])
+                        .ok()
+                        .zip(nominal.eval(b[0]).ok())
+                        .map(|(x, y)| x - y)
+                } else {
+                    check.passes[k - 1]
+                        .along_z
+                        .get(i)
+                        .filter(|q| (q[0] - b[0]).abs() < 1e-9)
+                        .map(|q| q[1])
+                };
+                if let Some(before) = before {
+                    cut = cut.max(before - b[1]);
+                }
+            }
+            passes.push(crate::process::PassStock {
+                name: p.name.clone(),
+                first_block: p.first_block - 1,
+                cut,
+                ridge: p.ridge_mm,
+                finishes: p.deviation.max_abs <= check.tolerance,
+            });
+        }
+        Ok(Self {
+            z0,
+            states,
+            blocks,
+            wheel: *wheel,
+            passes,
+        })
+    }
+
+    /// The surface when block `block` (from 0) begins: the one before the
+    /// cutting pass it belongs to (the part as that pass finds it).
+    fn state(&self, block: usize) -> &[Real] {
+        let done = self.blocks.iter().filter(|r| r.end <= block).count();
+        &self.states[done.min(self.states.len() - 1)]
+    }
+
+    /// The grid's indices within `half` of `z`, with their z.
+    fn around(&self, z: Real, half: Real, n: usize) -> impl Iterator<Item = (usize, Real)> + '_ {
+        let lo = ((z - half - self.z0) / STOCK_STEP).floor().max(0.0) as usize;
+        let hi =
+            (((z + half - self.z0) / STOCK_STEP).ceil().max(0.0) as usize).min(n.saturating_sub(1));
+        (lo..=hi)
+            .map(move |i| (i, self.z0 + i as Real * STOCK_STEP))
+            .filter(move |(_, zi)| (zi - z).abs() <= half)
+    }
+}
+
+impl crate::process::Stock for GroundStock {
+    fn tool_depth(&self, block: usize, pose: &[Real]) -> Real {
+        // The wheel's section: its roundings' centres a flat apart about
+        // the tracked point, at its radius from the part's axis.
+        let (z, r) = (pose[2], pose[0].hypot(pose[1]));
+        let (rs, half_flat) = (self.wheel.rounding_radius, self.wheel.flat() / 2.0);
+        let s = self.state(block);
+        self.around(z, half_flat + rs, s.len())
+            .map(|(i, zi)| {
+                let off = ((zi - z).abs() - half_flat).max(0.0);
+                let bottom = r - (rs * rs - off * off).max(0.0).sqrt();
+                s[i] - bottom
+            })
+            .fold(Real::NEG_INFINITY, Real::max)
+    }
+
+    fn body_gap(
+        &self,
+        block: usize,
+        shape: &crate::process::Roller,
+        frame: &crate::math::Mat4,
+    ) -> Option<Real> {
+        // A roller across the axial section: a circle of its radius in it.
+        let (x, y, z) = (frame[(0, 3)], frame[(1, 3)], frame[(2, 3)]);
+        let (u, r) = (x.hypot(y), shape.radius);
+        let s = self.state(block);
+        let drop = self
+            .around(z, r, s.len())
+            .map(|(i, zi)| s[i] + (r * r - (zi - z) * (zi - z)).max(0.0).sqrt())
+            .fold(Real::NEG_INFINITY, Real::max);
+        drop.is_finite().then_some(u - drop)
+    }
+
+    fn passes(&self) -> Vec<crate::process::PassStock> {
+        self.passes.clone()
+    }
 }
 
 impl GrindingCheck {

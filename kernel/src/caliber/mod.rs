@@ -29,7 +29,7 @@ mod solid;
 
 pub use check::{
     check_groove, contact_patch, wheel_distance, ContactPatch, DeviationMap, GrooveCheck,
-    GroovePlace, GrooveRequest, MAP_CELLS, NEIGHBOUR_PASSES,
+    GroovePlace, GrooveRequest, GrooveStock, MAP_CELLS, NEIGHBOUR_PASSES,
 };
 pub use groove::{Groove, GrooveError};
 pub use pass::{pass_poses, pose_at, PassPose, SwivelPlane, MAX_PASS_BLOCKS};

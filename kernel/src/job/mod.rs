@@ -36,7 +36,7 @@ use crate::program::{build, AxisProgram};
 use crate::tool::ToolShape;
 use crate::toolpath::Toolpath;
 use crate::verdict::{Finding, Verdict};
-use crate::verify::{check_grinding, GrindingCheck};
+use crate::verify::{replay_grinding, GrindingCheck};
 use serde::Serialize;
 
 /// How a run makes its outputs.
@@ -366,6 +366,9 @@ pub fn run(
         Some(Verification::Groove(g)) => (None, Some(g), None),
         Some(Verification::Worm(w)) => (None, None, Some(w)),
     };
+    // The material as each verification knows it, for the process's
+    // rules.
+    let mut stock: Option<Box<dyn crate::process::Stock>> = None;
     // The worm's cut, simulated pass by pass from the program as written.
     let worm = match &worm_request {
         None => None,
@@ -376,13 +379,9 @@ pub fn run(
                     message: "fn verify(p) of a worm needs a thread cutter".into(),
                 }));
             };
-            Some(crate::worm::simulate(
-                &program,
-                kin,
-                &toolpath.tool.reference,
-                &c,
-                r,
-            )?)
+            let check = crate::worm::simulate(&program, kin, &toolpath.tool.reference, &c, r)?;
+            stock = Some(Box::new(crate::worm::WormStock::new(&check, r, &c)));
+            Some(check)
         }
     };
     // The caliber's replay.
@@ -392,6 +391,15 @@ pub fn run(
             let ToolShape::Wheel(wheel) = toolpath.tool.shape else {
                 return Err(needs_wheel());
             };
+            if let Some(allowance) = g.stock {
+                stock = Some(Box::new(crate::caliber::GrooveStock::new(
+                    g,
+                    allowance,
+                    &wheel,
+                    &program,
+                    &toolpath.passes,
+                )));
+            }
             Some(crate::caliber::check_groove(
                 &program,
                 kin,
@@ -408,7 +416,7 @@ pub fn run(
             let ToolShape::Wheel(w) = toolpath.tool.shape else {
                 return Err(needs_wheel());
             };
-            Some(check_grinding(
+            let (check, ground) = replay_grinding(
                 &program,
                 kin,
                 &toolpath.tool.reference,
@@ -418,7 +426,11 @@ pub fn run(
                 v.blank.as_deref(),
                 (v.from, v.to),
                 v.tolerance,
-            )?)
+            )?;
+            if let Some(g) = ground {
+                stock = Some(Box::new(g));
+            }
+            Some(check)
         }
     };
     // What the verification found: its figures, and what failed.
@@ -435,11 +447,28 @@ pub fn run(
         figures.extend(f);
         failures.extend(x);
     }
-    let warnings: Vec<Finding> = toolpath
+    let mut warnings: Vec<Finding> = toolpath
         .warnings
         .iter()
         .map(|w| Finding::new("the family", w.clone()))
         .collect();
+    // The process, checked as well as the geometry.
+    let process = crate::process::check(
+        &program,
+        kin,
+        &toolpath.tool.reference,
+        stock.as_deref(),
+        &crate::process::ProcessLimits::of(info),
+    )?;
+    failures.extend(process.errors);
+    warnings.extend(process.warnings);
+    figures.extend(process.figures);
+    if stock.is_none() {
+        warnings.push(Finding::new(
+            "the process",
+            "the rules that need the material (rapids through air only, into the stock at the infeed feed, the steady rest's approach, the finishing stock) were not checked: the family's verification gives no blank",
+        ));
+    }
     // The scene shows the tool where asked; a failed run's, where it
     // failed; else the middle of the last cutting pass.
     let pose_place = match (

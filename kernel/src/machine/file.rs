@@ -85,6 +85,7 @@ struct BodyFile {
     label: String,
     chain: Spanned<Vec<FactorFile>>,
     shape: Option<Spanned<BodyShape>>,
+    approach_feed: Option<Spanned<crate::machine::Quantity>>,
 }
 
 /// Turns byte spans into `file:line:column` errors.
@@ -211,6 +212,7 @@ impl Machine {
                 label: body.label.clone(),
                 chain: read_chain(&src, body.chain.get_ref())?,
                 shape: body.shape.as_ref().map(|s| s.get_ref().clone()),
+                approach_feed: body.approach_feed.as_ref().map(|s| s.get_ref().clone()),
             });
         }
         let tool = match &file.tool {

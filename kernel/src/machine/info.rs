@@ -331,6 +331,20 @@ fn check_body(info: &MachineInfo, b: &BodySpec) -> Result<(), Invalid> {
             ),
         ));
     }
+    if let Some(q) = &b.approach_feed {
+        let v = q.resolve(&info.constants).map_err(|m| {
+            invalid(
+                Place::Body(b.name.clone(), "approach_feed"),
+                format!("body {}: approach_feed: {m}", b.name),
+            )
+        })?;
+        if !(v.is_finite() && v > 0.0) {
+            return Err(invalid(
+                Place::Body(b.name.clone(), "approach_feed"),
+                format!("body {}: approach_feed = {v} mm/min must be > 0", b.name),
+            ));
+        }
+    }
     match &b.shape {
         None => Ok(()),
         Some(BodyShape::Roller { radius, length }) => {

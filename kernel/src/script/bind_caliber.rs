@@ -124,9 +124,10 @@ pub mod caliber_api {
     /// along the contact's trajectory, its axis square to the radius
     /// through the contact (`cross`: a machine with the cross axis Y) or
     /// through its centre (a 4-axis machine). Columns: `x`, `y`, `z` (the
-    /// wheel's centre), `i`, `j`, `k` (its axis), `theta` (the contact's,
-    /// rad), `turn` (rad), `seed_centre` (mm) and `seed_axis` (rad), how
-    /// far the seed's model is from each pose.
+    /// wheel's centre), `i`, `j`, `k` (its axis), `nx`, `ny`, `nz` (the
+    /// groove's normal at the contact, out of the material), `theta` (the
+    /// contact's, rad), `turn` (rad), `seed_centre` (mm) and `seed_axis`
+    /// (rad), how far the seed's model is from each pose.
     #[rhai_fn(pure, return_raw)]
     pub fn pass(
         g: &mut Groove,
@@ -361,6 +362,9 @@ fn pass_map(poses: &[caliber::PassPose]) -> rhai::Map {
     m.insert("i".into(), col(&|p| p.wheel.axis.x));
     m.insert("j".into(), col(&|p| p.wheel.axis.y));
     m.insert("k".into(), col(&|p| p.wheel.axis.z));
+    m.insert("nx".into(), col(&|p| p.normal.x));
+    m.insert("ny".into(), col(&|p| p.normal.y));
+    m.insert("nz".into(), col(&|p| p.normal.z));
     m.insert("theta".into(), col(&|p| p.theta));
     m.insert("turn".into(), col(&|p| p.turn));
     m.insert("seed_centre".into(), col(&|p| p.seed_centre_error));

@@ -676,7 +676,7 @@ impl PartFamily for ScriptFamily {
         let d = self.call_with_params("verify", values)?;
         let shape = || {
             self.contract(
-                "fn verify(p) must return #{ profile, from, to, tolerance } (and optionally blank, a profile), #{ groove, psi, tolerance, grid_theta, grid_per_step, patch_gap } or #{ worm, length, space_centre, tolerance: #{ form, thickness, diameter, position, flank_angle_deg, lead (optional) } }".into(),
+                "fn verify(p) must return #{ profile, from, to, tolerance } (and optionally blank, a profile), #{ groove, psi, tolerance, grid_theta, grid_per_step, patch_gap } (and optionally stock, the allowance) or #{ worm, length, space_centre, tolerance: #{ form, thickness, diameter, position, flank_angle_deg, lead (optional) } }".into(),
             )
         };
         let m = d.try_cast::<Map>().ok_or_else(shape)?;
@@ -739,6 +739,10 @@ impl PartFamily for ScriptFamily {
                     grid_theta: num("grid_theta")?,
                     grid_per_step: per as usize,
                     patch_gap: num("patch_gap")?,
+                    stock: match m.get("stock") {
+                        None => None,
+                        Some(_) => Some(num("stock")?),
+                    },
                 },
             ))));
         }

@@ -34,7 +34,8 @@ pub use plan::{
 };
 pub use servo::{approach_error, approach_length, runout_error, runout_length};
 pub use simulate::{
-    simulate, SimulatedPass, StartProfile, WormCheck, WormRequest, WormTolerances, LEAD_ERROR,
+    simulate, SimulatedPass, StartProfile, WormCheck, WormRequest, WormStock, WormTolerances,
+    LEAD_ERROR,
 };
 pub use sizes::WormSizes;
 pub use solid::{worm_solid, WormSweep, MAX_AROUND};

@@ -91,6 +91,10 @@ pub struct SimulatedPass {
     pub right_area: Real,
     /// The deepest cut beyond the nominal space (mm; 0 where none).
     pub gouge: Real,
+    /// The chip's thickness: the farthest its outline stands inside the
+    /// cutter's (mm), the stock the pass takes.
+    #[serde(default)]
+    pub thickness: Real,
     /// How far the carriage travels before the leading cutting edge, at
     /// the blank's radius, meets the worm's face (mm): the pass's S1.
     pub approach_mm: Real,
@@ -534,6 +538,31 @@ pub fn simulate(
         let cutter_mp = MultiPolygon::new(vec![placed(-lead), placed(0.0), placed(lead)]);
         let chip = material.intersection(&cutter_mp);
         let chip_area = chip.unsigned_area();
+        // The chip's thickness: the farthest its outline stands inside the
+        // cutter's (the depth of the cut, normal to the edge that takes it).
+        let thickness = chip
+            .0
+            .iter()
+            .flat_map(|p| p.exterior().coords())
+            .map(|c| {
+                [-lead, 0.0, lead]
+                    .iter()
+                    .map(|dz| {
+                        let n = section.len();
+                        (0..n)
+                            .map(|j| {
+                                let at = |q: [Real; 2]| [q[0] + zw + dz, q[1] + r1];
+                                segment_distance(
+                                    [c.x, c.y],
+                                    at(section[j]),
+                                    at(section[(j + 1) % n]),
+                                )
+                            })
+                            .fold(Real::INFINITY, Real::min)
+                    })
+                    .fold(Real::INFINITY, Real::min)
+            })
+            .fold(0.0, Real::max);
         let left_side = MultiPolygon::new(
             [-lead, 0.0, lead]
                 .iter()
@@ -622,6 +651,7 @@ pub fn simulate(
             left_area,
             right_area: chip_area - left_area,
             gouge,
+            thickness,
             approach_mm,
             face_lead_error,
             runout_mm,
@@ -651,6 +681,94 @@ pub fn simulate(
         section: material,
         window: (w0, lead),
     })
+}
+
+/// The worm's material for the process's rules ([`crate::process`]): the
+/// blank, a cylinder of the tip's radius over the thread's length, which
+/// a tool moving otherwise than along the thread meets as the part turns
+/// under it (the envelope of the section over a turn); and each thread
+/// block's chip, the last at each start finishing it.
+#[derive(Debug, Clone)]
+pub struct WormStock {
+    tip_radius: Real,
+    length: Real,
+    /// The cutter's outline about its tip's centre, sampled every 0.1 mm.
+    outline: Vec<[Real; 2]>,
+    passes: Vec<crate::process::PassStock>,
+}
+
+impl WormStock {
+    /// The material of the worm of `req` that `check` simulated, cut by
+    /// `cutter`.
+    pub fn new(check: &WormCheck, req: &WormRequest, cutter: &ThreadCutter) -> Self {
+        let section = cutter.section(cutter.height);
+        let mut outline = Vec::new();
+        for j in 0..section.len() {
+            let (a, b) = (section[j], section[(j + 1) % section.len()]);
+            let n = ((a[0] - b[0]).hypot(a[1] - b[1]) / 0.1).ceil().max(1.0) as usize;
+            outline.extend((0..n).map(|i| {
+                let t = i as Real / n as Real;
+                [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
+            }));
+        }
+        let last_of_start = |k: usize| {
+            check.passes[k + 1..]
+                .iter()
+                .all(|p| p.start != check.passes[k].start)
+        };
+        let passes = check
+            .passes
+            .iter()
+            .enumerate()
+            .map(|(k, p)| crate::process::PassStock {
+                name: p.name.clone(),
+                first_block: p.block - 1,
+                cut: p.thickness,
+                ridge: 0.0,
+                finishes: last_of_start(k),
+            })
+            .collect();
+        Self {
+            tip_radius: req.sizes.tip_radius(),
+            length: req.length,
+            outline,
+            passes,
+        }
+    }
+}
+
+impl crate::process::Stock for WormStock {
+    fn tool_depth(&self, _: usize, pose: &[Real]) -> Real {
+        let (z, r) = (pose[2], pose[0].hypot(pose[1]));
+        // Into the blank, the outline's points over it; off it, the
+        // nearest's distance.
+        self.outline
+            .iter()
+            .map(|p| {
+                let (pz, pr) = (z + p[0], r + p[1]);
+                let dz = (pz - 0.0).max(-self.length - pz).max(0.0);
+                let dr = pr - self.tip_radius;
+                if dz == 0.0 {
+                    -dr
+                } else {
+                    -dz.hypot(dr.max(0.0))
+                }
+            })
+            .fold(Real::NEG_INFINITY, Real::max)
+    }
+
+    fn body_gap(
+        &self,
+        _: usize,
+        _: &crate::process::Roller,
+        _: &crate::math::Mat4,
+    ) -> Option<Real> {
+        None
+    }
+
+    fn passes(&self) -> Vec<crate::process::PassStock> {
+        self.passes.clone()
+    }
 }
 
 /// The least-squares slope `b` of `z = a + b r`.

@@ -87,8 +87,9 @@ pub const ABI_MAJOR: u32 = 1;
 /// types since the major (1.1: the table's `capabilities`; the descriptor's
 /// `driven_axes`, `bodies`, `chain`, `tool`, `min_feed`; 1.2: the
 /// descriptor's and the program's `setup`, a block's `keep`; 1.3: the
-/// setup's `feed_group`; 1.4: a thread block's `start_deg`).
-pub const ABI_MINOR: u32 = 4;
+/// setup's `feed_group`; 1.4: a thread block's `start_deg`; 1.5: a body's
+/// `approach_feed`).
+pub const ABI_MINOR: u32 = 5;
 
 /// The call succeeded.
 pub const STATUS_OK: i32 = 0;

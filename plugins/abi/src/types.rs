@@ -297,6 +297,11 @@ pub struct BodySpec {
     /// Its solid, if it is drawn.
     #[serde(default)]
     pub shape: Option<BodyShape>,
+    /// Since 1.5: for a body that rides the part (a steady rest), the
+    /// largest speed at which it may come onto it (mm/min), or the
+    /// constant that gives it; `None` for a body that never touches it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub approach_feed: Option<Quantity>,
 }
 
 /// The tool's tracked point and axis in the tool's own frame, as the

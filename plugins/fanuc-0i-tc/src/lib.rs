@@ -94,6 +94,13 @@ pub fn describe() -> MachineInfo {
         constants: [
             // The carriage's servo time constant T (s), usually 0.033 s.
             ("servo_time_constant".to_owned(), 0.033),
+            // The process (the kernel's process rules): a tool moves into
+            // the stock at most at 100 mm/min (a plunge; a thread enters
+            // at its lead); a rapid stops 1 mm off the material as it
+            // approaches it; a finishing pass takes at most 0.2 mm.
+            ("infeed_feed".to_owned(), 100.0),
+            ("rapid_clearance".to_owned(), 1.0),
+            ("finish_stock".to_owned(), 0.2),
         ]
         .into_iter()
         .collect(),

@@ -120,6 +120,16 @@ pub fn describe() -> MachineInfo {
             // Radius R_o of the rest's support in the axial section (mm).
             // U programs the support's centre (the seed, MATH §2.3).
             ("rest_radius".to_owned(), 25.0),
+            // The process (kernel/src/process.rs): the wheel moves into the
+            // stock (a plunge, the infeed at a pass's reversal) at most at
+            // 2 mm/min, a cylindrical grinder's radial infeed in hardened
+            // steel; a rapid stops 0.5 mm off the material as it
+            // approaches it; a finishing pass takes at most 0.03 mm; the
+            // rest comes onto the turning part at 100 mm/min.
+            ("infeed_feed".to_owned(), 2.0),
+            ("rapid_clearance".to_owned(), 0.5),
+            ("finish_stock".to_owned(), 0.03),
+            ("rest_approach_feed".to_owned(), 100.0),
         ]
         .into_iter()
         .collect(),
@@ -147,6 +157,9 @@ pub fn describe() -> MachineInfo {
                 radius: Quantity::Constant("rest_radius".into()),
                 length: Quantity::Value(40.0),
             }),
+            // The rest rides the part: it comes onto the turning part at
+            // this speed, never at rapid.
+            approach_feed: Some(Quantity::Constant("rest_approach_feed".into())),
         }],
         chain: vec![
             FactorSpec::axis(FactorKind::Tz, "Z"),

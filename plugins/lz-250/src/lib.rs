@@ -129,7 +129,18 @@ pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInf
         control: "sinumerik".into(),
         axes,
         solved_axes: solved,
-        constants: Default::default(),
+        // The process (the kernel's process rules): the wheel moves into
+        // the stock at most at 2 mm/min; a rapid stops 0.5 mm off the
+        // material as it approaches it; a finishing pass takes at most
+        // 0.1 mm (each pass of a groove grinds its strip's whole
+        // allowance, the seed's process).
+        constants: [
+            ("infeed_feed".to_owned(), 2.0),
+            ("rapid_clearance".to_owned(), 0.5),
+            ("finish_stock".to_owned(), 0.1),
+        ]
+        .into_iter()
+        .collect(),
         program_decimals: None,
         driven_axes: vec![],
         bodies: vec![],

@@ -1,0 +1,528 @@
+//! The process checked as well as the geometry: the rules a machinist holds
+//! every program to, whatever the family, each finding naming the block as
+//! the program numbers it.
+//!
+//! A program verified to a tenth of a micron may still plunge the wheel at
+//! the traverse feed or bring the steady rest onto the turning part at
+//! rapid. So every program a run writes is replayed move by move against
+//! the material as the family's replay knows it at that moment (the
+//! [`Stock`] its verification gives: the blank cut by the passes before),
+//! in sub-steps of each move as the control interpolates it:
+//!
+//! - **rapids through air only** ([`RAPID`]): a rapid that comes nearer
+//!   the material than the machine's `rapid_clearance`, or into it, is an
+//!   error (a rapid that leaves the part, a retract, may start on it);
+//! - **into the stock at the infeed feed** ([`INFEED`]): a feed move that
+//!   goes into the material more than along it (deeper by at least half
+//!   its length inside, and by more than [`PLUNGE_MIN`]) is an infeed, at
+//!   most the machine's `infeed_feed`;
+//! - **a body that rides the part meets it at its approach feed**
+//!   ([`APPROACH`]): a block that brings a steady rest (a body with an
+//!   `approach_feed`) from clear of the material (more than the rapid
+//!   clearance off it) onto it is a feed move at most that fast, never a
+//!   rapid;
+//! - **the spindle turns and the coolant flows before cutting**
+//!   ([`SPINDLE`]): every cutting block runs at a speed the program writes
+//!   as at least 1 rpm and the spindle's least, with the coolant on where
+//!   the machine's setup has coolant;
+//! - **a finishing pass takes no more than the finishing stock**
+//!   ([`FINISH`]): each pass that leaves the part at its nominal removes at
+//!   most the machine's `finish_stock` (a family may set it for its run);
+//! - **a ridge taller than the cut** ([`RIDGE`], a warning): a pass whose
+//!   feed leaves ridges taller than its cut leaves the surface before it
+//!   untouched at the crests.
+//!
+//! The machine states its limits as constants ([`ProcessLimits::of`]); a
+//! machine that states none is held to [`ProcessLimits::DEFAULT`]. A family
+//! whose verification gives no [`Stock`] is checked for the spindle and
+//! coolant only, and the verdict says which rules were not checked.
+//!
+//! The rules are written here by hand: they read the kernel's own replays,
+//! which no collision library knows; each is a few lines over them.
+
+use crate::machine::{BodyShape, MachineInfo, MachineKinematics};
+use crate::math::{Mat4, Real};
+use crate::program::{block_name, AxisProgram};
+use crate::toolpath::Motion;
+use crate::transform::ToolFrame;
+use crate::verdict::{Figure, Finding};
+
+/// The rule of rapids through air only.
+pub const RAPID: &str = "rapid through air only";
+/// The rule of the infeed feed.
+pub const INFEED: &str = "into the stock at the infeed feed";
+/// The rule of a riding body's approach feed.
+pub const APPROACH: &str = "the steady rest meets the part at its approach feed";
+/// The rule of the spindle and coolant before cutting.
+pub const SPINDLE: &str = "spindle at speed and coolant on before cutting";
+/// The rule of the finishing stock.
+pub const FINISH: &str = "a finishing pass takes no more than the finishing stock";
+/// The warning of a ridge taller than the cut.
+pub const RIDGE: &str = "a pass's ridge taller than its cut";
+
+/// The least a feed move must go deeper into the material to count as
+/// going into it (mm): below it, the replay's own sampling of the surface.
+pub const PLUNGE_MIN: Real = 2e-3;
+
+/// How far the tool may reach into the material on a rapid that leaves it
+/// (mm): the finished surface's ridges and the program's rounding.
+pub const RAPID_SLACK: Real = 1e-3;
+
+/// What the material is, as a family's replay knows it at every moment
+/// of the program.
+pub trait Stock {
+    /// How deep the tool stands in the material at `pose` (a row of 6, the
+    /// tracked point and the axis in the part frame, as the replay places
+    /// them), the material as the program has left it when block `block`
+    /// (from 0) begins (mm; negative: clear of it by that much, as far as
+    /// the model can tell).
+    fn tool_depth(&self, block: usize, pose: &[Real]) -> Real;
+
+    /// How far a body of `shape` (its sizes resolved: radius and length
+    /// of a roller) placed at `frame` in the part frame stands off the
+    /// material when block `block` begins (mm; 0 or less: on it), or
+    /// `None` where the model cannot say.
+    fn body_gap(&self, block: usize, shape: &Roller, frame: &Mat4) -> Option<Real>;
+
+    /// What each cutting pass removed.
+    fn passes(&self) -> Vec<PassStock>;
+}
+
+/// A roller body's sizes (mm): a cylinder along its frame's Y, centred on
+/// its origin (a steady rest's support).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Roller {
+    /// Radius.
+    pub radius: Real,
+    /// Length.
+    pub length: Real,
+}
+
+/// What one cutting pass removed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PassStock {
+    /// The pass's name.
+    pub name: String,
+    /// Its first block (from 0).
+    pub first_block: usize,
+    /// The most material it removed under the tool's path (mm): its cut,
+    /// the surface before it less the surface it left, at the valleys.
+    pub cut: Real,
+    /// The ridge its feed leaves on the surface (mm; 0 where none).
+    pub ridge: Real,
+    /// Whether it leaves the part at its nominal (within the tolerance):
+    /// a finishing pass.
+    pub finishes: bool,
+}
+
+/// The machine's process limits: constants the machine states, or the
+/// kernel's defaults.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProcessLimits {
+    /// The fastest the tool may move into the stock (mm/min): the machine's
+    /// constant `infeed_feed`.
+    pub infeed_feed: Real,
+    /// How far off the material a rapid stops as it approaches it (mm):
+    /// `rapid_clearance`.
+    pub rapid_clearance: Real,
+    /// The most a finishing pass may take (mm): `finish_stock`.
+    pub finish_stock: Real,
+}
+
+impl ProcessLimits {
+    /// The limits a machine is held to that states none: a grinder's
+    /// infeed (5 mm/min), 0.5 mm of clearance, 0.05 mm of finishing stock.
+    pub const DEFAULT: Self = Self {
+        infeed_feed: 5.0,
+        rapid_clearance: 0.5,
+        finish_stock: 0.05,
+    };
+
+    /// The limits `info` states in its constants, the defaults for those
+    /// it does not.
+    pub fn of(info: &MachineInfo) -> Self {
+        let c = |name: &str, default: Real| {
+            info.constants
+                .get(name)
+                .copied()
+                .filter(|v| v.is_finite() && *v > 0.0)
+                .unwrap_or(default)
+        };
+        let d = Self::DEFAULT;
+        Self {
+            infeed_feed: c("infeed_feed", d.infeed_feed),
+            rapid_clearance: c("rapid_clearance", d.rapid_clearance),
+            finish_stock: c("finish_stock", d.finish_stock),
+        }
+    }
+}
+
+/// What the process check found.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ProcessFindings {
+    /// Errors: each fails the run.
+    pub errors: Vec<Finding>,
+    /// Warnings: the report and the page show them.
+    pub warnings: Vec<Finding>,
+    /// Figures against their limits (the finishing stock).
+    pub figures: Vec<Figure>,
+}
+
+/// How many sub-steps a move is checked in: enough that the tool moves at
+/// most `step` mm between two, at most [`MAX_SUBSTEPS`].
+fn substeps(length: Real, step: Real) -> usize {
+    ((length / step).ceil() as usize).clamp(1, MAX_SUBSTEPS)
+}
+
+/// The most sub-steps of one move.
+pub const MAX_SUBSTEPS: usize = 200;
+
+/// Checks `program` (run on `machine`, the tool tracked at `tool`) against
+/// the rules of the [module docs](self), the material `stock` (if the
+/// family's verification gives one), the machine's `limits` (the finishing
+/// stock as the run sets it).
+///
+/// # Failures
+/// The machine's forward kinematics failing (the replay has already run
+/// it on the same program, so only a plugin that changed its mind).
+pub fn check(
+    program: &AxisProgram,
+    machine: &dyn MachineKinematics,
+    tool: &ToolFrame,
+    stock: Option<&dyn Stock>,
+    limits: &ProcessLimits,
+) -> Result<ProcessFindings, crate::verify::VerifyError> {
+    let mut out = ProcessFindings::default();
+    spindle_and_coolant(program, machine.info(), &mut out);
+    let Some(stock) = stock else {
+        return Ok(out);
+    };
+    let (written, _) = crate::verify::as_written(program);
+    let info = machine.info();
+    let name = |k: usize| block_name(program, k);
+    let n = written.blocks.len();
+    let rows = crate::program::axis_rows(&written, info, &info.solved_axes, 0..n)
+        .map_err(crate::verify::VerifyError::Replay)?;
+    let width = info.solved_axes.len();
+    // The tool at `t` of the way through block k's move.
+    let pose_at = |k: usize, t: Real| -> Result<Vec<Real>, crate::verify::VerifyError> {
+        let b = &rows[k * width..(k + 1) * width];
+        let a = if k > 0 {
+            &rows[(k - 1) * width..k * width]
+        } else {
+            b
+        };
+        let q: Vec<Real> = a.iter().zip(b).map(|(a, b)| a + (b - a) * t).collect();
+        let mut p = Vec::with_capacity(6);
+        machine.forward(&q, tool, &mut p).map_err(|source| {
+            crate::verify::VerifyError::Kinematics {
+                first: k + 1,
+                last: k + 1,
+                source,
+            }
+        })?;
+        Ok(p)
+    };
+    let ends = crate::verify::replay(&written, machine, tool)?;
+    for k in 1..n {
+        let b = &written.blocks[k];
+        let (p0, p1) = (&ends[6 * (k - 1)..6 * k], &ends[6 * k..6 * k + 6]);
+        let length =
+            ((p1[0] - p0[0]).powi(2) + (p1[1] - p0[1]).powi(2) + (p1[2] - p0[2]).powi(2)).sqrt();
+        match b.motion {
+            Motion::Rapid => {
+                let steps = substeps(length, limits.rapid_clearance.max(0.05));
+                let d0 = stock.tool_depth(k, p0);
+                // The deepest the move takes the tool where it comes nearer
+                // the material than it started.
+                let mut worst: Option<(Real, Real)> = None;
+                for i in 1..=steps {
+                    let t = i as Real / steps as Real;
+                    let d = if i == steps {
+                        stock.tool_depth(k, p1)
+                    } else {
+                        stock.tool_depth(k, &pose_at(k, t)?)
+                    };
+                    let nearer = d > d0 + RAPID_SLACK;
+                    let bad = nearer && (d > RAPID_SLACK || d > -0.99 * limits.rapid_clearance);
+                    if bad && worst.is_none_or(|w| d > w.0) {
+                        worst = Some((d, t));
+                    }
+                }
+                if let Some((d, t)) = worst {
+                    out.errors.push(
+                        Finding::new(
+                            RAPID,
+                            format!(
+                                "{}: a rapid {} ({} mm {} the material {} of the way through the move; rapids stop {} mm off it, the rest at feed)",
+                                name(k),
+                                if d > 0.0 { "into the material" } else { "onto the part" },
+                                crate::math::fixed(d.abs(), 3),
+                                if d > 0.0 { "into" } else { "off" },
+                                crate::math::fixed(t, 2),
+                                limits.rapid_clearance
+                            ),
+                        )
+                        .at(k, name(k)),
+                    );
+                }
+            }
+            Motion::Linear => {
+                // How much deeper the move takes the tool, over how much of
+                // its length inside the material.
+                let steps = substeps(length, 0.25);
+                let mut inside_from: Option<Real> = None;
+                let d0 = stock.tool_depth(k, p0);
+                let mut d_end = d0;
+                let mut previous = d0;
+                for i in 1..=steps {
+                    let t = i as Real / steps as Real;
+                    let d = if i == steps {
+                        stock.tool_depth(k, p1)
+                    } else {
+                        stock.tool_depth(k, &pose_at(k, t)?)
+                    };
+                    if inside_from.is_none() && d > 0.0 {
+                        // Where the depth crossed 0, between the samples.
+                        let t0 = (i - 1) as Real / steps as Real;
+                        let f = if d > previous && previous < 0.0 {
+                            -previous / (d - previous)
+                        } else {
+                            0.0
+                        };
+                        inside_from = Some(t0 + f / steps as Real);
+                    }
+                    previous = d;
+                    d_end = d;
+                }
+                let deeper = d_end - d0.max(0.0);
+                let inside = length * (1.0 - inside_from.unwrap_or(1.0));
+                if deeper > PLUNGE_MIN
+                    && deeper >= 0.5 * inside
+                    && b.feed > limits.infeed_feed * (1.0 + 1e-9)
+                {
+                    out.errors.push(
+                        Finding::new(
+                            INFEED,
+                            format!(
+                                "{}: the tool goes {} mm into the stock at F{} mm/min; the machine's infeed feed is at most {} mm/min (give the move into the material its own block at that feed)",
+                                name(k),
+                                crate::math::fixed(deeper, 4),
+                                crate::math::fixed(b.feed, 1),
+                                limits.infeed_feed
+                            ),
+                        )
+                        .at(k, name(k)),
+                    );
+                }
+            }
+            Motion::Thread { .. } => {}
+        }
+    }
+    bodies(program, &written, machine, stock, limits, &mut out)?;
+    finishing(program, stock, limits, &mut out);
+    Ok(out)
+}
+
+/// The spindle and coolant before every cutting block (as written: a
+/// speed rounded to whole rpm).
+fn spindle_and_coolant(program: &AxisProgram, info: &MachineInfo, out: &mut ProcessFindings) {
+    let least = info
+        .axes
+        .iter()
+        .find(|a| a.kind == crate::machine::AxisKind::Spindle)
+        .map_or(0.0, |a| a.min)
+        .max(1.0);
+    let mut rpm = program.spindle_rpm.round();
+    for (k, b) in program.blocks.iter().enumerate() {
+        if let Some(s) = b.spindle {
+            rpm = s.round();
+        }
+        if b.motion == Motion::Rapid {
+            continue;
+        }
+        if !(rpm >= least) {
+            out.errors.push(
+                Finding::new(
+                    SPINDLE,
+                    format!(
+                        "{}: the program cuts with the spindle at S{rpm}, below its least speed {least} rpm",
+                        block_name(program, k)
+                    ),
+                )
+                .at(k, block_name(program, k)),
+            );
+            return;
+        }
+        if info.setup.coolant && !program.setup.coolant {
+            out.errors.push(
+                Finding::new(
+                    SPINDLE,
+                    format!(
+                        "{}: the program cuts with the coolant off, which the machine's setup turns on",
+                        block_name(program, k)
+                    ),
+                )
+                .at(k, block_name(program, k)),
+            );
+            return;
+        }
+    }
+}
+
+/// The bodies that ride the part come onto it at their approach feed.
+fn bodies(
+    program: &AxisProgram,
+    written: &AxisProgram,
+    machine: &dyn MachineKinematics,
+    stock: &dyn Stock,
+    limits: &ProcessLimits,
+    out: &mut ProcessFindings,
+) -> Result<(), crate::verify::VerifyError> {
+    let info = machine.info();
+    let Ok(bodies) = crate::machine::bodies_of(info) else {
+        return Ok(());
+    };
+    let axes: Vec<Option<&crate::machine::Axis>> =
+        written.axes.iter().map(|a| info.axis(&a.name)).collect();
+    let known: Vec<&crate::machine::Axis> = axes.iter().flatten().copied().collect();
+    for body in bodies {
+        let spec = body.spec();
+        let (Some(feed), Some(BodyShape::Roller { radius, length })) =
+            (&spec.approach_feed, &spec.shape)
+        else {
+            continue;
+        };
+        let (Ok(feed), Ok(radius), Ok(length)) = (
+            feed.resolve(&info.constants),
+            radius.resolve(&info.constants),
+            length.resolve(&info.constants),
+        ) else {
+            continue;
+        };
+        let roller = Roller { radius, length };
+        let Ok(rows) = crate::program::axis_rows(
+            written,
+            info,
+            body.chain().axis_names(),
+            0..written.blocks.len(),
+        ) else {
+            continue; // the program does not drive the body
+        };
+        let width = body.chain().axis_names().len();
+        let frame = |k: usize| body.chain().matrix(&rows[k * width..(k + 1) * width]).ok();
+        // A body stands clear of the part when it is more than the rapid
+        // clearance off it; as it rides, it stands within the difference
+        // between the replay's surface and the one the family rode it on.
+        let clear = limits.rapid_clearance;
+        let mut gap_before = frame(0).and_then(|f| stock.body_gap(0, &roller, &f));
+        for k in 1..written.blocks.len() {
+            let gap = frame(k).and_then(|f| stock.body_gap(k, &roller, &f));
+            if let (Some(g0), Some(g1)) = (gap_before, gap) {
+                if g0 > clear && g1 <= clear {
+                    // It comes onto the part in this block: how fast.
+                    let b = &written.blocks[k];
+                    let moved = frame(k - 1).zip(frame(k)).map_or(0.0, |(a, b)| {
+                        let (a, b) = (a.column(3), b.column(3));
+                        ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2))
+                            .sqrt()
+                    });
+                    let speed = if b.motion == Motion::Rapid {
+                        Real::INFINITY
+                    } else {
+                        let deltas: Vec<Real> = b
+                            .values
+                            .iter()
+                            .zip(&written.blocks[k - 1].values)
+                            .zip(&axes)
+                            .filter(|(_, a)| a.is_some())
+                            .map(|((q, p), _)| q - p)
+                            .collect();
+                        let path =
+                            crate::machine::feed_length(&known, &deltas, &info.setup.feed_group);
+                        if path > 0.0 {
+                            moved * b.feed / path
+                        } else {
+                            0.0
+                        }
+                    };
+                    if speed > feed * (1.0 + 1e-9) {
+                        let name = block_name(program, k);
+                        out.errors.push(
+                            Finding::new(
+                                APPROACH,
+                                format!(
+                                    "{name}: {} comes onto the part {}; it may meet it at most at {feed} mm/min (bring it to its clearance at rapid, then onto the part at feed)",
+                                    spec.name,
+                                    if speed.is_infinite() {
+                                        "at rapid".to_owned()
+                                    } else {
+                                        format!("at {} mm/min", crate::math::fixed(speed, 1))
+                                    }
+                                ),
+                            )
+                            .at(k, name.clone()),
+                        );
+                    }
+                }
+            }
+            gap_before = gap;
+        }
+    }
+    Ok(())
+}
+
+/// The finishing passes' stock, and the ridges taller than their cuts.
+fn finishing(
+    program: &AxisProgram,
+    stock: &dyn Stock,
+    limits: &ProcessLimits,
+    out: &mut ProcessFindings,
+) {
+    let passes = stock.passes();
+    let mut worst: Option<&PassStock> = None;
+    for p in &passes {
+        let name = block_name(program, p.first_block);
+        if p.finishes {
+            if worst.is_none_or(|w| p.cut > w.cut) {
+                worst = Some(p);
+            }
+            if p.cut > limits.finish_stock * (1.0 + 1e-9) {
+                out.errors.push(
+                    Finding::new(
+                        FINISH,
+                        format!(
+                            "{name}: the finishing pass \"{}\" takes {} mm, more than the finishing stock {} mm (leave it less: a lighter cut before it)",
+                            p.name,
+                            crate::math::fixed(p.cut, 4),
+                            limits.finish_stock
+                        ),
+                    )
+                    .at(p.first_block, name.clone()),
+                );
+            }
+        } else if p.ridge > p.cut && p.cut > 0.0 {
+            out.warnings.push(
+                Finding::new(
+                    RIDGE,
+                    format!(
+                        "{name}: pass \"{}\" leaves ridges {} mm high on a cut of {} mm: at the crests it leaves the surface before it untouched (a lower feed, or a deeper cut)",
+                        p.name,
+                        crate::math::fixed(p.ridge, 4),
+                        crate::math::fixed(p.cut, 4)
+                    ),
+                )
+                .at(p.first_block, name),
+            );
+        }
+    }
+    if let Some(w) = worst {
+        out.figures.push(Figure::new(
+            "the finishing stock",
+            w.cut,
+            limits.finish_stock,
+            "mm",
+            block_name(program, w.first_block),
+        ));
+    }
+}
