@@ -93,6 +93,32 @@ fn caliber_verify(c: &mut Criterion) {
     let mut g = c.benchmark_group("caliber_verify");
     g.sample_size(10).measurement_time(Duration::from_secs(12));
     g.bench_function("replay_default_program", |b| b.iter(|| black_box(replay())));
+    // The process's rules over the same program: the wheel's depth in the
+    // turned groove at every block's end (a local search from the block
+    // before's nearest point), the rapids in sub-steps.
+    let allowance = req.stock.expect("the caliber states its stock");
+    let limits = pilgrim_kernel::process::ProcessLimits::of(kin.info());
+    let process = || {
+        let stock = pilgrim_kernel::caliber::GrooveStock::new(
+            &req,
+            allowance,
+            &wheel,
+            &out.program,
+            &out.toolpath.passes,
+        );
+        pilgrim_kernel::process::check(
+            &out.program,
+            kin,
+            &out.toolpath.tool.reference,
+            Some(&stock),
+            &limits,
+        )
+        .unwrap()
+    };
+    assert!(process().errors.is_empty());
+    g.bench_function("process_rules_default_program", |b| {
+        b.iter(|| black_box(process()))
+    });
     g.finish();
 }
 

@@ -18,8 +18,8 @@ use pilgrim_kernel::offset::rest::{track, RestSetup};
 use pilgrim_kernel::offset::surface::{GroundSurface, PassLayer, WheelSection};
 use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
 use pilgrim_kernel::{
-    equidistant, ClPoint, MandrelLaw, Motion, PartFamily, Pass, ProfileBuilder, Side, Tool,
-    Toolpath, Wheel,
+    drop_circle, equidistant, ClPoint, MandrelLaw, Motion, PartFamily, Pass, ProfileBuilder, Side,
+    Tool, Toolpath, Wheel,
 };
 use std::hint::black_box;
 use std::path::Path;
@@ -80,7 +80,9 @@ fn native_toolpath() -> Toolpath {
         radius: r_s,
         flat: wheel.flat(),
     };
-    let finish = (wheel.feed_for_ridge(0.4 * tol) * rpm).min(2000.0);
+    let (rough, infeed, rest_feed, clearance, rest_clearance, finish_cut) =
+        (1200.0, 2.0, 100.0, 0.5, 2.0, 0.02);
+    let finish = (wheel.feed_for_ridge(0.4 * tol) * rpm).min(rough);
     let mut tp = Toolpath::new(
         "mandrel",
         Tool::wheel("wheel", 1, wheel),
@@ -101,8 +103,13 @@ fn native_toolpath() -> Toolpath {
         aux: vec![u],
     };
     for j in 1..=passes {
-        let h = stock * (1.0 - j as f64 / passes as f64);
-        let feed = if h > 0.0 { 2000.0 } else { finish };
+        // Three equal roughing cuts, then the finishing cut.
+        let h = if j < passes {
+            stock - (stock - finish_cut) * j as f64 / (passes - 1) as f64
+        } else {
+            0.0
+        };
+        let feed = if h > 0.0 { rough } else { finish };
         let mut pass = centres.shifted(h).simplified(tol / 2.0);
         if j % 2 == 0 {
             pass = pass.reversed();
@@ -110,15 +117,29 @@ fn native_toolpath() -> Toolpath {
         let rest = track(&surface, &pass, section, feed, rpm, &setup).unwrap();
         let (cz, cx) = (&rest.path.z, &rest.path.x);
         if j == 1 {
+            // The wheel at rapid to its clearance over the blank, the rest
+            // to its own off the part, then onto it at its feed.
+            let air = drop_circle(surface.blank(), cz[0], r_s, Side::Outside)
+                .unwrap()
+                .centre_x
+                + clearance;
+            let u = rest.centre_x[0];
             tp.passes.push(Pass {
                 name: "approach".into(),
-                points: vec![pt(cz[0], cx[0] + 2.0, Motion::Rapid, 0.0, rest.centre_x[0])],
+                points: vec![
+                    pt(cz[0], air, Motion::Rapid, 1.0, u + rest_clearance),
+                    pt(cz[0], air, Motion::Linear, rest_feed, u),
+                ],
             });
         }
+        // Into the stock at the infeed feed, then the traverse.
         tp.passes.push(Pass {
             name: format!("pass {j}"),
             points: (0..cz.len())
-                .map(|k| pt(cz[k], cx[k], Motion::Linear, feed, rest.centre_x[k]))
+                .map(|k| {
+                    let f = if k == 0 { infeed } else { feed };
+                    pt(cz[k], cx[k], Motion::Linear, f, rest.centre_x[k])
+                })
                 .collect(),
         });
         let layer = PassLayer::new(cz, cx, section, feed, rpm).unwrap();

@@ -121,6 +121,25 @@ fn the_default_job_holds_its_tolerance_read_back_from_the_program() {
     let tol = v["tolerance"].as_f64().unwrap();
     assert_eq!(tol, 0.01);
     assert!(v["max_abs_mm"].as_f64().unwrap() <= tol);
+    // The process's rules hold, the groove's stock measured: the wheel
+    // comes in at rapid to its clearance off the turned groove and into it
+    // at the infeed feed, along the groove's normal at the first contact,
+    // by the linear axes alone (X and Z: the turn and the swivel stand).
+    assert_eq!(r["verdict"]["status"], "passed", "{}", r["verdict"]);
+    let mpf = std::fs::read_to_string(out.join("program.mpf")).unwrap();
+    let first = mpf
+        .lines()
+        .skip_while(|l| !l.starts_with("; pass 1,"))
+        .nth(1)
+        .unwrap();
+    assert!(
+        first.starts_with("N40 G1 X")
+            && first.contains(" Z")
+            && first.ends_with(" F2.0")
+            && !first.contains(" A")
+            && !first.contains(" B"),
+        "{first}"
+    );
     // The contact patch is reported with a size and is in the scene.
     let patch = &v["patch"];
     assert!(

@@ -133,6 +133,25 @@ fn cutter(dir: &Path) -> pilgrim_kernel::worm::ThreadCutter {
     }
 }
 
+/// What the family asks the simulation to hold for a worm of module `m`,
+/// `z1` starts, pitch diameter `d1`, `b1` long, placed as the run's report
+/// `r` says: the family's default tolerances.
+fn request(r: &serde_json::Value, m: f64, z1: i64, d1: f64, b1: f64) -> WormRequest {
+    WormRequest {
+        sizes: WormSizes::new(m, z1, d1, 0.2, 20f64.to_radians(), None).unwrap(),
+        length: b1,
+        space_centre: r["notes"]["space_centre_mm"].as_f64().unwrap(),
+        tolerances: WormTolerances {
+            form: 0.01,
+            thickness: 0.02,
+            diameter: 0.02,
+            position: 0.01,
+            flank_angle: 0.05f64.to_radians(),
+            lead: 0.01,
+        },
+    }
+}
+
 /// The run in `dir` simulated again from its `program.nc`.
 fn simulate_nc(
     dir: &Path,
@@ -145,19 +164,7 @@ fn simulate_nc(
     let r = report(dir);
     let rpm = r["parameters"]["spindle"]["value"].as_f64().unwrap();
     let program = read_nc(nc, rpm);
-    let req = WormRequest {
-        sizes: WormSizes::new(m, z1, d1, 0.2, 20f64.to_radians(), None).unwrap(),
-        length: b1,
-        space_centre: r["notes"]["space_centre_mm"].as_f64().unwrap(),
-        tolerances: WormTolerances {
-            form: 0.01,
-            thickness: 0.02,
-            diameter: 0.02,
-            position: 0.01,
-            flank_angle: 0.05f64.to_radians(),
-            lead: 0.01,
-        },
-    };
+    let req = request(&r, m, z1, d1, b1);
     simulate(&program, &lathe(), &Default::default(), &cutter(dir), &req)
         .and_then(|c| c.verified())
         .map_err(|e| e.to_string())
@@ -840,19 +847,7 @@ fn a_rapid_through_the_stock_is_refused() {
         serde_json::from_str(&std::fs::read_to_string(out.join("program.json")).unwrap()).unwrap();
     let r = report(&out);
     assert_eq!(r["verdict"]["status"], "passed");
-    let req = WormRequest {
-        sizes: WormSizes::new(5.0, 2, 50.0, 0.2, 20f64.to_radians(), None).unwrap(),
-        length: 60.0,
-        space_centre: r["notes"]["space_centre_mm"].as_f64().unwrap(),
-        tolerances: WormTolerances {
-            form: 0.01,
-            thickness: 0.02,
-            diameter: 0.02,
-            position: 0.01,
-            flank_angle: 0.05f64.to_radians(),
-            lead: 0.01,
-        },
-    };
+    let req = request(&r, 5.0, 2, 50.0, 60.0);
     let c = cutter(&out);
     use pilgrim_kernel::MachineKinematics;
     let errors = |p: &AxisProgram| {

@@ -14,8 +14,9 @@
 //!   error (a rapid that leaves the part, a retract, may start on it);
 //! - **into the stock at the infeed feed** ([`INFEED`]): a feed move that
 //!   goes into the material more than along it (deeper by at least half
-//!   its length inside, and by more than [`PLUNGE_MIN`]) is an infeed, at
-//!   most the machine's `infeed_feed`;
+//!   its length inside, the depth taken as straight between its ends, and
+//!   by more than [`PLUNGE_MIN`]) is an infeed, at most the machine's
+//!   `infeed_feed`;
 //! - **a body that rides the part meets it at its approach feed**
 //!   ([`APPROACH`]): a block that brings a steady rest (a body with an
 //!   `approach_feed`) from clear of the material (more than the rapid
@@ -81,8 +82,12 @@ pub trait Stock {
     /// How far a body of `shape` (its sizes resolved: radius and length
     /// of a roller) placed at `frame` in the part frame stands off the
     /// material when block `block` begins (mm; 0 or less: on it), or
-    /// `None` where the model cannot say.
-    fn body_gap(&self, block: usize, shape: &Roller, frame: &Mat4) -> Option<Real>;
+    /// `None` where the model cannot say (the default: a part no body
+    /// rides).
+    fn body_gap(&self, block: usize, shape: &Roller, frame: &Mat4) -> Option<Real> {
+        let _ = (block, shape, frame);
+        None
+    }
 
     /// What each cutting pass removed.
     fn passes(&self) -> Vec<PassStock>;
@@ -269,34 +274,18 @@ pub fn check(
             }
             Motion::Linear => {
                 // How much deeper the move takes the tool, over how much of
-                // its length inside the material.
-                let steps = substeps(length, 0.25);
-                let mut inside_from: Option<Real> = None;
-                let d0 = stock.tool_depth(k, p0);
-                let mut d_end = d0;
-                let mut previous = d0;
-                for i in 1..=steps {
-                    let t = i as Real / steps as Real;
-                    let d = if i == steps {
-                        stock.tool_depth(k, p1)
-                    } else {
-                        stock.tool_depth(k, &pose_at(k, t)?)
-                    };
-                    if inside_from.is_none() && d > 0.0 {
-                        // Where the depth crossed 0, between the samples.
-                        let t0 = (i - 1) as Real / steps as Real;
-                        let f = if d > previous && previous < 0.0 {
-                            -previous / (d - previous)
-                        } else {
-                            0.0
-                        };
-                        inside_from = Some(t0 + f / steps as Real);
-                    }
-                    previous = d;
-                    d_end = d;
-                }
-                let deeper = d_end - d0.max(0.0);
-                let inside = length * (1.0 - inside_from.unwrap_or(1.0));
+                // its length inside the material (the depth taken as
+                // straight along the move: a feed move is short, and the
+                // material smooth on its scale).
+                let (d0, d1) = (stock.tool_depth(k, p0), stock.tool_depth(k, p1));
+                let deeper = d1 - d0.max(0.0);
+                let inside = if d0 >= 0.0 {
+                    length
+                } else if d1 > 0.0 {
+                    length * d1 / (d1 - d0)
+                } else {
+                    0.0
+                };
                 if deeper > PLUNGE_MIN
                     && deeper >= 0.5 * inside
                     && b.feed > limits.infeed_feed * (1.0 + 1e-9)
@@ -341,32 +330,18 @@ fn spindle_and_coolant(program: &AxisProgram, info: &MachineInfo, out: &mut Proc
         if b.motion == Motion::Rapid {
             continue;
         }
-        if !(rpm >= least) {
-            out.errors.push(
-                Finding::new(
-                    SPINDLE,
-                    format!(
-                        "{}: the program cuts with the spindle at S{rpm}, below its least speed {least} rpm",
-                        block_name(program, k)
-                    ),
-                )
-                .at(k, block_name(program, k)),
-            );
-            return;
-        }
-        if info.setup.coolant && !program.setup.coolant {
-            out.errors.push(
-                Finding::new(
-                    SPINDLE,
-                    format!(
-                        "{}: the program cuts with the coolant off, which the machine's setup turns on",
-                        block_name(program, k)
-                    ),
-                )
-                .at(k, block_name(program, k)),
-            );
-            return;
-        }
+        let wrong = if !(rpm >= least) {
+            format!("the spindle at S{rpm}, below its least speed {least} rpm")
+        } else if info.setup.coolant && !program.setup.coolant {
+            "the coolant off, which the machine's setup turns on".to_owned()
+        } else {
+            continue;
+        };
+        let name = block_name(program, k);
+        out.errors.push(
+            Finding::new(SPINDLE, format!("{name}: the program cuts with {wrong}")).at(k, name),
+        );
+        return;
     }
 }
 

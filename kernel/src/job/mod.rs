@@ -232,12 +232,29 @@ fn post_all(
 /// the verdict: what failed, where, and every figure), `report.html`, the
 /// plots and the scene at the place it failed, the data files; no program
 /// a control could load. [`Error::Failed`] carries it.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub struct FailedRun {
     /// The report.
     pub report: Report,
     /// Every file's name and bytes.
     pub files: Vec<(String, Vec<u8>)>,
+}
+
+impl std::fmt::Debug for FailedRun {
+    /// What failed and the files' names (not their bytes: megabytes).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FailedRun")
+            .field("failures", &self.report.verdict.message())
+            .field(
+                "files",
+                &self
+                    .files
+                    .iter()
+                    .map(|(n, _)| n.as_str())
+                    .collect::<Vec<_>>(),
+            )
+            .finish()
+    }
 }
 
 /// The failed run of `report` with the `files` made so far: the page and

@@ -757,15 +757,6 @@ impl crate::process::Stock for WormStock {
             .fold(Real::NEG_INFINITY, Real::max)
     }
 
-    fn body_gap(
-        &self,
-        _: usize,
-        _: &crate::process::Roller,
-        _: &crate::math::Mat4,
-    ) -> Option<Real> {
-        None
-    }
-
     fn passes(&self) -> Vec<crate::process::PassStock> {
         self.passes.clone()
     }
