@@ -206,21 +206,7 @@ fn banner(out: &mut String, r: &Report) {
         out,
         "<div class=\"banner {class}\" id=\"verdict\"><b>{head}</b>"
     );
-    if !v.failures.is_empty() {
-        out.push_str("<ul>\n");
-        for f in &v.failures {
-            let _ = writeln!(
-                out,
-                "<li><b>{}</b>{}: {}</li>",
-                escape(&f.rule),
-                f.block
-                    .as_ref()
-                    .map_or(String::new(), |b| format!(" at {}", escape(b))),
-                escape(&f.message)
-            );
-        }
-        out.push_str("</ul>\n");
-    }
+    findings(out, "", "", &v.failures);
     if !v.figures.is_empty() {
         out.push_str("<table><tr><th>figure</th><th>value</th><th>tolerance</th><th>of the tolerance</th><th>where</th></tr>\n");
         for f in &v.figures {
@@ -241,22 +227,28 @@ fn banner(out: &mut String, r: &Report) {
         }
         out.push_str("</table>\n");
     }
-    if !v.warnings.is_empty() {
-        out.push_str("<ul class=\"warn\">\n");
-        for w in &v.warnings {
-            let _ = writeln!(
-                out,
-                "<li>warning ({}){}: {}</li>",
-                escape(&w.rule),
-                w.block
-                    .as_ref()
-                    .map_or(String::new(), |b| format!(" at {}", escape(b))),
-                escape(&w.message)
-            );
-        }
-        out.push_str("</ul>\n");
-    }
+    findings(out, " class=\"warn\"", "warning: ", &v.warnings);
     out.push_str("</div>\n");
+}
+
+/// A list of findings, each its rule, its block and what it says.
+fn findings(out: &mut String, class: &str, prefix: &str, list: &[crate::verdict::Finding]) {
+    if list.is_empty() {
+        return;
+    }
+    let _ = writeln!(out, "<ul{class}>");
+    for f in list {
+        let _ = writeln!(
+            out,
+            "<li>{prefix}<b>{}</b>{}: {}</li>",
+            escape(&f.rule),
+            f.block
+                .as_ref()
+                .map_or(String::new(), |b| format!(" at {}", escape(b))),
+            escape(&f.message)
+        );
+    }
+    out.push_str("</ul>\n");
 }
 
 /// The page's text.
