@@ -499,6 +499,16 @@ fn step_solids_and_page_are_the_runs() {
     assert!(share > 0.5 && share <= 1.0, "{finish}");
     let page = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(page.contains("<b>PASSED: every check and figure held</b>"));
+    // The page names the finish's worst place by the block the program
+    // numbers (it once named the block after it).
+    let finish = &report["verification"]["passes"][3]["deviation"];
+    let b = finish["block"].as_u64().unwrap() as usize;
+    let worst = format!(
+        "the worst at z = {:.3} mm, {}.",
+        finish["at_z"].as_f64().unwrap(),
+        block_label("sinumerik", b - 1)
+    );
+    assert!(page.contains(&worst), "{worst} not on the page");
     assert!(
         page.contains(&format!("{:.1}%", 100.0 * share)),
         "no share on the page"

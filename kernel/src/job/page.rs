@@ -77,8 +77,12 @@ fn verification(out: &mut String, r: &Report) {
             fixed(v.resolution_mm, 4)
         );
         if let Some(f) = v.passes.last() {
+            // The block counts from 1 (the program's and report.csv's).
             let block = f.deviation.block.map_or_else(String::new, |b| {
-                format!(", {}", escape(&crate::program::block_label(&r.control, b)))
+                format!(
+                    ", {}",
+                    escape(&crate::program::block_label(&r.control, b - 1))
+                )
             });
             let _ = writeln!(
                 out,
@@ -244,6 +248,7 @@ fn findings(out: &mut String, class: &str, prefix: &str, list: &[crate::verdict:
             escape(&f.rule),
             f.block
                 .as_ref()
+                .filter(|b| !f.message.contains(b.as_str()))
                 .map_or(String::new(), |b| format!(" at {}", escape(b))),
             escape(&f.message)
         );
