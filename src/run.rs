@@ -153,9 +153,9 @@ pub fn export(
     block: Option<usize>,
     formats: Formats,
 ) -> Result<String, String> {
-    pilgrim_kernel::output::check_replaceable(dir).map_err(|e| e.to_string())?;
-    let e = job::export(dir, catalog, machine, block, formats).map_err(|e| e.to_string())?;
-    pilgrim_kernel::output::update_dir(dir, &e.files).map_err(|e| e.to_string())?;
+    let run = pilgrim_kernel::output::RunDir::open(dir).map_err(|e| e.to_string())?;
+    let e = job::export(&run, catalog, machine, block, formats).map_err(|e| e.to_string())?;
+    pilgrim_kernel::output::update_dir(&run, &e.files).map_err(|e| e.to_string())?;
     Ok(format!(
         "{}: the scene placed at block {}",
         dir.display(),

@@ -79,8 +79,7 @@ fn report(dir: &Path) -> serde_json::Value {
 /// The groove the run ground: the example table, smoothed as the family
 /// does (5 iterations from the middle of the sizing section).
 fn groove() -> Groove {
-    let t = pilgrim_kernel::profile::read_table(root().join("scripts/examples/caliber-groove.csv"))
-        .unwrap();
+    let t = pilgrim_kernel::profile::read_table(root().join("scripts/caliber-groove.csv")).unwrap();
     let g =
         Groove::from_tables(150.0, (&t, "theta_deg", "Hp_mm"), (&t, "theta_deg", "B_mm")).unwrap();
     g.smoothed(5, g.sizing_middle()).unwrap().0
@@ -398,7 +397,7 @@ fn a_corrupted_block_is_named() {
 #[test]
 fn bad_input_is_refused_with_no_output() {
     let dir = scratch_dir("bad");
-    let good = std::fs::read_to_string(root().join("scripts/examples/caliber-groove.csv")).unwrap();
+    let good = std::fs::read_to_string(root().join("scripts/caliber-groove.csv")).unwrap();
     let rows: Vec<&str> = good.lines().collect();
     let header = rows
         .iter()

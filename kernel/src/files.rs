@@ -24,7 +24,7 @@ pub struct FileError {
 
 fn error(path: &Path, message: impl Into<String>) -> FileError {
     FileError {
-        file: path.display().to_string(),
+        file: shown_path(path),
         message: message.into(),
     }
 }
@@ -91,12 +91,61 @@ pub fn is_plain_name(name: &str) -> bool {
             .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
 }
 
-/// `text` cut to [`MAX_EXCERPT`] characters, marking the cut.
-pub fn excerpt(text: &str) -> String {
-    match text.char_indices().nth(MAX_EXCERPT) {
-        None => text.to_owned(),
-        Some((i, _)) => format!("{}...", &text[..i]),
+/// One character as a message shows it: control characters (line ends,
+/// escapes, bidirectional controls) as escapes, so that quoted text can
+/// neither drive a terminal nor hide what it says.
+fn shown_char(c: char, out: &mut String) {
+    match c {
+        '\n' => out.push_str("\\n"),
+        '\r' => out.push_str("\\r"),
+        '\t' => out.push_str("\\t"),
+        c if c.is_control()
+            || matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}') =>
+        {
+            out.push_str(&format!("\\u{{{:x}}}", u32::from(c)));
+        }
+        c => out.push(c),
     }
+}
+
+/// `text` as a message quotes it: control characters escaped, at most
+/// [`MAX_EXCERPT`] characters of it, marking the cut with `...`.
+pub fn excerpt(text: &str) -> String {
+    let mut out = String::new();
+    let mut count = 0;
+    for c in text.chars() {
+        let mut one = String::new();
+        shown_char(c, &mut one);
+        let n = one.chars().count();
+        if count + n > MAX_EXCERPT {
+            out.push_str("...");
+            return out;
+        }
+        count += n;
+        out.push_str(&one);
+    }
+    out
+}
+
+/// A path as a message shows it: control characters escaped, and a path
+/// longer than [`MAX_EXCERPT`] characters cut in the middle, so that both
+/// where it starts and the file's name show.
+pub fn shown_path(path: &Path) -> String {
+    let text = path.display().to_string();
+    let mut escaped = String::new();
+    for c in text.chars() {
+        shown_char(c, &mut escaped);
+    }
+    let chars: Vec<char> = escaped.chars().collect();
+    if chars.len() <= MAX_EXCERPT {
+        return escaped;
+    }
+    let half = MAX_EXCERPT / 2;
+    let head: String = chars[..half].iter().collect();
+    let tail: String = chars[chars.len() - (MAX_EXCERPT - half - 3)..]
+        .iter()
+        .collect();
+    format!("{head}...{tail}")
 }
 
 #[cfg(test)]
@@ -109,6 +158,14 @@ mod tests {
         let long = "é".repeat(10_000);
         let e = excerpt(&long);
         assert_eq!(e.chars().count(), MAX_EXCERPT + 3);
+        // Escapes count towards the length and are never cut in two.
+        let e = excerpt(&"\u{1b}]52;c;AAAA\u{7}".repeat(100));
+        assert!(e.chars().count() <= MAX_EXCERPT + 3, "{e}");
+        assert!(!e.contains('\u{1b}') && e.starts_with("\\u{1b}]52"), "{e}");
+        let p = Path::new("/tmp").join("d".repeat(300)).join("part.stl");
+        let s = shown_path(&p);
+        assert_eq!(s.chars().count(), MAX_EXCERPT);
+        assert!(s.starts_with("/tmp/ddd") && s.ends_with("/part.stl"), "{s}");
     }
 
     #[test]

@@ -1,23 +1,38 @@
-//! Writing a run's output directory: all of it or none of it, and only
-//! over a directory that pilgrim wrote.
+//! Writing and reading a run's output directory: all of it or none of it,
+//! only over a directory pilgrim wrote, never through a link, and never
+//! removing a file pilgrim did not write.
 //!
-//! A run writes its files into a temporary directory beside the target
-//! (`.NAME.tmp-PID`), marks it with [`MARKER`] (which lists the files), and
-//! swaps it in: on Linux by an atomic exchange of the two directories
-//! (`renameat2(RENAME_EXCHANGE)`), so the target always holds the old
-//! output or the whole new one; elsewhere by two renames. The target must
-//! be new, or a previous pilgrim output (it holds the marker) holding no
-//! file the marker does not list: anything else is refused, naming what
-//! is in the way, and nothing is touched. Temporary directories that killed
-//! runs left beside the target are removed by the next run, but only those
-//! of a process that is gone and only if pilgrim marked them.
+//! Every write goes through [`write_dir`] (a run, a failed run's
+//! diagnostic, an export: [`update_dir`] carries the run's other files
+//! over) or [`write_generated_file`] (`api-docs`). A directory is written
+//! whole into a temporary directory beside the target, created exclusively
+//! under a name no other process uses (`.NAME.tmp-PID.N`: `mkdir` fails on
+//! anything already there, a planted link included, and the next `N` is
+//! tried), its files created exclusively inside it. It is marked with
+//! [`MARKER`], which lists its files, and swapped in: on Linux by an atomic
+//! exchange of the two directories (`renameat2(RENAME_EXCHANGE)`), so the
+//! target always holds the old output or the whole new one; elsewhere by
+//! two renames. The target must be new, or a previous pilgrim output (it
+//! holds the marker) holding only the files its marker lists: anything
+//! else, whatever its name, is refused, naming what is in the way, and
+//! nothing is touched.
+//!
+//! What is removed is only what a marker lists: the old output once the
+//! new one is in place, and the temporary directories killed runs left
+//! beside the target (of a process that is gone). Each is emptied of the
+//! files its marker lists, then removed if that left it empty; a file
+//! pilgrim did not write keeps the directory in place.
+//!
+//! A run's files are read back ([`RunDir`]) only by the plain names its
+//! marker lists, never through a link, and only if they are regular files.
 
+use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 /// The file that marks a directory as pilgrim's output.
 pub const MARKER: &str = ".pilgrim-output";
 
-/// An output that cannot be written.
+/// An output that cannot be written or read.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{path}: {message}")]
 pub struct OutputError {
@@ -29,7 +44,7 @@ pub struct OutputError {
 
 fn err(path: &Path, message: impl Into<String>) -> OutputError {
     OutputError {
-        path: path.display().to_string(),
+        path: crate::files::shown_path(path),
         message: message.into(),
     }
 }
@@ -56,14 +71,21 @@ fn marker_text(files: &[&str], failed: bool) -> String {
     s
 }
 
-/// The files a marker lists.
+/// The files a marker lists (plain names only: a line that is not one is
+/// not pilgrim's and lists nothing).
 fn marked_files(text: &str) -> Vec<&str> {
-    text.lines().skip(1).filter(|l| !l.is_empty()).collect()
+    text.lines().skip(1).filter(|l| plain(l)).collect()
+}
+
+/// Whether a marker's text says its run failed.
+fn says_failed(text: &str) -> bool {
+    text.lines().next().is_some_and(|l| l.contains(FAILED_RUN))
 }
 
 /// Whether `name` may be written in an output directory: a plain file name.
 fn plain(name: &str) -> bool {
     !name.is_empty()
+        && name.len() <= 255
         && name != "."
         && name != ".."
         && !name.starts_with('.')
@@ -72,12 +94,83 @@ fn plain(name: &str) -> bool {
             .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'))
 }
 
+/// The bytes of the regular file `path`, at most `limit`, opened without
+/// following a link (a link, a directory, a FIFO or a device is refused,
+/// and nothing is waited on).
+fn read_no_follow(path: &Path, limit: u64) -> Result<Vec<u8>, OutputError> {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK);
+    }
+    #[cfg(not(unix))]
+    if std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()) {
+        return Err(err(
+            path,
+            "is a link: pilgrim reads a run's files only as it wrote them",
+        ));
+    }
+    let file = options.open(path).map_err(|e| {
+        #[cfg(unix)]
+        if e.raw_os_error() == Some(libc::ELOOP) {
+            return err(
+                path,
+                "is a link: pilgrim reads a run's files only as it wrote them, never through a link",
+            );
+        }
+        err(path, e.to_string())
+    })?;
+    let meta = file.metadata().map_err(|e| err(path, e.to_string()))?;
+    if !meta.is_file() {
+        return Err(err(
+            path,
+            "is not a regular file: pilgrim reads a run's files only as it wrote them",
+        ));
+    }
+    if meta.len() > limit {
+        return Err(err(
+            path,
+            format!(
+                "{} bytes, more than the {limit} bytes read from a run's file",
+                meta.len()
+            ),
+        ));
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(limit + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| err(path, e.to_string()))?;
+    if bytes.len() as u64 > limit {
+        return Err(err(
+            path,
+            format!("grew past {limit} bytes while it was read"),
+        ));
+    }
+    Ok(bytes)
+}
+
+/// The marker of `dir`, read without following a link; `None` if there is
+/// none (or it is not a regular file, or not text).
+fn read_marker(dir: &Path) -> Option<String> {
+    read_no_follow(&dir.join(MARKER), crate::files::MAX_TEXT_BYTES)
+        .ok()
+        .and_then(|b| String::from_utf8(b).ok())
+}
+
+/// Whether `path` is a directory itself (not a link to one).
+fn is_real_dir(path: &Path) -> bool {
+    std::fs::symlink_metadata(path).is_ok_and(|m| m.is_dir())
+}
+
 /// Checks that `out` may be replaced: it does not exist, or it is a
-/// directory pilgrim wrote, holding only the files its marker lists.
+/// directory pilgrim wrote, holding only the marker and the files it lists.
 ///
 /// # Failures
-/// A path that is not a directory, a directory without the marker, or one
-/// holding files the marker does not list: each named.
+/// A path that is not a directory (a link to one included), a directory
+/// without the marker, or one holding anything the marker does not list,
+/// whatever its name: each named.
 pub fn check_replaceable(out: &Path) -> Result<(), OutputError> {
     let meta = match std::fs::symlink_metadata(out) {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
@@ -90,57 +183,86 @@ pub fn check_replaceable(out: &Path) -> Result<(), OutputError> {
             "is not a directory: pilgrim writes its outputs into a directory of their own; give --out a new directory name",
         ));
     }
-    let marker = std::fs::read_to_string(out.join(MARKER)).ok();
-    let entries: Vec<String> = std::fs::read_dir(out)
+    let marker = read_marker(out);
+    let mut entries: Vec<String> = std::fs::read_dir(out)
         .map_err(|e| err(out, e.to_string()))?
         .filter_map(|e| e.ok())
         .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n != MARKER && !is_temporary(n))
+        .filter(|n| n != MARKER)
         .collect();
+    entries.sort_unstable();
+    let shown = |names: &[&String]| {
+        let mut s: Vec<String> = names
+            .iter()
+            .take(5)
+            .map(|n| crate::names::quoted(n))
+            .collect();
+        if names.len() > 5 {
+            s.push(format!("and {} more", names.len() - 5));
+        }
+        s.join(", ")
+    };
     let Some(marker) = marker else {
-        let mut shown: Vec<&str> = entries.iter().map(String::as_str).collect();
-        shown.sort_unstable();
-        shown.truncate(5);
+        let all: Vec<&String> = entries.iter().collect();
         return Err(err(
             out,
             format!(
                 "exists and was not written by pilgrim (it holds {}): pilgrim replaces only its own output directories; give --out a new directory name, or move this one away yourself",
-                if shown.is_empty() {
+                if all.is_empty() {
                     "nothing".to_owned()
                 } else {
-                    shown.join(", ")
+                    shown(&all)
                 }
             ),
         ));
     };
     let listed = marked_files(&marker);
-    let mut foreign: Vec<&str> = entries
+    let foreign: Vec<&String> = entries
         .iter()
-        .map(String::as_str)
-        .filter(|n| !listed.contains(n))
+        .filter(|n| !listed.contains(&n.as_str()))
         .collect();
     if !foreign.is_empty() {
-        foreign.sort_unstable();
-        foreign.truncate(5);
         return Err(err(
             out,
             format!(
                 "is a pilgrim output, but holds files pilgrim did not write ({}): move them away, or give --out another directory",
-                foreign.join(", ")
+                shown(&foreign)
             ),
         ));
     }
     Ok(())
 }
 
-/// Whether `name` is one of pilgrim's own temporary files or directories
-/// (`.NAME.tmp-PID`, `.NAME.old-PID`).
-fn is_temporary(name: &str) -> bool {
-    name.starts_with('.')
-        && [".tmp-", ".old-"].iter().any(|k| {
-            name.rsplit_once(k)
-                .is_some_and(|(_, pid)| !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit()))
-        })
+/// Removes from `dir` the files its marker lists, then the marker, then
+/// `dir` itself if that left it empty (a file pilgrim did not write keeps
+/// it). A directory without pilgrim's marker is left as it is.
+fn remove_listed(dir: &Path) {
+    if !is_real_dir(dir) {
+        return;
+    }
+    let Some(marker) = read_marker(dir) else {
+        return;
+    };
+    for name in marked_files(&marker) {
+        let p = dir.join(name);
+        // A listed name that is now a directory is not a file pilgrim wrote.
+        if std::fs::symlink_metadata(&p).is_ok_and(|m| !m.is_dir()) {
+            let _ = std::fs::remove_file(&p);
+        }
+    }
+    let _ = std::fs::remove_file(dir.join(MARKER));
+    let _ = std::fs::remove_dir(dir);
+}
+
+/// The process of a temporary directory's name `.BASE.tmp-PID.N` or
+/// `.BASE.old-PID.N` (as [`write_marked`] names them).
+fn temporary_pid(name: &str, base: &str) -> Option<u32> {
+    [".tmp-", ".old-"].iter().find_map(|kind| {
+        let rest = name.strip_prefix(&format!(".{base}{kind}"))?;
+        let (pid, n) = rest.split_once('.')?;
+        n.parse::<u32>().ok()?;
+        pid.parse::<u32>().ok()
+    })
 }
 
 /// Whether the process `pid` is gone (Linux: no `/proc/PID`; elsewhere
@@ -149,27 +271,19 @@ fn process_gone(pid: u32) -> bool {
     cfg!(target_os = "linux") && !Path::new("/proc").join(pid.to_string()).exists()
 }
 
-/// Removes the temporary directories of killed runs to `base` in `parent`:
-/// `.BASE.tmp-PID` and `.BASE.old-PID` of a process that is gone, if pilgrim
-/// marked them.
+/// Removes what killed runs to `base` left in `parent`: the files their
+/// markers list, in the temporary directories of processes that are gone.
 fn clean_stale(parent: &Path, base: &str) {
     let Ok(entries) = std::fs::read_dir(parent) else {
         return;
     };
     for e in entries.flatten() {
         let name = e.file_name().to_string_lossy().into_owned();
-        let pid = [".tmp-", ".old-"].iter().find_map(|kind| {
-            name.strip_prefix(&format!(".{base}{kind}"))
-                .and_then(|p| p.parse::<u32>().ok())
-        });
-        let Some(pid) = pid else { continue };
-        let path = e.path();
-        if pid != std::process::id()
-            && process_gone(pid)
-            && path.join(MARKER).is_file()
-            && std::fs::symlink_metadata(&path).is_ok_and(|m| m.is_dir())
-        {
-            let _ = std::fs::remove_dir_all(&path);
+        let Some(pid) = temporary_pid(&name, base) else {
+            continue;
+        };
+        if pid != std::process::id() && process_gone(pid) {
+            remove_listed(&e.path());
         }
     }
 }
@@ -211,8 +325,7 @@ fn exchange(_: &Path, _: &Path) -> std::io::Result<bool> {
 /// Whether `dir` holds a pilgrim output of a run that succeeded: its
 /// marker is there and does not say the run failed.
 pub fn holds_good_output(dir: &Path) -> bool {
-    std::fs::read_to_string(dir.join(MARKER))
-        .is_ok_and(|m| m.lines().next().is_some_and(|l| !l.contains(FAILED_RUN)))
+    read_marker(dir).is_some_and(|m| !says_failed(&m))
 }
 
 /// Where a failed run's diagnostic goes when it was asked to write into
@@ -222,12 +335,17 @@ pub fn holds_good_output(dir: &Path) -> bool {
 /// and it holds no program.
 pub fn failed_dir(out: &Path) -> PathBuf {
     if holds_good_output(out) {
-        let mut name = out.file_name().unwrap_or_default().to_os_string();
-        name.push(".failed");
-        out.with_file_name(name)
+        failed_sibling(out)
     } else {
         out.to_owned()
     }
+}
+
+/// `<out>.failed`.
+fn failed_sibling(out: &Path) -> PathBuf {
+    let mut name = out.file_name().unwrap_or_default().to_os_string();
+    name.push(".failed");
+    out.with_file_name(name)
 }
 
 /// Writes a failed run's `files` (its diagnostic: no program) where
@@ -251,18 +369,39 @@ pub fn write_failed(out: &Path, files: &[(String, Vec<u8>)]) -> Result<PathBuf, 
 /// or rename failing (the target is then as it was).
 pub fn write_dir(out: &Path, files: &[(String, Vec<u8>)]) -> Result<(), OutputError> {
     write_marked(out, files, false)?;
-    let mut name = out.file_name().unwrap_or_default().to_os_string();
-    name.push(".failed");
-    let stale = out.with_file_name(name);
-    let failed_marker = std::fs::read_to_string(stale.join(MARKER))
-        .is_ok_and(|m| m.lines().next().is_some_and(|l| l.contains(FAILED_RUN)));
-    if failed_marker
-        && std::fs::symlink_metadata(&stale).is_ok_and(|m| m.is_dir())
-        && check_replaceable(&stale).is_ok()
-    {
-        let _ = std::fs::remove_dir_all(&stale);
+    let stale = failed_sibling(out);
+    if read_marker(&stale).is_some_and(|m| says_failed(&m)) && check_replaceable(&stale).is_ok() {
+        remove_listed(&stale);
     }
     Ok(())
+}
+
+/// Creates a directory of pilgrim's own beside `out`: `.BASE.KIND-PID.N`,
+/// the first `N` free (`mkdir` never follows or reuses what is there).
+fn create_own_dir(parent: &Path, base: &str, kind: &str) -> Result<PathBuf, OutputError> {
+    let pid = std::process::id();
+    for n in 0..1000 {
+        let p = parent.join(format!(".{base}.{kind}-{pid}.{n}"));
+        match std::fs::create_dir(&p) {
+            Ok(()) => return Ok(p),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(err(&p, e.to_string())),
+        }
+    }
+    Err(err(
+        parent,
+        format!("a thousand names .{base}.{kind}-{pid}.N are taken: remove them"),
+    ))
+}
+
+/// Writes `bytes` as the new file `path` (never over anything there).
+fn create_file(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+    let mut f = std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(path)
+        .map_err(|e| err(path, e.to_string()))?;
+    f.write_all(bytes).map_err(|e| err(path, e.to_string()))
 }
 
 /// [`write_dir`]'s writing, the marker saying whether the run failed.
@@ -276,80 +415,198 @@ fn write_marked(out: &Path, files: &[(String, Vec<u8>)], failed: bool) -> Result
         .and_then(|n| n.to_str())
         .ok_or_else(|| err(out, "not a directory name"))?;
     if let Some((bad, _)) = files.iter().find(|(n, _)| !plain(n)) {
-        return Err(err(out, format!("'{bad}' is not a plain file name")));
+        return Err(err(
+            out,
+            format!("'{}' is not a plain file name", crate::names::quoted(bad)),
+        ));
     }
     check_replaceable(out)?;
     std::fs::create_dir_all(&parent).map_err(|e| err(&parent, e.to_string()))?;
     clean_stale(&parent, base);
-    let tmp = parent.join(format!(".{base}.tmp-{}", std::process::id()));
-    let old = parent.join(format!(".{base}.old-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&tmp);
+    let tmp = create_own_dir(&parent, base, "tmp")?;
     let result = (|| {
-        std::fs::create_dir(&tmp).map_err(|e| err(&tmp, e.to_string()))?;
         let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
-        std::fs::write(tmp.join(MARKER), marker_text(&names, failed))
-            .map_err(|e| err(&tmp, e.to_string()))?;
+        // The marker first: a killed run's directory lists what it holds.
+        create_file(&tmp.join(MARKER), marker_text(&names, failed).as_bytes())?;
         for (name, bytes) in files {
-            let p = tmp.join(name);
-            std::fs::write(&p, bytes).map_err(|e| err(&p, e.to_string()))?;
+            create_file(&tmp.join(name), bytes)?;
         }
-        if out.exists() {
+        if std::fs::symlink_metadata(out).is_ok() {
             if exchange(&tmp, out).map_err(|e| err(out, e.to_string()))? {
                 // `tmp` now holds the old output.
-                let _ = std::fs::remove_dir_all(&tmp);
+                remove_listed(&tmp);
                 return Ok(());
             }
+            let old = create_own_dir(&parent, base, "old")?;
+            std::fs::remove_dir(&old).map_err(|e| err(&old, e.to_string()))?;
             std::fs::rename(out, &old).map_err(|e| err(out, e.to_string()))?;
+            std::fs::rename(&tmp, out).map_err(|e| {
+                let _ = std::fs::rename(&old, out);
+                err(out, e.to_string())
+            })?;
+            remove_listed(&old);
+            return Ok(());
         }
-        std::fs::rename(&tmp, out).map_err(|e| {
-            let _ = std::fs::rename(&old, out);
-            err(out, e.to_string())
-        })?;
-        let _ = std::fs::remove_dir_all(&old);
-        Ok(())
+        std::fs::rename(&tmp, out).map_err(|e| err(out, e.to_string()))
     })();
     if result.is_err() {
-        let _ = std::fs::remove_dir_all(&tmp);
+        remove_listed(&tmp);
     }
     result
 }
 
-/// Writes `files` over some of those of the pilgrim output `dir`, each
-/// through a temporary file and a rename, and adds them to its marker.
+/// A run's output directory, read back: the files its marker lists, each
+/// read only as pilgrim wrote it.
+#[derive(Debug, Clone)]
+pub struct RunDir {
+    dir: PathBuf,
+    files: Vec<String>,
+    failed: bool,
+}
+
+impl RunDir {
+    /// Opens the pilgrim output `dir`.
+    ///
+    /// # Failures
+    /// `dir` not a pilgrim output, or holding files pilgrim did not write
+    /// ([`check_replaceable`]).
+    pub fn open(dir: &Path) -> Result<Self, OutputError> {
+        let marker = read_marker(dir)
+            .filter(|_| is_real_dir(dir))
+            .ok_or_else(|| err(dir, "is not a pilgrim output directory"))?;
+        check_replaceable(dir)?;
+        Ok(Self {
+            dir: dir.to_owned(),
+            files: marked_files(&marker)
+                .into_iter()
+                .map(str::to_owned)
+                .collect(),
+            failed: says_failed(&marker),
+        })
+    }
+
+    /// The directory.
+    pub fn path(&self) -> &Path {
+        &self.dir
+    }
+
+    /// The files the run wrote, as its marker lists them.
+    pub fn files(&self) -> &[String] {
+        &self.files
+    }
+
+    /// Whether the run failed (its marker says so).
+    pub fn failed(&self) -> bool {
+        self.failed
+    }
+
+    /// The bytes of the run's file `name`, at most `limit`.
+    ///
+    /// # Failures
+    /// A name the marker does not list (the run did not write it), a link,
+    /// anything but a regular file, a larger file, a read error.
+    pub fn read(&self, name: &str, limit: u64) -> Result<Vec<u8>, OutputError> {
+        if !self.files.iter().any(|f| f == name) {
+            return Err(err(
+                &self.dir.join(crate::names::quoted(name)),
+                "is not a file this run wrote (its .pilgrim-output does not list it)",
+            ));
+        }
+        read_no_follow(&self.dir.join(name), limit)
+    }
+
+    /// The text (UTF-8) of the run's file `name`, at most `limit` bytes.
+    ///
+    /// # Failures
+    /// As [`Self::read`]; text that is not UTF-8.
+    pub fn read_text(&self, name: &str, limit: u64) -> Result<String, OutputError> {
+        String::from_utf8(self.read(name, limit)?).map_err(|e| {
+            err(
+                &self.dir.join(name),
+                format!("not UTF-8 text: {}", e.utf8_error()),
+            )
+        })
+    }
+}
+
+/// Writes `files` over some of those of the run `dir` (opened as
+/// [`RunDir::open`]), the others carried over as they are: the whole
+/// directory is written again as [`write_dir`] writes it, so an export
+/// killed part way leaves the run as it was.
 ///
 /// # Failures
-/// `dir` not a pilgrim output ([`check_replaceable`]); a file name that is
-/// not a plain name; a write failing.
-pub fn update_dir(dir: &Path, files: &[(String, Vec<u8>)]) -> Result<(), OutputError> {
-    if !dir.join(MARKER).is_file() {
-        return Err(err(dir, "is not a pilgrim output directory"));
-    }
-    check_replaceable(dir)?;
-    let marker = std::fs::read_to_string(dir.join(MARKER)).map_err(|e| err(dir, e.to_string()))?;
-    let mut names: Vec<String> = marked_files(&marker)
-        .iter()
-        .map(|s| (*s).to_owned())
-        .collect();
-    for (name, bytes) in files {
-        if !plain(name) {
-            return Err(err(dir, format!("'{name}' is not a plain file name")));
-        }
-        let path = dir.join(name);
-        let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-        std::fs::write(&tmp, bytes).map_err(|e| err(&tmp, e.to_string()))?;
-        std::fs::rename(&tmp, &path).map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            err(&path, e.to_string())
-        })?;
-        if !names.contains(name) {
-            names.push(name.clone());
+/// As [`RunDir::open`] and [`write_dir`]; a file of the run that cannot be
+/// read as pilgrim wrote it.
+pub fn update_dir(dir: &RunDir, files: &[(String, Vec<u8>)]) -> Result<(), OutputError> {
+    let mut all: Vec<(String, Vec<u8>)> = Vec::new();
+    for name in dir.files() {
+        if !files.iter().any(|(n, _)| n == name) {
+            all.push((name.clone(), dir.read(name, crate::files::MAX_DATA_BYTES)?));
         }
     }
-    let refs: Vec<&str> = names.iter().map(String::as_str).collect();
-    let tmp = dir.join(format!("{MARKER}.tmp-{}", std::process::id()));
-    let failed = !holds_good_output(dir);
-    std::fs::write(&tmp, marker_text(&refs, failed)).map_err(|e| err(&tmp, e.to_string()))?;
-    std::fs::rename(&tmp, dir.join(MARKER)).map_err(|e| err(dir, e.to_string()))
+    all.extend(files.iter().cloned());
+    write_marked(dir.path(), &all, dir.failed())
+}
+
+/// Writes `bytes` as the file `path`: a new file, or one that begins as
+/// `bytes` does in its first `header_lines` lines (one pilgrim generated
+/// before), replaced through a temporary file created exclusively beside
+/// it and a rename. Anything else (a user's file, a link, a directory) is
+/// refused and left as it is.
+///
+/// # Failures
+/// What is at `path` is not pilgrim's; a write or rename failing.
+pub fn write_generated_file(
+    path: &Path,
+    bytes: &[u8],
+    header_lines: usize,
+) -> Result<(), OutputError> {
+    let header = |b: &[u8]| -> Vec<u8> {
+        b.split_inclusive(|&c| c == b'\n')
+            .take(header_lines)
+            .flatten()
+            .copied()
+            .collect()
+    };
+    match std::fs::symlink_metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => return Err(err(path, e.to_string())),
+        Ok(m) if m.file_type().is_symlink() => {
+            return Err(err(
+                path,
+                "is a link: pilgrim writes a new file or replaces one it generated, never through a link",
+            ))
+        }
+        Ok(_) => {
+            let old = read_no_follow(path, crate::files::MAX_DATA_BYTES).map_err(|_| {
+                err(path, "exists and is not a file pilgrim generated: give a new file name")
+            })?;
+            if header_lines == 0 || header(&old) != header(bytes) {
+                return Err(err(
+                    path,
+                    "exists and is not a file pilgrim generated (its first lines differ): pilgrim replaces only its own; give a new file name, or move this one away yourself",
+                ));
+            }
+        }
+    }
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
+        _ => PathBuf::from("."),
+    };
+    let base = path
+        .file_name()
+        .and_then(|n| n.to_str())
+        .ok_or_else(|| err(path, "not a file name"))?;
+    let pid = std::process::id();
+    let tmp = (0..1000)
+        .map(|n| parent.join(format!(".{base}.tmp-{pid}.{n}")))
+        .find(|p| std::fs::symlink_metadata(p).is_err())
+        .ok_or_else(|| err(&parent, format!("the names .{base}.tmp-{pid}.N are taken")))?;
+    create_file(&tmp, bytes)?;
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        err(path, e.to_string())
+    })
 }
 
 #[cfg(test)]
@@ -363,6 +620,20 @@ mod tests {
         }
         for good in ["part.stl", "scene.glb", "report-2.csv"] {
             assert!(plain(good), "{good}");
+        }
+    }
+
+    #[test]
+    fn temporaries_are_named_by_process_and_number() {
+        assert_eq!(temporary_pid(".out.tmp-123.0", "out"), Some(123));
+        assert_eq!(temporary_pid(".out.old-9.12", "out"), Some(9));
+        for other in [
+            ".out.tmp-123",
+            ".out.tmp-x.1",
+            ".other.tmp-1.1",
+            "out.tmp-1.1",
+        ] {
+            assert_eq!(temporary_pid(other, "out"), None, "{other}");
         }
     }
 }

@@ -278,14 +278,14 @@ fn smoothing_keeps_smooth_tables_and_removes_a_planted_dent() {
     );
 }
 
-/// The example groove (`scripts/examples/caliber-groove.csv`, with a notes
+/// The example groove (`scripts/caliber-groove.csv`, with a notes
 /// column) reads into a groove: its depth falls from the hollow's radius
 /// through the reduction zone to the tube's, constant over the sizing
 /// section, and its sections are rounder than a 10 mm wheel rounding.
 #[test]
 fn the_example_groove_reads_from_its_table() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../scripts/examples/caliber-groove.csv");
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scripts/caliber-groove.csv");
     let t = pilgrim_kernel::read_table(&path).unwrap();
     let g =
         Groove::from_tables(150.0, (&t, "theta_deg", "Hp_mm"), (&t, "theta_deg", "B_mm")).unwrap();
@@ -375,8 +375,8 @@ fn passes_are_spread_across_the_groove() {
 #[test]
 fn the_caliber_solid_is_closed_and_holds_its_volume() {
     use pilgrim_kernel::caliber::caliber_solid;
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../scripts/examples/caliber-groove.csv");
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scripts/caliber-groove.csv");
     let t = pilgrim_kernel::read_table(&path).unwrap();
     let g =
         Groove::from_tables(150.0, (&t, "theta_deg", "Hp_mm"), (&t, "theta_deg", "B_mm")).unwrap();
@@ -419,22 +419,19 @@ fn the_caliber_solid_is_closed_and_holds_its_volume() {
 #[test]
 fn scripts_reach_the_caliber_geometry() {
     use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
-    let examples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scripts/examples");
-    let src = format!(
-        "fn params() {{ #{{}} }}\n\
-         fn toolpath(p) {{ () }}\n\
-         fn probe(p) {{\n\
-           let g = groove(150.0, read_table(\"{}\"), \"theta_deg\", \"Hp_mm\", \"B_mm\");\n\
+    let examples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scripts");
+    let src = "fn params() { #{} }\n\
+         fn toolpath(p) { () }\n\
+         fn probe(p) {\n\
+           let g = groove(150.0, read_table(\"caliber-groove.csv\"), \"theta_deg\", \"Hp_mm\", \"B_mm\");\n\
            let passes = g.pass_angles(10.0, 0.02, 1.4);\n\
            let s = g.seed_pose(0.5, 0.3, 150.0, 10.0);\n\
            [g.min_curvature_radius, passes.psi.len, passes.scallop, s.x_k, s.mu, g.point(0.5, 0.3)[2]]\n\
-         }}",
-        examples.join("caliber-groove.csv").display()
-    );
+         }";
     let access = Access {
         input_dirs: vec![examples.clone()],
     };
-    let fam = ScriptFamily::from_source(&src, "probe.rhai", &Limits::default(), &access).unwrap();
+    let fam = ScriptFamily::from_source(src, "probe.rhai", &Limits::default(), &access).unwrap();
     let values = pilgrim_kernel::params::resolve(
         pilgrim_kernel::PartFamily::params(&fam),
         &Default::default(),

@@ -171,7 +171,7 @@ fn endless_loop_is_stopped() {
 }
 
 #[test]
-fn files_only_inside_the_input_directories() {
+fn files_only_beside_the_input_files() {
     let dir = std::env::temp_dir().join(format!("pilgrim-script-{}", std::process::id()));
     let inside = dir.join("in");
     std::fs::create_dir_all(&inside).unwrap();
@@ -187,7 +187,7 @@ fn files_only_inside_the_input_directories() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("../secret.csv: not a readable file inside the input directories"),
+        e.contains("../secret.csv: not a readable file beside the script or the parameter file"),
         "{e}"
     );
     let e = family("fn params() { #{} }\nimport \"x\" as y;\nfn toolpath(p) {}")

@@ -5,9 +5,13 @@ use super::scene::{self, Formats};
 use super::Report;
 use crate::catalog::Catalog;
 use crate::error::Error;
+use crate::output::RunDir;
 use crate::program::AxisProgram;
 use crate::toolpath::Toolpath;
-use std::path::Path;
+
+/// The most part bodies an export places (a family's part is a few
+/// bodies; a report listing one body thousands of times is not a run's).
+pub const MAX_PART_BODIES: usize = 64;
 
 /// What an export made: the files to write over the run's, and the block.
 #[derive(Debug, Clone)]
@@ -20,40 +24,73 @@ pub struct Exported {
     pub block: usize,
 }
 
-/// The scene of the run in `dir` placed at `block` (from 1; `None`: the
+/// The scene of the run `run` placed at `block` (from 1; `None`: the
 /// middle of the last cutting pass).
 ///
-/// Nothing in the run's files is trusted: they are read only from `dir`, by
-/// plain names; the machine is the built-in the report names, or the one
-/// the caller names (`machine`, what the user gave on the command line):
-/// a plugin or a machine file named only by the report is never opened.
+/// Nothing in the run's files is trusted: they are read only as the run
+/// wrote them ([`RunDir::read`]: names its marker lists, no links), and
+/// checked before any work: the toolpath as a run checks it, the program's
+/// shape ([`crate::program::check_shape`]), the part bodies (plain names,
+/// each once, at most [`MAX_PART_BODIES`], their files the run's); the
+/// machine is the built-in the report names, or the one the caller names
+/// (`machine`, what the user gave on the command line): a plugin or a
+/// machine file named only by the report is never opened.
 ///
 /// # Failures
 /// A file of the run missing or not what the run wrote; a run without 3-D
 /// models; a report naming a machine that is not a built-in, with no
 /// `machine` given; block 0; the machine or the replay failing.
 pub fn export(
-    dir: &Path,
+    run: &RunDir,
     catalog: &Catalog,
     machine: Option<&str>,
     block: Option<usize>,
     formats: Formats,
 ) -> Result<Exported, Error> {
+    let dir = run.path();
+    let shown = crate::files::shown_path(dir);
     let read = |name: &str| {
-        crate::files::read_text(&dir.join(name), crate::files::MAX_DATA_BYTES)
+        run.read_text(name, crate::files::MAX_DATA_BYTES)
             .map_err(|e| Error::Read(e.to_string()))
     };
-    let parse = |name: &str, e: serde_json::Error| Error::Read(format!("{name}: {e}"));
-    let mut report: Report =
-        serde_json::from_str(&read("report.json")?).map_err(|e| parse("report.json", e))?;
-    let program: AxisProgram =
-        serde_json::from_str(&read("program.json")?).map_err(|e| parse("program.json", e))?;
-    let toolpath: Toolpath =
-        serde_json::from_str(&read("toolpath.json")?).map_err(|e| parse("toolpath.json", e))?;
+    let bad = |name: &str, e: String| {
+        Error::Read(format!(
+            "{shown}/{name}: {} (not as the run wrote it)",
+            crate::files::excerpt(&e)
+        ))
+    };
+    let mut report: Report = serde_json::from_str(&read("report.json")?)
+        .map_err(|e| bad("report.json", e.to_string()))?;
+    let program: AxisProgram = serde_json::from_str(&read("program.json")?)
+        .map_err(|e| bad("program.json", e.to_string()))?;
+    crate::program::check_shape(&program).map_err(|e| bad("program.json", e))?;
+    let toolpath: Toolpath = serde_json::from_str(&read("toolpath.json")?)
+        .map_err(|e| bad("toolpath.json", e.to_string()))?;
+    toolpath
+        .validate()
+        .map_err(|e| bad("toolpath.json", e.to_string()))?;
+    let part_bodies: Vec<&super::scene::BodyFile> =
+        report.bodies.iter().filter(|b| b.kind == "part").collect();
+    if part_bodies.len() > MAX_PART_BODIES {
+        return Err(bad(
+            "report.json",
+            format!(
+                "{} part bodies, more than the {MAX_PART_BODIES} an export places",
+                part_bodies.len()
+            ),
+        ));
+    }
+    for (i, b) in part_bodies.iter().enumerate() {
+        if part_bodies[..i].iter().any(|o| o.name == b.name) {
+            return Err(bad(
+                "report.json",
+                format!("the body {} is listed twice", crate::names::quoted(&b.name)),
+            ));
+        }
+    }
     if report.bodies.is_empty() {
         return Err(Error::Read(format!(
-            "{}: the run has no 3-D models (its family has no fn part(p))",
-            dir.display()
+            "{shown}: the run has no 3-D models (its family has no fn part(p))"
         )));
     }
     let spec = match machine {
@@ -67,8 +104,7 @@ pub fn export(
         }
         None => {
             return Err(Error::Read(format!(
-                "{}: the run's machine '{}' is not a built-in: name it with --machine (pilgrim loads a plugin or machine file only when the command line names it)",
-                dir.display(),
+                "{shown}: the run's machine '{}' is not a built-in: name it with --machine (pilgrim loads a plugin or machine file only when the command line names it)",
                 crate::files::excerpt(&report.machine_spec)
             )))
         }
@@ -81,24 +117,23 @@ pub fn export(
         None => scene::default_pose_block(&program, &toolpath.passes),
     };
     let index = place.block;
-    let parts = report
-        .bodies
+    let mut stl_bytes = 0u64;
+    let parts = part_bodies
         .iter()
-        .filter(|b| b.kind == "part")
         .map(|b| {
             // Only the run's own files, by the names the run gives them.
             if !crate::files::is_plain_name(&b.name) || b.file != format!("{}.stl", b.name) {
                 return Err(Error::Read(format!(
-                    "{}: report.json names the file '{}' for body '{}', which is not a file of this run",
-                    dir.display(),
+                    "{shown}: report.json names the file '{}' for body '{}', which is not a file of this run",
                     crate::files::excerpt(&b.file),
                     crate::files::excerpt(&b.name)
                 )));
             }
-            let path = dir.join(&b.file);
-            crate::files::check_regular(&path, crate::files::MAX_DATA_BYTES)
+            let bytes = run
+                .read(&b.file, crate::files::MAX_DATA_BYTES - stl_bytes)
                 .map_err(|e| Error::Read(e.to_string()))?;
-            crate::mesh::read_stl(&path)
+            stl_bytes += bytes.len() as u64;
+            crate::mesh::read_stl_bytes(&bytes, &format!("{shown}/{}", b.file))
                 .map(|m| (b.name.clone(), m))
                 .map_err(|e| Error::Read(e.to_string()))
         })
@@ -129,8 +164,7 @@ pub fn export(
     // The page shows the new scene, with the run's plots and program.
     let control = crate::program::post::dialect(&report.control).ok_or_else(|| {
         Error::Read(format!(
-            "{}: report.json names the control '{}', which pilgrim does not know",
-            dir.display(),
+            "{shown}: report.json names the control '{}', which pilgrim does not know",
             crate::files::excerpt(&report.control)
         ))
     })?;

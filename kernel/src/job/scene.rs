@@ -335,6 +335,20 @@ pub fn files(
     overlays: Vec<Placed>,
     formats: Formats,
 ) -> Result<(Files, Vec<BodyFile>), SceneError> {
+    // The scene as a whole is bounded as each mesh is.
+    let total: usize = parts.iter().map(|(_, m)| m.triangle_count()).sum::<usize>()
+        + tool.as_ref().map_or(0, |(m, _)| m.triangle_count())
+        + others
+            .iter()
+            .chain(&overlays)
+            .map(|p| p.1.triangle_count())
+            .sum::<usize>();
+    if total > mesh::MAX_TRIANGLES {
+        return Err(SceneError::Place(format!(
+            "the scene would hold {total} triangles, more than the ceiling {}",
+            mesh::MAX_TRIANGLES
+        )));
+    }
     let mut scene = Scene::new();
     let mut out = Vec::new();
     let mut bodies = Vec::new();

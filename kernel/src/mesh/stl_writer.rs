@@ -102,18 +102,51 @@ pub fn write_stl<W: Write>(
     }
 }
 
-/// Reads an STL file (binary or ASCII) into a mesh, welded by `stl_io`,
-/// with vertex normals averaged from the faces.
+/// Whether `bytes` are as long as a binary STL of the triangle count in
+/// its header.
+fn binary_length_matches(bytes: &[u8]) -> bool {
+    bytes.len() >= 84
+        && bytes[80..84]
+            .try_into()
+            .map(u32::from_le_bytes)
+            .is_ok_and(|n| bytes.len() as u64 == 84 + 50 * u64::from(n))
+}
+
+/// Reads an STL file (binary or ASCII) into a mesh, as [`read_stl_bytes`].
 ///
 /// # Failures
 /// A read error or a malformed file.
 pub fn read_stl(path: &std::path::Path) -> Result<TriMesh, MeshError> {
+    let bytes = crate::files::read_bytes(path, crate::files::MAX_DATA_BYTES).map_err(|e| {
+        MeshError::Io {
+            file: e.file,
+            message: e.message,
+        }
+    })?;
+    read_stl_bytes(&bytes, &crate::files::shown_path(path))
+}
+
+/// An STL file's bytes (binary or ASCII; `file` names it in errors) as a
+/// mesh, welded by `stl_io`, with vertex normals averaged from the faces.
+/// A binary file must be as long as its triangle count says before any of
+/// it is read (a count of four billion in a short file would otherwise be
+/// believed).
+///
+/// # Failures
+/// A malformed file.
+pub fn read_stl_bytes(bytes: &[u8], file: &str) -> Result<TriMesh, MeshError> {
     let err = |m: String| MeshError::Io {
-        file: path.display().to_string(),
+        file: file.to_owned(),
         message: m,
     };
-    let mut f = std::fs::File::open(path).map_err(|e| err(e.to_string()))?;
-    let stl = stl_io::read_stl(&mut f).map_err(|e| err(e.to_string()))?;
+    let ascii = bytes.starts_with(b"solid") && !binary_length_matches(bytes);
+    if !ascii && !binary_length_matches(bytes) {
+        return Err(err(format!(
+            "not an STL file: {} bytes, where a binary STL holds 84 + 50 per triangle of its count",
+            bytes.len()
+        )));
+    }
+    let stl = stl_io::read_stl(&mut std::io::Cursor::new(bytes)).map_err(|e| err(e.to_string()))?;
     let positions: Vec<[f64; 3]> = stl
         .vertices
         .iter()

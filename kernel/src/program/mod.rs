@@ -217,6 +217,76 @@ pub fn pass_blocks<'a>(
     pass_ranges(passes).map(move |(p, r)| (p, r.start + lead..r.end + lead))
 }
 
+/// Checks a program read back from a file (a run's `program.json`, which
+/// anyone may have edited) before anything is done with it: every block
+/// holds one finite value per axis, feeds and spindle speeds are finite
+/// and not negative, the axes and the axes a block keeps are the
+/// program's, and the blocks are at most [`crate::toolpath::MAX_POINTS`]
+/// and a few more for the setup's moves.
+///
+/// # Failures
+/// The first fault, naming the block as the program numbers it.
+pub fn check_shape(program: &AxisProgram) -> Result<(), String> {
+    let width = program.axes.len();
+    let letters = crate::machine::AXIS_LETTERS;
+    if width == 0 || width > letters.len() {
+        return Err(format!(
+            "{width} axes (a program has 1 to {})",
+            letters.len()
+        ));
+    }
+    for (i, a) in program.axes.iter().enumerate() {
+        if !(a.name.len() == 1 && letters.contains(a.name.as_str()))
+            || program.axes[..i].iter().any(|b| b.name == a.name)
+        {
+            return Err(format!(
+                "axis {} is not one of the letters {letters}, once each",
+                crate::names::quoted(&a.name)
+            ));
+        }
+    }
+    let most = crate::toolpath::MAX_POINTS + 64;
+    if program.blocks.len() > most {
+        return Err(format!(
+            "{} blocks, more than the {most} a run writes",
+            program.blocks.len()
+        ));
+    }
+    for (i, b) in program.blocks.iter().enumerate() {
+        let at = || block_label(&program.control, i);
+        if b.values.len() != width {
+            return Err(format!(
+                "{}: {} values for the program's {width} axes",
+                at(),
+                b.values.len()
+            ));
+        }
+        if let Some(v) = b.values.iter().find(|v| !v.is_finite()) {
+            return Err(format!("{}: the value {v} is not a finite number", at()));
+        }
+        if !(b.feed.is_finite() && b.feed >= 0.0)
+            || b.spindle.is_some_and(|s| !(s.is_finite() && s >= 0.0))
+        {
+            return Err(format!(
+                "{}: a feed or spindle speed that is not a finite number of at least 0",
+                at()
+            ));
+        }
+        if let Some(k) = b
+            .keep
+            .iter()
+            .find(|k| !program.axes.iter().any(|a| &a.name == *k))
+        {
+            return Err(format!(
+                "{}: it keeps axis {}, which is not the program's",
+                at(),
+                crate::names::quoted(k)
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The number a program in the dialect `control` gives its block `index`
 /// (from 0): `N570` where the dialect numbers blocks (the shared writer's
 /// numbering, [`post::Dialect::numbering`]), else `block 57`.
@@ -240,7 +310,7 @@ pub(crate) fn name_in(control: &str, blocks: &[Block], index: usize) -> String {
         .get(..=index.min(blocks.len().saturating_sub(1)))
         .and_then(|b| b.iter().rev().find_map(|b| b.comment.as_deref()));
     match pass {
-        Some(p) => format!("{label} in \"{p}\""),
+        Some(p) => format!("{label} in \"{}\"", crate::files::excerpt(p)),
         None => label,
     }
 }

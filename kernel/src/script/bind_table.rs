@@ -43,7 +43,9 @@ pub mod table_api {
     }
 }
 
-/// `read_table(path)`, allowed only inside the input directories.
+/// `read_table(name)`: a file directly inside one of the input
+/// directories, by its plain name (no directory in it: a script reads
+/// beside itself and beside the parameter file, never below or above).
 pub(super) fn register(engine: &mut Engine, access: &Access) {
     let dirs: Vec<PathBuf> = access
         .input_dirs
@@ -51,39 +53,41 @@ pub(super) fn register(engine: &mut Engine, access: &Access) {
         .filter_map(|d| d.canonicalize().ok())
         .collect();
     rhai::FuncRegistration::new("read_table")
-        .with_params_info(["path: &str", "Table"])
+        .with_params_info(["name: &str", "Table"])
         .with_comments([
-            "/// A table (CSV, XLSX, XLS, ODS) from a file inside the input directories",
-            "/// (the script's own, and the parameter file's); a relative path is taken",
-            "/// from the first of them that holds it. Its columns are read by header:",
-            "/// `t[\"theta\"]`.",
+            "/// A table (CSV, XLSX, XLS, ODS) from a file beside the script or beside the",
+            "/// parameter file, named by its file name alone (no directory: a script reads",
+            "/// nothing below or above those two); the script's directory is looked in",
+            "/// first. Its columns are read by header: `t[\"theta\"]`.",
         ])
         .register_into_engine(
             engine,
-            move |path: &str| -> Result<Table, Box<EvalAltResult>> {
-                let p = Path::new(path);
-                if dirs.is_empty() {
-                    return Err("no input directory is open to scripts".into());
-                }
-                let full = if p.is_absolute() {
-                    p.to_owned()
-                } else {
-                    // The first directory holding it (a script's own example,
-                    // or a table beside the parameter file that names it).
-                    dirs.iter()
-                        .map(|d| d.join(p))
-                        .find(|f| f.is_file())
-                        .unwrap_or_else(|| dirs[0].join(p))
-                };
-                // A missing file and one outside get the same answer: a
-                // script must not learn what lies outside.
+            move |name: &str| -> Result<Table, Box<EvalAltResult>> {
+                // A missing file, one elsewhere, and a link leading
+                // elsewhere get the same answer: a script must not learn
+                // what lies outside.
                 let refused = || -> Box<EvalAltResult> {
-                    format!("{path}: not a readable file inside the input directories").into()
+                    format!(
+                        "{}: not a readable file beside the script or the parameter file (a table is named by its file name alone)",
+                        crate::files::excerpt(name)
+                    )
+                    .into()
                 };
-                let canon = full.canonicalize().map_err(|_| refused())?;
-                if !dirs.iter().any(|d| canon.starts_with(d)) {
+                let plain = Path::new(name)
+                    .file_name()
+                    .is_some_and(|f| f == std::ffi::OsStr::new(name))
+                    && name != "."
+                    && name != "..";
+                if !plain {
                     return Err(refused());
                 }
+                let found = dirs
+                    .iter()
+                    .filter_map(|d| d.join(name).canonicalize().ok().map(|c| (d, c)))
+                    .find(|(d, c)| c.parent() == Some(d.as_path()) && c.is_file());
+                let Some((_, canon)) = found else {
+                    return Err(refused());
+                };
                 kernel(crate::profile::read_table(&canon))
             },
         );
