@@ -110,12 +110,17 @@ fn stale_temporaries_of_dead_runs_are_cleaned() {
     let dead_pid = dead.id();
     let mut dead = dead;
     dead.wait().unwrap();
-    let stale = dir.join(format!(".out.tmp-{dead_pid}"));
+    let stale = dir.join(format!(".out.tmp-{dead_pid}.0"));
     std::fs::create_dir(&stale).unwrap();
-    std::fs::write(stale.join(".pilgrim-output"), "").unwrap();
+    // Its marker lists what it wrote: only that is removed.
+    std::fs::write(
+        stale.join(".pilgrim-output"),
+        "pilgrim output directory: the next run to it replaces it as a whole.\npart.stl\n",
+    )
+    .unwrap();
     std::fs::write(stale.join("part.stl"), "half").unwrap();
     // One of a live process (this test).
-    let live = dir.join(format!(".out.tmp-{}", std::process::id()));
+    let live = dir.join(format!(".out.tmp-{}.0", std::process::id()));
     std::fs::create_dir(&live).unwrap();
     std::fs::write(live.join(".pilgrim-output"), "").unwrap();
     let out = dir.join("out");
@@ -216,7 +221,7 @@ fn outside_files_are_not_told_apart() {
     }
     assert_eq!(answers[0], answers[1]);
     assert!(
-        answers[0].contains("not a readable file inside the input directories"),
+        answers[0].contains("not a readable file beside the script or the parameter file"),
         "{}",
         answers[0]
     );
@@ -655,5 +660,114 @@ fn a_spindle_that_writes_as_zero_is_refused() {
         "{err}"
     );
     assert!(!out.exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Every message quotes outside text short (at most 120 characters) with
+/// its control characters escaped, whatever its source: a 1 MB table
+/// cell, a 3 MB parameter key (in a file and on the command line), a 3 MB
+/// axis name, a script's `print` of escape sequences (OSC 52 writes the
+/// clipboard); and `report.csv` neutralises a pass name a spreadsheet
+/// would evaluate (`=1+2`).
+#[test]
+fn every_message_quotes_outside_text_short() {
+    let dir = scratch("quotes");
+    let out = dir.join("o");
+    let escape = "\u{1b}]52;c;cHduZWQ=\u{7}\u{1b}[31m";
+    let clean = |what: &str, err: &str| {
+        assert!(
+            !err.contains('\u{1b}') && !err.contains('\u{7}'),
+            "{what}: raw escapes in {err:?}"
+        );
+        assert!(err.len() < 2000, "{what}: {} bytes of message", err.len());
+    };
+    // A table cell.
+    let table = dir.join("t.csv");
+    std::fs::write(&table, format!("a,b\n1,{escape}{}\n", "9x".repeat(1 << 19))).unwrap();
+    let script = dir.join("f.rhai");
+    std::fs::write(
+        &script,
+        "fn params() { #{} }\nfn default_machine() { \"vertical-mill\" }\nfn toolpath(p) { read_table(\"t.csv\")[\"b\"] }\n",
+    )
+    .unwrap();
+    let (code, _, err) = pilgrim(&["run", s(&script), "--out", s(&out)]);
+    assert_eq!(code, 1, "{err}");
+    clean("table cell", &err);
+    assert!(
+        err.contains("t.csv") && err.contains("column B (b)"),
+        "{err}"
+    );
+    // A parameter key, from a file and from --set.
+    let key = format!("{escape}{}", "k".repeat(3 << 20));
+    let params = dir.join("p.toml");
+    std::fs::write(
+        &params,
+        format!(
+            "\"{}\" = 1\n",
+            key.replace('\u{1b}', "\\u001b").replace('\u{7}', "\\u0007")
+        ),
+    )
+    .unwrap();
+    let (code, _, err) = pilgrim(&["run", DEMO, "--params", s(&params), "--out", s(&out)]);
+    assert_eq!(code, 1, "{err}");
+    clean("parameter key in a file", &err);
+    assert!(err.contains("unknown parameter"), "{err}");
+    // (one argument is at most 128 KiB on Linux)
+    let set = format!("{}=1", &key[..100_000]);
+    let (code, _, err) = pilgrim(&["run", DEMO, "--set", &set, "--out", s(&out)]);
+    assert_eq!(code, 1, "{err}");
+    clean("parameter key on the command line", &err);
+    // An axis name.
+    let mill = pilgrim_kernel::machine::BUILTIN_SOURCES
+        .iter()
+        .find(|(n, _)| *n == "vertical-mill")
+        .unwrap()
+        .1;
+    let machine = dir.join("m.toml");
+    std::fs::write(
+        &machine,
+        mill.replacen(
+            "name = \"X\"",
+            &format!(
+                "name = \"{}\"",
+                key.replace('\u{1b}', "\\u001b").replace('\u{7}', "\\u0007")
+            ),
+            1,
+        ),
+    )
+    .unwrap();
+    let (code, _, err) = pilgrim(&["run", DEMO, "--machine", s(&machine), "--out", s(&out)]);
+    assert_eq!(code, 1, "{err}");
+    clean("axis name", &err);
+    // A script's print.
+    std::fs::write(
+        &script,
+        format!(
+            "fn params() {{ #{{}} }}\nfn default_machine() {{ \"vertical-mill\" }}\n\
+             fn toolpath(p) {{ print(\"{}\" + \"x\".pad(1000000, \"x\")); throw \"stop\"; }}\n",
+            escape.replace('\u{1b}', "\\x1b").replace('\u{7}', "\\x07")
+        ),
+    )
+    .unwrap();
+    let (code, _, err) = pilgrim(&["run", s(&script), "--out", s(&out)]);
+    assert_eq!(code, 1, "{err}");
+    clean("print", &err);
+    assert!(err.contains("\\u{1b}]52"), "{err}");
+    // A pass name a spreadsheet would evaluate.
+    std::fs::write(
+        &script,
+        "fn params() { #{} }\nfn default_machine() { \"vertical-mill\" }\n\
+         fn toolpath(p) {\n\
+           let tp = new_toolpath(\"t\", end_mill(\"m\", 1, 6.0, 10.0), 1000.0, [\"C\"]);\n\
+           tp.add_pass(\"=1+2\", #{ x: [50.0, 50.0], y: [0.0, 0.0], z: [5.0, 5.0], motion: \"rapid\", aux: #{ C: 0.0 } });\n\
+           tp\n\
+         }\n",
+    )
+    .unwrap();
+    let (code, _, err) = pilgrim(&["run", s(&script), "--out", s(&out), "--quiet"]);
+    assert_eq!(code, 0, "{err}");
+    let csv = std::fs::read_to_string(out.join("report.csv")).unwrap();
+    assert!(csv.contains(",'=1+2,"), "{csv}");
+    assert!(!csv.contains(",=1+2"), "{csv}");
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -323,7 +323,7 @@ pub fn resolve(
             .iter()
             .find(|s| s.name == name)
             .ok_or_else(|| ParamError::Unknown {
-                name: name.to_owned(),
+                name: crate::files::excerpt(name),
                 source_name: source.to_owned(),
                 known: specs
                     .iter()
@@ -333,7 +333,7 @@ pub fn resolve(
             })
     };
     let bad = |name: &str, source: &str, message: String| ParamError::Bad {
-        name: name.to_owned(),
+        name: crate::files::excerpt(name),
         source_name: source.to_owned(),
         message,
     };

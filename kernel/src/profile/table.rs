@@ -399,7 +399,7 @@ impl Table {
     /// `B (Hp)`: the column's letter, and its header if it has one.
     pub fn column_label(&self, col: usize) -> String {
         match self.headers.get(col).filter(|h| !h.is_empty()) {
-            Some(h) => format!("{} ({h})", column_letter(col)),
+            Some(h) => format!("{} ({})", column_letter(col), crate::files::excerpt(h)),
             None => column_letter(col),
         }
     }
@@ -426,11 +426,13 @@ impl Table {
         }
         Err(TableError::UnknownColumn {
             file: self.source.clone(),
-            column: name.to_owned(),
-            available: (0..width)
-                .map(|i| self.column_label(i))
-                .collect::<Vec<_>>()
-                .join(", "),
+            column: crate::files::excerpt(name),
+            available: crate::files::excerpt(
+                &(0..width.min(64))
+                    .map(|i| self.column_label(i))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            ),
         })
     }
 
@@ -456,7 +458,7 @@ impl Table {
                         file: self.source.clone(),
                         row: *row,
                         column: self.column_label(col),
-                        text: t.clone(),
+                        text: crate::files::excerpt(t),
                     }),
                     Cell::Empty => Err(TableError::MissingCell {
                         file: self.source.clone(),

@@ -168,9 +168,17 @@ pub fn engine(limits: &Limits, access: &Access) -> Engine {
             _ => None,
         })
     });
-    // Scripts print to the error stream, never into outputs.
-    e.on_print(|s| eprintln!("{s}"));
-    e.on_debug(|s, src, pos| eprintln!("{}:{pos}: {s}", src.unwrap_or("script")));
+    // Scripts print to the error stream, never into outputs, quoted as any
+    // outside text is: short, control characters (a terminal's escape
+    // sequences) escaped.
+    e.on_print(|s| eprintln!("{}", crate::files::excerpt(s)));
+    e.on_debug(|s, src, pos| {
+        eprintln!(
+            "{}:{pos}: {}",
+            crate::files::excerpt(src.unwrap_or("script")),
+            crate::files::excerpt(s)
+        )
+    });
     register_types(&mut e);
     for group in API {
         (group.register)(&mut e, access);
