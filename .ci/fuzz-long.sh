@@ -13,7 +13,7 @@ set -uo pipefail
 cd "$(dirname "$0")/.."
 secs=${1:-600}; shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_params_toml fuzz_machine_toml fuzz_tables fuzz_rhai_family fuzz_plugin_descriptor fuzz_export_report)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_params_toml fuzz_machine_toml fuzz_tables fuzz_rhai_family fuzz_plugin_descriptor fuzz_export_report fuzz_damaged_plugin)
 status=0
 for t in "${targets[@]}"; do
   name=${t#fuzz_}

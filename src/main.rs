@@ -44,6 +44,10 @@ struct Cli {
     /// Print nothing but errors.
     #[arg(long, short, global = true)]
     quiet: bool,
+    /// Time limit of a plugin library's loading and of each of its calls
+    /// (seconds): a plugin past it is stopped and named in the error.
+    #[arg(long, value_name = "S", global = true, default_value_t = 30.0)]
+    plugin_seconds: f64,
     #[command(subcommand)]
     command: Command,
 }
@@ -136,10 +140,20 @@ enum Command {
         /// The family's script (.rhai).
         script: PathBuf,
     },
-    /// Load a plugin and print its descriptor, or say exactly why not.
+    /// Load a plugin (in a child process), try its kinematics over the
+    /// travel and print its descriptor, or say exactly why not.
     PluginCheck {
         /// The shared library.
         lib: PathBuf,
+    },
+    /// Serve a plugin library to its host (the child process that holds a
+    /// library's code; not for direct use).
+    #[command(hide = true)]
+    PluginServer {
+        /// The library.
+        lib: PathBuf,
+        /// Its entry symbol.
+        symbol: String,
     },
     /// Write the script API reference (Markdown).
     ApiDocs {
@@ -249,12 +263,12 @@ fn params(script: &Path) -> Result<String, String> {
 
 fn plugin_check(lib: &Path) -> Result<String, String> {
     use pilgrim_kernel::MachineKinematics;
-    let m = PluginMachine::load(lib).map_err(|e| e.to_string())?;
+    let (m, tried) = PluginMachine::load_checked(lib).map_err(|e| e.to_string())?;
     let (major, minor) = m.abi_version();
     let descriptor = serde_json::to_string_pretty(m.info()).map_err(|e| e.to_string())?;
     Ok(format!(
-        "{}: pilgrim machine plugin, ABI {major}.{minor}, machine {} ({}), solves {}\n{descriptor}\n",
-        lib.display(),
+        "{}: pilgrim machine plugin, ABI {major}.{minor}, machine {} ({}), solves {}\n{tried}{descriptor}\n",
+        m.origin(),
         m.info().name,
         m.info().control,
         m.info().solved_axes.join(", ")
@@ -262,7 +276,35 @@ fn plugin_check(lib: &Path) -> Result<String, String> {
 }
 
 fn main() -> ExitCode {
+    // A panic is a defect: said short, escaped, with where it happened.
+    std::panic::set_hook(Box::new(|info| {
+        eprintln!(
+            "pilgrim: {}",
+            pilgrim_kernel::error::panic_text(info.payload(), info.location())
+        );
+    }));
     let cli = Cli::parse();
+    if let Command::PluginServer { lib, symbol } = &cli.command {
+        let code = pilgrim_kernel::plugin::server::serve(lib, symbol);
+        return ExitCode::from(u8::try_from(code).unwrap_or(3));
+    }
+    let Ok(seconds) = std::time::Duration::try_from_secs_f64(cli.plugin_seconds)
+        .map_err(|_| ())
+        .and_then(|d| if d.is_zero() { Err(()) } else { Ok(d) })
+    else {
+        eprintln!(
+            "pilgrim: --plugin-seconds {} must be a positive number of seconds",
+            cli.plugin_seconds
+        );
+        return ExitCode::from(2);
+    };
+    pilgrim_kernel::plugin::configure(
+        None,
+        pilgrim_kernel::plugin::Bounds {
+            load: seconds,
+            call: seconds,
+        },
+    );
     let catalog = match Catalog::new(&COMPILED_PLUGINS) {
         Ok(c) => c,
         Err(e) => {
@@ -333,12 +375,15 @@ fn main() -> ExitCode {
         .map(|s| s + "\n"),
         Command::Params { script } => params(script),
         Command::PluginCheck { lib } => plugin_check(lib),
+        Command::PluginServer { .. } => Err("the plugin server runs before anything else".into()),
         Command::ApiDocs { out } => {
             let text = pilgrim_kernel::script::api_reference();
             match out {
-                Some(p) => std::fs::write(p, text.as_bytes())
+                // A new file, or the reference an earlier api-docs wrote
+                // (its heading and the line saying so), never a user's.
+                Some(p) => pilgrim_kernel::output::write_generated_file(p, text.as_bytes(), 3)
                     .map(|_| String::new())
-                    .map_err(|e| format!("{}: {e}", p.display())),
+                    .map_err(|e| e.to_string()),
                 None => Ok(text),
             }
         }

@@ -167,7 +167,7 @@ impl Catalog {
             .to_ascii_lowercase();
         match ext.as_str() {
             "so" | "dylib" | "dll" => Ok(OpenMachine::plugin(
-                PluginMachine::load(path)?,
+                PluginMachine::load_checked(path)?.0,
                 spec,
                 Origin::Plugin(path.to_owned()),
             )),

@@ -106,3 +106,41 @@ pub enum Error {
     #[error("{}", .0.report.verdict.message())]
     Failed(Box<crate::job::FailedRun>),
 }
+
+/// What the program says of a panic (a defect of pilgrim, never the user's
+/// input): the panic's message quoted short with its control characters
+/// escaped ([`crate::files::excerpt`]: a message may carry outside text),
+/// where it happened, and what to do. The `pilgrim` program's panic hook
+/// prints it instead of the default hook's raw text.
+pub fn panic_text(
+    payload: &(dyn std::any::Any + Send),
+    location: Option<&std::panic::Location<'_>>,
+) -> String {
+    let message = payload
+        .downcast_ref::<&str>()
+        .map(|s| (*s).to_owned())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "no message".into());
+    let at = location
+        .map(|l| format!(" at {}:{}", l.file(), l.line()))
+        .unwrap_or_default();
+    format!(
+        "internal error{at}: {} (a defect of pilgrim, not of your input: please report it with the command that gave it)",
+        crate::files::excerpt(&message)
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    /// A panic's 800 KB message with escapes is quoted short and escaped.
+    #[test]
+    fn panics_are_quoted_short() {
+        let text = format!("\u{1b}[31m{}", "x".repeat(800 << 10));
+        let said = super::panic_text(&text, Some(std::panic::Location::caller()));
+        assert!(said.len() < 400 && !said.contains('\u{1b}'), "{said}");
+        assert!(
+            said.contains("\\u{1b}[31mxxx") && said.contains("error.rs"),
+            "{said}"
+        );
+    }
+}

@@ -20,6 +20,12 @@ pub fn artifact_dir() -> PathBuf {
 pub fn shared_lib(name: &str) -> PathBuf {
     static BUILT: OnceLock<()> = OnceLock::new();
     BUILT.get_or_init(|| {
+        // Libraries loaded in this process are held by `pilgrim
+        // plugin-server` child processes, as the program holds them.
+        pilgrim_kernel::plugin::configure(
+            Some(env!("CARGO_BIN_EXE_pilgrim").into()),
+            pilgrim_kernel::plugin::Bounds::default(),
+        );
         let dir = artifact_dir();
         let mut cmd = std::process::Command::new(env!("CARGO"));
         cmd.args([

@@ -1,42 +1,95 @@
 //! The plugin host: machine plugins (ARCHITECTURE §4, the ABI in the
 //! `pilgrim-plugin-abi` crate), loaded from shared libraries or compiled
-//! in.
+//! in. How to write one: `docs/plugins.md`.
 //!
-//! [`PluginMachine::load`] first checks, with the `object` crate's ELF
-//! reader, that the file is a complete shared object for this machine (its
-//! program headers and loaded segments lie inside the file: a truncated
-//! library would otherwise crash the process with SIGBUS when mapped), then
-//! opens it (a bare file name is a path in the working directory, never a
-//! search of the system's library path; a failure gives the system's
-//! reason) and finds its entry
-//! `pilgrim_plugin_<name>` (`<name>`: the file name without `lib` and the
-//! extension, `-` read as `_`); [`PluginMachine::from_entry`] takes the
-//! entry of a plugin compiled into the program. Both then go the same way:
-//! the ABI version is checked (another major is refused, naming both), the
-//! table is read field by field, only the fields lying wholly below its
-//! declared `size`, the entries its capabilities promise must be there, and
-//! the machine's descriptor is read and checked
-//! ([`crate::machine::check_description`]). It is wrapped as a
-//! [`MachineKinematics`], and as a [`PostProcessor`] when it posts its own
-//! programs ([`PluginMachine::post_processor`]). Every failure is an error
-//! naming the library; a plugin's panic comes back as an error and the host
-//! goes on. A loaded library stays loaded for the life of the process, so
-//! nothing from it can outlive it.
-//!
-//! # Safety
-//! Loading a library runs its initialisation code and trusts its entry
-//! table to follow the ABI: load only plugins you would run as programs.
+//! A library's code never runs in the host. [`PluginMachine::load`] first
+//! reads the file ([`elf`]): a complete shared object for this machine,
+//! its dynamic section pointing inside it, and its entry, the one function
+//! it exports named `pilgrim_plugin_*` (whatever the file is called). A
+//! bare file name is a path in the working directory, never a search of
+//! the system's library path. The library is then opened in a child
+//! process ([`remote`]: `pilgrim plugin-server`), which runs its
+//! initialisers, calls its entry and answers every later call; a crash, an
+//! abort, an exit or a hang there is an error naming the library and what
+//! it did, within a time bound ([`Bounds`]), and the host goes on.
+//! [`PluginMachine::from_entry`] takes the entry of a plugin compiled into
+//! the program, called in this process. Both then go the same way: the ABI
+//! version is checked (another major is refused, naming both), only the
+//! table's fields lying wholly below its declared `size` are read, the
+//! entries its capabilities promise must be there, and the machine's
+//! descriptor is read and checked ([`crate::machine::check_description`]).
+//! It is wrapped as a [`MachineKinematics`], and as a [`PostProcessor`]
+//! when it posts its own programs ([`PluginMachine::post_processor`]). A
+//! plugin's panic comes back as an error; its messages are quoted short.
+//! [`exercise`] tries its kinematics over the travel (`pilgrim
+//! plugin-check`).
+
+mod elf;
+pub mod exercise;
+mod remote;
+pub mod server;
+mod table;
+mod wire;
+
+pub use elf::ENTRY_PREFIX;
+pub use remote::{configure, Bounds, CHUNK_ROWS};
 
 use crate::machine::{batch_rows, KinematicsError, MachineInfo, MachineKinematics};
 use crate::program::{AxisProgram, PostError, PostProcessor};
 use crate::transform::ToolFrame;
 use pilgrim_plugin_abi::{
-    Buffer, EntryFn, PluginTable, PostRequest, ABI_MAJOR, ABI_MINOR, CAP_ABI_1_0, CAP_FORWARD,
-    CAP_INVERSE, CAP_POST, NO_ROW, STATUS_OK, STATUS_PANIC,
+    EntryFn, PostRequest, ABI_MAJOR, ABI_MINOR, CAP_FORWARD, CAP_INVERSE, CAP_POST,
 };
-use std::mem::{offset_of, size_of};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use wire::TableHeader;
+
+/// A failed call of a plugin: the row of a batch it failed at, and the
+/// message (the plugin's own text quoted at most
+/// [`crate::files::MAX_EXCERPT`] characters long, control characters
+/// escaped, where it enters the host).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct CallError {
+    row: Option<usize>,
+    message: String,
+}
+
+impl CallError {
+    fn whole(message: impl Into<String>) -> Self {
+        Self {
+            row: None,
+            message: message.into(),
+        }
+    }
+}
+
+/// A plugin's entries, called in this process ([`table::Table`]) or in a
+/// child process ([`remote::Remote`]). Batches are already checked for
+/// length: `out` holds a row of output per row of input.
+pub(crate) trait Calls:
+    Send + Sync + std::fmt::Debug + std::panic::RefUnwindSafe + std::panic::UnwindSafe
+{
+    /// The descriptor's JSON.
+    fn describe(&self) -> Result<String, CallError>;
+    /// Inverse kinematics: rows of 6 to rows of `width`.
+    fn inverse(
+        &self,
+        poses: &[f64],
+        tool: &[f64; 6],
+        width: usize,
+        out: &mut [f64],
+    ) -> Result<(), CallError>;
+    /// Forward kinematics: rows of `width` to rows of 6.
+    fn forward(
+        &self,
+        axes: &[f64],
+        tool: &[f64; 6],
+        width: usize,
+        out: &mut [f64],
+    ) -> Result<(), CallError>;
+    /// The program's text for a JSON post request.
+    fn post(&self, request: &[u8]) -> Result<String, CallError>;
+}
 
 /// Why a plugin could not be loaded or called.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -57,13 +110,30 @@ pub enum PluginLoadError {
         /// The system's message.
         message: String,
     },
-    /// The library has no entry symbol.
-    #[error("{path}: no entry symbol '{symbol}' (a pilgrim machine plugin exports pilgrim_plugin_<library name>)")]
+    /// The library has no entry, or several and none named for its file.
+    #[error("{path}: no entry: {message}")]
     NoEntry {
         /// The library.
         path: String,
-        /// The symbol looked for.
-        symbol: String,
+        /// What it exports instead.
+        message: String,
+    },
+    /// The plugin's kinematics disagree with themselves or with its
+    /// declared chain ([`exercise`]).
+    #[error("{path}: the plugin's kinematics are not consistent; pilgrim refuses to program with them (`pilgrim plugin-check` reports the same):\n{report}")]
+    Kinematics {
+        /// The library.
+        path: String,
+        /// The exercise's report.
+        report: String,
+    },
+    /// The library's process crashed, ended, hung or could not start.
+    #[error("{path}: the plugin {message}")]
+    Process {
+        /// The library.
+        path: String,
+        /// What happened, and when.
+        message: String,
     },
     /// The entry returned a null table.
     #[error("{path}: the entry '{symbol}' returned no table")]
@@ -110,305 +180,161 @@ pub enum PluginLoadError {
     },
 }
 
-/// A plugin's entry table as read: the fields its size covers.
-#[derive(Debug, Clone, Copy)]
-struct Table {
-    table: *const PluginTable,
-    size: u32,
-    capabilities: u32,
-}
-
-// SAFETY: the table is a static of the plugin, which is never unloaded, and
-// its entries are `extern "C"` functions the ABI requires to be callable
-// from any thread (each keeps its last error per thread).
-unsafe impl Send for Table {}
-// SAFETY: as above; the table is never written.
-unsafe impl Sync for Table {}
-
-/// Reads field `$field` of the table at `$ptr` if it lies wholly below
-/// `$size`, else `None`.
-macro_rules! field {
-    ($ptr:expr, $size:expr, $field:ident) => {{
-        let end = offset_of!(PluginTable, $field) + size_of_field(|t: &PluginTable| &t.$field);
-        if ($size as usize) < end {
-            None
-        } else {
-            // SAFETY: the field lies inside the table the plugin declared,
-            // and reading it unaligned copies its bytes.
-            Some(unsafe { std::ptr::addr_of!((*$ptr).$field).read_unaligned() })
-        }
-    }};
-}
-
-/// The size of a field, from an accessor (for [`field!`]).
-fn size_of_field<T>(_: impl Fn(&PluginTable) -> &T) -> usize {
-    size_of::<T>()
-}
-
-/// A machine plugin, loaded from a shared library or compiled in.
+/// A machine plugin, loaded from a shared library (in a child process) or
+/// compiled in.
 #[derive(Debug, Clone)]
 pub struct PluginMachine {
     origin: String,
-    table: Arc<Table>,
+    calls: Arc<dyn Calls>,
     info: MachineInfo,
     abi: (u32, u32),
-}
-
-/// Checks that `path` is a complete ELF shared object of this machine's
-/// class, byte order and architecture: its program headers and every
-/// loaded segment lie inside the file.
-fn check_elf(path: &Path) -> Result<(), String> {
-    use object::elf;
-    use object::read::elf::{FileHeader, ProgramHeader};
-    use object::Endianness;
-    let data =
-        crate::files::read_bytes(path, crate::files::MAX_DATA_BYTES).map_err(|e| e.message)?;
-    let data = data.as_slice();
-    if !data.starts_with(&elf::ELFMAG) {
-        return Err(
-            "not an ELF shared object (pilgrim loads machine plugins built as .so libraries)"
-                .into(),
-        );
-    }
-    let incomplete = |what: &str| {
-        format!("not a complete shared object: {what} (the file is cut short or damaged)")
-    };
-    let header = elf::FileHeader64::<Endianness>::parse(data)
-        .map_err(|_| incomplete("its ELF header cannot be read, or it is not a 64-bit library"))?;
-    let endian = header
-        .endian()
-        .map_err(|_| incomplete("its byte order cannot be read"))?;
-    if (endian == Endianness::Little) != cfg!(target_endian = "little") {
-        return Err("a library for another byte order".into());
-    }
-    let machine = if cfg!(target_arch = "x86_64") {
-        Some(elf::EM_X86_64)
-    } else if cfg!(target_arch = "aarch64") {
-        Some(elf::EM_AARCH64)
-    } else {
-        None
-    };
-    if machine.is_some_and(|m| header.e_machine(endian) != m) {
-        return Err(format!(
-            "a library for another machine (ELF machine {})",
-            header.e_machine(endian)
-        ));
-    }
-    if header.e_type(endian) != elf::ET_DYN {
-        return Err(format!(
-            "not a shared object (ELF type {})",
-            header.e_type(endian)
-        ));
-    }
-    let phdrs = header
-        .program_headers(endian, data)
-        .map_err(|_| incomplete("its program headers lie beyond its end"))?;
-    for ph in phdrs {
-        if ph.p_type(endian) == elf::PT_LOAD {
-            let end = ph.p_offset(endian).checked_add(ph.p_filesz(endian));
-            if end.is_none_or(|e| e > data.len() as u64) {
-                return Err(incomplete("a loaded segment lies beyond its end"));
-            }
-        }
-    }
-    Ok(())
-}
-
-/// The entry symbol for a library file: `pilgrim_plugin_<stem>`.
-pub fn entry_symbol(path: &Path) -> String {
-    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("");
-    let stem = stem.strip_prefix("lib").unwrap_or(stem);
-    format!("pilgrim_plugin_{}", stem.replace(['-', '.'], "_"))
-}
-
-impl Table {
-    /// Calls entry `$field`, which loading checked is present.
-    fn describe(&self) -> Option<pilgrim_plugin_abi::DescribeFn> {
-        field!(self.table, self.size, describe).flatten()
-    }
-    fn inverse(&self) -> Option<pilgrim_plugin_abi::InverseFn> {
-        field!(self.table, self.size, inverse).flatten()
-    }
-    fn forward(&self) -> Option<pilgrim_plugin_abi::ForwardFn> {
-        field!(self.table, self.size, forward).flatten()
-    }
-    fn post(&self) -> Option<pilgrim_plugin_abi::PostFn> {
-        field!(self.table, self.size, post).flatten()
-    }
-    fn last_error(&self) -> Option<pilgrim_plugin_abi::LastErrorFn> {
-        field!(self.table, self.size, last_error).flatten()
-    }
-    fn free_buffer(&self) -> Option<pilgrim_plugin_abi::FreeBufferFn> {
-        field!(self.table, self.size, free_buffer).flatten()
-    }
-
-    /// The message of the plugin's last failure on this thread.
-    fn last_error_text(&self, status: i32) -> String {
-        let text = match self.last_error() {
-            // SAFETY: the entry fills the buffer it is given.
-            Some(f) => self.call_text(|out| unsafe { f(out) }).ok(),
-            None => None,
-        }
-        .unwrap_or_else(|| "unknown error".into());
-        if status == STATUS_PANIC && !text.contains("panick") {
-            format!("the plugin panicked: {text}")
-        } else {
-            text
-        }
-    }
-
-    /// Calls an entry that fills a buffer; copies its text and frees it.
-    fn call_text(&self, f: impl FnOnce(*mut Buffer) -> i32) -> Result<String, String> {
-        let mut buf = Buffer::empty();
-        let status = f(&mut buf);
-        let text = if buf.ptr.is_null() {
-            String::new()
-        } else {
-            // SAFETY: the plugin filled buf with len readable bytes.
-            let bytes = unsafe { std::slice::from_raw_parts(buf.ptr, buf.len) };
-            let t = String::from_utf8_lossy(bytes).into_owned();
-            if let Some(free) = self.free_buffer() {
-                // SAFETY: the buffer came from this plugin and is returned once.
-                unsafe { free(buf) };
-            }
-            t
-        };
-        if status == STATUS_OK {
-            Ok(text)
-        } else {
-            Err(self.last_error_text(status))
-        }
-    }
+    capabilities: u32,
 }
 
 impl PluginMachine {
-    /// Loads and checks a plugin library. See the [module docs](self).
+    /// Loads and checks a plugin library, in a child process. See the
+    /// [module docs](self).
     ///
     /// # Failures
-    /// [`PluginLoadError`]: the library cannot be opened; no entry symbol; a
-    /// null table; another ABI major; a missing entry; a bad descriptor.
+    /// [`PluginLoadError`]: not a complete library; no entry; the library
+    /// cannot be opened; its process crashing, ending or hanging while it
+    /// loads; a null table; another ABI major; a missing entry; a bad
+    /// descriptor.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, PluginLoadError> {
         let given = path.as_ref();
-        let shown = given.display().to_string();
+        let shown = crate::files::shown_path(given);
         // A bare name would make dlopen search the system's library path.
         let path = if given.components().count() == 1 && !given.is_absolute() {
             Path::new(".").join(given)
         } else {
             given.to_owned()
         };
-        let symbol = entry_symbol(&path);
-        check_elf(&path).map_err(|message| PluginLoadError::NotLibrary {
-            path: shown.clone(),
-            message,
-        })?;
-        // SAFETY: loading runs the library's initialisers; see the module docs.
-        let lib = unsafe { libloading::Library::new(&path) }.map_err(|e| {
-            use std::error::Error as _;
-            PluginLoadError::Open {
+        let symbol = elf::inspect(&path).map_err(|r| match r {
+            elf::Refusal::NotLibrary(message) => PluginLoadError::NotLibrary {
                 path: shown.clone(),
-                message: match e.source() {
-                    Some(reason) => format!("{e}: {reason}"),
-                    None => e.to_string(),
+                message,
+            },
+            elf::Refusal::NoEntry(message) => PluginLoadError::NoEntry {
+                path: shown.clone(),
+                message,
+            },
+        })?;
+        let (remote, header) =
+            remote::Remote::start(&path, &symbol, &shown).map_err(|e| match e {
+                remote::StartError::Open(message) => PluginLoadError::Open {
+                    path: shown.clone(),
+                    message: crate::files::excerpt(&message),
                 },
-            }
-        })?;
-        // Never unloaded: nothing from the library may outlive it.
-        let lib: &'static libloading::Library = Box::leak(Box::new(lib));
-        // SAFETY: the symbol's type is the ABI's entry type.
-        let entry: libloading::Symbol<'static, EntryFn> = unsafe { lib.get(symbol.as_bytes()) }
-            .map_err(|_| PluginLoadError::NoEntry {
-                path: shown.clone(),
-                symbol: symbol.clone(),
+                remote::StartError::NoEntry => PluginLoadError::NoEntry {
+                    path: shown.clone(),
+                    message: format!("the loader finds no symbol {symbol}"),
+                },
+                remote::StartError::NullTable => PluginLoadError::NullTable {
+                    path: shown.clone(),
+                    symbol: symbol.clone(),
+                },
+                remote::StartError::Process(message) => PluginLoadError::Process {
+                    path: shown.clone(),
+                    message,
+                },
             })?;
-        Self::from_entry(&shown, &symbol, *entry)
+        Self::checked(&shown, header, Arc::new(remote))
+    }
+
+    /// [`Self::load`], then its kinematics tried over the travel
+    /// ([`exercise`]): what a run does before it trusts a library.
+    ///
+    /// # Failures
+    /// As [`Self::load`]; [`PluginLoadError::Kinematics`].
+    pub fn load_checked(
+        path: impl AsRef<Path>,
+    ) -> Result<(Self, exercise::Exercise), PluginLoadError> {
+        let plugin = Self::load(&path)?;
+        let tried = exercise::exercise(&plugin);
+        if !tried.passed() {
+            return Err(PluginLoadError::Kinematics {
+                path: plugin.origin.clone(),
+                report: tried.to_string(),
+            });
+        }
+        Ok((plugin, tried))
     }
 
     /// A plugin compiled into the program, from its entry function;
-    /// `origin` names it in messages. Checked as a loaded library is.
+    /// `origin` names it in messages. Called in this process, and checked
+    /// as a loaded library is.
     ///
     /// # Failures
     /// As [`Self::load`], but for opening the library.
     pub fn from_entry(origin: &str, symbol: &str, entry: EntryFn) -> Result<Self, PluginLoadError> {
-        let shown = origin.to_owned();
-        // SAFETY: calling the plugin's entry, which takes no arguments.
-        let ptr = unsafe { entry() };
-        if ptr.is_null() {
+        // SAFETY: calling the entry of a plugin compiled into this program,
+        // which returns its static table.
+        let read = unsafe { table::Table::read(entry()) };
+        let Some((table, header)) = read else {
             return Err(PluginLoadError::NullTable {
-                path: shown,
+                path: origin.to_owned(),
                 symbol: symbol.to_owned(),
             });
-        }
-        // The first three fields are fixed for every version.
-        // SAFETY: any plugin's table starts with three u32s.
-        let (major, minor, size) = unsafe {
-            (
-                std::ptr::addr_of!((*ptr).abi_major).read_unaligned(),
-                std::ptr::addr_of!((*ptr).abi_minor).read_unaligned(),
-                std::ptr::addr_of!((*ptr).size).read_unaligned(),
-            )
         };
-        if major != ABI_MAJOR {
+        Self::checked(origin, header, Arc::new(table))
+    }
+
+    /// The table's header checked, the descriptor read and checked.
+    fn checked(
+        shown: &str,
+        header: TableHeader,
+        calls: Arc<dyn Calls>,
+    ) -> Result<Self, PluginLoadError> {
+        let shown = shown.to_owned();
+        if header.major != ABI_MAJOR {
             return Err(PluginLoadError::Version {
                 path: shown,
-                plugin_major: major,
-                plugin_minor: minor,
+                plugin_major: header.major,
+                plugin_minor: header.minor,
                 host_major: ABI_MAJOR,
                 host_minor: ABI_MINOR,
             });
         }
-        let capabilities = field!(ptr, size, capabilities).unwrap_or(CAP_ABI_1_0);
-        let table = Table {
-            table: ptr,
-            size,
-            capabilities,
-        };
-        let missing = |entry: &'static str| PluginLoadError::MissingEntry {
-            path: shown.clone(),
-            entry,
-            size,
-        };
-        for (present, needed, name) in [
-            (table.describe().is_some(), true, "describe"),
-            (
-                table.inverse().is_some(),
-                capabilities & CAP_INVERSE != 0,
-                "inverse",
-            ),
-            (
-                table.forward().is_some(),
-                capabilities & CAP_FORWARD != 0,
-                "forward",
-            ),
-            (table.post().is_some(), capabilities & CAP_POST != 0, "post"),
-            (table.last_error().is_some(), true, "last_error"),
-            (table.free_buffer().is_some(), true, "free_buffer"),
+        let caps = header.capabilities;
+        let [describe, inverse, forward, post, last_error, free_buffer] = header.present;
+        for (present, needed, entry) in [
+            (describe, true, "describe"),
+            (inverse, caps & CAP_INVERSE != 0, "inverse"),
+            (forward, caps & CAP_FORWARD != 0, "forward"),
+            (post, caps & CAP_POST != 0, "post"),
+            (last_error, true, "last_error"),
+            (free_buffer, true, "free_buffer"),
         ] {
             if needed && !present {
-                return Err(missing(name));
+                return Err(PluginLoadError::MissingEntry {
+                    path: shown,
+                    entry,
+                    size: header.size,
+                });
             }
         }
-        let describe = table.describe().ok_or_else(|| missing("describe"))?;
         let bad = |message: String| PluginLoadError::Descriptor {
             path: shown.clone(),
             message,
         };
-        // SAFETY: the entry fills the buffer it is given.
-        let descriptor = table
-            .call_text(|out| unsafe { describe(out) })
-            .map_err(bad)?;
-        let info: MachineInfo =
-            serde_json::from_str(&descriptor).map_err(|e| bad(e.to_string()))?;
+        let descriptor = calls.describe().map_err(|e| bad(e.message))?;
+        let info: MachineInfo = serde_json::from_str(&descriptor)
+            .map_err(|e| bad(crate::files::excerpt(&e.to_string())))?;
         for s in &info.solved_axes {
             if info.axis(s).is_none() {
-                return Err(bad(format!("solved axis '{s}' is not among the axes")));
+                return Err(bad(format!(
+                    "solved axis {} is not among the axes",
+                    crate::names::quoted(s)
+                )));
             }
         }
         crate::machine::check_description(&info).map_err(|e| bad(e.to_string()))?;
         Ok(Self {
             origin: shown,
-            table: Arc::new(table),
+            calls,
             info,
-            abi: (major, minor),
+            abi: (header.major, header.minor),
+            capabilities: caps,
         })
     }
 
@@ -430,14 +356,22 @@ impl PluginMachine {
 
     /// The plugin's capabilities (`CAP_*` bits).
     pub fn capabilities(&self) -> u32 {
-        self.table.capabilities
+        self.capabilities
     }
 
     /// The plugin's own post-processor, if it posts its programs.
     pub fn post_processor(&self) -> Option<PluginPost> {
-        (self.table.capabilities & CAP_POST != 0).then(|| PluginPost {
-            table: self.table.clone(),
+        (self.capabilities & CAP_POST != 0).then(|| PluginPost {
+            calls: self.calls.clone(),
         })
+    }
+
+    /// A failed call as a kinematics error.
+    fn message(e: CallError) -> KinematicsError {
+        KinematicsError {
+            index: e.row,
+            message: e.message,
+        }
     }
 }
 
@@ -495,34 +429,19 @@ impl MachineKinematics for PluginMachine {
         out: &mut Vec<f64>,
     ) -> Result<(), KinematicsError> {
         let count = batch_rows(poses, 6, "pose")?;
-        let inverse = self
-            .table
-            .inverse()
-            .ok_or_else(|| KinematicsError::whole("the plugin offers no inverse kinematics"))?;
+        if self.capabilities & CAP_INVERSE == 0 {
+            return Err(KinematicsError::whole(
+                "the plugin offers no inverse kinematics",
+            ));
+        }
         let width = self.info.solved_axes.len();
         out.clear();
         out.resize(count * width, 0.0);
-        let t = tool6(tool);
-        let mut failed = NO_ROW;
-        // SAFETY: arrays of the sizes the ABI states.
-        let status = unsafe {
-            inverse(
-                poses.as_ptr(),
-                count,
-                t.as_ptr(),
-                out.as_mut_ptr(),
-                width,
-                &mut failed,
-            )
-        };
-        if status != STATUS_OK {
+        let result = self.calls.inverse(poses, &tool6(tool), width, out);
+        result.map_err(|e| {
             out.clear();
-            return Err(KinematicsError {
-                index: (failed != NO_ROW).then_some(failed),
-                message: self.table.last_error_text(status),
-            });
-        }
-        Ok(())
+            Self::message(e)
+        })
     }
 
     fn forward(
@@ -533,27 +452,25 @@ impl MachineKinematics for PluginMachine {
     ) -> Result<(), KinematicsError> {
         let width = self.info.solved_axes.len();
         let count = batch_rows(axes, width, "axis")?;
-        let forward = self
-            .table
-            .forward()
-            .ok_or_else(|| KinematicsError::whole("the plugin offers no forward kinematics"))?;
+        if self.capabilities & CAP_FORWARD == 0 {
+            return Err(KinematicsError::whole(
+                "the plugin offers no forward kinematics",
+            ));
+        }
         out.clear();
         out.resize(count * 6, 0.0);
-        let t = tool6(tool);
-        // SAFETY: arrays of the sizes the ABI states.
-        let status = unsafe { forward(axes.as_ptr(), count, width, t.as_ptr(), out.as_mut_ptr()) };
-        if status != STATUS_OK {
+        let result = self.calls.forward(axes, &tool6(tool), width, out);
+        result.map_err(|e| {
             out.clear();
-            return Err(KinematicsError::whole(self.table.last_error_text(status)));
-        }
-        Ok(())
+            KinematicsError::whole(Self::message(e).message)
+        })
     }
 }
 
 /// A plugin's own post-processor ([`PluginMachine::post_processor`]).
 #[derive(Debug, Clone)]
 pub struct PluginPost {
-    table: Arc<Table>,
+    calls: Arc<dyn Calls>,
 }
 
 impl PostProcessor for PluginPost {
@@ -563,13 +480,8 @@ impl PostProcessor for PluginPost {
             program: program.clone(),
         })
         .map_err(|e| PostError::Plugin(e.to_string()))?;
-        let post = self
-            .table
-            .post()
-            .ok_or_else(|| PostError::Plugin("the plugin offers no post-processor".into()))?;
-        // SAFETY: the request's bytes are readable for its length.
-        self.table
-            .call_text(|out| unsafe { post(request.as_ptr(), request.len(), out) })
-            .map_err(PostError::Plugin)
+        self.calls
+            .post(request.as_bytes())
+            .map_err(|e| PostError::Plugin(e.message))
     }
 }

@@ -153,8 +153,11 @@ fn fuzz_export_report() {
                 serde_json::to_vec(&report).unwrap(),
             )
             .unwrap();
+            let Ok(opened) = pilgrim_kernel::output::RunDir::open(&dir) else {
+                panic!("the copy of the run is a run");
+            };
             let _ = pilgrim_kernel::job::export(
-                &dir,
+                &opened,
                 &catalog,
                 None,
                 Some(2),
@@ -191,4 +194,135 @@ fn tempdir(run: &std::path::Path) -> std::path::PathBuf {
         std::fs::copy(e.path(), dir.join(e.file_name())).unwrap();
     }
     dir
+}
+
+/// The directory of this build's artifacts (`target/<profile>`), with the
+/// `pilgrim` program and the fixture plugin library built in it (once per
+/// test process): the damaged libraries are loaded as the program loads
+/// them, in `pilgrim plugin-server` child processes.
+fn plugin_artifacts() -> std::path::PathBuf {
+    static BUILT: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
+    BUILT
+        .get_or_init(|| {
+            let exe = std::env::current_exe().unwrap();
+            let dir = exe
+                .parent()
+                .and_then(std::path::Path::parent)
+                .unwrap()
+                .to_owned();
+            let profile = dir.file_name().unwrap().to_string_lossy().into_owned();
+            let mut cmd = std::process::Command::new(env!("CARGO"));
+            cmd.args([
+                "build",
+                "--bin",
+                "pilgrim",
+                "-p",
+                "pilgrim",
+                "--lib",
+                "-p",
+                "pilgrim-plugin-fixture",
+            ])
+            .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."));
+            if profile != "debug" {
+                cmd.args([
+                    "--profile",
+                    if profile == "release" {
+                        "release"
+                    } else {
+                        &profile
+                    },
+                ]);
+            }
+            assert!(cmd.status().unwrap().success(), "building pilgrim failed");
+            pilgrim_kernel::plugin::configure(
+                Some(dir.join("pilgrim")),
+                pilgrim_kernel::plugin::Bounds {
+                    load: Duration::from_secs(5),
+                    call: Duration::from_secs(5),
+                },
+            );
+            dir
+        })
+        .clone()
+}
+
+/// Damaged plugin libraries, checked as `pilgrim plugin-check` checks them
+/// (loaded in a child process, their kinematics tried): every damage is
+/// an error or a plugin that loads, never a crash or a hang of the host.
+/// An input is up to 8 damages of 5 bytes each (where, as a `u32`, and the
+/// new byte); its first byte picks the part of the file they fall in: the
+/// whole file, its first 4 KiB (headers), or its dynamic section.
+#[test]
+fn fuzz_damaged_plugin() {
+    use pilgrim_kernel::plugin::PluginMachine;
+    let dir = plugin_artifacts();
+    let good = std::fs::read(dir.join("libplugin_fixture.so")).unwrap();
+    let dynamic = dynamic_range(&good);
+    let scratch = std::env::temp_dir().join(format!("pilgrim-fuzz-so-{}", std::process::id()));
+    std::fs::create_dir_all(&scratch).unwrap();
+    let path = scratch.join("liblathe.so");
+    // What became of the inputs (shown with --nocapture).
+    let seen = std::sync::Mutex::new(std::collections::BTreeMap::<&str, usize>::new());
+    bolero::check!()
+        .with_iterations(300)
+        .for_each(|bytes: &[u8]| {
+            let Some((&pick, damages)) = bytes.split_first() else {
+                return;
+            };
+            let range = match pick % 3 {
+                0 => 0..good.len(),
+                1 => 0..good.len().min(4096),
+                _ => dynamic.clone(),
+            };
+            let mut lib = good.clone();
+            for d in damages.chunks_exact(5).take(8) {
+                let at = u32::from_le_bytes([d[0], d[1], d[2], d[3]]) as usize;
+                lib[range.start + at % range.len().max(1)] = d[4];
+            }
+            // A new file each time: a library is never written over in place.
+            let _ = std::fs::remove_file(&path);
+            std::fs::write(&path, &lib).unwrap();
+            let outcome = match PluginMachine::load_checked(&path) {
+                Ok(_) => "loaded",
+                Err(e) => {
+                    let text = e.to_string();
+                    assert!(text.len() < 4096, "{} bytes of error", text.len());
+                    assert!(text.contains("liblathe.so"), "{text}");
+                    if text.contains("crashed") {
+                        "crashed in its child process"
+                    } else if text.contains("did not answer") {
+                        "hung in its child process, stopped"
+                    } else if text.contains("not a complete") || text.contains("no entry") {
+                        "refused from its bytes"
+                    } else {
+                        "another error"
+                    }
+                }
+            };
+            if let Ok(mut s) = seen.lock() {
+                *s.entry(outcome).or_default() += 1;
+            }
+        });
+    eprintln!(
+        "fuzz_damaged_plugin: {:?}",
+        seen.lock().map(|s| s.clone()).unwrap_or_default()
+    );
+    std::fs::remove_dir_all(&scratch).ok();
+}
+
+/// The file range of a library's dynamic section.
+fn dynamic_range(lib: &[u8]) -> std::ops::Range<usize> {
+    // The dynamic section's program header, read by hand from the ELF64
+    // header (`e_phoff` at 32, `e_phentsize` at 54, `e_phnum` at 56).
+    let u16_at = |i: usize| u16::from_le_bytes([lib[i], lib[i + 1]]) as usize;
+    let u64_at = |i: usize| u64::from_le_bytes(lib[i..i + 8].try_into().unwrap()) as usize;
+    let (phoff, size, count) = (u64_at(32), u16_at(54), u16_at(56));
+    for k in 0..count {
+        let h = phoff + k * size;
+        if u32::from_le_bytes(lib[h..h + 4].try_into().unwrap()) == 2 {
+            // PT_DYNAMIC: p_offset at 8, p_filesz at 32.
+            return u64_at(h + 8)..u64_at(h + 8) + u64_at(h + 32);
+        }
+    }
+    panic!("the fixture library has no dynamic section");
 }

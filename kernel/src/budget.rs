@@ -1,0 +1,137 @@
+//! The run's time limit, seen from inside the kernel's long loops.
+//!
+//! A run (and each call of a family's script within it) has a deadline:
+//! [`with_limit`] sets it for the work `f` does on this thread (a nested
+//! limit can only bring it closer). Native loops whose length the input
+//! drives (the steady rest's track, replays, posts, lints, meshes) call
+//! [`check`], or [`Ticker::tick`] where an iteration is cheap, and stop with
+//! [`OverTime`] once the deadline has passed: a limit holds wherever the
+//! work is done, not only between a script's operations. Threads a loop
+//! spawns take the deadline along ([`current`], [`with_deadline`]).
+
+use std::cell::Cell;
+use std::time::{Duration, Instant};
+
+/// A deadline and the limit (s) it came from.
+pub type Deadline = (Instant, f64);
+
+thread_local! {
+    static DEADLINE: Cell<Option<Deadline>> = const { Cell::new(None) };
+}
+
+/// The work ran past its time limit.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[error("the run ran past its time limit of {seconds} s (in {stage}) and was stopped")]
+pub struct OverTime {
+    /// The limit (s).
+    pub seconds: f64,
+    /// What was being done.
+    pub stage: &'static str,
+}
+
+/// Runs `f` with a time limit of `seconds` from now (or the one already
+/// set, if that is sooner), restoring the outer limit afterwards.
+pub fn with_limit<T>(seconds: f64, f: impl FnOnce() -> T) -> T {
+    let limit = Duration::try_from_secs_f64(seconds.max(0.0)).unwrap_or(Duration::MAX);
+    let mine = Instant::now().checked_add(limit).map(|t| (t, seconds));
+    let outer = current();
+    let chosen = match (outer, mine) {
+        (Some(o), Some(m)) if o.0 <= m.0 => Some(o),
+        (_, Some(m)) => Some(m),
+        (o, None) => o,
+    };
+    with_deadline(chosen, f)
+}
+
+/// Runs `f` with `deadline` (a spawned thread takes its parent's).
+pub fn with_deadline<T>(deadline: Option<Deadline>, f: impl FnOnce() -> T) -> T {
+    struct Restore(Option<Deadline>);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            DEADLINE.with(|d| d.set(self.0));
+        }
+    }
+    let _restore = Restore(DEADLINE.with(|d| d.replace(deadline)));
+    f()
+}
+
+/// This thread's deadline, if any.
+pub fn current() -> Option<Deadline> {
+    DEADLINE.with(Cell::get)
+}
+
+/// The limit (s) whose deadline has passed, if it has.
+pub fn expired() -> Option<f64> {
+    current().and_then(|(until, seconds)| (Instant::now() > until).then_some(seconds))
+}
+
+/// An error once the deadline has passed, naming `stage`.
+pub fn check(stage: &'static str) -> Result<(), OverTime> {
+    match expired() {
+        Some(seconds) => Err(OverTime { seconds, stage }),
+        None => Ok(()),
+    }
+}
+
+/// A wait of at most `wait` that ends no later than the run's deadline:
+/// the deadline, and the run's limit (s) if it is the nearer one.
+pub fn bounded(wait: Duration) -> (Option<f64>, Instant) {
+    let mine = Instant::now() + wait;
+    match current() {
+        Some((until, seconds)) if until < mine => (Some(seconds), until),
+        _ => (None, mine),
+    }
+}
+
+/// [`check`] every `every` ticks, for loops whose iterations are cheap.
+#[derive(Debug, Clone)]
+pub struct Ticker {
+    every: u32,
+    count: u32,
+    stage: &'static str,
+}
+
+impl Ticker {
+    /// A ticker looking at the clock every `every` ticks, for `stage`.
+    pub fn new(stage: &'static str, every: u32) -> Self {
+        Self {
+            every: every.max(1),
+            count: 0,
+            stage,
+        }
+    }
+
+    /// Counts one iteration; every `every`-th, [`check`].
+    pub fn tick(&mut self) -> Result<(), OverTime> {
+        self.count += 1;
+        if self.count >= self.every {
+            self.count = 0;
+            check(self.stage)
+        } else {
+            Ok(())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn limits_nest_to_the_nearer_and_restore() {
+        assert!(current().is_none());
+        with_limit(100.0, || {
+            let outer = current().unwrap();
+            with_limit(1000.0, || assert_eq!(current().unwrap().0, outer.0));
+            with_limit(0.0, || {
+                std::thread::sleep(Duration::from_millis(2));
+                let e = check("a test").unwrap_err();
+                assert_eq!(e.seconds, 0.0);
+                assert!(e.to_string().contains("in a test"), "{e}");
+            });
+            assert_eq!(current().unwrap().0, outer.0);
+            assert!(check("x").is_ok());
+        });
+        assert!(current().is_none());
+    }
+}
