@@ -16,6 +16,16 @@ use pilgrim_kernel::PartFamily;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+/// The allocator, counting what it holds so that a script's memory limit is
+/// looked at after every operation (`pilgrim_kernel::script::set_allocated_probe`).
+#[global_allocator]
+static ALLOCATOR: cap::Cap<std::alloc::System> = cap::Cap::new(std::alloc::System, usize::MAX);
+
+/// Bytes the allocator holds now.
+fn allocated() -> usize {
+    ALLOCATOR.allocated()
+}
+
 /// The machine plugins compiled into the program.
 const COMPILED_PLUGINS: [CompiledPlugin; 4] = [
     CompiledPlugin {
@@ -91,9 +101,17 @@ enum Command {
         /// Also write the scene as scene.gltf + scene.bin.
         #[arg(long)]
         gltf: bool,
-        /// Wall-clock limit of each call of the family's script (seconds).
+        /// Wall-clock limit of each call of the family's script (seconds),
+        /// kernel calls made from it included.
         #[arg(long, value_name = "S", default_value_t = 60.0)]
         script_seconds: f64,
+        /// Memory the process may hold while the family's script runs (MB).
+        #[arg(long, value_name = "MB", default_value_t = 4096)]
+        script_memory_mb: u64,
+        /// Wall-clock limit of the whole run (seconds): checked inside the
+        /// kernel's long loops (the rest's track, replays, posts, lints).
+        #[arg(long, value_name = "S", default_value_t = 600.0)]
+        run_seconds: f64,
         /// Write a whole program numbered N (Fanuc: `%`, `O` number, the
         /// tool call) instead of the block to paste after the tool call.
         #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=9999))]
@@ -288,6 +306,7 @@ fn main() -> ExitCode {
         let code = pilgrim_kernel::plugin::server::serve(lib, symbol);
         return ExitCode::from(u8::try_from(code).unwrap_or(3));
     }
+    pilgrim_kernel::script::set_allocated_probe(allocated);
     let Ok(seconds) = std::time::Duration::try_from_secs_f64(cli.plugin_seconds)
         .map_err(|_| ())
         .and_then(|d| if d.is_zero() { Err(()) } else { Ok(d) })
@@ -325,6 +344,8 @@ fn main() -> ExitCode {
             stl_ascii,
             gltf,
             script_seconds,
+            script_memory_mb,
+            run_seconds,
             program_number,
             also_post,
         } => run::run(
@@ -345,6 +366,8 @@ fn main() -> ExitCode {
                 }),
                 quiet: cli.quiet,
                 script_seconds: *script_seconds,
+                script_memory_mb: *script_memory_mb,
+                run_seconds: *run_seconds,
                 program_number: *program_number,
                 also_post: also_post.clone(),
             },

@@ -22,6 +22,8 @@ pub struct RunArgs {
     pub out: PathBuf,
     pub quiet: bool,
     pub script_seconds: f64,
+    pub script_memory_mb: u64,
+    pub run_seconds: f64,
     pub program_number: Option<u32>,
     pub also_post: Vec<String>,
 }
@@ -45,6 +47,19 @@ fn progress(quiet: bool) -> ProgressBar {
 /// [`pilgrim_kernel::output::failed_dir`] says; on any other error nothing
 /// is written and the previous output directory is left as it was.
 pub fn run(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
+    for (flag, v) in [
+        ("--script-seconds", args.script_seconds),
+        ("--run-seconds", args.run_seconds),
+    ] {
+        if !(v > 0.0) {
+            return Err(format!("{flag} {v} must be > 0"));
+        }
+    }
+    pilgrim_kernel::budget::with_limit(args.run_seconds, "the run's", || run_within(args, catalog))
+}
+
+/// [`run`] within the run's time limit.
+fn run_within(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
     let bar = progress(args.quiet);
     let next = |what: &str| {
         bar.set_message(what.to_owned());
@@ -59,14 +74,9 @@ pub fn run(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
             dir.to_owned()
         });
     }
-    if !(args.script_seconds > 0.0) {
-        return Err(format!(
-            "--script-seconds {} must be > 0",
-            args.script_seconds
-        ));
-    }
     let limits = Limits {
         max_seconds: args.script_seconds,
+        max_memory_mb: args.script_memory_mb,
         ..Limits::default()
     };
     let family = ScriptFamily::load(&args.script, &limits, &access).map_err(|e| e.to_string())?;

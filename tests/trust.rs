@@ -10,6 +10,23 @@ mod common;
 use common::{pilgrim, pilgrim_in, root, s};
 
 fn pilgrim_within(args: &[&str], limit: Duration) -> Option<(i32, String)> {
+    measured(args, limit).map(|m| (m.code, m.err))
+}
+
+/// How a run of pilgrim ended and what it took: its exit code, its error
+/// stream, its peak resident memory and its CPU time, as the system
+/// accounts them (`wait4`), not as a clock in the test sees them.
+struct Measured {
+    code: i32,
+    err: String,
+    peak_mb: f64,
+    cpu_seconds: f64,
+}
+
+/// Runs pilgrim with `args`, killed after `limit` (then `None`).
+// The child is reaped by `wait4`, which clippy does not see.
+#[allow(clippy::zombie_processes)]
+fn measured(args: &[&str], limit: Duration) -> Option<Measured> {
     let mut child = Command::new(env!("CARGO_BIN_EXE_pilgrim"))
         .current_dir(root())
         .args(args)
@@ -17,13 +34,34 @@ fn pilgrim_within(args: &[&str], limit: Duration) -> Option<(i32, String)> {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
+    let mut stderr = child.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut err = String::new();
+        use std::io::Read;
+        stderr.read_to_string(&mut err).ok();
+        err
+    });
+    let pid = child.id() as libc::pid_t;
     let start = Instant::now();
     loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            let mut err = String::new();
-            use std::io::Read;
-            child.stderr.take().unwrap().read_to_string(&mut err).ok();
-            return Some((status.code().unwrap_or(-1), err));
+        let mut status = 0;
+        // SAFETY: an all-zero rusage is valid; wait4 fills it.
+        let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+        // SAFETY: the child's pid, valid pointers to locals.
+        let got = unsafe { libc::wait4(pid, &mut status, libc::WNOHANG, &mut usage) };
+        if got == pid {
+            let code = if libc::WIFEXITED(status) {
+                libc::WEXITSTATUS(status)
+            } else {
+                -libc::WTERMSIG(status)
+            };
+            let seconds = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+            return Some(Measured {
+                code,
+                err: reader.join().unwrap(),
+                peak_mb: usage.ru_maxrss as f64 / 1024.0,
+                cpu_seconds: seconds(usage.ru_utime) + seconds(usage.ru_stime),
+            });
         }
         if start.elapsed() > limit {
             child.kill().ok();
@@ -324,45 +362,104 @@ fn parameters_that_drive_work_are_bounded() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// A script cannot pass its limits: memory through Floats, time through
-/// operations that each cost more as an array grows, memory through a map
-/// grown by index (which Rhai 1.27 does not count against its map size).
+/// A script cannot pass its limits, and each limit that stops it is the
+/// one it passed, said by name, with the work stopped within its bound as
+/// the system accounts it (peak memory and CPU time, compared with a run
+/// that passes on the same machine, so a slow machine changes nothing):
+/// memory through Floats (the kernel's ceiling), time through operations
+/// that each cost more as an array grows, memory through a map grown by
+/// index (which Rhai 1.27 does not count against its map size), and time
+/// inside a kernel call (the steady rest's track of a pass at a feed of
+/// 5e-324 mm/min, which once ran 108 s past a 5 s limit).
 #[test]
 fn scripts_are_bounded_in_memory_and_time() {
     let dir = scratch("rhai");
+    let out = dir.join("o");
     let head = "fn params() { #{} }\nfn default_machine() { \"vertical-mill\" }\n";
-    for (body, expected) in [
-        (
-            "fn toolpath(p) { let v = linspace(0.0, 1.0, 1000); for i in 0..40 { v = concat(v, v); } v }",
-            "ceiling of 10000000",
-        ),
-        (
-            "fn toolpath(p) { let a = []; loop { a.push(1); } }",
-            "limit",
-        ),
-        (
-            "fn toolpath(p) { let m = #{}; for i in 0..100000000 { m[`k${i}`] = i; } m }",
-            "limit",
-        ),
-    ] {
-        let script = dir.join("f.rhai");
+    let within = Duration::from_secs(300);
+    let run = |args: &[&str]| measured(args, within).expect("the run was not stopped");
+    // What runs that pass take here: the small family and the mandrel.
+    let small = run(&["run", DEMO, "--out", s(&out), "--quiet"]);
+    assert_eq!(small.code, 0, "{}", small.err);
+    let mandrel = run(&["run", "scripts/mandrel.rhai", "--out", s(&out), "--quiet"]);
+    assert_eq!(mandrel.code, 0, "{}", mandrel.err);
+    let script = dir.join("f.rhai");
+    let family = |body: &str| {
         std::fs::write(&script, format!("{head}{body}\n")).unwrap();
-        let Some((code, err)) = pilgrim_within(
-            &[
-                "run",
-                s(&script),
-                "--out",
-                s(&dir.join("o")),
-                "--quiet",
-                "--script-seconds",
-                "2",
-            ],
-            Duration::from_secs(60),
-        ) else {
-            panic!("{body} was not stopped");
-        };
-        assert_eq!(code, 1, "{body}: {err}");
-        assert!(err.to_lowercase().contains(expected), "{body}: {err}");
+        s(&script).to_owned()
+    };
+    // The kernel's ceiling on Floats.
+    let f = family("fn toolpath(p) { let v = linspace(0.0, 1.0, 1000); for i in 0..40 { v = concat(v, v); } v }");
+    let m = run(&["run", &f, "--out", s(&out), "--quiet"]);
+    assert_eq!(m.code, 1, "{}", m.err);
+    assert!(m.err.contains("ceiling of 10000000"), "{}", m.err);
+    assert!(m.peak_mb < small.peak_mb + 400.0, "{} MB", m.peak_mb);
+    // Time, between a script's operations.
+    let f = family("fn toolpath(p) { let a = []; loop { a.push(1); } }");
+    let m = run(&[
+        "run",
+        &f,
+        "--out",
+        s(&out),
+        "--quiet",
+        "--script-seconds",
+        "2",
+    ]);
+    assert_eq!(m.code, 1, "{}", m.err);
+    assert!(
+        m.err.contains("the script's time limit of 2 s passed"),
+        "{}",
+        m.err
+    );
+    assert!(
+        m.cpu_seconds < 2.0 + small.cpu_seconds + 1.0,
+        "{} s of CPU",
+        m.cpu_seconds
+    );
+    // Memory, after every operation.
+    let f = family("fn toolpath(p) { let m = #{}; for i in 0..100000000 { m[`k${i}`] = i; } m }");
+    let m = run(&[
+        "run",
+        &f,
+        "--out",
+        s(&out),
+        "--quiet",
+        "--script-memory-mb",
+        "200",
+    ]);
+    assert_eq!(m.code, 1, "{}", m.err);
+    assert!(m.err.contains("memory limit of 200 MB"), "{}", m.err);
+    assert!(
+        m.peak_mb < 200.0 + small.peak_mb + 20.0,
+        "{} MB at its peak",
+        m.peak_mb
+    );
+    // Time, inside a kernel call made by the script, and the run's own
+    // limit over the whole run.
+    for (limit, flag, whose) in [
+        ("2", "--script-seconds", "the script's"),
+        ("1", "--run-seconds", "the run's"),
+    ] {
+        let m = run(&[
+            "run",
+            "scripts/mandrel.rhai",
+            "--set",
+            "rough_feed=5e-324",
+            "--out",
+            s(&out),
+            "--quiet",
+            flag,
+            limit,
+        ]);
+        assert_eq!(m.code, 1, "{}", m.err);
+        let said = format!("{whose} time limit of {limit} s passed (in the steady rest's track)");
+        assert!(m.err.contains(&said), "{}", m.err);
+        let limit: f64 = limit.parse().unwrap();
+        assert!(
+            m.cpu_seconds < limit + mandrel.cpu_seconds + 1.0,
+            "{} s of CPU",
+            m.cpu_seconds
+        );
     }
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -439,28 +536,70 @@ fn errors_quote_short_excerpts() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// A run killed part way leaves the previous output or none, never a
-/// half-written one; the same input gives the same bytes.
+/// A run killed part way leaves the previous output whole, never a
+/// half-written one, and the next run cleans what the killed one left. The
+/// kills land at points the test knows were reached (a preloaded shim kills
+/// the run as it creates its K-th file, or just before or after it swaps
+/// the new output in), so the test proves the same whatever the machine's
+/// speed.
 #[test]
 fn killed_runs_leave_the_old_output_whole() {
     let dir = scratch("kill");
+    let shim = dir.join("libkill.so");
+    let cc = Command::new("cc")
+        .args(["-shared", "-fPIC", "-O1", "-o"])
+        .arg(&shim)
+        .arg(root().join("tests/fixtures/kill-shim/kill.c"))
+        .arg("-ldl")
+        .output()
+        .expect("a C compiler (cc) builds the test's shim");
+    assert!(
+        cc.status.success(),
+        "{}",
+        String::from_utf8_lossy(&cc.stderr)
+    );
     let out = dir.join("o");
-    let (code, _, err) = pilgrim(&["run", "scripts/mandrel.rhai", "--out", s(&out), "--quiet"]);
+    let args = ["run", "scripts/mandrel.rhai", "--out", s(&out), "--quiet"];
+    let (code, _, err) = pilgrim(&args);
     assert_eq!(code, 0, "{err}");
     let before = snapshot(&out);
-    for delay_ms in [5u64, 15, 30, 45, 60, 90] {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_pilgrim"))
+    // The marker and every file (the snapshot holds both): that many
+    // exclusive creations.
+    let files = before.len();
+    let killed = |var: &str, value: &str| {
+        let status = Command::new(env!("CARGO_BIN_EXE_pilgrim"))
             .current_dir(root())
-            .args(["run", "scripts/mandrel.rhai", "--out", s(&out), "--quiet"])
-            .spawn()
+            .args(args)
+            .env("LD_PRELOAD", &shim)
+            .env(var, value)
+            .stderr(Stdio::null())
+            .status()
             .unwrap();
-        std::thread::sleep(Duration::from_millis(delay_ms));
-        child.kill().ok();
-        child.wait().unwrap();
-        let now = snapshot(&out);
+        use std::os::unix::process::ExitStatusExt;
+        assert_eq!(
+            status.signal(),
+            Some(libc::SIGKILL),
+            "{var}={value}: the run did not reach its kill point ({status})"
+        );
         // Either untouched, or the whole new output: the same bytes.
-        assert_eq!(now, before, "after a kill at {delay_ms} ms");
+        assert_eq!(snapshot(&out), before, "after a kill at {var}={value}");
+    };
+    for k in [0, 1, files / 2, files - 1] {
+        killed("PILGRIM_KILL_AT_CREATE", &k.to_string());
     }
+    killed("PILGRIM_KILL_AT_SWAP", "before");
+    killed("PILGRIM_KILL_AT_SWAP", "after");
+    // The next run replaces the output and cleans what the killed ones left.
+    let (code, _, err) = pilgrim(&args);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(snapshot(&out), before);
+    let left: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(".o."))
+        .collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -769,5 +908,52 @@ fn every_message_quotes_outside_text_short() {
     let csv = std::fs::read_to_string(out.join("report.csv")).unwrap();
     assert!(csv.contains(",'=1+2,"), "{csv}");
     assert!(!csv.contains(",=1+2"), "{csv}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A workbook that says more than it holds is refused before it is
+/// expanded: an ODS of a few hundred bytes whose row of a thousand values is
+/// repeated a million times (once 6.2 GB and 21 s before the cell limit).
+#[test]
+fn spreadsheets_are_bounded_before_they_expand() {
+    use std::io::Write;
+    let dir = scratch("bomb");
+    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    let stored =
+        zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored);
+    zip.start_file("mimetype", stored).unwrap();
+    zip.write_all(b"application/vnd.oasis.opendocument.spreadsheet")
+        .unwrap();
+    zip.start_file("content.xml", stored).unwrap();
+    zip.write_all(
+        b"<?xml version=\"1.0\"?><office:document-content><office:body><office:spreadsheet>\
+          <table:table table:name=\"S\"><table:table-row table:number-rows-repeated=\"1000000\">\
+          <table:table-cell table:number-columns-repeated=\"1000\" office:value-type=\"float\" office:value=\"1\"/>\
+          </table:table-row></table:table></office:spreadsheet></office:body></office:document-content>",
+    )
+    .unwrap();
+    let bytes = zip.finish().unwrap().into_inner();
+    assert!(bytes.len() < 1000, "{} bytes", bytes.len());
+    std::fs::write(dir.join("t.ods"), &bytes).unwrap();
+    let script = dir.join("f.rhai");
+    std::fs::write(
+        &script,
+        "fn params() { #{} }\nfn default_machine() { \"vertical-mill\" }\nfn toolpath(p) { read_table(\"t.ods\") }\n",
+    )
+    .unwrap();
+    let Some(m) = measured(
+        &["run", s(&script), "--out", s(&dir.join("o"))],
+        Duration::from_secs(60),
+    ) else {
+        panic!("the ODS was expanded");
+    };
+    assert_eq!(m.code, 1, "{}", m.err);
+    assert!(
+        m.err.contains("t.ods") && m.err.contains("more than 10000000 cells"),
+        "{}",
+        m.err
+    );
+    // Refused before it was expanded: no more memory than a small run.
+    assert!(m.peak_mb < 200.0, "{} MB at its peak", m.peak_mb);
     std::fs::remove_dir_all(&dir).ok();
 }

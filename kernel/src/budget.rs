@@ -12,8 +12,9 @@
 use std::cell::Cell;
 use std::time::{Duration, Instant};
 
-/// A deadline and the limit (s) it came from.
-pub type Deadline = (Instant, f64);
+/// A deadline: when, the limit (s) it came from, and whose limit it is
+/// (`"the run's"`, `"the script's"`).
+pub type Deadline = (Instant, f64, &'static str);
 
 thread_local! {
     static DEADLINE: Cell<Option<Deadline>> = const { Cell::new(None) };
@@ -21,19 +22,23 @@ thread_local! {
 
 /// The work ran past its time limit.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
-#[error("the run ran past its time limit of {seconds} s (in {stage}) and was stopped")]
+#[error("{whose} time limit of {seconds} s passed (in {stage}) and the work was stopped")]
 pub struct OverTime {
     /// The limit (s).
     pub seconds: f64,
+    /// Whose limit it is (`"the run's"`).
+    pub whose: &'static str,
     /// What was being done.
     pub stage: &'static str,
 }
 
-/// Runs `f` with a time limit of `seconds` from now (or the one already
-/// set, if that is sooner), restoring the outer limit afterwards.
-pub fn with_limit<T>(seconds: f64, f: impl FnOnce() -> T) -> T {
+/// Runs `f` with `whose` time limit of `seconds` from now (or the one
+/// already set, if that is sooner), restoring the outer limit afterwards.
+pub fn with_limit<T>(seconds: f64, whose: &'static str, f: impl FnOnce() -> T) -> T {
     let limit = Duration::try_from_secs_f64(seconds.max(0.0)).unwrap_or(Duration::MAX);
-    let mine = Instant::now().checked_add(limit).map(|t| (t, seconds));
+    let mine = Instant::now()
+        .checked_add(limit)
+        .map(|t| (t, seconds, whose));
     let outer = current();
     let chosen = match (outer, mine) {
         (Some(o), Some(m)) if o.0 <= m.0 => Some(o),
@@ -60,15 +65,20 @@ pub fn current() -> Option<Deadline> {
     DEADLINE.with(Cell::get)
 }
 
-/// The limit (s) whose deadline has passed, if it has.
-pub fn expired() -> Option<f64> {
-    current().and_then(|(until, seconds)| (Instant::now() > until).then_some(seconds))
+/// The limit (s) whose deadline has passed, and whose it is, if it has.
+pub fn expired() -> Option<(f64, &'static str)> {
+    current()
+        .and_then(|(until, seconds, whose)| (Instant::now() > until).then_some((seconds, whose)))
 }
 
 /// An error once the deadline has passed, naming `stage`.
 pub fn check(stage: &'static str) -> Result<(), OverTime> {
     match expired() {
-        Some(seconds) => Err(OverTime { seconds, stage }),
+        Some((seconds, whose)) => Err(OverTime {
+            seconds,
+            whose,
+            stage,
+        }),
         None => Ok(()),
     }
 }
@@ -78,7 +88,7 @@ pub fn check(stage: &'static str) -> Result<(), OverTime> {
 pub fn bounded(wait: Duration) -> (Option<f64>, Instant) {
     let mine = Instant::now() + wait;
     match current() {
-        Some((until, seconds)) if until < mine => (Some(seconds), until),
+        Some((until, seconds, _)) if until < mine => (Some(seconds), until),
         _ => (None, mine),
     }
 }
@@ -120,14 +130,19 @@ mod tests {
     #[test]
     fn limits_nest_to_the_nearer_and_restore() {
         assert!(current().is_none());
-        with_limit(100.0, || {
+        with_limit(100.0, "the run's", || {
             let outer = current().unwrap();
-            with_limit(1000.0, || assert_eq!(current().unwrap().0, outer.0));
-            with_limit(0.0, || {
+            with_limit(1000.0, "the script's", || {
+                assert_eq!(current().unwrap(), outer)
+            });
+            with_limit(0.0, "the script's", || {
                 std::thread::sleep(Duration::from_millis(2));
                 let e = check("a test").unwrap_err();
                 assert_eq!(e.seconds, 0.0);
-                assert!(e.to_string().contains("in a test"), "{e}");
+                assert_eq!(
+                    e.to_string(),
+                    "the script's time limit of 0 s passed (in a test) and the work was stopped"
+                );
             });
             assert_eq!(current().unwrap().0, outer.0);
             assert!(check("x").is_ok());

@@ -19,6 +19,9 @@ use crate::verify::VerifyError;
 /// Any error of the kernel.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Error {
+    /// The run's time limit passed while this was being done.
+    #[error(transparent)]
+    OverTime(#[from] crate::budget::OverTime),
     /// A rejected input value.
     #[error(transparent)]
     Value(#[from] InputError),

@@ -235,12 +235,14 @@ pub fn check_replaceable(out: &Path) -> Result<(), OutputError> {
 
 /// Removes from `dir` the files its marker lists, then the marker, then
 /// `dir` itself if that left it empty (a file pilgrim did not write keeps
-/// it). A directory without pilgrim's marker is left as it is.
+/// it). A directory without pilgrim's marker is removed only when empty (a
+/// run killed before it wrote its marker).
 fn remove_listed(dir: &Path) {
     if !is_real_dir(dir) {
         return;
     }
     let Some(marker) = read_marker(dir) else {
+        let _ = std::fs::remove_dir(dir);
         return;
     };
     for name in marked_files(&marker) {

@@ -229,7 +229,9 @@ pub fn check(
         Ok(p)
     };
     let ends = crate::verify::replay(&written, machine, tool)?;
+    let mut ticker = crate::budget::Ticker::new("the process's rules", 64);
     for k in 1..n {
+        ticker.tick()?;
         let b = &written.blocks[k];
         let (p0, p1) = (&ends[6 * (k - 1)..6 * k], &ends[6 * k..6 * k + 6]);
         let length =

@@ -26,6 +26,9 @@ use serde::{Deserialize, Serialize};
 /// Why a program could not be verified, or failed verification.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum VerifyError {
+    /// The run's time limit passed while this was being done.
+    #[error(transparent)]
+    OverTime(#[from] crate::budget::OverTime),
     /// A rejected number (a tolerance that is not positive).
     #[error(transparent)]
     Input(#[from] InputError),
@@ -370,6 +373,7 @@ pub fn replay_grinding(
     let mut ordinals: Vec<Vec<usize>> = vec![Vec::new(); GENERATRICES];
     let mut cut_blocks: Vec<std::ops::Range<usize>> = Vec::new();
     for (pass, blocks) in pass_blocks(program, passes) {
+        crate::budget::check("the grinding replay")?;
         for b in &written.blocks[blocks.clone()] {
             if let Some(s) = b.spindle {
                 rpm = s;
@@ -460,6 +464,7 @@ pub fn replay_grinding(
         let mut lo = vec![Real::INFINITY; zs.len()];
         let mut hi = vec![Real::NEG_INFINITY; zs.len()];
         for (g, env) in envs.iter().enumerate() {
+            crate::budget::check("the grinding replay")?;
             let surface = env.eval_many(&zs);
             // The surface the pass cut into (not finite where an earlier
             // sweep never reached: there it does not bound).

@@ -22,6 +22,7 @@
 
 use super::groove::Groove;
 use super::pose::TorusWheel;
+use crate::budget::OverTime;
 use crate::machine::MachineKinematics;
 use crate::math::{Real, Vec3};
 use crate::mesh::TriMesh;
@@ -267,6 +268,7 @@ fn samples(
     let mut worst: Real = 0.0;
     let mut count = 0;
     for (_, blocks) in pass_blocks(program, passes).filter(|(p, _)| p.cuts()) {
+        crate::budget::check("the groove's replay")?;
         let mut rows_sub: Vec<Real> = Vec::new();
         let mut owner = Vec::new();
         for k in blocks.start.max(1)..blocks.end {
@@ -425,9 +427,10 @@ pub fn check_groove(
     }
     let np = psi_grid.len();
     // Each point against the passes around it; two threads share rows.
-    let measure = |rows: std::ops::Range<usize>| -> Vec<(Real, usize)> {
+    let measure = |rows: std::ops::Range<usize>| -> Result<Vec<(Real, usize)>, OverTime> {
         let mut out = Vec::with_capacity(rows.len() * np);
         for i in rows {
+            crate::budget::check("the groove's measurement")?;
             for (j, &(_, k)) in psi_grid.iter().enumerate() {
                 let q = &points[i * np + j];
                 let from = k.saturating_sub(NEIGHBOUR_PASSES);
@@ -442,19 +445,24 @@ pub fn check_groove(
                 out.push(best);
             }
         }
-        out
+        Ok(out)
     };
     let half = n_theta / 2;
+    // The second thread keeps the run's deadline.
+    let deadline = crate::budget::current();
     let mut dist = std::thread::scope(|s| {
-        let h = s.spawn(|| measure(half..n_theta));
-        let mut a = measure(0..half);
-        a.extend(h.join().expect("the measuring thread does not panic"));
-        a
-    });
+        let h = s.spawn(|| crate::budget::with_deadline(deadline, || measure(half..n_theta)));
+        let a = measure(0..half);
+        let b = h.join().expect("the measuring thread does not panic");
+        let mut a = a?;
+        a.extend(b?);
+        Ok::<_, OverTime>(a)
+    })?;
     // Each block's wheel across the whole section at its own theta; the
     // two threads take the two halves of the rows again.
     let across = |rows: std::ops::Range<usize>, dist: &mut [(Real, usize)]| {
         for list in &lists {
+            crate::budget::check("the groove's measurement")?;
             for (idx, s) in list.iter().enumerate() {
                 if idx + 1 < list.len() && list[idx + 1].block == s.block {
                     continue; // one sample per block: its last, at the block
@@ -473,13 +481,17 @@ pub fn check_groove(
                 }
             }
         }
+        Ok::<_, OverTime>(())
     };
     {
         let (first, second) = dist.split_at_mut(half * np);
         std::thread::scope(|s| {
-            s.spawn(|| across(half..n_theta, second));
-            across(0..half, first);
-        });
+            let h = s
+                .spawn(|| crate::budget::with_deadline(deadline, || across(half..n_theta, second)));
+            let a = across(0..half, first);
+            let b = h.join().expect("the measuring thread does not panic");
+            a.and(b)
+        })?;
     }
     let place = |idx: usize| {
         let (i, j) = (idx / np, idx % np);

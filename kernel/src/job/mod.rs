@@ -519,8 +519,10 @@ pub fn run(
     // thread writes them while this one posts and lints. A run that failed
     // writes no program a control could load.
     let failed_already = !failures.is_empty();
+    let deadline = crate::budget::current();
     let (data, posted) = std::thread::scope(|s| {
-        let data = s.spawn(|| data_files(&toolpath, &program));
+        let data =
+            s.spawn(|| crate::budget::with_deadline(deadline, || data_files(&toolpath, &program)));
         let posted = if failed_already {
             Ok(Vec::new())
         } else {

@@ -214,7 +214,11 @@ impl ChainMachine {
         let mut seed: Vec<Real> = free.iter().map(|&i| home[i]).collect();
         let tol_dir = self.options.tol_dir.max(1e-9);
         out.clear();
+        let mut ticker = crate::budget::Ticker::new("inverse kinematics", 64);
         for (k, p) in poses.chunks_exact(6).enumerate() {
+            ticker
+                .tick()
+                .map_err(|e| KinematicsError::at(k, e.to_string()))?;
             let row_held = &values[k * held.len()..(k + 1) * held.len()];
             let reduced;
             let solving = if held.is_empty() {

@@ -47,6 +47,9 @@ pub const DEFAULT_TOLERANCE: Real = 0.01;
 /// Errors of tessellation and mesh files.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MeshError {
+    /// The run's time limit passed while this was being done.
+    #[error(transparent)]
+    OverTime(#[from] crate::budget::OverTime),
     /// A rejected number.
     #[error(transparent)]
     Input(#[from] crate::input::InputError),

@@ -300,6 +300,7 @@ pub fn track(
     let mut k = 1;
     let original = pts.len();
     while k < pts.len() {
+        crate::budget::check("the steady rest's track")?;
         let (a, b) = (pts[k - 1], pts[k]);
         let (ua, ub) = (drops[k - 1].0.centre_x, drops[k].0.centre_x);
         let n = ((b.0 - a.0).abs() / REST_CHECK_STEP)
@@ -312,6 +313,7 @@ pub fn track(
         let mut kink: Option<(Real, Real)> = None;
         let at_s = |s: Real| at(a.0 + s * (b.0 - a.0), a.2 + s * (b.2 - a.2), k, false);
         for i in 1..=n {
+            crate::budget::check("the steady rest's track")?;
             let s = i as Real / n as Real;
             let d = if i == n { drops[k].0 } else { at_s(s)?.0 };
             // The support's contact jumping from one feature of the

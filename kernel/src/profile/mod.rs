@@ -19,6 +19,7 @@ mod law;
 mod simplify;
 mod smooth;
 mod table;
+mod workbook;
 
 pub use builder::{Bulge, ProfileBuilder};
 pub use ellipse::EllipseSection;
@@ -58,6 +59,9 @@ pub(crate) fn check_node_count(what: &str, count: Real, step: Real) -> Result<us
 /// Errors of profiles, their generators, equidistants and envelopes.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ProfileError {
+    /// The run's time limit passed while this was being done.
+    #[error(transparent)]
+    OverTime(#[from] crate::budget::OverTime),
     /// A rejected number or array.
     #[error(transparent)]
     Input(#[from] InputError),

@@ -16,8 +16,9 @@
 //! [`crate::files::MAX_DATA_BYTES`]; a table holds at most [`MAX_CELLS`]
 //! cells (its rows' widths added up), checked as it is read: an XLSX sheet
 //! is read cell by cell, never as the rectangle its farthest cell spans.
-//! (An XLS sheet is at most 65,536 x 256 cells by its format; an ODS
-//! sheet's repetitions are bounded by the reader.)
+//! Before a zipped workbook (XLSX, ODS) is opened, its parts' inflated size
+//! and an ODS sheet's repetitions are bounded ([`super::workbook`]). (An XLS
+//! sheet is at most 65,536 x 256 cells by its format.)
 
 use super::{Profile, ProfileError};
 use crate::input::InputError;
@@ -296,6 +297,7 @@ fn read_spreadsheet(bytes: &[u8], file: String) -> Result<Table, TableError> {
         file: file.clone(),
         message: crate::files::excerpt(&e.to_string()),
     };
+    super::workbook::check(bytes, &file)?;
     let mut book = calamine::open_workbook_auto_from_rs(std::io::Cursor::new(bytes))
         .map_err(|e| read_err(&e))?;
     let first = book

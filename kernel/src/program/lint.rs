@@ -244,7 +244,11 @@ fn lint_gcode(
     let mut has_code = vec![false; lines.len()];
     let framed = d.header.first().is_some_and(|h| *h == "%")
         || (d.header.first().is_some_and(|h| *h == "{WHOLE}%") && program.number > 0);
+    let mut ticker = crate::budget::Ticker::new("the program's lint", 1024);
     for (i, line) in lines.iter().enumerate() {
+        ticker
+            .tick()
+            .map_err(|e| fault(at_line(i), e.to_string()))?;
         let mut l = read_line(d, i, line).map_err(|m| fault(at_line(i), m))?;
         let header_name = format!("%_N_{}_MPF", program.name);
         let program_number = format!("O{:04}", program.number % 10000);
@@ -308,7 +312,7 @@ fn lint_gcode(
             format!(
                 "not G-code the control reads: {:?} in '{}'",
                 first.map(|x| &x.kind),
-                lines.get(line).unwrap_or(&"")
+                crate::files::excerpt(lines.get(line).unwrap_or(&""))
             ),
         )
     })?;
@@ -320,6 +324,9 @@ fn lint_gcode(
     let mut k = 0; // the next move of the axis program
     for block in &parsed.blocks {
         let line = block.span.line;
+        ticker
+            .tick()
+            .map_err(|e| fault(at_line(line), e.to_string()))?;
         let own_here = own.get_mut(line).map(std::mem::take).unwrap_or_default();
         if block.codes.is_empty()
             && block.word_addresses.is_empty()
@@ -778,8 +785,10 @@ fn lint_apt(text: &str, program: &AxisProgram, d: &Dialect) -> Result<Linted, Li
     let (mut rapid_next, mut coolant) = (false, false);
     let mut speed: Option<Real> = None;
     let written_by = format!("written by pilgrim {}", crate::VERSION);
+    let mut ticker = crate::budget::Ticker::new("the CL file's lint", 1024);
     for (l, line) in lines.iter().enumerate() {
         let at = || format!("line {}", l + 1);
+        ticker.tick().map_err(|e| fault(at(), e.to_string()))?;
         if let Some(c) = line.chars().find(|c| c.is_control() || !c.is_ascii()) {
             return Err(fault(
                 at(),
@@ -842,14 +851,16 @@ fn lint_apt(text: &str, program: &AxisProgram, d: &Dialect) -> Result<Linted, Li
         let Some(values) = line.strip_prefix("GOTO/") else {
             continue;
         };
-        let place = name_in(d.name, &program.blocks, k);
+        // Named only when a fault is told: finding the pass of a block
+        // walks back through the blocks before it.
+        let place = || name_in(d.name, &program.blocks, k);
         let Some(b) = program.blocks.get(k) else {
             return Err(fault(at(), "a GOTO beyond the axis program".into()));
         };
         let rapid = std::mem::take(&mut rapid_next);
         if rapid != (b.motion == Motion::Rapid) {
             return Err(fault(
-                place,
+                place(),
                 format!(
                     "{}, where the axis program has a {:?} move",
                     if rapid { "RAPID" } else { "a feed move" },
@@ -858,11 +869,11 @@ fn lint_apt(text: &str, program: &AxisProgram, d: &Dialect) -> Result<Linted, Li
             ));
         }
         if !rapid && speed.is_none() {
-            return Err(fault(place, "a cutting move with the spindle off".into()));
+            return Err(fault(place(), "a cutting move with the spindle off".into()));
         }
         if !rapid && program.setup.coolant && !coolant {
             return Err(fault(
-                place,
+                place(),
                 "a cutting move with the coolant off (no COOLNT/ON), which the machine's setup turns on".into(),
             ));
         }
@@ -870,17 +881,17 @@ fn lint_apt(text: &str, program: &AxisProgram, d: &Dialect) -> Result<Linted, Li
             .split(',')
             .map(|v| v.parse())
             .collect::<Result<_, _>>()
-            .map_err(|_| fault(place.clone(), format!("'{values}' are not numbers")))?;
+            .map_err(|_| fault(place(), format!("'{values}' are not numbers")))?;
         if read.len() != b.values.len() {
             return Err(fault(
-                place,
+                place(),
                 format!("{} values for {} axes", read.len(), b.values.len()),
             ));
         }
         for (i, (r, w)) in read.iter().zip(&b.values).enumerate() {
             if !((r - w).abs() <= half) {
                 return Err(fault(
-                    place,
+                    place(),
                     format!(
                         "{} = {r} read back, the axis program's {w}",
                         program.axes[i].name

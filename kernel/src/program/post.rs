@@ -304,6 +304,9 @@ pub fn dialect(name: &str) -> Option<&'static Dialect> {
 /// Errors writing a program.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PostError {
+    /// The run's time limit passed while this was being done.
+    #[error(transparent)]
+    OverTime(#[from] crate::budget::OverTime),
     /// No dialect of that name.
     #[error("no post-processor dialect '{name}' (dialects: sinumerik, fanuc, linuxcnc, cld)")]
     UnknownDialect {
@@ -561,7 +564,9 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
     // The preamble started the spindle at the program's speed.
     let mut last_spindle = program.spindle_rpm.round() as i64;
     let mut last_start: Option<String> = None;
+    let mut ticker = crate::budget::Ticker::new("the post", 1024);
     for (k, b) in program.blocks.iter().enumerate() {
+        ticker.tick()?;
         if let Some(c) = &b.comment {
             w.comment(c);
         }

@@ -164,8 +164,9 @@ pub mod caliber_api {
                 .collect()
         };
         let half = psis.len() / 2;
+        let deadline = crate::budget::current();
         let (a, b) = std::thread::scope(|s| {
-            let h = s.spawn(|| run(&psis[half..]));
+            let h = s.spawn(|| crate::budget::with_deadline(deadline, || run(&psis[half..])));
             let a = run(&psis[..half]);
             (
                 a,

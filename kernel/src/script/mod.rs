@@ -63,10 +63,11 @@ pub struct Limits {
     /// count alone does not bound time (an operation on a large array costs
     /// in proportion to it).
     pub max_seconds: f64,
-    /// Megabytes the process may hold while a script runs (its resident
-    /// memory, looked at every few thousand operations; Linux): the size
-    /// limits alone do not bound memory (Rhai 1.27 does not count a map's
-    /// entries added by `m[key] = value`).
+    /// Megabytes the process may hold while a script runs (what its
+    /// allocator holds, after every operation, where the program counts it
+    /// ([`set_allocated_probe`]); else its resident memory every 4096
+    /// operations, Linux): the size limits alone do not bound memory (Rhai
+    /// 1.27 does not count a map's entries added by `m[key] = value`).
     pub max_memory_mb: u64,
 }
 
@@ -88,6 +89,19 @@ impl Default for Limits {
     }
 }
 
+/// Bytes the process's allocator holds now: set by a program whose global
+/// allocator counts them ([`set_allocated_probe`]), so that a script's
+/// memory is looked at after every operation at the cost of one load.
+static ALLOCATED: std::sync::OnceLock<fn() -> usize> = std::sync::OnceLock::new();
+
+/// Tells the script engines how to read the bytes the process's allocator
+/// holds (the `pilgrim` program counts them with the `cap` allocator).
+/// Without it the memory limit reads the resident size from the system
+/// every 4096 operations, which one operation on a large value can outrun.
+pub fn set_allocated_probe(probe: fn() -> usize) {
+    let _ = ALLOCATED.set(probe);
+}
+
 /// The process's resident memory (MB), where the system tells it (Linux).
 fn resident_mb() -> Option<u64> {
     let text = std::fs::read_to_string("/proc/self/statm").ok()?;
@@ -95,25 +109,6 @@ fn resident_mb() -> Option<u64> {
     // SAFETY: sysconf reads a system constant.
     let page = unsafe { libc::sysconf(libc::_SC_PAGESIZE) };
     Some(pages * u64::try_from(page).ok()? / (1 << 20))
-}
-
-thread_local! {
-    /// When the running call of a script must stop, and its limit (s).
-    static DEADLINE: std::cell::Cell<Option<(std::time::Instant, f64)>> =
-        const { std::cell::Cell::new(None) };
-}
-
-/// Runs `f` with a wall-clock limit of `seconds` on the script calls in it.
-fn with_deadline<T>(seconds: f64, f: impl FnOnce() -> T) -> T {
-    let limit = std::time::Duration::try_from_secs_f64(seconds.max(0.0))
-        .unwrap_or(std::time::Duration::MAX);
-    let until = std::time::Instant::now()
-        .checked_add(limit)
-        .map(|t| (t, seconds));
-    let before = DEADLINE.with(|d| d.replace(until));
-    let out = f();
-    DEADLINE.with(|d| d.set(before));
-    out
 }
 
 /// Where scripts may read files.
@@ -151,22 +146,25 @@ pub fn engine(limits: &Limits, access: &Access) -> Engine {
         .set_max_string_size(limits.max_string_size)
         .set_max_map_size(limits.max_map_size)
         .set_module_resolver(rhai::module_resolvers::DummyModuleResolver::new());
-    // The wall-clock limit, looked at every 64 operations, and the memory
-    // limit every 4096.
+    // The memory limit after every operation where the allocator counts
+    // (else the resident size every 4096), the time limit every 64. One
+    // operation's growth is bounded by the size limits above.
     let max_mb = limits.max_memory_mb;
+    let max_bytes = usize::try_from(max_mb.saturating_mul(1 << 20)).unwrap_or(usize::MAX);
+    let probe = ALLOCATED.get().copied();
     e.on_progress(move |ops| {
+        let over = match probe {
+            Some(allocated) => allocated() > max_bytes,
+            None => ops % 4096 == 0 && resident_mb().is_some_and(|mb| mb > max_mb),
+        };
+        if over {
+            return Some(Dynamic::from_int(max_mb as rhai::INT));
+        }
         if ops % 64 != 0 {
             return None;
         }
-        if ops % 4096 == 0 && resident_mb().is_some_and(|mb| mb > max_mb) {
-            return Some(Dynamic::from_int(max_mb as rhai::INT));
-        }
-        DEADLINE.with(|d| match d.get() {
-            Some((until, seconds)) if std::time::Instant::now() > until => {
-                Some(Dynamic::from_float(seconds))
-            }
-            _ => None,
-        })
+        crate::budget::expired()
+            .map(|(seconds, whose)| Dynamic::from(format!("{whose} time limit of {seconds} s")))
     });
     // Scripts print to the error stream, never into outputs, quoted as any
     // outside text is: short, control characters (a terminal's escape
@@ -311,9 +309,7 @@ fn locate(file: &str, called: &str, e: &EvalAltResult) -> FamilyError {
     let mut message = match inner {
         EvalAltResult::ErrorTerminated(token, _) => match token.as_int() {
             Ok(mb) => format!("the script ran past its memory limit of {mb} MB and was stopped"),
-            Err(_) => format!(
-                "the script ran past its time limit of {token} s and was stopped (an endless loop?)"
-            ),
+            Err(_) => format!("{token} passed and the script was stopped (an endless loop?)"),
         },
         EvalAltResult::ErrorTooManyOperations(_) => {
             "the script ran past its operation limit and was stopped (an endless loop?)".to_owned()
@@ -504,7 +500,7 @@ impl ScriptFamily {
 
     fn call(&self, name: &str, args: impl rhai::FuncArgs) -> Result<Dynamic, FamilyError> {
         let mut scope = Scope::new();
-        with_deadline(self.max_seconds, || {
+        crate::budget::with_limit(self.max_seconds, "the script's", || {
             self.engine
                 .call_fn::<Dynamic>(&mut scope, &self.ast, name, args)
         })
@@ -790,10 +786,11 @@ pub fn machine_from_script(path: &Path) -> Result<Machine, MachineError> {
     let ast = engine
         .compile(&source)
         .map_err(|e| io(format!("{}: {}", e.position(), e.err_type())))?;
-    let map: Dynamic = with_deadline(Limits::default().max_seconds, || {
-        engine.call_fn(&mut Scope::new(), &ast, "machine", ())
-    })
-    .map_err(|e| io(format!("fn machine(): {e}")))?;
+    let map: Dynamic =
+        crate::budget::with_limit(Limits::default().max_seconds, "the script's", || {
+            engine.call_fn(&mut Scope::new(), &ast, "machine", ())
+        })
+        .map_err(|e| io(format!("fn machine(): {e}")))?;
     let value: toml::Value = rhai::serde::from_dynamic(&map)
         .map_err(|e| io(format!("fn machine() must return the machine's table: {e}")))?;
     let text = toml::to_string(&value).map_err(|e| io(e.to_string()))?;

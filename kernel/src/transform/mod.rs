@@ -142,6 +142,9 @@ impl Factor {
 /// Errors of chains and inverse kinematics.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum TransformError {
+    /// The run's time limit passed while this was being done.
+    #[error(transparent)]
+    OverTime(#[from] crate::budget::OverTime),
     /// A rejected number.
     #[error(transparent)]
     Input(#[from] InputError),

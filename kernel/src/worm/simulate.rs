@@ -463,7 +463,9 @@ pub fn simulate(
         failures
             .push(Finding::new("verification", fail(m).to_string()).at(i, block_name(&written, i)));
     };
+    let mut ticker = crate::budget::Ticker::new("the thread's simulation", 16);
     for i in 1..written.blocks.len() {
+        ticker.tick()?;
         let b = &written.blocks[i];
         if let Some(s) = b.spindle {
             rpm = s;
