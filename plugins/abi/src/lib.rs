@@ -7,10 +7,12 @@
 //! allocation crosses the boundary; this crate does not depend on the
 //! kernel, so a plugin links this crate (and serde) only.
 //!
-//! A plugin exports one function, `pilgrim_plugin_<name>`, `<name>` being
-//! its library's file name without `lib` and the extension (so that two
-//! plugins compiled into one binary never clash, as Python's
-//! `PyInit_<module>`). It returns a pointer to a static [`PluginTable`]:
+//! A plugin exports one function whose name starts with `pilgrim_plugin_`
+//! (`pilgrim_plugin_acme_lathe`); the host finds it by that prefix, so the
+//! library's file may be renamed. (A library exporting several, a bundle of
+//! machines, is loaded by the one named after its file; distinct names also
+//! let several plugins be compiled into one binary.) It returns a pointer
+//! to a static [`PluginTable`]:
 //!
 //! - `abi_major`, `abi_minor`, `size` first: the host refuses another major
 //!   and reads only the fields that lie wholly below `size` (fields are only
@@ -27,6 +29,10 @@
 //!   `last_error` gives the message;
 //! - a [`Buffer`] is freed by whoever allocated it: buffers a plugin returns
 //!   go back through its `free_buffer`.
+//!
+//! The crate stands alone (nothing inherited from pilgrim's workspace); C
+//! plugins use its header `include/pilgrim_plugin.h`, generated from it by
+//! cbindgen. pilgrim's `docs/plugins.md` is the how-to and the contract.
 //!
 //! A Rust plugin implements [`Plugin`] and exports it with [`export_plugin!`]:
 //!
@@ -191,21 +197,50 @@ pub struct PluginTable {
     pub abi_minor: u32,
     /// `size_of::<PluginTable>()` in the plugin's build.
     pub size: u32,
+    // The entries' types are written out, not named by their aliases
+    // below: cbindgen cannot see through `Option<alias>` (cbindgen #326),
+    // and the C header must have function pointers here. The assertions
+    // after the struct hold each field to its alias.
     /// See [`DescribeFn`].
-    pub describe: Option<DescribeFn>,
+    pub describe: Option<unsafe extern "C" fn(out: *mut Buffer) -> i32>,
     /// See [`InverseFn`].
-    pub inverse: Option<InverseFn>,
+    pub inverse: Option<
+        unsafe extern "C" fn(
+            poses: *const f64,
+            count: usize,
+            tool: *const f64,
+            out: *mut f64,
+            width: usize,
+            failed_row: *mut usize,
+        ) -> i32,
+    >,
     /// See [`ForwardFn`].
-    pub forward: Option<ForwardFn>,
+    pub forward: Option<
+        unsafe extern "C" fn(
+            axes: *const f64,
+            count: usize,
+            width: usize,
+            tool: *const f64,
+            out: *mut f64,
+        ) -> i32,
+    >,
     /// See [`PostFn`]; `None` unless [`CAP_POST`].
-    pub post: Option<PostFn>,
+    pub post: Option<unsafe extern "C" fn(request: *const u8, len: usize, out: *mut Buffer) -> i32>,
     /// See [`LastErrorFn`].
-    pub last_error: Option<LastErrorFn>,
+    pub last_error: Option<unsafe extern "C" fn(out: *mut Buffer) -> i32>,
     /// See [`FreeBufferFn`].
-    pub free_buffer: Option<FreeBufferFn>,
+    pub free_buffer: Option<unsafe extern "C" fn(buffer: Buffer)>,
     /// Since 1.1: the `CAP_*` bits of the entries offered.
     pub capabilities: u32,
 }
+
+// Each entry of the table is its alias's type (a compile error otherwise).
+const _: fn(&PluginTable) -> Option<DescribeFn> = |t| t.describe;
+const _: fn(&PluginTable) -> Option<InverseFn> = |t| t.inverse;
+const _: fn(&PluginTable) -> Option<ForwardFn> = |t| t.forward;
+const _: fn(&PluginTable) -> Option<PostFn> = |t| t.post;
+const _: fn(&PluginTable) -> Option<LastErrorFn> = |t| t.last_error;
+const _: fn(&PluginTable) -> Option<FreeBufferFn> = |t| t.free_buffer;
 
 /// The size of the table in this build (what `size` says).
 pub const TABLE_SIZE: u32 = std::mem::size_of::<PluginTable>() as u32;
@@ -538,7 +573,8 @@ pub mod entry {
 }
 
 /// Exports a [`Plugin`] (a type with `Default`) as the C entry `$symbol`,
-/// which must be `pilgrim_plugin_<library name>`. The plugin is built on
+/// whose name must start with `pilgrim_plugin_` (the library's only such
+/// export, or the one named after its file). The plugin is built on
 /// its first call, inside that call's panic guard: a `Default` that panics
 /// is an error the host reports, not an abort.
 #[macro_export]
