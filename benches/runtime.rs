@@ -123,6 +123,12 @@ fn plugin_batch(c: &mut Criterion) {
             "building the plugin's shared library failed"
         );
     }
+    // The library runs in a child process (`pilgrim plugin-server`): the
+    // batch crosses a pipe both ways.
+    pilgrim_kernel::plugin::configure(
+        Some(env!("CARGO_BIN_EXE_pilgrim").into()),
+        pilgrim_kernel::plugin::Bounds::default(),
+    );
     let loaded = PluginMachine::load(&lib).unwrap();
     // Compiled in: the same ABI, without the library.
     let built_in = PluginMachine::from_entry(
