@@ -926,6 +926,8 @@ fn spreadsheets_are_bounded_before_they_expand() {
     zip.start_file("mimetype", stored).unwrap();
     zip.write_all(b"application/vnd.oasis.opendocument.spreadsheet")
         .unwrap();
+    zip.start_file("META-INF/manifest.xml", stored).unwrap();
+    zip.write_all(b"<manifest:manifest/>").unwrap();
     zip.start_file("content.xml", stored).unwrap();
     zip.write_all(
         b"<?xml version=\"1.0\"?><office:document-content><office:body><office:spreadsheet>\
