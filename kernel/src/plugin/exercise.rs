@@ -9,8 +9,8 @@
 //! with the declared chain's (the descriptor's `chain`, as the kernel
 //! evaluates it); its inverse kinematics of those poses, solved forward
 //! again, with the poses (the two solutions against each other); and each
-//! axis moved a little both ways, by the plugin and by the chain, to name
-//! an axis whose sign disagrees. A difference beyond [`POSITION_TOL`] or
+//! axis moved a little, by the plugin and by the chain (all axes' moves in
+//! one batch each), to name an axis whose sign disagrees. A difference beyond [`POSITION_TOL`] or
 //! [`ANGLE_TOL`], or a sign that disagrees, fails.
 
 use crate::machine::{AxisKind, Machine, MachineKinematics};
@@ -204,8 +204,10 @@ fn worst(machine: &dyn MachineKinematics, a: &[f64], b: &[f64], axes: &[f64]) ->
 }
 
 /// Tries `plugin`'s kinematics over its travel. See the [module docs](self).
-pub fn exercise(plugin: &dyn MachineKinematics) -> Exercise {
+pub fn exercise(plugin: &super::PluginMachine) -> Exercise {
+    use pilgrim_plugin_abi::{CAP_FORWARD, CAP_INVERSE};
     let info = plugin.info();
+    let offers = |cap: u32| plugin.capabilities() & cap != 0;
     let tool = ToolFrame::default();
     let width = info.solved_axes.len();
     let mut out = Exercise {
@@ -237,18 +239,14 @@ pub fn exercise(plugin: &dyn MachineKinematics) -> Exercise {
         c.forward(&axes, &tool, &mut p).ok().map(|_| p)
     });
     let mut poses = Vec::new();
-    let has_forward = match plugin.forward(&axes, &tool, &mut poses) {
-        Ok(()) => true,
-        Err(e) if e.message.contains("offers no forward") => {
-            out.notes
-                .push("the plugin offers no forward kinematics: poses come from the chain".into());
-            false
-        }
-        Err(e) => {
-            out.failed = Some(format!("forward kinematics failed: {e}"));
-            return out;
-        }
-    };
+    let has_forward = offers(CAP_FORWARD);
+    if !has_forward {
+        out.notes
+            .push("the plugin offers no forward kinematics: poses come from the chain".into());
+    } else if let Err(e) = plugin.forward(&axes, &tool, &mut poses) {
+        out.failed = Some(format!("forward kinematics failed: {e}"));
+        return out;
+    }
     if has_forward {
         if let Some(c) = &chain_poses {
             out.against_chain = Some(worst(plugin, &poses, c, &axes));
@@ -262,8 +260,13 @@ pub fn exercise(plugin: &dyn MachineKinematics) -> Exercise {
     }
     // Inverse, then forward again (the plugin's, else the chain's).
     let mut solved = Vec::new();
-    match plugin.inverse(&poses, &tool, &mut solved) {
-        Ok(()) => {
+    let inverse = if offers(CAP_INVERSE) {
+        Some(plugin.inverse(&poses, &tool, &mut solved))
+    } else {
+        None
+    };
+    match inverse {
+        Some(Ok(())) => {
             let mut again = Vec::new();
             let forward = if has_forward {
                 plugin.forward(&solved, &tool, &mut again)
@@ -277,10 +280,10 @@ pub fn exercise(plugin: &dyn MachineKinematics) -> Exercise {
                 Err(e) => out.failed = Some(format!("forward kinematics failed: {e}")),
             }
         }
-        Err(e) if e.message.contains("offers no inverse") => out
+        None => out
             .notes
             .push("the plugin offers no inverse kinematics".into()),
-        Err(e) => {
+        Some(Err(e)) => {
             let at = e
                 .index
                 .and_then(|i| axes.get(i * width..(i + 1) * width))
@@ -292,8 +295,10 @@ pub fn exercise(plugin: &dyn MachineKinematics) -> Exercise {
             ));
         }
     }
-    // Each axis moved a little, by the plugin and by the chain.
+    // Each axis moved a little, by the plugin and by the chain: the rows
+    // of every axis's move in one batch for each.
     if let (true, Some(c), Some(base_chain)) = (has_forward, &chain, &chain_poses) {
+        let mut moved = Vec::with_capacity(width * axes.len());
         for (j, name) in info.solved_axes.iter().enumerate() {
             let span = info.axis(name).map_or(1.0, |a| {
                 let s = (a.max - a.min).abs();
@@ -303,23 +308,28 @@ pub fn exercise(plugin: &dyn MachineKinematics) -> Exercise {
                     1.0
                 }
             });
-            let step = 1e-3 * span;
-            let mut moved = axes.clone();
-            for row in moved.chunks_exact_mut(width) {
-                row[j] += step;
+            for row in axes.chunks_exact(width) {
+                moved.extend_from_slice(row);
+                let last = moved.len() - width;
+                moved[last + j] += 1e-3 * span;
             }
-            let (mut p, mut q) = (Vec::new(), Vec::new());
-            if plugin.forward(&moved, &tool, &mut p).is_err()
-                || c.forward(&moved, &tool, &mut q).is_err()
-            {
-                continue;
-            }
-            let mut agree = 0.0;
-            for k in 0..p.len() {
-                agree += (p[k] - poses[k]) * (q[k] - base_chain[k]);
-            }
-            if agree < 0.0 {
-                out.signs.push(name.clone());
+        }
+        let (mut p, mut q) = (Vec::new(), Vec::new());
+        if plugin.forward(&moved, &tool, &mut p).is_ok()
+            && c.forward(&moved, &tool, &mut q).is_ok()
+        {
+            let per_axis = poses.len();
+            for (j, name) in info.solved_axes.iter().enumerate() {
+                let block = j * per_axis..(j + 1) * per_axis;
+                let agree: f64 = p[block.clone()]
+                    .iter()
+                    .zip(&q[block])
+                    .zip(poses.iter().zip(base_chain))
+                    .map(|((p, q), (p0, q0))| (p - p0) * (q - q0))
+                    .sum();
+                if agree < 0.0 {
+                    out.signs.push(name.clone());
+                }
             }
         }
     }
