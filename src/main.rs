@@ -4,6 +4,7 @@
 //! kernel call. Exit codes: 0 done, 1 the job failed (the message says
 //! why, naming file, line, parameter or block), 2 a bad command line.
 
+mod counting;
 mod run;
 
 use clap::{Parser, Subcommand};
@@ -16,15 +17,11 @@ use pilgrim_kernel::PartFamily;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-/// The allocator, counting what it holds so that a script's memory limit is
-/// looked at after every operation (`pilgrim_kernel::script::set_allocated_probe`).
+/// The allocator, counting per thread what each holds, so that a script's
+/// memory limit is looked at after every operation
+/// (`pilgrim_kernel::script::set_allocated_probe`).
 #[global_allocator]
-static ALLOCATOR: cap::Cap<std::alloc::System> = cap::Cap::new(std::alloc::System, usize::MAX);
-
-/// Bytes the allocator holds now.
-fn allocated() -> usize {
-    ALLOCATOR.allocated()
-}
+static ALLOCATOR: counting::Counting = counting::Counting;
 
 /// The machine plugins compiled into the program.
 const COMPILED_PLUGINS: [CompiledPlugin; 4] = [
@@ -105,7 +102,7 @@ enum Command {
         /// kernel calls made from it included.
         #[arg(long, value_name = "S", default_value_t = 60.0)]
         script_seconds: f64,
-        /// Memory the process may hold while the family's script runs (MB).
+        /// Memory the family's script may hold (MB), looked at after every operation.
         #[arg(long, value_name = "MB", default_value_t = 4096)]
         script_memory_mb: u64,
         /// Wall-clock limit of the whole run (seconds): checked inside the
@@ -306,7 +303,7 @@ fn main() -> ExitCode {
         let code = pilgrim_kernel::plugin::server::serve(lib, symbol);
         return ExitCode::from(u8::try_from(code).unwrap_or(3));
     }
-    pilgrim_kernel::script::set_allocated_probe(allocated);
+    pilgrim_kernel::script::set_allocated_probe(counting::held);
     let Ok(seconds) = std::time::Duration::try_from_secs_f64(cli.plugin_seconds)
         .map_err(|_| ())
         .and_then(|d| if d.is_zero() { Err(()) } else { Ok(d) })

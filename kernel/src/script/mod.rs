@@ -63,10 +63,10 @@ pub struct Limits {
     /// count alone does not bound time (an operation on a large array costs
     /// in proportion to it).
     pub max_seconds: f64,
-    /// Megabytes the process may hold while a script runs (what its
-    /// allocator holds, after every operation, where the program counts it
-    /// ([`set_allocated_probe`]); else its resident memory every 4096
-    /// operations, Linux): the size limits alone do not bound memory (Rhai
+    /// Megabytes a script may hold (what its thread holds, after every
+    /// operation, where the program's allocator counts it
+    /// ([`set_allocated_probe`]); else the process's resident memory every
+    /// 4096 operations, Linux): the size limits alone do not bound memory (Rhai
     /// 1.27 does not count a map's entries added by `m[key] = value`).
     pub max_memory_mb: u64,
 }
@@ -89,13 +89,14 @@ impl Default for Limits {
     }
 }
 
-/// Bytes the process's allocator holds now: set by a program whose global
+/// Bytes the calling thread holds now: set by a program whose global
 /// allocator counts them ([`set_allocated_probe`]), so that a script's
-/// memory is looked at after every operation at the cost of one load.
+/// memory is looked at after every operation at the cost of one read.
 static ALLOCATED: std::sync::OnceLock<fn() -> usize> = std::sync::OnceLock::new();
 
-/// Tells the script engines how to read the bytes the process's allocator
-/// holds (the `pilgrim` program counts them with the `cap` allocator).
+/// Tells the script engines how to read the bytes the calling thread holds
+/// (the `pilgrim` program's allocator counts them per thread; a script runs
+/// on one thread).
 /// Without it the memory limit reads the resident size from the system
 /// every 4096 operations, which one operation on a large value can outrun.
 pub fn set_allocated_probe(probe: fn() -> usize) {
