@@ -8,7 +8,11 @@
 //!   pose's solution, as along a toolpath);
 //! - `equidistant_1m`: the equidistant of a 1M-point profile (<= 30 ms);
 //! - `envelope_100k`: the envelope of 100k wheel positions evaluated at a
-//!   100k-point profile (<= 100 ms).
+//!   100k-point profile (<= 100 ms);
+//! - `lint_1m`: a program of 1M blocks in one pass (a circle of the demo
+//!   family at its largest `points`) read back by the lint, CL file and
+//!   Sinumerik: linear in the blocks (the CL file's lint was quadratic,
+//!   about 30 minutes).
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use pilgrim_kernel::{
@@ -137,5 +141,74 @@ fn envelope_100k(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(kernel, chain_fk, ik_5axis, equidistant_1m, envelope_100k);
+/// A one-pass program of `n` blocks round a circle on X, Y, Z.
+fn circle_program(n: usize) -> pilgrim_kernel::program::AxisProgram {
+    use pilgrim_kernel::program::{AxisProgram, Block, ProgramAxis, ProgramSetup};
+    use pilgrim_kernel::toolpath::Motion;
+    let axis = |name: &str| ProgramAxis {
+        name: name.into(),
+        unit: "mm".into(),
+    };
+    let blocks = (0..n)
+        .map(|i| {
+            let t = i as f64 / n as f64 * std::f64::consts::TAU;
+            Block {
+                motion: if i == 0 {
+                    Motion::Rapid
+                } else {
+                    Motion::Linear
+                },
+                values: vec![50.0 * t.cos(), 50.0 * t.sin(), -2.0],
+                feed: if i == 0 { 0.0 } else { 1000.0 },
+                spindle: None,
+                comment: (i == 0).then(|| "circle".to_owned()),
+                keep: Vec::new(),
+            }
+        })
+        .collect();
+    AxisProgram {
+        name: "CIRCLE".into(),
+        number: 1,
+        machine: "vertical-mill".into(),
+        control: "sinumerik".into(),
+        tool_number: 1,
+        tool_name: "end mill".into(),
+        spindle_rpm: 1000.0,
+        decimals: None,
+        axes: vec![axis("X"), axis("Y"), axis("Z")],
+        blocks,
+        setup: ProgramSetup::default(),
+    }
+}
+
+fn lint_1m(c: &mut Criterion) {
+    use pilgrim_kernel::program::lint::lint;
+    use pilgrim_kernel::program::post::{post, CLD, SINUMERIK};
+    const N: usize = 1_000_000;
+    let program = circle_program(N);
+    let axes: Vec<_> = ["X", "Y", "Z"]
+        .iter()
+        .map(|n| pilgrim_kernel::machine::Axis::linear(n, -500.0, 500.0, 1e4, [0.0; 3], ""))
+        .collect();
+    let mut g = c.benchmark_group("lint_1m");
+    g.throughput(Throughput::Elements(N as u64));
+    g.sample_size(10).measurement_time(Duration::from_secs(10));
+    for d in [&CLD, &SINUMERIK] {
+        let text = post(&program, d).unwrap();
+        assert_eq!(lint(&text, &program, d, &axes).unwrap().moves, N);
+        g.bench_function(d.name, |b| {
+            b.iter(|| lint(black_box(&text), &program, d, &axes).unwrap())
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(
+    kernel,
+    chain_fk,
+    ik_5axis,
+    equidistant_1m,
+    envelope_100k,
+    lint_1m
+);
 criterion_main!(kernel);
