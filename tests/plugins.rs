@@ -399,36 +399,9 @@ fn pilgrim_bounded(
     env: &[(&str, &std::path::Path)],
     limit: std::time::Duration,
 ) -> (Option<i32>, String, u32) {
-    use std::io::Read;
-    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_pilgrim"));
-    cmd.current_dir(common::root())
-        .args(args)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::piped());
-    for (k, v) in env {
-        cmd.env(k, v);
-    }
-    let mut child = cmd.spawn().unwrap();
-    let pid = child.id();
-    let mut stderr = child.stderr.take().unwrap();
-    let reader = std::thread::spawn(move || {
-        let mut s = String::new();
-        stderr.read_to_string(&mut s).ok();
-        s
-    });
-    let start = std::time::Instant::now();
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if start.elapsed() > limit {
-            child.kill().ok();
-            child.wait().ok();
-            panic!("pilgrim {args:?} did not end within {limit:?}");
-        }
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    };
-    (status.code(), reader.join().unwrap(), pid)
+    let m = common::measured(args, env, limit)
+        .unwrap_or_else(|| panic!("pilgrim {args:?} did not end within {limit:?}"));
+    (m.code, m.err, m.pid)
 }
 
 /// The processes still serving the library `lib`.

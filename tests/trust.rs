@@ -4,72 +4,18 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 mod common;
 use common::{pilgrim, pilgrim_in, root, s};
 
 fn pilgrim_within(args: &[&str], limit: Duration) -> Option<(i32, String)> {
-    measured(args, limit).map(|m| (m.code, m.err))
-}
-
-/// How a run of pilgrim ended and what it took: its exit code, its error
-/// stream, its peak resident memory and its CPU time, as the system
-/// accounts them (`wait4`), not as a clock in the test sees them.
-struct Measured {
-    code: i32,
-    err: String,
-    peak_mb: f64,
-    cpu_seconds: f64,
+    measured(args, limit).map(|m| (m.code.unwrap_or(-1), m.err))
 }
 
 /// Runs pilgrim with `args`, killed after `limit` (then `None`).
-// The child is reaped by `wait4`, which clippy does not see.
-#[allow(clippy::zombie_processes)]
-fn measured(args: &[&str], limit: Duration) -> Option<Measured> {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_pilgrim"))
-        .current_dir(root())
-        .args(args)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut stderr = child.stderr.take().unwrap();
-    let reader = std::thread::spawn(move || {
-        let mut err = String::new();
-        use std::io::Read;
-        stderr.read_to_string(&mut err).ok();
-        err
-    });
-    let pid = child.id() as libc::pid_t;
-    let start = Instant::now();
-    loop {
-        let mut status = 0;
-        // SAFETY: an all-zero rusage is valid; wait4 fills it.
-        let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-        // SAFETY: the child's pid, valid pointers to locals.
-        let got = unsafe { libc::wait4(pid, &mut status, libc::WNOHANG, &mut usage) };
-        if got == pid {
-            let code = if libc::WIFEXITED(status) {
-                libc::WEXITSTATUS(status)
-            } else {
-                -libc::WTERMSIG(status)
-            };
-            let seconds = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
-            return Some(Measured {
-                code,
-                err: reader.join().unwrap(),
-                peak_mb: usage.ru_maxrss as f64 / 1024.0,
-                cpu_seconds: seconds(usage.ru_utime) + seconds(usage.ru_stime),
-            });
-        }
-        if start.elapsed() > limit {
-            child.kill().ok();
-            child.wait().ok();
-            return None;
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
+fn measured(args: &[&str], limit: Duration) -> Option<common::Measured> {
+    common::measured(args, &[], limit)
 }
 
 fn scratch(name: &str) -> PathBuf {
@@ -380,9 +326,9 @@ fn scripts_are_bounded_in_memory_and_time() {
     let run = |args: &[&str]| measured(args, within).expect("the run was not stopped");
     // What runs that pass take here: the small family and the mandrel.
     let small = run(&["run", DEMO, "--out", s(&out), "--quiet"]);
-    assert_eq!(small.code, 0, "{}", small.err);
+    assert_eq!(small.code, Some(0), "{}", small.err);
     let mandrel = run(&["run", "scripts/mandrel.rhai", "--out", s(&out), "--quiet"]);
-    assert_eq!(mandrel.code, 0, "{}", mandrel.err);
+    assert_eq!(mandrel.code, Some(0), "{}", mandrel.err);
     let script = dir.join("f.rhai");
     let family = |body: &str| {
         std::fs::write(&script, format!("{head}{body}\n")).unwrap();
@@ -391,7 +337,7 @@ fn scripts_are_bounded_in_memory_and_time() {
     // The kernel's ceiling on Floats.
     let f = family("fn toolpath(p) { let v = linspace(0.0, 1.0, 1000); for i in 0..40 { v = concat(v, v); } v }");
     let m = run(&["run", &f, "--out", s(&out), "--quiet"]);
-    assert_eq!(m.code, 1, "{}", m.err);
+    assert_eq!(m.code, Some(1), "{}", m.err);
     assert!(m.err.contains("ceiling of 10000000"), "{}", m.err);
     assert!(m.peak_mb < small.peak_mb + 400.0, "{} MB", m.peak_mb);
     // Time, between a script's operations.
@@ -405,7 +351,7 @@ fn scripts_are_bounded_in_memory_and_time() {
         "--script-seconds",
         "2",
     ]);
-    assert_eq!(m.code, 1, "{}", m.err);
+    assert_eq!(m.code, Some(1), "{}", m.err);
     assert!(
         m.err.contains("the script's time limit of 2 s passed"),
         "{}",
@@ -427,7 +373,7 @@ fn scripts_are_bounded_in_memory_and_time() {
         "--script-memory-mb",
         "200",
     ]);
-    assert_eq!(m.code, 1, "{}", m.err);
+    assert_eq!(m.code, Some(1), "{}", m.err);
     assert!(m.err.contains("memory limit of 200 MB"), "{}", m.err);
     assert!(
         m.peak_mb < 200.0 + small.peak_mb + 20.0,
@@ -451,7 +397,7 @@ fn scripts_are_bounded_in_memory_and_time() {
             flag,
             limit,
         ]);
-        assert_eq!(m.code, 1, "{}", m.err);
+        assert_eq!(m.code, Some(1), "{}", m.err);
         let said = format!("{whose} time limit of {limit} s passed (in the steady rest's track)");
         assert!(m.err.contains(&said), "{}", m.err);
         let limit: f64 = limit.parse().unwrap();
@@ -951,7 +897,7 @@ fn spreadsheets_are_bounded_before_they_expand() {
     ) else {
         panic!("the ODS was expanded");
     };
-    assert_eq!(m.code, 1, "{}", m.err);
+    assert_eq!(m.code, Some(1), "{}", m.err);
     assert!(
         m.err.contains("t.ods") && m.err.contains("more than 10000000 cells"),
         "{}",

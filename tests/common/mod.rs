@@ -349,3 +349,69 @@ pub fn leave_for_rs274(dir: &Path, tag: &str) {
         std::fs::copy(dir.join(f), check.join(f)).unwrap();
     }
 }
+
+/// How a run of pilgrim ended and what it took: its exit code (`None` when
+/// a signal ended it), its error stream, its process id, its peak resident
+/// memory and its CPU time, as the system accounts them (`wait4`), not as
+/// a clock in the test sees them.
+#[allow(dead_code)]
+pub struct Measured {
+    pub code: Option<i32>,
+    pub err: String,
+    pub pid: u32,
+    pub peak_mb: f64,
+    pub cpu_seconds: f64,
+}
+
+/// Runs pilgrim in the repository's root with `args` and the environment
+/// `env` added, killed after `limit` (then `None`).
+// The child is reaped by `wait4`, which clippy does not see.
+#[allow(dead_code, clippy::zombie_processes)]
+pub fn measured(
+    args: &[&str],
+    env: &[(&str, &Path)],
+    limit: std::time::Duration,
+) -> Option<Measured> {
+    use std::io::Read;
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_pilgrim"));
+    cmd.current_dir(root())
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped());
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    let mut child = cmd.spawn().unwrap();
+    let mut stderr = child.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut err = String::new();
+        stderr.read_to_string(&mut err).ok();
+        err
+    });
+    let pid = child.id();
+    let start = std::time::Instant::now();
+    loop {
+        let mut status = 0;
+        // SAFETY: an all-zero rusage is valid; wait4 fills it.
+        let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+        // SAFETY: the child's pid, valid pointers to locals.
+        let got =
+            unsafe { libc::wait4(pid as libc::pid_t, &mut status, libc::WNOHANG, &mut usage) };
+        if got == pid as libc::pid_t {
+            let seconds = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+            return Some(Measured {
+                code: libc::WIFEXITED(status).then(|| libc::WEXITSTATUS(status)),
+                err: reader.join().unwrap(),
+                pid,
+                peak_mb: usage.ru_maxrss as f64 / 1024.0,
+                cpu_seconds: seconds(usage.ru_utime) + seconds(usage.ru_stime),
+            });
+        }
+        if start.elapsed() > limit {
+            child.kill().ok();
+            child.wait().ok();
+            return None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+}
