@@ -315,8 +315,7 @@ pub fn exercise(plugin: &super::PluginMachine) -> Exercise {
             }
         }
         let (mut p, mut q) = (Vec::new(), Vec::new());
-        if plugin.forward(&moved, &tool, &mut p).is_ok()
-            && c.forward(&moved, &tool, &mut q).is_ok()
+        if plugin.forward(&moved, &tool, &mut p).is_ok() && c.forward(&moved, &tool, &mut q).is_ok()
         {
             let per_axis = poses.len();
             for (j, name) in info.solved_axes.iter().enumerate() {
