@@ -212,6 +212,10 @@ impl ChainMachine {
         let free_travel: Vec<(Real, Real)> = free.iter().map(|&i| travel[i]).collect();
         let home = super::home_seed(chain, &travel);
         let mut seed: Vec<Real> = free.iter().map(|&i| home[i]).collect();
+        // The last two solutions and the step between their poses: a pose
+        // that continues a steady step is seeded by extrapolating them.
+        let mut last: Option<(Vec<Real>, &[Real])> = None;
+        let mut stride: Option<(Vec<Real>, Vec<Real>)> = None;
         let tol_dir = self.options.tol_dir.max(1e-9);
         out.clear();
         let mut ticker = crate::budget::Ticker::new("inverse kinematics", 64);
@@ -244,11 +248,23 @@ impl ChainMachine {
             } else {
                 Target::point(point)
             };
+            let start = match (&last, &stride) {
+                (Some((_, before)), Some((dq, dp))) => {
+                    continued(p, before, dp, &seed, dq, |i| solving.is_rotary(i))
+                }
+                _ => None,
+            };
             let q = if free.is_empty() {
                 vec![]
             } else {
                 solving
-                    .inverse(&target, tool, &seed, Some(&free_travel), &self.options)
+                    .inverse(
+                        &target,
+                        tool,
+                        start.as_deref().unwrap_or(&seed),
+                        Some(&free_travel),
+                        &self.options,
+                    )
                     .map_err(|e| KinematicsError::at(k, self.explain(e.into())))?
                     .q
             };
@@ -279,11 +295,46 @@ impl ChainMachine {
             }
             out.extend_from_slice(&row);
             if !q.is_empty() {
+                stride = last.as_ref().map(|(q0, p0)| {
+                    (
+                        q.iter().zip(q0).map(|(a, b)| a - b).collect(),
+                        p.iter().zip(p0.iter()).map(|(a, b)| a - b).collect(),
+                    )
+                });
+                last = Some((q.clone(), p));
                 seed = q;
             }
         }
         Ok(())
     }
+}
+
+/// The seed of a pose `p` that continues the step from the pose `before`
+/// (the last solved, at `q`) by about the last step `dp` (solved as
+/// `dq`): `q + dq`, the two solutions extrapolated. `None` when the pose
+/// does not continue the step (its step differs from the last by more
+/// than a fifth of it: a new pass, a rapid) or a rotary turned more than
+/// a quarter turn. Where the target does not fix an axis (a singular
+/// pose: a swivel at zero leaves the roll's turn free) the solver keeps
+/// the seed's value there, so the machine moves on as it moved, rather
+/// than standing still on one axis while another makes up for it.
+fn continued(
+    p: &[Real],
+    before: &[Real],
+    dp: &[Real],
+    q: &[Real],
+    dq: &[Real],
+    rotary: impl Fn(usize) -> bool,
+) -> Option<Vec<Real>> {
+    let norm = |v: &mut dyn Iterator<Item = Real>| v.map(|x| x * x).sum::<Real>().sqrt();
+    let step = norm(&mut dp.iter().copied());
+    let change = norm(&mut p.iter().zip(before).zip(dp).map(|((a, b), d)| a - b - d));
+    let steady = step > 0.0 && change <= 0.2 * step;
+    let turned = dq
+        .iter()
+        .enumerate()
+        .any(|(i, d)| rotary(i) && d.abs() > std::f64::consts::FRAC_PI_4);
+    (steady && !turned).then(|| q.iter().zip(dq).map(|(a, d)| a + d).collect())
 }
 
 /// The number of rows of `width` values in a batch; a ragged end (or a

@@ -192,9 +192,49 @@ impl<'a> Solver<'a> {
         (pos, dir)
     }
 
-    /// Runs Levenberg–Marquardt from `q`; returns (converged, iterations).
-    /// With `bounds`, every trial point is projected into the box (the
-    /// entries that are `None`, rotary axes, stay free).
+    /// The Gauss–Newton step at the last evaluation with its Jacobian:
+    /// the least-squares solution of `J d = -r` by the Jacobian's SVD.
+    /// A direction whose singular value is below [`SINGULAR`] of the
+    /// largest (an axis whose effect nearly vanishes, as a rotary's on the
+    /// tool's axis when the tool lies almost along it) is left out while
+    /// the residual along it is within `tol` (the tolerances, weighted as
+    /// the residual is): there the target does not fix the axis, and the
+    /// solution keeps the start's value (the caller's seed decides, not
+    /// rounding errors in the target amplified by the weak effect).
+    fn gauss_newton(&self, tol: Real) -> Option<nalgebra::DVector<Real>> {
+        let j = nalgebra::DMatrix::from_row_slice(self.rows, self.m, &self.jac);
+        let svd = j.svd(true, true);
+        let (u, v_t) = (svd.u.as_ref()?, svd.v_t.as_ref()?);
+        let sigma = &svd.singular_values;
+        let largest = sigma.max();
+        if !(largest > 0.0 && largest.is_finite()) {
+            return None;
+        }
+        let mut step = nalgebra::DVector::zeros(self.m);
+        for (i, &s) in sigma.iter().enumerate() {
+            let c: Real = -(0..self.rows)
+                .map(|r| u[(r, i)] * self.res[r])
+                .sum::<Real>();
+            let weak = s < SINGULAR * largest;
+            if s <= Real::EPSILON * largest || (weak && c.abs() <= tol) {
+                continue;
+            }
+            step += v_t.row(i).transpose() * (c / s);
+        }
+        Some(step)
+    }
+
+    /// Runs Levenberg–Marquardt from `q`, each iteration trying the
+    /// undamped Gauss–Newton step first ([`Self::gauss_newton`]): near a
+    /// singular pose the damped steps crawl along the valley the weak
+    /// direction leaves, where Gauss–Newton converges in a step or two.
+    /// Once within the tolerances, one more Gauss–Newton step is taken if
+    /// it lowers the residual, so that the solution is as exact as the
+    /// target (a rotary barely fixed by the tool's axis is then right to
+    /// the program's decimals, not only to the axis tolerance). Returns
+    /// (converged, iterations). With `bounds`, every trial point is
+    /// projected into the box (the entries that are `None`, rotary axes,
+    /// stay free).
     fn solve(
         &mut self,
         q: &mut [Real],
@@ -207,15 +247,53 @@ impl<'a> Solver<'a> {
         let mut delta = vec![0.0; m];
         let mut damped = vec![0.0; m * m];
         let mut trial = q.to_vec();
-        let mut lambda = 1e-3;
+        let mut lambda: Real = 1e-3;
         let mut cost = self.eval(q, true);
         // A start that gains less than 10% in STALL iterations is stuck
         // (against the travel box, or in a local minimum): give it up.
         const STALL: usize = 6;
         let mut checkpoint = cost;
+        // The tolerances as the residual weighs them (mm).
+        let tol_weighted = if self.rows == 6 {
+            opts.tol_pos.min(opts.tol_dir * self.weight)
+        } else {
+            opts.tol_pos
+        };
         for it in 0..opts.max_iter {
             let (pe, de) = self.errors();
-            if pe <= opts.tol_pos && de <= opts.tol_dir {
+            let within = pe <= opts.tol_pos && de <= opts.tol_dir;
+            // The Gauss–Newton step, shortened by halves until it lowers
+            // the residual (a long step along a weak direction meets the
+            // chain's curvature), kept if one does.
+            if let Some(step) = self.gauss_newton(0.5 * tol_weighted) {
+                let mut accepted = false;
+                for halving in 0..8 {
+                    let f = 0.5f64.powi(halving);
+                    for (i, t) in trial.iter_mut().enumerate() {
+                        *t = q[i] + f * step[i];
+                        if let Some(Some((lo, hi))) = bounds.get(i) {
+                            *t = t.clamp(*lo, *hi);
+                        }
+                    }
+                    let c = self.eval(&trial, false);
+                    if c.is_finite() && c < cost {
+                        accepted = true;
+                        break;
+                    }
+                }
+                if accepted {
+                    q.copy_from_slice(&trial);
+                    cost = self.eval(q, true);
+                    lambda = (lambda / 3.0).max(1e-12);
+                    if within {
+                        return (true, it + 1);
+                    }
+                    continue;
+                }
+                // Back to the last point's residual and Jacobian.
+                self.eval(q, true);
+            }
+            if within {
                 return (true, it);
             }
             if it > 0 && it % STALL == 0 {
@@ -271,6 +349,104 @@ impl<'a> Solver<'a> {
         }
         let (pe, de) = self.errors();
         (pe <= opts.tol_pos && de <= opts.tol_dir, opts.max_iter)
+    }
+}
+
+/// A direction of the Jacobian whose singular value is below this share of
+/// the largest is weak: on a caliber grinder, a roll turn whose effect on
+/// the wheel's axis is the sine of a swivel below about 3e-7 rad, where
+/// rounding errors of 1e-13 in the asked axis would swing the turn by
+/// 3e-7 rad and the cross slide by tenths of a micron.
+const SINGULAR: Real = 1e-7;
+
+impl Solver<'_> {
+    /// At a solution `q`, the directions the target leaves free (the weak
+    /// ones of [`Self::gauss_newton`]: a singular pose) are settled so that
+    /// the linear axes change least from the `seed`: where the pose leaves
+    /// a turn and a slide to make up for each other (a swivel at zero
+    /// leaves a caliber grinder's roll turn free, its cross slide making
+    /// up for it), the rotary turns and the slides stay as the seed had
+    /// them. Moves along the free directions, then back onto the target
+    /// with Gauss–Newton, at most three rounds; kept only if the target is
+    /// still met within the tolerances. Returns the iterations spent.
+    fn settle(
+        &mut self,
+        q: &mut [Real],
+        seed: &[Real],
+        opts: &IkOptions,
+        bounds: &[Option<(Real, Real)>],
+    ) -> usize {
+        let linear: Vec<usize> = (0..self.m).filter(|&i| !self.chain.is_rotary(i)).collect();
+        let mut spent = 0;
+        for _ in 0..3 {
+            self.eval(q, true);
+            let j = nalgebra::DMatrix::from_row_slice(self.rows, self.m, &self.jac);
+            let svd = j.svd(false, true);
+            let Some(v_t) = svd.v_t.as_ref() else { break };
+            let largest = svd.singular_values.max();
+            let free: Vec<usize> = (0..svd.singular_values.len())
+                .filter(|&i| svd.singular_values[i] < SINGULAR * largest)
+                .collect();
+            // A singular direction also stands for each missing row.
+            let mut basis: Vec<nalgebra::DVector<Real>> =
+                free.iter().map(|&i| v_t.row(i).transpose()).collect();
+            if self.rows < self.m {
+                let full = nalgebra::DMatrix::from_row_slice(self.rows, self.m, &self.jac)
+                    .transpose()
+                    * nalgebra::DMatrix::from_row_slice(self.rows, self.m, &self.jac);
+                let eig = full.symmetric_eigen();
+                basis = (0..self.m)
+                    .filter(|&i| eig.eigenvalues[i] < SINGULAR * SINGULAR * largest * largest)
+                    .map(|i| eig.eigenvectors.column(i).into_owned())
+                    .collect();
+            }
+            if basis.is_empty() || linear.is_empty() {
+                break;
+            }
+            // The move along the free directions that brings the linear
+            // axes nearest the seed's, each weighed by its share in those
+            // directions (the slide that makes up for the turn, not one
+            // the turn moves only at second order).
+            let share: Vec<Real> = linear
+                .iter()
+                .map(|&i| basis.iter().map(|v| v[i] * v[i]).sum::<Real>().sqrt())
+                .collect();
+            let a = nalgebra::DMatrix::from_fn(linear.len(), basis.len(), |r, c| {
+                share[r] * basis[c][linear[r]]
+            });
+            let d = nalgebra::DVector::from_iterator(
+                linear.len(),
+                linear
+                    .iter()
+                    .zip(&share)
+                    .map(|(&i, w)| w * (seed[i] - q[i])),
+            );
+            let Ok(alpha) = a.svd(true, true).solve(&d, 1e-12) else {
+                break;
+            };
+            let mut moved = q.to_vec();
+            for (c, v) in basis.iter().enumerate() {
+                for (i, m) in moved.iter_mut().enumerate() {
+                    *m += alpha[c] * v[i];
+                }
+            }
+            let change: Real = moved
+                .iter()
+                .zip(q.iter())
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, Real::max);
+            if !(change > 1e-12) {
+                break;
+            }
+            let (ok, it) = self.solve(&mut moved, opts, bounds);
+            spent += it;
+            if !ok {
+                break;
+            }
+            q.copy_from_slice(&moved);
+        }
+        self.eval(q, true);
+        spent
     }
 }
 
@@ -456,6 +632,9 @@ impl Chain {
             }
             let (ok, it) = solver.solve(&mut q, opts, &boxed);
             iterations += it;
+            if ok {
+                iterations += solver.settle(&mut q, seed, opts, &boxed);
+            }
             let (pe, de) = solver.errors();
             if pe + de * opts.axis_weight < best.0 + best.1 * opts.axis_weight {
                 best = (pe, de);
@@ -540,6 +719,30 @@ mod tests {
                     jac[r * 5 + i]
                 );
             }
+        }
+    }
+
+    /// Near a singular pose (a swivel of 3e-6 rad: the roll's turn moves
+    /// the wheel's axis by that much per radian) the turn is still solved
+    /// to what the axis fixes, not left where the tolerance stops; at the
+    /// singular pose itself (the swivel at zero) the turn is free, and the
+    /// solution keeps the cross slide where the seed has it, the turn
+    /// making up the point, as the plugin's closed form does.
+    #[test]
+    fn singular_poses_are_solved_exactly_and_settled_by_the_seed() {
+        let ch = five_axis();
+        let tool = ToolFrame::default();
+        for (b, seed_y) in [(3e-6, 0.0), (0.0, 0.0), (0.0, 0.4)] {
+            let truth = [0.7, 5.0, 250.0, seed_y, b];
+            let pose = ch.pose(&truth, &tool).unwrap();
+            let target = Target::pose(pose.point, pose.axis);
+            // The last block's solution: a degree of turn behind.
+            let seed = [0.7 - 0.0175, 5.1, 249.0, seed_y, 1.2 * b];
+            let sol = ch
+                .inverse(&target, &tool, &seed, None, &IkOptions::default())
+                .unwrap();
+            assert!((sol.q[0] - 0.7).abs() < 1e-9, "B = {b}: {:?}", sol.q);
+            assert!((sol.q[3] - seed_y).abs() < 1e-7, "B = {b}: {:?}", sol.q);
         }
     }
 
