@@ -84,7 +84,7 @@ pub use offset::{
 pub use params::{ParamSource, ParamSpec, ParamValue, Params};
 pub use profile::{
     read_table, read_table_str, uniform_grid, Bulge, CurvatureViolation, EllipseSection,
-    MandrelLaw, Profile, ProfileBuilder, ProfileError, Smoothing, Table, TableError,
+    Interpolation, MandrelLaw, Profile, ProfileBuilder, ProfileError, Smoothing, Table, TableError,
 };
 pub use program::{AxisProgram, Block, ProgramError};
 pub use tool::{Tool, ToolShape, Wheel};

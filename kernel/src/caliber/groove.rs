@@ -72,8 +72,8 @@ pub enum GrooveError {
 
 /// A roll of radius `R_d` whose groove, in the section through the roll's
 /// axis at angle `theta`, is half an ellipse centred on the periphery:
-/// `B(theta) / 2` wide along the axis, `Hp(theta)` deep (tables, Hermite
-/// interpolated between rows). The point at polar angle `psi` of the
+/// `B(theta) / 2` wide along the axis, `Hp(theta)` deep (tables,
+/// interpolated between rows as [`Self::with_interpolation`] states). The point at polar angle `psi` of the
 /// section (from the depth direction, positive toward +Z) is at axial
 /// position `x_A`, radius `R_d - z_A`, angle `theta`.
 #[derive(Debug, Clone, PartialEq)]
@@ -297,47 +297,102 @@ impl Groove {
     /// the smoothing's default anchor (MATH §3.2: its length shrinks
     /// least); the middle row if no two rows have one depth.
     pub fn sizing_middle(&self) -> usize {
-        let x = self.hp.x();
+        match self.sizing_rows() {
+            Some((first, last)) => (first + last) / 2,
+            None => self.hp.len() / 2,
+        }
+    }
+
+    /// The sizing section's first and last rows (from 0): the longest run
+    /// of rows of one depth and one width (the groove that sizes the
+    /// tube), the first such run if several are as long; `None` if no two
+    /// neighbouring rows have one depth and one width.
+    pub fn sizing_rows(&self) -> Option<(usize, usize)> {
+        let (h, b) = (self.hp.x(), self.b.x());
+        let same = |i: usize| (h[i] - h[i - 1]).abs() <= 1e-9 && (b[i] - b[i - 1]).abs() <= 1e-9;
         let (mut best, mut start) = ((0, 0), 0);
-        for i in 1..=x.len() {
-            if i == x.len() || (x[i] - x[i - 1]).abs() > 1e-9 {
+        for i in 1..=h.len() {
+            if i == h.len() || !same(i) {
                 if i - 1 - start > best.1 - best.0 {
                     best = (start, i - 1);
                 }
                 start = i;
             }
         }
-        if best.1 > best.0 {
-            (best.0 + best.1) / 2
-        } else {
-            x.len() / 2
+        (best.1 > best.0).then_some(best)
+    }
+
+    /// The rows (first and last, from 0) whose angles lie within
+    /// `[from_deg, to_deg]`: a sizing section given by the user.
+    ///
+    /// # Failures
+    /// Fewer than two rows in the range.
+    pub fn rows_between(
+        &self,
+        from_deg: Real,
+        to_deg: Real,
+    ) -> Result<(usize, usize), GrooveError> {
+        let deg: Vec<Real> = self.hp.z().iter().map(|t| t.to_degrees()).collect();
+        let inside: Vec<usize> = (0..deg.len())
+            .filter(|&i| deg[i] >= from_deg - 1e-9 && deg[i] <= to_deg + 1e-9)
+            .collect();
+        match (inside.first(), inside.last()) {
+            (Some(&a), Some(&b)) if b > a => Ok((a, b)),
+            _ => Err(InputError::out_of_range(
+                "the sizing section's end (deg)",
+                to_deg,
+                format!("a range from {from_deg} deg holding at least two of the table's rows"),
+            )
+            .into()),
         }
     }
 
     /// The groove with both tables smoothed (MATH §3.2,
-    /// [`Profile::smooth_derivative`]): `iterations` of the three-point
-    /// rule on the first differences, rebuilt from the row `anchor`; with
-    /// what smoothing did to Hp and to B.
+    /// [`Profile::smooth_derivative_holding`]): `iterations` of the
+    /// three-point rule on the first differences, the rows `held` (the
+    /// sizing section, first and last) kept exactly, rebuilt from the row
+    /// `anchor` (inside the held rows); with what smoothing did to Hp and
+    /// to B.
     ///
     /// # Failures
-    /// An anchor beyond the tables; a rebuilt depth or width that is not
-    /// positive (named as the tables' errors are).
+    /// An anchor beyond the tables or outside the held rows; a rebuilt
+    /// depth or width that is not positive (named as the tables' errors
+    /// are).
     pub fn smoothed(
         &self,
         iterations: usize,
         anchor: usize,
+        held: Option<(usize, usize)>,
     ) -> Result<(Self, crate::profile::Smoothing, crate::profile::Smoothing), GrooveError> {
-        let hp = self.hp.smooth_derivative(iterations, anchor)?;
-        let b = self.b.smooth_derivative(iterations, anchor)?;
+        let hp = self
+            .hp
+            .smooth_derivative_holding(iterations, anchor, held)?;
+        let b = self.b.smooth_derivative_holding(iterations, anchor, held)?;
         let deg: Vec<Real> = self.hp.z().iter().map(|t| t.to_degrees()).collect();
         let g = Self::new(self.r_d, (&deg, &deg), hp.profile.x(), b.profile.x())?;
         // The same angles exactly (not through degrees and back).
         let g = Self {
-            hp: Profile::new(self.hp.z().to_vec(), g.hp.x().to_vec())?,
-            b: Profile::new(self.b.z().to_vec(), g.b.x().to_vec())?,
+            hp: hp.profile.clone(),
+            b: b.profile.clone(),
             ..g
         };
         Ok((g, hp, b))
+    }
+
+    /// The groove with its tables interpolated between rows by
+    /// `interpolation` (MATH §3.2: a stated choice; the toolpath and the
+    /// verification use the same groove).
+    pub fn with_interpolation(self, interpolation: crate::profile::Interpolation) -> Self {
+        Self {
+            hp: self.hp.with_interpolation(interpolation),
+            b: self.b.with_interpolation(interpolation),
+            ..self
+        }
+    }
+
+    /// How the tables are interpolated between rows.
+    pub fn interpolation(&self) -> crate::profile::Interpolation {
+        self.hp.interpolation()
     }
 
     /// The roll's radius (mm).

@@ -26,6 +26,7 @@ pub use ellipse::EllipseSection;
 pub use law::{uniform_grid, MandrelLaw};
 pub use simplify::{simplify_polyline, Polyline};
 pub use smooth::Smoothing;
+
 pub use table::{
     read_table, read_table_bytes, read_table_str, Table, TableError, TableFormat, MAX_CELLS,
 };
@@ -141,11 +142,48 @@ fn list_violations(v: &[CurvatureViolation]) -> String {
     s.join(", ")
 }
 
+/// How a profile without analytic derivatives is interpolated between its
+/// nodes: a stated choice, since a table's curve between rows is not in
+/// the table (a groove moves by microns between the choices).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Interpolation {
+    /// Cubic Hermite, each node's slope that of the parabola through it
+    /// and its two neighbours: C1, exact for parabolas, but it overshoots
+    /// beside a flat run (a node ending a constant stretch takes a slope
+    /// from the node beyond it).
+    #[default]
+    Parabolic,
+    /// Monotone cubic Hermite (Fritsch–Carlson, as PCHIP): C1, each
+    /// node's slope the weighted harmonic mean of its two sides, zero
+    /// where they differ in sign or one is zero: no overshoot, monotone
+    /// stretches stay monotone and a constant stretch stays exactly flat.
+    Monotone,
+    /// Straight lines between nodes: C0, with a kink at every node.
+    Linear,
+}
+
+impl Interpolation {
+    /// The interpolation named `name` (`parabolic`, `monotone` or
+    /// `linear`), or `None`.
+    pub fn named(name: &str) -> Option<Self> {
+        match name.trim().to_ascii_lowercase().as_str() {
+            "parabolic" => Some(Self::Parabolic),
+            "monotone" | "pchip" => Some(Self::Monotone),
+            "linear" => Some(Self::Linear),
+            _ => None,
+        }
+    }
+}
+
 /// A curve `x(z)` sampled at strictly increasing `z`. See the [module docs](self).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Profile {
     z: Vec<Real>,
     x: Vec<Real>,
+    /// How it is interpolated between nodes without analytic derivatives.
+    #[serde(default)]
+    interpolation: Interpolation,
     /// Analytic dx/dz at the nodes, when known.
     dx: Option<Vec<Real>>,
     /// Analytic d2x/dz2 at the nodes, when known (may be infinite at a kink).
@@ -212,6 +250,7 @@ impl Profile {
         Ok(Self {
             z,
             x,
+            interpolation: Interpolation::default(),
             dx: None,
             d2x: None,
             estimated: SlopeCache::default(),
@@ -245,6 +284,19 @@ impl Profile {
         p.dx = Some(dx);
         p.d2x = Some(d2x);
         Ok(p)
+    }
+
+    /// The profile interpolated between its nodes by `interpolation`
+    /// (analytic derivatives, if it has them, still rule).
+    pub fn with_interpolation(mut self, interpolation: Interpolation) -> Self {
+        self.interpolation = interpolation;
+        self.estimated = SlopeCache::default();
+        self
+    }
+
+    /// How the profile is interpolated between its nodes.
+    pub fn interpolation(&self) -> Interpolation {
+        self.interpolation
     }
 
     /// Number of nodes (at least [`MIN_POINTS`]).
@@ -317,8 +369,59 @@ impl Profile {
         Cow::Borrowed(self.estimated.0.get_or_init(|| self.estimate_slopes()))
     }
 
-    /// The three-point estimate of the slopes ([`Self::slopes`]).
+    /// The node slopes the interpolation uses ([`Self::slopes`]).
     fn estimate_slopes(&self) -> Vec<Real> {
+        match self.interpolation {
+            Interpolation::Parabolic => self.parabolic_slopes(),
+            Interpolation::Monotone => self.monotone_slopes(),
+            Interpolation::Linear => {
+                // Each node the mean of its two sides (the kinks' slopes
+                // are not used by the interpolation itself).
+                let d = self.divided_differences();
+                let n = self.len();
+                (0..n)
+                    .map(|i| match i {
+                        0 => d[0],
+                        _ if i == n - 1 => d[n - 2],
+                        _ => 0.5 * (d[i - 1] + d[i]),
+                    })
+                    .collect()
+            }
+        }
+    }
+
+    /// Fritsch–Carlson slopes (PCHIP): inside, the weighted harmonic mean
+    /// of the two sides' differences, zero where they differ in sign or
+    /// one is zero; at the ends the three-point estimate, kept to the
+    /// first difference's sign and to three times it.
+    fn monotone_slopes(&self) -> Vec<Real> {
+        let (z, n) = (&self.z, self.len());
+        let d = self.divided_differences();
+        let h: Vec<Real> = z.windows(2).map(|w| w[1] - w[0]).collect();
+        let mut out = vec![0.0; n];
+        for i in 1..n - 1 {
+            if d[i - 1] * d[i] > 0.0 {
+                let (w1, w2) = (2.0 * h[i] + h[i - 1], h[i] + 2.0 * h[i - 1]);
+                out[i] = (w1 + w2) / (w1 / d[i - 1] + w2 / d[i]);
+            }
+        }
+        let end = |h0: Real, h1: Real, d0: Real, d1: Real| {
+            let m = ((2.0 * h0 + h1) * d0 - h0 * d1) / (h0 + h1);
+            if m * d0 <= 0.0 {
+                0.0
+            } else if d0 * d1 < 0.0 && m.abs() > 3.0 * d0.abs() {
+                3.0 * d0
+            } else {
+                m
+            }
+        };
+        out[0] = end(h[0], h[1], d[0], d[1]);
+        out[n - 1] = end(h[n - 2], h[n - 3], d[n - 2], d[n - 3]);
+        out
+    }
+
+    /// The three-point (parabola) estimate of the slopes.
+    fn parabolic_slopes(&self) -> Vec<Real> {
         let (z, x) = (&self.z, &self.x);
         let n = z.len();
         let mut out = vec![0.0; n];
@@ -425,7 +528,12 @@ impl Profile {
                 let i = crate::math::floor_index(&self.z, z)
                     .unwrap_or(0)
                     .min(self.z.len() - 2);
+                let linear = self.interpolation == Interpolation::Linear && self.dx.is_none();
                 match kinks {
+                    _ if linear => {
+                        let t = ((z - self.z[i]) / (self.z[i + 1] - self.z[i])).clamp(0.0, 1.0);
+                        self.x[i] + t * (self.x[i + 1] - self.x[i])
+                    }
                     Some(d2) if d2[i].is_infinite() || d2[i + 1].is_infinite() => {
                         let t = (z - self.z[i]) / (self.z[i + 1] - self.z[i]);
                         self.x[i] + t * (self.x[i + 1] - self.x[i])
@@ -526,6 +634,7 @@ impl Profile {
         Profile {
             z: self.z.clone(),
             x,
+            interpolation: self.interpolation,
             dx: None,
             d2x: None,
             estimated: SlopeCache::default(),
@@ -652,6 +761,35 @@ mod tests {
             };
             assert_near!(p.eval(z).unwrap(), exact, 1e-12, "z = {z}");
         }
+    }
+
+    /// Beside a flat run the parabolic slopes bulge between its rows; the
+    /// monotone ones keep it flat and never overshoot the nodes; linear
+    /// runs straight.
+    #[test]
+    fn interpolations_between_rows() {
+        let z: Vec<Real> = (0..8).map(|i| i as Real).collect();
+        let x = vec![5.0, 4.0, 2.5, 1.0, 1.0, 1.0, 1.5, 3.0];
+        let p = Profile::new(z.clone(), x.clone()).unwrap();
+        let flat = |p: &Profile| -> Real {
+            (0..=100)
+                .map(|i| (p.eval(3.0 + 2.0 * i as Real / 100.0).unwrap() - 1.0).abs())
+                .fold(0.0, Real::max)
+        };
+        assert!(flat(&p) > 0.01, "{}", flat(&p));
+        let m = p.clone().with_interpolation(Interpolation::Monotone);
+        assert_eq!(flat(&m), 0.0);
+        for w in 0..7 {
+            let (lo, hi) = (x[w].min(x[w + 1]), x[w].max(x[w + 1]));
+            for i in 0..=20 {
+                let v = m.eval(w as Real + i as Real / 20.0).unwrap();
+                assert!(v >= lo - 1e-12 && v <= hi + 1e-12, "{w} {i}: {v}");
+            }
+        }
+        let l = p.with_interpolation(Interpolation::Linear);
+        assert_eq!(l.eval(1.5).unwrap(), 3.25);
+        assert_eq!(Interpolation::named("PCHIP"), Some(Interpolation::Monotone));
+        assert_eq!(Interpolation::named("spline"), None);
     }
 
     #[test]

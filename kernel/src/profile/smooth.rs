@@ -19,6 +19,10 @@ pub struct Smoothing {
     pub d2_before: Vec<Real>,
     /// Second divided differences after.
     pub d2_after: Vec<Real>,
+    /// The change of x at every node (after minus before, mm).
+    pub change: Vec<Real>,
+    /// The nodes held exactly (first and last, from 0), if any.
+    pub held: Option<(usize, usize)>,
     /// The largest change of x the smoothing made (mm).
     pub max_change: Real,
     /// The z where that change is.
@@ -47,6 +51,53 @@ impl Profile {
         iterations: usize,
         anchor: usize,
     ) -> Result<Smoothing, ProfileError> {
+        self.smooth_derivative_holding(iterations, anchor, None)
+    }
+
+    /// [`Self::smooth_derivative`] holding the nodes `held` (first and
+    /// last, from 0) exactly: the differences between them keep their
+    /// values through every iteration and are the fixed neighbours the
+    /// rule blends into at the section's ends, so the smoothed slope meets
+    /// the held one there; the anchor, inside the section, keeps its
+    /// value, and so every node of the section does. A groove's sizing
+    /// section sets the tube's finished size and must not move (MATH §3.2).
+    ///
+    /// ```
+    /// use pilgrim_kernel::Profile;
+    /// let z: Vec<f64> = (0..9).map(|i| i as f64).collect();
+    /// let x = vec![4.0, 3.0, 2.0, 1.0, 1.0, 1.0, 1.0, 2.0, 3.0];
+    /// let p = Profile::new(z, x.clone()).unwrap();
+    /// let s = p.smooth_derivative_holding(5, 4, Some((3, 6))).unwrap();
+    /// assert_eq!(&s.profile.x()[3..=6], &x[3..=6]);
+    /// ```
+    ///
+    /// # Failures
+    /// An anchor beyond the last node, a held section beyond the nodes or
+    /// of one node, an anchor outside the held section.
+    pub fn smooth_derivative_holding(
+        &self,
+        iterations: usize,
+        anchor: usize,
+        held: Option<(usize, usize)>,
+    ) -> Result<Smoothing, ProfileError> {
+        if let Some((first, last)) = held {
+            if !(first < last && last < self.len()) {
+                return Err(InputError::out_of_range(
+                    "the held section's last node",
+                    last as Real,
+                    format!("after its first, {first}, and at most {}", self.len() - 1),
+                )
+                .into());
+            }
+            if !(first..=last).contains(&anchor) {
+                return Err(InputError::out_of_range(
+                    "smoothing anchor node",
+                    anchor as Real,
+                    format!("inside the held section, nodes {first}..{last}"),
+                )
+                .into());
+            }
+        }
         if anchor >= self.len() {
             return Err(InputError::out_of_range(
                 "smoothing anchor node",
@@ -59,8 +110,13 @@ impl Profile {
         let mut a = d1_before.clone();
         let mut next = a.clone();
         let m = a.len();
+        let fixed = |i: usize| held.is_some_and(|(first, last)| (first..last).contains(&i));
         for _ in 0..iterations {
             for i in 0..m {
+                if fixed(i) {
+                    next[i] = a[i];
+                    continue;
+                }
                 let left = a[i.saturating_sub(1)];
                 let right = a[(i + 1).min(m - 1)];
                 next[i] = 0.25 * (left + 2.0 * a[i] + right);
@@ -76,19 +132,25 @@ impl Profile {
         for i in (0..anchor).rev() {
             x[i] = x[i + 1] - a[i] * (z[i + 1] - z[i]);
         }
-        let profile = Profile::new(z.to_vec(), x)?;
-        let (max_change, at) = profile
+        let profile = Profile::new(z.to_vec(), x)?.with_interpolation(self.interpolation());
+        let change: Vec<Real> = profile
             .x()
             .iter()
             .zip(self.x())
+            .map(|(a, b)| a - b)
+            .collect();
+        let (max_change, at) = change
+            .iter()
             .enumerate()
-            .map(|(i, (new, old))| ((new - old).abs(), i))
+            .map(|(i, c)| (c.abs(), i))
             .fold((0.0, anchor), |best, c| if c.0 > best.0 { c } else { best });
         Ok(Smoothing {
             d2_before: self.second_divided_differences(),
             d2_after: profile.second_divided_differences(),
             d1_before,
             d1_after: a,
+            change,
+            held,
             max_change,
             max_change_z: z[at],
             profile,

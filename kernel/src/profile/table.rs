@@ -472,6 +472,25 @@ impl Table {
             .collect()
     }
 
+    /// The cells of one column as text, every data row (numbers as
+    /// written by Rust's shortest form, empty cells empty): a column of
+    /// notes or names, such as a groove table's zones.
+    ///
+    /// # Failures
+    /// An unknown column.
+    pub fn texts(&self, name: &str) -> Result<Vec<String>, TableError> {
+        let col = self.column_index(name)?;
+        Ok(self
+            .rows
+            .iter()
+            .map(|(_, cells)| match cells.get(col).unwrap_or(&Cell::Empty) {
+                Cell::Number(v) => v.to_string(),
+                Cell::Text(t) => t.trim().to_owned(),
+                Cell::Empty => String::new(),
+            })
+            .collect())
+    }
+
     /// A profile from two columns: `z` (must increase strictly) and `x`.
     ///
     /// # Failures

@@ -56,12 +56,84 @@ pub mod caliber_api {
             )
             .into());
         }
-        let (groove, hp, b) = kernel(g.smoothed(iterations as usize, anchor as usize))?;
+        smoothed_holding(g, iterations, anchor, Array::new())
+    }
+
+    /// [`smoothed`] holding the rows `held`, `[first, last]` (from 0),
+    /// exactly: the sizing section, which sets the tube's finished size
+    /// (MATH §3.2); `[]` holds none. The anchor must lie inside them.
+    #[rhai_fn(name = "smoothed", pure, return_raw)]
+    pub fn smoothed_holding(
+        g: &mut Groove,
+        iterations: i64,
+        anchor: i64,
+        held: Array,
+    ) -> Result<rhai::Map, Box<EvalAltResult>> {
+        if !(0..=10_000).contains(&iterations) || anchor < 0 {
+            return Err(format!(
+                "smoothed: iterations = {iterations} must be from 0 to 10000, anchor = {anchor} not negative"
+            )
+            .into());
+        }
+        let rows: Vec<i64> = held.iter().filter_map(|v| v.as_int().ok()).collect();
+        let held = match rows.as_slice() {
+            [] => None,
+            &[a, b] if a >= 0 && b >= 0 => Some((a as usize, b as usize)),
+            _ => {
+                return Err(format!(
+                    "smoothed: the held rows must be [first, last] (from 0) or [], not {held:?}"
+                )
+                .into())
+            }
+        };
+        let (groove, hp, b) = kernel(g.smoothed(iterations as usize, anchor as usize, held))?;
         let mut m = rhai::Map::new();
         m.insert("groove".into(), Dynamic::from(groove));
         m.insert("hp".into(), Dynamic::from(hp));
         m.insert("b".into(), Dynamic::from(b));
         Ok(m)
+    }
+
+    /// The groove with its tables interpolated between rows by `name`:
+    /// `"monotone"` (Fritsch–Carlson: no overshoot, a constant stretch
+    /// stays flat), `"parabolic"` (cubic Hermite with the slopes of the
+    /// parabola through each row and its neighbours) or `"linear"`.
+    #[rhai_fn(pure, return_raw)]
+    pub fn interpolated(g: &mut Groove, name: &str) -> Result<Groove, Box<EvalAltResult>> {
+        let mode = crate::profile::Interpolation::named(name).ok_or_else(|| {
+            format!(
+                "interpolation '{}' is none of monotone, parabolic, linear",
+                crate::files::excerpt(name)
+            )
+        })?;
+        Ok(g.clone().with_interpolation(mode))
+    }
+
+    /// The sizing section's rows `[first, last]` (from 0): the longest
+    /// run of rows of one depth and width; `[]` if there is none.
+    #[rhai_fn(get = "sizing_rows", pure)]
+    pub fn sizing_rows(g: &mut Groove) -> Array {
+        g.sizing_rows().map_or_else(Array::new, |(a, b)| {
+            vec![(a as i64).into(), (b as i64).into()]
+        })
+    }
+
+    /// The rows `[first, last]` (from 0) whose angles lie within
+    /// `[from_deg, to_deg]`: a sizing section given by its angles.
+    #[rhai_fn(pure, return_raw)]
+    pub fn rows_between(
+        g: &mut Groove,
+        from_deg: Real,
+        to_deg: Real,
+    ) -> Result<Array, Box<EvalAltResult>> {
+        let (a, b) = kernel(g.rows_between(from_deg, to_deg))?;
+        Ok(vec![(a as i64).into(), (b as i64).into()])
+    }
+
+    /// The change the smoothing made at every row (after minus before, mm).
+    #[rhai_fn(get = "change", pure)]
+    pub fn change(s: &mut Smoothing) -> Floats {
+        Floats::new(s.change.clone())
     }
 
     /// The first differences before smoothing (one per interval).

@@ -27,6 +27,20 @@ pub mod table_api {
         kernel(t.column(name)).map(Floats::new)
     }
 
+    /// The cells of the column `name` as text (a column of notes or
+    /// names; numbers in their shortest form, empty cells empty).
+    ///
+    /// ```rhai
+    /// let zones = read_table("caliber-groove.csv").texts("zone");
+    /// ```
+    #[rhai_fn(pure, return_raw)]
+    pub fn texts(t: &mut Table, name: &str) -> Result<Array, Box<EvalAltResult>> {
+        Ok(kernel(t.texts(name))?
+            .into_iter()
+            .map(|c| Dynamic::from(crate::files::excerpt(&c)))
+            .collect())
+    }
+
     /// The column headers, in order.
     #[rhai_fn(get = "headers", pure)]
     pub fn headers(t: &mut Table) -> Array {
