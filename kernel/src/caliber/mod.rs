@@ -33,6 +33,6 @@ pub use check::{
 };
 pub use groove::{Groove, GrooveError};
 pub use pass::{pass_poses, pose_at, PassPose, SwivelPlane, MAX_PASS_BLOCKS};
-pub use pose::{exact_pose, seed_pose, SeedPose, TorusWheel};
+pub use pose::{exact_pose, exact_pose_toward, seed_pose, SeedPose, TorusWheel};
 pub use scallop::{scallop_height, step_for_scallop};
 pub use solid::{caliber_solid, Roll, SolidError};

@@ -4,7 +4,7 @@
 //! model is from it.
 
 use super::groove::{Groove, GrooveError};
-use super::pose::{exact_pose, seed_pose, TorusWheel};
+use super::pose::{exact_pose_toward, seed_pose, TorusWheel};
 use crate::input::InputError;
 use crate::math::{Real, Vec3};
 
@@ -100,19 +100,23 @@ fn exact_at(
         let w = w.normalize();
         Ok(if w.z < 0.0 { -w } else { w })
     };
-    let place = |w: Vec3| exact_pose(p, n, w, r_k0, r_k).map_err(GrooveError::from);
+    // At the groove's edge the normal lies along the axis: the wheel's
+    // centre then stands out along the radius at the turn.
+    let place = |w: Vec3, turn: Real| {
+        exact_pose_toward(p, n, w, r_k0, r_k, radial(turn)).map_err(GrooveError::from)
+    };
     let (wheel, turn) = match plane {
-        SwivelPlane::Contact => (place(axis_for(theta)?)?, theta),
+        SwivelPlane::Contact => (place(axis_for(theta)?, theta)?, theta),
         SwivelPlane::Wheel => {
             let mut turn = theta;
-            let mut wheel = place(axis_for(turn)?)?;
+            let mut wheel = place(axis_for(turn)?, turn)?;
             for _ in 0..50 {
                 let next = wheel.centre.y.atan2(wheel.centre.x);
                 // Unwrapped near the contact's angle.
                 let next = theta + crate::math::wrap_angle(next - theta);
                 let moved = (next - turn).abs();
                 turn = next;
-                wheel = place(axis_for(turn)?)?;
+                wheel = place(axis_for(turn)?, turn)?;
                 if moved < 1e-13 {
                     break;
                 }
@@ -308,6 +312,29 @@ mod tests {
             }
             assert_eq!(poses[0].theta, 0.0);
             assert!((poses.last().unwrap().theta - 180f64.to_radians()).abs() < 1e-12);
+        }
+    }
+
+    /// At the groove's edge (psi = +-90 deg) the wall is radial and the
+    /// wheel's axis lies along its normal: the pose is the wheel's side
+    /// face on the wall, its centre out along the radius, continuing the
+    /// poses just inside the edge.
+    #[test]
+    fn the_edge_is_reached_by_the_wheels_side() {
+        let g = lifting();
+        for plane in [SwivelPlane::Contact, SwivelPlane::Wheel] {
+            for side in [1.0, -1.0] {
+                let edge = side * std::f64::consts::FRAC_PI_2;
+                let p = pose_at(&g, 1.0, edge, 100.0, 8.0, plane).unwrap();
+                assert!(p.wheel.distance(&p.contact).abs() < 1e-9);
+                let near = pose_at(&g, 1.0, edge - side * 1e-5, 100.0, 8.0, plane).unwrap();
+                assert!(
+                    (near.wheel.centre - p.wheel.centre).norm() < 1e-3,
+                    "{plane:?} {side}: {:?} against {:?}",
+                    p.wheel.centre,
+                    near.wheel.centre
+                );
+            }
         }
     }
 

@@ -48,6 +48,26 @@ pub fn exact_pose(
     r_k0: Real,
     r_k: Real,
 ) -> Result<TorusWheel, InputError> {
+    exact_pose_toward(p, n, w, r_k0, r_k, Vec3::zeros())
+}
+
+/// [`exact_pose`], the wheel's centre toward `away` (its part across the
+/// axis) where `w` lies along `n`: the wheel's side face flat on the
+/// surface, as at a groove's edge, where the wall is radial and the
+/// wheel's plane along the edge; `u` tends to the radial direction there
+/// as the contact nears the edge, so the radius out of the roll continues
+/// the pass.
+///
+/// # Failures
+/// As [`exact_pose`], and `w` along `n` with `away` along `w` or zero.
+pub fn exact_pose_toward(
+    p: Vec3,
+    n: Vec3,
+    w: Vec3,
+    r_k0: Real,
+    r_k: Real,
+    away: Vec3,
+) -> Result<TorusWheel, InputError> {
     positive("wheel radius R_k0", r_k0)?;
     positive("wheel rounding radius r_k", r_k)?;
     if r_k >= r_k0 {
@@ -58,7 +78,10 @@ pub fn exact_pose(
         ));
     }
     let (n, w) = (n.normalize(), w.normalize());
-    let across = n - n.dot(&w) * w;
+    let mut across = n - n.dot(&w) * w;
+    if !(across.norm() > 1e-9) {
+        across = away - away.dot(&w) * w;
+    }
     if !(across.norm() > 1e-9) {
         return Err(InputError::out_of_range(
             "wheel axis against the surface normal (sine of the angle)",
