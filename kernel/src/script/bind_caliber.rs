@@ -42,20 +42,14 @@ pub mod caliber_api {
     /// The groove with both tables smoothed (MATH §3.2): `iterations` of
     /// the three-point rule (0: none, reported all the same), rebuilt from
     /// row `anchor` (from 0). `#{ groove, hp, b }`: `hp` and `b` are the
-    /// smoothings (`.max_change`, `.max_change_z`, `.d1_before`,
-    /// `.d1_after`, `.d2_before`, `.d2_after`).
+    /// smoothings (`.change`, `.max_change`, `.max_change_z`,
+    /// `.d1_before`, `.d1_after`, `.d2_before`, `.d2_after`).
     #[rhai_fn(pure, return_raw)]
     pub fn smoothed(
         g: &mut Groove,
         iterations: i64,
         anchor: i64,
     ) -> Result<rhai::Map, Box<EvalAltResult>> {
-        if !(0..=10_000).contains(&iterations) || anchor < 0 {
-            return Err(format!(
-                "smoothed: iterations = {iterations} must be from 0 to 10000, anchor = {anchor} not negative"
-            )
-            .into());
-        }
         smoothed_holding(g, iterations, anchor, Array::new())
     }
 
