@@ -4,6 +4,7 @@
 use super::{Machine, MachineError, MachineInfo};
 use crate::math::{Point3, Real, Vec3};
 use crate::transform::{IkOptions, Target, ToolFrame, TransformError};
+use std::f64::consts::FRAC_PI_4;
 
 /// A kinematics failure; `index` is the pose (row) it happened at.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -211,11 +212,11 @@ impl ChainMachine {
         let free: Vec<usize> = (0..dof).filter(|i| !held.contains(i)).collect();
         let free_travel: Vec<(Real, Real)> = free.iter().map(|&i| travel[i]).collect();
         let home = super::home_seed(chain, &travel);
-        let mut seed: Vec<Real> = free.iter().map(|&i| home[i]).collect();
-        // The last two solutions and the step between their poses: a pose
-        // that continues a steady step is seeded by extrapolating them.
-        let mut last: Option<(Vec<Real>, &[Real])> = None;
-        let mut stride: Option<(Vec<Real>, Vec<Real>)> = None;
+        let home: Vec<Real> = free.iter().map(|&i| home[i]).collect();
+        // The last two solutions with their poses (the latest first): each
+        // pose is seeded by the last, or by extrapolating both where it
+        // continues their step.
+        let mut solved: [Option<(Vec<Real>, &[Real])>; 2] = [None, None];
         let tol_dir = self.options.tol_dir.max(1e-9);
         out.clear();
         let mut ticker = crate::budget::Ticker::new("inverse kinematics", 64);
@@ -248,23 +249,17 @@ impl ChainMachine {
             } else {
                 Target::point(point)
             };
-            let start = match (&last, &stride) {
-                (Some((_, before)), Some((dq, dp))) => {
-                    continued(p, before, dp, &seed, dq, |i| solving.is_rotary(i))
-                }
-                _ => None,
+            let seed = match &solved {
+                [Some(last), Some(before)] => continued(p, last, before, |i| solving.is_rotary(i))
+                    .unwrap_or_else(|| last.0.clone()),
+                [Some(last), None] => last.0.clone(),
+                _ => home.clone(),
             };
             let q = if free.is_empty() {
                 vec![]
             } else {
                 solving
-                    .inverse(
-                        &target,
-                        tool,
-                        start.as_deref().unwrap_or(&seed),
-                        Some(&free_travel),
-                        &self.options,
-                    )
+                    .inverse(&target, tool, &seed, Some(&free_travel), &self.options)
                     .map_err(|e| KinematicsError::at(k, self.explain(e.into())))?
                     .q
             };
@@ -295,46 +290,35 @@ impl ChainMachine {
             }
             out.extend_from_slice(&row);
             if !q.is_empty() {
-                stride = last.as_ref().map(|(q0, p0)| {
-                    (
-                        q.iter().zip(q0).map(|(a, b)| a - b).collect(),
-                        p.iter().zip(p0.iter()).map(|(a, b)| a - b).collect(),
-                    )
-                });
-                last = Some((q.clone(), p));
-                seed = q;
+                solved = [Some((q, p)), solved[0].take()];
             }
         }
         Ok(())
     }
 }
 
-/// The seed of a pose `p` that continues the step from the pose `before`
-/// (the last solved, at `q`) by about the last step `dp` (solved as
-/// `dq`): `q + dq`, the two solutions extrapolated. `None` when the pose
-/// does not continue the step (its step differs from the last by more
-/// than a fifth of it: a new pass, a rapid) or a rotary turned more than
-/// a quarter turn. Where the target does not fix an axis (a singular
+/// The seed of a pose `p` that continues the step between the last two
+/// solved, `last` and `before` (each its solution and pose): the two
+/// solutions extrapolated. `None` when the pose does not continue the step
+/// (its step differs from the last by more than a fifth of it: a new pass,
+/// a rapid) or a rotary turned more than a quarter turn. Where the target does not fix an axis (a singular
 /// pose: a swivel at zero leaves the roll's turn free) the solver keeps
 /// the seed's value there, so the machine moves on as it moved, rather
 /// than standing still on one axis while another makes up for it.
 fn continued(
     p: &[Real],
-    before: &[Real],
-    dp: &[Real],
-    q: &[Real],
-    dq: &[Real],
+    (q1, p1): &(Vec<Real>, &[Real]),
+    (q0, p0): &(Vec<Real>, &[Real]),
     rotary: impl Fn(usize) -> bool,
 ) -> Option<Vec<Real>> {
-    let norm = |v: &mut dyn Iterator<Item = Real>| v.map(|x| x * x).sum::<Real>().sqrt();
-    let step = norm(&mut dp.iter().copied());
-    let change = norm(&mut p.iter().zip(before).zip(dp).map(|((a, b), d)| a - b - d));
-    let steady = step > 0.0 && change <= 0.2 * step;
-    let turned = dq
-        .iter()
-        .enumerate()
-        .any(|(i, d)| rotary(i) && d.abs() > std::f64::consts::FRAC_PI_4);
-    (steady && !turned).then(|| q.iter().zip(dq).map(|(a, d)| a + d).collect())
+    fn length(v: impl Iterator<Item = Real>) -> Real {
+        v.map(|x| x * x).sum::<Real>().sqrt()
+    }
+    let step = length((0..p.len()).map(|i| p1[i] - p0[i]));
+    let change = length((0..p.len()).map(|i| p[i] - 2.0 * p1[i] + p0[i]));
+    let turned = (0..q1.len()).any(|i| rotary(i) && (q1[i] - q0[i]).abs() > FRAC_PI_4);
+    (step > 0.0 && change <= 0.2 * step && !turned)
+        .then(|| (0..q1.len()).map(|i| 2.0 * q1[i] - q0[i]).collect())
 }
 
 /// The number of rows of `width` values in a batch; a ragged end (or a

@@ -519,6 +519,7 @@ impl Profile {
         }
         let slopes = self.slopes();
         let kinks = self.d2x.as_deref();
+        let linear = self.interpolation == Interpolation::Linear && self.dx.is_none();
         Ok(zs
             .iter()
             .map(|&z| {
@@ -528,7 +529,6 @@ impl Profile {
                 let i = crate::math::floor_index(&self.z, z)
                     .unwrap_or(0)
                     .min(self.z.len() - 2);
-                let linear = self.interpolation == Interpolation::Linear && self.dx.is_none();
                 match kinks {
                     _ if linear => {
                         let t = ((z - self.z[i]) / (self.z[i + 1] - self.z[i])).clamp(0.0, 1.0);

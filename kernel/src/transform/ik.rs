@@ -192,6 +192,11 @@ impl<'a> Solver<'a> {
         (pos, dir)
     }
 
+    /// The Jacobian of the last evaluation that made it, `rows x m`.
+    fn jacobian(&self) -> nalgebra::DMatrix<Real> {
+        nalgebra::DMatrix::from_row_slice(self.rows, self.m, &self.jac)
+    }
+
     /// The Gauss–Newton step at the last evaluation with its Jacobian:
     /// the least-squares solution of `J d = -r` by the Jacobian's SVD.
     /// A direction whose singular value is below [`SINGULAR`] of the
@@ -202,8 +207,7 @@ impl<'a> Solver<'a> {
     /// solution keeps the start's value (the caller's seed decides, not
     /// rounding errors in the target amplified by the weak effect).
     fn gauss_newton(&self, tol: Real) -> Option<nalgebra::DVector<Real>> {
-        let j = nalgebra::DMatrix::from_row_slice(self.rows, self.m, &self.jac);
-        let svd = j.svd(true, true);
+        let svd = self.jacobian().svd(true, true);
         let (u, v_t) = (svd.u.as_ref()?, svd.v_t.as_ref()?);
         let sigma = &svd.singular_values;
         let largest = sigma.max();
@@ -380,26 +384,16 @@ impl Solver<'_> {
         let mut spent = 0;
         for _ in 0..3 {
             self.eval(q, true);
-            let j = nalgebra::DMatrix::from_row_slice(self.rows, self.m, &self.jac);
-            let svd = j.svd(false, true);
-            let Some(v_t) = svd.v_t.as_ref() else { break };
-            let largest = svd.singular_values.max();
-            let free: Vec<usize> = (0..svd.singular_values.len())
-                .filter(|&i| svd.singular_values[i] < SINGULAR * largest)
+            // The free directions: the eigenvectors of J^T J whose
+            // eigenvalues (the singular values squared) are weak, which
+            // also gives the directions of rows a position-only target
+            // does not have.
+            let eig = (self.jacobian().transpose() * self.jacobian()).symmetric_eigen();
+            let largest = eig.eigenvalues.max();
+            let basis: Vec<nalgebra::DVector<Real>> = (0..self.m)
+                .filter(|&i| eig.eigenvalues[i] < SINGULAR * SINGULAR * largest)
+                .map(|i| eig.eigenvectors.column(i).into_owned())
                 .collect();
-            // A singular direction also stands for each missing row.
-            let mut basis: Vec<nalgebra::DVector<Real>> =
-                free.iter().map(|&i| v_t.row(i).transpose()).collect();
-            if self.rows < self.m {
-                let full = nalgebra::DMatrix::from_row_slice(self.rows, self.m, &self.jac)
-                    .transpose()
-                    * nalgebra::DMatrix::from_row_slice(self.rows, self.m, &self.jac);
-                let eig = full.symmetric_eigen();
-                basis = (0..self.m)
-                    .filter(|&i| eig.eigenvalues[i] < SINGULAR * SINGULAR * largest * largest)
-                    .map(|i| eig.eigenvectors.column(i).into_owned())
-                    .collect();
-            }
             if basis.is_empty() || linear.is_empty() {
                 break;
             }
