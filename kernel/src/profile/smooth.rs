@@ -21,8 +21,6 @@ pub struct Smoothing {
     pub d2_after: Vec<Real>,
     /// The change of x at every node (after minus before, mm).
     pub change: Vec<Real>,
-    /// The nodes held exactly (first and last, from 0), if any.
-    pub held: Option<(usize, usize)>,
     /// The largest change of x the smoothing made (mm).
     pub max_change: Real,
     /// The z where that change is.
@@ -150,7 +148,6 @@ impl Profile {
             d1_before,
             d1_after: a,
             change,
-            held,
             max_change,
             max_change_z: z[at],
             profile,
