@@ -784,15 +784,10 @@ fn every_message_quotes_outside_text_short() {
     );
     // A parameter key, from a file and from --set.
     let key = format!("{escape}{}", "k".repeat(3 << 20));
+    // The key as a TOML string spells its control characters.
+    let toml_key = key.replace('\u{1b}', "\\u001b").replace('\u{7}', "\\u0007");
     let params = dir.join("p.toml");
-    std::fs::write(
-        &params,
-        format!(
-            "\"{}\" = 1\n",
-            key.replace('\u{1b}', "\\u001b").replace('\u{7}', "\\u0007")
-        ),
-    )
-    .unwrap();
+    std::fs::write(&params, format!("\"{toml_key}\" = 1\n")).unwrap();
     let (code, _, err) = pilgrim(&["run", DEMO, "--params", s(&params), "--out", s(&out)]);
     assert_eq!(code, 1, "{err}");
     clean("parameter key in a file", &err);
@@ -811,14 +806,7 @@ fn every_message_quotes_outside_text_short() {
     let machine = dir.join("m.toml");
     std::fs::write(
         &machine,
-        mill.replacen(
-            "name = \"X\"",
-            &format!(
-                "name = \"{}\"",
-                key.replace('\u{1b}', "\\u001b").replace('\u{7}', "\\u0007")
-            ),
-            1,
-        ),
+        mill.replacen("name = \"X\"", &format!("name = \"{toml_key}\""), 1),
     )
     .unwrap();
     let (code, _, err) = pilgrim(&["run", DEMO, "--machine", s(&machine), "--out", s(&out)]);
