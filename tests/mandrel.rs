@@ -125,25 +125,17 @@ fn bad_mandrel_parameters_are_refused_and_nothing_is_written() {
     let out = dir.join("out");
     let run = |sets: &[&str]| {
         let mut args = vec![
-            "run".to_owned(),
-            "scripts/mandrel.rhai".into(),
-            "--out".into(),
-            out.display().to_string(),
-            "--quiet".into(),
+            "run",
+            "scripts/mandrel.rhai",
+            "--out",
+            common::s(&out),
+            "--quiet",
         ];
         for s in sets {
-            args.push("--set".into());
-            args.push((*s).into());
+            args.extend(["--set", s]);
         }
-        let o = std::process::Command::new(env!("CARGO_BIN_EXE_pilgrim"))
-            .current_dir(env!("CARGO_MANIFEST_DIR"))
-            .args(&args)
-            .output()
-            .unwrap();
-        (
-            o.status.code().unwrap_or(-1),
-            String::from_utf8_lossy(&o.stderr).into_owned(),
-        )
+        let (code, _, err) = common::pilgrim(&args);
+        (code, err)
     };
     let (code, err) = run(&[]);
     assert_eq!(code, 0, "{err}");
@@ -412,23 +404,16 @@ fn example_parameter_files_run() {
             "pilgrim-mandrel-example-{}-{f}",
             std::process::id()
         ));
-        let o = std::process::Command::new(env!("CARGO_BIN_EXE_pilgrim"))
-            .current_dir(env!("CARGO_MANIFEST_DIR"))
-            .args([
-                "run",
-                "scripts/mandrel.rhai",
-                "--params",
-                &format!("scripts/examples/{f}"),
-                "--out",
-            ])
-            .arg(&out)
-            .output()
-            .unwrap();
-        let (stdout, stderr) = (
-            String::from_utf8_lossy(&o.stdout),
-            String::from_utf8_lossy(&o.stderr),
-        );
-        assert!(o.status.success(), "{f}: {stderr}");
+        let params = format!("scripts/examples/{f}");
+        let (code, stdout, stderr) = common::pilgrim(&[
+            "run",
+            "scripts/mandrel.rhai",
+            "--params",
+            &params,
+            "--out",
+            common::s(&out),
+        ]);
+        assert_eq!(code, 0, "{f}: {stderr}");
         assert!(stdout.contains("finish within 0.000"), "{f}: {stdout}");
         let svg = std::fs::read_to_string(out.join("profile.svg")).unwrap();
         assert!(svg.starts_with("<svg ") && svg.ends_with("</svg>\n"), "{f}");
@@ -479,13 +464,14 @@ fn example_parameter_files_run() {
 #[test]
 fn step_solids_and_page_are_the_runs() {
     let out = common::scratch("mandrel", "step").join("out");
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pilgrim"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(["run", "scripts/mandrel.rhai", "-q", "--out"])
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (code, _, err) = common::pilgrim(&[
+        "run",
+        "scripts/mandrel.rhai",
+        "-q",
+        "--out",
+        common::s(&out),
+    ]);
+    assert_eq!(code, 0, "{err}");
     let report: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
     let tol = report["step_tolerance_mm"].as_f64().unwrap();
@@ -704,19 +690,15 @@ fn rest_parameters_are_the_machines() {
         "--set wins"
     );
     let out = std::env::temp_dir().join(format!("pilgrim-rest-b-{}", std::process::id()));
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pilgrim"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args([
-            "run",
-            "scripts/mandrel.rhai",
-            "--set",
-            "rest_b=-150",
-            "--out",
-        ])
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (code, _, err) = common::pilgrim(&[
+        "run",
+        "scripts/mandrel.rhai",
+        "--set",
+        "rest_b=-150",
+        "--out",
+        common::s(&out),
+    ]);
+    assert_eq!(code, 0, "{err}");
     rest_stands_where_u_puts_it(&out, -150.0);
     std::fs::remove_dir_all(&out).ok();
     // A whole-number parameter cannot follow a fractional constant.
@@ -872,15 +854,18 @@ fn the_process_meets_the_part_at_its_feeds() {
 #[test]
 fn a_heavy_finish_fails_and_tall_ridges_are_reported() {
     let out = common::scratch("mandrel", "seed-schedule").join("out");
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pilgrim"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(["run", "scripts/mandrel.rhai", "-q", "--out"])
-        .arg(&out)
-        .args(["--set", "rough_feed=2000", "--set", "finish_cut=0.075"])
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "{err}");
+    let (code, _, err) = common::pilgrim(&[
+        "run",
+        "scripts/mandrel.rhai",
+        "-q",
+        "--out",
+        common::s(&out),
+        "--set",
+        "rough_feed=2000",
+        "--set",
+        "finish_cut=0.075",
+    ]);
+    assert_eq!(code, 1, "{err}");
     assert!(
         err.contains("the finishing pass \"pass 4, stock 0.0 um\" takes 0.07")
             && err.contains("more than the finishing stock 0.03 mm"),
@@ -902,15 +887,18 @@ fn a_heavy_finish_fails_and_tall_ridges_are_reported() {
         "{warnings:?}"
     );
     // With a finishing stock as large as its cut, it runs, and warns.
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pilgrim"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(["run", "scripts/mandrel.rhai", "--out"])
-        .arg(&out)
-        .args(["--set", "rough_feed=2000", "--set", "finish_cut=0.075"])
-        .args(["--set", "finish_stock=0.08"])
-        .output()
-        .unwrap();
-    let said = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (code, said, err) = common::pilgrim(&[
+        "run",
+        "scripts/mandrel.rhai",
+        "--out",
+        common::s(&out),
+        "--set",
+        "rough_feed=2000",
+        "--set",
+        "finish_cut=0.075",
+        "--set",
+        "finish_stock=0.08",
+    ]);
+    assert_eq!(code, 0, "{err}");
     assert!(said.contains("warning: N"), "{said}");
 }

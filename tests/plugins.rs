@@ -592,17 +592,8 @@ fn plugin_check_exercises_the_kinematics() {
     assert!(err.contains("refuses to program with them"), "{err}");
     assert!(!dir.join("o").exists());
     // The real machines agree, and say so.
-    let (code, out) = {
-        let o = std::process::Command::new(env!("CARGO_BIN_EXE_pilgrim"))
-            .args(["plugin-check", common::s(&lib("fanuc_0i_tc"))])
-            .output()
-            .unwrap();
-        (
-            o.status.code(),
-            String::from_utf8_lossy(&o.stdout).into_owned(),
-        )
-    };
-    assert_eq!(code, Some(0));
+    let (code, out, err) = common::pilgrim(&["plugin-check", common::s(&lib("fanuc_0i_tc"))]);
+    assert_eq!(code, 0, "{err}");
     assert!(
         out.contains("kinematics over the travel") && out.contains("agree"),
         "{out}"
