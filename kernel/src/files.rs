@@ -60,14 +60,46 @@ pub fn check_regular(path: &Path, limit: u64) -> Result<u64, FileError> {
 /// As [`check_regular`]; a read error; a file that grew past the limit
 /// while it was read.
 pub fn read_bytes(path: &Path, limit: u64) -> Result<Vec<u8>, FileError> {
-    let len = check_regular(path, limit)?;
+    // Checked before it is opened: opening a FIFO would wait for a writer.
+    check_regular(path, limit)?;
     let file = std::fs::File::open(path).map_err(|e| error(path, e.to_string()))?;
-    let mut bytes = Vec::with_capacity(len as usize);
+    read_opened(path, file, limit)
+}
+
+/// The bytes of the opened file `file` (at `path`, for messages), at most
+/// `limit`: it must be a regular file (as opened: what a link pointed to,
+/// or the link itself refused by the way it was opened) of at most
+/// `limit` bytes, and must not grow past them while it is read.
+///
+/// # Failures
+/// A file that is not regular, larger than `limit`, or grew past it; a
+/// read error.
+pub fn read_opened(path: &Path, file: std::fs::File, limit: u64) -> Result<Vec<u8>, FileError> {
+    let meta = file.metadata().map_err(|e| error(path, e.to_string()))?;
+    if !meta.is_file() {
+        return Err(error(
+            path,
+            "not a regular file (pilgrim reads only regular files)",
+        ));
+    }
+    if meta.len() > limit {
+        return Err(error(
+            path,
+            format!(
+                "{} bytes, more than the {limit} bytes read from such a file",
+                meta.len()
+            ),
+        ));
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
     file.take(limit + 1)
         .read_to_end(&mut bytes)
         .map_err(|e| error(path, e.to_string()))?;
     if bytes.len() as u64 > limit {
-        return Err(error(path, format!("more than {limit} bytes")));
+        return Err(error(
+            path,
+            format!("grew past {limit} bytes while it was read"),
+        ));
     }
     Ok(bytes)
 }

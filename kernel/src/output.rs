@@ -26,7 +26,7 @@
 //! A run's files are read back ([`RunDir`]) only by the plain names its
 //! marker lists, never through a link, and only if they are regular files.
 
-use std::io::{Read, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The file that marks a directory as pilgrim's output.
@@ -122,33 +122,10 @@ fn read_no_follow(path: &Path, limit: u64) -> Result<Vec<u8>, OutputError> {
         }
         err(path, e.to_string())
     })?;
-    let meta = file.metadata().map_err(|e| err(path, e.to_string()))?;
-    if !meta.is_file() {
-        return Err(err(
-            path,
-            "is not a regular file: pilgrim reads a run's files only as it wrote them",
-        ));
-    }
-    if meta.len() > limit {
-        return Err(err(
-            path,
-            format!(
-                "{} bytes, more than the {limit} bytes read from a run's file",
-                meta.len()
-            ),
-        ));
-    }
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    file.take(limit + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| err(path, e.to_string()))?;
-    if bytes.len() as u64 > limit {
-        return Err(err(
-            path,
-            format!("grew past {limit} bytes while it was read"),
-        ));
-    }
-    Ok(bytes)
+    crate::files::read_opened(path, file, limit).map_err(|e| OutputError {
+        path: e.file,
+        message: e.message,
+    })
 }
 
 /// The marker of `dir`, read without following a link; `None` if there is
