@@ -36,6 +36,12 @@ fn error(path: &Path, message: impl Into<String>) -> FileError {
 /// A missing file, one that is not a regular file, or a larger one.
 pub fn check_regular(path: &Path, limit: u64) -> Result<u64, FileError> {
     let meta = std::fs::metadata(path).map_err(|e| error(path, e.to_string()))?;
+    regular_within(path, &meta, limit)
+}
+
+/// The length of the file `meta` describes, if it is a regular file of at
+/// most `limit` bytes.
+fn regular_within(path: &Path, meta: &std::fs::Metadata, limit: u64) -> Result<u64, FileError> {
     if !meta.is_file() {
         return Err(error(
             path,
@@ -76,22 +82,8 @@ pub fn read_bytes(path: &Path, limit: u64) -> Result<Vec<u8>, FileError> {
 /// read error.
 pub fn read_opened(path: &Path, file: std::fs::File, limit: u64) -> Result<Vec<u8>, FileError> {
     let meta = file.metadata().map_err(|e| error(path, e.to_string()))?;
-    if !meta.is_file() {
-        return Err(error(
-            path,
-            "not a regular file (pilgrim reads only regular files)",
-        ));
-    }
-    if meta.len() > limit {
-        return Err(error(
-            path,
-            format!(
-                "{} bytes, more than the {limit} bytes read from such a file",
-                meta.len()
-            ),
-        ));
-    }
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    let len = regular_within(path, &meta, limit)?;
+    let mut bytes = Vec::with_capacity(len as usize);
     file.take(limit + 1)
         .read_to_end(&mut bytes)
         .map_err(|e| error(path, e.to_string()))?;
