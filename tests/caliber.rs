@@ -122,10 +122,16 @@ fn the_default_job_holds_its_tolerance_read_back_from_the_program() {
     let tol = v["tolerance"].as_f64().unwrap();
     assert_eq!(tol, 0.01);
     assert!(v["max_abs_mm"].as_f64().unwrap() <= tol);
+    // The whole section, edge to edge, and the periphery beside it.
+    assert_eq!(v["psi_range_deg"], serde_json::json!([-90.0, 90.0]));
+    let cut = v["periphery_cut"]["mm"].as_f64().unwrap();
+    assert!((-tol..=0.0).contains(&cut), "{}", v["periphery_cut"]);
     // The process's rules hold, the groove's stock measured: the wheel
     // comes in at rapid to its clearance off the turned groove and into it
     // at the infeed feed, along the groove's normal at the first contact,
-    // by the linear axes alone (X and Z: the turn and the swivel stand).
+    // by the linear axes alone (the turn and the swivel stand; at the
+    // edge, where the first pass runs, the normal is along the roll's
+    // axis: X alone).
     assert_eq!(r["verdict"]["status"], "passed", "{}", r["verdict"]);
     let mpf = std::fs::read_to_string(out.join("program.mpf")).unwrap();
     let first = mpf
@@ -135,7 +141,6 @@ fn the_default_job_holds_its_tolerance_read_back_from_the_program() {
         .unwrap();
     assert!(
         first.starts_with("N40 G1 X")
-            && first.contains(" Z")
             && first.ends_with(" F2.0")
             && !first.contains(" A")
             && !first.contains(" B"),
@@ -348,8 +353,8 @@ fn the_four_axis_machine_reports_its_figure_and_refuses_what_it_cannot_do() {
 /// The sizing section (theta 200..250 deg in the example table, one depth
 /// and width: it sets the tube's finished size) is the groove the family
 /// grinds and verifies against, within 0.1 um, between its rows as on
-/// them, though the smoothing changes the reliefs beside it by tenths of
-/// a millimetre.
+/// them, though the smoothing changes the reliefs beside it by tens of
+/// microns.
 #[test]
 fn the_sizing_section_is_held_through_the_smoothing() {
     let fam =
@@ -379,8 +384,9 @@ fn the_sizing_section_is_held_through_the_smoothing() {
         "the sizing section moved {worst} mm at theta {at} deg"
     );
     // The reliefs beside it do move: the smoothing is not a no-op.
-    let entry = req.groove.section(4f64.to_radians()).unwrap();
-    assert!((entry.b - hp[2]).abs() > 0.01, "{}", entry.b);
+    let row = deg.iter().position(|&d| d == 10.0).unwrap();
+    let entry = req.groove.section(10f64.to_radians()).unwrap();
+    assert!((2.0 * entry.a - b[row]).abs() > 0.01, "{}", entry.a);
 }
 
 /// A block moved 0.05 mm off its place in the program: the replay names
@@ -404,7 +410,6 @@ fn a_corrupted_block_is_named() {
             ("dpsi_deg", "4"),
             ("verify_theta_deg", "1.5"),
             ("tolerance", "0.5"),
-            ("psi_max_deg", "60"),
         ],
     );
     let tp = fam.toolpath(&values).unwrap();
@@ -430,6 +435,59 @@ fn a_corrupted_block_is_named() {
         e.contains("gouge") && e.contains(&name),
         "{e} (expected {name})"
     );
+}
+
+/// The groove is verified over its whole section whatever the passes
+/// cover: passes that stop at psi 80 deg are refused, naming the material
+/// they leave by the edge and what to change; a groove whose edge bends
+/// toward the wheel's flat side (the example's reliefs as they were, a
+/// cosine blend whose width falls ever faster from the groove's ends) is
+/// refused naming where the wheel's side cuts it, and why.
+#[test]
+fn the_groove_is_verified_to_its_edges() {
+    let dir = scratch_dir("edges");
+    let short = dir.join("short");
+    let (code, _, err) = pilgrim(&["run", SCRIPT, "--set", "psi_max_deg=80", "--out", s(&short)]);
+    assert_ne!(code, 0, "passes short of the edge accepted");
+    assert!(
+        err.contains("psi = 90.000 deg") || err.contains("psi = -90.000 deg"),
+        "{err}"
+    );
+    assert!(
+        err.contains("material left") && err.contains("outermost passes"),
+        "{err}"
+    );
+    let r = report(&short);
+    assert_eq!(r["verdict"]["status"], "failed");
+    let left = r["groove_verification"]["max_left"]["mm"].as_f64().unwrap();
+    assert!(left > 0.1, "{left}");
+    assert!(!short.join("program.mpf").exists());
+
+    let bends = dir.join("bends");
+    std::fs::create_dir_all(&bends).unwrap();
+    std::fs::copy(
+        root().join("tests/fixtures/caliber/cosine-relief.csv"),
+        bends.join("groove.csv"),
+    )
+    .unwrap();
+    std::fs::write(bends.join("p.toml"), "table = \"groove.csv\"\n").unwrap();
+    let out = bends.join("out");
+    let script = root().join(SCRIPT);
+    let (code, _, err) = pilgrim_in(
+        &bends,
+        &["run", s(&script), "--params", "p.toml", "--out", s(&out)],
+    );
+    assert_ne!(code, 0, "an edge bending toward the wheel accepted");
+    let r = report(&out);
+    let g = &r["groove_verification"]["max_gouge"];
+    let (theta, psi) = (
+        g["theta_deg"].as_f64().unwrap(),
+        g["psi_deg"].as_f64().unwrap(),
+    );
+    assert!(g["mm"].as_f64().unwrap() < -0.05, "{g}");
+    assert!(psi.abs() > 80.0 && !(12.0..=267.0).contains(&theta), "{g}");
+    assert!(err.contains("bends toward the wheel"), "{err}");
+    assert!(!out.join("program.mpf").exists());
 }
 
 /// Bad input: each a clear error naming the value and where it is, and no

@@ -94,7 +94,7 @@ pub enum VerifyError {
     /// The finished groove strays from the nominal beyond the tolerance.
     #[error(
         "verification failed: the finished groove strays {} mm from the nominal at theta = {} deg, psi = {} deg, \
-         where {block} leaves it (tolerance {tolerance} mm; positive: material left, negative: a gouge)",
+         where {block} leaves it (tolerance {tolerance} mm; positive: material left, negative: a gouge){why}",
         crate::math::fixed(*deviation, 5),
         crate::math::fixed(*theta_deg, 3),
         crate::math::fixed(*psi_deg, 3)
@@ -107,6 +107,33 @@ pub enum VerifyError {
         /// Where: psi (deg).
         psi_deg: Real,
         /// The block whose wheel is nearest there, as the program names it.
+        block: String,
+        /// The tolerance (mm).
+        tolerance: Real,
+        /// Why, where the check can tell, and what to change (from `: `;
+        /// empty if it cannot).
+        why: String,
+    },
+    /// The wheel cuts the roll's periphery beside the groove, which is not
+    /// to be ground.
+    #[error(
+        "verification failed: the wheel cuts the roll's periphery {} mm deep at theta = {} deg, {} mm beyond the groove's edge at psi = {} deg, \
+         where {block} reaches it (tolerance {tolerance} mm): the periphery beside the groove is not ground",
+        crate::math::fixed(*deviation, 5),
+        crate::math::fixed(*theta_deg, 3),
+        crate::math::fixed(*beyond_mm, 3),
+        crate::math::fixed(*psi_deg, 0)
+    )]
+    Periphery {
+        /// The cut (mm, negative).
+        deviation: Real,
+        /// Where: theta (deg).
+        theta_deg: Real,
+        /// The edge's side: psi (deg), -90 or 90.
+        psi_deg: Real,
+        /// How far beyond the edge along the roll's axis (mm).
+        beyond_mm: Real,
+        /// The block whose wheel cuts it, as the program names it.
         block: String,
         /// The tolerance (mm).
         tolerance: Real,

@@ -19,6 +19,13 @@
 //! [`NEIGHBOUR_PASSES`] of it across the groove. Every block's wheel is
 //! also measured across the whole section at its own theta, so that a
 //! wheel cutting the groove away from its contact (across it) is seen.
+//!
+//! The grid covers the whole section, edge to edge (psi from -90 to 90
+//! deg, where the groove meets the roll's periphery), whatever the passes
+//! cover: beyond the outermost passes it runs on at the same spacing,
+//! measured against them. Beside each edge the periphery is measured too,
+//! a strip [`PERIPHERY_REACH`] rounding radii wide, for cuts only (it is
+//! turned, not ground): a wheel whose side reaches past the edge cuts it.
 
 use super::groove::Groove;
 use super::pose::TorusWheel;
@@ -48,6 +55,18 @@ pub const MAX_GRID_POINTS: usize = 20_000_000;
 /// The most wheel samples a replay may place.
 pub const MAX_SAMPLES: usize = 20_000_000;
 
+/// The coarsest step of the grid across the groove beyond the outermost
+/// passes (rad): 1 deg, when there is one pass and no spacing to follow.
+const EDGE_GRID_STEP: Real = 0.017_453_292_519_943_295;
+
+/// How far the periphery strip beside each edge runs, in rounding radii:
+/// the rounding, touching the edge, reaches no farther along the axis.
+pub const PERIPHERY_REACH: Real = 1.0;
+
+/// From how far from the groove's bottom (deg of psi, either side) a place
+/// is by the edge, for the failure's explanation.
+const BY_THE_EDGE_DEG: Real = 80.0;
+
 /// What a caliber job asks the replay to hold.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GrooveRequest {
@@ -72,7 +91,7 @@ pub struct GrooveRequest {
 }
 
 /// A place on the groove with the block whose wheel made the figure there.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct GroovePlace {
     /// The figure (mm).
     pub mm: Real,
@@ -85,6 +104,14 @@ pub struct GroovePlace {
     /// The block (from 1, the program's and `report.csv`'s count).
     #[serde(default)]
     pub block_index: usize,
+    /// On the periphery beside the groove: how far beyond the edge at
+    /// `psi_deg` (-90 or 90) along the roll's axis (mm); 0 on the groove.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub beyond_edge_mm: Real,
+}
+
+fn is_zero(x: &Real) -> bool {
+    *x == 0.0
 }
 
 /// The region of the groove within a small distance of the wheel at one
@@ -127,14 +154,25 @@ pub struct GrooveCheck {
     pub grid_psi: usize,
     /// The grid's step along theta (deg).
     pub grid_theta_step_deg: Real,
-    /// The psi range measured (deg), the outermost passes'.
+    /// The psi range measured (deg): the whole section, edge to edge.
     pub psi_range_deg: [Real; 2],
+    /// The outermost passes' psi (deg).
+    #[serde(default)]
+    pub pass_range_deg: [Real; 2],
     /// The most material left (mm, >= 0) and where.
     pub max_left: GroovePlace,
     /// The deepest gouge (mm, <= 0; 0 if none) and where.
     pub max_gouge: GroovePlace,
     /// The larger of the two in size (mm).
     pub max_abs_mm: Real,
+    /// The deepest cut into the roll's periphery beside the groove (mm,
+    /// <= 0; 0 if none) and where.
+    #[serde(default)]
+    pub periphery_cut: GroovePlace,
+    /// Why the worst place strays, where the check can tell, and what to
+    /// change (empty if it cannot or nothing strays).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub why: String,
     /// The contact patch at the scene's block (set by the job).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub patch: Option<ContactPatch>,
@@ -408,31 +446,84 @@ pub fn check_groove(
             psi_grid.push((a + (b - a) * s as Real / per as Real, k));
         }
     }
-    psi_grid.push((req.psi[*order.last().expect("passes")], order.len() - 1));
-    if n_theta.saturating_mul(psi_grid.len()) > MAX_GRID_POINTS {
+    let last = order.len() - 1;
+    psi_grid.push((req.psi[order[last]], last));
+    let pass_range = [psi_grid[0].0, psi_grid[psi_grid.len() - 1].0];
+    // On to the edges beyond the outermost passes, no coarser than between
+    // them, against the outermost passes.
+    let h = psi_grid
+        .windows(2)
+        .map(|w| w[1].0 - w[0].0)
+        .fold(EDGE_GRID_STEP, Real::min);
+    let edge = std::f64::consts::FRAC_PI_2;
+    let spans = |from: Real, to: Real| ((to - from) / h - 1e-9).ceil().max(0.0) as usize;
+    let below = spans(-edge, pass_range[0]);
+    let above = spans(pass_range[1], edge);
+    let mut grid: Vec<(Real, usize)> = (0..below)
+        .map(|i| {
+            (
+                -edge + (pass_range[0] + edge) * i as Real / below as Real,
+                0,
+            )
+        })
+        .collect();
+    grid.extend(psi_grid);
+    grid.extend((1..=above).map(|i| {
+        let psi = pass_range[1] + (edge - pass_range[1]) * i as Real / above as Real;
+        (psi, last)
+    }));
+    let psi_grid = grid;
+    // The periphery beside each edge: (side, distance beyond the edge,
+    // pass), from the tolerance out, doubling, to the rounding's reach.
+    let reach = PERIPHERY_REACH * wheel.rounding_radius;
+    let mut offsets = Vec::new();
+    let mut d = req.tolerance;
+    while d < reach {
+        offsets.push(d);
+        d *= 2.0;
+    }
+    offsets.push(reach);
+    let rim: Vec<(Real, Real, usize)> = [(-1.0, 0), (1.0, last)]
+        .into_iter()
+        .flat_map(|(side, k)| offsets.iter().map(move |&d| (side, d, k)))
+        .collect();
+    let np = psi_grid.len();
+    let nc = np + rim.len();
+    if n_theta.saturating_mul(nc) > MAX_GRID_POINTS {
         return Err(VerifyError::Replay(format!(
-            "a grid of {n_theta} x {} points is more than {MAX_GRID_POINTS}: a coarser grid",
-            psi_grid.len()
+            "a grid of {n_theta} x {nc} points is more than {MAX_GRID_POINTS}: a coarser grid"
         )));
     }
     let thetas: Vec<Real> = (0..n_theta)
         .map(|i| (lo + req.grid_theta * i as Real).min(hi))
         .collect();
-    // The groove's points, row by row of theta.
-    let mut points = Vec::with_capacity(n_theta * psi_grid.len());
+    // The points, row by row of theta: the groove's, then the periphery's.
+    let r_d = req.groove.roll_radius();
+    let mut points = Vec::with_capacity(n_theta * nc);
     for &t in &thetas {
         for &(psi, _) in &psi_grid {
             points.push(req.groove.point(t, psi)?);
         }
+        let half = req.groove.section(t)?.a;
+        for &(side, d, _) in &rim {
+            points.push(Vec3::new(r_d * t.cos(), r_d * t.sin(), side * (half + d)));
+        }
     }
-    let np = psi_grid.len();
+    let pass_of = |j: usize| {
+        if j < np {
+            psi_grid[j].1
+        } else {
+            rim[j - np].2
+        }
+    };
     // Each point against the passes around it; two threads share rows.
     let measure = |rows: std::ops::Range<usize>| -> Result<Vec<(Real, usize)>, OverTime> {
-        let mut out = Vec::with_capacity(rows.len() * np);
+        let mut out = Vec::with_capacity(rows.len() * nc);
         for i in rows {
             crate::budget::check("the groove's measurement")?;
-            for (j, &(_, k)) in psi_grid.iter().enumerate() {
-                let q = &points[i * np + j];
+            for j in 0..nc {
+                let k = pass_of(j);
+                let q = &points[i * nc + j];
                 let from = k.saturating_sub(NEIGHBOUR_PASSES);
                 let to = (k + NEIGHBOUR_PASSES + 1).min(order.len() - 1);
                 let mut best = (Real::INFINITY, 0);
@@ -472,9 +563,9 @@ pub fn check_groove(
                     continue;
                 }
                 let i = i as usize;
-                for j in 0..np {
-                    let d = wheel_distance(&s.wheel, &points[i * np + j]);
-                    let at = &mut dist[(i - rows.start) * np + j];
+                for j in 0..nc {
+                    let d = wheel_distance(&s.wheel, &points[i * nc + j]);
+                    let at = &mut dist[(i - rows.start) * nc + j];
                     if d < at.0 {
                         *at = (d, s.block);
                     }
@@ -484,7 +575,7 @@ pub fn check_groove(
         Ok::<_, OverTime>(())
     };
     {
-        let (first, second) = dist.split_at_mut(half * np);
+        let (first, second) = dist.split_at_mut(half * nc);
         std::thread::scope(|s| {
             let h = s
                 .spawn(|| crate::budget::with_deadline(deadline, || across(half..n_theta, second)));
@@ -494,17 +585,28 @@ pub fn check_groove(
         })?;
     }
     let place = |idx: usize| {
-        let (i, j) = (idx / np, idx % np);
+        let (i, j) = (idx / nc, idx % nc);
+        let (psi, beyond) = match j.checked_sub(np) {
+            None => (psi_grid[j].0, 0.0),
+            Some(r) => (rim[r].0 * edge, rim[r].1),
+        };
         GroovePlace {
             mm: dist[idx].0,
             theta_deg: thetas[i].to_degrees(),
-            psi_deg: psi_grid[j].0.to_degrees(),
+            psi_deg: psi.to_degrees(),
             block: block_name(program, dist[idx].1),
             block_index: dist[idx].1 + 1,
+            beyond_edge_mm: beyond,
         }
     };
-    let (mut left, mut gouge) = (0, 0);
+    let (mut left, mut gouge, mut cut) = (0, 0, np);
     for (idx, d) in dist.iter().enumerate() {
+        if idx % nc >= np {
+            if d.0 < dist[cut].0 {
+                cut = idx;
+            }
+            continue;
+        }
         if d.0 > dist[left].0 {
             left = idx;
         }
@@ -517,7 +619,19 @@ pub fn check_groove(
     if max_gouge.mm > 0.0 {
         max_gouge.mm = 0.0;
     }
+    let mut periphery_cut = place(cut);
+    periphery_cut.mm = periphery_cut.mm.min(0.0);
     let max_abs = max_left.mm.max(-max_gouge.mm);
+    let worst = if max_left.mm >= -max_gouge.mm {
+        &max_left
+    } else {
+        &max_gouge
+    };
+    let why = if max_abs > req.tolerance {
+        explain(&req.groove, worst, pass_range)?
+    } else {
+        String::new()
+    };
     let check = GrooveCheck {
         tolerance: req.tolerance,
         resolution_mm: resolution,
@@ -527,17 +641,61 @@ pub fn check_groove(
         grid_psi: np,
         grid_theta_step_deg: req.grid_theta.to_degrees(),
         psi_range_deg: [psi_grid[0].0.to_degrees(), psi_grid[np - 1].0.to_degrees()],
+        pass_range_deg: pass_range.map(Real::to_degrees),
         max_left,
         max_gouge,
         max_abs_mm: max_abs,
+        periphery_cut,
+        why,
         patch: None,
         map: DeviationMap::of(
             &thetas,
             &psi_grid.iter().map(|p| p.0).collect::<Vec<_>>(),
-            &dist.iter().map(|d| d.0).collect::<Vec<_>>(),
+            &dist
+                .chunks_exact(nc)
+                .flat_map(|row| row[..np].iter().map(|d| d.0))
+                .collect::<Vec<_>>(),
         ),
     };
     Ok(check)
+}
+
+/// Why `worst` strays, where the geometry tells: material left beyond
+/// the outermost passes (at `pass_range`, rad) is short passes; a gouge by
+/// the edge where the groove's width bends toward the wheel (`B'' < 0`) is
+/// the wheel's flat side, which reaches along the groove far beyond the
+/// contact, meeting the wall where the edge curves in. Empty otherwise.
+fn explain(g: &Groove, worst: &GroovePlace, pass_range: [Real; 2]) -> Result<String, VerifyError> {
+    let (psi, theta) = (worst.psi_deg, worst.theta_deg.to_radians());
+    let [a, b] = pass_range.map(Real::to_degrees);
+    if worst.mm > 0.0 && (psi < a - 1e-9 || psi > b + 1e-9) {
+        return Ok(format!(
+            ": the outermost passes are at psi {} and {} deg, short of the groove's edges at -90 and 90 deg; \
+             place the outermost passes at the edges",
+            crate::math::fixed(a, 2),
+            crate::math::fixed(b, 2)
+        ));
+    }
+    if worst.mm < 0.0 && psi.abs() >= BY_THE_EDGE_DEG {
+        // B'' by the second difference over half a degree each side
+        // (inside the tables at their ends).
+        let (lo, hi) = g.theta_range();
+        let step = 0.5f64.to_radians();
+        let t = theta.clamp(lo + step, hi - step);
+        let width = |t: Real| g.section(t).map(|s| 2.0 * s.a);
+        let bend = (width(t + step)? - 2.0 * width(t)? + width(t - step)?) / 0.25;
+        if bend < 0.0 {
+            return Ok(format!(
+                ": by the edge the groove's width bends toward the wheel (B'' = {} mm/deg^2 at theta {} deg), \
+                 and the wheel's flat side, reaching along the groove far beyond its contact, cuts the wall where the edge curves in; \
+                 a groove whose width bends away by its edges (B'' >= 0 there: a relief widening ever faster toward the groove's end) \
+                 or a smaller wheel can be ground",
+                crate::math::fixed(bend, 5),
+                crate::math::fixed(t.to_degrees(), 2)
+            ));
+        }
+    }
+    Ok(String::new())
 }
 
 /// The groove's material for the process's rules ([`crate::process`]):
@@ -675,16 +833,39 @@ impl GrooveCheck {
         }
     }
 
+    /// The place the check fails at: the groove's worst, then the cut into
+    /// the periphery.
+    fn failed_place(&self) -> Option<&GroovePlace> {
+        if self.max_abs_mm > self.tolerance {
+            Some(self.worst())
+        } else {
+            (-self.periphery_cut.mm > self.tolerance).then_some(&self.periphery_cut)
+        }
+    }
+
     /// The groove's failure, if it strays more than the tolerance from the
-    /// nominal ([`VerifyError::Groove`]).
+    /// nominal ([`VerifyError::Groove`]), or the wheel cuts the periphery
+    /// beside it more than that ([`VerifyError::Periphery`]).
     pub fn failure(&self) -> Option<VerifyError> {
-        let worst = self.worst();
-        (self.max_abs_mm > self.tolerance).then(|| VerifyError::Groove {
-            deviation: worst.mm,
-            theta_deg: worst.theta_deg,
-            psi_deg: worst.psi_deg,
-            block: worst.block.clone(),
-            tolerance: self.tolerance,
+        let place = self.failed_place()?;
+        Some(if place.beyond_edge_mm > 0.0 {
+            VerifyError::Periphery {
+                deviation: place.mm,
+                theta_deg: place.theta_deg,
+                psi_deg: place.psi_deg,
+                beyond_mm: place.beyond_edge_mm,
+                block: place.block.clone(),
+                tolerance: self.tolerance,
+            }
+        } else {
+            VerifyError::Groove {
+                deviation: place.mm,
+                theta_deg: place.theta_deg,
+                psi_deg: place.psi_deg,
+                block: place.block.clone(),
+                tolerance: self.tolerance,
+                why: self.why.clone(),
+            }
         })
     }
 
@@ -725,13 +906,24 @@ impl GrooveCheck {
                 "mm",
                 place(&self.max_gouge),
             ),
+            Figure::new(
+                "the roll's periphery beside the groove: deepest cut",
+                self.periphery_cut.mm,
+                self.tolerance,
+                "mm",
+                format!(
+                    "{}, {} mm beyond the edge",
+                    place(&self.periphery_cut),
+                    crate::math::fixed(self.periphery_cut.beyond_edge_mm, 3)
+                ),
+            ),
         ];
-        let worst = self.worst();
         let failures = self
             .failure()
-            .map(|e| {
+            .zip(self.failed_place())
+            .map(|(e, at)| {
                 Finding::new("verification", e.to_string())
-                    .at(worst.block_index.saturating_sub(1), worst.block.clone())
+                    .at(at.block_index.saturating_sub(1), at.block.clone())
             })
             .into_iter()
             .collect();

@@ -128,13 +128,26 @@ fn verification(out: &mut String, r: &Report) {
         };
         let _ = write!(
             out,
-            "<h2>Verification: the groove replayed in 3-D</h2>\n<p class=\"verdict\">Within <b>{} mm</b> of the groove (tolerance {} mm) on {} samples.</p>\n<table>\n",
+            "<h2>Verification: the groove replayed in 3-D</h2>\n<p class=\"verdict\">Within <b>{} mm</b> of the groove (tolerance {} mm), edge to edge (psi {} to {} deg), on {} samples.</p>\n<table>\n",
             fixed(g.max_abs_mm, 5),
             fixed(g.tolerance, 4),
+            fixed(g.psi_range_deg[0], 0),
+            fixed(g.psi_range_deg[1], 0),
             g.samples
         );
         row(out, &["most material left".into(), place(&g.max_left)]);
         row(out, &["deepest gouge".into(), place(&g.max_gouge)]);
+        row(
+            out,
+            &[
+                "deepest cut into the periphery beside it".into(),
+                format!(
+                    "{}, {} mm beyond the edge",
+                    place(&g.periphery_cut),
+                    fixed(g.periphery_cut.beyond_edge_mm, 3)
+                ),
+            ],
+        );
         out.push_str("</table>\n");
     }
     if let Some(w) = &r.worm_verification {
