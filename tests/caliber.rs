@@ -152,6 +152,13 @@ fn the_default_job_holds_its_tolerance_read_back_from_the_program() {
         patch["along_mm"].as_f64().unwrap() > 0.1 && patch["across_mm"].as_f64().unwrap() > 0.1,
         "{patch}"
     );
+    // On the groove (the pose block's pass runs at its edge), and no
+    // deeper into it than the verification found anywhere.
+    assert!(patch["psi_deg"].as_f64().unwrap().abs() <= 90.0, "{patch}");
+    assert!(
+        patch["least_distance_mm"].as_f64().unwrap() >= -tol,
+        "{patch}"
+    );
     let doc = gltf::Gltf::from_slice(&std::fs::read(out.join("scene.glb")).unwrap()).unwrap();
     let names: Vec<String> = doc
         .nodes()

@@ -975,8 +975,11 @@ pub fn contact_patch(
         let ts: Vec<Real> = (0..=N)
             .map(|i| (best.1 - w_theta + 2.0 * w_theta * i as Real / N as Real).clamp(lo, hi))
             .collect();
+        // Within the section: beyond psi = -+90 deg the ellipse runs on
+        // out of the roll, where the wheel is.
+        let edge = std::f64::consts::FRAC_PI_2;
         let ps: Vec<Real> = (0..=N)
-            .map(|j| best.2 - w_psi + 2.0 * w_psi * j as Real / N as Real)
+            .map(|j| (best.2 - w_psi + 2.0 * w_psi * j as Real / N as Real).clamp(-edge, edge))
             .collect();
         let mut inside = vec![false; (N + 1) * (N + 1)];
         let mut least = Real::INFINITY;
@@ -996,7 +999,7 @@ pub fn contact_patch(
         }
         let at_edge = |a: usize, b: usize| a == 0 || b == N;
         let theta_edge = at_edge(i0, i1) && ts[0] > lo && ts[N] < hi;
-        let psi_edge = at_edge(j0, j1);
+        let psi_edge = (j0 == 0 && ps[0] > -edge) || (j1 == N && ps[N] < edge);
         if (theta_edge || psi_edge) && w_theta < 30f64.to_radians() {
             if theta_edge {
                 w_theta *= 2.0;
