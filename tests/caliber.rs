@@ -494,6 +494,9 @@ fn the_groove_is_verified_to_its_edges() {
     assert!(g["mm"].as_f64().unwrap() < -0.05, "{g}");
     assert!(psi.abs() > 80.0 && !(12.0..=267.0).contains(&theta), "{g}");
     assert!(err.contains("bends toward the wheel"), "{err}");
+    // The wheel's side runs on past the edge into the periphery there.
+    let cut = &r["groove_verification"]["periphery_cut"];
+    assert!(cut["mm"].as_f64().unwrap() < -0.05, "{cut}");
     assert!(!out.join("program.mpf").exists());
 }
 

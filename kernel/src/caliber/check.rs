@@ -688,8 +688,8 @@ fn explain(g: &Groove, worst: &GroovePlace, pass_range: [Real; 2]) -> Result<Str
             return Ok(format!(
                 ": by the edge the groove's width bends toward the wheel (B'' = {} mm/deg^2 at theta {} deg), \
                  and the wheel's flat side, reaching along the groove far beyond its contact, cuts the wall where the edge curves in; \
-                 a groove whose width bends away by its edges (B'' >= 0 there: a relief widening ever faster toward the groove's end) \
-                 or a smaller wheel can be ground",
+                 give the groove a width that bends away by its edges (B'' >= 0 there: a relief widening ever faster toward the groove's end), \
+                 or use a smaller wheel, whose side reaches less far",
                 crate::math::fixed(bend, 5),
                 crate::math::fixed(t.to_degrees(), 2)
             ));
