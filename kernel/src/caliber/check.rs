@@ -1,6 +1,6 @@
-//! The caliber program replayed in 3-D (issue 12): the torus swept along
-//! the moves the machine makes, measured against the groove's surface over
-//! a grid of `(theta, psi)`, and the contact patch at one block.
+//! The caliber program replayed in 3-D: the torus swept along the moves
+//! the machine makes, measured against the groove's surface over a grid of
+//! `(theta, psi)` (the contact patch at one block is in `patch.rs`).
 //!
 //! The replay reads the program as written ([`crate::verify::as_written`]),
 //! moves every solved axis in a straight line between blocks as the
@@ -28,11 +28,11 @@
 //! turned, not ground): a wheel whose side reaches past the edge cuts it.
 
 use super::groove::Groove;
+use super::patch::ContactPatch;
 use super::pose::TorusWheel;
 use crate::budget::OverTime;
 use crate::machine::MachineKinematics;
 use crate::math::{Real, Vec3};
-use crate::mesh::TriMesh;
 use crate::program::{axis_rows, block_name, pass_blocks, AxisProgram};
 use crate::tool::Wheel;
 use crate::toolpath::Pass;
@@ -112,29 +112,6 @@ pub struct GroovePlace {
 
 fn is_zero(x: &Real) -> bool {
     *x == 0.0
-}
-
-/// The region of the groove within a small distance of the wheel at one
-/// block (MATH §3.6: what the seed reads off the CAD model).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ContactPatch {
-    /// The block (from 1).
-    pub block: usize,
-    /// The distance that counts as contact (mm).
-    pub gap_mm: Real,
-    /// Its size along the groove (mm, on the surface).
-    pub along_mm: Real,
-    /// Its size across the groove (mm, on the section).
-    pub across_mm: Real,
-    /// Its middle: theta (deg).
-    pub theta_deg: Real,
-    /// Its middle: psi (deg).
-    pub psi_deg: Real,
-    /// The deepest the wheel reaches into the nominal there (mm, <= 0 if
-    /// it does).
-    pub least_distance_mm: Real,
-    /// Grid points in the patch.
-    pub points: usize,
 }
 
 /// The replayed caliber program against the nominal groove.
@@ -256,7 +233,7 @@ pub fn wheel_distance(w: &TorusWheel, q: &Vec3) -> Real {
 
 /// The wheel (a full-radius wheel: a torus of its diameter and rounding)
 /// at a replayed pose, a row of 6 (centre, axis).
-fn placed(pose: &[Real], wheel: &Wheel) -> TorusWheel {
+pub(super) fn placed(pose: &[Real], wheel: &Wheel) -> TorusWheel {
     TorusWheel {
         centre: Vec3::new(pose[0], pose[1], pose[2]),
         axis: Vec3::new(pose[3], pose[4], pose[5]).normalize(),
@@ -267,7 +244,7 @@ fn placed(pose: &[Real], wheel: &Wheel) -> TorusWheel {
 
 /// The middle of the groove's range of theta (rad): angles about the
 /// roll's axis are taken within half a turn of it.
-fn groove_middle(g: &Groove) -> Real {
+pub(super) fn groove_middle(g: &Groove) -> Real {
     let (lo, hi) = g.theta_range();
     0.5 * (lo + hi)
 }
@@ -698,131 +675,6 @@ fn explain(g: &Groove, worst: &GroovePlace, pass_range: [Real; 2]) -> Result<Str
     Ok(String::new())
 }
 
-/// The groove's material for the process's rules ([`crate::process`]):
-/// the roll with its groove as turned, before any pass grinds it (its
-/// surface `stock` into the groove's open space from the nominal
-/// everywhere: each pass, grinding its strip's whole allowance, meets it
-/// so); every pass a finishing pass taking the allowance.
-#[derive(Debug)]
-pub struct GrooveStock {
-    groove: Groove,
-    stock: Real,
-    wheel: Wheel,
-    passes: Vec<crate::process::PassStock>,
-    /// The last pose measured: consecutive blocks start from it.
-    memo: std::cell::Cell<Option<Measured>>,
-}
-
-/// A pose measured against the groove: the pose, the wheel's depth in the
-/// stock there, and the groove's nearest point `(theta, psi)`.
-type Measured = ([Real; 6], Real, (Real, Real));
-
-impl GrooveStock {
-    /// The material of `req`'s groove, its allowance `stock`, ground by
-    /// `passes` of `program` with `wheel`.
-    pub fn new(
-        req: &GrooveRequest,
-        stock: Real,
-        wheel: &Wheel,
-        program: &AxisProgram,
-        passes: &[Pass],
-    ) -> Self {
-        let passes = pass_blocks(program, passes)
-            .filter(|(p, _)| p.cuts())
-            .map(|(p, r)| crate::process::PassStock {
-                name: p.name.clone(),
-                first_block: r.start,
-                cut: stock,
-                ridge: 0.0,
-                finishes: true,
-            })
-            .collect();
-        Self {
-            groove: req.groove.clone(),
-            stock,
-            wheel: *wheel,
-            passes,
-            memo: std::cell::Cell::new(None),
-        }
-    }
-
-    /// The least distance from the wheel to the nominal groove, and where
-    /// on the groove: a grid about the wheel's angle from a cold start, a
-    /// pattern search from the last pose's point on a warm one.
-    fn nearest(&self, w: &TorusWheel, from: Option<(Real, Real)>) -> (Real, (Real, Real)) {
-        use std::f64::consts::FRAC_PI_2;
-        let (lo, hi) = self.groove.theta_range();
-        let f = |t: Real, p: Real| {
-            self.groove
-                .point(t.clamp(lo, hi), p.clamp(-FRAC_PI_2, FRAC_PI_2))
-                .map_or(Real::INFINITY, |q| wheel_distance(w, &q))
-        };
-        let mut best = match from {
-            Some(tp) => (f(tp.0, tp.1), tp),
-            None => {
-                let turn = w.centre.y.atan2(w.centre.x);
-                let mut best = (Real::INFINITY, (turn, 0.0));
-                for i in -5..=5 {
-                    let t = turn + 0.03 * i as Real;
-                    for j in -11..=11 {
-                        let p = 8f64.to_radians() * j as Real;
-                        let d = f(t, p);
-                        if d < best.0 {
-                            best = (d, (t, p));
-                        }
-                    }
-                }
-                best
-            }
-        };
-        // Down to 1e-5 rad (2.5 um along the groove): at the least distance
-        // the error is of second order, hundredths of a micron.
-        let (mut st, mut sp) = (0.01, 2f64.to_radians());
-        while st > 1e-5 {
-            let (t, p) = best.1;
-            let next = [(t + st, p), (t - st, p), (t, p + sp), (t, p - sp)]
-                .into_iter()
-                .map(|(a, b)| (f(a, b), (a.clamp(lo, hi), b.clamp(-FRAC_PI_2, FRAC_PI_2))))
-                .min_by(|a, b| a.0.total_cmp(&b.0));
-            match next {
-                Some(n) if n.0 < best.0 => best = n,
-                _ => {
-                    st /= 2.0;
-                    sp /= 2.0;
-                }
-            }
-        }
-        best
-    }
-}
-
-impl crate::process::Stock for GrooveStock {
-    fn tool_depth(&self, _: usize, pose: &[Real]) -> Real {
-        let key: [Real; 6] = std::array::from_fn(|i| pose[i]);
-        let memo = self.memo.get();
-        if let Some((_, d, _)) = memo.filter(|m| m.0 == key) {
-            return d;
-        }
-        let w = placed(pose, &self.wheel);
-        // Warm from the last pose when the wheel moved little.
-        // Warm from the last pose's point when the wheel moved little.
-        let warm = memo
-            .filter(|m| {
-                let c = Vec3::new(m.0[0], m.0[1], m.0[2]);
-                (c - w.centre).norm() < 5.0
-            })
-            .map(|m| m.2);
-        let (distance, at) = self.nearest(&w, warm);
-        let depth = self.stock - distance;
-        self.memo.set(Some((key, depth, at)));
-        depth
-    }
-
-    fn passes(&self) -> Vec<crate::process::PassStock> {
-        self.passes.clone()
-    }
-}
-
 impl GrooveCheck {
     /// The larger of the most material left and the deepest gouge.
     fn worst(&self) -> &GroovePlace {
@@ -928,137 +780,6 @@ impl GrooveCheck {
             .into_iter()
             .collect();
         (figures, failures)
-    }
-}
-
-/// The contact patch at block `block` (from 0) of `program` (as written):
-/// the groove points within `req.patch_gap` of the wheel on a fine grid of
-/// `(theta, psi)` round the contact (widened until the patch is inside
-/// it), its sizes along and across the groove, its middle, and its cells
-/// as a mesh (lifted 1 um off the groove along its normal, to show over
-/// it).
-///
-/// # Failures
-/// The block beyond the program; the replay failing. `None`: no groove
-/// point within the gap (the wheel does not touch the groove there).
-pub fn contact_patch(
-    program: &AxisProgram,
-    machine: &dyn MachineKinematics,
-    tool: &ToolFrame,
-    wheel: &Wheel,
-    req: &GrooveRequest,
-    block: usize,
-) -> Result<Option<(ContactPatch, TriMesh)>, VerifyError> {
-    crate::math::positive("contact patch gap", req.patch_gap)?;
-    let pose = crate::verify::replay_blocks(program, machine, tool, block..block + 1)?;
-    let wheel = placed(&pose, wheel);
-    let g = &req.groove;
-    let (lo, hi) = g.theta_range();
-    // The contact: the groove point nearest the wheel, near the wheel's
-    // turn, over psi.
-    let mid = groove_middle(g);
-    let turn = mid + crate::math::wrap_angle(wheel.centre.y.atan2(wheel.centre.x) - mid);
-    let mut best = (Real::INFINITY, turn.clamp(lo, hi), 0.0);
-    for i in 0..=60 {
-        for j in 0..=180 {
-            let t = (turn + (i as Real - 30.0) * 0.2f64.to_radians()).clamp(lo, hi);
-            let psi = (j as Real - 90.0).to_radians();
-            let d = wheel_distance(&wheel, &g.point(t, psi)?);
-            if d < best.0 {
-                best = (d, t, psi);
-            }
-        }
-    }
-    let (mut w_theta, mut w_psi) = (2f64.to_radians(), 10f64.to_radians());
-    const N: usize = 200;
-    loop {
-        let ts: Vec<Real> = (0..=N)
-            .map(|i| (best.1 - w_theta + 2.0 * w_theta * i as Real / N as Real).clamp(lo, hi))
-            .collect();
-        // Within the section: beyond psi = -+90 deg the ellipse runs on
-        // out of the roll, where the wheel is.
-        let edge = std::f64::consts::FRAC_PI_2;
-        let ps: Vec<Real> = (0..=N)
-            .map(|j| (best.2 - w_psi + 2.0 * w_psi * j as Real / N as Real).clamp(-edge, edge))
-            .collect();
-        let mut inside = vec![false; (N + 1) * (N + 1)];
-        let mut least = Real::INFINITY;
-        let (mut i0, mut i1, mut j0, mut j1) = (N, 0, N, 0);
-        for (i, &t) in ts.iter().enumerate() {
-            for (j, &p) in ps.iter().enumerate() {
-                let d = wheel_distance(&wheel, &g.point(t, p)?);
-                least = least.min(d);
-                if d <= req.patch_gap {
-                    inside[i * (N + 1) + j] = true;
-                    (i0, i1, j0, j1) = (i0.min(i), i1.max(i), j0.min(j), j1.max(j));
-                }
-            }
-        }
-        if i0 > i1 {
-            return Ok(None); // the wheel does not touch the groove here
-        }
-        let at_edge = |a: usize, b: usize| a == 0 || b == N;
-        let theta_edge = at_edge(i0, i1) && ts[0] > lo && ts[N] < hi;
-        let psi_edge = (j0 == 0 && ps[0] > -edge) || (j1 == N && ps[N] < edge);
-        if (theta_edge || psi_edge) && w_theta < 30f64.to_radians() {
-            if theta_edge {
-                w_theta *= 2.0;
-            }
-            if psi_edge {
-                w_psi = (w_psi * 2.0).min(std::f64::consts::FRAC_PI_2);
-            }
-            continue;
-        }
-        let (tm, pm) = (0.5 * (ts[i0] + ts[i1]), 0.5 * (ps[j0] + ps[j1]));
-        // Sizes on the surface: along theta at the middle psi, across psi
-        // at the middle theta.
-        let arc = |pts: &[Vec3]| pts.windows(2).map(|w| (w[1] - w[0]).norm()).sum::<Real>();
-        let along: Vec<Vec3> = ts[i0..=i1]
-            .iter()
-            .map(|&t| g.point(t, pm))
-            .collect::<Result<_, _>>()?;
-        let across: Vec<Vec3> = ps[j0..=j1]
-            .iter()
-            .map(|&p| g.point(tm, p))
-            .collect::<Result<_, _>>()?;
-        let mut mesh = TriMesh::default();
-        let mut index = std::collections::BTreeMap::new();
-        for i in i0..i1 {
-            for j in j0..j1 {
-                let cell = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)];
-                if !cell.iter().all(|&(a, b)| inside[a * (N + 1) + b]) {
-                    continue;
-                }
-                let mut ids = [0u32; 4];
-                for (c, &(a, b)) in cell.iter().enumerate() {
-                    ids[c] = match index.get(&(a, b)) {
-                        Some(&id) => id,
-                        None => {
-                            let n = g.normal(ts[a], ps[b])?;
-                            let p = g.point(ts[a], ps[b])? + 0.001 * n;
-                            mesh.positions.push([p.x, p.y, p.z]);
-                            mesh.normals.push([n.x, n.y, n.z]);
-                            let id = (mesh.positions.len() - 1) as u32;
-                            index.insert((a, b), id);
-                            id
-                        }
-                    };
-                }
-                mesh.triangles.push([ids[0], ids[2], ids[1]]);
-                mesh.triangles.push([ids[0], ids[3], ids[2]]);
-            }
-        }
-        let patch = ContactPatch {
-            block: block + 1,
-            gap_mm: req.patch_gap,
-            along_mm: arc(&along),
-            across_mm: arc(&across),
-            theta_deg: tm.to_degrees(),
-            psi_deg: pm.to_degrees(),
-            least_distance_mm: least,
-            points: inside.iter().filter(|&&b| b).count(),
-        };
-        return Ok(Some((patch, mesh)));
     }
 }
 

@@ -12,8 +12,9 @@
 //!   point with its normal, and the distance of any point from it;
 //! - [`pass_poses`]: a pass's exact poses at a uniform step of the roll's
 //!   turn, within what the machine reaches ([`SwivelPlane`]);
-//! - [`check_groove`]: the program replayed in 3-D against the groove, and
-//!   the [`contact_patch`] at a block;
+//! - [`check_groove`]: the program replayed in 3-D against the groove,
+//!   edge to edge, and the periphery beside it; the [`contact_patch`] at a
+//!   block; [`GrooveStock`], the turned groove for the process's rules;
 //! - [`caliber_solid`]: the roll's sector with its groove as a closed mesh;
 //!   [`Roll`]: the same exactly, for STEP.
 //!
@@ -23,16 +24,20 @@
 mod check;
 mod groove;
 mod pass;
+mod patch;
 mod pose;
 mod scallop;
 mod solid;
+mod stock;
 
 pub use check::{
-    check_groove, contact_patch, wheel_distance, ContactPatch, DeviationMap, GrooveCheck,
-    GroovePlace, GrooveRequest, GrooveStock, MAP_CELLS, NEIGHBOUR_PASSES,
+    check_groove, wheel_distance, DeviationMap, GrooveCheck, GroovePlace, GrooveRequest, MAP_CELLS,
+    NEIGHBOUR_PASSES,
 };
 pub use groove::{Groove, GrooveError};
 pub use pass::{pass_poses, pose_at, PassPose, SwivelPlane, MAX_PASS_BLOCKS};
+pub use patch::{contact_patch, ContactPatch};
 pub use pose::{exact_pose, exact_pose_toward, seed_pose, SeedPose, TorusWheel};
 pub use scallop::{scallop_height, step_for_scallop};
 pub use solid::{caliber_solid, Roll, SolidError};
+pub use stock::GrooveStock;
