@@ -7,6 +7,8 @@ use std::process::{Command, Stdio};
 use std::time::Duration;
 
 mod common;
+#[path = "../kernel/tests/support/ods.rs"]
+mod ods;
 use common::{pilgrim, pilgrim_in, root, s};
 
 fn pilgrim_within(args: &[&str], limit: Duration) -> Option<(i32, String)> {
@@ -852,25 +854,13 @@ fn every_message_quotes_outside_text_short() {
 /// limit was seen.
 #[test]
 fn spreadsheets_are_bounded_before_they_expand() {
-    use std::io::Write;
     let dir = scratch("bomb");
-    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
-    let stored =
-        zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored);
-    zip.start_file("mimetype", stored).unwrap();
-    zip.write_all(b"application/vnd.oasis.opendocument.spreadsheet")
-        .unwrap();
-    zip.start_file("META-INF/manifest.xml", stored).unwrap();
-    zip.write_all(b"<manifest:manifest/>").unwrap();
-    zip.start_file("content.xml", stored).unwrap();
-    zip.write_all(
-        b"<?xml version=\"1.0\"?><office:document-content><office:body><office:spreadsheet>\
+    let bytes = ods::ods_bytes(
+        "<?xml version=\"1.0\"?><office:document-content><office:body><office:spreadsheet>\
           <table:table table:name=\"S\"><table:table-row table:number-rows-repeated=\"90000\">\
           <table:table-cell table:number-columns-repeated=\"1000\" office:value-type=\"float\" office:value=\"1\"/>\
           </table:table-row></table:table></office:spreadsheet></office:body></office:document-content>",
-    )
-    .unwrap();
-    let bytes = zip.finish().unwrap().into_inner();
+    );
     assert!(bytes.len() < 1000, "{} bytes", bytes.len());
     std::fs::write(dir.join("t.ods"), &bytes).unwrap();
     let script = dir.join("f.rhai");

@@ -225,27 +225,20 @@ mod tests {
 }
 
 #[cfg(test)]
+#[path = "../../tests/support/ods.rs"]
+mod ods;
+
+#[cfg(test)]
 mod reader_tests {
     /// The ODS shape the bounds count is one the reader reads and expands:
     /// a row of values repeated, its cells repeated (small here).
     #[test]
     fn the_reader_expands_what_is_counted() {
-        use std::io::Write;
-        let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
-        let stored = zip::write::SimpleFileOptions::default()
-            .compression_method(zip::CompressionMethod::Stored);
-        zip.start_file("mimetype", stored).unwrap();
-        zip.write_all(b"application/vnd.oasis.opendocument.spreadsheet")
-            .unwrap();
-        zip.start_file("META-INF/manifest.xml", stored).unwrap();
-        zip.write_all(b"<manifest:manifest/>").unwrap();
-        zip.start_file("content.xml", stored).unwrap();
         let content = "<?xml version=\"1.0\"?><office:document-content><office:body><office:spreadsheet>\
             <table:table table:name=\"S\"><table:table-row table:number-rows-repeated=\"30\">\
             <table:table-cell table:number-columns-repeated=\"20\" office:value-type=\"float\" office:value=\"1\"/>\
             </table:table-row></table:table></office:spreadsheet></office:body></office:document-content>";
-        zip.write_all(content.as_bytes()).unwrap();
-        let bytes = zip.finish().unwrap().into_inner();
+        let bytes = super::ods::ods_bytes(content);
         assert_eq!(super::ods_cells(content.as_bytes()).unwrap(), 20 + 30 * 20);
         let table = super::super::table::read_table_bytes(&bytes, "t.ods").unwrap();
         assert_eq!(table.column("T").unwrap().len(), 30);
