@@ -358,10 +358,22 @@ pub fn write_dir(out: &Path, files: &[(String, Vec<u8>)]) -> Result<(), OutputEr
 /// Creates a directory of pilgrim's own beside `out`: `.BASE.KIND-PID.N`,
 /// the first `N` free (`mkdir` never follows or reuses what is there).
 fn create_own_dir(parent: &Path, base: &str, kind: &str) -> Result<PathBuf, OutputError> {
+    create_own(parent, base, kind, |p| std::fs::create_dir(p))
+}
+
+/// Creates `.<base>.<kind>-<pid>.<n>` in `parent` by `create` (which fails
+/// with `AlreadyExists` on a name taken), the first `n` free: this
+/// process's own, which [`clean_stale`] recognises.
+fn create_own(
+    parent: &Path,
+    base: &str,
+    kind: &str,
+    create: impl Fn(&Path) -> std::io::Result<()>,
+) -> Result<PathBuf, OutputError> {
     let pid = std::process::id();
     for n in 0..1000 {
         let p = parent.join(format!(".{base}.{kind}-{pid}.{n}"));
-        match std::fs::create_dir(&p) {
+        match create(&p) {
             Ok(()) => return Ok(p),
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
             Err(e) => return Err(err(&p, e.to_string())),
@@ -371,6 +383,19 @@ fn create_own_dir(parent: &Path, base: &str, kind: &str) -> Result<PathBuf, Outp
         parent,
         format!("a thousand names .{base}.{kind}-{pid}.N are taken: remove them"),
     ))
+}
+
+/// The directory `path` lies in (`.` for a bare name) and its own name.
+fn parent_and_base(path: &Path) -> Result<(PathBuf, &str), OutputError> {
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
+        _ => PathBuf::from("."),
+    };
+    let base = path
+        .file_name()
+        .and_then(|n| n.to_str())
+        .ok_or_else(|| err(path, "not a plain name"))?;
+    Ok((parent, base))
 }
 
 /// Writes `bytes` as the new file `path` (never over anything there).
@@ -385,14 +410,7 @@ fn create_file(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
 
 /// [`write_dir`]'s writing, the marker saying whether the run failed.
 fn write_marked(out: &Path, files: &[(String, Vec<u8>)], failed: bool) -> Result<(), OutputError> {
-    let parent = match out.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
-        _ => PathBuf::from("."),
-    };
-    let base = out
-        .file_name()
-        .and_then(|n| n.to_str())
-        .ok_or_else(|| err(out, "not a directory name"))?;
+    let (parent, base) = parent_and_base(out)?;
     if let Some((bad, _)) = files.iter().find(|(n, _)| !plain(n)) {
         return Err(err(
             out,
@@ -568,20 +586,14 @@ pub fn write_generated_file(
             }
         }
     }
-    let parent = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
-        _ => PathBuf::from("."),
-    };
-    let base = path
-        .file_name()
-        .and_then(|n| n.to_str())
-        .ok_or_else(|| err(path, "not a file name"))?;
-    let pid = std::process::id();
-    let tmp = (0..1000)
-        .map(|n| parent.join(format!(".{base}.tmp-{pid}.{n}")))
-        .find(|p| std::fs::symlink_metadata(p).is_err())
-        .ok_or_else(|| err(&parent, format!("the names .{base}.tmp-{pid}.N are taken")))?;
-    create_file(&tmp, bytes)?;
+    let (parent, base) = parent_and_base(path)?;
+    let tmp = create_own(&parent, base, "tmp", |p| {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(p)?
+            .write_all(bytes)
+    })?;
     std::fs::rename(&tmp, path).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
         err(path, e.to_string())
