@@ -57,7 +57,7 @@ pub const MAX_SAMPLES: usize = 20_000_000;
 
 /// The coarsest step of the grid across the groove beyond the outermost
 /// passes (rad): 1 deg, when there is one pass and no spacing to follow.
-const EDGE_GRID_STEP: Real = 0.017_453_292_519_943_295;
+const EDGE_GRID_STEP: Real = std::f64::consts::PI / 180.0;
 
 /// How far the periphery strip beside each edge runs, in rounding radii:
 /// the rounding, touching the edge, reaches no farther along the axis.
