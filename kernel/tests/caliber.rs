@@ -88,7 +88,7 @@ fn the_rounding_centre_is_r_k_along_the_ellipses_normal() {
     let r_k = 10.0;
     for theta_deg in [0.0, 37.0, 90.0, 140.0] {
         let theta = f64::to_radians(theta_deg);
-        let s = g.section(theta).unwrap();
+        let s = g.section(theta).unwrap().ellipse;
         assert!((s.radius(0.0) - g.depth().eval(theta).unwrap()).abs() < 1e-12);
         assert!((s.radius(FRAC_PI_2) - g.width().eval(theta).unwrap() / 2.0).abs() < 1e-12);
         for psi_deg in [-60.0, -20.0, 0.0, 15.0, 45.0, 70.0] {
@@ -368,6 +368,61 @@ fn passes_are_spread_across_the_groove() {
     );
 }
 
+/// On the edges' rounding the passes run closer: between any two
+/// neighbouring passes on it, in every row's section, the cusp their
+/// rounding circles leave on the convex arc (the circles intersected here)
+/// is no higher than the scallop the step leaves in the widest section.
+#[test]
+fn passes_run_closer_on_the_edges_rounding() {
+    let g = reduction_groove().with_edge_rounding(&[2.0; 81]).unwrap();
+    let r_k = 10.0;
+    let (psi, rz) = g.pass_angles(r_k, 1f64.to_radians(), FRAC_PI_2).unwrap();
+    assert!((psi[0] + FRAC_PI_2).abs() < 1e-12 && (psi[psi.len() - 1] - FRAC_PI_2).abs() < 1e-12);
+    assert!(psi.windows(2).all(|w| w[1] > w[0]));
+    let main = psi[psi.len() / 2 + 1] - psi[psi.len() / 2];
+    let edge = psi[psi.len() - 1] - psi[psi.len() - 2];
+    assert!(edge < 0.5 * main, "{edge} vs {main}");
+    let mut on = 0;
+    for &theta in g.depth().z() {
+        let s = g.section(theta).unwrap();
+        let from = s.rounding_from();
+        for w in psi.windows(2).filter(|w| w[0] >= from) {
+            let dphi = (s.normal_angle(w[0]) - s.normal_angle(w[1])).abs();
+            // Rounding circles r_k from the arc, 2 + r_k from its centre,
+            // dphi apart: the cusp where they cross nearer that centre.
+            let d = 2.0 + r_k;
+            let half = d * (dphi / 2.0).sin();
+            let cusp = d * (dphi / 2.0).cos() - (r_k * r_k - half * half).sqrt();
+            assert!(
+                cusp - 2.0 <= rz * (1.0 + 1e-9),
+                "{} um at theta {theta}",
+                1e3 * (cusp - 2.0)
+            );
+            on += 1;
+        }
+    }
+    assert!(on > 81 * 5, "{on} steps on the rounding");
+}
+
+/// An edge's rounding that cannot be: refused naming the row and the angle.
+#[test]
+fn a_bad_edge_rounding_is_named() {
+    let g = reduction_groove();
+    let mut radii = vec![2.0; 81];
+    radii[7] = -0.5;
+    let e = g
+        .clone()
+        .with_edge_rounding(&radii)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("row 8") && e.contains("theta = 14 deg") && e.contains("positive"),
+        "{e}"
+    );
+    let e = g.with_edge_rounding(&[2.0; 80]).unwrap_err().to_string();
+    assert!(e.contains("81") && e.contains("80"), "{e}");
+}
+
 /// The caliber's solid: the example groove's roll sector is a closed mesh
 /// whose volume is the section's first moment about the axis integrated
 /// over theta (Pappus, section by section) within 0.1 %, refused when the
@@ -392,9 +447,10 @@ fn the_caliber_solid_is_closed_and_holds_its_volume() {
         let s = g.section(theta).unwrap();
         let mut moment = width * (150.0f64.powi(2) - hub * hub) / 2.0;
         for j in 0..n_x {
-            let x = -s.a + 2.0 * s.a * (j as f64 + 0.5) / n_x as f64;
-            let z = s.b * (1.0 - (x / s.a).powi(2)).max(0.0).sqrt();
-            moment -= (150.0f64.powi(2) - (150.0 - z).powi(2)) / 2.0 * (2.0 * s.a / n_x as f64);
+            let (a, b) = (s.ellipse.a, s.ellipse.b);
+            let x = -a + 2.0 * a * (j as f64 + 0.5) / n_x as f64;
+            let z = b * (1.0 - (x / a).powi(2)).max(0.0).sqrt();
+            moment -= (150.0f64.powi(2) - (150.0 - z).powi(2)) / 2.0 * (2.0 * a / n_x as f64);
         }
         v += moment * (t1 - t0) / n_t as f64;
     }

@@ -481,7 +481,7 @@ pub fn check_groove(
         for &(psi, _) in &psi_grid {
             points.push(req.groove.point(t, psi)?);
         }
-        let half = req.groove.section(t)?.a;
+        let half = req.groove.section(t)?.edge_x();
         for &(side, d, _) in &rim {
             points.push(Vec3::new(r_d * t.cos(), r_d * t.sin(), side * (half + d)));
         }
@@ -659,7 +659,7 @@ fn explain(g: &Groove, worst: &GroovePlace, pass_range: [Real; 2]) -> Result<Str
         let (lo, hi) = g.theta_range();
         let step = 0.5f64.to_radians();
         let t = theta.clamp(lo + step, hi - step);
-        let width = |t: Real| g.section(t).map(|s| 2.0 * s.a);
+        let width = |t: Real| g.section(t).map(|s| 2.0 * s.half_width());
         let bend = (width(t + step)? - 2.0 * width(t)? + width(t - step)?) / 0.25;
         if bend < 0.0 {
             return Ok(format!(

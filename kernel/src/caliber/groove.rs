@@ -1,8 +1,9 @@
 //! The roll and its groove in 3-D (MATH §3.1).
 
+use super::section::GrooveSection;
 use crate::input::InputError;
 use crate::math::{Real, Vec3};
-use crate::profile::{EllipseSection, Profile, ProfileError, Table};
+use crate::profile::{Profile, ProfileError, Table};
 
 /// Why a groove cannot be built from its tables.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -75,13 +76,20 @@ pub enum GrooveError {
 /// `B(theta) / 2` wide along the axis, `Hp(theta)` deep (tables,
 /// interpolated between rows as [`Self::with_interpolation`] states). The point at polar angle `psi` of the
 /// section (from the depth direction, positive toward +Z) is at axial
-/// position `x_A`, radius `R_d - z_A`, angle `theta`.
+/// position `x_A`, radius `R_d - z_A`, angle `theta`. The edges, where
+/// the groove meets the periphery, are sharp, or rounded by a radius from
+/// a third table ([`Self::with_edge_rounding`]; the section's parameter
+/// then runs on along the rounding, [`GrooveSection`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Groove {
     r_d: Real,
     hp: Profile,
     b: Profile,
+    edge: Option<Profile>,
 }
+
+/// The edge's rounding, as its table and errors name it.
+const EDGE: &str = "r_edge";
 
 /// Step of the numerical derivatives of the surface (rad).
 const DIFF_STEP: Real = 1e-6;
@@ -146,6 +154,109 @@ impl Groove {
             r_d,
             hp: profile("Hp", hp)?,
             b: profile("B", b)?,
+            edge: None,
+        })
+    }
+
+    /// The groove with its edges rounded into the periphery, radius
+    /// `radii` (mm) at each of the tables' rows, interpolated between them
+    /// as the tables are.
+    ///
+    /// # Failures
+    /// Not one radius per row; a radius not positive (named by row and
+    /// angle).
+    pub fn with_edge_rounding(self, radii: &[Real]) -> Result<Self, GrooveError> {
+        let theta = self.hp.z();
+        if radii.len() != theta.len() {
+            return Err(GrooveError::DifferentRows {
+                hp: theta.len(),
+                b: radii.len(),
+            });
+        }
+        if let Some(i) = (0..radii.len()).find(|&i| !(radii[i] > 0.0 && radii[i].is_finite())) {
+            return Err(GrooveError::Value {
+                table: EDGE,
+                row: i + 1,
+                theta: theta[i].to_degrees(),
+                value: radii[i],
+                expected: "must be a positive number".into(),
+            });
+        }
+        let edge = Profile::new(theta.to_vec(), radii.to_vec())
+            .map_err(|source| GrooveError::Table {
+                table: EDGE,
+                source,
+            })?
+            .with_interpolation(self.interpolation());
+        let g = Self {
+            edge: Some(edge),
+            ..self
+        };
+        // Every row's section can be built.
+        for &t in g.hp.z() {
+            g.section(t)?;
+        }
+        Ok(g)
+    }
+
+    /// [`Self::with_edge_rounding`] from a table: its column `theta`
+    /// (degrees) at the groove's angles, the radii in `column` (mm).
+    /// Errors name the file, the row as the file numbers it and the
+    /// column.
+    ///
+    /// # Failures
+    /// As [`Self::with_edge_rounding`]; a cell that is not a number; the
+    /// table's angles not the groove's.
+    pub fn with_edge_rounding_from(
+        self,
+        table: &Table,
+        theta: &str,
+        column: &str,
+    ) -> Result<Self, GrooveError> {
+        table.profile(theta, column)?;
+        let (deg, radii) = (table.column(theta)?, table.column(column)?);
+        let label = table
+            .column_index(column)
+            .map(|c| table.column_label(c))
+            .unwrap_or_else(|_| column.to_owned());
+        let file = || table.source().to_owned();
+        let ours: Vec<Real> = self.hp.z().iter().map(|t| t.to_degrees()).collect();
+        if deg.len() != ours.len() {
+            return Err(GrooveError::File {
+                file: file(),
+                message: format!(
+                    "{} rows of the edge's rounding in column {label}, but the groove has {} rows: the tables must be at the same angles",
+                    deg.len(),
+                    ours.len()
+                ),
+            });
+        }
+        if let Some(i) = (0..deg.len()).find(|&i| (deg[i] - ours[i]).abs() > 1e-9) {
+            return Err(GrooveError::File {
+                file: file(),
+                message: format!(
+                    "row {}: theta = {} deg, but the groove's row there is at theta = {} deg: the edge's rounding must be at the groove's angles",
+                    table.row_number(i),
+                    deg[i],
+                    ours[i]
+                ),
+            });
+        }
+        self.with_edge_rounding(&radii).map_err(|e| match e {
+            GrooveError::Value {
+                row,
+                theta,
+                value,
+                expected,
+                ..
+            } => GrooveError::File {
+                file: file(),
+                message: format!(
+                    "row {}, column {label}: the edge's rounding r_edge = {value} mm at theta = {theta} deg {expected}",
+                    table.row_number(row - 1)
+                ),
+            },
+            other => other,
         })
     }
 
@@ -217,25 +328,25 @@ impl Groove {
         })
     }
 
-    /// Where the section at `theta` is most curved: `0` (the bottom) when
-    /// the groove is deeper than half its width, else `pi/2` (the edge).
+    /// Where the concave part of the section at `theta` is most curved:
+    /// `0` (the bottom), or where the ellipse ends (`pi/2` at a sharp
+    /// edge, where the rounding begins at a rounded one).
     ///
     /// # Failures
     /// `theta` outside the tables.
     pub fn tightest_psi(&self, theta: Real) -> Result<Real, GrooveError> {
-        let s = self.section(theta)?;
-        Ok(if s.b > s.a {
-            0.0
-        } else {
-            std::f64::consts::FRAC_PI_2
-        })
+        Ok(self.section(theta)?.tightest_psi())
     }
 
     /// The pass angles `psi` (rad) of a wheel's rounding `r_k` across the
     /// groove, symmetric about its middle out to `psi_max`, `dpsi` apart at
     /// most (the passes spread evenly), with the scallop the step leaves in
     /// the widest section (MATH §3.3: the section circle the groove's
-    /// largest profile radius, `max(B/2, Hp)` over the tables).
+    /// largest profile radius, `max(B/2, Hp)` over the tables). On the
+    /// edges' rounding, where there is one, the passes run closer, evenly
+    /// from where the rounding begins in the section it begins soonest, so
+    /// that their scallop on the convex arc is no higher
+    /// ([`super::step_for_scallop_convex`], the finest any section needs).
     ///
     /// # Failures
     /// `r_k` not smaller than every section's curvature radius (named by
@@ -270,26 +381,86 @@ impl Groove {
             )
             .into());
         }
-        let n = (2.0 * psi_max / dpsi).ceil();
-        if n > 10_000.0 {
+        let spans = |width: Real, step: Real| {
+            let n = (width / step).ceil();
+            if n > 10_000.0 {
+                Err(InputError::out_of_range(
+                    "passes across the groove",
+                    n,
+                    "at most 10000: a larger step",
+                ))
+            } else {
+                Ok(n.max(1.0) as usize)
+            }
+        };
+        // Where the edges' rounding begins soonest: the passes within it
+        // are the section's, evenly at `dpsi` at most.
+        let sections = match self.edge {
+            Some(_) => self
+                .rows_and_midpoints()
+                .into_iter()
+                .map(|t| self.section(t))
+                .collect::<Result<Vec<_>, _>>()?,
+            None => Vec::new(),
+        };
+        let inner = sections
+            .iter()
+            .map(|s| s.rounding_from())
+            .fold(psi_max, Real::min);
+        let n = spans(2.0 * inner, dpsi)?;
+        let step = 2.0 * inner / n as Real;
+        let rz = super::scallop_height(self.widest_radius(), r_k, step)?;
+        // Beyond it, as finely as the finest rounding needs for that
+        // scallop.
+        let mut band_step = Real::INFINITY;
+        for s in &sections {
+            let r = s.edge_rounding().expect("a rounded groove's section");
+            let dphi = super::step_for_scallop_convex(r, r_k, rz)?;
+            band_step = band_step.min(s.rounding_psi_step(dphi).expect("a rounded section"));
+        }
+        let m = if psi_max > inner {
+            spans(psi_max - inner, band_step)?
+        } else {
+            0
+        };
+        if 2 * m + n > 10_000 {
             return Err(InputError::out_of_range(
                 "passes across the groove",
-                n,
+                (2 * m + n) as Real,
                 "at most 10000: a larger step",
             )
             .into());
         }
-        let n = n as usize;
-        let step = 2.0 * psi_max / n as Real;
-        let widest = self
-            .hp
+        let outer = |i: usize| inner + (psi_max - inner) * i as Real / m as Real;
+        let mut psi: Vec<Real> = (1..=m).rev().map(|i| -outer(i)).collect();
+        psi.extend((0..=n).map(|i| -inner + step * i as Real));
+        psi.extend((1..=m).map(outer));
+        Ok((psi, rz))
+    }
+
+    /// The groove's largest profile radius, `max(B/2, Hp)` over the
+    /// tables (mm): the section circle the scallop is figured in.
+    fn widest_radius(&self) -> Real {
+        self.hp
             .x()
             .iter()
             .zip(self.b.x())
             .map(|(h, b)| h.max(b / 2.0))
-            .fold(0.0, Real::max);
-        let rz = super::scallop_height(widest, r_k, step)?;
-        Ok(((0..=n).map(|i| -psi_max + step * i as Real).collect(), rz))
+            .fold(0.0, Real::max)
+    }
+
+    /// The tables' angles and the midpoints between them (rad): where
+    /// properties of every section are sampled.
+    fn rows_and_midpoints(&self) -> Vec<Real> {
+        let z = self.hp.z();
+        let mut at = Vec::with_capacity(2 * z.len());
+        for i in 0..z.len() {
+            at.push(z[i]);
+            if i + 1 < z.len() {
+                at.push(0.5 * (z[i] + z[i + 1]));
+            }
+        }
+        at
     }
 
     /// The node (row, from 0) in the middle of the sizing section: the
@@ -374,6 +545,7 @@ impl Groove {
         let g = Self {
             hp: hp.profile.clone(),
             b: b.profile.clone(),
+            edge: self.edge.clone(),
             ..g
         };
         Ok((g, hp, b))
@@ -386,6 +558,7 @@ impl Groove {
         Self {
             hp: self.hp.with_interpolation(interpolation),
             b: self.b.with_interpolation(interpolation),
+            edge: self.edge.map(|e| e.with_interpolation(interpolation)),
             ..self
         }
     }
@@ -415,14 +588,21 @@ impl Groove {
         &self.b
     }
 
+    /// The edge's rounding radius table (theta in rad), if it has one.
+    pub fn edge_rounding(&self) -> Option<&Profile> {
+        self.edge.as_ref()
+    }
+
     /// The section at `theta` (rad).
     ///
     /// # Failures
-    /// `theta` outside the tables.
-    pub fn section(&self, theta: Real) -> Result<EllipseSection, GrooveError> {
+    /// `theta` outside the tables; a rounding interpolated to a radius
+    /// not positive.
+    pub fn section(&self, theta: Real) -> Result<GrooveSection, GrooveError> {
         let hp = self.hp.eval(theta)?;
         let b = self.b.eval(theta)?;
-        Ok(EllipseSection::new(b / 2.0, hp)?)
+        let edge = self.edge.as_ref().map(|e| e.eval(theta)).transpose()?;
+        Ok(GrooveSection::new(b / 2.0, hp, edge)?)
     }
 
     /// The groove's point at `(theta, psi)` (rad) in the roll's frame.
@@ -461,24 +641,18 @@ impl Groove {
         ((theta - DIFF_STEP).max(lo), (theta + DIFF_STEP).min(hi))
     }
 
-    /// The smallest radius of curvature of the groove's sections, over the
-    /// tables' rows and the midpoints between them, with the theta where
-    /// it is (rad): the largest a wheel's rounding may be. In a section it
-    /// is at the bottom (`psi = 0`, `a^2 / b`) or at the edge (`psi = 90
-    /// deg`, `b^2 / a`): [`Self::tightest_psi`] says which.
+    /// The smallest radius of curvature of the groove's sections' concave
+    /// part, over the tables' rows and the midpoints between them, with
+    /// the theta where it is (rad): the largest a wheel's rounding may be.
+    /// In a section it is at the bottom (`psi = 0`, `a^2 / b`) or where the
+    /// ellipse ends (`b^2 / a` at a sharp edge): [`Self::tightest_psi`]
+    /// says which.
     pub fn min_curvature_radius(&self) -> Result<(Real, Real), GrooveError> {
-        let z = self.hp.z();
-        let mut best = (Real::INFINITY, z[0]);
-        for i in 0..z.len() {
-            let mut at = vec![z[i]];
-            if i + 1 < z.len() {
-                at.push(0.5 * (z[i] + z[i + 1]));
-            }
-            for t in at {
-                let r = self.section(t)?.min_curvature_radius();
-                if r < best.0 {
-                    best = (r, t);
-                }
+        let mut best = (Real::INFINITY, self.hp.z()[0]);
+        for t in self.rows_and_midpoints() {
+            let r = self.section(t)?.min_curvature_radius();
+            if r < best.0 {
+                best = (r, t);
             }
         }
         Ok(best)

@@ -11,7 +11,8 @@
 //!   [`TorusWheel`] and [`exact_pose`]: the torus touching the groove at a
 //!   point with its normal, and the distance of any point from it;
 //! - [`pass_poses`]: a pass's exact poses at a uniform step of the roll's
-//!   turn, within what the machine reaches ([`SwivelPlane`]);
+//!   turn, within what the machine reaches ([`SwivelPlane`]); the
+//!   [`step_over`] between passes;
 //! - [`check_groove`]: the program replayed in 3-D against the groove,
 //!   edge to edge, and the periphery beside it; the [`contact_patch`] at a
 //!   block; [`GrooveStock`], the turned groove for the process's rules;
@@ -27,6 +28,7 @@ mod pass;
 mod patch;
 mod pose;
 mod scallop;
+mod section;
 mod solid;
 mod stock;
 
@@ -35,9 +37,10 @@ pub use check::{
     NEIGHBOUR_PASSES,
 };
 pub use groove::{Groove, GrooveError};
-pub use pass::{pass_poses, pose_at, PassPose, SwivelPlane, MAX_PASS_BLOCKS};
+pub use pass::{pass_poses, pose_at, step_over, PassPose, SwivelPlane, MAX_PASS_BLOCKS};
 pub use patch::{contact_patch, ContactPatch};
 pub use pose::{exact_pose, exact_pose_toward, seed_pose, SeedPose, TorusWheel};
-pub use scallop::{scallop_height, step_for_scallop};
+pub use scallop::{scallop_height, step_for_scallop, step_for_scallop_convex};
+pub use section::GrooveSection;
 pub use solid::{caliber_solid, Roll, SolidError};
 pub use stock::GrooveStock;

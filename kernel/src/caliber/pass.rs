@@ -274,9 +274,68 @@ pub fn pass_poses(
     Ok(poses)
 }
 
+/// The deepest a step-over is split: `2^20` poses at most between two
+/// passes.
+const MAX_STEP_OVER_DEPTH: usize = 20;
+
+/// The wheel's poses stepping over, at the contact's `theta`, from the
+/// pass at `from` to the pass at `to` (psi, rad), both ends left out: as
+/// many as keep the rounding's centre within `sag` (mm) of the straight
+/// move between neighbouring poses (halving the step where the middle
+/// strays more). Across a concave section the straight move stands off
+/// the groove, and none is needed; across a convex one, an edge's
+/// rounding, it would cut a chord into it.
+///
+/// # Failures
+/// `sag` not positive; `theta` outside the tables; the wheel's radii.
+#[allow(clippy::too_many_arguments)]
+pub fn step_over(
+    groove: &Groove,
+    theta: Real,
+    (from, to): (Real, Real),
+    r_k0: Real,
+    r_k: Real,
+    plane: SwivelPlane,
+    sag: Real,
+) -> Result<Vec<PassPose>, GrooveError> {
+    crate::math::positive("the step-over's sag (mm)", sag)?;
+    let at = |psi: Real| pose_at(groove, theta, psi, r_k0, r_k, plane);
+    let mut out = Vec::new();
+    split(&at, (from, at(from)?), (to, at(to)?), r_k, sag, 0, &mut out)?;
+    Ok(out)
+}
+
+/// [`step_over`] between the poses `a` and `b` (psi, pose), `depth`
+/// halvings in: the middle pose if the rounding's centre strays more
+/// than `sag` from the straight move, each half split likewise first.
+fn split(
+    at: &dyn Fn(Real) -> Result<PassPose, GrooveError>,
+    a: (Real, PassPose),
+    b: (Real, PassPose),
+    r_k: Real,
+    sag: Real,
+    depth: usize,
+    out: &mut Vec<PassPose>,
+) -> Result<(), GrooveError> {
+    let m = 0.5 * (a.0 + b.0);
+    let pm = at(m)?;
+    let centre = |p: &PassPose| p.contact + r_k * p.normal;
+    let (ca, cb, cm) = (centre(&a.1), centre(&b.1), centre(&pm));
+    let chord = cb - ca;
+    let v = cm - ca;
+    let off = v - v.dot(&chord) / chord.norm_squared().max(1e-300) * chord;
+    if off.norm() <= sag || depth >= MAX_STEP_OVER_DEPTH {
+        return Ok(());
+    }
+    split(at, a, (m, pm), r_k, sag, depth + 1, out)?;
+    out.push(pm);
+    split(at, (m, pm), b, r_k, sag, depth + 1, out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::FRAC_PI_2;
 
     /// A groove that deepens round the roll: the pressure angle is not 0.
     fn lifting() -> Groove {
@@ -284,6 +343,70 @@ mod tests {
         let hp: Vec<Real> = theta.iter().map(|t| 24.0 - 0.05 * t).collect();
         let b: Vec<Real> = hp.iter().map(|h| 2.1 * h).collect();
         Groove::new(150.0, (&theta, &theta), &hp, &b).unwrap()
+    }
+
+    /// The least distance from the wheel, moved in a straight line (centre
+    /// and axis, as the control moves the axes) through `poses`, to the
+    /// groove's section at `theta` from `psi_from` to 90 deg.
+    fn least_on_the_way(g: &Groove, theta: Real, psi_from: Real, poses: &[PassPose]) -> Real {
+        let mut least = Real::INFINITY;
+        for w in poses.windows(2) {
+            for s in 0..=20 {
+                let t = s as Real / 20.0;
+                let mut wheel = w[0].wheel;
+                wheel.centre += t * (w[1].wheel.centre - w[0].wheel.centre);
+                wheel.axis =
+                    (w[0].wheel.axis + t * (w[1].wheel.axis - w[0].wheel.axis)).normalize();
+                for k in 0..=400 {
+                    let psi = psi_from + (FRAC_PI_2 - psi_from) * k as Real / 400.0;
+                    least = least.min(wheel.distance(&g.point(theta, psi).unwrap()));
+                }
+            }
+        }
+        least
+    }
+
+    /// On the edge's convex rounding a straight step-over from one pass to
+    /// the next cuts a chord into it; the step-over's poses keep it within
+    /// the sag asked.
+    #[test]
+    fn stepping_over_the_rounding_keeps_off_it() {
+        let g = lifting().with_edge_rounding(&[2.0; 37]).unwrap();
+        let (r_k0, r_k) = (125.0, 8.0);
+        let (psi, _) = g.pass_angles(r_k, 1f64.to_radians(), FRAC_PI_2).unwrap();
+        // Two neighbouring passes on the rounding.
+        let theta = 60f64.to_radians();
+        let from = g.section(theta).unwrap().rounding_from();
+        let j = psi.iter().position(|&p| p > from + 0.02).unwrap();
+        let (a, b) = (psi[j], psi[j + 1]);
+        let plane = SwivelPlane::Wheel;
+        let ends = [
+            pose_at(&g, theta, a, r_k0, r_k, plane).unwrap(),
+            pose_at(&g, theta, b, r_k0, r_k, plane).unwrap(),
+        ];
+        let straight = least_on_the_way(&g, theta, from, &ends);
+        let sag = 1e-3;
+        assert!(
+            straight < -5.0 * sag,
+            "a straight step over cuts {straight} mm"
+        );
+        let mut poses = vec![ends[0]];
+        poses.extend(step_over(&g, theta, (a, b), r_k0, r_k, plane, sag).unwrap());
+        poses.push(ends[1]);
+        assert!(poses.len() > 2);
+        let over = least_on_the_way(&g, theta, from, &poses);
+        assert!(over > -sag, "the step-over cuts {over} mm");
+        // Across the concave ellipse none is needed.
+        let none = step_over(
+            &g,
+            theta,
+            (0.0, psi[psi.len() / 2 + 1]),
+            r_k0,
+            r_k,
+            plane,
+            sag,
+        );
+        assert!(none.unwrap().is_empty());
     }
 
     /// Each pose touches the groove at the contact (the torus's distance 0

@@ -57,6 +57,26 @@ pub fn step_for_scallop(r_section: Real, r_k: Real, rz: Real) -> Result<Real, In
     Ok(2.0 * c.acos())
 }
 
+/// The largest pass step (rad of the rounding circles' angle about their
+/// centre) whose scallop is at most `rz` mm on a convex arc of radius
+/// `r_arc` (an edge's rounding) ground by a rounding `r_k`: the rounding
+/// centres lie on the circle of `D = r_arc + r_k`, the cusp on the
+/// bisector at `rho = r_arc + rz`, `r_k` from both centres:
+/// `cos(dphi / 2) = (rho^2 + D^2 - r_k^2) / (2 rho D)`. For small steps
+/// the cusp is `(r_arc dphi)^2 / 8 (1 / r_k + 1 / r_arc)`: a convex arc
+/// needs finer steps than a flat or concave one.
+///
+/// # Failures
+/// A radius or `rz` that is not positive.
+pub fn step_for_scallop_convex(r_arc: Real, r_k: Real, rz: Real) -> Result<Real, InputError> {
+    positive("edge rounding radius", r_arc)?;
+    positive("wheel rounding radius r_k", r_k)?;
+    positive("scallop height Rz", rz)?;
+    let (rho, d) = (r_arc + rz, r_arc + r_k);
+    let c = ((rho * rho + d * d - r_k * r_k) / (2.0 * rho * d)).clamp(-1.0, 1.0);
+    Ok(2.0 * c.acos())
+}
+
 fn centre_distance(r_section: Real, r_k: Real) -> Result<Real, InputError> {
     positive("section radius", r_section)?;
     positive("wheel rounding radius r_k", r_k)?;
@@ -68,4 +88,28 @@ fn centre_distance(r_section: Real, r_k: Real) -> Result<Real, InputError> {
         ));
     }
     Ok(r_section - r_k)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_convex_step_leaves_its_scallop() {
+        // Two rounding circles dphi apart about the arc's centre: the
+        // point of the bisector rz above the arc is on both.
+        let (r_arc, r_k, rz) = (2.0, 8.0, 0.003);
+        let dphi = step_for_scallop_convex(r_arc, r_k, rz).unwrap();
+        let d = r_arc + r_k;
+        let centre = (d * (dphi / 2.0).sin(), d * (dphi / 2.0).cos());
+        let cusp = (0.0, r_arc + rz);
+        let far = (centre.0 - cusp.0).hypot(centre.1 - cusp.1);
+        assert!((far - r_k).abs() < 1e-12, "{far}");
+        // The small-step rule, s^2 / 8 (1 / r_k + 1 / r_arc), within 1 %.
+        let s = r_arc * dphi;
+        let h = s * s / 8.0 * (1.0 / r_k + 1.0 / r_arc);
+        assert!((h - rz).abs() < 1e-2 * rz, "{h}");
+        // Finer than on a flat or concave section.
+        assert!(dphi * r_arc < step_for_scallop(1e6, r_k, rz).unwrap() * 1e6);
+    }
 }

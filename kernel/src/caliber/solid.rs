@@ -21,11 +21,13 @@ pub enum SolidError {
 
 /// The roll's sector over the groove tables' angles, exactly: the section
 /// (the roll's rim `width` wide, from the hub radius `hub` to the periphery
-/// `R_d`, the groove's half ellipse cut in its middle) carried round the
-/// roll's axis (Z), flat ends at the tables' first and last angle. Its
-/// section's pieces, in order: up the left face, along the periphery to the
-/// groove, the groove (psi from -pi/2 to pi/2), the periphery to the right
-/// face, down it, back along the hub; `v` runs over the tables' angles.
+/// `R_d`, the groove cut in its middle) carried round the roll's axis (Z),
+/// flat ends at the tables' first and last angle. Its section's pieces, in
+/// order: up the left face, along the periphery to the groove, the groove
+/// (psi from -pi/2 to pi/2: the ellipse, and where the edges are rounded
+/// the left rounding before it and the right one after, each its own
+/// smooth piece), the periphery to the right face, down it, back along
+/// the hub; `v` runs over the tables' angles.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Roll {
     groove: Groove,
@@ -33,15 +35,36 @@ pub struct Roll {
     hub: Real,
 }
 
+/// What a piece of the roll's section is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Piece {
+    /// A straight line between two corners of the section.
+    Line(Corner, Corner),
+    /// The groove between two angles: the edge (`-1` left, `1` right) or
+    /// where its rounding begins (`-0.5`, `0.5`).
+    Groove(Real, Real),
+}
+
+/// A corner of the roll's section.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Corner {
+    LeftHub,
+    LeftTop,
+    LeftEdge,
+    RightEdge,
+    RightTop,
+    RightHub,
+}
+
 impl Roll {
     /// The roll of `groove` with a rim `width` wide from radius `hub`.
     ///
     /// # Failures
-    /// A width not wider than every section's groove; a hub not inside the
-    /// groove's deepest point.
+    /// A width not wider than every section's groove, its edges' rounding
+    /// included; a hub not inside the groove's deepest point.
     pub fn new(groove: &Groove, width: Real, hub: Real) -> Result<Self, SolidError> {
         let r_d = groove.roll_radius();
-        let (widest, deepest) = extremes(groove);
+        let (widest, deepest) = extremes(groove)?;
         if !(width > widest) {
             return Err(SolidError::Size(format!(
                 "the rim's width {width} mm must exceed the widest groove, {widest} mm"
@@ -66,6 +89,44 @@ impl Roll {
         t0 + (t1 - t0) * v
     }
 
+    /// The section's pieces, in order round it.
+    fn pieces_list(&self) -> Vec<Piece> {
+        use Corner::*;
+        let mut list = vec![
+            Piece::Line(LeftHub, LeftTop),
+            Piece::Line(LeftTop, LeftEdge),
+        ];
+        if self.groove.edge_rounding().is_some() {
+            list.extend([
+                Piece::Groove(-1.0, -0.5),
+                Piece::Groove(-0.5, 0.5),
+                Piece::Groove(0.5, 1.0),
+            ]);
+        } else {
+            list.push(Piece::Groove(-1.0, 1.0));
+        }
+        list.extend([
+            Piece::Line(RightEdge, RightTop),
+            Piece::Line(RightTop, RightHub),
+            Piece::Line(RightHub, LeftHub),
+        ]);
+        list
+    }
+
+    /// The groove's angle psi (rad) at the section's mark `m` (as
+    /// [`Piece::Groove`] gives them) at `theta`.
+    fn psi_at(&self, theta: Real, m: Real) -> Real {
+        use std::f64::consts::FRAC_PI_2;
+        if m.abs() == 1.0 {
+            return m * FRAC_PI_2;
+        }
+        let from = self
+            .groove
+            .section(theta)
+            .map_or(Real::NAN, |s| s.rounding_from());
+        2.0 * m * from
+    }
+
     /// The groove's point at `psi` in the section at `theta`, `(x, rho)`.
     fn groove_at(&self, theta: Real, psi: Real) -> (Real, Real) {
         self.groove
@@ -76,37 +137,82 @@ impl Roll {
             })
     }
 
+    /// A corner of the section at `theta`, `(x, rho)`.
+    fn corner(&self, c: Corner, theta: Real) -> (Real, Real) {
+        use std::f64::consts::FRAC_PI_2;
+        let (half, r_d, hub) = (self.width / 2.0, self.groove.roll_radius(), self.hub);
+        match c {
+            Corner::LeftHub => (-half, hub),
+            Corner::LeftTop => (-half, r_d),
+            Corner::LeftEdge => self.groove_at(theta, -FRAC_PI_2),
+            Corner::RightEdge => self.groove_at(theta, FRAC_PI_2),
+            Corner::RightTop => (half, r_d),
+            Corner::RightHub => (half, hub),
+        }
+    }
+
     /// The roll as a closed triangle mesh in its frame, sampled so that its
     /// chords stay within `tol` of the groove and the periphery (each
-    /// section's groove with the same number of points, evenly in psi: the
-    /// widest section sets it).
+    /// section's ellipse with the same number of points, evenly in psi, the
+    /// widest section setting it; each rounding likewise, the largest
+    /// setting it).
     ///
     /// # Failures
     /// A tolerance not positive, or more triangles than
     /// [`crate::mesh::MAX_TRIANGLES`]; a groove that cannot be evaluated.
     pub fn mesh(&self, tol: Real) -> Result<TriMesh, SolidError> {
-        use crate::step::Sections;
+        use std::f64::consts::{FRAC_PI_2, PI};
         crate::math::positive("chordal tolerance", tol).map_err(MeshError::from)?;
         let groove = &self.groove;
         let r_d = groove.roll_radius();
-        let (widest, deepest) = extremes(groove);
-        // The groove's arc: chords within tol on its tightest curvature.
+        let (widest, deepest) = (max(groove.width()), max(groove.depth()));
+        // The ellipse's arc: chords within tol on its tightest curvature;
+        // the roundings' (a quarter circle at most) on the smallest.
         let (r_min, _) = groove.min_curvature_radius()?;
-        let chord = (8.0 * tol * r_min).sqrt();
-        let arc = std::f64::consts::PI * (widest / 2.0).max(deepest);
-        let n_psi = ((arc / chord).ceil() as usize).max(8);
+        let points =
+            |arc: Real, radius: Real| ((arc / (8.0 * tol * radius).sqrt()).ceil() as usize).max(8);
+        let n_ellipse = points(PI * (widest / 2.0).max(deepest), r_min);
+        let n_rounding = groove.edge_rounding().map_or(0, |e| {
+            let (small, large) = (min(e), max(e));
+            points(FRAC_PI_2 * large, small)
+        });
         let (t0, t1) = groove.theta_range();
         let d_theta = (8.0 * tol / r_d).sqrt();
         let n_theta = (((t1 - t0) / d_theta).ceil() as usize).max(2);
-        crate::mesh::check_triangles(2 * (n_theta + 1) * (n_psi + 6), tol)?;
-        // Each ring: the section's corners and the groove's points, in the
-        // order of the roll's pieces.
+        let pieces = self.pieces_list();
+        let per_ring: usize = pieces
+            .iter()
+            .map(|p| match p {
+                Piece::Line(..) => 1,
+                Piece::Groove(a, _) if a.abs() == 0.5 => n_ellipse,
+                Piece::Groove(-1.0, 1.0) => n_ellipse,
+                Piece::Groove(..) => n_rounding,
+            })
+            .sum();
+        crate::mesh::check_triangles(2 * (n_theta + 1) * per_ring, tol)?;
+        // Each ring: every piece from its start, up to the next one's.
         let rings = (0..=n_theta)
             .map(|i| {
                 let v = i as Real / n_theta as Real;
-                let mut ring = vec![self.point(0, 0.0, v), self.point(1, 0.0, v)];
-                ring.extend((0..=n_psi).map(|j| self.point(2, j as Real / n_psi as Real, v)));
-                ring.extend([self.point(4, 0.0, v), self.point(5, 0.0, v)]);
+                let theta = self.theta(v);
+                let mut ring = Vec::with_capacity(per_ring);
+                for p in &pieces {
+                    match *p {
+                        Piece::Line(a, _) => ring.push(self.xyz(self.corner(a, theta), theta)),
+                        Piece::Groove(a, b) => {
+                            let n = if a.abs() == 0.5 || (a, b) == (-1.0, 1.0) {
+                                n_ellipse
+                            } else {
+                                n_rounding
+                            };
+                            let (from, to) = (self.psi_at(theta, a), self.psi_at(theta, b));
+                            ring.extend((0..n).map(|j| {
+                                let psi = from + (to - from) * j as Real / n as Real;
+                                self.xyz(self.groove_at(theta, psi), theta)
+                            }));
+                        }
+                    }
+                }
                 ring
             })
             .collect::<Vec<_>>();
@@ -121,33 +227,35 @@ impl Roll {
         }
         Ok(crate::mesh::sweep(&rings)?)
     }
+
+    /// The point `(x, rho)` of the section at `theta` in the roll's frame.
+    fn xyz(&self, (x, rho): (Real, Real), theta: Real) -> [Real; 3] {
+        let (s, c) = theta.sin_cos();
+        [rho * c, rho * s, x]
+    }
 }
 
 impl crate::step::Sections for Roll {
     fn pieces(&self) -> usize {
-        6
+        self.pieces_list().len()
     }
 
     fn straight(&self, k: usize) -> bool {
-        k != 2
+        matches!(self.pieces_list()[k], Piece::Line(..))
     }
 
     fn point(&self, k: usize, u: Real, v: Real) -> [Real; 3] {
-        use std::f64::consts::FRAC_PI_2;
         let theta = self.theta(v);
-        let (half, r_d, hub) = (self.width / 2.0, self.groove.roll_radius(), self.hub);
         let lerp =
             |a: (Real, Real), b: (Real, Real)| (a.0 + u * (b.0 - a.0), a.1 + u * (b.1 - a.1));
-        let (x, rho) = match k {
-            0 => lerp((-half, hub), (-half, r_d)),
-            1 => lerp((-half, r_d), self.groove_at(theta, -FRAC_PI_2)),
-            2 => self.groove_at(theta, -FRAC_PI_2 + std::f64::consts::PI * u),
-            3 => lerp(self.groove_at(theta, FRAC_PI_2), (half, r_d)),
-            4 => lerp((half, r_d), (half, hub)),
-            _ => lerp((half, hub), (-half, hub)),
+        let p = match self.pieces_list()[k] {
+            Piece::Line(a, b) => lerp(self.corner(a, theta), self.corner(b, theta)),
+            Piece::Groove(a, b) => {
+                let (from, to) = (self.psi_at(theta, a), self.psi_at(theta, b));
+                self.groove_at(theta, from + (to - from) * u)
+            }
         };
-        let (s, c) = theta.sin_cos();
-        [rho * c, rho * s, x]
+        self.xyz(p, theta)
     }
 
     fn along(&self) -> usize {
@@ -171,8 +279,25 @@ pub fn caliber_solid(
     Roll::new(groove, width, hub)?.mesh(tol)
 }
 
-/// The widest and the deepest the groove is in its tables (mm).
-fn extremes(groove: &Groove) -> (Real, Real) {
-    let max = |t: &crate::profile::Profile| t.x().iter().copied().fold(0.0, Real::max);
-    (max(groove.width()), max(groove.depth()))
+/// The widest the groove is, its edges' rounding included, and the
+/// deepest, over its tables' rows and the midpoints between them (mm).
+fn extremes(groove: &Groove) -> Result<(Real, Real), GrooveError> {
+    let (t0, t1) = groove.theta_range();
+    let n = 2 * groove.depth().len();
+    let mut widest = max(groove.width());
+    for i in 0..=n {
+        let t = t0 + (t1 - t0) * i as Real / n as Real;
+        widest = widest.max(2.0 * groove.section(t)?.edge_x());
+    }
+    Ok((widest, max(groove.depth())))
+}
+
+/// The largest value of a table.
+fn max(t: &crate::profile::Profile) -> Real {
+    t.x().iter().copied().fold(0.0, Real::max)
+}
+
+/// The smallest value of a table.
+fn min(t: &crate::profile::Profile) -> Real {
+    t.x().iter().copied().fold(Real::INFINITY, Real::min)
 }

@@ -208,6 +208,36 @@ pub mod caliber_api {
         Ok(super::pass_map(&poses))
     }
 
+    /// The wheel's poses stepping over at the contact's `theta` from the
+    /// pass at `psi_from` to the pass at `psi_to` (rad), ends left out, as
+    /// many as keep the rounding's centre within `sag` (mm) of the straight
+    /// moves between them (on an edge's convex rounding a straight step
+    /// over would cut a chord into it): a pass's map, possibly empty.
+    #[rhai_fn(pure, return_raw)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn step_over(
+        g: &mut Groove,
+        theta: Real,
+        psi_from: Real,
+        psi_to: Real,
+        r_k0: Real,
+        r_k: Real,
+        cross: bool,
+        sag: Real,
+    ) -> Result<rhai::Map, Box<EvalAltResult>> {
+        let plane = super::swivel_plane(cross);
+        let poses = kernel(caliber::step_over(
+            g,
+            theta,
+            (psi_from, psi_to),
+            r_k0,
+            r_k,
+            plane,
+            sag,
+        ))?;
+        Ok(super::pass_map(&poses))
+    }
+
     /// [`pass`] for every angle of `psis` (rad), computed on two threads:
     /// an array of the passes' maps, in the order of `psis`.
     #[rhai_fn(pure, return_raw)]
@@ -283,6 +313,33 @@ pub mod caliber_api {
             (&depth_table, theta, depth),
             (&width_table, theta, width),
         ))
+    }
+
+    /// The groove with its edges rounded into the periphery by the radii
+    /// (mm) in `column` of `table`, whose column `theta` (deg) gives the
+    /// groove's angles; errors name file, row and column.
+    #[rhai_fn(name = "rounded", pure, return_raw)]
+    pub fn rounded_from(
+        g: &mut Groove,
+        table: Table,
+        theta: &str,
+        column: &str,
+    ) -> Result<Groove, Box<EvalAltResult>> {
+        kernel(g.clone().with_edge_rounding_from(&table, theta, column))
+    }
+
+    /// The groove with its edges rounded into the periphery by `radius`
+    /// (mm) all round.
+    #[rhai_fn(pure, return_raw)]
+    pub fn rounded(g: &mut Groove, radius: Real) -> Result<Groove, Box<EvalAltResult>> {
+        let radii = vec![radius; g.depth().len()];
+        kernel(g.clone().with_edge_rounding(&radii))
+    }
+
+    /// The edge's rounding radius at each row (mm); `[]` for sharp edges.
+    #[rhai_fn(get = "edge_rounding", pure)]
+    pub fn edge_rounding(g: &mut Groove) -> Floats {
+        Floats::new(g.edge_rounding().map_or_else(Vec::new, |e| e.x().to_vec()))
     }
 
     /// The groove's point `[x, y, z]` at `(theta, psi)` in the roll's frame.
