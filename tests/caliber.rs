@@ -72,6 +72,59 @@ fn distance(c: [f64; 3], w: [f64; 3], r_k0: f64, r_k: f64, q: [f64; 3]) -> f64 {
     }
 }
 
+/// The wheels along every move of a program's passes (8 straight steps
+/// each, as the control moves the axes), placed by the Mannesmann plugin's
+/// closed form: by pass and by whole degree of the wheel centre's angle.
+fn replayed(blocks: &[(usize, [f64; 5])]) -> Vec<Vec<Vec<Wheel>>> {
+    let k = CaliberKinematics { cross: true };
+    let pose = |row: &[f64; 5]| {
+        let q = [
+            row[0],
+            row[1],
+            row[2],
+            row[3].to_radians(),
+            row[4].to_radians(),
+        ];
+        k.pose(&q, [0.0; 3], [0.0, 0.0, 1.0])
+    };
+    let n_pass = blocks.last().unwrap().0 + 1;
+    let mut buckets: Vec<Vec<Vec<Wheel>>> = vec![vec![Vec::new(); 360]; n_pass];
+    for w in blocks.windows(2) {
+        for s in 1..=8 {
+            let t = s as f64 / 8.0;
+            let mut row = [0.0; 5];
+            for i in 0..5 {
+                row[i] = w[0].1[i] + (w[1].1[i] - w[0].1[i]) * t;
+            }
+            let p = pose(&row);
+            let deg = p[1].atan2(p[0]).to_degrees().rem_euclid(360.0) as usize % 360;
+            buckets[w[1].0][deg].push(([p[0], p[1], p[2]], [p[3], p[4], p[5]]));
+        }
+    }
+    buckets
+}
+
+/// The least signed distance from `q` to the default wheel (125 mm, its
+/// rounding 8 mm) over the replayed `passes`, within 4 degrees of
+/// `theta_deg`.
+fn least_distance(
+    buckets: &[Vec<Vec<Wheel>>],
+    passes: std::ops::Range<usize>,
+    theta_deg: f64,
+    q: [f64; 3],
+) -> f64 {
+    let mut d = f64::INFINITY;
+    for pass in passes {
+        for off in -4i64..=4 {
+            let b = (theta_deg.round() as i64 + off).rem_euclid(360) as usize;
+            for s in &buckets[pass][b] {
+                d = d.min(distance(s.0, s.1, 125.0, 8.0, q));
+            }
+        }
+    }
+    d
+}
+
 fn report(dir: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap()
 }
@@ -179,33 +232,8 @@ fn the_default_job_holds_its_tolerance_read_back_from_the_program() {
     let blocks = moves(&mpf);
     assert!(blocks.len() > 40_000, "{}", blocks.len());
     assert!(blocks.iter().all(|b| b.1.iter().all(|v| v.is_finite())));
-    let k = CaliberKinematics { cross: true };
-    let pose = |row: &[f64; 5]| {
-        let q = [
-            row[0],
-            row[1],
-            row[2],
-            row[3].to_radians(),
-            row[4].to_radians(),
-        ];
-        k.pose(&q, [0.0; 3], [0.0, 0.0, 1.0])
-    };
-    // Samples along every move (8 straight steps, as the control moves
-    // the axes), by pass and by whole degree of the wheel centre's angle.
-    let n_pass = blocks.last().unwrap().0 + 1;
-    let mut buckets: Vec<Vec<Vec<Wheel>>> = vec![vec![Vec::new(); 360]; n_pass];
-    for w in blocks.windows(2) {
-        for s in 1..=8 {
-            let t = s as f64 / 8.0;
-            let mut row = [0.0; 5];
-            for i in 0..5 {
-                row[i] = w[0].1[i] + (w[1].1[i] - w[0].1[i]) * t;
-            }
-            let p = pose(&row);
-            let deg = p[1].atan2(p[0]).to_degrees().rem_euclid(360.0) as usize % 360;
-            buckets[w[1].0][deg].push(([p[0], p[1], p[2]], [p[3], p[4], p[5]]));
-        }
-    }
+    let buckets = replayed(&blocks);
+    let n_pass = buckets.len();
     let g = groove();
     let psis: Vec<f64> = r["tables"]["passes"]["psi_deg"]
         .as_array()
@@ -221,15 +249,8 @@ fn the_default_job_holds_its_tolerance_read_back_from_the_program() {
             for psi in [psis[j], 0.5 * (psis[j] + psis[j + 1])] {
                 let q = g.point(ti, psi).unwrap();
                 let q = [q.x, q.y, q.z];
-                let mut d = f64::INFINITY;
-                for pass in j.saturating_sub(1)..(j + 3).min(n_pass) {
-                    for off in -4i64..=4 {
-                        let b = (step as i64 * 5 + off).rem_euclid(360) as usize;
-                        for s in &buckets[pass][b] {
-                            d = d.min(distance(s.0, s.1, 125.0, 8.0, q));
-                        }
-                    }
-                }
+                let passes = j.saturating_sub(1)..(j + 3).min(n_pass);
+                let d = least_distance(&buckets, passes, step as f64 * 5.0, q);
                 worst = worst.max(d.abs());
             }
         }
@@ -381,7 +402,9 @@ fn the_sizing_section_is_held_through_the_smoothing() {
     for i in 0..=2000 {
         let theta = 200.0 + 50.0 * i as f64 / 2000.0;
         let s = req.groove.section(theta.to_radians()).unwrap();
-        let d = (s.b - hp[row]).abs().max((2.0 * s.a - b[row]).abs());
+        let d = (s.ellipse.b - hp[row])
+            .abs()
+            .max((2.0 * s.half_width() - b[row]).abs());
         if d > worst {
             (worst, at) = (d, theta);
         }
@@ -393,7 +416,11 @@ fn the_sizing_section_is_held_through_the_smoothing() {
     // The reliefs beside it do move: the smoothing is not a no-op.
     let row = deg.iter().position(|&d| d == 10.0).unwrap();
     let entry = req.groove.section(10f64.to_radians()).unwrap();
-    assert!((2.0 * entry.a - b[row]).abs() > 0.01, "{}", entry.a);
+    assert!(
+        (2.0 * entry.half_width() - b[row]).abs() > 0.01,
+        "{}",
+        entry.half_width()
+    );
 }
 
 /// A block moved 0.05 mm off its place in the program: the replay names
@@ -498,6 +525,171 @@ fn the_groove_is_verified_to_its_edges() {
     let cut = &r["groove_verification"]["periphery_cut"];
     assert!(cut["mm"].as_f64().unwrap() < -0.05, "{cut}");
     assert!(!out.join("program.mpf").exists());
+}
+
+/// The rounding of the groove's edge in section `(a, b)` (half-width,
+/// depth) by radius `r`, found here as the circle `r` deep that stands `r`
+/// from the ellipse (the least distance by golden-section search, the
+/// centre by bisection), not by the kernel's tangent equation: its centre
+/// along the axis and where it touches the ellipse, `(x, z)`.
+fn rounding(a: f64, b: f64, r: f64) -> (f64, (f64, f64)) {
+    let nearest = |xc: f64| {
+        let d = |t: f64| (a * t.sin() - xc).hypot(b * t.cos() - r);
+        let t = common::golden_min(d, 0.0, std::f64::consts::FRAC_PI_2, 200);
+        (d(t), (a * t.sin(), b * t.cos()))
+    };
+    let (mut lo, mut hi) = (a - r, a + r);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if nearest(mid).0 < r {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    (lo, nearest(lo).1)
+}
+
+/// The edge's rounding from the table's column: the section runs from the
+/// ellipse round a circle tangent to it and to the periphery (the solid's
+/// sections lie on it), the passes grind it, and this test's own replay of
+/// `program.mpf` finds it within the tolerance, with the periphery beside
+/// it; a radius that cannot be is refused naming its cell.
+#[test]
+fn the_edges_rounding_from_the_table_is_ground_and_verified() {
+    let dir = scratch_dir("rounded");
+    std::fs::create_dir_all(&dir).unwrap();
+    let table = root().join("tests/fixtures/caliber/rounded-edge.csv");
+    std::fs::copy(&table, dir.join("groove.csv")).unwrap();
+    std::fs::write(dir.join("p.toml"), "table = \"groove.csv\"\n").unwrap();
+    let out = dir.join("out");
+    let script = root().join(SCRIPT);
+    let (code, _, err) = pilgrim_in(
+        &dir,
+        &["run", s(&script), "--params", "p.toml", "--out", s(&out)],
+    );
+    assert_eq!(code, 0, "{err}");
+    let r = report(&out);
+    assert_eq!(r["verdict"]["status"], "passed", "{}", r["verdict"]);
+    assert_eq!(r["notes"]["edge_rounding_max_mm"], 3.0);
+    assert_eq!(r["notes"]["edge_rounding_min_mm"], 2.0);
+    let v = &r["groove_verification"];
+    let tol = v["tolerance"].as_f64().unwrap();
+    assert!(v["max_abs_mm"].as_f64().unwrap() <= tol, "{v}");
+    assert_eq!(v["psi_range_deg"], serde_json::json!([-90.0, 90.0]));
+    let cut = v["periphery_cut"]["mm"].as_f64().unwrap();
+    assert!((-tol..=0.0).contains(&cut), "{}", v["periphery_cut"]);
+
+    // The groove as ground, its rounding from the same column.
+    let t = pilgrim_kernel::profile::read_table(&table).unwrap();
+    let g = Groove::from_tables(150.0, (&t, "theta_deg", "Hp_mm"), (&t, "theta_deg", "B_mm"))
+        .unwrap()
+        .with_interpolation(pilgrim_kernel::Interpolation::Monotone)
+        .with_edge_rounding_from(&t, "theta_deg", "edge_r_mm")
+        .unwrap();
+    let g = g.smoothed(5, g.sizing_middle(), g.sizing_rows()).unwrap().0;
+    let at = |theta: f64| {
+        let th = theta.to_radians();
+        let (a, b) = (
+            g.width().eval(th).unwrap() / 2.0,
+            g.depth().eval(th).unwrap(),
+        );
+        let r = g.edge_rounding().unwrap().eval(th).unwrap();
+        (a, b, r, rounding(a, b, r))
+    };
+
+    // The solid's first section (theta 0, y = 0): each point of the groove
+    // on the ellipse or on the rounding, the rounding's own points there.
+    let mut stl = std::fs::File::open(out.join("caliber.stl")).unwrap();
+    let mesh = stl_io::read_stl(&mut stl).unwrap();
+    let (a, b, rr, (xc, (xt, zt))) = at(0.0);
+    let mut on_rounding = 0;
+    for p in &mesh.vertices {
+        let (x, y, axial) = (p[0] as f64, p[1] as f64, p[2] as f64);
+        let z = 150.0 - x; // depth from the periphery
+        if y.abs() > 1e-9 || x < 0.0 || z <= 1e-4 || axial.abs() > xc + 1e-4 {
+            continue;
+        }
+        if axial.abs() >= xt && z <= zt + 1e-4 {
+            let d = (axial.abs() - xc).hypot(z - rr);
+            assert!(
+                (d - rr).abs() < 2e-4,
+                "({axial}, {z}) is {d} from the rounding's centre"
+            );
+            on_rounding += 1;
+        } else {
+            let e = (axial / a).powi(2) + (z / b).powi(2);
+            assert!(
+                (e - 1.0).abs() < 2e-5,
+                "({axial}, {z}) off the ellipse: {e}"
+            );
+        }
+    }
+    assert!(
+        on_rounding >= 8,
+        "{on_rounding} points of the solid on the rounding"
+    );
+
+    // This test's replay of program.mpf on the rounding, each side, every
+    // 5 degrees, against every pass; and on the periphery beside it.
+    let mpf = std::fs::read_to_string(out.join("program.mpf")).unwrap();
+    let blocks = moves(&mpf);
+    let buckets = replayed(&blocks);
+    let n_pass = buckets.len();
+    let (mut worst, mut periphery): (f64, f64) = (0.0, f64::INFINITY);
+    for step in 0..=56 {
+        let theta = step as f64 * 5.0;
+        let th = theta.to_radians();
+        let (_, _, rr, (xc, (xt, zt))) = at(theta);
+        let phi_t = (xc - xt).atan2(rr - zt);
+        let place = |x: f64, z: f64| [(150.0 - z) * th.cos(), (150.0 - z) * th.sin(), x];
+        for side in [-1.0, 1.0] {
+            for k in 0..=8 {
+                let phi = phi_t * k as f64 / 8.0;
+                let q = place(side * (xc - rr * phi.sin()), rr * (1.0 - phi.cos()));
+                worst = worst.max(least_distance(&buckets, 0..n_pass, theta, q).abs());
+            }
+            for d in [0.05, 0.5, 2.0] {
+                let q = place(side * (xc + d), 0.0);
+                periphery = periphery.min(least_distance(&buckets, 0..n_pass, theta, q));
+            }
+        }
+    }
+    eprintln!("the rounding replayed from program.mpf: largest |distance| {worst:.6} mm, periphery {periphery:.6} mm");
+    assert!(worst <= tol, "the replay strays {worst} mm on the rounding");
+    assert!(periphery >= -tol, "the periphery is cut {periphery} mm");
+
+    // A radius that is not positive, named by file, row and column.
+    let bad = dir.join("bad");
+    std::fs::create_dir_all(&bad).unwrap();
+    let text = std::fs::read_to_string(&table).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
+    let header = lines
+        .iter()
+        .position(|l| l.starts_with("theta_deg"))
+        .unwrap();
+    let row = header + 6;
+    let mut cells: Vec<String> = lines[row].split(',').map(str::to_owned).collect();
+    cells[3] = "-1".into();
+    lines[row] = cells.join(",");
+    std::fs::write(bad.join("groove.csv"), lines.join("\n") + "\n").unwrap();
+    std::fs::write(bad.join("p.toml"), "table = \"groove.csv\"\n").unwrap();
+    let out = bad.join("out");
+    let (code, _, err) = pilgrim_in(
+        &bad,
+        &["run", s(&script), "--params", "p.toml", "--out", s(&out)],
+    );
+    assert_ne!(code, 0, "a negative rounding accepted");
+    for e in [
+        "groove.csv",
+        &format!("row {}", row + 1),
+        "edge_r_mm",
+        "-1",
+        "positive",
+    ] {
+        assert!(err.contains(e), "'{e}' not in: {err}");
+    }
+    assert!(!out.exists(), "output written");
 }
 
 /// Bad input: each a clear error naming the value and where it is, and no
