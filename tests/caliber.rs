@@ -550,16 +550,91 @@ fn rounding(a: f64, b: f64, r: f64) -> (f64, (f64, f64)) {
     (lo, nearest(lo).1)
 }
 
-/// The edge's rounding from the table's column: the section runs from the
-/// ellipse round a circle tangent to it and to the periphery (the solid's
-/// sections lie on it), the passes grind it, and this test's own replay of
-/// `program.mpf` finds it within the tolerance, with the periphery beside
-/// it; a radius that cannot be is refused naming its cell.
-#[test]
-fn the_edges_rounding_from_the_table_is_ground_and_verified() {
-    let dir = scratch_dir("rounded");
+/// The 45 deg chamfer `c` of the groove's edge in section `(a, b)`: the
+/// line from the periphery `c` beyond the edge, `(a + c - s, s)`, walked
+/// in small steps to where it first enters the ellipse and bisected there,
+/// not the kernel's quadratic: where it meets the ellipse, `(x, z)`.
+fn chamfer(a: f64, b: f64, c: f64) -> (f64, f64) {
+    let inside = |s: f64| ((a + c - s) / a).powi(2) + (s / b).powi(2) < 1.0;
+    let step = c / 1000.0;
+    let mut s = 0.0;
+    while !inside(s + step) {
+        s += step;
+    }
+    let (mut lo, mut hi) = (s, s + step);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if inside(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    (a + c - lo, lo)
+}
+
+/// An edge as the tests find it in one section, on the right: where it
+/// leaves the ellipse, where it meets the periphery, points along it in
+/// order (its corners among them), and how far a point is from it.
+struct EdgeModel {
+    joint: (f64, f64),
+    end_x: f64,
+    points: Vec<(f64, f64)>,
+    off: Box<dyn Fn(f64, f64) -> f64>,
+}
+
+/// The edge of `kind` ("rounding" or "chamfer") and `size` in the section
+/// `(a, b)`.
+fn edge_model(kind: &str, a: f64, b: f64, size: f64) -> EdgeModel {
+    if kind == "rounding" {
+        let (xc, joint) = rounding(a, b, size);
+        let phi_t = (xc - joint.0).atan2(size - joint.1);
+        let points = (0..=8)
+            .map(|k| {
+                let phi = phi_t * (1.0 - k as f64 / 8.0);
+                (xc - size * phi.sin(), size * (1.0 - phi.cos()))
+            })
+            .collect();
+        EdgeModel {
+            joint,
+            end_x: xc,
+            points,
+            off: Box::new(move |x, z| ((x - xc).hypot(z - size) - size).abs()),
+        }
+    } else {
+        let joint = chamfer(a, b, size);
+        let end = a + size;
+        let points = (0..=8)
+            .map(|k| {
+                let v = k as f64 / 8.0;
+                (joint.0 + (end - joint.0) * v, joint.1 * (1.0 - v))
+            })
+            .collect();
+        EdgeModel {
+            joint,
+            end_x: end,
+            points,
+            off: Box::new(move |x, z| (x + z - end).abs() / std::f64::consts::SQRT_2),
+        }
+    }
+}
+
+/// The example groove with its edge from `fixture`'s `column` (a rounding
+/// or a chamfer, `kind`): the run verifies it, the notes give its sizes,
+/// the solid's first section lies on the ellipse and the edge as this
+/// test finds it, and this test's own replay of `program.mpf` finds the
+/// edge (its corners included) within the tolerance and the periphery
+/// beside it uncut.
+fn the_edge_from_the_table_is_ground_and_verified(
+    name: &str,
+    fixture: &str,
+    kind: pilgrim_kernel::caliber::EdgeKind,
+    column: &str,
+    sizes: (f64, f64),
+) {
+    let dir = scratch_dir(name);
     std::fs::create_dir_all(&dir).unwrap();
-    let table = root().join("tests/fixtures/caliber/rounded-edge.csv");
+    let table = root().join(fixture);
     std::fs::copy(&table, dir.join("groove.csv")).unwrap();
     std::fs::write(dir.join("p.toml"), "table = \"groove.csv\"\n").unwrap();
     let out = dir.join("out");
@@ -571,8 +646,12 @@ fn the_edges_rounding_from_the_table_is_ground_and_verified() {
     assert_eq!(code, 0, "{err}");
     let r = report(&out);
     assert_eq!(r["verdict"]["status"], "passed", "{}", r["verdict"]);
-    assert_eq!(r["notes"]["edge_rounding_max_mm"], 3.0);
-    assert_eq!(r["notes"]["edge_rounding_min_mm"], 2.0);
+    let word = match kind {
+        pilgrim_kernel::caliber::EdgeKind::Rounding => "rounding",
+        pilgrim_kernel::caliber::EdgeKind::Chamfer => "chamfer",
+    };
+    assert_eq!(r["notes"][format!("edge_{word}_min_mm")], sizes.0);
+    assert_eq!(r["notes"][format!("edge_{word}_max_mm")], sizes.1);
     let v = &r["groove_verification"];
     let tol = v["tolerance"].as_f64().unwrap();
     assert!(v["max_abs_mm"].as_f64().unwrap() <= tol, "{v}");
@@ -580,12 +659,12 @@ fn the_edges_rounding_from_the_table_is_ground_and_verified() {
     let cut = v["periphery_cut"]["mm"].as_f64().unwrap();
     assert!((-tol..=0.0).contains(&cut), "{}", v["periphery_cut"]);
 
-    // The groove as ground, its rounding from the same column.
+    // The groove as ground, its edge from the same column.
     let t = pilgrim_kernel::profile::read_table(&table).unwrap();
     let g = Groove::from_tables(150.0, (&t, "theta_deg", "Hp_mm"), (&t, "theta_deg", "B_mm"))
         .unwrap()
         .with_interpolation(pilgrim_kernel::Interpolation::Monotone)
-        .with_edge_rounding_from(&t, "theta_deg", "edge_r_mm")
+        .with_edge_from(kind, &t, "theta_deg", column)
         .unwrap();
     let g = g.smoothed(5, g.sizing_middle(), g.sizing_rows()).unwrap().0;
     let at = |theta: f64| {
@@ -594,29 +673,26 @@ fn the_edges_rounding_from_the_table_is_ground_and_verified() {
             g.width().eval(th).unwrap() / 2.0,
             g.depth().eval(th).unwrap(),
         );
-        let r = g.edge_rounding().unwrap().eval(th).unwrap();
-        (a, b, r, rounding(a, b, r))
+        let size = g.edge().unwrap().1.eval(th).unwrap();
+        (a, b, edge_model(word, a, b, size))
     };
 
     // The solid's first section (theta 0, y = 0): each point of the groove
-    // on the ellipse or on the rounding, the rounding's own points there.
+    // on the ellipse or on the edge, some on the edge.
     let mut stl = std::fs::File::open(out.join("caliber.stl")).unwrap();
     let mesh = stl_io::read_stl(&mut stl).unwrap();
-    let (a, b, rr, (xc, (xt, zt))) = at(0.0);
-    let mut on_rounding = 0;
+    let (a, b, edge) = at(0.0);
+    let mut on_edge = 0;
     for p in &mesh.vertices {
         let (x, y, axial) = (p[0] as f64, p[1] as f64, p[2] as f64);
         let z = 150.0 - x; // depth from the periphery
-        if y.abs() > 1e-9 || x < 0.0 || z <= 1e-4 || axial.abs() > xc + 1e-4 {
+        if y.abs() > 1e-9 || x < 0.0 || z <= 1e-4 || axial.abs() > edge.end_x + 1e-4 {
             continue;
         }
-        if axial.abs() >= xt && z <= zt + 1e-4 {
-            let d = (axial.abs() - xc).hypot(z - rr);
-            assert!(
-                (d - rr).abs() < 2e-4,
-                "({axial}, {z}) is {d} from the rounding's centre"
-            );
-            on_rounding += 1;
+        if axial.abs() >= edge.joint.0 - 1e-4 && z <= edge.joint.1 + 1e-4 {
+            let d = (edge.off)(axial.abs(), z);
+            assert!(d < 2e-4, "({axial}, {z}) is {d} off the {word}");
+            on_edge += 1;
         } else {
             let e = (axial / a).powi(2) + (z / b).powi(2);
             assert!(
@@ -625,13 +701,10 @@ fn the_edges_rounding_from_the_table_is_ground_and_verified() {
             );
         }
     }
-    assert!(
-        on_rounding >= 8,
-        "{on_rounding} points of the solid on the rounding"
-    );
+    assert!(on_edge >= 2, "{on_edge} points of the solid on the {word}");
 
-    // This test's replay of program.mpf on the rounding, each side, every
-    // 5 degrees, against every pass; and on the periphery beside it.
+    // This test's replay of program.mpf on the edge, each side, every 5
+    // degrees, against every pass; and on the periphery beside it.
     let mpf = std::fs::read_to_string(out.join("program.mpf")).unwrap();
     let blocks = moves(&mpf);
     let buckets = replayed(&blocks);
@@ -640,56 +713,116 @@ fn the_edges_rounding_from_the_table_is_ground_and_verified() {
     for step in 0..=56 {
         let theta = step as f64 * 5.0;
         let th = theta.to_radians();
-        let (_, _, rr, (xc, (xt, zt))) = at(theta);
-        let phi_t = (xc - xt).atan2(rr - zt);
+        let (_, _, edge) = at(theta);
         let place = |x: f64, z: f64| [(150.0 - z) * th.cos(), (150.0 - z) * th.sin(), x];
         for side in [-1.0, 1.0] {
-            for k in 0..=8 {
-                let phi = phi_t * k as f64 / 8.0;
-                let q = place(side * (xc - rr * phi.sin()), rr * (1.0 - phi.cos()));
+            for &(x, z) in &edge.points {
+                let q = place(side * x, z);
                 worst = worst.max(least_distance(&buckets, 0..n_pass, theta, q).abs());
             }
             for d in [0.05, 0.5, 2.0] {
-                let q = place(side * (xc + d), 0.0);
+                let q = place(side * (edge.end_x + d), 0.0);
                 periphery = periphery.min(least_distance(&buckets, 0..n_pass, theta, q));
             }
         }
     }
-    eprintln!("the rounding replayed from program.mpf: largest |distance| {worst:.6} mm, periphery {periphery:.6} mm");
-    assert!(worst <= tol, "the replay strays {worst} mm on the rounding");
+    eprintln!(
+        "the {word} replayed from program.mpf: largest |distance| {worst:.6} mm, periphery {periphery:.6} mm"
+    );
+    assert!(worst <= tol, "the replay strays {worst} mm on the {word}");
     assert!(periphery >= -tol, "the periphery is cut {periphery} mm");
+}
 
-    // A radius that is not positive, named by file, row and column.
-    let bad = dir.join("bad");
-    std::fs::create_dir_all(&bad).unwrap();
-    let text = std::fs::read_to_string(&table).unwrap();
+/// A copy of `fixture` in `dir` whose data row `row` (from 0) has `value`
+/// in column `col`, and the row as the file numbers it.
+fn with_cell(fixture: &str, dir: &Path, row: usize, col: usize, value: &str) -> usize {
+    std::fs::create_dir_all(dir).unwrap();
+    let text = std::fs::read_to_string(root().join(fixture)).unwrap();
     let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
     let header = lines
         .iter()
         .position(|l| l.starts_with("theta_deg"))
         .unwrap();
-    let row = header + 6;
-    let mut cells: Vec<String> = lines[row].split(',').map(str::to_owned).collect();
-    cells[3] = "-1".into();
-    lines[row] = cells.join(",");
-    std::fs::write(bad.join("groove.csv"), lines.join("\n") + "\n").unwrap();
-    std::fs::write(bad.join("p.toml"), "table = \"groove.csv\"\n").unwrap();
-    let out = bad.join("out");
+    let mut cells: Vec<String> = lines[header + 1 + row]
+        .split(',')
+        .map(str::to_owned)
+        .collect();
+    cells[col] = value.into();
+    lines[header + 1 + row] = cells.join(",");
+    std::fs::write(dir.join("groove.csv"), lines.join("\n") + "\n").unwrap();
+    std::fs::write(dir.join("p.toml"), "table = \"groove.csv\"\n").unwrap();
+    header + 2 + row
+}
+
+/// Runs the caliber job in `dir` on its `groove.csv`: refused with every
+/// one of `expect` in the error, nothing written.
+fn refused(dir: &Path, expect: &[&str]) {
+    let out = dir.join("out");
+    let script = root().join(SCRIPT);
     let (code, _, err) = pilgrim_in(
-        &bad,
+        dir,
         &["run", s(&script), "--params", "p.toml", "--out", s(&out)],
     );
-    assert_ne!(code, 0, "a negative rounding accepted");
-    for e in [
-        "groove.csv",
-        &format!("row {}", row + 1),
-        "edge_r_mm",
-        "-1",
-        "positive",
-    ] {
+    assert_ne!(code, 0, "accepted");
+    for e in expect {
         assert!(err.contains(e), "'{e}' not in: {err}");
     }
     assert!(!out.exists(), "output written");
+}
+
+/// The edge's rounding from the table's column (3 mm at the entry to 2 mm
+/// from 20 deg): ground and verified; a radius not positive is refused
+/// naming its cell.
+#[test]
+fn the_edges_rounding_from_the_table_is_ground_and_verified() {
+    let fixture = "tests/fixtures/caliber/rounded-edge.csv";
+    the_edge_from_the_table_is_ground_and_verified(
+        "rounded",
+        fixture,
+        pilgrim_kernel::caliber::EdgeKind::Rounding,
+        "edge_r_mm",
+        (2.0, 3.0),
+    );
+    let bad = scratch_dir("rounded-bad");
+    let row = with_cell(fixture, &bad, 5, 3, "-1");
+    refused(
+        &bad,
+        &[
+            "groove.csv",
+            &format!("row {row}"),
+            "edge_r_mm",
+            "-1",
+            "positive",
+        ],
+    );
+}
+
+/// The edge's 45 deg chamfer from the table's column (1.5 mm at the entry
+/// to 1 mm from 20 deg): ground and verified, the wheel rolling round its
+/// corners; a chamfer so large it meets the wall where it is flatter than
+/// 45 deg (a concave corner) is refused naming its cell.
+#[test]
+fn the_edges_chamfer_from_the_table_is_ground_and_verified() {
+    let fixture = "tests/fixtures/caliber/chamfered-edge.csv";
+    the_edge_from_the_table_is_ground_and_verified(
+        "chamfered",
+        fixture,
+        pilgrim_kernel::caliber::EdgeKind::Chamfer,
+        "edge_c_mm",
+        (1.0, 1.5),
+    );
+    let bad = scratch_dir("chamfered-bad");
+    let row = with_cell(fixture, &bad, 100, 3, "12");
+    refused(
+        &bad,
+        &[
+            "groove.csv",
+            &format!("row {row}"),
+            "edge_c_mm",
+            "12",
+            "concave corner",
+        ],
+    );
 }
 
 /// Bad input: each a clear error naming the value and where it is, and no
@@ -761,6 +894,16 @@ fn bad_input_is_refused_with_no_output() {
             good.clone(),
             vec!["roll_r=500".into()],
             vec!["N".into(), "travel".into()],
+        ),
+        (
+            "both-edges",
+            good.clone(),
+            vec!["edge_r=2".into(), "edge_c=1".into()],
+            vec![
+                "rounded or chamfered".into(),
+                "edge_r = 2".into(),
+                "edge_c = 1".into(),
+            ],
         ),
     ];
     // Widths from a second table whose row 20 is at another angle.

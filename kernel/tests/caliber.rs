@@ -374,7 +374,9 @@ fn passes_are_spread_across_the_groove() {
 /// is no higher than the scallop the step leaves in the widest section.
 #[test]
 fn passes_run_closer_on_the_edges_rounding() {
-    let g = reduction_groove().with_edge_rounding(&[2.0; 81]).unwrap();
+    let g = reduction_groove()
+        .with_edge(pilgrim_kernel::caliber::EdgeKind::Rounding, &[2.0; 81])
+        .unwrap();
     let r_k = 10.0;
     let (psi, rz) = g.pass_angles(r_k, 1f64.to_radians(), FRAC_PI_2).unwrap();
     assert!((psi[0] + FRAC_PI_2).abs() < 1e-12 && (psi[psi.len() - 1] - FRAC_PI_2).abs() < 1e-12);
@@ -385,7 +387,7 @@ fn passes_run_closer_on_the_edges_rounding() {
     let mut on = 0;
     for &theta in g.depth().z() {
         let s = g.section(theta).unwrap();
-        let from = s.rounding_from();
+        let from = s.edge_from();
         for w in psi.windows(2).filter(|w| w[0] >= from) {
             let dphi = (s.normal_angle(w[0]) - s.normal_angle(w[1])).abs();
             // Rounding circles r_k from the arc, 2 + r_k from its centre,
@@ -404,6 +406,41 @@ fn passes_run_closer_on_the_edges_rounding() {
     assert!(on > 81 * 5, "{on} steps on the rounding");
 }
 
+/// At a chamfer's corners the point stands while psi turns the normal:
+/// the groove's normal there is unit and turns with it, between the two
+/// faces', round the corner from the ellipse's to the line's and on to the
+/// periphery's.
+#[test]
+fn the_normal_turns_round_a_chamfers_corners() {
+    use pilgrim_kernel::caliber::EdgeKind;
+    let g = reduction_groove()
+        .with_edge(EdgeKind::Chamfer, &[1.5; 81])
+        .unwrap();
+    let theta = 50f64.to_radians();
+    let s = g.section(theta).unwrap();
+    let from = s.edge_from();
+    let radial = Vec3::new(theta.cos(), theta.sin(), 0.0);
+    let mut last = f64::INFINITY;
+    for k in 0..=400 {
+        let psi = from + (FRAC_PI_2 - from) * k as f64 / 400.0;
+        let n = g.normal(theta, psi).unwrap();
+        assert!((n.norm() - 1.0).abs() < 1e-12, "{psi}: {n}");
+        // Its angle in the section from the outward radius, toward the
+        // groove's middle (-Z on this side).
+        let angle = (-n.z).atan2(n.dot(&radial));
+        assert!(angle <= last + 1e-6, "the normal turns back at psi {psi}");
+        last = angle;
+        let phi = s.normal_angle(psi);
+        assert!(
+            (angle - phi).abs() < 0.01,
+            "{} vs {}",
+            angle.to_degrees(),
+            phi.to_degrees()
+        );
+    }
+    assert!(last.abs() < 1e-6, "{last}");
+}
+
 /// An edge's rounding that cannot be: refused naming the row and the angle.
 #[test]
 fn a_bad_edge_rounding_is_named() {
@@ -412,14 +449,17 @@ fn a_bad_edge_rounding_is_named() {
     radii[7] = -0.5;
     let e = g
         .clone()
-        .with_edge_rounding(&radii)
+        .with_edge(pilgrim_kernel::caliber::EdgeKind::Rounding, &radii)
         .unwrap_err()
         .to_string();
     assert!(
         e.contains("row 8") && e.contains("theta = 14 deg") && e.contains("positive"),
         "{e}"
     );
-    let e = g.with_edge_rounding(&[2.0; 80]).unwrap_err().to_string();
+    let e = g
+        .with_edge(pilgrim_kernel::caliber::EdgeKind::Rounding, &[2.0; 80])
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("81") && e.contains("80"), "{e}");
 }
 

@@ -1,6 +1,6 @@
 //! The roll and its groove in 3-D (MATH §3.1).
 
-use super::section::GrooveSection;
+use super::section::{Edge, EdgeKind, GrooveSection};
 use crate::input::InputError;
 use crate::math::{Real, Vec3};
 use crate::profile::{Profile, ProfileError, Table};
@@ -78,18 +78,15 @@ pub enum GrooveError {
 /// section (from the depth direction, positive toward +Z) is at axial
 /// position `x_A`, radius `R_d - z_A`, angle `theta`. The edges, where
 /// the groove meets the periphery, are sharp, or rounded by a radius from
-/// a third table ([`Self::with_edge_rounding`]; the section's parameter
+/// a third table ([`Self::with_edge`]; the section's parameter
 /// then runs on along the rounding, [`GrooveSection`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Groove {
     r_d: Real,
     hp: Profile,
     b: Profile,
-    edge: Option<Profile>,
+    edge: Option<(EdgeKind, Profile)>,
 }
-
-/// The edge's rounding, as its table and errors name it.
-const EDGE: &str = "r_edge";
 
 /// Step of the numerical derivatives of the surface (rad).
 const DIFF_STEP: Real = 1e-6;
@@ -158,74 +155,93 @@ impl Groove {
         })
     }
 
-    /// The groove with its edges rounded into the periphery, radius
-    /// `radii` (mm) at each of the tables' rows, interpolated between them
-    /// as the tables are.
+    /// The groove with its edges rounded or chamfered into the periphery
+    /// ([`EdgeKind`]), `sizes` (mm) at each of the tables' rows,
+    /// interpolated between them as the tables are.
     ///
     /// # Failures
-    /// Not one radius per row; a radius not positive (named by row and
-    /// angle).
-    pub fn with_edge_rounding(self, radii: &[Real]) -> Result<Self, GrooveError> {
-        let theta = self.hp.z();
-        if radii.len() != theta.len() {
+    /// Not one size per row; a size not positive, or an edge that cannot
+    /// be in its section (a chamfer meeting the wall where it is flatter
+    /// than 45 deg), named by row and angle.
+    pub fn with_edge(self, kind: EdgeKind, sizes: &[Real]) -> Result<Self, GrooveError> {
+        let theta = self.hp.z().to_vec();
+        if sizes.len() != theta.len() {
             return Err(GrooveError::DifferentRows {
                 hp: theta.len(),
-                b: radii.len(),
+                b: sizes.len(),
             });
         }
-        if let Some(i) = (0..radii.len()).find(|&i| !(radii[i] > 0.0 && radii[i].is_finite())) {
-            return Err(GrooveError::Value {
-                table: EDGE,
-                row: i + 1,
-                theta: theta[i].to_degrees(),
-                value: radii[i],
-                expected: "must be a positive number".into(),
-            });
+        let value = |i: usize, expected: String| GrooveError::Value {
+            table: kind.name(),
+            row: i + 1,
+            theta: theta[i].to_degrees(),
+            value: sizes[i],
+            expected,
+        };
+        if let Some(i) = (0..sizes.len()).find(|&i| !(sizes[i] > 0.0 && sizes[i].is_finite())) {
+            return Err(value(i, "must be a positive number".into()));
         }
-        let edge = Profile::new(theta.to_vec(), radii.to_vec())
+        let edge = Profile::new(theta.clone(), sizes.to_vec())
             .map_err(|source| GrooveError::Table {
-                table: EDGE,
+                table: kind.name(),
                 source,
             })?
             .with_interpolation(self.interpolation());
         let g = Self {
-            edge: Some(edge),
+            edge: Some((kind, edge)),
             ..self
         };
-        // Every row's section can be built.
-        for &t in g.hp.z() {
-            g.section(t)?;
+        // Every row's section, then every one between, can be built.
+        let at = g.rows_and_midpoints();
+        let order = (0..at.len()).step_by(2).chain((1..at.len()).step_by(2));
+        for (k, t) in order.map(|k| (k, at[k])) {
+            if let Err(e) = g.section(t) {
+                let why = match e {
+                    GrooveError::Query(ProfileError::Input(e)) => e.to_string(),
+                    other => other.to_string(),
+                };
+                let between = if k % 2 == 1 {
+                    format!(
+                        " (between it and the next row, at theta = {:.3} deg)",
+                        t.to_degrees()
+                    )
+                } else {
+                    String::new()
+                };
+                return Err(value(k / 2, format!("cannot be{between}: {why}")));
+            }
         }
         Ok(g)
     }
 
-    /// [`Self::with_edge_rounding`] from a table: its column `theta`
-    /// (degrees) at the groove's angles, the radii in `column` (mm).
-    /// Errors name the file, the row as the file numbers it and the
-    /// column.
+    /// [`Self::with_edge`] from a table: its column `theta` (degrees) at
+    /// the groove's angles, the sizes in `column` (mm). Errors name the
+    /// file, the row as the file numbers it and the column.
     ///
     /// # Failures
-    /// As [`Self::with_edge_rounding`]; a cell that is not a number; the
-    /// table's angles not the groove's.
-    pub fn with_edge_rounding_from(
+    /// As [`Self::with_edge`]; a cell that is not a number; the table's
+    /// angles not the groove's.
+    pub fn with_edge_from(
         self,
+        kind: EdgeKind,
         table: &Table,
         theta: &str,
         column: &str,
     ) -> Result<Self, GrooveError> {
         table.profile(theta, column)?;
-        let (deg, radii) = (table.column(theta)?, table.column(column)?);
+        let (deg, sizes) = (table.column(theta)?, table.column(column)?);
         let label = table
             .column_index(column)
             .map(|c| table.column_label(c))
             .unwrap_or_else(|_| column.to_owned());
         let file = || table.source().to_owned();
+        let what = kind.describe();
         let ours: Vec<Real> = self.hp.z().iter().map(|t| t.to_degrees()).collect();
         if deg.len() != ours.len() {
             return Err(GrooveError::File {
                 file: file(),
                 message: format!(
-                    "{} rows of the edge's rounding in column {label}, but the groove has {} rows: the tables must be at the same angles",
+                    "{} rows of {what} in column {label}, but the groove has {} rows: the tables must be at the same angles",
                     deg.len(),
                     ours.len()
                 ),
@@ -235,14 +251,14 @@ impl Groove {
             return Err(GrooveError::File {
                 file: file(),
                 message: format!(
-                    "row {}: theta = {} deg, but the groove's row there is at theta = {} deg: the edge's rounding must be at the groove's angles",
+                    "row {}: theta = {} deg, but the groove's row there is at theta = {} deg: {what} must be at the groove's angles",
                     table.row_number(i),
                     deg[i],
                     ours[i]
                 ),
             });
         }
-        self.with_edge_rounding(&radii).map_err(|e| match e {
+        self.with_edge(kind, &sizes).map_err(|e| match e {
             GrooveError::Value {
                 row,
                 theta,
@@ -252,8 +268,9 @@ impl Groove {
             } => GrooveError::File {
                 file: file(),
                 message: format!(
-                    "row {}, column {label}: the edge's rounding r_edge = {value} mm at theta = {theta} deg {expected}",
-                    table.row_number(row - 1)
+                    "row {}, column {label}: {what} {} = {value} mm at theta = {theta} deg {expected}",
+                    table.row_number(row - 1),
+                    kind.name()
                 ),
             },
             other => other,
@@ -343,10 +360,10 @@ impl Groove {
     /// most (the passes spread evenly), with the scallop the step leaves in
     /// the widest section (MATH §3.3: the section circle the groove's
     /// largest profile radius, `max(B/2, Hp)` over the tables). On the
-    /// edges' rounding, where there is one, the passes run closer, evenly
-    /// from where the rounding begins in the section it begins soonest, so
-    /// that their scallop on the convex arc is no higher
-    /// ([`super::step_for_scallop_convex`], the finest any section needs).
+    /// edges' rounding or chamfer, where there is one, the passes run
+    /// closer, evenly from where the edge begins in the section it begins
+    /// soonest, so that their scallop there is no higher
+    /// ([`GrooveSection::edge_psi_step`], the finest any section needs).
     ///
     /// # Failures
     /// `r_k` not smaller than every section's curvature radius (named by
@@ -393,8 +410,8 @@ impl Groove {
                 Ok(n.max(1.0) as usize)
             }
         };
-        // Where the edges' rounding begins soonest: the passes within it
-        // are the section's, evenly at `dpsi` at most.
+        // Where the edges begin soonest: the passes within it are the
+        // section's, evenly at `dpsi` at most.
         let sections = match self.edge {
             Some(_) => self
                 .rows_and_midpoints()
@@ -405,18 +422,17 @@ impl Groove {
         };
         let inner = sections
             .iter()
-            .map(|s| s.rounding_from())
+            .map(|s| s.edge_from())
             .fold(psi_max, Real::min);
         let n = spans(2.0 * inner, dpsi)?;
         let step = 2.0 * inner / n as Real;
         let rz = super::scallop_height(self.widest_radius(), r_k, step)?;
-        // Beyond it, as finely as the finest rounding needs for that
-        // scallop.
+        // Beyond it, as finely as the finest edge needs for that scallop.
         let mut band_step = Real::INFINITY;
         for s in &sections {
-            let r = s.edge_rounding().expect("a rounded groove's section");
-            let dphi = super::step_for_scallop_convex(r, r_k, rz)?;
-            band_step = band_step.min(s.rounding_psi_step(dphi).expect("a rounded section"));
+            if let Some(step) = s.edge_psi_step(r_k, rz)? {
+                band_step = band_step.min(step);
+            }
         }
         let m = if psi_max > inner {
             spans(psi_max - inner, band_step)?
@@ -558,7 +574,9 @@ impl Groove {
         Self {
             hp: self.hp.with_interpolation(interpolation),
             b: self.b.with_interpolation(interpolation),
-            edge: self.edge.map(|e| e.with_interpolation(interpolation)),
+            edge: self
+                .edge
+                .map(|(kind, e)| (kind, e.with_interpolation(interpolation))),
             ..self
         }
     }
@@ -588,20 +606,24 @@ impl Groove {
         &self.b
     }
 
-    /// The edge's rounding radius table (theta in rad), if it has one.
-    pub fn edge_rounding(&self) -> Option<&Profile> {
-        self.edge.as_ref()
+    /// The edge's kind and its size's table (theta in rad), if it is not
+    /// sharp.
+    pub fn edge(&self) -> Option<(EdgeKind, &Profile)> {
+        self.edge.as_ref().map(|(kind, p)| (*kind, p))
     }
 
     /// The section at `theta` (rad).
     ///
     /// # Failures
-    /// `theta` outside the tables; a rounding interpolated to a radius
-    /// not positive.
+    /// `theta` outside the tables; an edge interpolated to a size that
+    /// cannot be.
     pub fn section(&self, theta: Real) -> Result<GrooveSection, GrooveError> {
         let hp = self.hp.eval(theta)?;
         let b = self.b.eval(theta)?;
-        let edge = self.edge.as_ref().map(|e| e.eval(theta)).transpose()?;
+        let edge = match &self.edge {
+            None => Edge::Sharp,
+            Some((kind, size)) => kind.of(size.eval(theta)?),
+        };
         Ok(GrooveSection::new(b / 2.0, hp, edge)?)
     }
 
@@ -618,20 +640,30 @@ impl Groove {
     /// The groove's unit normal at `(theta, psi)`, out of the roll's
     /// material into the groove's open space (toward a wheel in it), from
     /// the surface's partial derivatives (central differences of 1e-6 rad,
-    /// one-sided at the tables' ends).
+    /// one-sided at the tables' ends); at a chamfer's corner, where the
+    /// point stands while psi turns the normal, the section's own tangent
+    /// takes the place of the derivative along psi. Turned to the side the
+    /// section's normal opens to.
     ///
     /// # Failures
     /// `theta` outside the tables.
     pub fn normal(&self, theta: Real, psi: Real) -> Result<Vec3, GrooveError> {
         let (t0, t1) = self.theta_pair(theta);
         let d_theta = (self.point(t1, psi)? - self.point(t0, psi)?) / (t1 - t0);
-        let d_psi = (self.point(theta, psi + DIFF_STEP)? - self.point(theta, psi - DIFF_STEP)?)
+        let mut d_psi = (self.point(theta, psi + DIFF_STEP)?
+            - self.point(theta, psi - DIFF_STEP)?)
             / (2.0 * DIFF_STEP);
+        // The section's normal into the material at psi, from the depth
+        // direction: its tangent and the side it opens to, in 3-D (depth
+        // is inward along the radius).
+        let phi = self.section(theta)?.normal_angle(psi);
+        let radial = Vec3::new(theta.cos(), theta.sin(), 0.0);
+        let open = -phi.sin() * Vec3::z() + phi.cos() * radial;
+        if !(d_psi.norm() > 1e-9) {
+            d_psi = phi.cos() * Vec3::z() + phi.sin() * radial;
+        }
         let n = d_theta.cross(&d_psi).normalize();
-        // The section's centre (on the periphery) is on the open side.
-        let centre = Vec3::new(self.r_d * theta.cos(), self.r_d * theta.sin(), 0.0);
-        let p = self.point(theta, psi)?;
-        Ok(if n.dot(&(centre - p)) >= 0.0 { n } else { -n })
+        Ok(if n.dot(&open) >= 0.0 { n } else { -n })
     }
 
     /// The angles either side of `theta` that derivatives along theta are

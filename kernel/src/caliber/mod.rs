@@ -4,9 +4,12 @@
 //!
 //! - [`Groove`]: the roll of radius `R_d` with its groove, half an ellipse
 //!   in each section (`B(theta)/2` wide, `Hp(theta)` deep, from tables),
-//!   its points and normals in the roll's frame;
+//!   its edges sharp, rounded or chamfered into the periphery
+//!   ([`GrooveSection`], [`Edge`]), its points and normals in the roll's
+//!   frame;
 //! - [`scallop_height`] and [`step_for_scallop`]: the cusp two neighbouring
-//!   passes leave, and its inverse (MATH §3.3);
+//!   passes leave, and its inverse (MATH §3.3); [`step_for_scallop_convex`]
+//!   on an edge's rounding;
 //! - [`seed_pose`]: the seed's wheel centre and corrections (MATH §3.4);
 //!   [`TorusWheel`] and [`exact_pose`]: the torus touching the groove at a
 //!   point with its normal, and the distance of any point from it;
@@ -41,6 +44,6 @@ pub use pass::{pass_poses, pose_at, step_over, PassPose, SwivelPlane, MAX_PASS_B
 pub use patch::{contact_patch, ContactPatch};
 pub use pose::{exact_pose, exact_pose_toward, seed_pose, SeedPose, TorusWheel};
 pub use scallop::{scallop_height, step_for_scallop, step_for_scallop_convex};
-pub use section::GrooveSection;
+pub use section::{Edge, EdgeKind, GrooveSection};
 pub use solid::{caliber_solid, Roll, SolidError};
 pub use stock::GrooveStock;

@@ -371,12 +371,14 @@ mod tests {
     /// the sag asked.
     #[test]
     fn stepping_over_the_rounding_keeps_off_it() {
-        let g = lifting().with_edge_rounding(&[2.0; 37]).unwrap();
+        let g = lifting()
+            .with_edge(crate::caliber::EdgeKind::Rounding, &[2.0; 37])
+            .unwrap();
         let (r_k0, r_k) = (125.0, 8.0);
         let (psi, _) = g.pass_angles(r_k, 1f64.to_radians(), FRAC_PI_2).unwrap();
         // Two neighbouring passes on the rounding.
         let theta = 60f64.to_radians();
-        let from = g.section(theta).unwrap().rounding_from();
+        let from = g.section(theta).unwrap().edge_from();
         let j = psi.iter().position(|&p| p > from + 0.02).unwrap();
         let (a, b) = (psi[j], psi[j + 1]);
         let plane = SwivelPlane::Wheel;

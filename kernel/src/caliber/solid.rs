@@ -2,6 +2,7 @@
 //! angles, the groove cut in its periphery (for `caliber.stl`).
 
 use super::groove::{Groove, GrooveError};
+use super::section::EdgeKind;
 use crate::math::Real;
 use crate::mesh::{MeshError, TriMesh};
 
@@ -25,9 +26,10 @@ pub enum SolidError {
 /// flat ends at the tables' first and last angle. Its section's pieces, in
 /// order: up the left face, along the periphery to the groove, the groove
 /// (psi from -pi/2 to pi/2: the ellipse, and where the edges are rounded
-/// the left rounding before it and the right one after, each its own
-/// smooth piece), the periphery to the right face, down it, back along
-/// the hub; `v` runs over the tables' angles.
+/// or chamfered the left edge before it and the right one after, each its
+/// own piece, a rounding smooth, a chamfer straight), the periphery to the
+/// right face, down it, back along the hub; `v` runs over the tables'
+/// angles.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Roll {
     groove: Groove,
@@ -41,7 +43,7 @@ enum Piece {
     /// A straight line between two corners of the section.
     Line(Corner, Corner),
     /// The groove between two angles: the edge (`-1` left, `1` right) or
-    /// where its rounding begins (`-0.5`, `0.5`).
+    /// where its rounding or chamfer begins (`-0.5`, `0.5`).
     Groove(Real, Real),
 }
 
@@ -60,8 +62,8 @@ impl Roll {
     /// The roll of `groove` with a rim `width` wide from radius `hub`.
     ///
     /// # Failures
-    /// A width not wider than every section's groove, its edges' rounding
-    /// included; a hub not inside the groove's deepest point.
+    /// A width not wider than every section's groove, its edges included;
+    /// a hub not inside the groove's deepest point.
     pub fn new(groove: &Groove, width: Real, hub: Real) -> Result<Self, SolidError> {
         let r_d = groove.roll_radius();
         let (widest, deepest) = extremes(groove)?;
@@ -96,7 +98,7 @@ impl Roll {
             Piece::Line(LeftHub, LeftTop),
             Piece::Line(LeftTop, LeftEdge),
         ];
-        if self.groove.edge_rounding().is_some() {
+        if self.groove.edge().is_some() {
             list.extend([
                 Piece::Groove(-1.0, -0.5),
                 Piece::Groove(-0.5, 0.5),
@@ -123,7 +125,7 @@ impl Roll {
         let from = self
             .groove
             .section(theta)
-            .map_or(Real::NAN, |s| s.rounding_from());
+            .map_or(Real::NAN, |s| s.edge_from());
         2.0 * m * from
     }
 
@@ -155,7 +157,7 @@ impl Roll {
     /// chords stay within `tol` of the groove and the periphery (each
     /// section's ellipse with the same number of points, evenly in psi, the
     /// widest section setting it; each rounding likewise, the largest
-    /// setting it).
+    /// setting it; a chamfer by its ends).
     ///
     /// # Failures
     /// A tolerance not positive, or more triangles than
@@ -172,23 +174,23 @@ impl Roll {
         let points =
             |arc: Real, radius: Real| ((arc / (8.0 * tol * radius).sqrt()).ceil() as usize).max(8);
         let n_ellipse = points(PI * (widest / 2.0).max(deepest), r_min);
-        let n_rounding = groove.edge_rounding().map_or(0, |e| {
-            let (small, large) = (min(e), max(e));
-            points(FRAC_PI_2 * large, small)
-        });
+        // A chamfer is straight in every section: its ends alone.
+        let n_edge = match groove.edge() {
+            None | Some((EdgeKind::Chamfer, _)) => 1,
+            Some((EdgeKind::Rounding, e)) => points(FRAC_PI_2 * max(e), min(e)),
+        };
         let (t0, t1) = groove.theta_range();
         let d_theta = (8.0 * tol / r_d).sqrt();
         let n_theta = (((t1 - t0) / d_theta).ceil() as usize).max(2);
         let pieces = self.pieces_list();
-        let per_ring: usize = pieces
-            .iter()
-            .map(|p| match p {
-                Piece::Line(..) => 1,
-                Piece::Groove(a, _) if a.abs() == 0.5 => n_ellipse,
-                Piece::Groove(-1.0, 1.0) => n_ellipse,
-                Piece::Groove(..) => n_rounding,
-            })
-            .sum();
+        // Points of each piece in a ring: the ellipse's (from edge to edge,
+        // or between the edges' joints) or an edge's; a line's start.
+        let points_of = |p: &Piece| match *p {
+            Piece::Line(..) => 1,
+            Piece::Groove(a, b) if a == -b => n_ellipse,
+            Piece::Groove(..) => n_edge,
+        };
+        let per_ring: usize = pieces.iter().map(points_of).sum();
         crate::mesh::check_triangles(2 * (n_theta + 1) * per_ring, tol)?;
         // Each ring: every piece from its start, up to the next one's.
         let rings = (0..=n_theta)
@@ -200,11 +202,7 @@ impl Roll {
                     match *p {
                         Piece::Line(a, _) => ring.push(self.xyz(self.corner(a, theta), theta)),
                         Piece::Groove(a, b) => {
-                            let n = if a.abs() == 0.5 || (a, b) == (-1.0, 1.0) {
-                                n_ellipse
-                            } else {
-                                n_rounding
-                            };
+                            let n = points_of(p);
                             let (from, to) = (self.psi_at(theta, a), self.psi_at(theta, b));
                             ring.extend((0..n).map(|j| {
                                 let psi = from + (to - from) * j as Real / n as Real;
@@ -241,7 +239,14 @@ impl crate::step::Sections for Roll {
     }
 
     fn straight(&self, k: usize) -> bool {
-        matches!(self.pieces_list()[k], Piece::Line(..))
+        match self.pieces_list()[k] {
+            Piece::Line(..) => true,
+            // A chamfer (its corners are its ends).
+            Piece::Groove(a, b) => {
+                a.abs() + b.abs() == 1.5
+                    && matches!(self.groove.edge(), Some((EdgeKind::Chamfer, _)))
+            }
+        }
     }
 
     fn point(&self, k: usize, u: Real, v: Real) -> [Real; 3] {
@@ -252,7 +257,13 @@ impl crate::step::Sections for Roll {
             Piece::Line(a, b) => lerp(self.corner(a, theta), self.corner(b, theta)),
             Piece::Groove(a, b) => {
                 let (from, to) = (self.psi_at(theta, a), self.psi_at(theta, b));
-                self.groove_at(theta, from + (to - from) * u)
+                if self.straight(k) {
+                    // A chamfer, evenly between its corners (psi stands
+                    // at each corner while the normal turns).
+                    lerp(self.groove_at(theta, from), self.groove_at(theta, to))
+                } else {
+                    self.groove_at(theta, from + (to - from) * u)
+                }
             }
         };
         self.xyz(p, theta)
@@ -279,7 +290,7 @@ pub fn caliber_solid(
     Roll::new(groove, width, hub)?.mesh(tol)
 }
 
-/// The widest the groove is, its edges' rounding included, and the
+/// The widest the groove is, its edges included, and the
 /// deepest, over its tables' rows and the midpoints between them (mm).
 fn extremes(groove: &Groove) -> Result<(Real, Real), GrooveError> {
     let (t0, t1) = groove.theta_range();

@@ -4,7 +4,7 @@
 //! the script API; the tables give theta in degrees.
 
 use super::floats::{kernel, Floats};
-use crate::caliber::{self, Groove, SeedPose};
+use crate::caliber::{self, EdgeKind, Groove, SeedPose};
 // The Rhai `Solid`: a mesh and the exact body it was meshed from.
 use crate::family::Swept as Solid;
 use crate::math::Real;
@@ -325,21 +325,59 @@ pub mod caliber_api {
         theta: &str,
         column: &str,
     ) -> Result<Groove, Box<EvalAltResult>> {
-        kernel(g.clone().with_edge_rounding_from(&table, theta, column))
+        kernel(
+            g.clone()
+                .with_edge_from(EdgeKind::Rounding, &table, theta, column),
+        )
     }
 
     /// The groove with its edges rounded into the periphery by `radius`
     /// (mm) all round.
     #[rhai_fn(pure, return_raw)]
     pub fn rounded(g: &mut Groove, radius: Real) -> Result<Groove, Box<EvalAltResult>> {
-        let radii = vec![radius; g.depth().len()];
-        kernel(g.clone().with_edge_rounding(&radii))
+        let sizes = vec![radius; g.depth().len()];
+        kernel(g.clone().with_edge(EdgeKind::Rounding, &sizes))
     }
 
-    /// The edge's rounding radius at each row (mm); `[]` for sharp edges.
-    #[rhai_fn(get = "edge_rounding", pure)]
-    pub fn edge_rounding(g: &mut Groove) -> Floats {
-        Floats::new(g.edge_rounding().map_or_else(Vec::new, |e| e.x().to_vec()))
+    /// The groove with its edges chamfered at 45 deg into the periphery
+    /// by the legs (mm) in `column` of `table`, whose column `theta` (deg)
+    /// gives the groove's angles; errors name file, row and column.
+    #[rhai_fn(name = "chamfered", pure, return_raw)]
+    pub fn chamfered_from(
+        g: &mut Groove,
+        table: Table,
+        theta: &str,
+        column: &str,
+    ) -> Result<Groove, Box<EvalAltResult>> {
+        kernel(
+            g.clone()
+                .with_edge_from(EdgeKind::Chamfer, &table, theta, column),
+        )
+    }
+
+    /// The groove with its edges chamfered `leg` x 45 deg (mm) all round.
+    #[rhai_fn(pure, return_raw)]
+    pub fn chamfered(g: &mut Groove, leg: Real) -> Result<Groove, Box<EvalAltResult>> {
+        let sizes = vec![leg; g.depth().len()];
+        kernel(g.clone().with_edge(EdgeKind::Chamfer, &sizes))
+    }
+
+    /// The edge: `"sharp"`, `"rounding"` or `"chamfer"`.
+    #[rhai_fn(get = "edge_kind", pure)]
+    pub fn edge_kind(g: &mut Groove) -> String {
+        match g.edge() {
+            None => "sharp",
+            Some((EdgeKind::Rounding, _)) => "rounding",
+            Some((EdgeKind::Chamfer, _)) => "chamfer",
+        }
+        .into()
+    }
+
+    /// The edge's size at each row (mm: the rounding's radius, the
+    /// chamfer's leg); `[]` for sharp edges.
+    #[rhai_fn(get = "edge_size", pure)]
+    pub fn edge_size(g: &mut Groove) -> Floats {
+        Floats::new(g.edge().map_or_else(Vec::new, |(_, e)| e.x().to_vec()))
     }
 
     /// The groove's point `[x, y, z]` at `(theta, psi)` in the roll's frame.
