@@ -4,7 +4,9 @@
 //!   through the kernel's job call, in process: the script loaded, the
 //!   tables read and smoothed, every pass's exact poses, inverse
 //!   kinematics, the 3-D replay, the posts, the meshes and the bytes of
-//!   every file (not written to disk) (target <= 2 s);
+//!   every file (not written to disk) (target <= 2 s); and the same with
+//!   the groove's edges rounded (`edge_r = 2`): the passes on the
+//!   roundings and the step-overs between them;
 //! - `caliber_verify`: the 3-D replay alone on the default program; its
 //!   grid (561 x 329 points of (theta, psi)) and the wheel positions
 //!   replayed are printed, with points per second.
@@ -49,9 +51,22 @@ fn caliber_job(c: &mut Criterion) {
         "{} files",
         out.files.len()
     );
+    let rounded = [pilgrim_kernel::params::ParamSource::Pairs {
+        label: "--set".into(),
+        pairs: vec![("edge_r".into(), "2".into())],
+    }];
+    let run_rounded = || {
+        let family = family();
+        let machine = catalog.open("Mannesmann").unwrap();
+        job::run(&family, &machine, &rounded, &options, &mut |_| {}).unwrap()
+    };
+    assert!(run_rounded().toolpath.passes.len() > out.toolpath.passes.len());
     let mut g = c.benchmark_group("caliber_job");
     g.sample_size(10).measurement_time(Duration::from_secs(20));
     g.bench_function("default_job_end_to_end", |b| b.iter(|| black_box(run())));
+    g.bench_function("rounded_edge_job_end_to_end", |b| {
+        b.iter(|| black_box(run_rounded()))
+    });
     g.finish();
 }
 

@@ -132,7 +132,7 @@ impl Shape {
     }
 }
 
-/// Iterations the tangent point may take (bracketed Newton: some five in
+/// Iterations the tangent point may take (bracketed Newton: some four in
 /// practice; 200 reach any double even halving the bracket).
 const MAX_ITERATIONS: usize = 200;
 
@@ -357,30 +357,27 @@ fn rounding(e: &EllipseSection, r: Real) -> Shape {
             -b * sin - r * a * b * b * sin / (n * n * n),
         )
     };
-    // The bracket's ends, (t, f, f'): f(0) = b, f(pi/2) = -r. Newton's
-    // step from the end nearer the root (smaller |f|), else halving: from
-    // the far end it overshoots the bracket where f bends away.
-    let mut lo = (0.0, b, 0.0);
-    let mut hi = (FRAC_PI_2, -r, -b - r * a / b);
+    // Newton's method from the edge (f(pi/2) = -r), kept in the bracket
+    // [lo, hi] of the root by halving it where a step would leave it;
+    // done when a step no longer moves t (some four steps).
+    let (mut lo, mut hi) = (0.0, FRAC_PI_2);
     let mut t = FRAC_PI_2;
+    let (mut v, mut dv) = (-r, -b - r * a / b);
     for _ in 0..MAX_ITERATIONS {
-        let near = if lo.1.abs() < hi.1.abs() { lo } else { hi };
-        let newton = near.0 - near.1 / near.2;
-        let next = if newton > lo.0 && newton < hi.0 && near.2 != 0.0 {
+        let newton = t - v / dv;
+        if (newton - t).abs() <= 1e-15 || v == 0.0 || hi - lo <= 1e-15 {
+            break;
+        }
+        t = if newton > lo && newton < hi {
             newton
         } else {
-            0.5 * (lo.0 + hi.0)
+            0.5 * (lo + hi)
         };
-        let moved = (next - t).abs();
-        t = next;
-        let (v, dv) = eval(t);
+        (v, dv) = eval(t);
         if v > 0.0 {
-            lo = (t, v, dv);
+            lo = t;
         } else {
-            hi = (t, v, dv);
-        }
-        if v == 0.0 || moved <= 1e-15 || hi.0 - lo.0 <= 1e-15 {
-            break;
+            hi = t;
         }
     }
     let (x, z) = (a * t.sin(), b * t.cos());
