@@ -325,18 +325,14 @@ pub mod caliber_api {
         theta: &str,
         column: &str,
     ) -> Result<Groove, Box<EvalAltResult>> {
-        kernel(
-            g.clone()
-                .with_edge_from(EdgeKind::Rounding, &table, theta, column),
-        )
+        edge_from(g, EdgeKind::Rounding, &table, theta, column)
     }
 
     /// The groove with its edges rounded into the periphery by `radius`
     /// (mm) all round.
     #[rhai_fn(pure, return_raw)]
     pub fn rounded(g: &mut Groove, radius: Real) -> Result<Groove, Box<EvalAltResult>> {
-        let sizes = vec![radius; g.depth().len()];
-        kernel(g.clone().with_edge(EdgeKind::Rounding, &sizes))
+        edge_all_along(g, EdgeKind::Rounding, radius)
     }
 
     /// The groove with its edges chamfered at 45 deg into the periphery
@@ -349,17 +345,13 @@ pub mod caliber_api {
         theta: &str,
         column: &str,
     ) -> Result<Groove, Box<EvalAltResult>> {
-        kernel(
-            g.clone()
-                .with_edge_from(EdgeKind::Chamfer, &table, theta, column),
-        )
+        edge_from(g, EdgeKind::Chamfer, &table, theta, column)
     }
 
     /// The groove with its edges chamfered `leg` x 45 deg (mm) all round.
     #[rhai_fn(pure, return_raw)]
     pub fn chamfered(g: &mut Groove, leg: Real) -> Result<Groove, Box<EvalAltResult>> {
-        let sizes = vec![leg; g.depth().len()];
-        kernel(g.clone().with_edge(EdgeKind::Chamfer, &sizes))
+        edge_all_along(g, EdgeKind::Chamfer, leg)
     }
 
     /// The edge: `"sharp"`, `"rounding"` or `"chamfer"`.
@@ -532,6 +524,24 @@ fn pass_map(poses: &[caliber::PassPose]) -> rhai::Map {
     m.insert("seed_centre".into(), col(&|p| p.seed_centre_error));
     m.insert("seed_axis".into(), col(&|p| p.seed_axis_error));
     m
+}
+
+/// The groove with its edges of `kind` sized by `column` of `table` (the
+/// groove's angles in its column `theta`).
+fn edge_from(
+    g: &Groove,
+    kind: EdgeKind,
+    table: &Table,
+    theta: &str,
+    column: &str,
+) -> Result<Groove, Box<EvalAltResult>> {
+    kernel(g.clone().with_edge_from(kind, table, theta, column))
+}
+
+/// The groove with its edges of `kind` and `size` (mm) all along.
+fn edge_all_along(g: &Groove, kind: EdgeKind, size: Real) -> Result<Groove, Box<EvalAltResult>> {
+    let sizes = vec![size; g.depth().len()];
+    kernel(g.clone().with_edge(kind, &sizes))
 }
 
 /// The plane a caliber wheel's axis keeps: the contact's with the cross
