@@ -428,6 +428,96 @@ fn every_script_runs_with_its_defaults() {
     }
 }
 
+/// A family written from the first release's script API runs: each
+/// renamed or re-shaped function answers under its old form, says its
+/// replacement in the report's warnings, and gives what its replacement
+/// gives in the same family written in today's API. An old form not kept
+/// is an error naming its replacement, not "function not found".
+#[test]
+fn scripts_of_the_first_release_still_run() {
+    let dir = scratch("first-release");
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/scripts");
+    let run = |name: &str| {
+        let out = dir.join(name);
+        let script = fixtures.join(format!("{name}.rhai"));
+        let (code, _, err) = pilgrim(&["run", s(&script), "--out", s(&out), "--quiet"]);
+        assert_eq!(code, 0, "{name}: {err}");
+        let r: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+        r
+    };
+    let (old, today) = (run("first-release"), run("today"));
+    let warnings: Vec<&str> = old["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w.as_str().unwrap())
+        .collect();
+    for (old_form, new_form) in [
+        ("raise(", "raised("),
+        ("resample(", "resampled("),
+        ("smooth(", "smoothed("),
+        ("simplify(", ".simplified(tol)"),
+        ("envelope(zc", "envelope(path(zc, xc)"),
+        ("cut(previous", "cut(ground_surface(previous)"),
+        ("transform(\"rz\"", "rz_deg(value)"),
+        ("transform(\"tx\"", "tx(value)"),
+        ("universal(q)", "universal_deg(q)"),
+        ("reverse(v)", "reversed(v)"),
+        ("dx(law", "slope(law"),
+        ("rest_seed_u(", "seed_centre_x"),
+        ("rest_exact_u(", ".centre_x"),
+    ] {
+        assert!(
+            warnings
+                .iter()
+                .any(|w| w.contains(old_form) && w.contains(new_form)),
+            "no warning for {old_form}: {warnings:?}"
+        );
+    }
+    // Today's twin has none (the report leaves out an empty list).
+    assert!(!today.to_string().contains("earlier release"));
+    let notes = today["notes"].as_object().unwrap();
+    assert!(notes.len() >= 9);
+    for (name, value) in notes {
+        assert_eq!(&old["notes"][name], value, "{name}");
+    }
+    // The old cut: what the wheel's rounding leaves over the blank, no
+    // lower than the blank, at the blank's nodes.
+    let cut = old["notes"]["cut_x_at_60"].as_f64().unwrap();
+    assert!(
+        cut <= old["notes"]["x_at_50"].as_f64().unwrap() + 1.0,
+        "{cut}"
+    );
+
+    // An old form not kept: refused naming what replaces it.
+    let gone = dir.join("gone.rhai");
+    std::fs::write(
+        &gone,
+        "fn params() { #{} }\n\
+         fn toolpath(p) {\n\
+           let b = profile(floats([0.0, 5.0, 10.0]), floats([5.0, 5.0, 5.0]));\n\
+           rest_track(b, floats([0.0, 10.0]), floats([13.0, 13.0]), 8.0, 10.0, 20.0)\n\
+         }\n",
+    )
+    .unwrap();
+    let out = dir.join("gone");
+    let (code, _, err) = pilgrim(&[
+        "run",
+        s(&gone),
+        "--machine",
+        "vertical-mill",
+        "--out",
+        s(&out),
+    ]);
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("earlier release") && err.contains("rest_track(surface, centres, wheel"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
+
 /// docs/script-api.md is what `pilgrim api-docs` writes now.
 #[test]
 fn api_reference_is_current() {

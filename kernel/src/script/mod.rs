@@ -28,6 +28,7 @@ mod bind_table;
 mod bind_toolpath;
 mod bind_transform;
 mod bind_worm;
+mod compat;
 mod docs;
 mod floats;
 
@@ -218,7 +219,7 @@ struct Group {
 }
 
 /// The script API, group by group, as the reference lists it.
-const API: [Group; 11] = [
+const API: [Group; 12] = [
     Group {
         title: "Numbers (`Floats`)",
         register: |e, _| {
@@ -286,6 +287,12 @@ const API: [Group; 11] = [
         register: |e, access| {
             e.register_global_module(rhai::exported_module!(bind_table::table_api).into());
             bind_table::register(e, access);
+        },
+    },
+    Group {
+        title: "Earlier releases' forms (callable for a release more, with a warning naming the replacement)",
+        register: |e, _| {
+            e.register_global_module(rhai::exported_module!(compat::compat_api).into());
         },
     },
 ];
@@ -501,11 +508,19 @@ impl ScriptFamily {
 
     fn call(&self, name: &str, args: impl rhai::FuncArgs) -> Result<Dynamic, FamilyError> {
         let mut scope = Scope::new();
-        crate::budget::with_limit(self.max_seconds, "the script's", || {
+        let got = crate::budget::with_limit(self.max_seconds, "the script's", || {
             self.engine
                 .call_fn::<Dynamic>(&mut scope, &self.ast, name, args)
         })
-        .map_err(|e| locate(&self.file, name, &e))
+        .map_err(|e| locate(&self.file, name, &e));
+        // Earlier releases' forms called outside the toolpath (which
+        // carries them into the report) are said on the error stream.
+        if name != "toolpath" {
+            for w in compat::take_warnings() {
+                eprintln!("{}: warning: {w}", self.file);
+            }
+        }
+        got
     }
 
     /// The script's file name.
@@ -626,9 +641,11 @@ impl PartFamily for ScriptFamily {
             })?;
         // The script's variables are gone: the handle is the last owner, and
         // the toolpath is moved out rather than copied.
-        Ok(std::rc::Rc::try_unwrap(handle)
+        let mut tp = std::rc::Rc::try_unwrap(handle)
             .map(|c| c.into_inner())
-            .unwrap_or_else(|h| h.borrow().clone()))
+            .unwrap_or_else(|h| h.borrow().clone());
+        tp.warnings.extend(compat::take_warnings());
+        Ok(tp)
     }
 
     /// `fn part(p)`, if the script has it: a profile (the body `part`), or

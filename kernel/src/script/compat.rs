@@ -1,0 +1,277 @@
+//! Script functions of earlier releases, kept callable: each renamed or
+//! re-shaped function of the script API answers under its old name and
+//! shape for at least one release after the change, doing what it did
+//! through today's kernel, and says once per run which function replaces
+//! it (a warning in the report and on the error stream). `CHANGELOG.md`
+//! lists each change and when the old form goes.
+//!
+//! `eval(p, z)` (today `x_at`) cannot be kept: `eval` is a Rhai keyword,
+//! which no function may be named, and no release could call it. Two old
+//! forms are not kept either: `rest_track` on a bare profile (the rest now
+//! rides the surface the passes cut, which needs the feed and the spindle
+//! speed the old call did not give), and the intermediate
+//! `cut(Profile, Path, Tool, float)`. Calling them is an error naming the
+//! replacement, not "function not found".
+
+use super::floats::{err, kernel, Floats, Numbers};
+use crate::math::Real;
+use crate::profile::{MandrelLaw, Polyline, Profile};
+use rhai::plugin::*;
+use rhai::{EvalAltResult, Map};
+use std::cell::RefCell;
+
+thread_local! {
+    /// The old forms called since the last [`take_warnings`], each once.
+    static CALLED: RefCell<Vec<String>> = const { RefCell::new(Vec::new()) };
+}
+
+/// Notes that the old form `old` was called; `new` replaces it.
+fn deprecated(old: &str, new: &str) {
+    let text = format!(
+        "the script calls {old}, an earlier release's form: it still works, but use {new} (the old form goes in a later release; CHANGELOG.md)"
+    );
+    CALLED.with(|c| {
+        let mut c = c.borrow_mut();
+        if !c.contains(&text) {
+            c.push(text);
+        }
+    });
+}
+
+/// The warnings for the old forms called since the last time, in the
+/// order first called.
+pub fn take_warnings() -> Vec<String> {
+    CALLED.with(|c| std::mem::take(&mut *c.borrow_mut()))
+}
+
+/// An old form no longer callable: the error naming its replacement.
+fn gone(old: &str, new: &str, why: &str) -> Box<EvalAltResult> {
+    format!("{old} is an earlier release's form and no longer callable ({why}): use {new}").into()
+}
+
+/// Earlier releases' names and shapes of today's functions.
+#[export_module]
+pub mod compat_api {
+    use super::*;
+
+    /// Earlier form of `raised(p, z_from, z_to, dx)`.
+    #[rhai_fn(return_raw)]
+    pub fn raise(
+        p: Profile,
+        z_from: Real,
+        z_to: Real,
+        dx: Real,
+    ) -> Result<Profile, Box<EvalAltResult>> {
+        deprecated("raise(p, z_from, z_to, dx)", "raised(p, z_from, z_to, dx)");
+        kernel(p.raised(z_from, z_to, dx))
+    }
+
+    /// Earlier form of `resampled(p, step)`.
+    #[rhai_fn(pure, return_raw)]
+    pub fn resample(p: &mut Profile, step: Real) -> Result<Profile, Box<EvalAltResult>> {
+        deprecated("resample(p, step)", "resampled(p, step)");
+        kernel(p.resample_uniform(step))
+    }
+
+    /// Earlier form of `smoothed(p, iterations, anchor)`: a map
+    /// `#{ profile, max_change, max_change_z }`.
+    #[rhai_fn(pure, return_raw)]
+    pub fn smooth(
+        p: &mut Profile,
+        iterations: i64,
+        anchor: i64,
+    ) -> Result<Map, Box<EvalAltResult>> {
+        deprecated(
+            "smooth(p, iterations, anchor)",
+            "smoothed(p, iterations, anchor)",
+        );
+        if iterations < 0 || anchor < 0 {
+            return err("smooth: iterations and anchor must not be negative");
+        }
+        let s = kernel(p.smooth_derivative(iterations as usize, anchor as usize))?;
+        let mut m = Map::new();
+        m.insert("max_change".into(), Dynamic::from_float(s.max_change));
+        m.insert("max_change_z".into(), Dynamic::from_float(s.max_change_z));
+        m.insert("profile".into(), Dynamic::from(s.profile));
+        Ok(m)
+    }
+
+    /// Earlier form of `slope(law, z)`.
+    #[rhai_fn(pure)]
+    pub fn dx(law: &mut MandrelLaw, z: Real) -> Real {
+        deprecated("dx(law, z)", "slope(law, z)");
+        law.dx(z)
+    }
+
+    /// Earlier form of `reversed(v)`.
+    #[rhai_fn(name = "reverse", pure)]
+    pub fn reverse_floats(v: &mut Floats) -> Floats {
+        deprecated("reverse(v) of Floats", "reversed(v)");
+        Floats::new(v.0.iter().rev().copied().collect())
+    }
+
+    /// Earlier form of `path(z, x).simplified(tol)`: a map `#{ z, x }`.
+    #[rhai_fn(return_raw)]
+    pub fn simplify(z: Floats, x: Floats, tol: Real) -> Result<Map, Box<EvalAltResult>> {
+        deprecated("simplify(z, x, tol)", "path(z, x).simplified(tol)");
+        let p = kernel(Polyline::new(z.0.to_vec(), x.0.to_vec()))?;
+        kernel(crate::math::positive("simplify tolerance", tol))?;
+        let p = p.simplified(tol);
+        let mut m = Map::new();
+        m.insert("z".into(), Dynamic::from(Floats::new(p.z)));
+        m.insert("x".into(), Dynamic::from(Floats::new(p.x)));
+        Ok(m)
+    }
+
+    /// Earlier form of `envelope(path(zc, xc), radius, at)`.
+    #[rhai_fn(name = "envelope", return_raw)]
+    pub fn envelope_of(
+        zc: Floats,
+        xc: Floats,
+        radius: Real,
+        at: Floats,
+    ) -> Result<Floats, Box<EvalAltResult>> {
+        deprecated(
+            "envelope(zc, xc, radius, at)",
+            "envelope(path(zc, xc), radius, at)",
+        );
+        let env = kernel(crate::offset::CircleEnvelope::new(
+            &zc.0,
+            &xc.0,
+            radius,
+            crate::offset::Side::Outside,
+        ))?;
+        Ok(Floats::new(env.eval_many(&at.0)))
+    }
+
+    /// Earlier form of `rx_deg`, `ry_deg`, `rz_deg`, `tx`, `ty`, `tz`:
+    /// `kind` "tx", "ty", "tz" (mm) or "rx", "ry", "rz" (degrees).
+    #[rhai_fn(return_raw)]
+    pub fn transform(
+        kind: &str,
+        value: Real,
+    ) -> Result<super::super::bind_transform::Transform, Box<EvalAltResult>> {
+        use super::super::bind_transform::transform_api as t;
+        let new = match kind {
+            "tx" => t::tx(value),
+            "ty" => t::ty(value),
+            "tz" => t::tz(value),
+            "rx" => t::rx_deg(value),
+            "ry" => t::ry_deg(value),
+            "rz" => t::rz_deg(value),
+            other => {
+                return err(format!(
+                    "transform: kind '{}' is none of tx, ty, tz, rx, ry, rz",
+                    crate::files::excerpt(other)
+                ))
+            }
+        };
+        let name = if kind.starts_with('r') {
+            format!("{kind}_deg")
+        } else {
+            kind.to_owned()
+        };
+        deprecated(
+            &format!("transform(\"{kind}\", value)"),
+            &format!("{name}(value)"),
+        );
+        Ok(new)
+    }
+
+    /// Earlier form of `universal_deg(q)`.
+    #[rhai_fn(return_raw)]
+    pub fn universal(
+        q: Numbers,
+    ) -> Result<super::super::bind_transform::Transform, Box<EvalAltResult>> {
+        deprecated("universal(q)", "universal_deg(q)");
+        super::super::bind_transform::transform_api::universal_deg(q)
+    }
+
+    /// Earlier form of the steady rest's seed formula at `z_r`.
+    #[rhai_fn(return_raw)]
+    pub fn rest_seed_u(surface: Profile, z_r: Real, r_o: Real) -> Result<Real, Box<EvalAltResult>> {
+        deprecated(
+            "rest_seed_u(surface, z_r, r_o)",
+            "rest_track(...).seed_centre_x",
+        );
+        kernel(crate::offset::rest::seed_u(&surface, z_r, r_o))
+    }
+
+    /// Earlier form of the steady rest's exact drop at `z_r`.
+    #[rhai_fn(return_raw)]
+    pub fn rest_exact_u(
+        surface: Profile,
+        z_r: Real,
+        r_o: Real,
+    ) -> Result<Real, Box<EvalAltResult>> {
+        deprecated(
+            "rest_exact_u(surface, z_r, r_o)",
+            "rest_track(...).centre_x",
+        );
+        Ok(kernel(crate::offset::rest::exact_u(&surface, z_r, r_o))?.centre_x)
+    }
+
+    /// Earlier form of `cut(ground_surface(previous), path(cz, cx), wheel,
+    /// feed, spindle_rpm)`: the surface the wheel's rounding of radius
+    /// `wheel_radius` leaves moving through `(cz, cx)` over `previous`, at
+    /// `previous`'s nodes. The old call gave no feed or spindle speed: the
+    /// ridges between turns are left out, as the old model had none.
+    #[rhai_fn(return_raw)]
+    pub fn cut(
+        previous: Profile,
+        cz: Floats,
+        cx: Floats,
+        wheel_radius: Real,
+    ) -> Result<Profile, Box<EvalAltResult>> {
+        deprecated(
+            "cut(previous, cz, cx, wheel_radius)",
+            "cut(ground_surface(previous), path(cz, cx), wheel, feed, spindle_rpm)",
+        );
+        let env = kernel(crate::offset::CircleEnvelope::new(
+            &cz.0,
+            &cx.0,
+            wheel_radius,
+            crate::offset::Side::Outside,
+        ))?;
+        let z = previous.z().to_vec();
+        let x: Vec<Real> = previous
+            .x()
+            .iter()
+            .zip(env.eval_many(&z))
+            .map(|(&a, b)| a.min(b))
+            .collect();
+        kernel(Profile::new(z, x))
+    }
+
+    /// Not kept: see the module's docs.
+    #[rhai_fn(name = "rest_track", return_raw)]
+    pub fn rest_track_profile(
+        _previous: Profile,
+        _cz: Floats,
+        _cx: Floats,
+        _wheel_radius: Real,
+        _r_o: Real,
+        _b: Real,
+    ) -> Result<Map, Box<EvalAltResult>> {
+        Err(gone(
+            "rest_track(previous, cz, cx, wheel_radius, r_o, b)",
+            "rest_track(surface, centres, wheel, steady_rest(r_o, b, sample, tolerance), feed, spindle_rpm)",
+            "the rest rides the surface the passes cut, which needs the feed and the spindle speed",
+        ))
+    }
+
+    /// Not kept: see the module's docs.
+    #[rhai_fn(name = "cut", return_raw)]
+    pub fn cut_path(
+        _previous: Profile,
+        _centres: Polyline,
+        _wheel: crate::tool::Tool,
+        _feed: Real,
+    ) -> Result<Profile, Box<EvalAltResult>> {
+        Err(gone(
+            "cut(previous, centres, wheel, feed)",
+            "cut(ground_surface(previous), centres, wheel, feed, spindle_rpm)",
+            "the surface carries each pass's ridges, which needs the spindle speed",
+        ))
+    }
+}
