@@ -17,7 +17,7 @@
 //! Both checks quote the value with its control characters escaped
 //! (`"T1)\nG00 X0 Z0 ("`), so the message shows what was refused.
 //! The writers of each dialect neutralise comments again
-//! ([`crate::program::post`]), and the lint refuses any line it cannot
+//! ([`crate::program::post()`]), and the lint refuses any line it cannot
 //! account for ([`crate::program::lint`]): three layers, each tested alone.
 
 use crate::input::InputError;

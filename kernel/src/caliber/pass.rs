@@ -161,7 +161,7 @@ fn with_seed(groove: &Groove, psi: Real, pose: PassPose) -> Result<PassPose, Gro
 /// uniform step `step` (rad) of the roll's turn (the last step shorter if
 /// the range is not a whole number of steps): each the exact pose
 /// ([`pose_at`]) whose turn is the step's, found on the contact's theta by
-/// the secant method within a bracket (Illinois, to [`TURN_TOLERANCE`]), not interpolated (MATH §3.4's
+/// the secant method within a bracket (Illinois, to `TURN_TOLERANCE`), not interpolated (MATH §3.4's
 /// re-interpolation, done exactly).
 ///
 /// # Failures

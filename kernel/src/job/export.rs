@@ -31,7 +31,7 @@ pub struct Exported {
 /// wrote them ([`RunDir::read`]: names its marker lists, no links), and
 /// checked before any work: the toolpath as a run checks it, the program's
 /// shape ([`crate::program::check_shape`]), the part bodies (plain names,
-/// each once, at most [`MAX_PART_BODIES`], their files the run's); the
+/// each once, at most `MAX_PART_BODIES`, their files the run's); the
 /// machine is the built-in the report names, or the one the caller names
 /// (`machine`, what the user gave on the command line): a plugin or a
 /// machine file named only by the report is never opened.

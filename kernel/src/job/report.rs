@@ -236,7 +236,7 @@ pub(crate) fn spreadsheet_text(text: &str) -> String {
 /// motion, axis values (the program's decimals; empty for an axis the
 /// block keeps where it stands), feed; written by the `csv` crate (RFC
 /// 4180, fields quoted where they need it), text cells as
-/// [`spreadsheet_text`] has them.
+/// `spreadsheet_text` has them.
 ///
 /// # Failures
 /// The writer failing (it writes to memory).

@@ -367,7 +367,7 @@ pub fn move_length(axes: &[&Axis], deltas: &[Real]) -> Real {
 }
 
 /// [`move_length`] on a control whose feed is the path of the axes
-/// `group` (Sinumerik `FGROUP`, [`ProgramSetup::feed_group`]): their path
+/// `group` (Sinumerik `FGROUP`, [`pilgrim_plugin_abi::types::ProgramSetup::feed_group`]): their path
 /// (mm and degrees summed alike, as the control does without `FGREF`)
 /// where one of them moves, else [`move_length`]'s.
 pub fn feed_length(axes: &[&Axis], deltas: &[Real], group: &[String]) -> Real {

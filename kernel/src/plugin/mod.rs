@@ -3,12 +3,12 @@
 //! in. How to write one: `docs/plugins.md`.
 //!
 //! A library's code never runs in the host. [`PluginMachine::load`] first
-//! reads the file ([`elf`]): a complete shared object for this machine,
+//! reads the file (`elf`): a complete shared object for this machine,
 //! its dynamic section pointing inside it, and its entry, the one function
 //! it exports named `pilgrim_plugin_*` (whatever the file is called). A
 //! bare file name is a path in the working directory, never a search of
 //! the system's library path. The library is then opened in a child
-//! process ([`remote`]: `pilgrim plugin-server`), which runs its
+//! process (`remote`: `pilgrim plugin-server`), which runs its
 //! initialisers, calls its entry and answers every later call; a crash, an
 //! abort, an exit or a hang there is an error naming the library and what
 //! it did, within a time bound ([`Bounds`]), and the host goes on.

@@ -1,6 +1,6 @@
 //! The child process side: `pilgrim plugin-server LIB SYMBOL` opens the
 //! library, calls its entry and answers the host's requests
-//! ([`super::wire`]) until the host closes the pipe.
+//! (`plugin::wire`) until the host closes the pipe.
 //!
 //! Before anything of the library runs, the protocol moves off the standard
 //! streams (a plugin that prints to standard output cannot garble it: its

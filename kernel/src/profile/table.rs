@@ -130,7 +130,7 @@ enum Cell {
     Empty,
 }
 
-/// A table of cells with optional headers. See the [module docs](self).
+/// A table of cells with optional headers. See the module docs (`profile::table`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Table {
     source: String,

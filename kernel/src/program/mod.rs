@@ -6,7 +6,7 @@
 //! [`Toolpath`] by a [`MachineKinematics`] ([`build`]: inverse kinematics of
 //! every point in one batch, then travel and feed checks naming the block
 //! and axis), and written as text by a [`PostProcessor`]: the shared writer
-//! in a control's dialect ([`post`]), or a plugin's own.
+//! in a control's dialect ([`post()`]), or a plugin's own.
 
 pub mod lint;
 pub mod post;
@@ -387,7 +387,7 @@ fn rotary_feeds(blocks: &mut [Block], axes: &[&Axis], toolpath: &Toolpath, info:
 /// it), values in program units; the machine's start before the first
 /// point (its axes cleared, then brought in, group by group, as its setup
 /// says: [`ProgramSetup`]) and its end after the last; then every word
-/// checked against the machine: travel, feeds ([`rotary_feeds`] where a
+/// checked against the machine: travel, feeds (`rotary_feeds` where a
 /// rotary axis moves) (each axis's and the
 /// least), the spindle's speed. Every pass's first block carries the
 /// pass's name as a comment; the start's and the end's blocks carry

@@ -394,7 +394,7 @@ impl ScriptFamily {
     /// Loads a family from source text; `file` names it in errors.
     ///
     /// # Failures
-    /// As [`Family::load`].
+    /// As [`ScriptFamily::load`].
     pub fn from_source(
         source: &str,
         file: &str,

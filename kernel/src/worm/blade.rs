@@ -27,8 +27,8 @@ pub const BLADE_THICKNESS: Real = 6.0;
 /// which its tip stands back from the cutting plane's (deg).
 pub const BLADE_RELIEF_DEG: Real = 3.0;
 
-/// A thread cutter's blade standing in a thread: see the [module
-/// docs](self).
+/// A thread cutter's blade standing in a thread: see the module docs
+/// (`worm::blade`).
 #[derive(Debug, Clone)]
 pub struct ThreadBlade {
     outline: Section,

@@ -189,7 +189,7 @@ pub struct PlannedPass {
     /// The chip area the plan expects (mm^2): for a roughing or finishing
     /// pass a radial infeed of this cutter from the last depth (the law's
     /// area), for a side step the area it removes beside the passes before
-    /// it at its start ([`side_step_areas`]).
+    /// it at its start (`side_step_areas`).
     pub planned_area: Real,
 }
 
