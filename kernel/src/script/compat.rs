@@ -49,28 +49,34 @@ fn gone(old: &str, new: &str, why: &str) -> Box<EvalAltResult> {
     format!("{old} is an earlier release's form and no longer callable ({why}): use {new}").into()
 }
 
-/// Earlier releases' names and shapes of today's functions.
+/// Earlier releases' names and shapes of today's functions: each says so
+/// and calls today's binding, reshaping only what the old form took or
+/// gave.
 #[export_module]
 pub mod compat_api {
     use super::*;
+    use crate::script::bind_offset::offset_api;
+    use crate::script::bind_profile::{path_api, profile_api};
+    use crate::script::bind_transform::{transform_api, Transform};
+    use crate::script::floats::floats_api;
 
     /// Earlier form of `raised(p, z_from, z_to, dx)`.
     #[rhai_fn(return_raw)]
     pub fn raise(
-        p: Profile,
+        mut p: Profile,
         z_from: Real,
         z_to: Real,
         dx: Real,
     ) -> Result<Profile, Box<EvalAltResult>> {
         deprecated("raise(p, z_from, z_to, dx)", "raised(p, z_from, z_to, dx)");
-        kernel(p.raised(z_from, z_to, dx))
+        profile_api::raised(&mut p, z_from, z_to, dx)
     }
 
     /// Earlier form of `resampled(p, step)`.
     #[rhai_fn(pure, return_raw)]
     pub fn resample(p: &mut Profile, step: Real) -> Result<Profile, Box<EvalAltResult>> {
         deprecated("resample(p, step)", "resampled(p, step)");
-        kernel(p.resample_uniform(step))
+        profile_api::resampled(p, step)
     }
 
     /// Earlier form of `smoothed(p, iterations, anchor)`: a map
@@ -85,10 +91,7 @@ pub mod compat_api {
             "smooth(p, iterations, anchor)",
             "smoothed(p, iterations, anchor)",
         );
-        if iterations < 0 || anchor < 0 {
-            return err("smooth: iterations and anchor must not be negative");
-        }
-        let s = kernel(p.smooth_derivative(iterations as usize, anchor as usize))?;
+        let s = profile_api::smoothed(p, iterations, anchor)?;
         let mut m = Map::new();
         m.insert("max_change".into(), Dynamic::from_float(s.max_change));
         m.insert("max_change_z".into(), Dynamic::from_float(s.max_change_z));
@@ -100,23 +103,22 @@ pub mod compat_api {
     #[rhai_fn(pure)]
     pub fn dx(law: &mut MandrelLaw, z: Real) -> Real {
         deprecated("dx(law, z)", "slope(law, z)");
-        law.dx(z)
+        profile_api::law_slope(law, z)
     }
 
     /// Earlier form of `reversed(v)`.
     #[rhai_fn(name = "reverse", pure)]
     pub fn reverse_floats(v: &mut Floats) -> Floats {
         deprecated("reverse(v) of Floats", "reversed(v)");
-        Floats::new(v.0.iter().rev().copied().collect())
+        floats_api::reversed(v)
     }
 
     /// Earlier form of `path(z, x).simplified(tol)`: a map `#{ z, x }`.
     #[rhai_fn(return_raw)]
     pub fn simplify(z: Floats, x: Floats, tol: Real) -> Result<Map, Box<EvalAltResult>> {
         deprecated("simplify(z, x, tol)", "path(z, x).simplified(tol)");
-        let p = kernel(Polyline::new(z.0.to_vec(), x.0.to_vec()))?;
-        kernel(crate::math::positive("simplify tolerance", tol))?;
-        let p = p.simplified(tol);
+        let mut p = path_api::path(Dynamic::from(z), Dynamic::from(x))?;
+        let p = path_api::simplified(&mut p, tol)?;
         let mut m = Map::new();
         m.insert("z".into(), Dynamic::from(Floats::new(p.z)));
         m.insert("x".into(), Dynamic::from(Floats::new(p.x)));
@@ -135,30 +137,21 @@ pub mod compat_api {
             "envelope(zc, xc, radius, at)",
             "envelope(path(zc, xc), radius, at)",
         );
-        let env = kernel(crate::offset::CircleEnvelope::new(
-            &zc.0,
-            &xc.0,
-            radius,
-            crate::offset::Side::Outside,
-        ))?;
-        Ok(Floats::new(env.eval_many(&at.0)))
+        let centres = path_api::path(Dynamic::from(zc), Dynamic::from(xc))?;
+        offset_api::envelope(centres, radius, Dynamic::from(at))
     }
 
     /// Earlier form of `rx_deg`, `ry_deg`, `rz_deg`, `tx`, `ty`, `tz`:
     /// `kind` "tx", "ty", "tz" (mm) or "rx", "ry", "rz" (degrees).
     #[rhai_fn(return_raw)]
-    pub fn transform(
-        kind: &str,
-        value: Real,
-    ) -> Result<super::super::bind_transform::Transform, Box<EvalAltResult>> {
-        use super::super::bind_transform::transform_api as t;
-        let new = match kind {
-            "tx" => t::tx(value),
-            "ty" => t::ty(value),
-            "tz" => t::tz(value),
-            "rx" => t::rx_deg(value),
-            "ry" => t::ry_deg(value),
-            "rz" => t::rz_deg(value),
+    pub fn transform(kind: &str, value: Real) -> Result<Transform, Box<EvalAltResult>> {
+        let (new, name): (fn(Real) -> Transform, &str) = match kind {
+            "tx" => (transform_api::tx, "tx"),
+            "ty" => (transform_api::ty, "ty"),
+            "tz" => (transform_api::tz, "tz"),
+            "rx" => (transform_api::rx_deg, "rx_deg"),
+            "ry" => (transform_api::ry_deg, "ry_deg"),
+            "rz" => (transform_api::rz_deg, "rz_deg"),
             other => {
                 return err(format!(
                     "transform: kind '{}' is none of tx, ty, tz, rx, ry, rz",
@@ -166,25 +159,18 @@ pub mod compat_api {
                 ))
             }
         };
-        let name = if kind.starts_with('r') {
-            format!("{kind}_deg")
-        } else {
-            kind.to_owned()
-        };
         deprecated(
             &format!("transform(\"{kind}\", value)"),
             &format!("{name}(value)"),
         );
-        Ok(new)
+        Ok(new(value))
     }
 
     /// Earlier form of `universal_deg(q)`.
     #[rhai_fn(return_raw)]
-    pub fn universal(
-        q: Numbers,
-    ) -> Result<super::super::bind_transform::Transform, Box<EvalAltResult>> {
+    pub fn universal(q: Numbers) -> Result<Transform, Box<EvalAltResult>> {
         deprecated("universal(q)", "universal_deg(q)");
-        super::super::bind_transform::transform_api::universal_deg(q)
+        transform_api::universal_deg(q)
     }
 
     /// Earlier form of the steady rest's seed formula at `z_r`.
@@ -214,8 +200,9 @@ pub mod compat_api {
     /// Earlier form of `cut(ground_surface(previous), path(cz, cx), wheel,
     /// feed, spindle_rpm)`: the surface the wheel's rounding of radius
     /// `wheel_radius` leaves moving through `(cz, cx)` over `previous`, at
-    /// `previous`'s nodes. The old call gave no feed or spindle speed: the
-    /// ridges between turns are left out, as the old model had none.
+    /// `previous`'s nodes (the lower of the two: `envelope`'s). The old
+    /// call gave no feed or spindle speed: the ridges between turns are
+    /// left out, as the old model had none.
     #[rhai_fn(return_raw)]
     pub fn cut(
         previous: Profile,
@@ -227,20 +214,16 @@ pub mod compat_api {
             "cut(previous, cz, cx, wheel_radius)",
             "cut(ground_surface(previous), path(cz, cx), wheel, feed, spindle_rpm)",
         );
-        let env = kernel(crate::offset::CircleEnvelope::new(
-            &cz.0,
-            &cx.0,
-            wheel_radius,
-            crate::offset::Side::Outside,
-        ))?;
-        let z = previous.z().to_vec();
+        let centres = path_api::path(Dynamic::from(cz), Dynamic::from(cx))?;
+        let z = Floats::new(previous.z().to_vec());
+        let env = offset_api::envelope(centres, wheel_radius, Dynamic::from(z.clone()))?;
         let x: Vec<Real> = previous
             .x()
             .iter()
-            .zip(env.eval_many(&z))
-            .map(|(&a, b)| a.min(b))
+            .zip(env.0.iter())
+            .map(|(&a, &b)| a.min(b))
             .collect();
-        kernel(Profile::new(z, x))
+        kernel(Profile::new(z.0.to_vec(), x))
     }
 
     /// Not kept: see the module's docs.
