@@ -632,38 +632,57 @@ impl Groove {
     /// # Failures
     /// `theta` outside the tables.
     pub fn point(&self, theta: Real, psi: Real) -> Result<Vec3, GrooveError> {
-        let (x_a, z_a) = self.section(theta)?.point(psi);
+        Ok(self.placed(theta, self.section(theta)?.point(psi)))
+    }
+
+    /// A point `(x_A, z_A)` of the section at `theta` in the roll's frame.
+    fn placed(&self, theta: Real, (x_a, z_a): (Real, Real)) -> Vec3 {
         let rho = self.r_d - z_a;
-        Ok(Vec3::new(rho * theta.cos(), rho * theta.sin(), x_a))
+        Vec3::new(rho * theta.cos(), rho * theta.sin(), x_a)
     }
 
     /// The groove's unit normal at `(theta, psi)`, out of the roll's
-    /// material into the groove's open space (toward a wheel in it), from
-    /// the surface's partial derivatives (central differences of 1e-6 rad,
-    /// one-sided at the tables' ends); at a chamfer's corner, where the
-    /// point stands while psi turns the normal, the section's own tangent
-    /// takes the place of the derivative along psi. Turned to the side the
-    /// section's normal opens to.
+    /// material into the groove's open space (toward a wheel in it): the
+    /// second of [`Self::frame`].
     ///
     /// # Failures
     /// `theta` outside the tables.
     pub fn normal(&self, theta: Real, psi: Real) -> Result<Vec3, GrooveError> {
+        Ok(self.frame(theta, psi)?.1)
+    }
+
+    /// The groove at `(theta, psi)`: its point, its unit normal out of the
+    /// roll's material into the groove's open space (toward a wheel in
+    /// it), and the point's derivative along theta (the contact's
+    /// trajectory along a pass), from the surface's partial derivatives
+    /// (central differences of 1e-6 rad, one-sided at the tables' ends;
+    /// the section at `theta` evaluated once for its own three points). At
+    /// a chamfer's corner, where the point stands while psi turns the
+    /// normal, the section's own tangent takes the place of the derivative
+    /// along psi. The normal is turned to the side the section's normal
+    /// opens to.
+    ///
+    /// # Failures
+    /// `theta` outside the tables.
+    pub fn frame(&self, theta: Real, psi: Real) -> Result<(Vec3, Vec3, Vec3), GrooveError> {
+        let s = self.section(theta)?;
         let (t0, t1) = self.theta_pair(theta);
         let d_theta = (self.point(t1, psi)? - self.point(t0, psi)?) / (t1 - t0);
-        let mut d_psi = (self.point(theta, psi + DIFF_STEP)?
-            - self.point(theta, psi - DIFF_STEP)?)
+        let mut d_psi = (self.placed(theta, s.point(psi + DIFF_STEP))
+            - self.placed(theta, s.point(psi - DIFF_STEP)))
             / (2.0 * DIFF_STEP);
         // The section's normal into the material at psi, from the depth
         // direction: its tangent and the side it opens to, in 3-D (depth
         // is inward along the radius).
-        let phi = self.section(theta)?.normal_angle(psi);
+        let phi = s.normal_angle(psi);
         let radial = Vec3::new(theta.cos(), theta.sin(), 0.0);
         let open = -phi.sin() * Vec3::z() + phi.cos() * radial;
         if !(d_psi.norm() > 1e-9) {
             d_psi = phi.cos() * Vec3::z() + phi.sin() * radial;
         }
         let n = d_theta.cross(&d_psi).normalize();
-        Ok(if n.dot(&open) >= 0.0 { n } else { -n })
+        let n = if n.dot(&open) >= 0.0 { n } else { -n };
+        Ok((self.placed(theta, s.point(psi)), n, d_theta))
     }
 
     /// The angles either side of `theta` that derivatives along theta are

@@ -82,11 +82,8 @@ fn exact_at(
     r_k: Real,
     plane: SwivelPlane,
 ) -> Result<PassPose, GrooveError> {
-    let p = groove.point(theta, psi)?;
-    let n = groove.normal(theta, psi)?;
-    let (t0, t1) = groove.theta_pair(theta);
-    // The contact's trajectory along the pass.
-    let tangent = (groove.point(t1, psi)? - groove.point(t0, psi)?) / (t1 - t0);
+    // The contact, the normal and the contact's trajectory along the pass.
+    let (p, n, tangent) = groove.frame(theta, psi)?;
     let axis_for = |turn: Real| -> Result<Vec3, GrooveError> {
         let w = tangent.cross(&radial(turn));
         if !(w.norm() > 1e-9 * tangent.norm()) {
