@@ -2,7 +2,7 @@
 //! angles, the groove cut in its periphery (for `caliber.stl`).
 
 use super::groove::{Groove, GrooveError};
-use super::section::EdgeKind;
+use super::section::{EdgeKind, GrooveSection};
 use crate::math::Real;
 use crate::mesh::{MeshError, TriMesh};
 
@@ -42,10 +42,44 @@ pub struct Roll {
 enum Piece {
     /// A straight line between two corners of the section.
     Line(Corner, Corner),
-    /// The groove between two angles: the edge (`-1` left, `1` right) or
-    /// where its rounding or chamfer begins (`-0.5`, `0.5`).
-    Groove(Real, Real),
+    /// A stretch of the groove.
+    Groove(Span),
 }
+
+/// A stretch of the groove in a section.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Span {
+    /// Edge to edge: a sharp-edged groove.
+    Whole,
+    /// The ellipse, between the joints of the edges' rounding or chamfer.
+    Ellipse,
+    /// The left edge's rounding or chamfer, from the periphery.
+    LeftEdge,
+    /// The right edge's, to the periphery.
+    RightEdge,
+}
+
+/// The pieces of a section with sharp edges, in order round it.
+const SHARP: [Piece; 6] = [
+    Piece::Line(Corner::LeftHub, Corner::LeftTop),
+    Piece::Line(Corner::LeftTop, Corner::LeftEdge),
+    Piece::Groove(Span::Whole),
+    Piece::Line(Corner::RightEdge, Corner::RightTop),
+    Piece::Line(Corner::RightTop, Corner::RightHub),
+    Piece::Line(Corner::RightHub, Corner::LeftHub),
+];
+
+/// The pieces of a section whose edges are rounded or chamfered.
+const EDGED: [Piece; 8] = [
+    Piece::Line(Corner::LeftHub, Corner::LeftTop),
+    Piece::Line(Corner::LeftTop, Corner::LeftEdge),
+    Piece::Groove(Span::LeftEdge),
+    Piece::Groove(Span::Ellipse),
+    Piece::Groove(Span::RightEdge),
+    Piece::Line(Corner::RightEdge, Corner::RightTop),
+    Piece::Line(Corner::RightTop, Corner::RightHub),
+    Piece::Line(Corner::RightHub, Corner::LeftHub),
+];
 
 /// A corner of the roll's section.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -92,41 +126,62 @@ impl Roll {
     }
 
     /// The section's pieces, in order round it.
-    fn pieces_list(&self) -> Vec<Piece> {
-        use Corner::*;
-        let mut list = vec![
-            Piece::Line(LeftHub, LeftTop),
-            Piece::Line(LeftTop, LeftEdge),
-        ];
+    fn pieces_list(&self) -> &'static [Piece] {
         if self.groove.edge().is_some() {
-            list.extend([
-                Piece::Groove(-1.0, -0.5),
-                Piece::Groove(-0.5, 0.5),
-                Piece::Groove(0.5, 1.0),
-            ]);
+            &EDGED
         } else {
-            list.push(Piece::Groove(-1.0, 1.0));
+            &SHARP
         }
-        list.extend([
-            Piece::Line(RightEdge, RightTop),
-            Piece::Line(RightTop, RightHub),
-            Piece::Line(RightHub, LeftHub),
-        ]);
-        list
     }
 
-    /// The groove's angle psi (rad) at the section's mark `m` (as
-    /// [`Piece::Groove`] gives them) at `theta`.
-    fn psi_at(&self, theta: Real, m: Real) -> Real {
+    /// Whether a stretch of the groove is straight in every section: a
+    /// chamfer (its corners are its ends).
+    fn straight_span(&self, span: Span) -> bool {
+        matches!(span, Span::LeftEdge | Span::RightEdge)
+            && matches!(self.groove.edge(), Some((EdgeKind::Chamfer, _)))
+    }
+
+    /// The stretch `span` of the groove in the section `s`: psi from and
+    /// to (rad).
+    fn psi_range(s: &GrooveSection, span: Span) -> (Real, Real) {
         use std::f64::consts::FRAC_PI_2;
-        if m.abs() == 1.0 {
-            return m * FRAC_PI_2;
+        let e = s.edge_from();
+        match span {
+            Span::Whole => (-FRAC_PI_2, FRAC_PI_2),
+            Span::Ellipse => (-e, e),
+            Span::LeftEdge => (-FRAC_PI_2, -e),
+            Span::RightEdge => (e, FRAC_PI_2),
         }
-        let from = self
-            .groove
-            .section(theta)
-            .map_or(Real::NAN, |s| s.edge_from());
-        2.0 * m * from
+    }
+
+    /// The points `(x, rho)` of the stretch `span` of the section at
+    /// `theta` at each of `at` across it, fractions `(j, n)` of its range
+    /// (`j / n`, taken as `(to - from) * j / n`): evenly in psi, or along
+    /// the straight chord of a chamfer (psi stands at each of its corners
+    /// while the normal turns). NaN where the section cannot be evaluated.
+    fn span_points(&self, theta: Real, span: Span, at: &[(Real, Real)]) -> Vec<(Real, Real)> {
+        let Ok(s) = self.groove.section(theta) else {
+            return vec![(Real::NAN, Real::NAN); at.len()];
+        };
+        let r_d = self.groove.roll_radius();
+        let point = |psi: Real| {
+            let (x, z) = s.point(psi);
+            (x, r_d - z)
+        };
+        let (from, to) = Self::psi_range(&s, span);
+        if self.straight_span(span) {
+            let (a, b) = (point(from), point(to));
+            at.iter()
+                .map(|&(j, n)| {
+                    let u = j / n;
+                    (a.0 + u * (b.0 - a.0), a.1 + u * (b.1 - a.1))
+                })
+                .collect()
+        } else {
+            at.iter()
+                .map(|&(j, n)| point(from + (to - from) * j / n))
+                .collect()
+        }
     }
 
     /// The groove's point at `psi` in the section at `theta`, `(x, rho)`.
@@ -187,8 +242,8 @@ impl Roll {
         // or between the edges' joints) or an edge's; a line's start.
         let points_of = |p: &Piece| match *p {
             Piece::Line(..) => 1,
-            Piece::Groove(a, b) if a == -b => n_ellipse,
-            Piece::Groove(..) => n_edge,
+            Piece::Groove(Span::Whole | Span::Ellipse) => n_ellipse,
+            Piece::Groove(_) => n_edge,
         };
         let per_ring: usize = pieces.iter().map(points_of).sum();
         crate::mesh::check_triangles(2 * (n_theta + 1) * per_ring, tol)?;
@@ -198,16 +253,18 @@ impl Roll {
                 let v = i as Real / n_theta as Real;
                 let theta = self.theta(v);
                 let mut ring = Vec::with_capacity(per_ring);
-                for p in &pieces {
+                for p in pieces {
                     match *p {
                         Piece::Line(a, _) => ring.push(self.xyz(self.corner(a, theta), theta)),
-                        Piece::Groove(a, b) => {
+                        Piece::Groove(span) => {
                             let n = points_of(p);
-                            let (from, to) = (self.psi_at(theta, a), self.psi_at(theta, b));
-                            ring.extend((0..n).map(|j| {
-                                let psi = from + (to - from) * j as Real / n as Real;
-                                self.xyz(self.groove_at(theta, psi), theta)
-                            }));
+                            let at: Vec<(Real, Real)> =
+                                (0..n).map(|j| (j as Real, n as Real)).collect();
+                            ring.extend(
+                                self.span_points(theta, span, &at)
+                                    .into_iter()
+                                    .map(|q| self.xyz(q, theta)),
+                            );
                         }
                     }
                 }
@@ -241,30 +298,18 @@ impl crate::step::Sections for Roll {
     fn straight(&self, k: usize) -> bool {
         match self.pieces_list()[k] {
             Piece::Line(..) => true,
-            // A chamfer (its corners are its ends).
-            Piece::Groove(a, b) => {
-                a.abs() + b.abs() == 1.5
-                    && matches!(self.groove.edge(), Some((EdgeKind::Chamfer, _)))
-            }
+            Piece::Groove(span) => self.straight_span(span),
         }
     }
 
     fn point(&self, k: usize, u: Real, v: Real) -> [Real; 3] {
         let theta = self.theta(v);
-        let lerp =
-            |a: (Real, Real), b: (Real, Real)| (a.0 + u * (b.0 - a.0), a.1 + u * (b.1 - a.1));
         let p = match self.pieces_list()[k] {
-            Piece::Line(a, b) => lerp(self.corner(a, theta), self.corner(b, theta)),
-            Piece::Groove(a, b) => {
-                let (from, to) = (self.psi_at(theta, a), self.psi_at(theta, b));
-                if self.straight(k) {
-                    // A chamfer, evenly between its corners (psi stands
-                    // at each corner while the normal turns).
-                    lerp(self.groove_at(theta, from), self.groove_at(theta, to))
-                } else {
-                    self.groove_at(theta, from + (to - from) * u)
-                }
+            Piece::Line(a, b) => {
+                let (a, b) = (self.corner(a, theta), self.corner(b, theta));
+                (a.0 + u * (b.0 - a.0), a.1 + u * (b.1 - a.1))
             }
+            Piece::Groove(span) => self.span_points(theta, span, &[(u, 1.0)])[0],
         };
         self.xyz(p, theta)
     }
