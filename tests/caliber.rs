@@ -423,6 +423,46 @@ fn the_sizing_section_is_held_through_the_smoothing() {
     );
 }
 
+/// The verification measures the groove the run was asked for: the
+/// tables interpolated between rows as `interpolation` says, the edges as
+/// `edge_r` or `edge_c` say (the toolpath and the verification build it by
+/// the script's one `smoothing(p)`).
+#[test]
+fn the_verification_measures_the_groove_asked_for() {
+    use pilgrim_kernel::caliber::EdgeKind;
+    use pilgrim_kernel::Interpolation;
+    let fam =
+        ScriptFamily::load(&root().join(SCRIPT), &Limits::default(), &Access::default()).unwrap();
+    for (sets, interpolation, edge) in [
+        (vec![], Interpolation::Monotone, None),
+        (
+            vec![("interpolation", "linear")],
+            Interpolation::Linear,
+            None,
+        ),
+        (
+            vec![("interpolation", "parabolic"), ("edge_r", "2")],
+            Interpolation::Parabolic,
+            Some(EdgeKind::Rounding),
+        ),
+        (
+            vec![("edge_c", "1.5")],
+            Interpolation::Monotone,
+            Some(EdgeKind::Chamfer),
+        ),
+    ] {
+        let values = common::params_from(&fam, &Default::default(), None, &sets);
+        let Some(Verification::Groove(req)) = fam.verification(&values).unwrap() else {
+            panic!("the caliber asks for the groove's replay")
+        };
+        assert_eq!(req.groove.interpolation(), interpolation, "{sets:?}");
+        assert_eq!(req.groove.edge().map(|e| e.0), edge, "{sets:?}");
+        if let Some((_, size)) = req.groove.edge() {
+            assert_eq!(size.interpolation(), interpolation, "{sets:?}");
+        }
+    }
+}
+
 /// A block moved 0.05 mm off its place in the program: the replay names
 /// it (on a coarse job, for time).
 #[test]
