@@ -3,7 +3,7 @@
 //! LZ-250's figure, a corrupted block named by the verification, and bad
 //! input refused with no output.
 
-mod common;
+use crate::common;
 
 use common::{pilgrim, pilgrim_in, root, s, scratch};
 use lz_250::CaliberKinematics;

@@ -6,7 +6,7 @@
 use std::os::unix::fs::symlink;
 use std::path::{Path, PathBuf};
 
-mod common;
+use crate::common;
 use common::{pilgrim, s};
 
 const DEMO: &str = "scripts/examples/mill_circle.rhai";

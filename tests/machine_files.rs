@@ -6,7 +6,7 @@
 //! the bottom pass and the sizing section), which the generic solver must
 //! settle as the plugin does.
 
-mod common;
+use crate::common;
 
 use common::{pilgrim, s, scratch};
 

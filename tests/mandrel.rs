@@ -7,7 +7,7 @@ use pilgrim_kernel::{MandrelLaw, Params, PartFamily, Profile, Side, Toolpath};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-mod common;
+use crate::common;
 use common::{grinder, params_on};
 
 const R_S: f64 = 20.0;

@@ -14,7 +14,7 @@ use pilgrim_kernel::{Params, PartFamily, PartGeometry};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-mod common;
+use crate::common;
 use common::grinder;
 
 fn family() -> ScriptFamily {

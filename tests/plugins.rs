@@ -9,7 +9,7 @@ use pilgrim_kernel::{equidistant, ClPoint, MandrelLaw, Motion, Pass, Side, Tool,
 use pilgrim_plugin_abi::{CAP_ABI_1_0, CAP_FORWARD, CAP_INVERSE};
 use std::path::PathBuf;
 
-mod common;
+use crate::common;
 use common::{grinder as built_in, shared_lib as lib};
 
 /// The fixture library under another name, selecting its entry. A copy is

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-mod common;
+use crate::common;
 use common::{pilgrim, s};
 
 /// The files of the page's blocks marked `file=NAME`, by name.

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-mod common;
+use crate::common;
 #[path = "../kernel/tests/support/ods.rs"]
 mod ods;
 use common::{pilgrim, pilgrim_in, root, s};

@@ -4,7 +4,7 @@
 //! program read by LinuxCNC's own interpreter, and bad input refused with
 //! no output.
 
-mod common;
+use crate::common;
 
 use common::{pilgrim, s, scratch};
 use pilgrim_kernel::plugin::PluginMachine;

@@ -28,21 +28,11 @@ pub fn shared_lib(name: &str) -> PathBuf {
         );
         let dir = artifact_dir();
         let mut cmd = std::process::Command::new(env!("CARGO"));
-        cmd.args([
-            "build",
-            "--lib",
-            "-p",
-            "pilgrim-grinder-3k152vf20",
-            "-p",
-            "pilgrim-plugin-fixture",
-            "-p",
-            "pilgrim-lz-250",
-            "-p",
-            "pilgrim-mannesmann",
-            "-p",
-            "pilgrim-fanuc-0i-tc",
-        ])
-        .current_dir(env!("CARGO_MANIFEST_DIR"));
+        // The workspace's libraries, programs and tests, as `cargo test
+        // --workspace` selects them: the same features, so nothing is
+        // built a second time with others (only the cdylibs are new).
+        cmd.args(["build", "--workspace", "--lib", "--bins", "--tests"])
+            .current_dir(env!("CARGO_MANIFEST_DIR"));
         if dir.file_name().is_some_and(|n| n == "release") {
             cmd.arg("--release");
         }

@@ -212,17 +212,10 @@ fn plugin_artifacts() -> std::path::PathBuf {
                 .to_owned();
             let profile = dir.file_name().unwrap().to_string_lossy().into_owned();
             let mut cmd = std::process::Command::new(env!("CARGO"));
-            cmd.args([
-                "build",
-                "--bin",
-                "pilgrim",
-                "-p",
-                "pilgrim",
-                "--lib",
-                "-p",
-                "pilgrim-plugin-fixture",
-            ])
-            .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."));
+            // As `cargo test --workspace` selects them: the same features,
+            // so nothing is built a second time with others.
+            cmd.args(["build", "--workspace", "--lib", "--bins", "--tests"])
+                .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."));
             if profile != "debug" {
                 cmd.args([
                     "--profile",
