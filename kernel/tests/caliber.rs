@@ -460,7 +460,11 @@ fn a_bad_edge_rounding_is_named() {
         .with_edge(pilgrim_kernel::caliber::EdgeKind::Rounding, &[2.0; 80])
         .unwrap_err()
         .to_string();
-    assert!(e.contains("81") && e.contains("80"), "{e}");
+    // The sizes are the edge's, not B's.
+    assert!(
+        e.contains("81") && e.contains("80") && e.contains("r_edge") && !e.contains(" in B"),
+        "{e}"
+    );
 }
 
 /// The caliber's solid: the example groove's roll sector is a closed mesh

@@ -28,12 +28,16 @@ pub enum GrooveError {
         b_theta: Real,
     },
     /// The tables of different lengths.
-    #[error("the groove tables Hp and B must have the same rows: {hp} in Hp, {b} in B")]
+    #[error(
+        "the groove tables Hp and {table} must have the same rows: {hp} in Hp, {rows} in {table}"
+    )]
     DifferentRows {
         /// Rows of Hp.
         hp: usize,
-        /// Rows of B.
-        b: usize,
+        /// The other table: `B`, or the edge's sizes.
+        table: &'static str,
+        /// Its rows.
+        rows: usize,
     },
     /// A depth or width that is not positive, or a depth through the roll.
     #[error(
@@ -110,7 +114,8 @@ impl Groove {
         if ht.len() != bt.len() || hp.len() != b.len() || ht.len() != hp.len() {
             return Err(GrooveError::DifferentRows {
                 hp: ht.len().min(hp.len()),
-                b: bt.len().min(b.len()),
+                table: "B",
+                rows: bt.len().min(b.len()),
             });
         }
         if let Some(i) = (0..ht.len()).find(|&i| ht[i] != bt[i]) {
@@ -168,7 +173,8 @@ impl Groove {
         if sizes.len() != theta.len() {
             return Err(GrooveError::DifferentRows {
                 hp: theta.len(),
-                b: sizes.len(),
+                table: kind.name(),
+                rows: sizes.len(),
             });
         }
         let value = |i: usize, expected: String| GrooveError::Value {
@@ -334,7 +340,7 @@ impl Groove {
                     ),
                 }
             }
-            GrooveError::DifferentRows { hp: h, b: n } => GrooveError::File {
+            GrooveError::DifferentRows { hp: h, rows: n, .. } => GrooveError::File {
                 file: hp.0.source().to_owned(),
                 message: format!(
                     "{h} rows of Hp, but {} has {n} rows of B: the tables must be at the same angles",
