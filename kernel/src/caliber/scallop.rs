@@ -52,9 +52,7 @@ pub fn step_for_scallop(r_section: Real, r_k: Real, rz: Real) -> Result<Real, In
             format!("below the rounding radius r_k = {r_k} mm"),
         ));
     }
-    let rho = r_section - rz;
-    let c = ((rho * rho + d * d - r_k * r_k) / (2.0 * rho * d)).clamp(-1.0, 1.0);
-    Ok(2.0 * c.acos())
+    Ok(cusp_step(r_section - rz, d, r_k))
 }
 
 /// The largest pass step (rad of the rounding circles' angle about their
@@ -72,9 +70,16 @@ pub fn step_for_scallop_convex(r_arc: Real, r_k: Real, rz: Real) -> Result<Real,
     positive("edge rounding radius", r_arc)?;
     positive("wheel rounding radius r_k", r_k)?;
     positive("scallop height Rz", rz)?;
-    let (rho, d) = (r_arc + rz, r_arc + r_k);
+    Ok(cusp_step(r_arc + rz, r_arc + r_k, r_k))
+}
+
+/// The angle between two rounding centres `d` from a section's centre
+/// whose circles (radius `r_k`) meet on the bisector `rho` from it:
+/// `2 acos((rho^2 + d^2 - r_k^2) / (2 rho d))`, the law of cosines in the
+/// triangle of the section's centre, a rounding centre and the cusp.
+fn cusp_step(rho: Real, d: Real, r_k: Real) -> Real {
     let c = ((rho * rho + d * d - r_k * r_k) / (2.0 * rho * d)).clamp(-1.0, 1.0);
-    Ok(2.0 * c.acos())
+    2.0 * c.acos()
 }
 
 fn centre_distance(r_section: Real, r_k: Real) -> Result<Real, InputError> {
