@@ -473,7 +473,7 @@ impl Groove {
 
     /// The tables' angles and the midpoints between them (rad): where
     /// properties of every section are sampled.
-    fn rows_and_midpoints(&self) -> Vec<Real> {
+    pub(super) fn rows_and_midpoints(&self) -> Vec<Real> {
         let z = self.hp.z();
         let mut at = Vec::with_capacity(2 * z.len());
         for i in 0..z.len() {

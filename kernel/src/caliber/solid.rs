@@ -338,11 +338,8 @@ pub fn caliber_solid(
 /// The widest the groove is, its edges included, and the
 /// deepest, over its tables' rows and the midpoints between them (mm).
 fn extremes(groove: &Groove) -> Result<(Real, Real), GrooveError> {
-    let (t0, t1) = groove.theta_range();
-    let n = 2 * groove.depth().len();
     let mut widest = max(groove.width());
-    for i in 0..=n {
-        let t = t0 + (t1 - t0) * i as Real / n as Real;
+    for t in groove.rows_and_midpoints() {
         widest = widest.max(2.0 * groove.section(t)?.edge_x());
     }
     Ok((widest, max(groove.depth())))
