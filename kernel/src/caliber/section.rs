@@ -155,14 +155,11 @@ impl GrooveSection {
             }
         }
         let s = Self { ellipse, edge };
-        if let Some(Shape::Chamfer { phi_e, j, .. }) = s.shape() {
+        if let (Edge::Chamfered(c), Some(Shape::Chamfer { phi_e, j, .. })) = (edge, s.shape()) {
             if !(phi_e > FRAC_PI_4) {
                 return Err(InputError::out_of_range(
                     "the groove edge's 45 deg chamfer c_edge (mm)",
-                    match edge {
-                        Edge::Chamfered(c) => c,
-                        _ => unreachable!("a chamfer's shape"),
-                    },
+                    c,
                     format!(
                         "small enough to meet the groove's wall where it is steeper than 45 deg (it meets it {:.3} mm deep, {:.3} mm from the middle, where the wall is at {:.1} deg: a concave corner)",
                         j.1,
@@ -391,10 +388,6 @@ fn rounding(e: &EllipseSection, r: Real) -> Shape {
     }
 }
 
-/// The chamfer `c` x 45 deg: the line from the periphery to where it first
-/// meets the ellipse ([`chamfer_depth`]). The range of `psi` beyond the
-/// joint is shared by the first corner, the line and the second corner as
-/// `c` times each corner's turn against the line's length.
 /// How deep the chamfer `c` x 45 deg meets the ellipse: the line
 /// `(a + c - s, s)` (`s` deep) from the periphery first meets it at
 /// `s^2 (1/a^2 + 1/b^2) - 2 s (a + c) / a^2 + (a + c)^2 / a^2 - 1 = 0`, the
@@ -411,6 +404,10 @@ fn chamfer_depth(e: &EllipseSection, c: Real) -> Real {
     2.0 * qc / (-qb + disc.sqrt())
 }
 
+/// The chamfer `c` x 45 deg: the line from the periphery to where it first
+/// meets the ellipse ([`chamfer_depth`]). The range of `psi` beyond the
+/// joint is shared by the first corner, the line and the second corner as
+/// `c` times each corner's turn against the line's length.
 fn chamfer(e: &EllipseSection, c: Real) -> Shape {
     let (a, b) = (e.a, e.b);
     let x_e = a + c;
