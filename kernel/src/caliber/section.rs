@@ -79,10 +79,10 @@ impl EdgeKind {
 pub struct GrooveSection {
     /// Half-width `B/2` and depth `Hp` of the ellipse (mm).
     pub ellipse: EllipseSection,
-    /// The edges (either side alike). Where the edge meets the ellipse is
-    /// found when asked: most points lie deeper than it, on the ellipse,
-    /// and need not know.
+    /// The edges (either side alike).
     edge: Edge,
+    /// Where the edge meets the ellipse and the periphery, found once.
+    shape: Option<Shape>,
 }
 
 /// Where an edge meets the ellipse and the periphery, and how `psi` runs
@@ -154,7 +154,16 @@ impl GrooveSection {
                 crate::math::positive("the groove edge's 45 deg chamfer c_edge", c)?;
             }
         }
-        let s = Self { ellipse, edge };
+        let shape = match edge {
+            Edge::Sharp => None,
+            Edge::Rounded(r) => Some(rounding(&ellipse, r)),
+            Edge::Chamfered(c) => Some(chamfer(&ellipse, c)),
+        };
+        let s = Self {
+            ellipse,
+            edge,
+            shape,
+        };
         if let (Edge::Chamfered(c), Some(Shape::Chamfer { phi_e, j, .. })) = (edge, s.shape()) {
             if !(phi_e > FRAC_PI_4) {
                 return Err(InputError::out_of_range(
@@ -196,11 +205,7 @@ impl GrooveSection {
 
     /// Where the edge meets the ellipse and the periphery.
     fn shape(&self) -> Option<Shape> {
-        match self.edge {
-            Edge::Sharp => None,
-            Edge::Rounded(r) => Some(rounding(&self.ellipse, r)),
-            Edge::Chamfered(c) => Some(chamfer(&self.ellipse, c)),
-        }
+        self.shape
     }
 
     /// The polar angle (rad) beyond which, either side, the section is the
@@ -258,18 +263,7 @@ impl GrooveSection {
     /// derivatives); on a chamfer round the first corner, along the line,
     /// round the second.
     fn on_edge(&self, psi: Real) -> Option<(Real, Real, Real)> {
-        // Where the edge meets the ellipse is at most so deep (a
-        // rounding's centre is as deep as its radius), and the ellipse
-        // rises toward the edge: a point deeper lies before it.
-        let bound = match self.edge {
-            Edge::Sharp => return None,
-            Edge::Rounded(r) => r,
-            Edge::Chamfered(c) => chamfer_depth(&self.ellipse, c),
-        };
-        if self.ellipse.point(psi).1 > bound {
-            return None;
-        }
-        let shape = self.shape()?;
+        let shape = self.shape?;
         let p = psi.abs();
         let psi_e = shape.psi_e();
         if p <= psi_e {
