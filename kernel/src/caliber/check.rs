@@ -827,3 +827,58 @@ mod map_tests {
         assert_eq!(m.mm[i * MAP_CELLS.1 + j], 0.0042);
     }
 }
+
+#[cfg(test)]
+mod failure_tests {
+    use super::*;
+
+    fn check(groove_mm: Real, periphery_mm: Real) -> GrooveCheck {
+        let at = |mm: Real, psi: Real, beyond: Real, block: usize| GroovePlace {
+            mm,
+            theta_deg: 40.0,
+            psi_deg: psi,
+            block: format!("N{}", 10 * block),
+            block_index: block,
+            beyond_edge_mm: beyond,
+        };
+        GrooveCheck {
+            tolerance: 0.01,
+            resolution_mm: 1e-4,
+            sampling_resolution_mm: 1e-4,
+            samples: 1,
+            grid_theta: 1,
+            grid_psi: 1,
+            grid_theta_step_deg: 1.0,
+            psi_range_deg: [-90.0, 90.0],
+            pass_range_deg: [-90.0, 90.0],
+            max_left: at(groove_mm, 3.0, 0.0, 7),
+            max_gouge: at(0.0, 3.0, 0.0, 7),
+            max_abs_mm: groove_mm,
+            periphery_cut: at(periphery_mm, 90.0, 1.25, 9),
+            why: String::new(),
+            patch: None,
+            map: DeviationMap::default(),
+        }
+    }
+
+    /// A wheel that cuts only the periphery fails the run there, naming
+    /// the block, the edge's side and how far beyond it; a groove that
+    /// strays too is named first.
+    #[test]
+    fn a_cut_periphery_fails_at_its_block() {
+        assert!(check(0.005, -0.005).failure().is_none());
+        let c = check(0.005, -0.03);
+        let e = c.failure().expect("the periphery is cut 30 um");
+        assert!(matches!(e, VerifyError::Periphery { .. }), "{e}");
+        let text = e.to_string();
+        assert!(
+            text.contains("periphery") && text.contains("N90") && text.contains("1.250 mm beyond"),
+            "{text}"
+        );
+        let (_, failures) = c.findings();
+        assert_eq!(failures.len(), 1);
+        assert_eq!(failures[0].block_index, Some(9));
+        let both = check(0.02, -0.03).failure().unwrap();
+        assert!(matches!(both, VerifyError::Groove { .. }), "{both}");
+    }
+}
