@@ -14,6 +14,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use pilgrim_kernel::catalog::{Catalog, CompiledPlugin};
 use pilgrim_kernel::job::{self, JobOptions};
 use pilgrim_kernel::offset::flat_path;
+use pilgrim_kernel::offset::phases::Infeed;
 use pilgrim_kernel::offset::rest::{track, RestSetup};
 use pilgrim_kernel::offset::surface::{GroundSurface, PassLayer, WheelSection};
 use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
@@ -102,6 +103,7 @@ fn native_toolpath() -> Toolpath {
         feed,
         aux: vec![u],
     };
+    let mut last_end = None;
     for j in 1..=passes {
         // Three equal roughing cuts, then the finishing cut.
         let h = if j < passes {
@@ -114,15 +116,24 @@ fn native_toolpath() -> Toolpath {
         if j % 2 == 0 {
             pass = pass.reversed();
         }
-        let rest = track(&surface, &pass, section, feed, rpm, &setup).unwrap();
+        // The wheel comes down onto the pass's first point at the infeed
+        // feed: from its clearance over the blank, then from where the last
+        // pass ended.
+        let air = drop_circle(surface.blank(), pass.z[0], r_s, Side::Outside)
+            .unwrap()
+            .centre_x
+            + clearance;
+        let (fz, fx) = last_end.unwrap_or((pass.z[0], air));
+        let entry = Infeed {
+            z: fz,
+            x: fx,
+            feed: infeed,
+        };
+        let rest = track(&surface, &pass, section, feed, Some(entry), rpm, &setup).unwrap();
         let (cz, cx) = (&rest.path.z, &rest.path.x);
         if j == 1 {
             // The wheel at rapid to its clearance over the blank, the rest
             // to its own off the part, then onto it at its feed.
-            let air = drop_circle(surface.blank(), cz[0], r_s, Side::Outside)
-                .unwrap()
-                .centre_x
-                + clearance;
             let u = rest.centre_x[0];
             tp.passes.push(Pass {
                 name: "approach".into(),
@@ -142,8 +153,9 @@ fn native_toolpath() -> Toolpath {
                 })
                 .collect(),
         });
-        let layer = PassLayer::new(cz, cx, section, feed, rpm).unwrap();
+        let layer = PassLayer::new(cz, cx, section, feed, Some(entry), rpm).unwrap();
         surface = surface.with(layer);
+        last_end = Some((cz[cz.len() - 1], cx[cx.len() - 1]));
     }
     tp
 }

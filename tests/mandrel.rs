@@ -819,10 +819,14 @@ fn the_process_meets_the_part_at_its_feeds() {
                 .starts_with("N50 in \"approach\": rest comes onto the part at rapid"),
         "{e:?}"
     );
-    // The wheel into the stock at the traverse feed.
+    // The wheel into the stock at the traverse feed. (It comes down in a
+    // fraction of a revolution, so the pass's first millimetres are not
+    // ground round: the rest meets them later, and says so too.)
     let e = changed(&|p| p.blocks[index("N60")].feed = 1200.0);
     assert!(
-        e.len() == 1
+        e.iter()
+            .all(|(rule, _)| rule == pilgrim_kernel::process::INFEED
+                || rule == pilgrim_kernel::process::RIDING)
             && e[0].1.contains("N60 in \"pass 1")
             && e[0].1.contains(
                 "into the stock at F1200.0 mm/min; the machine's infeed feed is at most 2 mm/min"

@@ -1,11 +1,14 @@
-//! The mandrel program against the physical process (issue 11), replayed
+//! The mandrel program against the physical process, replayed
 //! independently from the text a control reads: the wheel's true section
 //! (flat and roundings), the part turning at S while the table feeds F
 //! (the helical ridge of f = F / S per revolution), the control's straight
-//! lines between blocks, the values as written. The simulation here shares
-//! no code with the kernel's: wheel positions are placed along each move
-//! every 0.05 mm, the surface under the steady rest is the blank's polyline
-//! lowered by each pass's swept wheel raised by its ridge, and the drop of
+//! lines between blocks at each block's F (the infeed block included), the
+//! values as written. The simulation here shares no code with the
+//! kernel's: each pass is timed from its blocks, the wheel's section is
+//! placed at the moments a generatrix passes under it for many spindle
+//! phases, and the surface under the steady rest is the blank's polyline
+//! lowered by each pass's highest generatrix (the spindle's phase between
+//! passes is not in the program: a rest meets the highest); the drop of
 //! the support is found by a grid search refined by golden sections.
 
 use pilgrim_kernel::program::{build, PostProcessor, SharedPost};
@@ -115,68 +118,182 @@ impl Section {
         }
     }
 
-    /// The ridge between touches f apart on a straight generatrix of a
-    /// tapered part: the rounding's (on a slope the flat stands off).
-    fn ridge(&self, f: f64) -> f64 {
-        let half = f / 2.0;
-        self.r - (self.r * self.r - half * half).sqrt()
+    /// How far along z from its reference the section reaches.
+    fn reach(&self) -> f64 {
+        self.r + self.flat / 2.0
     }
 }
 
-/// Wheel positions along a pass, every 0.05 mm or closer, in the order the
-/// wheel reaches them; `end[k]`: how many are placed once block k is reached.
-struct Sweep {
+/// A pass as the control moves the wheel: from where the block before it
+/// left the wheel (its infeed starts there), every axis straight between
+/// blocks at the block's F, Z and X against the time (minutes) each block
+/// ends.
+struct Pass {
     z: Vec<f64>,
     x: Vec<f64>,
-    end: Vec<usize>,
-    up: bool,
-    ridge: f64,
+    t: Vec<f64>,
 }
 
-const SPACING: f64 = 0.02;
-
-impl Sweep {
-    fn new(blocks: &[Blk], section: Section, rpm: f64) -> Self {
-        let (mut z, mut x, mut end) = (vec![blocks[0].z], vec![blocks[0].x], vec![1]);
-        let mut feed: f64 = 0.0;
-        for w in blocks.windows(2) {
-            let (a, b) = (w[0], w[1]);
-            let n = ((b.z - a.z).hypot(b.x - a.x) / SPACING).ceil().max(1.0) as usize;
-            for i in 1..=n {
-                let s = i as f64 / n as f64;
-                z.push(a.z + s * (b.z - a.z));
-                x.push(a.x + s * (b.x - a.x));
-            }
-            end.push(z.len());
-            feed = feed.max(b.f);
+impl Pass {
+    fn new(before: Blk, blocks: &[Blk]) -> Self {
+        let (mut z, mut x, mut t) = (vec![before.z], vec![before.x], vec![0.0]);
+        for b in blocks {
+            let (pz, px, pt) = (z[z.len() - 1], x[x.len() - 1], t[t.len() - 1]);
+            z.push(b.z);
+            x.push(b.x);
+            t.push(pt + (b.z - pz).hypot(b.x - px) / b.f);
         }
-        let up = blocks[blocks.len() - 1].z >= blocks[0].z;
+        Self { z, x, t }
+    }
+
+    /// The wheel's reference at time `t` (clamped to the pass).
+    fn at(&self, t: f64) -> (f64, f64) {
+        let k = self
+            .t
+            .partition_point(|&v| v < t)
+            .clamp(1, self.t.len() - 1);
+        let (t0, t1) = (self.t[k - 1], self.t[k]);
+        let s = if t1 > t0 {
+            ((t - t0) / (t1 - t0)).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        (
+            self.z[k - 1] + s * (self.z[k] - self.z[k - 1]),
+            self.x[k - 1] + s * (self.x[k] - self.x[k - 1]),
+        )
+    }
+
+    /// The first and last times the section reaches z (None: never).
+    fn covers(&self, z: f64, reach: f64) -> Option<(f64, f64)> {
+        let mut span: Option<(f64, f64)> = None;
+        for k in 1..self.z.len() {
+            let (z0, z1, t0, t1) = (self.z[k - 1], self.z[k], self.t[k - 1], self.t[k]);
+            let (a, b) = if z1 == z0 {
+                if (z0 - z).abs() > reach {
+                    continue;
+                }
+                (0.0, 1.0)
+            } else {
+                let (p, q) = ((z - reach - z0) / (z1 - z0), (z + reach - z0) / (z1 - z0));
+                (p.min(q).max(0.0), p.max(q).min(1.0))
+            };
+            if a <= b {
+                let (ta, tb) = (t0 + a * (t1 - t0), t0 + b * (t1 - t0));
+                span = Some(span.map_or((ta, tb), |(s, e)| (s.min(ta), e.max(tb))));
+            }
+        }
+        span
+    }
+
+    /// At z, counting the wheel's touches up to `until`, with the part
+    /// turning once every `period` minutes and `phases` generatrices evenly
+    /// round it: the highest generatrix (the crest a rest meets, whatever
+    /// the spindle's phase) and the lowest (the swept envelope). Infinite
+    /// where some generatrix is never touched.
+    fn cut(&self, s: Section, period: f64, phases: usize, z: f64, until: f64) -> (f64, f64) {
+        let Some((a, b)) = self.covers(z, s.reach()) else {
+            return (f64::INFINITY, f64::INFINITY);
+        };
+        let b = b.min(until);
+        let dt = period / phases as f64;
+        let (first, last) = ((a / dt).ceil() as i64, (b / dt).floor() as i64);
+        if last - first + 1 < phases as i64 {
+            return (f64::INFINITY, f64::INFINITY);
+        }
+        let mut low = vec![f64::INFINITY; phases];
+        for m in first..=last {
+            let (cz, cx) = self.at(m as f64 * dt);
+            let i = m.rem_euclid(phases as i64) as usize;
+            low[i] = low[i].min(s.lower(cz, cx, z));
+        }
+        let crest = low.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let valley = low.iter().copied().fold(f64::INFINITY, f64::min);
+        (crest, valley)
+    }
+}
+
+/// How many generatrices a pass's crest is sampled on: the highest of them
+/// lies within `2 h / n` of the crest over all phases (h: the rounding's
+/// ridge at the pass's largest feed per revolution; the crest over phases
+/// moves by at most `f^2 / R = 8 h` per revolution of phase), so the
+/// sampling costs at most 0.1 um.
+fn phases_for(pass: &Pass, s: Section, period: f64) -> usize {
+    let mut f: f64 = 0.0;
+    for k in 1..pass.t.len() {
+        let dt = pass.t[k] - pass.t[k - 1];
+        if dt > 0.0 {
+            f = f.max((pass.z[k] - pass.z[k - 1]).abs() / dt * period);
+        }
+    }
+    let h = s.r - (s.r * s.r - (f / 2.0).min(s.r).powi(2)).sqrt();
+    ((2.0 * h / 1e-4).ceil() as usize).clamp(16, 4096)
+}
+
+/// A pass's crest on a grid of [`GRID`] mm over its reach, with the first
+/// and last times the section reaches each point: where the pass has left
+/// both ends of a cell the grid's line stands for it (the crest over phases
+/// is flat along a steady pass), elsewhere it is sampled where asked.
+struct Crest {
+    pass: Pass,
+    section: Section,
+    period: f64,
+    phases: usize,
+    z0: f64,
+    crest: Vec<f64>,
+    first: Vec<f64>,
+    last: Vec<f64>,
+}
+
+const GRID: f64 = 0.05;
+
+impl Crest {
+    fn new(pass: Pass, section: Section, rpm: f64) -> Self {
+        let period = 1.0 / rpm;
+        let phases = phases_for(&pass, section, period);
+        let lo = pass.z.iter().copied().fold(f64::INFINITY, f64::min) - section.reach();
+        let hi = pass.z.iter().copied().fold(f64::NEG_INFINITY, f64::max) + section.reach();
+        let n = ((hi - lo) / GRID).ceil() as usize + 1;
+        let (mut crest, mut first, mut last) = (vec![], vec![], vec![]);
+        for i in 0..n {
+            let z = lo + i as f64 * GRID;
+            crest.push(pass.cut(section, period, phases, z, f64::INFINITY).0);
+            let (a, b) = pass
+                .covers(z, section.reach())
+                .unwrap_or((f64::INFINITY, f64::INFINITY));
+            first.push(a);
+            last.push(b);
+        }
         Self {
-            z,
-            x,
-            end,
-            up,
-            ridge: section.ridge(feed / rpm),
+            pass,
+            section,
+            period,
+            phases,
+            z0: lo,
+            crest,
+            first,
+            last,
         }
     }
 
-    /// The crest the first `n` positions leave at z (infinite where none
-    /// reaches within `reach`), the wheel at `extra` too if given.
-    fn crest(&self, n: usize, extra: Option<(f64, f64)>, z: f64, reach: f64, s: Section) -> f64 {
-        let zs = &self.z[..n];
-        let range = if self.up {
-            zs.partition_point(|&c| c < z - reach)..zs.partition_point(|&c| c <= z + reach)
-        } else {
-            zs.partition_point(|&c| c > z + reach)..zs.partition_point(|&c| c >= z - reach)
-        };
-        let mut v = f64::INFINITY;
-        for i in range {
-            v = v.min(s.lower(self.z[i], self.x[i], z));
+    /// The crest at z, counting the touches up to `until`.
+    fn at(&self, z: f64, until: f64) -> f64 {
+        let u = (z - self.z0) / GRID;
+        if !(u >= 0.0 && u <= (self.crest.len() - 1) as f64) {
+            return f64::INFINITY;
         }
-        if let Some((ez, ex)) = extra {
-            v = v.min(s.lower(ez, ex, z));
+        let i = (u.floor() as usize).min(self.crest.len() - 2);
+        if self.first[i].min(self.first[i + 1]) > until {
+            return f64::INFINITY;
         }
-        v + self.ridge
+        let (a, b) = (self.crest[i], self.crest[i + 1]);
+        if self.last[i].max(self.last[i + 1]) > until || a.is_finite() != b.is_finite() {
+            return self
+                .pass
+                .cut(self.section, self.period, self.phases, z, until)
+                .0;
+        }
+        a + (u - i as f64) * (b - a)
     }
 }
 
@@ -193,24 +310,21 @@ fn polyline(z: &[f64], x: &[f64], q: f64) -> f64 {
 }
 
 /// The surface under the rest: the blank's polyline lowered by the crests
-/// of the passes done.
+/// of the passes done and of the pass in progress up to its time.
 struct Surface {
     bz: Vec<f64>,
     bx: Vec<f64>,
-    done: Vec<Sweep>,
-    reach: f64,
-    section: Section,
+    done: Vec<Crest>,
 }
 
 impl Surface {
-    /// At z, with the first `n` positions of the pass `current` placed and
-    /// the wheel at `extra`.
-    fn at(&self, current: &Sweep, n: usize, extra: Option<(f64, f64)>, z: f64) -> f64 {
+    /// At z, the pass `current` cut up to `until`.
+    fn at(&self, current: &Crest, until: f64, z: f64) -> f64 {
         let mut v = polyline(&self.bz, &self.bx, z);
         for d in &self.done {
-            v = v.min(d.crest(d.z.len(), None, z, self.reach, self.section));
+            v = v.min(d.at(z, f64::INFINITY));
         }
-        v.min(current.crest(n, extra, z, self.reach, self.section))
+        v.min(current.at(z, until))
     }
 }
 
@@ -281,42 +395,32 @@ fn replay_rest(file: Option<&str>, sets: &[(&str, &str)]) -> (RestReplay, Params
     let (lo, hi) = (bz[0], bz[bz.len() - 1]);
     let step_z = -float(&values, "overrun");
     let tol = float(&values, "rest_tol");
-    let passes: Vec<&Vec<Blk>> = written
-        .groups
-        .iter()
-        .filter(|g| g.0.starts_with("pass "))
-        .map(|g| &g.1)
-        .collect();
-    assert!(passes.len() >= 4);
-    // The wheel's lowest point at z is within `reach` of its position there:
-    // the foot of a rounding on a path of slope s is R s / sqrt(1 + s^2)
-    // off, and the path's slope under the rest is measured.
-    let mut slope: f64 = 0.0;
-    for p in &passes {
-        for w in p.windows(2) {
-            if w[0].z + b < hi && (w[1].z - w[0].z).abs() > 1e-3 {
-                slope = slope.max(((w[1].x - w[0].x) / (w[1].z - w[0].z)).abs());
-            }
+    // Each pass with the block before it (where its infeed starts).
+    let mut passes: Vec<(Blk, &[Blk])> = Vec::new();
+    let mut before = None;
+    for (name, blocks) in &written.groups {
+        if name.starts_with("pass ") {
+            passes.push((before.expect("a block before the first pass"), blocks));
         }
+        before = blocks.last().copied().or(before);
     }
-    assert!(slope < 0.2, "path slope {slope} under the rest");
-    let reach = section.r * slope / (1.0 + slope * slope).sqrt() + section.flat / 2.0 + 1.0;
+    assert!(passes.len() >= 4);
     let mut out = RestReplay::default();
     let mut sim = Surface {
         bz,
         bx,
         done: Vec::new(),
-        reach,
-        section,
     };
-    for (j, blocks) in passes.into_iter().enumerate() {
-        let sweep = Sweep::new(blocks, section, written.spindle);
+    for (j, (before, blocks)) in passes.into_iter().enumerate() {
+        let crest = Crest::new(Pass::new(before, blocks), section, written.spindle);
+        // The time each block ends (the pass's point k + 1).
+        let ends = crest.pass.t[1..].to_vec();
         for (k, blk) in blocks.iter().enumerate() {
             let zr = blk.z + b;
             if (zr - step_z).abs() < ro {
                 out.crossed_step = true;
             }
-            let at = |z| sim.at(&sweep, sweep.end[k], None, z);
+            let at = |z| sim.at(&crest, ends[k], z);
             let exact = drop(&at, zr, ro, lo, hi);
             if (blk.u - exact).abs() > out.at_blocks {
                 out.at_blocks = (blk.u - exact).abs();
@@ -331,10 +435,9 @@ fn replay_rest(file: Option<&str>, sets: &[(&str, &str)]) -> (RestReplay, Params
             let n = ((blk.z - prev.z).abs() / 2.0).ceil().max(2.0) as usize;
             for i in 1..n {
                 let s = i as f64 / n as f64;
-                let (z, x) = (prev.z + s * (blk.z - prev.z), prev.x + s * (blk.x - prev.x));
-                let placed = sweep.end[k - 1]
-                    + ((sweep.end[k] - sweep.end[k - 1]) as f64 * s).floor() as usize;
-                let at = |q| sim.at(&sweep, placed, Some((z, x)), q);
+                let z = prev.z + s * (blk.z - prev.z);
+                let until = ends[k - 1] + s * (ends[k] - ends[k - 1]);
+                let at = |q| sim.at(&crest, until, q);
                 let exact = drop(&at, z + b, ro, lo, hi);
                 let line = prev.u + s * (blk.u - prev.u);
                 if (line - exact).abs() > out.gap.max(out.press) {
@@ -345,7 +448,7 @@ fn replay_rest(file: Option<&str>, sets: &[(&str, &str)]) -> (RestReplay, Params
                 out.between += 1;
             }
         }
-        sim.done.push(sweep);
+        sim.done.push(crest);
     }
     assert!(
         out.gap <= tol + 1e-4 && out.press <= tol + 1e-4,
@@ -355,13 +458,20 @@ fn replay_rest(file: Option<&str>, sets: &[(&str, &str)]) -> (RestReplay, Params
 }
 
 /// U at every block equals the exact drop on the surface simulated from
-/// the program's text (ridges included) within 0.1 um, and between blocks
+/// the program's text (ridges and infeeds included) within 1 um: the two
+/// crests agree within 0.03 um where each is computed exactly, but the
+/// kernel drops the support on its surface sampled every 0.05 mm (the
+/// family's choice) and this replay reads its crests off a 0.05 mm grid;
+/// where an infeed's last revolution bends the crest sharply (a pass's
+/// first millimetres) that costs up to about half a micron. Between blocks
 /// the control's straight line keeps within the rest tolerance: the
-/// default job (whose rest crosses the blank's stock step), and with the
-/// rest's offset B set to -150 mm (the machine's chain follows).
+/// default job (whose rest crosses the blank's stock step), with the
+/// rest's offset B set to -150 mm (the machine's chain follows), and with a
+/// wheel whose roundings of 15 mm leave a 10 mm flat (whose crest is not
+/// the rounding's ridge: the flat cuts it).
 #[test]
 fn the_rest_rides_the_simulated_surface() {
-    for sets in [vec![], vec![("rest_b", "-150")]] {
+    for sets in [vec![], vec![("rest_b", "-150")], vec![("rounding_r", "15")]] {
         let (r, _) = replay_rest(None, &sets);
         eprintln!("{sets:?}: {r:?}");
         assert!(
@@ -370,7 +480,7 @@ fn the_rest_rides_the_simulated_surface() {
         );
         assert!(r.blocks > 200 && r.between > 500, "{sets:?}: {r:?}");
         assert!(
-            r.at_blocks <= 1e-4,
+            r.at_blocks <= 1e-3,
             "{sets:?}: U off by {} mm at a block",
             r.at_blocks
         );
@@ -384,7 +494,7 @@ fn the_rest_rides_the_large_mandrel() {
     eprintln!("{r:?}");
     assert!(r.crossed_step && r.blocks > 200, "{r:?}");
     assert!(
-        r.at_blocks <= 1e-4,
+        r.at_blocks <= 1e-3,
         "U off by {} mm at a block",
         r.at_blocks
     );
@@ -490,7 +600,17 @@ fn a_wheel_with_a_flat_grinds_within_tolerance() {
         r: 15.0,
         flat: 10.0,
     };
-    let sweep = Sweep::new(finish, section, written.spindle);
+    let before = written
+        .groups
+        .iter()
+        .rev()
+        .skip_while(|g| !g.0.starts_with("pass "))
+        .nth(1)
+        .and_then(|g| g.1.last().copied())
+        .unwrap();
+    let pass = Pass::new(before, finish);
+    let period = 1.0 / written.spindle;
+    let phases = phases_for(&pass, section, period);
     let fam = family();
     let nominal = fam
         .call_with_params("ground_profile", &values)
@@ -501,8 +621,7 @@ fn a_wheel_with_a_flat_grinds_within_tolerance() {
     let n = 20_000;
     for i in 0..=n {
         let z = to * i as f64 / n as f64;
-        let crest = sweep.crest(sweep.z.len(), None, z, 16.0, section);
-        let valley = crest - sweep.ridge;
+        let (crest, valley) = pass.cut(section, period, phases, z, f64::INFINITY);
         let p = nominal.eval(z).unwrap();
         below = below.min(valley - p);
         above = above.max(crest - p);

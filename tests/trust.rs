@@ -391,8 +391,12 @@ fn scripts_are_bounded_in_memory_and_time() {
         let m = run(&[
             "run",
             "scripts/mandrel.rhai",
+            // A support of 500 mm held to 0.1 um: the rest's track
+            // samples a metre of surface for each of its many blocks.
             "--set",
-            "rough_feed=5e-324",
+            "rest_tol=0.0001",
+            "--set",
+            "rest_r=500",
             "--out",
             s(&out),
             "--quiet",

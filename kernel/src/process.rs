@@ -22,6 +22,11 @@
 //!   `approach_feed`) from clear of the material (more than the rapid
 //!   clearance off it) onto it is a feed move at most that fast, never a
 //!   rapid;
+//! - **a body that rides the part stays on it** ([`RIDING`]): while such a
+//!   body is on the part (both ends of a move within the rapid clearance),
+//!   at every block and between blocks it stands off the highest surface
+//!   any spindle phase leaves, or presses into it, by at most the
+//!   machine's `rest_tolerance`;
 //! - **the spindle turns and the coolant flows before cutting**
 //!   ([`SPINDLE`]): every cutting block runs at a speed the program writes
 //!   as at least 1 rpm and the spindle's least, with the coolant on where
@@ -56,6 +61,8 @@ pub const INFEED: &str = "into the stock at the infeed feed";
 pub const APPROACH: &str = "the steady rest meets the part at its approach feed";
 /// The rule of the spindle and coolant before cutting.
 pub const SPINDLE: &str = "spindle at speed and coolant on before cutting";
+/// The rule of a riding body's stand-off while it rides.
+pub const RIDING: &str = "the steady rest rides the part within its tolerance";
 /// The rule of the finishing stock.
 pub const FINISH: &str = "a finishing pass takes no more than the finishing stock";
 /// The warning of a ridge taller than the cut.
@@ -81,11 +88,12 @@ pub trait Stock {
 
     /// How far a body of `shape` (its sizes resolved: radius and length
     /// of a roller) placed at `frame` in the part frame stands off the
-    /// material when block `block` begins (mm; 0 or less: on it), or
-    /// `None` where the model cannot say (the default: a part no body
-    /// rides).
-    fn body_gap(&self, block: usize, shape: &Roller, frame: &Mat4) -> Option<Real> {
-        let _ = (block, shape, frame);
+    /// material at `along` (0 to 1) of the move into block `block` (from
+    /// 0), as the tool has left it by then (mm; negative: pressed into
+    /// it), or `None` where the model cannot say (the default: a part no
+    /// body rides).
+    fn body_gap(&self, block: usize, along: Real, shape: &Roller, frame: &Mat4) -> Option<Real> {
+        let _ = (block, along, shape, frame);
         None
     }
 
@@ -132,15 +140,20 @@ pub struct ProcessLimits {
     pub rapid_clearance: Real,
     /// The most a finishing pass may take (mm): `finish_stock`.
     pub finish_stock: Real,
+    /// How far a riding body may stand off the part or press into it
+    /// (mm): `rest_tolerance`.
+    pub rest_tolerance: Real,
 }
 
 impl ProcessLimits {
     /// The limits a machine is held to that states none: a grinder's
-    /// infeed (5 mm/min), 0.5 mm of clearance, 0.05 mm of finishing stock.
+    /// infeed (5 mm/min), 0.5 mm of clearance, 0.05 mm of finishing stock,
+    /// a steady rest within 5 um of the part.
     pub const DEFAULT: Self = Self {
         infeed_feed: 5.0,
         rapid_clearance: 0.5,
         finish_stock: 0.05,
+        rest_tolerance: 0.005,
     };
 
     /// The limits `info` states in its constants, the defaults for those
@@ -158,6 +171,7 @@ impl ProcessLimits {
             infeed_feed: c("infeed_feed", d.infeed_feed),
             rapid_clearance: c("rapid_clearance", d.rapid_clearance),
             finish_stock: c("finish_stock", d.finish_stock),
+            rest_tolerance: c("rest_tolerance", d.rest_tolerance),
         }
     }
 }
@@ -392,9 +406,37 @@ fn bodies(
         // clearance off it; as it rides, it stands within the difference
         // between the replay's surface and the one the family rode it on.
         let clear = limits.rapid_clearance;
-        let mut gap_before = frame(0).and_then(|f| stock.body_gap(0, &roller, &f));
+        // The frame at `along` of the move into block k: the axes move in
+        // straight lines between blocks.
+        let between = |k: usize, along: Real| {
+            let (a, b) = (
+                &rows[(k - 1) * width..k * width],
+                &rows[k * width..(k + 1) * width],
+            );
+            let v: Vec<Real> = a.iter().zip(b).map(|(p, q)| p + along * (q - p)).collect();
+            body.chain().matrix(&v).ok()
+        };
+        // While it rides: its worst stand-off (+) or press (-), where.
+        let mut worst: Option<(Real, usize)> = None;
+        let mut gap_before = frame(0).and_then(|f| stock.body_gap(0, 1.0, &roller, &f));
         for k in 1..written.blocks.len() {
-            let gap = frame(k).and_then(|f| stock.body_gap(k, &roller, &f));
+            let gap = frame(k).and_then(|f| stock.body_gap(k, 1.0, &roller, &f));
+            if let (Some(g0), Some(g1)) = (gap_before, gap) {
+                if g0.abs() <= clear && g1.abs() <= clear {
+                    let mut ride = vec![g1];
+                    for i in 1..RIDING_CHECKS {
+                        let along = i as Real / RIDING_CHECKS as Real;
+                        ride.extend(
+                            between(k, along).and_then(|f| stock.body_gap(k, along, &roller, &f)),
+                        );
+                    }
+                    for g in ride {
+                        if worst.is_none_or(|w| g.abs() > w.0.abs()) {
+                            worst = Some((g, k));
+                        }
+                    }
+                }
+            }
             if let (Some(g0), Some(g1)) = (gap_before, gap) {
                 if g0 > clear && g1 <= clear {
                     // It comes onto the part in this block: how fast.
@@ -445,9 +487,41 @@ fn bodies(
             }
             gap_before = gap;
         }
+        if let Some((g, k)) = worst {
+            let name = block_name(program, k);
+            let tol = limits.rest_tolerance;
+            out.figures.push(Figure::new(
+                &format!(
+                    "{}: off the part while it rides (+ stand-off, - press)",
+                    spec.name
+                ),
+                g,
+                tol,
+                "mm",
+                name.clone(),
+            ));
+            if g.abs() > tol * (1.0 + 1e-9) {
+                out.errors.push(
+                    Finding::new(
+                        RIDING,
+                        format!(
+                            "{name}: {} {} mm {} the highest surface the part can have there (the machine's rest_tolerance is {tol} mm)",
+                            spec.name,
+                            crate::math::fixed(g.abs(), 4),
+                            if g > 0.0 { "off" } else { "into" }
+                        ),
+                    )
+                    .at(k, name),
+                );
+            }
+        }
     }
     Ok(())
 }
+
+/// The places a riding body is checked at along each move (its ends
+/// included): every quarter.
+pub const RIDING_CHECKS: usize = 4;
 
 /// The finishing passes' stock, and the ridges taller than their cuts.
 fn finishing(

@@ -12,7 +12,10 @@
 use crate::input::InputError;
 use crate::machine::{KinematicsError, MachineKinematics};
 use crate::math::{positive, Real};
-use crate::offset::surface::{touches, GENERATRICES};
+use crate::offset::phases::{Infeed, TimedPath};
+use crate::offset::surface::{
+    touches, GroundSurface, PartLayer, PassLayer, WheelSection, GENERATRICES,
+};
 use crate::offset::{CapsuleEnvelope, Side};
 use crate::profile::{Profile, ProfileError};
 use crate::program::pass_blocks;
@@ -230,6 +233,13 @@ pub struct PassCheck {
     /// Its surface against the nominal, over every generatrix simulated
     /// (blocks from 1): ridges included.
     pub deviation: Deviation,
+    /// How far the highest surface any spindle phase leaves (what the
+    /// steady rest rides on: [`crate::offset::phases`]) stands above the
+    /// highest generatrix simulated, after this pass (mm): the stand-off
+    /// the spindle's unknown phase allows the rest.
+    pub phase_stand_off_mm: Real,
+    /// Where it is largest (z).
+    pub phase_stand_off_z: Real,
     /// Its surface minus the nominal along z, for drawing: `[z, lowest,
     /// highest]` over the generatrices, in at most [`PROFILE_BUCKETS`]
     /// stretches of z (each the extremes within it, so no ridge is lost).
@@ -384,6 +394,13 @@ pub fn replay_grinding(
     let axes: Vec<Option<&crate::machine::Axis>> =
         written.axes.iter().map(|a| info.axis(&a.name)).collect();
     let known: Vec<&crate::machine::Axis> = axes.iter().flatten().copied().collect();
+    // A rapid moves the wheel as fast as the slowest linear axis may.
+    let rapid = info
+        .axes
+        .iter()
+        .filter(|a| a.kind == crate::machine::AxisKind::Linear)
+        .map(|a| a.max_feed)
+        .fold(Real::INFINITY, Real::min);
     let mut out = GrindingCheck {
         tolerance,
         generatrices: GENERATRICES,
@@ -399,6 +416,15 @@ pub fn replay_grinding(
     // pass's blocks (from 0).
     let mut ordinals: Vec<Vec<usize>> = vec![Vec::new(); GENERATRICES];
     let mut cut_blocks: Vec<std::ops::Range<usize>> = Vec::new();
+    // The surface over every spindle phase: before each cutting pass, and
+    // the time of each of its blocks (the cutting pass, from 0, and
+    // minutes from its start).
+    let mut phases = GroundSurface::new(match blank {
+        Some(b) => b.clone(),
+        None => nominal.clone(),
+    });
+    let mut phase_states = Vec::new();
+    let mut block_time = std::collections::BTreeMap::new();
     for (pass, blocks) in pass_blocks(program, passes) {
         crate::budget::check("the grinding replay")?;
         for b in &written.blocks[blocks.clone()] {
@@ -414,11 +440,10 @@ pub fn replay_grinding(
             .clone()
             .map(|b| poses[6 * b].hypot(poses[6 * b + 1]))
             .collect();
-        // The wheel's speed along its (z, x) line: the block's feed over
-        // the control's path (every linear axis of the block).
-        let mut feeds = vec![0.0; z.len()];
-        let mut cutting_feed: Real = 0.0;
-        for (i, k) in blocks.clone().enumerate().skip(1) {
+        // The wheel's speed along its (z, x) line on block k (from block
+        // k - 1, `line` mm): the block's feed over the control's path
+        // (every linear axis of the block).
+        let line_feed = |k: usize, line: Real| {
             let (a, b) = (&written.blocks[k - 1], &written.blocks[k]);
             let deltas: Vec<Real> = a
                 .values
@@ -429,20 +454,58 @@ pub fn replay_grinding(
                 .map(|((p, q), _)| q - p)
                 .collect();
             let path = crate::machine::feed_length(&known, &deltas, &info.setup.feed_group);
-            let line = (z[i] - z[i - 1]).hypot(x[i] - x[i - 1]);
             let f = if b.motion == crate::toolpath::Motion::Rapid {
-                info.axes
-                    .iter()
-                    .filter(|a| a.kind == crate::machine::AxisKind::Linear)
-                    .map(|a| a.max_feed)
-                    .fold(Real::INFINITY, Real::min)
+                rapid
             } else {
-                cutting_feed = cutting_feed.max(b.feed);
                 b.feed
             };
-            feeds[i] = if path > 0.0 { f * line / path } else { f };
+            if path > 0.0 {
+                f * line / path
+            } else {
+                f
+            }
+        };
+        let mut feeds = vec![0.0; z.len()];
+        let mut cutting_feed: Real = 0.0;
+        for (i, k) in blocks.clone().enumerate().skip(1) {
+            let b = &written.blocks[k];
+            if b.motion != crate::toolpath::Motion::Rapid {
+                cutting_feed = cutting_feed.max(b.feed);
+            }
+            feeds[i] = line_feed(k, (z[i] - z[i - 1]).hypot(x[i] - x[i - 1]));
         }
-        let t = touches(&z, &x, &feeds, rpm, GENERATRICES)?;
+        // The wheel came to the pass's first point by the block before it
+        // (the infeed at its feed, the part turning all the while).
+        let infeed = match blocks.start {
+            k if k > 0 && !blocks.is_empty() => {
+                let (iz, ix) = (
+                    poses[6 * (k - 1) + 2],
+                    poses[6 * (k - 1)].hypot(poses[6 * (k - 1) + 1]),
+                );
+                Some(Infeed {
+                    z: iz,
+                    x: ix,
+                    feed: line_feed(k, (z[0] - iz).hypot(x[0] - ix)),
+                })
+            }
+            _ => None,
+        };
+        let timed = TimedPath::entered(infeed, &z, &x, &feeds)?;
+        let t = touches(&timed, rpm, GENERATRICES)?;
+        phase_states.push(phases.clone());
+        // The same section at the same moments, over every spindle phase.
+        let section = WheelSection {
+            radius: wheel.rounding_radius,
+            flat: wheel.flat(),
+        };
+        let layer = PassLayer::timed(timed, section, rpm)?;
+        block_time.extend(
+            blocks
+                .clone()
+                .zip(layer.path().times())
+                .map(|(k, &tm)| (k, (cut_blocks.len(), tm))),
+        );
+        phases = phases.with(layer);
         // Each generatrix met: the wheel's section at its touches.
         let met: Vec<usize> = (0..t.z.len()).filter(|&g| !t.z[g].is_empty()).collect();
         let envs = met
@@ -528,6 +591,15 @@ pub fn replay_grinding(
                 }
             }
         }
+        // The phases' surface against the highest generatrix.
+        let envelope = phases.cut_many(&zs);
+        let (mut stand_off, mut stand_off_z) = (0.0, range.0);
+        for i in 0..zs.len() {
+            let s = envelope[i].min(before[i]) - (hi[i] + profile[i]);
+            if s.is_finite() && s > stand_off {
+                (stand_off, stand_off_z) = (s, zs[i]);
+            }
+        }
         let gen_at = if d.max_above >= -d.max_below {
             (d.max_abs, d.at_z) = (d.max_above.abs(), d.above_z);
             g_above
@@ -565,6 +637,8 @@ pub fn replay_grinding(
             feed_per_rev_mm: f,
             ridge_mm: wheel.ridge(f),
             deviation: d,
+            phase_stand_off_mm: stand_off,
+            phase_stand_off_z: stand_off_z,
             along_z: bucketed(&zs, &lo, &hi, PROFILE_BUCKETS),
         });
     }
@@ -572,9 +646,14 @@ pub fn replay_grinding(
         return Err(VerifyError::NoCuttingPass);
     }
     let stock = match blank {
-        Some(b) => Some(GroundStock::new(
-            &out, b, nominal, wheel, &earlier, &ordinals, cut_blocks,
-        )?),
+        Some(b) => {
+            phase_states.push(phases);
+            let mut stock =
+                GroundStock::new(&out, b, nominal, wheel, &earlier, &ordinals, cut_blocks)?;
+            stock.phases = phase_states;
+            stock.block_time = block_time;
+            Some(stock)
+        }
         None => None,
     };
     Ok((out, stock))
@@ -599,6 +678,12 @@ pub struct GroundStock {
     blocks: Vec<std::ops::Range<usize>>,
     wheel: Wheel,
     passes: Vec<crate::process::PassStock>,
+    /// The surface over every spindle phase before each cutting pass and
+    /// after the last: what a body riding the part meets.
+    phases: Vec<GroundSurface>,
+    /// Each cutting block's pass (from 0) and time from the pass's start
+    /// (minutes).
+    block_time: std::collections::BTreeMap<usize, (usize, Real)>,
 }
 
 impl GroundStock {
@@ -679,6 +764,8 @@ impl GroundStock {
             blocks,
             wheel: *wheel,
             passes,
+            phases: Vec::new(),
+            block_time: std::collections::BTreeMap::new(),
         })
     }
 
@@ -687,6 +774,37 @@ impl GroundStock {
     fn state(&self, block: usize) -> &[Real] {
         let done = self.blocks.iter().filter(|r| r.end <= block).count();
         &self.states[done.min(self.states.len() - 1)]
+    }
+
+    /// The surface over every spindle phase at `along` (0 to 1) of the
+    /// move into block `block` (from 0), with the pass in progress then.
+    fn phases_at(
+        &self,
+        block: usize,
+        along: Real,
+    ) -> Option<(&GroundSurface, Option<PartLayer<'_>>)> {
+        match self.block_time.get(&block) {
+            Some(&(pass, t1)) => {
+                let t0 = block
+                    .checked_sub(1)
+                    .and_then(|b| self.block_time.get(&b))
+                    .filter(|(p, _)| *p == pass)
+                    .map_or(t1, |(_, t)| *t);
+                let layer = self.phases.last()?.layer(pass)?;
+                Some((
+                    self.phases.get(pass)?,
+                    Some(layer.by_time(t0 + along.clamp(0.0, 1.0) * (t1 - t0))),
+                ))
+            }
+            None => {
+                let done = self.blocks.iter().filter(|r| r.end <= block).count();
+                Some((
+                    self.phases
+                        .get(done.min(self.phases.len().checked_sub(1)?))?,
+                    None,
+                ))
+            }
+        }
     }
 
     /// The grid's indices within `half` of `z`, with their z.
@@ -719,18 +837,23 @@ impl crate::process::Stock for GroundStock {
     fn body_gap(
         &self,
         block: usize,
+        along: Real,
         shape: &crate::process::Roller,
         frame: &crate::math::Mat4,
     ) -> Option<Real> {
-        // A roller across the axial section: a circle of its radius in it.
+        // A roller across the axial section: a circle of its radius in it,
+        // dropped onto the highest surface any spindle phase leaves.
         let (x, y, z) = (frame[(0, 3)], frame[(1, 3)], frame[(2, 3)]);
         let (u, r) = (x.hypot(y), shape.radius);
-        let s = self.state(block);
-        let drop = self
-            .around(z, r, s.len())
-            .map(|(i, zi)| s[i] + (r * r - (zi - z) * (zi - z)).max(0.0).sqrt())
-            .fold(Real::NEG_INFINITY, Real::max);
-        drop.is_finite().then_some(u - drop)
+        let (surface, extra) = self.phases_at(block, along)?;
+        let (lo, hi) = surface.z_range();
+        let (a, b) = ((z - r).max(lo), (z + r).min(hi));
+        if a >= b {
+            return None;
+        }
+        let window = surface.window(a, b, STOCK_STEP, extra.as_ref()).ok()?;
+        let drop = crate::offset::drop_circle(&window, z, r, Side::Outside).ok()?;
+        Some(u - drop.centre_x)
     }
 
     fn passes(&self) -> Vec<crate::process::PassStock> {

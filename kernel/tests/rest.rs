@@ -31,6 +31,7 @@ fn ridge_free(stock: &Profile, cz: &[f64], cx: &[f64], b: f64) -> Result<RestTra
         &path,
         wheel,
         100.0,
+        None,
         1e6,
         &setup(b),
     )

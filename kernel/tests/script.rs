@@ -308,6 +308,7 @@ fn mandrel_building_blocks_in_scripts() {
         &path,
         wheel,
         2000.0,
+        None,
         399.0,
         &setup,
     )

@@ -28,7 +28,7 @@ fn sweep_deviation(z: &[f64], x: &[f64], p: &Profile) -> (f64, f64, f64) {
         radius: R_S,
         flat: 0.0,
     };
-    let layer = PassLayer::new(z, x, wheel, 100.0, 1e6).unwrap();
+    let layer = PassLayer::new(z, x, wheel, 100.0, None, 1e6).unwrap();
     let zs: Vec<f64> = (0..=40_000).map(|i| i as f64 * 0.01).collect();
     let (s, n) = (layer.valleys(&zs), p.eval_many(&zs).unwrap());
     let (mut worst, mut below, mut at) = (0.0f64, f64::INFINITY, 0.0);
@@ -83,6 +83,7 @@ fn adaptive_blocks_keep_the_tolerance_and_skip_straight_runs() {
             flat: 0.0,
         },
         100.0,
+        None,
         1e6,
     )
     .unwrap();

@@ -211,6 +211,8 @@ mod tests {
             feed_per_rev_mm: 1.0,
             ridge_mm: 0.0,
             deviation: d,
+            phase_stand_off_mm: 0.0,
+            phase_stand_off_z: 0.0,
             along_z,
         }
     }

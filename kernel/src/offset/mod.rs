@@ -13,6 +13,7 @@
 mod capsule;
 mod drop;
 mod envelope;
+pub mod phases;
 pub mod rest;
 pub mod surface;
 

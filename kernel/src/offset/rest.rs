@@ -23,6 +23,7 @@
 //! (the edge of the current pass) the seed's model has no such bound: that
 //! is why the exact model is the default.
 
+use super::phases::Infeed;
 pub use super::surface::WheelSection;
 use super::surface::{GroundSurface, PassLayer};
 use super::{drop_circle, Drop, Side};
@@ -208,13 +209,15 @@ pub const KINK_WIDTH: Real = 1e-3;
 const MAX_REST_POINTS: usize = 200_000;
 
 /// The steady rest along a pass (MATH §2.3, §2.4): the wheel's reference
-/// moves along `path` (one way along z) at `feed` (mm/min) while the part
-/// turns at `rpm`, over a part whose surface before the pass is `before`.
+/// moves along `path` (one way along z) at `feed` (mm/min), having come to
+/// its first point by `infeed` (without one: it stood there a revolution),
+/// while the part turns at `rpm`, over a part whose surface before the
+/// pass is `before`.
 /// At each moment the rest at `z_r = z + B` rides the current surface: the
-/// crests of the ridges already left by earlier passes and by this one as
-/// far as the wheel has come ([`PassLayer`]: the wheel's section swept
-/// along the path, raised by the pass's ridge). U is the exact drop of the
-/// support on that surface (sampled `setup.sample` mm apart under the
+/// highest surface the earlier passes and this one as far as the wheel
+/// has come can leave, whatever the spindle's phase ([`PassLayer`]: the
+/// wheel's true section at the moments it meets the part). U is the exact
+/// drop of the support on that surface (sampled `setup.sample` mm apart under the
 /// support) at every block, and at [`MIN_REST_CHECKS`] or more places a
 /// move, at most [`REST_CHECK_STEP`] apart; where the control's straight
 /// line of U between two blocks strays more than `setup.tolerance` from
@@ -231,6 +234,7 @@ pub fn track(
     path: &Polyline,
     wheel: WheelSection,
     feed: Real,
+    infeed: Option<Infeed>,
     rpm: Real,
     setup: &RestSetup,
 ) -> Result<RestTrack, ProfileError> {
@@ -246,11 +250,8 @@ pub fn track(
         }
         .into());
     }
-    let layer = PassLayer::new(&path.z, &path.x, wheel, feed, rpm)?;
-    let mut time = vec![0.0; path.len()];
-    for k in 1..path.len() {
-        time[k] = time[k - 1] + (path.z[k] - path.z[k - 1]).hypot(path.x[k] - path.x[k - 1]) / feed;
-    }
+    let layer = PassLayer::new(&path.z, &path.x, wheel, feed, infeed, rpm)?;
+    let time = layer.path().times();
     let (lo, hi) = before.z_range();
     // The exact drop with the wheel at `(z, time)`, and the seed's formula
     // there if asked.
@@ -269,7 +270,7 @@ pub fn track(
                 z_max: hi,
             });
         }
-        let part = layer.by_time(time, a, b)?;
+        let part = Some(layer.by_time(time));
         let window = before.window(a, b, setup.sample, part.as_ref())?;
         let d = super::drop_circle(&window, z_r, setup.radius, Side::Outside)?;
         if !seed {
@@ -287,7 +288,7 @@ pub fn track(
         .z
         .iter()
         .zip(&path.x)
-        .zip(&time)
+        .zip(time)
         .map(|((&z, &x), &tm)| (z, x, tm))
         .collect();
     let mut drops: Vec<(Drop, Real)> = pts

@@ -10,11 +10,13 @@
 //!   moves at their feeds, the control's linear interpolation in time.
 //! - [`PassLayer`] is what one pass leaves as a surface of revolution: the
 //!   wheel's true section swept along the path (the valleys) and the
-//!   ridges' crests above it: what a steady rest's support riding the
-//!   turning part meets. (The verification simulates each generatrix's
-//!   touches instead: [`crate::verify::check_grinding`].)
+//!   highest surface any spindle phase leaves ([`super::phases`]): what a
+//!   steady rest's support riding the turning part meets. The verification
+//!   cuts the same section at the same moments on each generatrix
+//!   ([`crate::verify::check_grinding`]) and reports how far the crest
+//!   stands above its own highest generatrix.
 //! - [`GroundSurface`] is the blank (a polyline: a step stays a step)
-//!   lowered by each pass's layer, exact at any z.
+//!   lowered by each pass's crest, exact at any z.
 //!
 //! # Generatrices
 //! [`GENERATRICES`] = 8, 45 degrees apart. On a straight generatrix the
@@ -23,6 +25,7 @@
 //! the true crest `h` (0.1 um for the default finish's 0.4 um ridge), and
 //! the lowest of them reaches the valleys (the touches themselves).
 
+use super::phases::{Infeed, PhaseCrest, TimedPath};
 use super::{CapsuleEnvelope, Side};
 use crate::math::Real;
 use crate::profile::{Profile, ProfileError};
@@ -48,49 +51,28 @@ pub struct Touches {
 /// The most touches a pass may have, over all its generatrices.
 pub const MAX_TOUCHES: usize = 50_000_000;
 
-/// Where `m` generatrices meet a wheel whose reference moves along the
-/// path `(z[k], x[k])` (straight moves, each at `feed[k]` mm/min, `feed[0]`
-/// unused) while the part turns at `rpm`: generatrix `g` passes under the
-/// wheel at the times `(g/m + j) / rpm` minutes after the pass's start.
+/// Where `m` generatrices meet a wheel whose reference moves along `path`
+/// (its infeed included, if it has one) while the part turns at `rpm`:
+/// generatrix `g` passes under the wheel at the times `(g/m + j) / rpm`
+/// minutes after the path's start.
 ///
 /// # Failures
-/// Arrays of different lengths or empty; a feed or speed that is not
-/// positive and finite; more than [`MAX_TOUCHES`] touches.
-pub fn touches(
-    z: &[Real],
-    x: &[Real],
-    feed: &[Real],
-    rpm: Real,
-    m: usize,
-) -> Result<Touches, ProfileError> {
-    use crate::input::InputError;
+/// A speed that is not positive and finite; no generatrices; more than
+/// [`MAX_TOUCHES`] touches.
+pub fn touches(path: &TimedPath, rpm: Real, m: usize) -> Result<Touches, ProfileError> {
     crate::math::positive("spindle speed", rpm)?;
-    if z.len() != x.len() || z.len() != feed.len() || z.is_empty() || m == 0 {
-        return Err(InputError::LengthMismatch {
-            what: "pass points z, x and feeds".into(),
-            left: z.len(),
-            right: x.len().min(feed.len()),
+    if m == 0 {
+        return Err(crate::input::InputError::TooFew {
+            what: "generatrices".into(),
+            got: 0,
+            min: 1,
         }
         .into());
     }
-    let mut time = Vec::with_capacity(z.len());
-    time.push(0.0);
-    for k in 1..z.len() {
-        let len = (z[k] - z[k - 1]).hypot(x[k] - x[k - 1]);
-        let f = feed[k];
-        if !(f.is_finite() && f > 0.0) {
-            return Err(InputError::NotPositive {
-                what: format!("feed of move {k}"),
-                value: f,
-            }
-            .into());
-        }
-        time.push(time[k - 1] + len / f);
-    }
-    let total = time[time.len() - 1];
+    let total = path.duration();
     let expected = total * rpm * m as Real;
     if !(expected <= MAX_TOUCHES as Real) {
-        return Err(InputError::out_of_range(
+        return Err(crate::input::InputError::out_of_range(
             "touches of the wheel on the part's generatrices",
             expected,
             format!("at most {MAX_TOUCHES}: a feed too slow for the pass's length"),
@@ -101,37 +83,19 @@ pub fn touches(
         z: vec![vec![]; m],
         x: vec![vec![]; m],
         block: vec![vec![]; m],
-        time,
+        time: path.times().to_vec(),
     };
     for g in 0..m {
-        let mut k = 1;
         let mut j = 0usize;
         loop {
             let t = (g as Real / m as Real + j as Real) / rpm;
             if t > total {
                 break;
             }
-            while k + 1 < out.time.len() && out.time[k] < t {
-                k += 1;
-            }
-            let (p, zz, xx) = if out.time.len() == 1 {
-                (0, z[0], x[0])
-            } else {
-                let (t0, t1) = (out.time[k - 1], out.time[k]);
-                let s = if t1 > t0 {
-                    ((t - t0) / (t1 - t0)).clamp(0.0, 1.0)
-                } else {
-                    1.0
-                };
-                (
-                    k,
-                    z[k - 1] + s * (z[k] - z[k - 1]),
-                    x[k - 1] + s * (x[k] - x[k - 1]),
-                )
-            };
+            let (zz, xx, k) = path.at(t);
             out.z[g].push(zz);
             out.x[g].push(xx);
-            out.block[g].push(p);
+            out.block[g].push(k);
             j += 1;
         }
     }
@@ -160,25 +124,21 @@ impl WheelSection {
 pub const SWEEP_RESOLUTION: Real = 1e-5;
 
 /// What one pass leaves, as a surface of revolution: the wheel's true
-/// section swept continuously along the path (the valleys, where a
-/// generatrix met the wheel), and above it the crests of the helical ridge
-/// (what a support riding the turning part meets): the sweep raised by the
-/// ridge of the pass's feed per revolution. On a straight generatrix both
-/// are exact; on a curved one the crest is off by the path's sagitta over
-/// `f`, `f^2 / (8 rho)` (0.3 um for f = 5 mm on the mandrel's 11.6 m).
+/// section swept continuously along the path (the valleys, the lowest any
+/// generatrix can be), and the highest surface any spindle phase leaves
+/// ([`PhaseCrest`]: the same section at the same moments as the replay's
+/// generatrices, over every phase): what a steady rest's support riding the
+/// turning part meets.
 #[derive(Debug, Clone)]
 pub struct PassLayer {
     swept: CapsuleEnvelope,
-    ridge: Real,
-    /// The sweep's circles (z, x) and the time each was placed (minutes
-    /// from the pass's start): what a partial pass has cut.
-    circles: (Vec<Real>, Vec<Real>, Vec<Real>),
-    wheel: WheelSection,
+    crest: PhaseCrest,
 }
 
 impl PassLayer {
-    /// The layer of `wheel` moved along `(z[k], x[k])` at `feed` mm/min
-    /// while the part turns at `rpm`.
+    /// The layer of `wheel` moved along `(z[k], x[k])` at `feed` mm/min,
+    /// entered by `infeed` (without one, the wheel stood a revolution at the
+    /// first point), while the part turns at `rpm`.
     ///
     /// # Failures
     /// Bad numbers; a path of no points; more circles than a sweep may have.
@@ -187,36 +147,32 @@ impl PassLayer {
         x: &[Real],
         wheel: WheelSection,
         feed: Real,
+        infeed: Option<Infeed>,
         rpm: Real,
     ) -> Result<Self, ProfileError> {
         crate::math::positive("feed", feed)?;
+        let path = TimedPath::entered(infeed, z, x, &vec![feed; z.len()])?;
+        Self::timed(path, wheel, rpm)
+    }
+
+    /// The layer of `wheel` moved along `path` (each move at its feed)
+    /// while the part turns at `rpm`.
+    ///
+    /// # Failures
+    /// As [`Self::new`].
+    pub fn timed(path: TimedPath, wheel: WheelSection, rpm: Real) -> Result<Self, ProfileError> {
         crate::math::positive("spindle speed", rpm)?;
-        let (cz, cx, block_of) = super::swept_circles(z, x, wheel.radius, SWEEP_RESOLUTION)?;
-        // Times: each circle's place along its move.
-        let mut time = Vec::with_capacity(cz.len());
-        let mut start = vec![0.0; z.len()];
-        for k in 1..z.len() {
-            start[k] = start[k - 1] + (z[k] - z[k - 1]).hypot(x[k] - x[k - 1]) / feed;
-        }
-        for (i, &k) in block_of.iter().enumerate() {
-            let t = if k == 0 {
-                0.0
-            } else {
-                start[k - 1] + (cz[i] - z[k - 1]).hypot(cx[i] - x[k - 1]) / feed
-            };
-            time.push(t);
-        }
+        let (pz, px) = path.points();
+        let (cz, cx, _) = super::swept_circles(pz, px, wheel.radius, SWEEP_RESOLUTION)?;
         Ok(Self {
             swept: CapsuleEnvelope::new(&cz, &cx, wheel.radius, wheel.flat, Side::Outside)?,
-            ridge: wheel.ridge(feed / rpm),
-            circles: (cz, cx, time),
-            wheel,
+            crest: PhaseCrest::new(path, wheel, rpm)?,
         })
     }
 
-    /// The ridge's height (mm).
-    pub fn ridge(&self) -> Real {
-        self.ridge
+    /// The path and its times.
+    pub fn path(&self) -> &TimedPath {
+        self.crest.path()
     }
 
     /// The valleys at sorted `zs`: the continuous sweep (infinite where the
@@ -225,67 +181,37 @@ impl PassLayer {
         self.swept.eval_many(zs)
     }
 
-    /// The crests at sorted `zs`: the sweep raised by the ridge.
+    /// The crests at `zs`: the highest surface over spindle phases
+    /// (infinite where some phase is never touched).
     pub fn crests(&self, zs: &[Real]) -> Vec<Real> {
-        self.swept
-            .eval_many(zs)
-            .into_iter()
-            .map(|v| v + self.ridge)
-            .collect()
+        self.crest.eval_many(zs, Real::INFINITY)
     }
 
-    /// The part of this pass cut by `time` (minutes from its start) near
-    /// `[a, b]`: `None` if nothing there yet, the whole layer if all of it.
-    ///
-    /// # Failures
-    /// As [`CapsuleEnvelope::new`].
-    pub fn by_time(
-        &self,
-        time: Real,
-        a: Real,
-        b: Real,
-    ) -> Result<Option<PartLayer<'_>>, ProfileError> {
-        let reach = self.wheel.radius + self.wheel.flat / 2.0;
-        let (cz, cx, ct) = &self.circles;
-        // A pass runs one way along z, and its circles are in its order:
-        // the near ones are a run, the placed ones a prefix of the times.
-        let up = cz.last() >= cz.first();
-        let (lo, hi) = (a - reach, b + reach);
-        let near = if up {
-            cz.partition_point(|&c| c < lo)..cz.partition_point(|&c| c <= hi)
+    /// The part of this pass cut by `time` (minutes from its start): the
+    /// crests counting the wheel's moments up to then.
+    pub fn by_time(&self, time: Real) -> PartLayer<'_> {
+        if time >= self.path().duration() {
+            PartLayer::Whole(self)
         } else {
-            cz.partition_point(|&c| c > hi)..cz.partition_point(|&c| c >= lo)
-        };
-        let placed_end = near.start + ct[near.clone()].partition_point(|&t| t <= time);
-        let (pz, px) = (&cz[near.start..placed_end], &cx[near.start..placed_end]);
-        let near = near.len();
-        Ok(if pz.is_empty() {
-            None
-        } else if pz.len() == near {
-            Some(PartLayer::Whole(self))
-        } else {
-            Some(PartLayer::Part(
-                CapsuleEnvelope::new(pz, px, self.wheel.radius, self.wheel.flat, Side::Outside)?,
-                self.ridge,
-            ))
-        })
+            PartLayer::Until(self, time)
+        }
     }
 }
 
 /// A pass's layer, whole or as far as it has cut.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Copy)]
 pub enum PartLayer<'a> {
     /// All of it.
     Whole(&'a PassLayer),
-    /// The sweep so far, with the pass's ridge.
-    Part(CapsuleEnvelope, Real),
+    /// What it has cut by a time (minutes from its start).
+    Until(&'a PassLayer, Real),
 }
 
 impl PartLayer<'_> {
     fn crests(&self, zs: &[Real]) -> Vec<Real> {
-        match self {
+        match *self {
             Self::Whole(l) => l.crests(zs),
-            Self::Part(env, ridge) => env.eval_many(zs).into_iter().map(|v| v + ridge).collect(),
+            Self::Until(l, t) => l.crest.eval_many(zs, t),
         }
     }
 }
@@ -296,7 +222,8 @@ impl PartLayer<'_> {
 #[derive(Debug, Clone)]
 pub struct GroundSurface {
     blank: Profile,
-    layers: Vec<PassLayer>,
+    /// Shared: a surface after one more pass keeps the ones before.
+    layers: Vec<std::sync::Arc<PassLayer>>,
 }
 
 impl GroundSurface {
@@ -311,7 +238,7 @@ impl GroundSurface {
     /// The surface after one more pass.
     pub fn with(&self, layer: PassLayer) -> Self {
         let mut s = self.clone();
-        s.layers.push(layer);
+        s.layers.push(std::sync::Arc::new(layer));
         s
     }
 
@@ -331,6 +258,23 @@ impl GroundSurface {
         let mut out = vec![linear(&self.blank, zs)];
         out.extend(self.layers.iter().map(|l| l.crests(zs)));
         out.extend(extra.map(|e| e.crests(zs)));
+        out
+    }
+
+    /// Pass `i`'s layer (from 0).
+    pub fn layer(&self, i: usize) -> Option<&PassLayer> {
+        self.layers.get(i).map(|l| l.as_ref())
+    }
+
+    /// The lowest of the passes' crests at `zs`, without the blank
+    /// (infinite where no pass has cut).
+    pub fn cut_many(&self, zs: &[Real]) -> Vec<Real> {
+        let mut out = vec![Real::INFINITY; zs.len()];
+        for l in &self.layers {
+            for (o, c) in out.iter_mut().zip(l.crests(zs)) {
+                *o = o.min(c);
+            }
+        }
         out
     }
 
@@ -442,7 +386,7 @@ mod tests {
         let (r, rpm, feed) = (20.0, 400.0, 2000.0); // f = 5 mm
         let z = [0.0, 200.0];
         let x = [r, r];
-        let t = touches(&z, &x, &[0.0, feed], rpm, 4).unwrap();
+        let t = touches(&TimedPath::new(&z, &x, &[0.0, feed]).unwrap(), rpm, 4).unwrap();
         assert_eq!(t.z.len(), 4);
         let f = feed / rpm;
         // Generatrix 0: touches at 0, 5, 10, ...
@@ -459,11 +403,11 @@ mod tests {
             radius: r,
             flat: 0.0,
         };
-        let layer = PassLayer::new(&z, &x, w, feed, rpm).unwrap();
+        let layer = PassLayer::new(&z, &x, w, feed, None, rpm).unwrap();
         let (v, c) = (layer.valleys(&[100.3])[0], layer.crests(&[100.3])[0]);
         // The continuous sweep within its resolution.
         assert!(
-            v.abs() <= 1.01 * SWEEP_RESOLUTION && (c - v - exact).abs() < 1e-12,
+            v.abs() <= 1.01 * SWEEP_RESOLUTION && (c - exact).abs() < 1e-9,
             "{v} {c}"
         );
     }

@@ -3,6 +3,7 @@
 
 use super::floats::{err, kernel, numbers, Floats, Numbers};
 use crate::math::Real;
+use crate::offset::phases::Infeed;
 use crate::offset::rest::{RestSetup, RestTrack};
 use crate::offset::surface::{GroundSurface, PassLayer, WheelSection};
 use crate::offset::{self, Equidistant, Side};
@@ -167,6 +168,8 @@ pub mod offset_api {
     /// (mm/min) while the part turns at `spindle_rpm`: on each generatrix
     /// the wheel's true section where it met it, the ridges' crests as one
     /// surface of revolution.
+    /// The wheel is taken to have stood a revolution at the path's first
+    /// point; give its `infeed` where it came down onto it.
     #[rhai_fn(return_raw)]
     pub fn cut(
         surface: GroundSurface,
@@ -175,8 +178,48 @@ pub mod offset_api {
         feed: Real,
         spindle_rpm: Real,
     ) -> Result<GroundSurface, Box<EvalAltResult>> {
-        let layer = PassLayer::new(&centres.z, &centres.x, section(&wheel)?, feed, spindle_rpm);
+        let layer = PassLayer::new(
+            &centres.z,
+            &centres.x,
+            section(&wheel)?,
+            feed,
+            None,
+            spindle_rpm,
+        );
         Ok(surface.with(kernel(layer)?))
+    }
+
+    /// The surface after a pass as `cut`, the wheel having come to the
+    /// path's first point by `infeed` (the part turning while it came
+    /// down: the infeed's last revolution is what the first point keeps).
+    #[rhai_fn(name = "cut", return_raw)]
+    pub fn cut_entered(
+        surface: GroundSurface,
+        centres: Polyline,
+        wheel: Tool,
+        feed: Real,
+        spindle_rpm: Real,
+        infeed: Infeed,
+    ) -> Result<GroundSurface, Box<EvalAltResult>> {
+        let layer = PassLayer::new(
+            &centres.z,
+            &centres.x,
+            section(&wheel)?,
+            feed,
+            Some(infeed),
+            spindle_rpm,
+        );
+        Ok(surface.with(kernel(layer)?))
+    }
+
+    /// How the wheel comes to a pass's first point: a straight move from
+    /// `(z, x)` at `feed` mm/min (the program's infeed block).
+    #[rhai_fn(return_raw)]
+    pub fn infeed(z: Real, x: Real, feed: Real) -> Result<Infeed, Box<EvalAltResult>> {
+        kernel(crate::math::finite("infeed start z", z))?;
+        kernel(crate::math::finite("infeed start x", x))?;
+        kernel(crate::math::positive("infeed feed", feed))?;
+        Ok(Infeed { z, x, feed })
     }
 
     /// The surface at `z`.
@@ -233,6 +276,30 @@ pub mod offset_api {
             &centres,
             section(&wheel)?,
             feed,
+            None,
+            spindle_rpm,
+            &rest,
+        ))
+    }
+
+    /// The steady rest along a pass as `rest_track`, the wheel having come
+    /// to the path's first point by `infeed`.
+    #[rhai_fn(name = "rest_track", return_raw)]
+    pub fn rest_track_entered(
+        surface: GroundSurface,
+        centres: Polyline,
+        wheel: Tool,
+        rest: RestSetup,
+        feed: Real,
+        spindle_rpm: Real,
+        infeed: Infeed,
+    ) -> Result<RestTrack, Box<EvalAltResult>> {
+        kernel(offset::rest::track(
+            &surface,
+            &centres,
+            section(&wheel)?,
+            feed,
+            Some(infeed),
             spindle_rpm,
             &rest,
         ))

@@ -200,6 +200,7 @@ fn register_types(e: &mut Engine) {
         .register_type_with_name::<Equidistant>("Equidistant")
         .register_type_with_name::<RestSetup>("SteadyRest")
         .register_type_with_name::<RestTrack>("RestTrack")
+        .register_type_with_name::<crate::offset::phases::Infeed>("Infeed")
         .register_type_with_name::<crate::offset::surface::GroundSurface>("GroundSurface")
         .register_type_with_name::<crate::tool::Tool>("Tool")
         .register_type_with_name::<bind_transform::Transform>("Transform")
