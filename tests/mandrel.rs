@@ -906,3 +906,56 @@ fn a_heavy_finish_fails_and_tall_ridges_are_reported() {
     assert_eq!(code, 0, "{err}");
     assert!(said.contains("warning: N"), "{said}");
 }
+
+/// A machine's chain is the one truth of where its bodies stand: a machine
+/// file whose rest chain places the rest 180 mm before the wheel while its
+/// constant `rest_offset_b` says 150 mm is refused before anything is
+/// computed, naming both; without the constant the rest's offset comes
+/// from the chain, and a `--set` the chain cannot follow (it holds a
+/// number, not the constant) is refused naming the chain's value.
+#[test]
+fn the_rests_place_comes_from_the_machines_chain() {
+    let file = common::root().join("tests/fixtures/grinder-rest-literal.toml");
+    let dir = common::scratch("mandrel", "rest-literal");
+    let out = dir.join("run");
+    let run = |machine: &Path, sets: &[&str]| {
+        let mut args = vec![
+            "run",
+            "scripts/mandrel.rhai",
+            "--machine",
+            common::s(machine),
+            "--out",
+            common::s(&out),
+        ];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        common::pilgrim(&args)
+    };
+    let (code, _, err) = run(&file, &[]);
+    assert_ne!(code, 0, "{err}");
+    assert!(
+        err.contains("rest_offset_b = -150 mm")
+            && err.contains("body rest")
+            && err.contains("-180 mm"),
+        "{err}"
+    );
+    assert!(!out.join("program.mpf").exists());
+    // Without the constant: the chain's -180 mm.
+    let text = std::fs::read_to_string(&file).unwrap();
+    let plain = dir.join("grinder.toml");
+    std::fs::write(&plain, text.replace("rest_offset_b = -150.0\n", "")).unwrap();
+    let (code, _, err) = run(&plain, &[]);
+    assert_eq!(code, 0, "{err}");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["parameters"]["rest_b"]["value"], -180.0);
+    rest_stands_where_u_puts_it(&out, -180.0);
+    let (code, _, err) = run(&plain, &["rest_b=-150"]);
+    assert_ne!(code, 0, "{err}");
+    assert!(
+        err.contains("rest_b = -150 mm") && err.contains("-180 mm"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

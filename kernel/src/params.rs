@@ -150,6 +150,12 @@ pub struct ParamSpec {
     /// it, if any.
     #[serde(default)]
     pub machine: Option<String>,
+    /// The place of a machine's body it restates, `"<body>.<x|y|z>"`: the
+    /// body's origin relative to the tool along that axis of the part, as
+    /// the machine's chain puts it (every axis at zero). The run takes its
+    /// default from the chain and refuses a value the chain contradicts.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body: Option<String>,
     /// The least value allowed (a number, or each number of a list).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min: Option<f64>,
@@ -171,10 +177,19 @@ impl ParamSpec {
             unit: unit.to_owned(),
             doc: doc.to_owned(),
             machine: None,
+            body: None,
             min: None,
             max: None,
             max_len: None,
         }
+    }
+
+    /// The machine body and part axis (0: x, 1: y, 2: z) of its `body`
+    /// place, if it has one and it is well formed.
+    pub fn body_place(&self) -> Option<(&str, usize)> {
+        let (body, axis) = self.body.as_deref()?.rsplit_once('.')?;
+        let along = ["x", "y", "z"].iter().position(|a| *a == axis)?;
+        (!body.is_empty()).then_some((body, along))
     }
 
     /// The bounds in words, for listings: `[1, 100]`, `>= 0.0001`, ...

@@ -306,11 +306,19 @@ pub fn run(
     // Parameters tied to machine constants default to this machine's; set
     // otherwise, they set the machine's for the whole run (its chains, its
     // bodies, the scene), so that the family and the machine cannot differ.
-    let values = resolve(
-        family.params(),
-        &machine.kinematics.info().constants,
-        sources,
-    )?;
+    // A parameter that restates where a machine body stands takes its
+    // default from the machine's chain when no constant states it.
+    let mut constants = machine.kinematics.info().constants.clone();
+    for s in family.params() {
+        if let (Some((body, along)), Some(c)) = (s.body_place(), &s.machine) {
+            if !constants.contains_key(c) {
+                if let Some(v) = crate::machine::body_offset(machine.kinematics.info(), body, along)? {
+                    constants.insert(c.clone(), v);
+                }
+            }
+        }
+    }
+    let values = resolve(family.params(), &constants, sources)?;
     let overrides: Vec<(String, f64)> = family
         .params()
         .iter()
@@ -332,6 +340,7 @@ pub fn run(
         changed.as_ref()
     };
     let info = kin.info();
+    body_places_agree(family, machine.kinematics.info(), info, &values)?;
     stage(STAGES[0]);
     let checks = family.checks(&values)?;
     for c in &checks {
@@ -777,4 +786,70 @@ mod tests {
         assert_eq!(null_at(&v, "report"), Some("report.notes.x".into()));
         assert_eq!(null_at(&serde_json::json!({"a": [1, 2]}), "r"), None);
     }
+}
+
+/// Checks every parameter that restates a machine body's place against the
+/// machine's chain as the run uses it (`used`, its constants set from the
+/// parameters): the chain is what the verification moves, so a constant
+/// or a value it contradicts is refused, naming both. `given` is the
+/// machine as opened, to say whether the value came from its constant.
+///
+/// # Failures
+/// [`crate::machine::MachineError::Description`] naming the parameter or
+/// constant, the body and the chain's value.
+fn body_places_agree(
+    family: &dyn PartFamily,
+    given: &crate::machine::MachineInfo,
+    used: &crate::machine::MachineInfo,
+    values: &Params,
+) -> Result<(), Error> {
+    for s in family.params() {
+        let Some((body, along)) = s.body_place() else {
+            continue;
+        };
+        let axis = ["x", "y", "z"][along];
+        let Some(chain) = crate::machine::body_offset(used, body, along)? else {
+            return Err(crate::machine::MachineError::Description {
+                machine: used.name.clone(),
+                message: format!(
+                    "family {} places its parameter {} at the body {body}, which this machine does not have",
+                    family.name(),
+                    s.name
+                ),
+            }
+            .into());
+        };
+        let Some(value) = values.get(&s.name).and_then(ParamValue::as_number) else {
+            continue;
+        };
+        if (value - chain).abs() <= 1e-9 * chain.abs().max(1.0) {
+            continue;
+        }
+        let constant = s
+            .machine
+            .as_ref()
+            .and_then(|c| given.constants.get(c).map(|v| (c, *v)));
+        let from_constant = matches!(constant, Some((_, v)) if v == value);
+        let said = match constant {
+            Some((c, _)) if from_constant => format!("its constant {c} = {value} mm"),
+            _ => format!("parameter {} = {value} mm", s.name),
+        };
+        let take = s.machine.as_ref().map_or_else(
+            || "change the machine's chain".to_owned(),
+            |c| format!("make the chain take the constant (a factor with constant = \"{c}\")"),
+        );
+        let fix = if from_constant {
+            format!("{take}, or leave the constant out and the run takes the chain's")
+        } else {
+            format!("leave {} unset (the run takes the chain's), or {take} so that setting it moves the body", s.name)
+        };
+        return Err(crate::machine::MachineError::Description {
+            machine: used.name.clone(),
+            message: format!(
+                "{said} disagrees with its chain of body {body}, which puts it at {chain} mm along {axis} from the tool (every axis at zero); the chain is what the verification moves: {fix}"
+            ),
+        }
+        .into());
+    }
+    Ok(())
 }

@@ -564,6 +564,39 @@ fn described(info: &MachineInfo, e: Invalid) -> MachineError {
     }
 }
 
+/// Where a machine's chains put the origin of its body `body` relative to
+/// the tool's programmed point, every axis at zero, along the part frame's
+/// axis `along` (0: x, 1: y, 2: z); `None` when it has no such body.
+///
+/// A family whose parameter restates a body's place (the steady rest's
+/// offset along the part) compares its value with this: the chain is what
+/// the verification moves, so it is the one truth.
+///
+/// # Failures
+/// As [`check_description`]; an axis index beyond 2.
+pub fn body_offset(info: &MachineInfo, body: &str, along: usize) -> Result<Option<Real>, MachineError> {
+    if along > 2 {
+        return Err(described(
+            info,
+            invalid(Place::Body(body.to_owned(), "chain"), format!("no part axis {along}")),
+        ));
+    }
+    let Some(spec) = info.bodies.iter().find(|b| b.name == body) else {
+        return Ok(None);
+    };
+    let origin = |chain: &Chain| -> Result<Real, MachineError> {
+        let p = chain.apply(&vec![0.0; chain.dof()], &Point3::origin())?;
+        Ok(p[along])
+    };
+    let at = origin(&compile_chain(info, Some(body), &spec.chain).map_err(|e| described(info, e))?)?;
+    let tool = if info.chain.is_empty() {
+        0.0
+    } else {
+        origin(&compile_chain(info, None, &info.chain).map_err(|e| described(info, e))?)?
+    };
+    Ok(Some(at - tool))
+}
+
 /// The other moving bodies of a machine, their chains compiled from its
 /// description.
 ///

@@ -471,17 +471,27 @@ impl ScriptFamily {
                 }
                 None => None,
             };
-            for k in ["unit", "doc"] {
+            for k in ["unit", "doc", "body"] {
                 crate::names::check_text(&format!("parameter '{name}': its {k}"), &text(k))
                     .map_err(|e| fam.contract(e.to_string()))?;
             }
+            let body = Some(text("body")).filter(|b| !b.is_empty());
             let spec = ParamSpec {
                 machine,
+                body,
                 min,
                 max,
                 max_len,
                 ..ParamSpec::new(&name, default, &text("unit"), &text("doc"))
             };
+            if spec.body.is_some()
+                && (spec.body_place().is_none() || spec.default.as_number().is_none())
+            {
+                return Err(fam.contract(format!(
+                    "parameter '{name}': body must read \"<body>.<x|y|z>\" (the machine body's place it restates, e.g. \"rest.z\") on a number, not {:?}",
+                    spec.body.as_deref().unwrap_or_default()
+                )));
+            }
             // The default must be allowed (a family's own mistake).
             if let Err(e) =
                 crate::params::resolve(std::slice::from_ref(&spec), &Default::default(), &[])
