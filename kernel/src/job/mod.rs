@@ -312,7 +312,9 @@ pub fn run(
     for s in family.params() {
         if let (Some((body, along)), Some(c)) = (s.body_place(), &s.machine) {
             if !constants.contains_key(c) {
-                if let Some(v) = crate::machine::body_offset(machine.kinematics.info(), body, along)? {
+                if let Some(v) =
+                    crate::machine::body_offset(machine.kinematics.info(), body, along)?
+                {
                     constants.insert(c.clone(), v);
                 }
             }
@@ -775,19 +777,6 @@ pub fn run(
     })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A number JSON cannot hold (NaN, infinity) is found, with its place.
-    #[test]
-    fn non_finite_numbers_are_found() {
-        let v = serde_json::json!({"a": 1.0, "notes": {"x": f64::NAN}});
-        assert_eq!(null_at(&v, "report"), Some("report.notes.x".into()));
-        assert_eq!(null_at(&serde_json::json!({"a": [1, 2]}), "r"), None);
-    }
-}
-
 /// Checks every parameter that restates a machine body's place against the
 /// machine's chain as the run uses it (`used`, its constants set from the
 /// parameters): the chain is what the verification moves, so a constant
@@ -852,4 +841,17 @@ fn body_places_agree(
         .into());
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A number JSON cannot hold (NaN, infinity) is found, with its place.
+    #[test]
+    fn non_finite_numbers_are_found() {
+        let v = serde_json::json!({"a": 1.0, "notes": {"x": f64::NAN}});
+        assert_eq!(null_at(&v, "report"), Some("report.notes.x".into()));
+        assert_eq!(null_at(&serde_json::json!({"a": [1, 2]}), "r"), None);
+    }
 }

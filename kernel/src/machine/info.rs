@@ -574,11 +574,18 @@ fn described(info: &MachineInfo, e: Invalid) -> MachineError {
 ///
 /// # Failures
 /// As [`check_description`]; an axis index beyond 2.
-pub fn body_offset(info: &MachineInfo, body: &str, along: usize) -> Result<Option<Real>, MachineError> {
+pub fn body_offset(
+    info: &MachineInfo,
+    body: &str,
+    along: usize,
+) -> Result<Option<Real>, MachineError> {
     if along > 2 {
         return Err(described(
             info,
-            invalid(Place::Body(body.to_owned(), "chain"), format!("no part axis {along}")),
+            invalid(
+                Place::Body(body.to_owned(), "chain"),
+                format!("no part axis {along}"),
+            ),
         ));
     }
     let Some(spec) = info.bodies.iter().find(|b| b.name == body) else {
@@ -588,7 +595,8 @@ pub fn body_offset(info: &MachineInfo, body: &str, along: usize) -> Result<Optio
         let p = chain.apply(&vec![0.0; chain.dof()], &Point3::origin())?;
         Ok(p[along])
     };
-    let at = origin(&compile_chain(info, Some(body), &spec.chain).map_err(|e| described(info, e))?)?;
+    let at =
+        origin(&compile_chain(info, Some(body), &spec.chain).map_err(|e| described(info, e))?)?;
     let tool = if info.chain.is_empty() {
         0.0
     } else {
