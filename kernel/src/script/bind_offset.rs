@@ -45,6 +45,44 @@ fn to_side(s: &str) -> Result<Side, Box<EvalAltResult>> {
 }
 
 /// Equidistants, drops, envelopes and the steady rest.
+/// The surface after a pass (the bindings `cut`, with or without the
+/// wheel's infeed).
+fn cut_layer(
+    surface: GroundSurface,
+    centres: &Polyline,
+    wheel: &Tool,
+    feed: Real,
+    infeed: Option<Infeed>,
+    spindle_rpm: Real,
+) -> Result<GroundSurface, Box<EvalAltResult>> {
+    let w = section(wheel)?;
+    let layer = PassLayer::new(&centres.z, &centres.x, w, feed, infeed, spindle_rpm);
+    Ok(surface.with(kernel(layer)?))
+}
+
+/// The steady rest along a pass (the bindings `rest_track`, with or
+/// without the wheel's infeed).
+fn track_rest(
+    surface: &GroundSurface,
+    centres: &Polyline,
+    wheel: &Tool,
+    rest: &RestSetup,
+    feed: Real,
+    infeed: Option<Infeed>,
+    spindle_rpm: Real,
+) -> Result<RestTrack, Box<EvalAltResult>> {
+    let w = section(wheel)?;
+    kernel(offset::rest::track(
+        surface,
+        centres,
+        w,
+        feed,
+        infeed,
+        spindle_rpm,
+        rest,
+    ))
+}
+
 #[export_module]
 pub mod offset_api {
     use super::*;
@@ -178,15 +216,7 @@ pub mod offset_api {
         feed: Real,
         spindle_rpm: Real,
     ) -> Result<GroundSurface, Box<EvalAltResult>> {
-        let layer = PassLayer::new(
-            &centres.z,
-            &centres.x,
-            section(&wheel)?,
-            feed,
-            None,
-            spindle_rpm,
-        );
-        Ok(surface.with(kernel(layer)?))
+        cut_layer(surface, &centres, &wheel, feed, None, spindle_rpm)
     }
 
     /// The surface after a pass as `cut`, the wheel having come to the
@@ -201,15 +231,7 @@ pub mod offset_api {
         spindle_rpm: Real,
         infeed: Infeed,
     ) -> Result<GroundSurface, Box<EvalAltResult>> {
-        let layer = PassLayer::new(
-            &centres.z,
-            &centres.x,
-            section(&wheel)?,
-            feed,
-            Some(infeed),
-            spindle_rpm,
-        );
-        Ok(surface.with(kernel(layer)?))
+        cut_layer(surface, &centres, &wheel, feed, Some(infeed), spindle_rpm)
     }
 
     /// How the wheel comes to a pass's first point: a straight move from
@@ -271,15 +293,7 @@ pub mod offset_api {
         feed: Real,
         spindle_rpm: Real,
     ) -> Result<RestTrack, Box<EvalAltResult>> {
-        kernel(offset::rest::track(
-            &surface,
-            &centres,
-            section(&wheel)?,
-            feed,
-            None,
-            spindle_rpm,
-            &rest,
-        ))
+        track_rest(&surface, &centres, &wheel, &rest, feed, None, spindle_rpm)
     }
 
     /// The steady rest along a pass as `rest_track`, the wheel having come
@@ -294,15 +308,15 @@ pub mod offset_api {
         spindle_rpm: Real,
         infeed: Infeed,
     ) -> Result<RestTrack, Box<EvalAltResult>> {
-        kernel(offset::rest::track(
+        track_rest(
             &surface,
             &centres,
-            section(&wheel)?,
+            &wheel,
+            &rest,
             feed,
             Some(infeed),
             spindle_rpm,
-            &rest,
-        ))
+        )
     }
 
     /// The pass with the rest's blocks added.
