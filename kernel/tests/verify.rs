@@ -1,6 +1,6 @@
 //! Verification by replay, and the adaptive spacing it justifies.
 
-use pilgrim_kernel::offset::surface::{PassLayer, WheelSection};
+use pilgrim_kernel::offset::{swept_circles, CapsuleEnvelope};
 use pilgrim_kernel::profile::simplify_polyline;
 use pilgrim_kernel::{equidistant, MandrelLaw, Profile, ProfileBuilder, Side};
 
@@ -20,17 +20,19 @@ fn mandrel() -> (MandrelLaw, Profile) {
 }
 
 /// The surface the wheel's rounding leaves swept continuously along the
-/// centres `(z, x)` (a feed of 1e-4 mm a revolution: no ridge), against the
-/// profile `p` over [0, 400] every 0.01 mm: the largest |deviation|, the
+/// centres `(z, x)`: its circles placed closely enough that their scallops
+/// stay under 1e-5 mm.
+fn sweep(z: &[f64], x: &[f64]) -> CapsuleEnvelope {
+    let (cz, cx, _) = swept_circles(z, x, R_S, 1e-5).unwrap();
+    CapsuleEnvelope::new(&cz, &cx, R_S, 0.0, Side::Outside).unwrap()
+}
+
+/// The sweep of the wheel's rounding along the centres `(z, x)` against
+/// the profile `p` over [0, 400] every 0.01 mm: the largest |deviation|, the
 /// deepest (signed) and where it is.
 fn sweep_deviation(z: &[f64], x: &[f64], p: &Profile) -> (f64, f64, f64) {
-    let wheel = WheelSection {
-        radius: R_S,
-        flat: 0.0,
-    };
-    let layer = PassLayer::new(z, x, wheel, 100.0, None, 1e6).unwrap();
     let zs: Vec<f64> = (0..=40_000).map(|i| i as f64 * 0.01).collect();
-    let (s, n) = (layer.valleys(&zs), p.eval_many(&zs).unwrap());
+    let (s, n) = (sweep(z, x).eval_many(&zs), p.eval_many(&zs).unwrap());
     let (mut worst, mut below, mut at) = (0.0f64, f64::INFINITY, 0.0);
     for ((z, s), n) in zs.iter().zip(s).zip(n) {
         worst = worst.max((s - n).abs());
@@ -75,19 +77,7 @@ fn adaptive_blocks_keep_the_tolerance_and_skip_straight_runs() {
     assert_eq!(inside(-150.0 + 1e-6, -R_S * 0.006 - 1e-3), 0);
     assert_eq!(inside(400.0 + 1.0, 500.0 - R_S * 0.04), 0);
     // The law itself is met on the working part.
-    let layer = PassLayer::new(
-        &z,
-        &x,
-        WheelSection {
-            radius: R_S,
-            flat: 0.0,
-        },
-        100.0,
-        None,
-        1e6,
-    )
-    .unwrap();
-    assert!((layer.valleys(&[200.0])[0] - law.x(200.0)).abs() <= tol);
+    assert!((sweep(&z, &x).eval(200.0) - law.x(200.0)).abs() <= tol);
 }
 
 /// A centre 10 um too deep leaves a gouge under it (the replay through a

@@ -146,12 +146,6 @@ impl TimedPath {
         &self.x[self.lead..]
     }
 
-    /// Every point the wheel passes, the infeed's start first if the path
-    /// has one: `(z, x)`.
-    pub fn points(&self) -> (&[Real], &[Real]) {
-        (&self.z, &self.x)
-    }
-
     /// How long the path takes (minutes).
     pub fn duration(&self) -> Real {
         self.time[self.time.len() - 1]

@@ -9,14 +9,13 @@
 //!   generatrices, `360/m` degrees apart, meets it, moving along straight
 //!   moves at their feeds, the control's linear interpolation in time.
 //! - [`PassLayer`] is what one pass leaves as a surface of revolution: the
-//!   wheel's true section swept along the path (the valleys) and the
-//!   highest surface any spindle phase leaves ([`super::phases`]): what a
+//!   highest surface any spindle phase leaves ([`super::phases`]), what a
 //!   steady rest's support riding the turning part meets. The verification
 //!   cuts the same section at the same moments on each generatrix
 //!   ([`crate::verify::check_grinding`]) and reports how far the crest
 //!   stands above its own highest generatrix.
 //! - [`GroundSurface`] is the blank (a polyline: a step stays a step)
-//!   lowered by each pass's crest, exact at any z.
+//!   lowered by each pass's crest.
 //!
 //! # Generatrices
 //! [`GENERATRICES`] = 8, 45 degrees apart. On a straight generatrix the
@@ -26,7 +25,6 @@
 //! the lowest of them reaches the valleys (the touches themselves).
 
 use super::phases::{Infeed, PhaseCrest, TimedPath};
-use super::{CapsuleEnvelope, Side};
 use crate::math::Real;
 use crate::profile::{Profile, ProfileError};
 
@@ -119,19 +117,12 @@ impl WheelSection {
     }
 }
 
-/// How finely a pass's sweep is placed: the scallops of the continuous
-/// sweep's circles stay below this (mm).
-pub const SWEEP_RESOLUTION: Real = 1e-5;
-
-/// What one pass leaves, as a surface of revolution: the wheel's true
-/// section swept continuously along the path (the valleys, the lowest any
-/// generatrix can be), and the highest surface any spindle phase leaves
-/// ([`PhaseCrest`]: the same section at the same moments as the replay's
-/// generatrices, over every phase): what a steady rest's support riding the
-/// turning part meets.
+/// What one pass leaves, as a surface of revolution: the highest surface
+/// any spindle phase leaves ([`PhaseCrest`]: the same section at the same
+/// moments as the replay's generatrices, over every phase), what a steady
+/// rest's support riding the turning part meets.
 #[derive(Debug, Clone)]
 pub struct PassLayer {
-    swept: CapsuleEnvelope,
     crest: PhaseCrest,
 }
 
@@ -141,7 +132,8 @@ impl PassLayer {
     /// first point), while the part turns at `rpm`.
     ///
     /// # Failures
-    /// Bad numbers; a path of no points; more circles than a sweep may have.
+    /// Bad numbers; a path of no points; a pass too long for its crest's
+    /// grid.
     pub fn new(
         z: &[Real],
         x: &[Real],
@@ -161,11 +153,7 @@ impl PassLayer {
     /// # Failures
     /// As [`Self::new`].
     pub fn timed(path: TimedPath, wheel: WheelSection, rpm: Real) -> Result<Self, ProfileError> {
-        crate::math::positive("spindle speed", rpm)?;
-        let (pz, px) = path.points();
-        let (cz, cx, _) = super::swept_circles(pz, px, wheel.radius, SWEEP_RESOLUTION)?;
         Ok(Self {
-            swept: CapsuleEnvelope::new(&cz, &cx, wheel.radius, wheel.flat, Side::Outside)?,
             crest: PhaseCrest::new(path, wheel, rpm)?,
         })
     }
@@ -173,12 +161,6 @@ impl PassLayer {
     /// The path and its times.
     pub fn path(&self) -> &TimedPath {
         self.crest.path()
-    }
-
-    /// The valleys at sorted `zs`: the continuous sweep (infinite where the
-    /// wheel never reached).
-    pub fn valleys(&self, zs: &[Real]) -> Vec<Real> {
-        self.swept.eval_many(zs)
     }
 
     /// The crests at `zs`: the highest surface over spindle phases
@@ -377,6 +359,7 @@ fn linear(p: &Profile, zs: &[Real]) -> Vec<Real> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::offset::{CapsuleEnvelope, Side};
 
     /// On a straight generatrix the ridges between touches `f` apart are
     /// `R - sqrt(R^2 - f^2/4)` high, `f^2 / (8 R)` to first order; the
@@ -404,10 +387,14 @@ mod tests {
             flat: 0.0,
         };
         let layer = PassLayer::new(&z, &x, w, feed, None, rpm).unwrap();
-        let (v, c) = (layer.valleys(&[100.3])[0], layer.crests(&[100.3])[0]);
-        // The continuous sweep within its resolution.
+        let c = layer.crests(&[100.3])[0];
+        // The continuous sweep (the valleys) within its circles' scallops.
+        let resolution = 1e-5;
+        let (cz, cx, _) = crate::offset::swept_circles(&z, &x, r, resolution).unwrap();
+        let swept = CapsuleEnvelope::new(&cz, &cx, r, 0.0, Side::Outside).unwrap();
+        let v = swept.eval(100.3);
         assert!(
-            v.abs() <= 1.01 * SWEEP_RESOLUTION && (c - exact).abs() < 1e-9,
+            v.abs() <= 1.01 * resolution && (c - exact).abs() < 1e-9,
             "{v} {c}"
         );
     }
