@@ -225,17 +225,32 @@ impl WheelSection {
 /// moving along `path` while the part turns once every `period` minutes,
 /// counting only the moments up to `until` (minutes from the path's
 /// start; infinite: all of it). Infinite where some phase is never touched.
-/// The wheel is taken to have come to the path's first point by an infeed
-/// and stood there a revolution (a pass's first block, as the replay's
-/// generatrices all meet it there within the first revolution).
+/// A path without its infeed ([`TimedPath::entered`]) is taken to have
+/// stood a revolution at its first point (how the wheel came there is not
+/// said; a pass's infeed takes at least that at a grinding infeed feed).
 pub fn crest_at(path: &TimedPath, wheel: WheelSection, period: Real, z: Real, until: Real) -> Real {
+    let covered = path.coverage(z, wheel.reach());
+    crest_covered(path, wheel, period, z, until, covered)
+}
+
+/// [`crest_at`], the first and last times the wheel reaches `z` given.
+fn crest_covered(
+    path: &TimedPath,
+    wheel: WheelSection,
+    period: Real,
+    z: Real,
+    until: Real,
+    covered: Option<(Real, Real)>,
+) -> Real {
     let end = path.duration().min(until);
-    let Some((t_in, t_out)) = path.coverage(z, wheel.reach()) else {
+    let Some((t_in, t_out)) = covered else {
         return Real::INFINITY;
     };
-    // The wheel came to the first point by an infeed: it stood there a
-    // revolution at least before it moved on.
-    let t_in = if t_in <= 0.0 { -period } else { t_in };
+    let t_in = if t_in <= 0.0 && path.lead == 0 {
+        -period
+    } else {
+        t_in
+    };
     let t_out = t_out.min(end);
     if t_out - t_in < period {
         return Real::INFINITY;
@@ -324,10 +339,16 @@ impl PhaseCrest {
         let mut last_touch = Vec::with_capacity(n);
         for i in 0..n {
             let z = lo + i as Real * CREST_STEP;
-            crest.push(crest_at(&path, wheel, period, z, Real::INFINITY));
-            let (a, b) = path
-                .coverage(z, reach)
-                .unwrap_or((Real::INFINITY, Real::INFINITY));
+            let covered = path.coverage(z, reach);
+            crest.push(crest_covered(
+                &path,
+                wheel,
+                period,
+                z,
+                Real::INFINITY,
+                covered,
+            ));
+            let (a, b) = covered.unwrap_or((Real::INFINITY, Real::INFINITY));
             first_touch.push(a);
             last_touch.push(b);
         }
