@@ -423,21 +423,17 @@ fn bodies(
             let gap = frame(k).and_then(|f| stock.body_gap(k, 1.0, &roller, &f));
             if let (Some(g0), Some(g1)) = (gap_before, gap) {
                 if g0.abs() <= clear && g1.abs() <= clear {
-                    let mut ride = vec![g1];
-                    for i in 1..RIDING_CHECKS {
+                    // It rides: at the block and at the quarters before it.
+                    let inside = (1..RIDING_CHECKS).filter_map(|i| {
                         let along = i as Real / RIDING_CHECKS as Real;
-                        ride.extend(
-                            between(k, along).and_then(|f| stock.body_gap(k, along, &roller, &f)),
-                        );
-                    }
-                    for g in ride {
+                        between(k, along).and_then(|f| stock.body_gap(k, along, &roller, &f))
+                    });
+                    for g in std::iter::once(g1).chain(inside) {
                         if worst.is_none_or(|w| g.abs() > w.0.abs()) {
                             worst = Some((g, k));
                         }
                     }
                 }
-            }
-            if let (Some(g0), Some(g1)) = (gap_before, gap) {
                 if g0 > clear && g1 <= clear {
                     // It comes onto the part in this block: how fast.
                     let b = &written.blocks[k];

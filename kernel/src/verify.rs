@@ -846,13 +846,7 @@ impl crate::process::Stock for GroundStock {
         let (x, y, z) = (frame[(0, 3)], frame[(1, 3)], frame[(2, 3)]);
         let (u, r) = (x.hypot(y), shape.radius);
         let (surface, extra) = self.phases_at(block, along)?;
-        let (lo, hi) = surface.z_range();
-        let (a, b) = ((z - r).max(lo), (z + r).min(hi));
-        if a >= b {
-            return None;
-        }
-        let window = surface.window(a, b, STOCK_STEP, extra.as_ref()).ok()?;
-        let drop = crate::offset::drop_circle(&window, z, r, Side::Outside).ok()?;
+        let drop = surface.support(z, r, STOCK_STEP, extra.as_ref()).ok()??;
         Some(u - drop.centre_x)
     }
 

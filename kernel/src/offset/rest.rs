@@ -257,8 +257,8 @@ pub fn track(
     // there if asked.
     let at = |z: Real, time: Real, k: usize, seed: bool| -> Result<(Drop, Real), ProfileError> {
         let z_r = z + setup.offset_b;
-        let (a, b) = ((z_r - setup.radius).max(lo), (z_r + setup.radius).min(hi));
-        if a >= b {
+        let part = Some(layer.by_time(time));
+        let Some(d) = before.support(z_r, setup.radius, setup.sample, part.as_ref())? else {
             return Err(ProfileError::OutsideProfile {
                 what: format!(
                     "the steady rest's support at point {} of the pass (z_r = z + B, B = {} mm) has nothing under it: its centre",
@@ -269,14 +269,12 @@ pub fn track(
                 z_min: lo,
                 z_max: hi,
             });
-        }
-        let part = Some(layer.by_time(time));
-        let window = before.window(a, b, setup.sample, part.as_ref())?;
-        let d = super::drop_circle(&window, z_r, setup.radius, Side::Outside)?;
+        };
         if !seed {
             return Ok((d, Real::NAN));
         }
         // The seed's formula reads the surface as an array at an even step.
+        let (a, b) = ((z_r - setup.radius).max(lo), (z_r + setup.radius).min(hi));
         let grid = crate::profile::uniform_grid(a, b, setup.sample)?;
         let even = Profile::new(grid.clone(), before.eval_many(&grid, part.as_ref()))?;
         let seed = seed_u(&even, z_r.clamp(a, b), setup.radius)?;
