@@ -44,7 +44,6 @@ fn to_side(s: &str) -> Result<Side, Box<EvalAltResult>> {
     }
 }
 
-/// Equidistants, drops, envelopes and the steady rest.
 /// The surface after a pass (the bindings `cut`, with or without the
 /// wheel's infeed).
 fn cut_layer(
@@ -83,6 +82,7 @@ fn track_rest(
     ))
 }
 
+/// Equidistants, drops, envelopes and the steady rest.
 #[export_module]
 pub mod offset_api {
     use super::*;
