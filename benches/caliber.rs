@@ -88,7 +88,7 @@ fn caliber_verify(c: &mut Criterion) {
             kin,
             &out.toolpath.tool.reference,
             &wheel,
-            &out.toolpath.passes,
+            &pilgrim_kernel::program::pass_blocks(&out.program, &out.toolpath.passes),
             &req,
         )
         .unwrap()
@@ -118,8 +118,7 @@ fn caliber_verify(c: &mut Criterion) {
             &req,
             allowance,
             &wheel,
-            &out.program,
-            &out.toolpath.passes,
+            &pilgrim_kernel::program::pass_blocks(&out.program, &out.toolpath.passes),
         );
         pilgrim_kernel::process::check(
             &out.program,

@@ -495,8 +495,15 @@ fn a_corrupted_block_is_named() {
         panic!("the caliber's tool is a wheel")
     };
     let check = |p: &pilgrim_kernel::program::AxisProgram| {
-        check_groove(p, &machine, &tp.tool.reference, &wheel, &tp.passes, &req)
-            .and_then(|c| c.verified())
+        check_groove(
+            p,
+            &machine,
+            &tp.tool.reference,
+            &wheel,
+            &pilgrim_kernel::program::pass_blocks(p, &tp.passes),
+            &req,
+        )
+        .and_then(|c| c.verified())
     };
     let clean = check(&program).unwrap();
     assert!(clean.max_abs_mm < 0.5, "{clean:?}");

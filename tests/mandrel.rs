@@ -296,7 +296,7 @@ fn job(
         .unwrap()
         .into_profile()
         .unwrap();
-    let passes = tp.passes.clone();
+    let passes = pilgrim_kernel::program::pass_blocks(&program, &tp.passes);
     let reference = tp.tool.reference;
     let pilgrim_kernel::ToolShape::Wheel(wheel) = tp.tool.shape else {
         panic!("the mandrel's tool is a wheel")
@@ -744,7 +744,7 @@ fn process_errors(
         &grinder,
         &tp.tool.reference,
         &wheel,
-        &tp.passes,
+        &pilgrim_kernel::program::pass_blocks(program, &tp.passes),
         &v.profile,
         v.blank.as_deref(),
         (v.from, v.to),

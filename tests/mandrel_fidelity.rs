@@ -525,7 +525,7 @@ fn verified(
         &machine,
         &tp.tool.reference,
         &wheel,
-        &tp.passes,
+        &pilgrim_kernel::program::pass_blocks(&program, &tp.passes),
         &v.profile,
         v.blank.as_deref(),
         (v.from, v.to),

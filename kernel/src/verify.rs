@@ -18,10 +18,8 @@ use crate::offset::surface::{
 };
 use crate::offset::{CapsuleEnvelope, Side};
 use crate::profile::{Profile, ProfileError};
-use crate::program::pass_blocks;
-use crate::program::{axis_rows, AxisProgram};
+use crate::program::{axis_rows, AxisProgram, ProgramPass};
 use crate::tool::Wheel;
-use crate::toolpath::Pass;
 use crate::transform::ToolFrame;
 use crate::verdict::{Figure, Finding};
 use serde::{Deserialize, Serialize};
@@ -337,7 +335,8 @@ pub fn as_written(program: &AxisProgram) -> (AxisProgram, Real) {
 /// surface the passes before left on that generatrix (into `blank`, where
 /// given, before the first); each cutting pass's surface, ridges included,
 /// against `nominal` over `[from, to]`, the worst generatrix counting.
-/// `passes` are the toolpath's, whose points became the program's blocks.
+/// `passes` are the program's ([`crate::program::pass_blocks`] of the
+/// toolpath it was built from, or as its text groups them).
 ///
 /// # Failures
 /// A tolerance finer than twice the program's resolution; the replay
@@ -351,7 +350,7 @@ pub fn check_grinding(
     machine: &dyn MachineKinematics,
     tool: &ToolFrame,
     wheel: &Wheel,
-    passes: &[Pass],
+    passes: &[ProgramPass],
     nominal: &Profile,
     blank: Option<&Profile>,
     range: (Real, Real),
@@ -375,7 +374,7 @@ pub fn replay_grinding(
     machine: &dyn MachineKinematics,
     tool: &ToolFrame,
     wheel: &Wheel,
-    passes: &[Pass],
+    passes: &[ProgramPass],
     nominal: &Profile,
     blank: Option<&Profile>,
     range: (Real, Real),
@@ -425,14 +424,15 @@ pub fn replay_grinding(
     });
     let mut phase_states = Vec::new();
     let mut block_time = std::collections::BTreeMap::new();
-    for (pass, blocks) in pass_blocks(program, passes) {
+    for pass in passes {
+        let blocks = pass.blocks.clone();
         crate::budget::check("the grinding replay")?;
         for b in &written.blocks[blocks.clone()] {
             if let Some(s) = b.spindle {
                 rpm = s;
             }
         }
-        if !pass.cuts() {
+        if !pass.cuts {
             continue;
         }
         let z: Vec<Real> = blocks.clone().map(|b| poses[6 * b + 2]).collect();

@@ -33,9 +33,8 @@ use super::pose::TorusWheel;
 use crate::budget::OverTime;
 use crate::machine::MachineKinematics;
 use crate::math::{Real, Vec3};
-use crate::program::{axis_rows, block_name, pass_blocks, AxisProgram};
+use crate::program::{axis_rows, block_name, AxisProgram, ProgramPass};
 use crate::tool::Wheel;
-use crate::toolpath::Pass;
 use crate::transform::ToolFrame;
 use crate::verdict::{Figure, Finding};
 use crate::verify::{as_written, VerifyError};
@@ -266,7 +265,7 @@ fn samples(
     machine: &dyn MachineKinematics,
     tool: &ToolFrame,
     wheel: &Wheel,
-    passes: &[Pass],
+    passes: &[ProgramPass],
     req: &GrooveRequest,
 ) -> Result<(Vec<Vec<Sample>>, Real, usize), VerifyError> {
     let info = machine.info();
@@ -282,7 +281,7 @@ fn samples(
     let mut out = Vec::new();
     let mut worst: Real = 0.0;
     let mut count = 0;
-    for (_, blocks) in pass_blocks(program, passes).filter(|(p, _)| p.cuts()) {
+    for blocks in passes.iter().filter(|p| p.cuts).map(|p| p.blocks.clone()) {
         crate::budget::check("the groove's replay")?;
         let mut rows_sub: Vec<Real> = Vec::new();
         let mut owner = Vec::new();
@@ -389,7 +388,7 @@ pub fn check_groove(
     machine: &dyn MachineKinematics,
     tool: &ToolFrame,
     wheel: &Wheel,
-    passes: &[Pass],
+    passes: &[ProgramPass],
     req: &GrooveRequest,
 ) -> Result<GrooveCheck, VerifyError> {
     crate::math::positive("verification tolerance", req.tolerance)?;

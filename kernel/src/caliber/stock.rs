@@ -5,9 +5,8 @@ use super::check::{placed, wheel_distance, GrooveRequest};
 use super::groove::Groove;
 use super::pose::TorusWheel;
 use crate::math::{Real, Vec3};
-use crate::program::{pass_blocks, AxisProgram};
+use crate::program::ProgramPass;
 use crate::tool::Wheel;
-use crate::toolpath::Pass;
 
 /// The groove's material for the process's rules ([`crate::process`]):
 /// the roll with its groove as turned, before any pass grinds it (its
@@ -30,19 +29,14 @@ type Measured = ([Real; 6], Real, (Real, Real));
 
 impl GrooveStock {
     /// The material of `req`'s groove, its allowance `stock`, ground by
-    /// `passes` of `program` with `wheel`.
-    pub fn new(
-        req: &GrooveRequest,
-        stock: Real,
-        wheel: &Wheel,
-        program: &AxisProgram,
-        passes: &[Pass],
-    ) -> Self {
-        let passes = pass_blocks(program, passes)
-            .filter(|(p, _)| p.cuts())
-            .map(|(p, r)| crate::process::PassStock {
+    /// `passes` with `wheel`.
+    pub fn new(req: &GrooveRequest, stock: Real, wheel: &Wheel, passes: &[ProgramPass]) -> Self {
+        let passes = passes
+            .iter()
+            .filter(|p| p.cuts)
+            .map(|p| crate::process::PassStock {
                 name: p.name.clone(),
-                first_block: r.start,
+                first_block: p.blocks.start,
                 cut: stock,
                 ridge: 0.0,
                 finishes: true,

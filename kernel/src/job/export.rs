@@ -114,7 +114,10 @@ pub fn export(
     let place = match block {
         Some(0) => return Err(Error::Options("--block counts blocks from 1".into())),
         Some(n) => scene::PosePlace::at_end(n - 1),
-        None => scene::default_pose_block(&program, &toolpath.passes),
+        None => scene::default_pose_block(
+            &program,
+            &crate::program::pass_blocks(&program, &toolpath.passes),
+        ),
     };
     let index = place.block;
     let mut stl_bytes = 0u64;

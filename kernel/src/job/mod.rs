@@ -377,6 +377,7 @@ pub fn run(
     stage(STAGES[2]);
     let mut program = build(&toolpath, kin, &options.program_name)?;
     program.number = options.program_number.unwrap_or(0);
+    let passes = crate::program::pass_blocks(&program, &toolpath.passes);
     let requested = family.verification(&values)?;
     let requested_any = requested.is_some();
     if options.pose_block == Some(0) {
@@ -421,11 +422,7 @@ pub fn run(
             };
             if let Some(allowance) = g.stock {
                 stock = Some(Box::new(crate::caliber::GrooveStock::new(
-                    g,
-                    allowance,
-                    &wheel,
-                    &program,
-                    &toolpath.passes,
+                    g, allowance, &wheel, &passes,
                 )));
             }
             Some(crate::caliber::check_groove(
@@ -433,7 +430,7 @@ pub fn run(
                 kin,
                 &toolpath.tool.reference,
                 &wheel,
-                &toolpath.passes,
+                &passes,
                 g,
             )?)
         }
@@ -449,7 +446,7 @@ pub fn run(
                 kin,
                 &toolpath.tool.reference,
                 &w,
-                &toolpath.passes,
+                &passes,
                 &v.profile,
                 v.blank.as_deref(),
                 (v.from, v.to),
@@ -505,7 +502,7 @@ pub fn run(
     ) {
         (Some(n), _) => scene::PosePlace::at_end(n - 1),
         (None, Some(b)) => scene::PosePlace::at_end(b - 1),
-        (None, None) => default_pose_block(&program, &toolpath.passes),
+        (None, None) => default_pose_block(&program, &passes),
     };
     let pose_index = pose_place.block;
     // The caliber's contact patch at the scene's block (in the report, and
@@ -729,9 +726,10 @@ pub fn run(
             .collect();
         let text = svg::profile_svg(
             &profiles,
-            &toolpath,
             &program,
+            &passes,
             kin,
+            &toolpath.tool.reference,
             &v.profile,
             w.rounding_radius,
         )

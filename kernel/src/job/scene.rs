@@ -6,10 +6,9 @@ use crate::family::{PartBody, PartGeometry};
 use crate::machine::{bodies_of, BodyShape, MachineKinematics};
 use crate::math::{Mat4, Point3, Vec3};
 use crate::mesh::{self, frame_from_pose, MeshError, Scene, StlFormat, TriMesh};
-use crate::program::pass_blocks;
+use crate::program::ProgramPass;
 use crate::program::{axis_rows, AxisProgram};
 use crate::tool::{Tool, ToolShape, WheelOrigin};
-use crate::toolpath::Pass;
 use serde::{Deserialize, Serialize};
 
 /// A body written to a file, for the report.
@@ -197,13 +196,13 @@ impl PosePlace {
 /// than a rapid), the tool at work on the finish, at its end; halfway
 /// through it if it cuts a thread (whose end lies beyond the thread, where
 /// the tool has left the part); else the first block of the last pass.
-pub fn default_pose_block(program: &AxisProgram, passes: &[Pass]) -> PosePlace {
+pub fn default_pose_block(program: &AxisProgram, passes: &[ProgramPass]) -> PosePlace {
     let (mut last_start, mut pick) = (0, None);
-    for (p, blocks) in pass_blocks(program, passes) {
-        if p.cuts() {
-            pick = Some(blocks.start + p.points.len() / 2);
+    for p in passes {
+        if p.cuts {
+            pick = Some(p.blocks.start + p.blocks.len() / 2);
         }
-        last_start = blocks.start;
+        last_start = p.blocks.start;
     }
     let block = pick.unwrap_or(last_start);
     let thread = program

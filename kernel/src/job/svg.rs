@@ -6,9 +6,8 @@
 use crate::machine::{bodies_of, MachineKinematics};
 use crate::math::fixed;
 use crate::profile::Profile;
-use crate::program::pass_blocks;
-use crate::program::{axis_rows, AxisProgram};
-use crate::toolpath::{Pass, Toolpath};
+use crate::program::{axis_rows, AxisProgram, ProgramPass};
+use crate::transform::ToolFrame;
 
 /// One line of a panel.
 struct Series {
@@ -41,13 +40,14 @@ const COLORS: [plotters::style::RGBColor; 4] = [
 /// The machine's bodies or the program's axes not matching.
 pub fn profile_svg(
     profiles: &[(String, Profile)],
-    toolpath: &Toolpath,
     program: &AxisProgram,
+    passes: &[ProgramPass],
     machine: &dyn MachineKinematics,
+    tool: &ToolFrame,
     nominal: &Profile,
     rounding: f64,
 ) -> Result<String, String> {
-    let cutting: Vec<&Pass> = toolpath.passes.iter().filter(|p| p.cuts()).collect();
+    let cutting: Vec<&ProgramPass> = passes.iter().filter(|p| p.cuts).collect();
     let mut shape: Vec<Series> = profiles
         .iter()
         .enumerate()
@@ -61,10 +61,10 @@ pub fn profile_svg(
         shape.push(Series {
             name: format!("wheel centre, {}", last.name),
             color: COLORS[2],
-            points: last
-                .points
-                .iter()
-                .map(|c| (c.point[2], c.point[0].hypot(c.point[1])))
+            points: crate::verify::replay_blocks(program, machine, tool, last.blocks.clone())
+                .map_err(|e| e.to_string())?
+                .chunks_exact(6)
+                .map(|p| (p[2], p[0].hypot(p[1])))
                 .collect(),
         });
     }
@@ -87,10 +87,8 @@ pub fn profile_svg(
         };
         let names = body.chain().axis_names();
         let mut series = Vec::new();
-        for (i, (p, blocks)) in pass_blocks(program, &toolpath.passes)
-            .filter(|(p, _)| p.cuts())
-            .enumerate()
-        {
+        for (i, p) in cutting.iter().enumerate() {
+            let blocks = p.blocks.clone();
             let rows = axis_rows(program, info, names, blocks.clone())?;
             let points = rows
                 .chunks_exact(names.len().max(1))

@@ -206,15 +206,33 @@ pub fn start_blocks(setup: &ProgramSetup) -> usize {
     usize::from(!setup.start_clear.is_empty()) + setup.approach.len()
 }
 
+/// A pass as a program holds it: its name, the blocks (indices from 0) it
+/// is, and whether it cuts ([`Pass::cuts`]: a move other than a rapid
+/// that moves the tool). The replays take passes in this form, whether
+/// they come from the toolpath a program was built from
+/// ([`pass_blocks`]) or from a program's text (its comments).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ProgramPass {
+    /// Its name (the comment before its first block).
+    pub name: String,
+    /// Its blocks in the program.
+    pub blocks: Range<usize>,
+    /// Whether it cuts.
+    pub cuts: bool,
+}
+
 /// Each of `passes` with the blocks (indices from 0) it became in
 /// `program`, which was built from them ([`build`]): after the setup's
 /// start blocks.
-pub fn pass_blocks<'a>(
-    program: &AxisProgram,
-    passes: &'a [Pass],
-) -> impl Iterator<Item = (&'a Pass, Range<usize>)> {
+pub fn pass_blocks(program: &AxisProgram, passes: &[Pass]) -> Vec<ProgramPass> {
     let lead = start_blocks(&program.setup);
-    pass_ranges(passes).map(move |(p, r)| (p, r.start + lead..r.end + lead))
+    pass_ranges(passes)
+        .map(|(p, r)| ProgramPass {
+            name: p.name.clone(),
+            blocks: r.start + lead..r.end + lead,
+            cuts: p.cuts(),
+        })
+        .collect()
 }
 
 /// Checks a program read back from a file (a run's `program.json`, which
