@@ -163,6 +163,7 @@ fn circle_program(n: usize) -> pilgrim_kernel::program::AxisProgram {
                 spindle: None,
                 comment: (i == 0).then(|| "circle".to_owned()),
                 keep: Vec::new(),
+                number: None,
             }
         })
         .collect();

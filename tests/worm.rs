@@ -101,6 +101,7 @@ fn read_nc(nc: &str, rpm: f64) -> AxisProgram {
             spindle: None,
             comment: comment.take(),
             keep: vec![],
+            number: None,
         });
     }
     let axis = |n: &str| ProgramAxis {

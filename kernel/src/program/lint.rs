@@ -91,8 +91,118 @@ pub fn lint(
 ) -> Result<Linted, LintError> {
     match d.style {
         Style::Apt => lint_apt(text, program, d),
-        Style::GCode => lint_gcode(text, program, d, axes),
+        Style::GCode => lint_gcode(text, program, d, axes, Mode::Lint).map(|r| r.linted),
     }
+}
+
+/// Reads `text`, a program in `d` for the machine whose axes (their
+/// travel) are `axes`, as its control reads it: the lint's reader and
+/// rules, the moves taken as they are written instead of held to an axis
+/// program. `frame` is the program the text is for, without blocks: its
+/// axes (the machine's programmed axes), its setup and decimals; the name,
+/// number, tool number and spindle speed are the text's where it writes
+/// them. Axes the text never writes are left out; an axis not yet written
+/// is kept where it stands until its first value ([`super::Block::keep`],
+/// as the writer's start does). Each block carries its `N` and, as its
+/// comment, the last comment line before it since the move before: the
+/// pass it begins.
+///
+/// # Failures
+/// The first word or block the reader cannot account for, named by its
+/// `N` or its line: a word outside the dialect's (an arc, a cycle, a
+/// variable), a modal rule broken, a value beyond travel; a CL file (a
+/// control reads G-code).
+pub fn read(
+    text: &str,
+    frame: &AxisProgram,
+    d: &Dialect,
+    axes: &[Axis],
+) -> Result<AxisProgram, LintError> {
+    if d.style != Style::GCode {
+        return Err(LintError {
+            dialect: d.name.to_owned(),
+            place: "line 1".into(),
+            message: "a CL file is not a program a control runs: read the control's program".into(),
+        });
+    }
+    let read = lint_gcode(text, frame, d, axes, Mode::Read)?;
+    let mut program = AxisProgram {
+        name: read.name.unwrap_or_else(|| frame.name.clone()),
+        number: read.number.unwrap_or(frame.number),
+        tool_number: read.tool.unwrap_or(frame.tool_number),
+        spindle_rpm: read.rpm.unwrap_or(frame.spindle_rpm),
+        blocks: Vec::new(),
+        ..frame.clone()
+    };
+    let written: Vec<usize> = (0..frame.axes.len())
+        .filter(|&i| read.blocks.iter().any(|b| b.values[i].is_some()))
+        .collect();
+    program.axes = written.iter().map(|&i| frame.axes[i].clone()).collect();
+    // Each axis's first value, for the blocks before it moves.
+    let first: Vec<Real> = written
+        .iter()
+        .map(|&i| {
+            read.blocks
+                .iter()
+                .find_map(|b| b.values[i])
+                .unwrap_or_default()
+        })
+        .collect();
+    program.blocks = read
+        .blocks
+        .into_iter()
+        .map(|b| {
+            let keep = written
+                .iter()
+                .filter(|&&i| b.values[i].is_none())
+                .map(|&i| frame.axes[i].name.clone())
+                .collect();
+            super::Block {
+                motion: b.motion,
+                values: written
+                    .iter()
+                    .zip(&first)
+                    .map(|(&i, f)| b.values[i].unwrap_or(*f))
+                    .collect(),
+                feed: b.feed,
+                spindle: b.spindle,
+                comment: b.comment,
+                keep,
+                number: b.number,
+            }
+        })
+        .collect();
+    Ok(program)
+}
+
+/// Whether a G-code text is held to an axis program (the lint of a
+/// program pilgrim wrote) or read as it stands ([`read`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    Lint,
+    Read,
+}
+
+/// A move as the reader took it: each axis's value where the text has
+/// given one so far.
+struct ReadBlock {
+    motion: Motion,
+    values: Vec<Option<Real>>,
+    feed: Real,
+    spindle: Option<Real>,
+    comment: Option<String>,
+    number: Option<u32>,
+}
+
+/// What a G-code text read as: the lint's count, and in [`Mode::Read`] the
+/// moves and what the text says of the program.
+struct ReadText {
+    linted: Linted,
+    blocks: Vec<ReadBlock>,
+    name: Option<String>,
+    number: Option<u32>,
+    tool: Option<u32>,
+    rpm: Option<Real>,
 }
 
 /// The modal state a G-code program has set so far.
@@ -100,6 +210,8 @@ pub fn lint(
 struct State {
     motion: Option<u32>,
     feed: bool,
+    /// The feed F as written, once written.
+    f: Option<Real>,
     lead: Option<Real>,
     spindle_on: bool,
     /// The spindle's speed as written (S), none before the first.
@@ -132,8 +244,9 @@ enum OwnWord {
 /// on its line, nothing but names' characters, nothing LinuxCNC acts on;
 /// and that the line holds no character pilgrim never writes (a control
 /// character such as a lone carriage return, which ends a line on some
-/// controls; anything beyond ASCII).
-fn read_line(d: &Dialect, i: usize, line: &str) -> Result<String, String> {
+/// controls; anything beyond ASCII). With it, the text of the line's last
+/// comment.
+fn read_line(d: &Dialect, i: usize, line: &str) -> Result<(String, Option<String>), String> {
     if let Some(c) = line.chars().find(|c| c.is_control() || !c.is_ascii()) {
         return Err(format!(
             "the character U+{:04X}, which pilgrim never writes (a carriage return or another control character ends or changes a line on some controls)",
@@ -166,6 +279,7 @@ fn read_line(d: &Dialect, i: usize, line: &str) -> Result<String, String> {
         Ok(())
     };
     let mut code = String::with_capacity(line.len());
+    let mut said = None;
     if d.comment.1.is_empty() {
         // A comment runs from its opening (`;`) to the line's end.
         let open = d.comment.0.trim_end();
@@ -175,10 +289,11 @@ fn read_line(d: &Dialect, i: usize, line: &str) -> Result<String, String> {
         };
         if let Some(comment) = comment {
             check(comment)?;
+            said = Some(comment.strip_prefix(' ').unwrap_or(comment).to_owned());
         }
         code.push_str(c);
         code.push_str(&" ".repeat(line.len() - c.len()));
-        return Ok(code);
+        return Ok((code, said));
     }
     // Parenthesised comments, closed on their line, none inside another.
     let mut rest = line;
@@ -195,6 +310,7 @@ fn read_line(d: &Dialect, i: usize, line: &str) -> Result<String, String> {
                     return Err("a comment inside a comment".into());
                 }
                 check(comment)?;
+                said = Some(comment.strip_prefix(' ').unwrap_or(comment).to_owned());
                 code.push_str(&" ".repeat(q + 2));
                 rest = &inner[q + 1..];
             }
@@ -203,7 +319,7 @@ fn read_line(d: &Dialect, i: usize, line: &str) -> Result<String, String> {
         }
     }
     code.push_str(rest);
-    Ok(code)
+    Ok((code, said))
 }
 
 fn lint_gcode(
@@ -211,7 +327,17 @@ fn lint_gcode(
     program: &AxisProgram,
     d: &Dialect,
     axes: &[Axis],
-) -> Result<Linted, LintError> {
+    mode: Mode,
+) -> Result<ReadText, LintError> {
+    let reading = mode == Mode::Read;
+    let mut out = ReadText {
+        linted: Linted { moves: 0, lines: 0 },
+        blocks: Vec::new(),
+        name: None,
+        number: None,
+        tool: None,
+        rpm: None,
+    };
     let fault = |place: String, message: String| LintError {
         dialect: d.name.to_owned(),
         place,
@@ -241,26 +367,51 @@ fn lint_gcode(
     // words read.
     let mut iso = String::with_capacity(text.len());
     let mut own: Vec<Vec<OwnWord>> = vec![Vec::new(); lines.len()];
+    // The comment of each line that holds nothing else.
+    let mut comments: Vec<Option<String>> = vec![None; lines.len()];
     let mut has_code = vec![false; lines.len()];
+    // A whole program is framed by `%` where its dialect frames one; a
+    // program read as it stands says by its first line whether it is whole.
+    let whole = if reading {
+        lines.first() == Some(&"%")
+    } else {
+        program.number > 0
+    };
     let framed = d.header.first().is_some_and(|h| *h == "%")
-        || (d.header.first().is_some_and(|h| *h == "{WHOLE}%") && program.number > 0);
+        || (d.header.first().is_some_and(|h| *h == "{WHOLE}%") && whole);
     let mut ticker = crate::budget::Ticker::new("the program's lint", 1024);
     for (i, line) in lines.iter().enumerate() {
         ticker
             .tick()
             .map_err(|e| fault(at_line(i), e.to_string()))?;
-        let mut l = read_line(d, i, line).map_err(|m| fault(at_line(i), m))?;
+        let (mut l, said) = read_line(d, i, line).map_err(|m| fault(at_line(i), m))?;
+        if l.trim().is_empty() {
+            comments[i] = said;
+        }
         let header_name = format!("%_N_{}_MPF", program.name);
         let program_number = format!("O{:04}", program.number % 10000);
-        if d.name == "sinumerik" && i == 0 && *line == header_name {
+        // A program read as it stands names itself.
+        let own_name = line
+            .strip_prefix("%_N_")
+            .and_then(|n| n.strip_suffix("_MPF"))
+            .filter(|n| {
+                reading && !n.is_empty() && n.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+            });
+        let own_number = first_code(&l)
+            .and_then(|w| w.strip_prefix('O'))
+            .filter(|n| reading && n.len() == 4)
+            .and_then(|n| n.parse::<u32>().ok());
+        if d.name == "sinumerik" && i == 0 && (*line == header_name || own_name.is_some()) {
+            out.name = own_name.map(str::to_owned);
             l = " ".repeat(line.len());
         } else if framed && *line == "%" && (i == 0 || i + 1 == lines.len()) {
             l = " ".into();
         } else if d.name == "fanuc"
             && framed
             && i == 1
-            && first_code(&l).is_some_and(|w| w == program_number)
+            && (first_code(&l).is_some_and(|w| w == program_number) || own_number.is_some())
         {
+            out.number = own_number;
             // Fanuc's program number, `O0001`, is not an ISO word.
             let n = l.find('O').unwrap_or(0);
             l.replace_range(n..n + 5, "     ");
@@ -322,6 +473,9 @@ fn lint_gcode(
     };
     let mut last_n: Option<u32> = None;
     let mut k = 0; // the next move of the axis program
+                   // Read: the first line not yet searched for a move's comment, and a
+                   // speed set among the moves for the next move.
+    let (mut comment_from, mut speed_next) = (0, None);
     for block in &parsed.blocks {
         let line = block.span.line;
         ticker
@@ -339,7 +493,11 @@ fn lint_gcode(
             *c = true;
         }
         let place = |k: usize| {
-            if k < program.blocks.len() {
+            if reading {
+                block
+                    .line_number
+                    .map_or_else(|| at_line(line), |n| format!("N{n}"))
+            } else if k < program.blocks.len() {
                 name_in(d.name, &program.blocks, k)
             } else {
                 at_line(line)
@@ -388,10 +546,7 @@ fn lint_gcode(
                 Code::General(g) => {
                     let n = number(&g.number.to_string());
                     if !g_ok.contains(&n) {
-                        return Err(fault(
-                            place(k),
-                            format!("G{} is not a word of {}", g.number, d.name),
-                        ));
+                        return Err(fault(place(k), not_read(reading, d, 'G', &g.number)));
                     }
                     match n {
                         0 | 1 | 32 | 33 => motion_here = Some(n),
@@ -405,10 +560,7 @@ fn lint_gcode(
                 Code::Miscellaneous(m) => {
                     let n = number(&m.number.to_string());
                     if !m_ok.contains(&n) {
-                        return Err(fault(
-                            place(k),
-                            format!("M{} is not a word of {}", m.number, d.name),
-                        ));
+                        return Err(fault(place(k), not_read(reading, d, 'M', &m.number)));
                     }
                     match n {
                         3 => st.spindle_on = true,
@@ -427,6 +579,13 @@ fn lint_gcode(
                             format!("a tool call T{} among the moves", t.number),
                         ));
                     }
+                    // A lathe's T names the tool and its offset (`T0303`).
+                    let n = number(&t.number.to_string());
+                    out.tool = Some(if d.name == "fanuc" && n >= 100 {
+                        n / 100
+                    } else {
+                        n
+                    });
                     words.extend(t.args.iter().map(|a| (a.letter, a)));
                 }
                 _ => return Err(fault(place(k), "a code the lint does not know".into())),
@@ -505,12 +664,27 @@ fn lint_gcode(
             }
             match letter {
                 'F' if motion_here.or(st.motion).is_some_and(|m| m == 32) => lead_here = Some(v),
-                'F' => st.feed = true,
+                'F' => {
+                    st.feed = true;
+                    st.f = Some(v);
+                }
                 'S' => s_here = Some(v),
                 'D' if d.name == "sinumerik" => {}
                 'Q' if d.name == "fanuc" => st.start_deg = v / 1000.0,
                 '@' => st.start_deg = v,
                 c if c == lead_letter => lead_here = Some(v),
+                c if reading => {
+                    return Err(fault(
+                        place(k),
+                        format!(
+                            "{c}{v}: a word the verification cannot simulate ({} on {} reads the axes {}, F, S, T{})",
+                            d.name,
+                            program.machine,
+                            names.iter().collect::<String>(),
+                            if d.name == "fanuc" { ", Q" } else { "" }
+                        ),
+                    ))
+                }
                 c => {
                     return Err(fault(
                         place(k),
@@ -535,7 +709,13 @@ fn lint_gcode(
                 Some(program.spindle_rpm)
             }
             .map(Real::round);
-            if want != Some(v) {
+            if reading {
+                if k == 0 && !moves {
+                    out.rpm = Some(v);
+                } else {
+                    speed_next = Some(v);
+                }
+            } else if want != Some(v) {
                 return Err(fault(
                     place(k),
                     format!(
@@ -574,7 +754,8 @@ fn lint_gcode(
             continue;
         }
         // A move: the modal values carried, held to the axis program.
-        let Some(b) = program.blocks.get(k) else {
+        let b = if reading { None } else { program.blocks.get(k) };
+        if !reading && b.is_none() {
             return Err(fault(
                 at_line(line),
                 format!(
@@ -595,16 +776,18 @@ fn lint_gcode(
             ));
         };
         let is_thread = m == 32 || m == 33;
-        let want = match b.motion {
-            Motion::Rapid => m == 0,
-            Motion::Linear => m == 1,
-            Motion::Thread { .. } => is_thread,
-        };
-        if !want {
-            return Err(fault(
-                place(k),
-                format!("G{m}, where the axis program has a {:?} move", b.motion),
-            ));
+        if let Some(b) = b {
+            let want = match b.motion {
+                Motion::Rapid => m == 0,
+                Motion::Linear => m == 1,
+                Motion::Thread { .. } => is_thread,
+            };
+            if !want {
+                return Err(fault(
+                    place(k),
+                    format!("G{m}, where the axis program has a {:?} move", b.motion),
+                ));
+            }
         }
         if m == 1 && !st.feed {
             return Err(fault(place(k), "G1 before any feed F".into()));
@@ -651,7 +834,16 @@ fn lint_gcode(
                 "a move before the feed group the machine's setup states".into(),
             ));
         }
-        if let Motion::Thread { lead, start_deg } = b.motion {
+        let read_lead = st.lead.unwrap_or(Real::NAN);
+        let motion = match m {
+            0 => Motion::Rapid,
+            1 => Motion::Linear,
+            _ => Motion::Thread {
+                lead: read_lead,
+                start_deg: st.start_deg,
+            },
+        };
+        if is_thread {
             if d.lead_every_block && lead_here.is_none() {
                 return Err(fault(
                     place(k),
@@ -664,37 +856,47 @@ fn lint_gcode(
                     "a thread before constant spindle speed (G97)".into(),
                 ));
             }
-            let read_lead = st.lead.unwrap_or(Real::NAN);
-            if !((read_lead - lead).abs() <= 0.5 * 10f64.powi(-(d.lead_decimals as i32)) + 1e-9) {
-                return Err(fault(
-                    place(k),
-                    format!("lead {read_lead}, the axis program's {lead}"),
-                ));
+            if !(read_lead > 0.0) {
+                return Err(fault(place(k), "a thread block before any lead".into()));
             }
-            if (st.start_deg - start_deg).abs() > 1e-3 {
-                return Err(fault(
-                    place(k),
-                    format!(
-                        "thread start {} deg, the axis program's {start_deg} deg",
-                        st.start_deg
-                    ),
-                ));
+            if let Some(Motion::Thread { lead, start_deg }) = b.map(|b| b.motion) {
+                if !((read_lead - lead).abs() <= 0.5 * 10f64.powi(-(d.lead_decimals as i32)) + 1e-9)
+                {
+                    return Err(fault(
+                        place(k),
+                        format!("lead {read_lead}, the axis program's {lead}"),
+                    ));
+                }
+                if (st.start_deg - start_deg).abs() > 1e-3 {
+                    return Err(fault(
+                        place(k),
+                        format!(
+                            "thread start {} deg, the axis program's {start_deg} deg",
+                            st.start_deg
+                        ),
+                    ));
+                }
             }
             if d.name == "fanuc" {
                 st.start_deg = 0.0; // Q holds for its block only
             }
         }
         for (i, name) in program.axes.iter().enumerate() {
-            if b.keep.contains(&name.name) {
+            if b.is_some_and(|b| b.keep.contains(&name.name)) {
                 continue;
             }
-            let Some(v) = st.values[i] else {
-                return Err(fault(
-                    place(k),
-                    format!("axis {} has no value yet", name.name),
-                ));
+            let v = match (st.values[i], b) {
+                (Some(v), _) => v,
+                // Read: an axis not yet written stands where it stands.
+                (None, None) => continue,
+                (None, Some(_)) => {
+                    return Err(fault(
+                        place(k),
+                        format!("axis {} has no value yet", name.name),
+                    ))
+                }
             };
-            if !((v - b.values[i]).abs() <= half) {
+            if let Some(b) = b.filter(|b| !((v - b.values[i]).abs() <= half)) {
                 return Err(fault(
                     place(k),
                     format!(
@@ -714,18 +916,38 @@ fn lint_gcode(
                 }
             }
         }
+        if reading {
+            let comment = comments[comment_from.min(line)..line]
+                .iter()
+                .rev()
+                .find_map(Clone::clone);
+            comment_from = line + 1;
+            out.blocks.push(ReadBlock {
+                motion,
+                values: st.values.clone(),
+                feed: match motion {
+                    Motion::Rapid => 0.0,
+                    Motion::Linear => st.f.unwrap_or_default(),
+                    Motion::Thread { lead, .. } => lead * st.speed.unwrap_or_default(),
+                },
+                spindle: speed_next.take(),
+                comment,
+                number: block.line_number,
+            });
+        }
         k += 1;
     }
     if let Some(i) = (0..lines.len()).find(|&i| has_code[i] && !consumed[i]) {
         return Err(fault(
             at_line(i),
             format!(
-                "'{}' is not a block the lint can account for",
-                crate::files::excerpt(lines[i])
+                "'{}' is not a block the {} can account for",
+                crate::files::excerpt(lines[i]),
+                if reading { "reader" } else { "lint" }
             ),
         ));
     }
-    if k != program.blocks.len() {
+    if !reading && k != program.blocks.len() {
         return Err(fault(
             at_line(lines.len().saturating_sub(1)),
             format!(
@@ -740,10 +962,37 @@ fn lint_gcode(
             format!("the program does not end (M{})", end_code(d)),
         ));
     }
-    Ok(Linted {
+    if reading && k == 0 {
+        return Err(fault(at_line(0), "no move: nothing to verify".into()));
+    }
+    out.linted = Linted {
         moves: k,
         lines: lines.len(),
-    })
+    };
+    Ok(out)
+}
+
+/// Why the reader refuses the word `letter number` in `d`: in a program
+/// pilgrim wrote, a word its dialect does not write; in a program read as
+/// it stands, a word the verification cannot simulate.
+fn not_read(reading: bool, d: &Dialect, letter: char, number: &dyn std::fmt::Display) -> String {
+    let (g, m) = codes(d);
+    if reading {
+        let list = |l: char, c: &[u32]| {
+            c.iter()
+                .map(|n| format!("{l}{n}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
+        format!(
+            "{letter}{number}: a word the verification cannot simulate (it reads {} and {} in {} programs); verify a program without it",
+            list('G', g),
+            list('M', m),
+            d.name
+        )
+    } else {
+        format!("{letter}{number} is not a word of {}", d.name)
+    }
 }
 
 /// The first word of a line (before a comment).
@@ -937,6 +1186,83 @@ mod tests {
             Axis::linear("X", -10.0, 400.0, 1e4, [0.5, 0.0, 0.0], ""),
             Axis::linear("Z", -700.0, 10.0, 1e4, [0.0, 0.0, 1.0], ""),
         ]
+    }
+
+    /// The reader takes a program's text as the control reads it: what
+    /// the writer wrote comes back as the program, its values as written,
+    /// its comments on the blocks they stand before, its N on each block.
+    #[test]
+    fn the_reader_reads_what_the_writer_wrote() {
+        let p = program();
+        let mut frame = p.clone();
+        frame.blocks.clear();
+        (frame.name, frame.number, frame.spindle_rpm) = ("X".into(), 0, 1.0);
+        for d in [&SINUMERIK, &FANUC, &LINUXCNC] {
+            let text = post(&p, d).unwrap();
+            let r = read(&text, &frame, d, &axes()).unwrap_or_else(|e| panic!("{e}\n{text}"));
+            // Sinumerik names the program in its header; Fanuc numbers it.
+            let number = if d.name == "fanuc" { 7 } else { 0 };
+            let name = if d.name == "sinumerik" { "DEMO" } else { "X" };
+            assert_eq!((r.name.as_str(), r.number), (name, number), "{}", d.name);
+            assert_eq!((r.spindle_rpm, r.tool_number), (399.0, 3), "{}", d.name);
+            assert_eq!(r.blocks.len(), p.blocks.len(), "{}", d.name);
+            let (written, _) = crate::verify::as_written(&p);
+            for (k, (a, b)) in r.blocks.iter().zip(&written.blocks).enumerate() {
+                let what = format!("{} block {k}", d.name);
+                assert_eq!(a.values, b.values, "{what}");
+                assert_eq!(a.motion, b.motion, "{what}");
+                assert_eq!(
+                    a.comment,
+                    b.comment
+                        .as_ref()
+                        .map(|c| super::super::post::comment_text(d, c)),
+                    "{what}"
+                );
+                if b.motion == Motion::Linear {
+                    assert_eq!(a.feed, b.feed, "{what}");
+                }
+                let n = d
+                    .numbering
+                    .map(|(first, step)| (first + step * k as u64) as u32);
+                assert_eq!(a.number, n, "{what}");
+            }
+            assert!(r.blocks[4].motion == written.blocks[4].motion);
+        }
+        // A CL file is no control's program.
+        let cld = post(&p, &CLD).unwrap();
+        assert!(read(&cld, &frame, &CLD, &axes())
+            .unwrap_err()
+            .message
+            .contains("CL file"));
+    }
+
+    /// A word the verification cannot simulate is refused, naming it and
+    /// the block; a program read as it stands may carry its own name.
+    #[test]
+    fn the_reader_refuses_what_it_cannot_simulate() {
+        let p = program();
+        let mut frame = p.clone();
+        frame.blocks.clear();
+        let text = post(&p, &SINUMERIK).unwrap();
+        for (from, to, word) in [
+            ("G1 X40.000", "G2 X40.000 I5.0", "G2"),
+            ("G1 X40.000", "G1 X40.000 R5", "R5"),
+            ("M3", "M98", "M98"),
+        ] {
+            let edited = text.replacen(from, to, 1);
+            assert_ne!(edited, text, "{from}");
+            let e = read(&edited, &frame, &SINUMERIK, &axes()).unwrap_err();
+            assert!(
+                e.message.starts_with(word) && e.message.contains("cannot simulate"),
+                "{e}"
+            );
+            assert!(e.place.starts_with('N'), "{e}");
+        }
+        let renamed = text.replacen("%_N_DEMO_MPF", "%_N_OTHER_MPF", 1);
+        assert_eq!(
+            read(&renamed, &frame, &SINUMERIK, &axes()).unwrap().name,
+            "OTHER"
+        );
     }
 
     /// What the writer writes, the lint reads back: every dialect.

@@ -323,7 +323,10 @@ pub fn block_name(program: &AxisProgram, index: usize) -> String {
 }
 
 pub(crate) fn name_in(control: &str, blocks: &[Block], index: usize) -> String {
-    let label = block_label(control, index);
+    let label = match blocks.get(index).and_then(|b| b.number) {
+        Some(n) => format!("N{n}"),
+        None => block_label(control, index),
+    };
     let pass = blocks
         .get(..=index.min(blocks.len().saturating_sub(1)))
         .and_then(|b| b.iter().rev().find_map(|b| b.comment.as_deref()));
@@ -556,6 +559,7 @@ pub fn build(
             spindle: (k == 0).then_some(toolpath.spindle_rpm),
             comment: (j == 0).then(|| toolpath.passes[p].name.clone()),
             keep: Vec::new(),
+            number: None,
         });
     }
     let col_axes: Vec<&Axis> = columns.iter().map(|(a, _)| *a).collect();
@@ -671,6 +675,7 @@ fn with_start_and_end(blocks: Vec<Block>, axes: &[&str], setup: &ProgramSetup) -
         spindle: None,
         comment: None,
         keep,
+        number: None,
     };
     let mut out = Vec::with_capacity(blocks.len() + start_blocks(setup) + setup.retract.len());
     let mut moved: Vec<bool> = vec![false; axes.len()];
@@ -827,6 +832,34 @@ pub fn program_name(name: &str) -> String {
     s
 }
 
+/// The program `info`'s machine runs, without blocks: what a program read
+/// from a file ([`lint::read`]) is read into. Its axes are the machine's
+/// programmed axes; its name, number, tool and speed are placeholders the
+/// text's own words replace.
+pub fn frame(info: &MachineInfo) -> AxisProgram {
+    AxisProgram {
+        name: "PROGRAM".into(),
+        number: 0,
+        machine: info.name.clone(),
+        control: info.control.clone(),
+        tool_number: 1,
+        tool_name: String::new(),
+        spindle_rpm: 0.0,
+        decimals: info.program_decimals,
+        axes: info
+            .axes
+            .iter()
+            .filter(|a| a.is_programmed())
+            .map(|a| ProgramAxis {
+                name: a.name.clone(),
+                unit: a.unit().to_owned(),
+            })
+            .collect(),
+        blocks: Vec::new(),
+        setup: info.setup.clone(),
+    }
+}
+
 /// A small lathe program of every motion (the post-processor's and the
 /// lint's tests).
 #[cfg(test)]
@@ -842,6 +875,7 @@ pub(crate) fn test_program() -> AxisProgram {
         spindle: None,
         comment: comment.map(str::to_owned),
         keep: Vec::new(),
+        number: None,
     };
     AxisProgram {
         name: "DEMO".into(),

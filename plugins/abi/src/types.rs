@@ -507,6 +507,11 @@ pub struct Block {
     /// value here is the one it takes next.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub keep: Vec<String>,
+    /// Since 1.5: the number the block carries in a program's text (`N`),
+    /// for a program read from a file; `None` for a program the host
+    /// builds, whose writer numbers it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub number: Option<u32>,
 }
 
 /// A program for one machine: named axes in program units (mm, degrees)
