@@ -118,6 +118,40 @@ enum Command {
         #[arg(long = "post", value_name = "DIALECT")]
         also_post: Vec<String>,
     },
+    /// Verify a program as its control reads it: a run's (its output
+    /// directory, after the program was edited by hand), or any program
+    /// file for a machine and a family. Writes the verification's report
+    /// (report.json, report.html, plots) into --out; exits 1 naming the
+    /// block where the program fails.
+    Verify {
+        /// A run's output directory, or a program file.
+        target: PathBuf,
+        /// The family's script (.rhai). Default for a run's directory: the
+        /// script the run names.
+        #[arg(long)]
+        family: Option<PathBuf>,
+        /// The machine: a built-in's name, a plugin (.so), a machine file
+        /// (.toml). Default: the run's built-in machine, or the family's
+        /// default_machine().
+        #[arg(long)]
+        machine: Option<String>,
+        /// Parameter values from a TOML file; for a run's directory they win
+        /// over the run's own.
+        #[arg(long, value_name = "FILE.toml")]
+        params: Option<PathBuf>,
+        /// A parameter value (repeatable); wins over --params.
+        #[arg(long = "set", value_name = "NAME=VALUE", value_parser = parse_set)]
+        sets: Vec<(String, String)>,
+        /// Where the report goes. Default: TARGET.verify beside the target.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Wall-clock limit of each call of the family's script (seconds).
+        #[arg(long, value_name = "S", default_value_t = 60.0)]
+        script_seconds: f64,
+        /// Wall-clock limit of the whole verification (seconds).
+        #[arg(long, value_name = "S", default_value_t = 600.0)]
+        run_seconds: f64,
+    },
     /// Re-export a finished run's 3-D scene with the tool at another block.
     Export {
         /// The run's output directory.
@@ -391,6 +425,33 @@ fn main() -> ExitCode {
                 stl_ascii: *stl_ascii,
                 gltf: *gltf,
             },
+        )
+        .map(|s| s + "\n"),
+        Command::Verify {
+            target,
+            family,
+            machine,
+            params,
+            sets,
+            out,
+            script_seconds,
+            run_seconds,
+        } => run::verify(
+            &run::VerifyArgs {
+                target: target.clone(),
+                family: family.clone(),
+                machine: machine.clone(),
+                params: params.clone(),
+                sets: sets.clone(),
+                out: out.clone().unwrap_or_else(|| {
+                    let mut o = target.clone().into_os_string();
+                    o.push(".verify");
+                    PathBuf::from(o)
+                }),
+                script_seconds: *script_seconds,
+                run_seconds: *run_seconds,
+            },
+            &catalog,
         )
         .map(|s| s + "\n"),
         Command::Params { script } => params(script),

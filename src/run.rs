@@ -1,5 +1,5 @@
-//! `pilgrim run` and `pilgrim export`: the kernel's job, its files written
-//! atomically.
+//! `pilgrim run`, `pilgrim verify` and `pilgrim export`: the kernel's job,
+//! its files written atomically.
 
 use indicatif::{ProgressBar, ProgressStyle};
 use pilgrim_kernel::catalog::Catalog;
@@ -47,15 +47,18 @@ fn progress(quiet: bool) -> ProgressBar {
 /// [`pilgrim_kernel::output::failed_dir`] says; on any other error nothing
 /// is written and the previous output directory is left as it was.
 pub fn run(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
-    for (flag, v) in [
-        ("--script-seconds", args.script_seconds),
-        ("--run-seconds", args.run_seconds),
-    ] {
+    positive_seconds(args.script_seconds, args.run_seconds)?;
+    pilgrim_kernel::budget::with_limit(args.run_seconds, "the run's", || run_within(args, catalog))
+}
+
+/// `--script-seconds` and `--run-seconds`, each refused unless positive.
+fn positive_seconds(script: f64, run: f64) -> Result<(), String> {
+    for (flag, v) in [("--script-seconds", script), ("--run-seconds", run)] {
         if !(v > 0.0) {
             return Err(format!("{flag} {v} must be > 0"));
         }
     }
-    pilgrim_kernel::budget::with_limit(args.run_seconds, "the run's", || run_within(args, catalog))
+    Ok(())
 }
 
 /// [`run`] within the run's time limit.
@@ -66,45 +69,16 @@ fn run_within(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
         bar.inc(1);
     };
     next("reading the family");
-    let mut access = Access::default();
-    if let Some(dir) = args.params.as_ref().and_then(|p| p.parent()) {
-        access.input_dirs.push(if dir.as_os_str().is_empty() {
-            PathBuf::from(".")
-        } else {
-            dir.to_owned()
-        });
-    }
     let limits = Limits {
         max_seconds: args.script_seconds,
         max_memory_mb: args.script_memory_mb,
         ..Limits::default()
     };
-    let family = ScriptFamily::load(&args.script, &limits, &access).map_err(|e| e.to_string())?;
-    let mut sources = Vec::new();
-    if let Some(p) = &args.params {
-        sources.push(ParamSource::Toml {
-            label: p.display().to_string(),
-            text: pilgrim_kernel::files::read_text(p, pilgrim_kernel::files::MAX_TEXT_BYTES)
-                .map_err(|e| e.to_string())?,
-        });
-    }
-    sources.push(ParamSource::Pairs {
-        label: "--set".into(),
-        pairs: args.sets.clone(),
-    });
-    let spec = match &args.machine {
-        Some(m) => m.clone(),
-        None => family
-            .default_machine()
-            .map_err(|e| e.to_string())?
-            .ok_or_else(|| {
-                pilgrim_kernel::Error::NoMachine {
-                    family: family.name().to_owned(),
-                }
-                .to_string()
-            })?,
-    };
-    let machine = catalog.open(&spec).map_err(|e| e.to_string())?;
+    let family = load_family(&args.script, args.params.as_deref(), &limits)?;
+    let sources = sources(Vec::new(), args.params.as_deref(), &args.sets)?;
+    let machine = catalog
+        .open(&machine_spec(args.machine.as_deref(), &family)?)
+        .map_err(|e| e.to_string())?;
     let options = JobOptions {
         program_name: args
             .script
@@ -153,6 +127,189 @@ fn run_within(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
         said += &format!("\nwarning: {}", w.message);
     }
     Ok(said)
+}
+
+/// The family of `script`, reading files (its tables) beside `params`.
+fn load_family(
+    script: &Path,
+    params: Option<&Path>,
+    limits: &Limits,
+) -> Result<ScriptFamily, String> {
+    let mut access = Access::default();
+    if let Some(dir) = params.and_then(Path::parent) {
+        access.input_dirs.push(if dir.as_os_str().is_empty() {
+            PathBuf::from(".")
+        } else {
+            dir.to_owned()
+        });
+    }
+    ScriptFamily::load(script, limits, &access).map_err(|e| e.to_string())
+}
+
+/// `first`, then the parameters of the `params` file, then the `sets`.
+fn sources(
+    mut first: Vec<ParamSource>,
+    params: Option<&Path>,
+    sets: &[(String, String)],
+) -> Result<Vec<ParamSource>, String> {
+    if let Some(p) = params {
+        first.push(ParamSource::Toml {
+            label: p.display().to_string(),
+            text: pilgrim_kernel::files::read_text(p, pilgrim_kernel::files::MAX_TEXT_BYTES)
+                .map_err(|e| e.to_string())?,
+        });
+    }
+    first.push(ParamSource::Pairs {
+        label: "--set".into(),
+        pairs: sets.to_vec(),
+    });
+    Ok(first)
+}
+
+/// The machine named on the command line, else the family's default.
+fn machine_spec(given: Option<&str>, family: &ScriptFamily) -> Result<String, String> {
+    match given {
+        Some(m) => Ok(m.to_owned()),
+        None => family
+            .default_machine()
+            .map_err(|e| e.to_string())?
+            .ok_or_else(|| {
+                pilgrim_kernel::Error::NoMachine {
+                    family: family.name().to_owned(),
+                }
+                .to_string()
+            }),
+    }
+}
+
+/// What `verify` was asked.
+pub struct VerifyArgs {
+    pub target: PathBuf,
+    pub family: Option<PathBuf>,
+    pub machine: Option<String>,
+    pub params: Option<PathBuf>,
+    pub sets: Vec<(String, String)>,
+    pub out: PathBuf,
+    pub script_seconds: f64,
+    pub run_seconds: f64,
+}
+
+/// `pilgrim verify`: a run's program (`target` its output directory) or a
+/// program file, read as its control reads it and verified against the
+/// family. The report goes to `args.out`, FAILED where the program fails
+/// (then the error names the block).
+pub fn verify(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String> {
+    positive_seconds(args.script_seconds, args.run_seconds)?;
+    pilgrim_kernel::budget::with_limit(args.run_seconds, "the verification's", || {
+        verify_within(args, catalog)
+    })
+}
+
+/// [`verify`] within its time limit.
+fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String> {
+    let limits = Limits {
+        max_seconds: args.script_seconds,
+        ..Limits::default()
+    };
+    let (family, mut first, spec, program) = if args.target.is_dir() {
+        // A run's directory: its program in the control's dialect, its
+        // family, parameters and (built-in) machine as its report says.
+        let run = pilgrim_kernel::output::RunDir::open(&args.target).map_err(|e| e.to_string())?;
+        let report: job::Report = serde_json::from_str(
+            &run.read_text("report.json", pilgrim_kernel::files::MAX_DATA_BYTES)
+                .map_err(|e| e.to_string())?,
+        )
+        .map_err(|e| format!("{}/report.json: {e}", args.target.display()))?;
+        let script = match &args.family {
+            Some(f) => f.clone(),
+            None if Path::new(&report.script).is_file() => PathBuf::from(&report.script),
+            None => {
+                return Err(format!(
+                    "{}: the run's family '{}' (its report names it from where the run was made) is not there: name its script with --family",
+                    args.target.display(),
+                    report.script
+                ))
+            }
+        };
+        let family = load_family(&script, args.params.as_deref(), &limits)?;
+        let label = format!("{}/report.json", args.target.display());
+        let first = vec![report.params_source(&label)?];
+        let spec = match &args.machine {
+            Some(m) => m.clone(),
+            None if catalog
+                .builtin_names()
+                .iter()
+                .any(|n| n.eq_ignore_ascii_case(&report.machine_spec)) =>
+            {
+                report.machine_spec.clone()
+            }
+            None => {
+                return Err(format!(
+                    "{}: the run's machine '{}' is not a built-in: name it with --machine",
+                    args.target.display(),
+                    report.machine_spec
+                ))
+            }
+        };
+        let name = pilgrim_kernel::program::post::dialect(&report.control)
+            .map(|d| format!("program.{}", d.extension))
+            .ok_or_else(|| {
+                format!(
+                    "{label}: the control '{}' is not a dialect pilgrim reads",
+                    report.control
+                )
+            })?;
+        let text = run
+            .read_text(&name, pilgrim_kernel::files::MAX_DATA_BYTES)
+            .map_err(|e| e.to_string())?;
+        (family, first, spec, text)
+    } else {
+        let script = args.family.as_ref().ok_or_else(|| {
+            format!(
+                "{}: a program file is verified against a family: name its script with --family",
+                args.target.display()
+            )
+        })?;
+        let family = load_family(script, args.params.as_deref(), &limits)?;
+        let spec = machine_spec(args.machine.as_deref(), &family)?;
+        let text =
+            pilgrim_kernel::files::read_text(&args.target, pilgrim_kernel::files::MAX_DATA_BYTES)
+                .map_err(|e| e.to_string())?;
+        (family, Vec::new(), spec, text)
+    };
+    first = sources(first, args.params.as_deref(), &args.sets)?;
+    let machine = catalog.open(&spec).map_err(|e| e.to_string())?;
+    let options = JobOptions {
+        program_name: "verify".into(),
+        ..JobOptions::default()
+    };
+    let what = args.target.display();
+    match job::verify(&family, &machine, &first, &program, &options, &mut |_| {}) {
+        Ok(out) => {
+            pilgrim_kernel::output::write_dir(&args.out, &out.files).map_err(|e| e.to_string())?;
+            let mut said = format!(
+                "{what}: verified{}; report in {}",
+                out.summary()
+                    .split_once(", about")
+                    .map_or(String::new(), |(_, s)| format!(": about{s}")),
+                args.out.display()
+            );
+            for w in &out.report.verdict.warnings {
+                said += &format!("\nwarning: {}", w.message);
+            }
+            Ok(said)
+        }
+        Err(pilgrim_kernel::Error::Failed(failed)) => {
+            let message = failed.report.verdict.message();
+            let dir = pilgrim_kernel::output::write_failed(&args.out, &failed.files)
+                .map_err(|e| format!("{message}\nthe report could not be written: {e}"))?;
+            Err(format!(
+                "{what}: {message}\nthe program FAILED its verification; see {}",
+                dir.join("report.html").display()
+            ))
+        }
+        Err(e) => Err(format!("{what}: {e}")),
+    }
 }
 
 /// `pilgrim export DIR --block N`: the run's scene placed at another block.

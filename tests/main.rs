@@ -17,6 +17,7 @@ mod mandrel_fidelity;
 mod plugins;
 mod sdk;
 mod trust;
+mod verify;
 mod worm;
 
 /// With `autotests = false` a test file that no `mod` line names is never

@@ -326,6 +326,54 @@ pub fn as_written(program: &AxisProgram) -> (AxisProgram, Real) {
     (p, 10f64.powi(-(decimals as i32)))
 }
 
+/// The passes of a program read from its text: a pass begins at each block
+/// with a comment (the line before it, as pilgrim writes a pass's name)
+/// and runs to the next; blocks before the first comment are one pass,
+/// `start`. A pass cuts ([`crate::toolpath::Pass::cuts`]) when one of its
+/// moves other than a rapid moves the tool: its first block, or a block
+/// that puts the tool (replayed on `machine` with `tool`) elsewhere than
+/// the block before.
+///
+/// # Failures
+/// The replay failing (a solved axis the program lacks); a program whose
+/// blocks are all one pass that cuts (no comment between its blocks): the
+/// surface each pass leaves, the rest rides and the finish's stock need
+/// its passes, which a comment before each names.
+pub fn passes_in(
+    program: &AxisProgram,
+    machine: &dyn MachineKinematics,
+    tool: &ToolFrame,
+) -> Result<Vec<ProgramPass>, VerifyError> {
+    let (written, _) = as_written(program);
+    let poses = replay(&written, machine, tool)?;
+    let mut out: Vec<ProgramPass> = Vec::new();
+    for (k, b) in written.blocks.iter().enumerate() {
+        match (&b.comment, out.last_mut()) {
+            (None, Some(p)) => p.blocks.end = k + 1,
+            (name, _) => out.push(ProgramPass {
+                name: name.clone().unwrap_or_else(|| "start".into()),
+                blocks: k..k + 1,
+                cuts: false,
+            }),
+        }
+        let moved = k == 0
+            || out.last().is_some_and(|p| p.blocks.start == k)
+            || poses[6 * k..6 * k + 6] != poses[6 * (k - 1)..6 * k];
+        if b.motion != crate::toolpath::Motion::Rapid && moved {
+            if let Some(p) = out.last_mut() {
+                p.cuts = true;
+            }
+        }
+    }
+    if out.len() == 1 && out[0].cuts {
+        return Err(VerifyError::Replay(format!(
+            "the program's {} blocks are one pass: the verification reads a pass as the blocks after a comment line (as pilgrim writes `; pass 1` or `(PASS 1)`); put a comment before the first block of each pass",
+            program.blocks.len()
+        )));
+    }
+    Ok(out)
+}
+
 /// Replays a grinding program as the machine runs it (MATH §2.4): the
 /// values rounded as written, every axis moving in a straight line between
 /// blocks at the block's feed while the part turns at the program's
@@ -459,7 +507,12 @@ pub fn replay_grinding(
             } else {
                 b.feed
             };
-            if path > 0.0 {
+            // A move that leaves the wheel standing (only the rest's U
+            // moves) adds no length to the wheel's path and no time to it:
+            // the part's turn meanwhile shifts every later touch alike,
+            // which the phases, free over every spindle phase, already
+            // cover.
+            if path > 0.0 && line > 0.0 {
                 f * line / path
             } else {
                 f

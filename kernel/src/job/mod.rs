@@ -303,6 +303,45 @@ pub fn run(
     options: &JobOptions,
     stage: &mut dyn FnMut(&str),
 ) -> Result<JobOutput, Error> {
+    run_on(family, machine, sources, options, stage, None)
+}
+
+/// Verifies `text`, a program in the control's dialect of `machine`,
+/// against `family` with the parameter `sources`: the text read as the
+/// control reads it ([`crate::program::lint::read`]: a word it cannot
+/// simulate is refused, naming it and its block), its passes as its
+/// comments group its blocks, then the run's own verification, process
+/// rules, plots, scene and report over it, as [`run`] verifies the program
+/// it writes (the same call). The family gives the nominal and the tool;
+/// the program is the text's. The files: the report and page, the plots,
+/// the scene, `program.json` (the program as read) and `report.csv`; no
+/// program.
+///
+/// # Failures
+/// As [`run`]: a failed verification is [`Error::Failed`] with its report
+/// naming the block as the text numbers it; a text the reader cannot
+/// account for is [`Error::Lint`].
+pub fn verify(
+    family: &dyn PartFamily,
+    machine: &OpenMachine,
+    sources: &[ParamSource],
+    text: &str,
+    options: &JobOptions,
+    stage: &mut dyn FnMut(&str),
+) -> Result<JobOutput, Error> {
+    run_on(family, machine, sources, options, stage, Some(text))
+}
+
+/// [`run`] of the program the run builds (`text` `None`), or [`verify`] of
+/// `text`.
+fn run_on(
+    family: &dyn PartFamily,
+    machine: &OpenMachine,
+    sources: &[ParamSource],
+    options: &JobOptions,
+    stage: &mut dyn FnMut(&str),
+    text: Option<&str>,
+) -> Result<JobOutput, Error> {
     // Parameters tied to machine constants default to this machine's; set
     // otherwise, they set the machine's for the whole run (its chains, its
     // bodies, the scene), so that the family and the machine cannot differ.
@@ -375,9 +414,78 @@ pub fn run(
     stage(STAGES[1]);
     let toolpath = family.toolpath(&values)?;
     stage(STAGES[2]);
-    let mut program = build(&toolpath, kin, &options.program_name)?;
-    program.number = options.program_number.unwrap_or(0);
-    let passes = crate::program::pass_blocks(&program, &toolpath.passes);
+    let control = dialect(&info.control).ok_or_else(|| Error::UnknownControl {
+        machine: info.name.clone(),
+        control: info.control.clone(),
+    })?;
+    // The program, the program the verification replays (the text a
+    // control reads, read back), its passes, the posted programs (or why
+    // none) and the data files.
+    let (program, verified, passes, posted, data) = match text {
+        None => {
+            let mut program = build(&toolpath, kin, &options.program_name)?;
+            program.number = options.program_number.unwrap_or(0);
+            let passes = crate::program::pass_blocks(&program, &toolpath.passes);
+            stage(STAGES[3]);
+            // The data files need only the toolpath and the program: a
+            // second thread writes them while this one posts and lints.
+            let deadline = crate::budget::current();
+            let (data, posted) = std::thread::scope(|s| {
+                let data = s.spawn(|| {
+                    crate::budget::with_deadline(deadline, || data_files(&toolpath, &program))
+                });
+                let posted = post_all(machine, info, &program, &options.also_post);
+                let data = data
+                    .join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+                (data, posted)
+            });
+            let [toolpath_json, program_json, csv] = data?;
+            let data = vec![
+                ("toolpath.json".into(), toolpath_json),
+                ("program.json".into(), program_json),
+                ("report.csv".into(), csv),
+            ];
+            let verified = match &posted {
+                Ok(files) => {
+                    let frame = AxisProgram {
+                        blocks: Vec::new(),
+                        ..program.clone()
+                    };
+                    let text = String::from_utf8_lossy(&files[0].1);
+                    let mut read = crate::program::lint::read(&text, &frame, control, &info.axes)?;
+                    // The passes' names as the family gave them (the text
+                    // writes them as its comments allow: Fanuc's in capitals).
+                    for (r, b) in read.blocks.iter_mut().zip(&program.blocks) {
+                        r.comment.clone_from(&b.comment);
+                    }
+                    read
+                }
+                Err(_) => program.clone(),
+            };
+            (program, verified, passes, posted, data)
+        }
+        Some(text) => {
+            let frame = crate::program::frame(info);
+            let read = crate::program::lint::read(text, &frame, control, &info.axes)?;
+            // No more blocks than a run writes: the replays' work is bounded.
+            crate::program::check_shape(&read).map_err(|message| {
+                crate::program::lint::LintError {
+                    dialect: control.name.to_owned(),
+                    place: "the program".into(),
+                    message,
+                }
+            })?;
+            let passes = crate::verify::passes_in(&read, kin, &toolpath.tool.reference)?;
+            stage(STAGES[3]);
+            let [_, program_json, csv] = data_files(&toolpath, &read)?;
+            let data = vec![
+                ("program.json".into(), program_json),
+                ("report.csv".into(), csv),
+            ];
+            (read.clone(), read, passes, Ok(Vec::new()), data)
+        }
+    };
     let requested = family.verification(&values)?;
     let requested_any = requested.is_some();
     if options.pose_block == Some(0) {
@@ -408,7 +516,7 @@ pub fn run(
                     message: "fn verify(p) of a worm needs a thread cutter".into(),
                 }));
             };
-            let check = crate::worm::simulate(&program, kin, &toolpath.tool.reference, &c, r)?;
+            let check = crate::worm::simulate(&verified, kin, &toolpath.tool.reference, &c, r)?;
             stock = Some(Box::new(crate::worm::WormStock::new(&check, r, &c)));
             Some(check)
         }
@@ -426,7 +534,7 @@ pub fn run(
                 )));
             }
             Some(crate::caliber::check_groove(
-                &program,
+                &verified,
                 kin,
                 &toolpath.tool.reference,
                 &wheel,
@@ -442,7 +550,7 @@ pub fn run(
                 return Err(needs_wheel());
             };
             let (check, ground) = replay_grinding(
-                &program,
+                &verified,
                 kin,
                 &toolpath.tool.reference,
                 &w,
@@ -462,7 +570,7 @@ pub fn run(
     let mut figures = Vec::new();
     let mut failures = Vec::new();
     for (f, x) in [
-        verification.as_ref().map(|v| v.findings(&program)),
+        verification.as_ref().map(|v| v.findings(&verified)),
         groove.as_ref().map(|g| g.findings()),
         worm.as_ref().map(|w| w.findings()),
     ]
@@ -479,7 +587,7 @@ pub fn run(
         .collect();
     // The process, checked as well as the geometry.
     let process = crate::process::check(
-        &program,
+        &verified,
         kin,
         &toolpath.tool.reference,
         stock.as_deref(),
@@ -502,14 +610,14 @@ pub fn run(
     ) {
         (Some(n), _) => scene::PosePlace::at_end(n - 1),
         (None, Some(b)) => scene::PosePlace::at_end(b - 1),
-        (None, None) => default_pose_block(&program, &passes),
+        (None, None) => default_pose_block(&verified, &passes),
     };
     let pose_index = pose_place.block;
     // The caliber's contact patch at the scene's block (in the report, and
     // its mesh in the scene).
     let patch_mesh = match (&mut groove, &groove_request, toolpath.tool.shape) {
         (Some(check), Some(g), ToolShape::Wheel(wheel)) => crate::caliber::contact_patch(
-            &crate::verify::as_written(&program).0,
+            &crate::verify::as_written(&verified).0,
             kin,
             &toolpath.tool.reference,
             &wheel,
@@ -522,26 +630,9 @@ pub fn run(
         }),
         _ => None,
     };
-    stage(STAGES[3]);
-    // The data files need only the toolpath and the program: a second
-    // thread writes them while this one posts and lints. A run that failed
-    // writes no program a control could load.
-    let failed_already = !failures.is_empty();
-    let deadline = crate::budget::current();
-    let (data, posted) = std::thread::scope(|s| {
-        let data =
-            s.spawn(|| crate::budget::with_deadline(deadline, || data_files(&toolpath, &program)));
-        let posted = if failed_already {
-            Ok(Vec::new())
-        } else {
-            post_all(machine, info, &program, &options.also_post)
-        };
-        let data = data
-            .join()
-            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        (data, posted)
-    });
+    // A run that failed writes no program a control could load.
     let programs = match posted {
+        Ok(_) if !failures.is_empty() => Vec::new(),
         Ok(p) => p,
         // A program that does not read back as the axis program (a
         // plugin's own post, a block its dialect cannot write): no
@@ -552,17 +643,11 @@ pub fn run(
         }
         Err(e) => return Err(e),
     };
-    let control = dialect(&info.control).ok_or_else(|| Error::UnknownControl {
-        machine: info.name.clone(),
-        control: info.control.clone(),
-    })?;
-    let [toolpath_json, program_json, csv] = data?;
-    let mut files: Vec<(String, Vec<u8>)> = vec![
-        ("toolpath.json".into(), toolpath_json),
-        ("program.json".into(), program_json),
-    ];
+    // The data files in the order a run lists them: the programs after
+    // the JSON files, the block table after the programs.
+    let (table, mut files): (Vec<_>, Vec<_>) = data.into_iter().partition(|f| f.0 == "report.csv");
     files.extend(programs);
-    files.push(("report.csv".into(), csv));
+    files.extend(table);
     stage(STAGES[4]);
     let mut parts = family.part(&values)?;
     if let Some(b) = parts.iter().find(|b| !crate::files::is_plain_name(&b.name)) {
@@ -726,7 +811,7 @@ pub fn run(
             .collect();
         let text = svg::profile_svg(
             &profiles,
-            &program,
+            &verified,
             &passes,
             kin,
             &toolpath.tool.reference,

@@ -100,6 +100,24 @@ pub struct Report {
 }
 
 impl Report {
+    /// The parameter values the run used, as a source a run or a
+    /// verification takes (`label`: where they come from, for messages).
+    ///
+    /// # Failures
+    /// A value TOML cannot hold (not finite).
+    pub fn params_source(&self, label: &str) -> Result<crate::params::ParamSource, String> {
+        let values: BTreeMap<&str, &ParamValue> = self
+            .parameters
+            .iter()
+            .map(|(k, p)| (k.as_str(), &p.value))
+            .collect();
+        let text = toml::to_string(&values).map_err(|e| format!("{label}: {e}"))?;
+        Ok(crate::params::ParamSource::Toml {
+            label: label.to_owned(),
+            text,
+        })
+    }
+
     /// The report of a run of `family` on `machine` (described by `info`,
     /// its constants as the run set them) with `values`, its `checks`
     /// made: what a run knows before its toolpath, the rest empty.

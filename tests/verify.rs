@@ -1,0 +1,211 @@
+//! `pilgrim verify`: programs read as their control reads them and verified
+//! against their family, a run's after hand-editing and programs pilgrim
+//! did not write; the job's own verification and `verify` of its files
+//! give the same figures.
+
+use crate::common::{pilgrim, s, scratch};
+use serde_json::Value;
+use std::path::Path;
+
+/// `v` with every text in lower case: Fanuc's comments (the passes' names
+/// as the program file gives them) are in capitals.
+fn lower(v: &Value) -> Value {
+    match v {
+        Value::String(t) => Value::String(t.to_lowercase()),
+        Value::Array(a) => Value::Array(a.iter().map(lower).collect()),
+        Value::Object(m) => Value::Object(m.iter().map(|(k, x)| (k.clone(), lower(x))).collect()),
+        x => x.clone(),
+    }
+}
+
+fn report(dir: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap()
+}
+
+/// A default run of `job` into a scratch directory.
+fn default_run(job: &str, name: &str) -> std::path::PathBuf {
+    let out = scratch("verify", name).join(job);
+    let (code, _, err) = pilgrim(&[
+        "run",
+        &format!("scripts/{job}.rhai"),
+        "--out",
+        s(&out),
+        "-q",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    out
+}
+
+/// The three default jobs: `verify` of each run's directory passes with the
+/// figures the run's own verification gave (its replay's sections and
+/// every figure of the verdict, each at the same block).
+#[test]
+fn the_default_runs_verify_with_their_own_figures() {
+    for job in ["mandrel", "caliber", "worm"] {
+        let out = default_run(job, job);
+        let (code, said, err) = pilgrim(&["verify", s(&out)]);
+        assert_eq!(code, 0, "{job}: {err}");
+        assert!(said.contains("verified"), "{job}: {said}");
+        let (run, verified) = (report(&out), report(&out.with_extension("verify")));
+        for key in ["verification", "groove_verification", "worm_verification"] {
+            assert_eq!(
+                lower(&run[key]),
+                lower(&verified[key]),
+                "{job}: {key} differs"
+            );
+        }
+        let figures = &run["verdict"]["figures"];
+        assert!(figures.as_array().is_some_and(|f| !f.is_empty()), "{job}");
+        assert_eq!(
+            lower(figures),
+            lower(&verified["verdict"]["figures"]),
+            "{job}"
+        );
+        assert!(
+            verified["verdict"]["failures"]
+                .as_array()
+                .is_none_or(Vec::is_empty),
+            "{job}"
+        );
+        // The verification writes its report, never a program.
+        let files = verified["files"].as_array().unwrap();
+        assert!(
+            !files
+                .iter()
+                .any(|f| f.as_str().unwrap().starts_with("program.")
+                    && !f.as_str().unwrap().ends_with(".json")),
+            "{job}: {files:?}"
+        );
+    }
+}
+
+/// The line of `text` holding the `n`-th move (from 0) after the comment
+/// `pass`, and that move's X value.
+fn move_after(text: &str, pass: &str, n: usize) -> (String, f64) {
+    let line = text
+        .lines()
+        .skip_while(|l| !l.contains(pass))
+        .filter(|l| l.starts_with('N') && l.contains(" X"))
+        .nth(n)
+        .unwrap()
+        .to_owned();
+    let x = line
+        .split_whitespace()
+        .find_map(|w| w.strip_prefix('X'))
+        .unwrap()
+        .parse()
+        .unwrap();
+    (line, x)
+}
+
+/// A run's program edited by hand: a value past the tolerance is refused,
+/// naming its block; a feed changed is verified at the new feed; a word the
+/// verification cannot simulate is refused, naming the word and its block,
+/// and nothing is verified (no report).
+#[test]
+fn a_hand_edited_program_is_verified_as_it_stands() {
+    let out = default_run("mandrel", "edited");
+    let program = out.join("program.mpf");
+    let text = std::fs::read_to_string(&program).unwrap();
+    let edit = |from: &str, to: &str| {
+        assert!(text.contains(from), "{from}");
+        std::fs::write(&program, text.replacen(from, to, 1)).unwrap();
+        let _ = std::fs::remove_dir_all(out.with_extension("verify"));
+        pilgrim(&["verify", s(&out)])
+    };
+    // The finishing pass's fourth block 20 um into the part.
+    let (line, x) = move_after(&text, "pass 4", 3);
+    let block = line.split_whitespace().next().unwrap().to_owned();
+    let deeper = line.replacen(&format!("X{x:.4}"), &format!("X{:.4}", x - 0.02), 1);
+    let (code, _, err) = edit(&line, &deeper);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains(&block) && err.contains("FAILED"), "{err}");
+    let failed = report(&out.with_extension("verify"));
+    assert!(failed["verdict"]["failures"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|f| f["message"].as_str().unwrap().contains(&block)));
+    // The finishing pass's traverse slower: still within tolerance, and
+    // verified at the feed as written.
+    let (line, _) = move_after(&text, "pass 4", 1);
+    let feed = line
+        .split_whitespace()
+        .find(|w| w.starts_with('F'))
+        .unwrap();
+    let (code, said, err) = edit(&line, &line.replacen(feed, "F90.0", 1));
+    assert_eq!(code, 0, "{err}");
+    assert!(said.contains("verified"), "{said}");
+    let finish = |r: &Value| {
+        r["verification"]["passes"]
+            .as_array()
+            .unwrap()
+            .last()
+            .unwrap()["feed_mm_min"]
+            .as_f64()
+            .unwrap()
+    };
+    assert_eq!(finish(&report(&out.with_extension("verify"))), 90.0);
+    assert!(finish(&report(&out)) > 90.0);
+    // An arc among the moves.
+    let (line, _) = move_after(&text, "pass 4", 5);
+    let block = line.split_whitespace().next().unwrap().to_owned();
+    let (code, _, err) = edit(&line, &line.replacen(' ', " G2 ", 1));
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains(&format!(
+            "{block}: G2: a word the verification cannot simulate"
+        )),
+        "{err}"
+    );
+    assert!(!out.with_extension("verify").exists());
+}
+
+/// A program file pilgrim did not write (its own name, a machine and a
+/// family named on the command line) is verified; one whose blocks no
+/// comment groups into passes is refused, saying what to add; a program
+/// file without a family is refused.
+#[test]
+fn a_program_file_is_verified_for_a_machine_and_a_family() {
+    let out = default_run("mandrel", "foreign");
+    let dir = out.parent().unwrap();
+    let text = std::fs::read_to_string(out.join("program.mpf")).unwrap();
+    let theirs = dir.join("SHOP_MANDREL.MPF");
+    std::fs::write(
+        &theirs,
+        text.replacen("%_N_MANDREL_MPF", "%_N_SHOP_MANDREL_MPF", 1),
+    )
+    .unwrap();
+    let (code, said, err) = pilgrim(&[
+        "verify",
+        s(&theirs),
+        "--machine",
+        "3K152VF20",
+        "--family",
+        "scripts/mandrel.rhai",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(said.contains("finish within"), "{said}");
+    let verified = report(&dir.join("SHOP_MANDREL.MPF.verify"));
+    assert_eq!(
+        verified["verification"],
+        report(&out)["verification"],
+        "the same program under another name"
+    );
+    let bare = dir.join("BARE.MPF");
+    let uncommented: String = text
+        .lines()
+        .filter(|l| !l.starts_with(';'))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    std::fs::write(&bare, uncommented).unwrap();
+    let (code, _, err) = pilgrim(&["verify", s(&bare), "--family", "scripts/mandrel.rhai"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("one pass") && err.contains("put a comment"),
+        "{err}"
+    );
+    let (code, _, err) = pilgrim(&["verify", s(&theirs)]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("--family"), "{err}");
+}
