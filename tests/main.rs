@@ -11,6 +11,7 @@ mod common;
 mod caliber;
 mod cli;
 mod containment;
+mod docs;
 mod machine_files;
 mod mandrel;
 mod mandrel_fidelity;

@@ -1,0 +1,65 @@
+//! The documentation as a newcomer meets it: a short README linking every
+//! page of `docs/`, each page linking back, and every relative link
+//! landing on a file that is there.
+
+use crate::common::root;
+use std::path::Path;
+
+/// The relative link targets of a Markdown text (`](target)`), without
+/// their anchors; web addresses left out.
+fn links(text: &str) -> Vec<String> {
+    text.split("](")
+        .skip(1)
+        .filter_map(|rest| rest.split_once(')').map(|(t, _)| t))
+        .filter(|t| !t.contains("://") && !t.starts_with('#'))
+        .map(|t| t.split('#').next().unwrap_or(t).to_owned())
+        .collect()
+}
+
+#[test]
+fn the_readme_is_short_and_the_docs_link_both_ways() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let lines = readme.lines().count();
+    assert!(
+        lines <= 150,
+        "README.md is {lines} lines: the manual belongs in docs/"
+    );
+    let pages: Vec<String> = std::fs::read_dir(root().join("docs"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n.ends_with(".md"))
+        .collect();
+    assert!(pages.len() >= 8, "{pages:?}");
+    let from_readme = links(&readme);
+    for page in &pages {
+        assert!(
+            from_readme.iter().any(|l| l == &format!("docs/{page}")),
+            "README.md does not link docs/{page}"
+        );
+        let text = std::fs::read_to_string(root().join("docs").join(page)).unwrap();
+        // The generated API reference links the guide that links it.
+        if page != "script-api.md" {
+            assert!(
+                links(&text).iter().any(|l| l == "../README.md"),
+                "docs/{page} does not link back to the README"
+            );
+        }
+    }
+    let mut checked = 0;
+    for file in ["README.md", "CHANGELOG.md", "benches/README.md"]
+        .into_iter()
+        .map(str::to_owned)
+        .chain(pages.iter().map(|p| format!("docs/{p}")))
+    {
+        let text = std::fs::read_to_string(root().join(&file)).unwrap();
+        let dir = Path::new(&file).parent().unwrap();
+        for l in links(&text) {
+            assert!(
+                root().join(dir).join(&l).exists(),
+                "{file} links {l}, which is not there"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 30, "{checked} links");
+}
