@@ -234,23 +234,9 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
         let family = load_family(&script, args.params.as_deref(), &limits)?;
         let label = format!("{}/report.json", args.target.display());
         let first = vec![report.params_source(&label)?];
-        let spec = match &args.machine {
-            Some(m) => m.clone(),
-            None if catalog
-                .builtin_names()
-                .iter()
-                .any(|n| n.eq_ignore_ascii_case(&report.machine_spec)) =>
-            {
-                report.machine_spec.clone()
-            }
-            None => {
-                return Err(format!(
-                    "{}: the run's machine '{}' is not a built-in: name it with --machine",
-                    args.target.display(),
-                    report.machine_spec
-                ))
-            }
-        };
+        let shown = args.target.display().to_string();
+        let spec = job::run_machine(&report, catalog, args.machine.as_deref(), &shown)
+            .map_err(|e| e.to_string())?;
         let name = pilgrim_kernel::program::post::dialect(&report.control)
             .map(|d| format!("program.{}", d.extension))
             .ok_or_else(|| {

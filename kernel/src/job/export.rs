@@ -24,6 +24,35 @@ pub struct Exported {
     pub block: usize,
 }
 
+/// The machine to open for the finished run whose report is `report`
+/// (`shown`: its directory, for messages): the one the command line names
+/// (`given`), else the run's own if it is a built-in. A plugin or machine
+/// file that only the run's files name is never opened.
+///
+/// # Failures
+/// No `given` and a run on a machine that is not a built-in.
+pub fn run_machine(
+    report: &Report,
+    catalog: &Catalog,
+    given: Option<&str>,
+    shown: &str,
+) -> Result<String, Error> {
+    match given {
+        Some(m) => Ok(m.to_owned()),
+        None if catalog
+            .builtin_names()
+            .iter()
+            .any(|n| n.eq_ignore_ascii_case(&report.machine_spec)) =>
+        {
+            Ok(report.machine_spec.clone())
+        }
+        None => Err(Error::Read(format!(
+            "{shown}: the run's machine '{}' is not a built-in: name it with --machine (pilgrim loads a plugin or machine file only when the command line names it)",
+            crate::files::excerpt(&report.machine_spec)
+        ))),
+    }
+}
+
 /// The scene of the run `run` placed at `block` (from 1; `None`: the
 /// middle of the last cutting pass).
 ///
@@ -93,23 +122,7 @@ pub fn export(
             "{shown}: the run has no 3-D models (its family has no fn part(p))"
         )));
     }
-    let spec = match machine {
-        Some(m) => m.to_owned(),
-        None if catalog
-            .builtin_names()
-            .iter()
-            .any(|n| n.eq_ignore_ascii_case(&report.machine_spec)) =>
-        {
-            report.machine_spec.clone()
-        }
-        None => {
-            return Err(Error::Read(format!(
-                "{shown}: the run's machine '{}' is not a built-in: name it with --machine (pilgrim loads a plugin or machine file only when the command line names it)",
-                crate::files::excerpt(&report.machine_spec)
-            )))
-        }
-    };
-    let machine = catalog.open(&spec)?;
+    let machine = catalog.open(&run_machine(&report, catalog, machine, &shown)?)?;
     let kin = machine.kinematics.as_ref();
     let place = match block {
         Some(0) => return Err(Error::Options("--block counts blocks from 1".into())),

@@ -22,7 +22,7 @@ mod solids;
 mod svg;
 mod worm_files;
 
-pub use export::{export, Exported};
+pub use export::{export, run_machine, Exported};
 pub use report::{axis_ranges, block_table, cycle_time, Report, ReportParam};
 pub use scene::{default_pose_block, BodyFile, Formats, PosePlace, SceneError};
 pub use solids::SolidFile;
