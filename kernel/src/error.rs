@@ -6,15 +6,15 @@
 use crate::catalog::CatalogError;
 use crate::family::FamilyError;
 use crate::input::InputError;
-use crate::job::SceneError;
 use crate::machine::MachineError;
 use crate::mesh::MeshError;
+use crate::mesh::SceneError;
 use crate::params::ParamError;
 use crate::plugin::PluginLoadError;
 use crate::profile::{ProfileError, TableError};
 use crate::program::{PostError, ProgramError};
+use crate::replay::VerifyError;
 use crate::transform::TransformError;
-use crate::verify::VerifyError;
 
 /// Any error of the kernel.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -107,7 +107,7 @@ pub enum Error {
     /// The run failed a check, a rule of the process or its verification:
     /// what it found, to write where the user looks (no program).
     #[error("{}", .0.report.verdict.message())]
-    Failed(Box<crate::job::FailedRun>),
+    Failed(Box<crate::report::FailedRun>),
 }
 
 /// What the program says of a panic (a defect of pilgrim, never the user's

@@ -61,6 +61,8 @@ pub mod plugin;
 pub mod process;
 pub mod profile;
 pub mod program;
+pub mod replay;
+pub mod report;
 pub mod script;
 pub mod step;
 pub mod tool;

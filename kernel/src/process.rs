@@ -210,21 +210,21 @@ pub fn check(
     tool: &ToolFrame,
     stock: Option<&dyn Stock>,
     limits: &ProcessLimits,
-) -> Result<ProcessFindings, crate::verify::VerifyError> {
+) -> Result<ProcessFindings, crate::replay::VerifyError> {
     let mut out = ProcessFindings::default();
     spindle_and_coolant(program, machine.info(), &mut out);
     let Some(stock) = stock else {
         return Ok(out);
     };
-    let (written, _) = crate::verify::as_written(program);
+    let (written, _) = crate::replay::as_written(program);
     let info = machine.info();
     let name = |k: usize| block_name(program, k);
     let n = written.blocks.len();
     let rows = crate::program::axis_rows(&written, info, &info.solved_axes, 0..n)
-        .map_err(crate::verify::VerifyError::Replay)?;
+        .map_err(crate::replay::VerifyError::Replay)?;
     let width = info.solved_axes.len();
     // The tool at `t` of the way through block k's move.
-    let pose_at = |k: usize, t: Real| -> Result<Vec<Real>, crate::verify::VerifyError> {
+    let pose_at = |k: usize, t: Real| -> Result<Vec<Real>, crate::replay::VerifyError> {
         let b = &rows[k * width..(k + 1) * width];
         let a = if k > 0 {
             &rows[(k - 1) * width..k * width]
@@ -234,7 +234,7 @@ pub fn check(
         let q: Vec<Real> = a.iter().zip(b).map(|(a, b)| a + (b - a) * t).collect();
         let mut p = Vec::with_capacity(6);
         machine.forward(&q, tool, &mut p).map_err(|source| {
-            crate::verify::VerifyError::Kinematics {
+            crate::replay::VerifyError::Kinematics {
                 first: k + 1,
                 last: k + 1,
                 source,
@@ -242,7 +242,7 @@ pub fn check(
         })?;
         Ok(p)
     };
-    let ends = crate::verify::replay(&written, machine, tool)?;
+    let ends = crate::replay::replay(&written, machine, tool)?;
     let mut ticker = crate::budget::Ticker::new("the process's rules", 64);
     for k in 1..n {
         ticker.tick()?;
@@ -369,7 +369,7 @@ fn bodies(
     stock: &dyn Stock,
     limits: &ProcessLimits,
     out: &mut ProcessFindings,
-) -> Result<(), crate::verify::VerifyError> {
+) -> Result<(), crate::replay::VerifyError> {
     let info = machine.info();
     let Ok(bodies) = crate::machine::bodies_of(info) else {
         return Ok(());

@@ -5,6 +5,10 @@ use crate::math::{positive, Point3, Real, Vec3};
 use crate::transform::ToolFrame;
 use serde::{Deserialize, Serialize};
 
+mod thread_cutter;
+
+pub use thread_cutter::{ThreadCutter, ARC_TOLERANCE};
+
 /// A grinding wheel: a disk of `diameter` and `width` whose periphery is
 /// rounded with `rounding_radius` (a torus, MATH §2.2). Every other radius
 /// is derived ([`Wheel::centre_radius`]).
@@ -110,7 +114,7 @@ pub enum ToolShape {
         nose_radius: Real,
     },
     /// A thread cutter: its section in the axial plane.
-    ThreadCutter(crate::worm::ThreadCutter),
+    ThreadCutter(ThreadCutter),
 }
 
 /// A tool: its shape, the number the control calls it by, and the
@@ -183,7 +187,7 @@ impl Tool {
     /// A thread cutter tracked at its tip's centre (the tool frame's
     /// origin), its section in the tool frame's XZ plane (X radial, Z
     /// along the part's axis).
-    pub fn thread_cutter(name: &str, number: u32, cutter: crate::worm::ThreadCutter) -> Self {
+    pub fn thread_cutter(name: &str, number: u32, cutter: ThreadCutter) -> Self {
         Self {
             name: name.to_owned(),
             number,

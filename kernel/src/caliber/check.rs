@@ -2,7 +2,7 @@
 //! the machine makes, measured against the groove's surface over a grid of
 //! `(theta, psi)` (the contact patch at one block is in `patch.rs`).
 //!
-//! The replay reads the program as written ([`crate::verify::as_written`]),
+//! The replay reads the program as written ([`crate::replay::as_written`]),
 //! moves every solved axis in a straight line between blocks as the
 //! control interpolates, and places the wheel by the machine's forward
 //! kinematics at sub-steps of each move, as many as keep the sampling
@@ -34,10 +34,10 @@ use crate::budget::OverTime;
 use crate::machine::MachineKinematics;
 use crate::math::{Real, Vec3};
 use crate::program::{axis_rows, block_name, AxisProgram, ProgramPass};
+use crate::replay::{as_written, VerifyError};
 use crate::tool::Wheel;
 use crate::transform::ToolFrame;
 use crate::verdict::{Figure, Finding};
-use crate::verify::{as_written, VerifyError};
 use serde::{Deserialize, Serialize};
 
 /// How many passes either side of a grid point (across the groove) its
@@ -272,7 +272,7 @@ fn samples(
     let n = program.blocks.len();
     let rows = axis_rows(program, info, &info.solved_axes, 0..n).map_err(VerifyError::Replay)?;
     let width = info.solved_axes.len();
-    let poses = crate::verify::replay(program, machine, tool)?;
+    let poses = crate::replay::replay(program, machine, tool)?;
     let at = |pose: &[Real]| placed(pose, wheel);
     let (r_k0, r_k) = (0.5 * wheel.diameter, wheel.rounding_radius);
     // Between samples no point of the wheel moves more than `step`.

@@ -715,3 +715,11 @@ impl Groove {
         Ok(best)
     }
 }
+
+/// A groove that cannot be evaluated where a replay measures it is the
+/// replay's failure, said as the groove says it.
+impl From<GrooveError> for crate::replay::VerifyError {
+    fn from(e: GrooveError) -> Self {
+        Self::Geometry(e.to_string())
+    }
+}

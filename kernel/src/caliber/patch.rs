@@ -6,9 +6,9 @@ use crate::machine::MachineKinematics;
 use crate::math::{Real, Vec3};
 use crate::mesh::TriMesh;
 use crate::program::AxisProgram;
+use crate::replay::VerifyError;
 use crate::tool::Wheel;
 use crate::transform::ToolFrame;
-use crate::verify::VerifyError;
 use serde::{Deserialize, Serialize};
 
 /// The region of the groove within a small distance of the wheel at one
@@ -53,7 +53,7 @@ pub fn contact_patch(
     block: usize,
 ) -> Result<Option<(ContactPatch, TriMesh)>, VerifyError> {
     crate::math::positive("contact patch gap", req.patch_gap)?;
-    let pose = crate::verify::replay_blocks(program, machine, tool, block..block + 1)?;
+    let pose = crate::replay::replay_blocks(program, machine, tool, block..block + 1)?;
     let wheel = placed(&pose, wheel);
     let g = &req.groove;
     let (lo, hi) = g.theta_range();

@@ -16,14 +16,13 @@ mod deviation;
 mod export;
 mod groove_plots;
 mod page;
-mod report;
 mod scene;
 mod solids;
 mod svg;
 mod worm_files;
 
+pub use crate::report::{axis_ranges, block_table, cycle_time, FailedRun, Report, ReportParam};
 pub use export::{export, run_machine, Exported};
-pub use report::{axis_ranges, block_table, cycle_time, Report, ReportParam};
 pub use scene::{default_pose_block, BodyFile, Formats, PosePlace, SceneError};
 pub use solids::SolidFile;
 
@@ -226,35 +225,6 @@ fn post_all(
         files.push((format!("program.{}", d.extension), text.into_bytes()));
     }
     Ok(files)
-}
-
-/// What a failed run leaves to look at: its report marked FAILED (with
-/// the verdict: what failed, where, and every figure), `report.html`, the
-/// plots and the scene at the place it failed, the data files; no program
-/// a control could load. [`Error::Failed`] carries it.
-#[derive(Clone, PartialEq)]
-pub struct FailedRun {
-    /// The report.
-    pub report: Report,
-    /// Every file's name and bytes.
-    pub files: Vec<(String, Vec<u8>)>,
-}
-
-impl std::fmt::Debug for FailedRun {
-    /// What failed and the files' names (not their bytes: megabytes).
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("FailedRun")
-            .field("failures", &self.report.verdict.message())
-            .field(
-                "files",
-                &self
-                    .files
-                    .iter()
-                    .map(|(n, _)| n.as_str())
-                    .collect::<Vec<_>>(),
-            )
-            .finish()
-    }
 }
 
 /// The failed run of `report` with the `files` made so far: the page and
@@ -476,7 +446,7 @@ fn run_on(
                     message,
                 }
             })?;
-            let passes = crate::verify::passes_in(&read, kin, &toolpath.tool.reference)?;
+            let passes = crate::replay::passes_in(&read, kin, &toolpath.tool.reference)?;
             stage(STAGES[3]);
             let [_, program_json, csv] = data_files(&toolpath, &read)?;
             let data = vec![
@@ -617,7 +587,7 @@ fn run_on(
     // its mesh in the scene).
     let patch_mesh = match (&mut groove, &groove_request, toolpath.tool.shape) {
         (Some(check), Some(g), ToolShape::Wheel(wheel)) => crate::caliber::contact_patch(
-            &crate::verify::as_written(&verified).0,
+            &crate::replay::as_written(&verified).0,
             kin,
             &toolpath.tool.reference,
             &wheel,

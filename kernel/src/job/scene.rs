@@ -5,47 +5,17 @@
 use crate::family::{PartBody, PartGeometry};
 use crate::machine::{bodies_of, BodyShape, MachineKinematics};
 use crate::math::{Mat4, Point3, Vec3};
+pub use crate::mesh::SceneError;
 use crate::mesh::{self, frame_from_pose, MeshError, Scene, StlFormat, TriMesh};
 use crate::program::ProgramPass;
 use crate::program::{axis_rows, AxisProgram};
+pub use crate::report::BodyFile;
 use crate::tool::{Tool, ToolShape, WheelOrigin};
-use serde::{Deserialize, Serialize};
-
-/// A body written to a file, for the report.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct BodyFile {
-    /// The body's name.
-    pub name: String,
-    /// `part`, `tool` or `machine`.
-    pub kind: String,
-    /// Its STL file.
-    pub file: String,
-    /// Triangles.
-    pub triangles: usize,
-    /// Enclosed volume (mm^3).
-    pub volume_mm3: f64,
-}
 
 const PART_COLOR: [f32; 4] = [0.72, 0.72, 0.76, 1.0];
 const TOOL_COLOR: [f32; 4] = [0.25, 0.42, 0.85, 1.0];
 const MACHINE_COLOR: [f32; 4] = [0.85, 0.55, 0.2, 1.0];
 const OVERLAY_COLOR: [f32; 4] = [0.9, 0.1, 0.1, 1.0];
-
-/// Why the scene could not be made.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum SceneError {
-    /// A body's mesh failed.
-    #[error("{body}: {source}")]
-    Mesh {
-        /// The body.
-        body: String,
-        /// The mesh's error.
-        source: MeshError,
-    },
-    /// Placing a body failed (a block beyond the program, a chain).
-    #[error("{0}")]
-    Place(String),
-}
 
 fn mesh_err(body: &str) -> impl Fn(MeshError) -> SceneError + '_ {
     move |source| SceneError::Mesh {
@@ -275,7 +245,7 @@ pub fn tool_pose(
     place: PosePlace,
 ) -> Result<ToolAt, SceneError> {
     let here = at_place(program, place)?;
-    let pose = crate::verify::replay_blocks(&here, machine, &tool.reference, 0..1)
+    let pose = crate::replay::replay_blocks(&here, machine, &tool.reference, 0..1)
         .map_err(|e| SceneError::Place(e.to_string()))?;
     let frame = frame_from_pose(
         &tool.reference,
@@ -296,7 +266,7 @@ pub fn tool_pose(
     // Where the block started: its thread's section at part angle 0 is
     // there, shifted by the start angle's share of the lead.
     let start = at_place(program, PosePlace::at_end(place.block - 1))?;
-    let from = crate::verify::replay_blocks(&start, machine, &tool.reference, 0..1)
+    let from = crate::replay::replay_blocks(&start, machine, &tool.reference, 0..1)
         .map_err(|e| SceneError::Place(e.to_string()))?;
     let dir = (pose[2] - from[2]).signum();
     let z_section = from[2] - dir * lead * start_deg / 360.0;

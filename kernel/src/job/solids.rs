@@ -4,28 +4,9 @@
 use super::scene::Files;
 use crate::family::{PartBody, PartGeometry};
 use crate::math::{Mat4, Real, Vec3};
+pub use crate::report::SolidFile;
 use crate::step::{self, StepError};
 use crate::tool::{Tool, ToolShape, WheelOrigin};
-use serde::{Deserialize, Serialize};
-
-/// One STEP file a run wrote.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct SolidFile {
-    /// The body's name.
-    pub name: String,
-    /// `part` or `tool`.
-    pub kind: String,
-    /// Its STEP file.
-    pub file: String,
-    /// The solid's volume from its own section (mm^3).
-    pub volume_mm3: f64,
-    /// The largest deviation of its B-spline from the family's profile
-    /// (mm); 0 for a section of lines and arcs, which is exact.
-    pub deviation_mm: f64,
-    /// Cubic Bezier segments its profile became (0 for lines and arcs); for
-    /// a swept body, its faces across a section.
-    pub segments: usize,
-}
 
 /// The STEP files of the part's bodies (in the part frame: bodies of
 /// revolution from their profiles, the caliber's roll and the worm swept

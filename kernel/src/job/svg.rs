@@ -61,7 +61,7 @@ pub fn profile_svg(
         shape.push(Series {
             name: format!("wheel centre, {}", last.name),
             color: COLORS[2],
-            points: crate::verify::replay_blocks(program, machine, tool, last.blocks.clone())
+            points: crate::replay::replay_blocks(program, machine, tool, last.blocks.clone())
                 .map_err(|e| e.to_string())?
                 .chunks_exact(6)
                 .map(|p| (p[2], p[0].hypot(p[1])))

@@ -285,3 +285,19 @@ pub(crate) fn arc_segments(
     }
     Ok((n as usize).max(min))
 }
+
+/// Why the scene could not be made.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SceneError {
+    /// A body's mesh failed.
+    #[error("{body}: {source}")]
+    Mesh {
+        /// The body.
+        body: String,
+        /// The mesh's error.
+        source: MeshError,
+    },
+    /// Placing a body failed (a block beyond the program, a chain).
+    #[error("{0}")]
+    Place(String),
+}

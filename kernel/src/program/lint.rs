@@ -1206,7 +1206,7 @@ mod tests {
             assert_eq!((r.name.as_str(), r.number), (name, number), "{}", d.name);
             assert_eq!((r.spindle_rpm, r.tool_number), (399.0, 3), "{}", d.name);
             assert_eq!(r.blocks.len(), p.blocks.len(), "{}", d.name);
-            let (written, _) = crate::verify::as_written(&p);
+            let (written, _) = crate::replay::as_written(&p);
             for (k, (a, b)) in r.blocks.iter().zip(&written.blocks).enumerate() {
                 let what = format!("{} block {k}", d.name);
                 assert_eq!(a.values, b.values, "{what}");

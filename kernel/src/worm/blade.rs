@@ -45,7 +45,7 @@ impl ThreadBlade {
     /// placed by `pose` in the part frame.
     pub fn new(cutter: &ThreadCutter, tip_radius: Real, lead: Real, pose: Mat4) -> Self {
         Self {
-            outline: cutter.outline(cutter.height),
+            outline: cutter_outline(cutter, cutter.height),
             nose_radius: cutter.nose_radius,
             top: cutter.height,
             tip_radius,
@@ -149,4 +149,41 @@ impl crate::step::Sections for ThreadBlade {
         // part's axis.
         true
     }
+}
+
+/// The outline of `cutter`'s section ([`ThreadCutter::section`]) up to
+/// `top`, closed along the top, in exact lines and arcs (the cutter's STEP
+/// solid), counter-clockwise.
+pub fn cutter_outline(cutter: &ThreadCutter, top: Real) -> Section {
+    use crate::step::Piece;
+    let (w, r) = (cutter.tip_width / 2.0, cutter.nose_radius);
+    let (tl, tr) = (cutter.left_angle.tan(), cutter.right_angle.tan());
+    let start = [-w - top * tl, top];
+    let mut pieces = Vec::new();
+    if r > 0.0 {
+        let at = |c: [Real; 2], a: Real| [c[0] + r * a.cos(), c[1] + r * a.sin()];
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        let cl = [-(w - cutter.inset(cutter.left_angle)), r];
+        let cr = [w - cutter.inset(cutter.right_angle), r];
+        let (l0, r1) = (
+            -std::f64::consts::PI + cutter.left_angle,
+            -cutter.right_angle,
+        );
+        pieces.push(Piece::Line(at(cl, l0)));
+        pieces.push(Piece::Arc {
+            through: at(cl, 0.5 * (l0 - half_pi)),
+            to: at(cl, -half_pi),
+        });
+        pieces.push(Piece::Line(at(cr, -half_pi)));
+        pieces.push(Piece::Arc {
+            through: at(cr, 0.5 * (r1 - half_pi)),
+            to: at(cr, r1),
+        });
+    } else {
+        pieces.push(Piece::Line([-w, 0.0]));
+        pieces.push(Piece::Line([w, 0.0]));
+    }
+    pieces.push(Piece::Line([w + top * tr, top]));
+    pieces.push(Piece::Line(start));
+    Section { start, pieces }
 }

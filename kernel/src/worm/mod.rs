@@ -19,15 +19,14 @@
 //! radial. The thread is right-handed.
 
 mod blade;
-mod cutter;
 mod plan;
 mod servo;
 mod simulate;
 mod sizes;
 mod solid;
 
-pub use blade::{ThreadBlade, BLADE_RELIEF_DEG, BLADE_THICKNESS};
-pub use cutter::{ThreadCutter, ARC_TOLERANCE};
+pub use crate::tool::{ThreadCutter, ARC_TOLERANCE};
+pub use blade::{cutter_outline, ThreadBlade, BLADE_RELIEF_DEG, BLADE_THICKNESS};
 pub use plan::{
     axial_offset, plan, rational_passes, roughing_depths, Flank, FlankOrder, PassKind,
     PlanSettings, PlannedPass, MAX_PASSES,

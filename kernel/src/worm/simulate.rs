@@ -24,10 +24,10 @@ use super::{ThreadCutter, WormSizes};
 use crate::machine::MachineKinematics;
 use crate::math::Real;
 use crate::program::{block_name, AxisProgram};
+use crate::replay::{as_written, replay, VerifyError};
 use crate::toolpath::Motion;
 use crate::transform::ToolFrame;
 use crate::verdict::{Figure, Finding};
-use crate::verify::{as_written, replay, VerifyError};
 use geo::{Area, BooleanOps, Coord, LineString, MultiPolygon, Polygon};
 use serde::{Deserialize, Serialize};
 

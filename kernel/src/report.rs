@@ -1,7 +1,9 @@
 //! What a run reports: `report.json` ([`Report`]) and `report.csv` (a row
-//! per block), with the program's cycle time and each axis's range.
+//! per block), with the program's cycle time and each axis's range; what a
+//! failed run leaves ([`FailedRun`]). Below the run ([`crate::job`]) and
+//! the page, which read it, and below [`crate::error`], which carries a
+//! failed run.
 
-use super::scene::BodyFile;
 use crate::family::Check;
 use crate::machine::{feed_length, Axis, MachineInfo};
 use crate::math::{fixed, Real};
@@ -70,7 +72,7 @@ pub struct Report {
     pub step_tolerance_mm: f64,
     /// The bodies written as exact solids (STEP).
     #[serde(default)]
-    pub solids: Vec<super::solids::SolidFile>,
+    pub solids: Vec<SolidFile>,
     /// Each programmed axis's range over the program: [min, max] (mm, deg).
     #[serde(default)]
     pub axis_ranges: BTreeMap<String, [f64; 2]>,
@@ -303,4 +305,67 @@ pub fn block_table(program: &AxisProgram) -> Result<String, String> {
     }
     let bytes = w.into_inner().map_err(|e| e.to_string())?;
     String::from_utf8(bytes).map_err(|e| e.to_string())
+}
+
+/// A body written to a file, for the report.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BodyFile {
+    /// The body's name.
+    pub name: String,
+    /// `part`, `tool` or `machine`.
+    pub kind: String,
+    /// Its STL file.
+    pub file: String,
+    /// Triangles.
+    pub triangles: usize,
+    /// Enclosed volume (mm^3).
+    pub volume_mm3: f64,
+}
+
+/// One STEP file a run wrote.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SolidFile {
+    /// The body's name.
+    pub name: String,
+    /// `part` or `tool`.
+    pub kind: String,
+    /// Its STEP file.
+    pub file: String,
+    /// The solid's volume from its own section (mm^3).
+    pub volume_mm3: f64,
+    /// The largest deviation of its B-spline from the family's profile
+    /// (mm); 0 for a section of lines and arcs, which is exact.
+    pub deviation_mm: f64,
+    /// Cubic Bezier segments its profile became (0 for lines and arcs); for
+    /// a swept body, its faces across a section.
+    pub segments: usize,
+}
+
+/// What a failed run leaves to look at: its report marked FAILED (with
+/// the verdict: what failed, where, and every figure), `report.html`, the
+/// plots and the scene at the place it failed, the data files; no program
+/// a control could load. [`Error::Failed`] carries it.
+#[derive(Clone, PartialEq)]
+pub struct FailedRun {
+    /// The report.
+    pub report: Report,
+    /// Every file's name and bytes.
+    pub files: Vec<(String, Vec<u8>)>,
+}
+
+impl std::fmt::Debug for FailedRun {
+    /// What failed and the files' names (not their bytes: megabytes).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FailedRun")
+            .field("failures", &self.report.verdict.message())
+            .field(
+                "files",
+                &self
+                    .files
+                    .iter()
+                    .map(|(n, _)| n.as_str())
+                    .collect::<Vec<_>>(),
+            )
+            .finish()
+    }
 }

@@ -85,7 +85,7 @@ impl ThreadCutter {
     }
 
     /// How far a corner's arc starts inside the tip's end: `r (1 - sin a) / cos a`.
-    fn inset(&self, angle: Real) -> Real {
+    pub(crate) fn inset(&self, angle: Real) -> Real {
         self.nose_radius * (1.0 - angle.sin()) / angle.cos()
     }
 
@@ -111,40 +111,6 @@ impl ThreadCutter {
             }
         };
         [side(self.left_angle), side(self.right_angle)]
-    }
-
-    /// The same outline as [`Self::section`] up to `top`, closed along the
-    /// top, in exact lines and arcs (the cutter's STEP solid),
-    /// counter-clockwise.
-    pub fn outline(&self, top: Real) -> crate::step::Section {
-        use crate::step::{Piece, Section};
-        let (w, r) = (self.tip_width / 2.0, self.nose_radius);
-        let (tl, tr) = (self.left_angle.tan(), self.right_angle.tan());
-        let start = [-w - top * tl, top];
-        let mut pieces = Vec::new();
-        if r > 0.0 {
-            let at = |c: [Real; 2], a: Real| [c[0] + r * a.cos(), c[1] + r * a.sin()];
-            let half_pi = std::f64::consts::FRAC_PI_2;
-            let cl = [-(w - self.inset(self.left_angle)), r];
-            let cr = [w - self.inset(self.right_angle), r];
-            let (l0, r1) = (-std::f64::consts::PI + self.left_angle, -self.right_angle);
-            pieces.push(Piece::Line(at(cl, l0)));
-            pieces.push(Piece::Arc {
-                through: at(cl, 0.5 * (l0 - half_pi)),
-                to: at(cl, -half_pi),
-            });
-            pieces.push(Piece::Line(at(cr, -half_pi)));
-            pieces.push(Piece::Arc {
-                through: at(cr, 0.5 * (r1 - half_pi)),
-                to: at(cr, r1),
-            });
-        } else {
-            pieces.push(Piece::Line([-w, 0.0]));
-            pieces.push(Piece::Line([w, 0.0]));
-        }
-        pieces.push(Piece::Line([w + top * tr, top]));
-        pieces.push(Piece::Line(start));
-        Section { start, pieces }
     }
 
     /// The section as a closed polygon `(z, r)` about the tracked point,
@@ -226,7 +192,7 @@ mod tests {
             }
         }
         // The exact outline encloses the same area, less the chords'.
-        let exact = c.outline(10.0).area();
+        let exact = crate::worm::cutter_outline(&c, 10.0).area();
         assert!(
             exact >= area && (exact - (trapezoid - 2.0 * corner)).abs() < 1e-9,
             "{exact}"
