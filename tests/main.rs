@@ -8,6 +8,8 @@
 
 mod common;
 
+mod architecture;
+
 mod caliber;
 mod cli;
 mod containment;

@@ -1,0 +1,94 @@
+//! The kernel's module graph as `docs/architecture.md` describes it: the
+//! top-level modules (a folder counts as one) and the arrows their code's
+//! `crate::<module>` paths draw (comments and unit tests left out). No
+//! circle; the generic modules that still name a family are the ones the
+//! page lists, and no other.
+
+use crate::common::root;
+use std::collections::{BTreeMap, BTreeSet};
+
+/// Each top-level module of the kernel and the modules its code names.
+fn graph() -> BTreeMap<String, BTreeSet<String>> {
+    let src = root().join("kernel/src");
+    let mut out: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    let mut stack = vec![src.clone()];
+    while let Some(dir) = stack.pop() {
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+                continue;
+            }
+            if p.extension().is_none_or(|x| x != "rs") {
+                continue;
+            }
+            let rel = p.strip_prefix(&src).unwrap();
+            let first = rel.iter().next().unwrap().to_str().unwrap();
+            let module = first.trim_end_matches(".rs").to_owned();
+            if module == "lib" {
+                continue;
+            }
+            let text = std::fs::read_to_string(&p).unwrap();
+            let code = text.split("#[cfg(test)]\nmod tests").next().unwrap();
+            let names = out.entry(module.clone()).or_default();
+            for line in code.lines().filter(|l| !l.trim_start().starts_with("//")) {
+                for (i, _) in line.match_indices("crate::") {
+                    let name: String = line[i + 7..]
+                        .chars()
+                        .take_while(|c| c.is_ascii_lowercase() || *c == '_')
+                        .collect();
+                    if !name.is_empty() && name != module {
+                        names.insert(name);
+                    }
+                }
+            }
+        }
+    }
+    let known: BTreeSet<String> = out.keys().cloned().collect();
+    for names in out.values_mut() {
+        names.retain(|n| known.contains(n));
+    }
+    out
+}
+
+#[test]
+fn the_kernels_modules_form_no_circle() {
+    let g = graph();
+    assert!(g.len() > 20, "{g:?}");
+    // Depth-first: a module met again while it is on the path closes a
+    // circle.
+    fn visit<'a>(
+        m: &'a str,
+        g: &'a BTreeMap<String, BTreeSet<String>>,
+        path: &mut Vec<&'a str>,
+        done: &mut BTreeSet<&'a str>,
+    ) {
+        if done.contains(m) {
+            return;
+        }
+        if let Some(i) = path.iter().position(|p| *p == m) {
+            panic!("an import circle: {} -> {m}", path[i..].join(" -> "));
+        }
+        path.push(m);
+        for n in &g[m] {
+            visit(n, g, path, done);
+        }
+        path.pop();
+        done.insert(m);
+    }
+    let mut done = BTreeSet::new();
+    for m in g.keys() {
+        visit(m, &g, &mut Vec::new(), &mut done);
+    }
+    // The generic modules that name a family: each is in the page's list
+    // of arrows still to go.
+    let families = ["verify", "caliber", "worm"];
+    let naming: Vec<&str> = g
+        .iter()
+        .filter(|(m, names)| {
+            !families.contains(&m.as_str()) && families.iter().any(|f| names.contains(*f))
+        })
+        .map(|(m, _)| m.as_str())
+        .collect();
+    assert_eq!(naming, ["family", "job", "report", "script"]);
+}
