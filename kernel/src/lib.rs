@@ -45,6 +45,7 @@
 pub mod budget;
 pub mod caliber;
 pub mod catalog;
+pub mod chart;
 pub mod error;
 pub mod family;
 pub mod files;

@@ -124,6 +124,19 @@ pub fn check_text(what: &str, value: &str) -> Result<(), InputError> {
     Ok(())
 }
 
+/// A text cell of a CSV file as a spreadsheet must show it, not evaluate
+/// it: text that opens with `=`, `+`, `-`, `@`, a tab or a carriage return
+/// (a formula to Excel, LibreOffice and Google Sheets; a pass may be named
+/// `=HYPERLINK(...)`) gets a leading `'`, the OWASP rule for CSV
+/// injection. Numbers are written by the caller and never pass here.
+pub(crate) fn spreadsheet_text(text: &str) -> String {
+    if text.starts_with(['=', '+', '-', '@', '\t', '\r']) {
+        format!("'{text}")
+    } else {
+        text.to_owned()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -237,26 +237,13 @@ pub fn cycle_time(program: &AxisProgram, info: &MachineInfo) -> Real {
     minutes
 }
 
-/// A text cell of a CSV file as a spreadsheet must show it, not evaluate
-/// it: text that opens with `=`, `+`, `-`, `@`, a tab or a carriage return
-/// (a formula to Excel, LibreOffice and Google Sheets; a pass may be named
-/// `=HYPERLINK(...)`) gets a leading `'`, the OWASP rule for CSV
-/// injection. Numbers are written by the caller and never pass here.
-pub(crate) fn spreadsheet_text(text: &str) -> String {
-    if text.starts_with(['=', '+', '-', '@', '\t', '\r']) {
-        format!("'{text}")
-    } else {
-        text.to_owned()
-    }
-}
-
 /// `report.csv`: one row per block of the program, the start's and the
 /// end's included: block number (from 1), the program's name for it
 /// ([`block_label`]: `N570`), the pass (the last comment at or before it),
 /// motion, axis values (the program's decimals; empty for an axis the
 /// block keeps where it stands), feed; written by the `csv` crate (RFC
 /// 4180, fields quoted where they need it), text cells as
-/// `spreadsheet_text` has them.
+/// [`crate::names::spreadsheet_text`] has them.
 ///
 /// # Failures
 /// The writer failing (it writes to memory).
@@ -290,7 +277,7 @@ pub fn block_table(program: &AxisProgram) -> Result<String, String> {
         let mut row = vec![
             (i + 1).to_string(),
             block_label(&program.control, i),
-            spreadsheet_text(pass),
+            crate::names::spreadsheet_text(pass),
             motion.to_owned(),
         ];
         row.extend(program.axes.iter().zip(&b.values).map(|(a, v)| {

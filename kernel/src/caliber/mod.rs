@@ -29,6 +29,7 @@ mod check;
 mod groove;
 mod pass;
 mod patch;
+mod plots;
 mod pose;
 mod scallop;
 mod section;
@@ -42,6 +43,7 @@ pub use check::{
 pub use groove::{Groove, GrooveError};
 pub use pass::{pass_poses, pose_at, step_over, PassPose, SwivelPlane, MAX_PASS_BLOCKS};
 pub use patch::{contact_patch, ContactPatch};
+pub use plots::{deviation_map_svg, section_svg};
 pub use pose::{exact_pose, exact_pose_toward, seed_pose, SeedPose, TorusWheel};
 pub use scallop::{scallop_height, step_for_scallop, step_for_scallop_convex};
 pub use section::{Edge, EdgeKind, GrooveSection};

@@ -11,15 +11,10 @@
 //! (the `pilgrim` program writes them atomically). [`export`] places a
 //! finished run's tool at another block.
 
-mod chart;
-mod deviation;
 mod export;
-mod groove_plots;
 mod page;
 mod scene;
 mod solids;
-mod svg;
-mod worm_files;
 
 pub use crate::report::{axis_ranges, block_table, cycle_time, FailedRun, Report, ReportParam};
 pub use export::{export, run_machine, Exported};
@@ -734,10 +729,10 @@ fn run_on(
             }
         }
         let table =
-            worm_files::worm_pass_table(w, report.tables.get("passes")).map_err(Error::Output)?;
+            crate::worm::worm_pass_table(w, report.tables.get("passes")).map_err(Error::Output)?;
         files.push(("passes.csv".into(), table.into_bytes()));
         report.files.push("passes.csv".into());
-        let svg = worm_files::worm_passes_svg(w).map_err(Error::Output)?;
+        let svg = crate::worm::worm_passes_svg(w).map_err(Error::Output)?;
         files.push(("passes.svg".into(), svg.into_bytes()));
         report.files.push("passes.svg".into());
     }
@@ -746,7 +741,7 @@ fn run_on(
         ..toolpath.clone()
     };
     for plot in &toolpath.plots {
-        let text = chart::chart_svg(&charted, plot).map_err(|message| {
+        let text = crate::chart::chart_svg(&charted, plot).map_err(|message| {
             Error::Family(crate::family::FamilyError::Contract {
                 family: family.name().to_owned(),
                 message,
@@ -779,7 +774,7 @@ fn run_on(
                 PartGeometry::Swept(_) => None,
             })
             .collect();
-        let text = svg::profile_svg(
+        let text = crate::verify::profile_svg(
             &profiles,
             &verified,
             &passes,
@@ -795,7 +790,7 @@ fn run_on(
     if let (Some(v), Some(n)) = (&verification, &nominal) {
         // The surface before the first pass: the blank the replay cut into.
         let start = |z: f64| Some(n.blank.as_deref()?.eval(z).ok()? - n.profile.eval(z).ok()?);
-        for (name, text) in deviation::deviation_svgs(v, start).map_err(Error::Output)? {
+        for (name, text) in crate::verify::deviation_svgs(v, start).map_err(Error::Output)? {
             files.push((name.clone(), text.into_bytes()));
             report.files.push(name);
         }
@@ -803,9 +798,9 @@ fn run_on(
     if let (Some(g), Some(req), ToolShape::Wheel(w)) =
         (&groove, &groove_request, toolpath.tool.shape)
     {
-        let map = groove_plots::deviation_map_svg(g).map_err(Error::Output)?;
+        let map = crate::caliber::deviation_map_svg(g).map_err(Error::Output)?;
         let section =
-            groove_plots::section_svg(g, req, w.rounding_radius).map_err(Error::Output)?;
+            crate::caliber::section_svg(g, req, w.rounding_radius).map_err(Error::Output)?;
         for (name, text) in [("deviation_map.svg", map), ("section.svg", section)] {
             files.push((name.into(), text.into_bytes()));
             report.files.push(name.into());

@@ -20,6 +20,7 @@
 
 mod blade;
 mod plan;
+mod plots;
 mod servo;
 mod simulate;
 mod sizes;
@@ -31,6 +32,7 @@ pub use plan::{
     axial_offset, plan, rational_passes, roughing_depths, Flank, FlankOrder, PassKind,
     PlanSettings, PlannedPass, MAX_PASSES,
 };
+pub use plots::{worm_pass_table, worm_passes_svg};
 pub use servo::{approach_error, approach_length, runout_error, runout_length};
 pub use simulate::{
     simulate, SimulatedPass, StartProfile, WormCheck, WormRequest, WormStock, WormTolerances,

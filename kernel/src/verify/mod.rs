@@ -28,6 +28,11 @@ use crate::verdict::{Figure, Finding};
 use serde::{Deserialize, Serialize};
 
 pub use crate::replay::{as_written, passes_in, replay, replay_blocks, VerifyError};
+pub use plots::deviation_svgs;
+pub use profile_svg::profile_svg;
+
+mod plots;
+mod profile_svg;
 
 /// How far a surface strays from the nominal profile over a range.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

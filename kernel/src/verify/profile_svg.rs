@@ -209,8 +209,8 @@ fn render(panels: &[Panel]) -> Result<String, String> {
                 .configure_mesh()
                 .x_desc("z, mm")
                 .y_desc(panel.y_label.as_str())
-                .x_label_formatter(&|v| fixed(*v, super::chart::tick_decimals(z1 - z0)))
-                .y_label_formatter(&|v| fixed(*v, super::chart::tick_decimals(y1 - y0)))
+                .x_label_formatter(&|v| fixed(*v, crate::chart::tick_decimals(z1 - z0)))
+                .y_label_formatter(&|v| fixed(*v, crate::chart::tick_decimals(y1 - y0)))
                 .label_style(("sans-serif", 13))
                 .axis_desc_style(("sans-serif", 14))
                 .draw()
@@ -226,7 +226,7 @@ fn render(panels: &[Panel]) -> Result<String, String> {
                     .map_err(e)?;
                 items.push((s.name.clone(), c));
             }
-            super::chart::legend(&legend_area, &items, (110, 320, 3), 14).map_err(e)?;
+            crate::chart::legend(&legend_area, &items, (110, 320, 3), 14).map_err(e)?;
         }
         rest.present().map_err(e)?;
     }

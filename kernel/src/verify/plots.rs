@@ -6,7 +6,7 @@
 //! (the surface before it minus the surface it left: the blank's for the
 //! first pass).
 
-use super::chart::{tick_decimals, COLOURS};
+use crate::chart::{tick_decimals, COLOURS};
 use crate::verify::{GrindingCheck, PassCheck};
 use plotters::prelude::*;
 
@@ -94,7 +94,7 @@ fn draw(
             }
             legend.push((format!("tolerance +-{:.1} um", 1e3 * t), grey));
         }
-        super::chart::legend(&bottom, &legend, (60, 520, 2), 14).map_err(e)?;
+        crate::chart::legend(&bottom, &legend, (60, 520, 2), 14).map_err(e)?;
         root.present().map_err(e)?;
     }
     Ok(svg)

@@ -3,8 +3,8 @@
 //! (theta, psi) as a heat map, and `section.svg`, the wheel's rounding at
 //! every pass in the groove's section where the most material is left.
 
-use super::chart::tick_decimals;
 use crate::caliber::{GrooveCheck, GrooveRequest};
+use crate::chart::tick_decimals;
 use plotters::prelude::*;
 
 /// Colour levels of the heat map, an odd number: the middle one is zero.
@@ -264,7 +264,7 @@ pub fn section_svg(
                     .map(|&(_, _, p)| Circle::new(p, 3, RGBColor(214, 39, 40).filled())),
             )
             .map_err(e)?;
-        super::chart::legend(
+        crate::chart::legend(
             &below,
             &[
                 ("the groove's section".into(), BLACK),

@@ -108,7 +108,7 @@ pub fn worm_passes_svg(check: &WormCheck) -> Result<String, String> {
 /// the approach and run-out from the cutting edges with the lead's error
 /// where they meet the thread's ends)
 /// and the plan's columns from `planned` where it has one row per pass;
-/// text cells as [`crate::report::spreadsheet_text`] has them.
+/// text cells as [`crate::names::spreadsheet_text`] has them.
 ///
 /// # Failures
 /// The writer failing.
@@ -148,13 +148,13 @@ pub fn worm_pass_table(
     .collect();
     head.extend(
         plan.iter()
-            .map(|(k, _)| crate::report::spreadsheet_text(&format!("plan_{k}"))),
+            .map(|(k, _)| crate::names::spreadsheet_text(&format!("plan_{k}"))),
     );
     w.write_record(&head).map_err(|e| e.to_string())?;
     for (i, p) in check.passes.iter().enumerate() {
         let mut row = vec![
             p.block.to_string(),
-            crate::report::spreadsheet_text(&p.name),
+            crate::names::spreadsheet_text(&p.name),
             (p.start + 1).to_string(),
             crate::math::fixed(p.x, 3),
             crate::math::fixed(p.offset, 4),

@@ -6,7 +6,7 @@ use crate::toolpath::{PlotSpec, Toolpath};
 use plotters::prelude::*;
 
 /// Line colours, in order (the legend's).
-pub(super) const COLOURS: [RGBColor; 6] = [
+pub(crate) const COLOURS: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
@@ -17,7 +17,7 @@ pub(super) const COLOURS: [RGBColor; 6] = [
 
 /// The decimals the ticks of an axis spanning `range` need: one more than
 /// the place of a tenth of the range (the ticks' spacing), at least 0.
-pub(super) fn tick_decimals(range: f64) -> usize {
+pub(crate) fn tick_decimals(range: f64) -> usize {
     let step = (range / 10.0).abs();
     if !(step > 0.0) {
         return 1;
@@ -28,7 +28,7 @@ pub(super) fn tick_decimals(range: f64) -> usize {
 /// A legend in `area` (below a chart: never over the data): each item a
 /// swatch of its colour and its name, `layout.2` to a row starting at
 /// `layout.0` and `layout.1` apart (pixels), in text of `size`.
-pub(super) fn legend<DB: DrawingBackend>(
+pub(crate) fn legend<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     items: &[(String, RGBColor)],
     layout: (i32, i32, usize),
