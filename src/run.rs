@@ -92,6 +92,7 @@ fn run_within(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
         formats: args.formats,
         program_number: args.program_number,
         also_post: args.also_post.clone(),
+        program_file: None,
     };
     let out = match job::run(&family, &machine, &sources, &options, &mut |s| next(s)) {
         Ok(out) => out,
@@ -211,7 +212,7 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
         max_seconds: args.script_seconds,
         ..Limits::default()
     };
-    let (family, mut first, spec, program) = if args.target.is_dir() {
+    let (family, mut first, spec, program, file) = if args.target.is_dir() {
         // A run's directory: its program in the control's dialect, its
         // family, parameters and (built-in) machine as its report says.
         let run = pilgrim_kernel::output::RunDir::open(&args.target).map_err(|e| e.to_string())?;
@@ -248,7 +249,7 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
         let text = run
             .read_text(&name, pilgrim_kernel::files::MAX_DATA_BYTES)
             .map_err(|e| e.to_string())?;
-        (family, first, spec, text)
+        (family, first, spec, text, args.target.join(&name))
     } else {
         let script = args.family.as_ref().ok_or_else(|| {
             format!(
@@ -261,12 +262,13 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
         let text =
             pilgrim_kernel::files::read_text(&args.target, pilgrim_kernel::files::MAX_DATA_BYTES)
                 .map_err(|e| e.to_string())?;
-        (family, Vec::new(), spec, text)
+        (family, Vec::new(), spec, text, args.target.clone())
     };
     first = sources(first, args.params.as_deref(), &args.sets)?;
     let machine = catalog.open(&spec).map_err(|e| e.to_string())?;
     let options = JobOptions {
         program_name: "verify".into(),
+        program_file: Some(pilgrim_kernel::files::shown_path(&file)),
         ..JobOptions::default()
     };
     let what = args.target.display();

@@ -187,6 +187,11 @@ fn a_program_file_is_verified_for_a_machine_and_a_family() {
     assert_eq!(code, 0, "{err}");
     assert!(said.contains("finish within"), "{said}");
     let verified = report(&dir.join("SHOP_MANDREL.MPF.verify"));
+    // The report and the page name the file the verification read.
+    assert_eq!(verified["program_file"].as_str(), Some(s(&theirs)));
+    let page = std::fs::read_to_string(dir.join("SHOP_MANDREL.MPF.verify/report.html")).unwrap();
+    assert!(page.contains("SHOP_MANDREL.MPF verified against scripts/mandrel.rhai"));
+    assert!(report(&out).get("program_file").is_none());
     assert_eq!(
         verified["verification"],
         report(&out)["verification"],

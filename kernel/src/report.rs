@@ -37,6 +37,10 @@ pub struct Report {
     pub machine_spec: String,
     /// The control's dialect.
     pub control: String,
+    /// The program file a verification read (`pilgrim verify`), as shown
+    /// in messages; none for a run, whose program is its own.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub program_file: Option<String>,
     /// Every parameter's value as used, with its unit.
     pub parameters: BTreeMap<String, ReportParam>,
     /// Passes in all.
@@ -135,6 +139,7 @@ impl Report {
             script: family.name().to_owned(),
             machine: info.name.clone(),
             machine_spec: machine.spec.clone(),
+            program_file: None,
             control: info.control.clone(),
             parameters: family
                 .params()

@@ -55,6 +55,9 @@ pub struct JobOptions {
     /// `None` the block to paste after the tool call, where the dialect
     /// tells them apart (Fanuc).
     pub program_number: Option<u32>,
+    /// The file the program [`verify`] reads came from, as messages show
+    /// it: named in the report and on the page.
+    pub program_file: Option<String>,
 }
 
 impl Default for JobOptions {
@@ -67,6 +70,7 @@ impl Default for JobOptions {
             step_tolerance: crate::step::DEFAULT_TOLERANCE,
             also_post: Vec::new(),
             program_number: None,
+            program_file: None,
         }
     }
 }
@@ -373,6 +377,7 @@ fn run_on(
         // Nothing to replay or draw: the report says which checks failed,
         // with every parameter.
         let mut report = Report::of_run(family, machine, info, &values, checks);
+        report.program_file = text.and(options.program_file.clone());
         report.verdict = Verdict::of(false, failed, Vec::new(), Vec::new());
         return Err(failed_run(report, Vec::new(), None));
     }
@@ -703,6 +708,7 @@ fn run_on(
         notes: toolpath.notes.clone(),
         tables: toolpath.tables.clone(),
         verdict: Verdict::of(requested_any, failures, warnings, figures),
+        program_file: text.and(options.program_file.clone()),
         ..Report::of_run(family, machine, info, &values, checks)
     };
     if let Some(w) = &worm {

@@ -277,7 +277,10 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
         MODEL_VIEWER.len() + inputs.scene.map_or(0, |s| s.0.len() * 4 / 3) + 200_000,
     );
     let title = format!(
-        "pilgrim: {} on {}{}",
+        "pilgrim: {}{} on {}{}",
+        r.program_file
+            .as_ref()
+            .map_or(String::new(), |f| format!("{f} verified against ")),
         r.script,
         r.machine,
         if r.verdict.failed() { " (FAILED)" } else { "" }
