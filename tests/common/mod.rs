@@ -103,12 +103,44 @@ pub fn pilgrim(args: &[&str]) -> (i32, String, String) {
 }
 
 /// A fresh scratch directory `pilgrim-<suite>-<pid>-<name>` for one test.
+/// The first call of a test process removes the scratch directories of
+/// test processes that have ended (their `<pid>` no longer runs), so that
+/// runs do not pile up their outputs in the temporary directory; a
+/// finished run's files stay until the next run, to be looked at.
 #[allow(dead_code)]
 pub fn scratch(suite: &str, name: &str) -> PathBuf {
+    static SWEPT: std::sync::Once = std::sync::Once::new();
+    SWEPT.call_once(remove_ended_scratch);
     let d = std::env::temp_dir().join(format!("pilgrim-{suite}-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
+}
+
+/// Removes the `pilgrim-<suite>-<pid>-<name>` directories (and the
+/// `.failed`, `.verify` beside them) whose process has ended: its pid is
+/// not in `/proc`. Nothing else is touched.
+fn remove_ended_scratch() {
+    let Ok(entries) = std::fs::read_dir(std::env::temp_dir()) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let Some(rest) = name.strip_prefix("pilgrim-") else {
+            continue;
+        };
+        // The first all-digit part is the pid (suites hold no digits).
+        let Some(pid) = rest
+            .split('-')
+            .find(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()))
+        else {
+            continue;
+        };
+        let is_dir = e.file_type().is_ok_and(|t| t.is_dir());
+        if is_dir && !Path::new("/proc").join(pid).exists() {
+            let _ = std::fs::remove_dir_all(e.path());
+        }
+    }
 }
 
 /// A path as the text an argument takes.
