@@ -16,7 +16,7 @@ use pilgrim_kernel::caliber::check_groove;
 use pilgrim_kernel::catalog::{Catalog, CompiledPlugin};
 use pilgrim_kernel::job::{self, JobOptions};
 use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
-use pilgrim_kernel::{PartFamily, Verification};
+use pilgrim_kernel::PartFamily;
 use std::hint::black_box;
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -47,7 +47,9 @@ fn caliber_job(c: &mut Criterion) {
     };
     let out = run();
     assert!(
-        out.groove.is_some() && out.files.len() >= 11,
+        out.check::<pilgrim_kernel::caliber::GrooveOutcome>()
+            .is_some()
+            && out.files.len() >= 11,
         "{} files",
         out.files.len()
     );
@@ -75,7 +77,10 @@ fn caliber_verify(c: &mut Criterion) {
     let machine = catalog.open("Mannesmann").unwrap();
     let family = family();
     let out = job::run(&family, &machine, &[], &JobOptions::default(), &mut |_| {}).unwrap();
-    let Some(Verification::Groove(req)) = family.verification(&out.params).unwrap() else {
+    let Some(req) = family.verification(&out.params).unwrap().and_then(|v| {
+        v.request::<pilgrim_kernel::caliber::GrooveRequest>()
+            .cloned()
+    }) else {
         panic!("the caliber asks for the groove's replay")
     };
     let pilgrim_kernel::ToolShape::Wheel(wheel) = out.toolpath.tool.shape else {

@@ -13,7 +13,7 @@ use pilgrim_kernel::catalog::{Catalog, CompiledPlugin};
 use pilgrim_kernel::job::{self, JobOptions};
 use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
 use pilgrim_kernel::worm::simulate;
-use pilgrim_kernel::{PartFamily, ToolShape, Verification};
+use pilgrim_kernel::{PartFamily, ToolShape};
 use std::hint::black_box;
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -44,7 +44,7 @@ fn worm_job(c: &mut Criterion) {
     };
     let out = run();
     assert!(
-        out.worm.is_some() && out.files.len() >= 12,
+        out.check::<pilgrim_kernel::worm::WormOutcome>().is_some() && out.files.len() >= 12,
         "{} files",
         out.files.len()
     );
@@ -59,7 +59,11 @@ fn worm_simulate(c: &mut Criterion) {
     let machine = catalog.open("fanuc-0i-tc").unwrap();
     let family = family();
     let out = job::run(&family, &machine, &[], &JobOptions::default(), &mut |_| {}).unwrap();
-    let Some(Verification::Worm(req)) = family.verification(&out.params).unwrap() else {
+    let Some(req) = family
+        .verification(&out.params)
+        .unwrap()
+        .and_then(|v| v.request::<pilgrim_kernel::worm::WormRequest>().cloned())
+    else {
         panic!("the worm asks for the simulation")
     };
     let ToolShape::ThreadCutter(cutter) = out.toolpath.tool.shape else {

@@ -7,9 +7,9 @@ use crate::common;
 
 use common::{pilgrim, pilgrim_in, root, s, scratch};
 use lz_250::CaliberKinematics;
-use pilgrim_kernel::caliber::{check_groove, Groove};
+use pilgrim_kernel::caliber::{check_groove, Groove, GrooveRequest};
 use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
-use pilgrim_kernel::{PartFamily, Verification};
+use pilgrim_kernel::PartFamily;
 use std::path::Path;
 
 const SCRIPT: &str = "scripts/caliber.rhai";
@@ -388,7 +388,11 @@ fn the_sizing_section_is_held_through_the_smoothing() {
     let fam =
         ScriptFamily::load(&root().join(SCRIPT), &Limits::default(), &Access::default()).unwrap();
     let values = common::params_from(&fam, &Default::default(), None, &[]);
-    let Some(Verification::Groove(req)) = fam.verification(&values).unwrap() else {
+    let Some(req) = fam
+        .verification(&values)
+        .unwrap()
+        .and_then(|v| v.request::<GrooveRequest>().cloned())
+    else {
         panic!("the caliber asks for the groove's replay")
     };
     let t = pilgrim_kernel::profile::read_table(root().join("scripts/caliber-groove.csv")).unwrap();
@@ -452,7 +456,11 @@ fn the_verification_measures_the_groove_asked_for() {
         ),
     ] {
         let values = common::params_from(&fam, &Default::default(), None, &sets);
-        let Some(Verification::Groove(req)) = fam.verification(&values).unwrap() else {
+        let Some(req) = fam
+            .verification(&values)
+            .unwrap()
+            .and_then(|v| v.request::<GrooveRequest>().cloned())
+        else {
             panic!("the caliber asks for the groove's replay")
         };
         assert_eq!(req.groove.interpolation(), interpolation, "{sets:?}");
@@ -488,7 +496,11 @@ fn a_corrupted_block_is_named() {
     );
     let tp = fam.toolpath(&values).unwrap();
     let mut program = pilgrim_kernel::program::build(&tp, &machine, "caliber").unwrap();
-    let Some(Verification::Groove(req)) = fam.verification(&values).unwrap() else {
+    let Some(req) = fam
+        .verification(&values)
+        .unwrap()
+        .and_then(|v| v.request::<GrooveRequest>().cloned())
+    else {
         panic!("the caliber asks for the groove's replay")
     };
     let pilgrim_kernel::ToolShape::Wheel(wheel) = tp.tool.shape else {

@@ -39,29 +39,173 @@ pub struct VerifyRequest {
     pub blank: Option<Box<Profile>>,
 }
 
-/// What a family's finished part must be, for the job's replay.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Verification {
-    /// A body of revolution ground by a wheel: the axial section.
-    Profile(VerifyRequest),
-    /// A caliber's groove ground by a torus wheel, replayed in 3-D.
-    Groove(Box<crate::caliber::GrooveRequest>),
-    /// A worm's thread cut in passes, simulated in the axial section.
-    Worm(Box<crate::worm::WormRequest>),
-}
+/// What a family's finished part must be, for the job's replay: a
+/// request of the family's own kind ([`Verifier`]), which replays a
+/// program and says what it found. The run knows no kind by name.
+#[derive(Debug)]
+pub struct Verification(Box<dyn Verifier>);
 
 impl Verification {
+    /// The verification `request` asks for.
+    pub fn new(request: impl Verifier + 'static) -> Self {
+        Self(Box::new(request))
+    }
+
+    /// The request, as its own type (`None` if it is of another kind).
+    pub fn request<T: 'static>(&self) -> Option<&T> {
+        self.0.as_any().downcast_ref()
+    }
+
     /// The axial-section request, if this is one.
     pub fn into_profile(self) -> Option<VerifyRequest> {
-        match self {
-            Self::Profile(v) => Some(v),
-            Self::Groove(_) | Self::Worm(_) => None,
-        }
+        self.request::<VerifyRequest>().cloned()
+    }
+
+    /// The verifier.
+    pub fn verifier(&self) -> &dyn Verifier {
+        self.0.as_ref()
     }
 }
 
+/// What a verification replays: the program as its control reads it, on
+/// the machine the run uses, with the family's tool, in its passes.
+pub struct ReplayContext<'a> {
+    /// The family's name, for messages.
+    pub family: &'a str,
+    /// The program, read as written.
+    pub program: &'a crate::program::AxisProgram,
+    /// The machine (its constants as the run set them).
+    pub machine: &'a dyn crate::machine::MachineKinematics,
+    /// The family's tool.
+    pub tool: &'a crate::tool::Tool,
+    /// The program's passes.
+    pub passes: &'a [crate::program::ProgramPass],
+}
+
+/// A family's request for a verification of its own kind: the replay it
+/// makes of a program.
+pub trait Verifier: std::fmt::Debug {
+    /// Replays `ctx`'s program: the outcome, and the material as the replay
+    /// left it (for the process's rules), where it knows it.
+    ///
+    /// # Failures
+    /// The replay failing; a tool of the wrong kind
+    /// ([`crate::replay::VerifyError::Replay`], naming what it needs).
+    fn verify(&self, ctx: &ReplayContext<'_>) -> Result<Verified, crate::replay::VerifyError>;
+
+    /// The request as [`std::any::Any`], for callers that know its type.
+    fn as_any(&self) -> &dyn std::any::Any;
+}
+
+/// What a verification found and the material it knows.
+pub struct Verified {
+    /// Its outcome.
+    pub outcome: Box<dyn Outcome>,
+    /// The material after each pass, for the process's rules.
+    pub stock: Option<Box<dyn crate::process::Stock>>,
+}
+
+/// The extra files of a verification: what it draws.
+pub struct FilesContext<'a> {
+    /// The replay's context.
+    pub replay: ReplayContext<'a>,
+    /// The part's bodies (of revolution, for the profile's picture).
+    pub parts: &'a [PartBody],
+}
+
+/// What a verification found, as the run uses it: figures and failures
+/// for the verdict, its entry in the report, and its own files, bodies and
+/// overlays.
+pub trait Outcome: std::fmt::Debug + Send + Sync {
+    /// Its key in `report.json` (one per kind: `verification`,
+    /// `groove_verification`, ...).
+    fn key(&self) -> &'static str;
+    /// Its entry in `report.json`.
+    ///
+    /// # Failures
+    /// The outcome not serialisable.
+    fn to_json(&self) -> Result<serde_json::Value, String>;
+    /// The verdict's figures, and what failed, over `program` (as read).
+    fn findings(
+        &self,
+        program: &crate::program::AxisProgram,
+    ) -> (Vec<crate::verdict::Figure>, Vec<crate::verdict::Finding>);
+    /// What the run's one-line summary says of it (from `, `).
+    fn summary(&self) -> String;
+    /// The outcome as [`std::any::Any`], for callers that know its type.
+    fn as_any(&self) -> &dyn std::any::Any;
+    /// A copy.
+    fn clone_box(&self) -> Box<dyn Outcome>;
+    /// A mesh to show at block `block` (from 0) in the scene, recording
+    /// what it shows in the outcome (the caliber's contact patch).
+    ///
+    /// # Failures
+    /// The replay failing at the block.
+    fn at_pose(
+        &mut self,
+        _ctx: &ReplayContext<'_>,
+        _block: usize,
+    ) -> Result<Option<crate::mesh::TriMesh>, crate::replay::VerifyError> {
+        Ok(None)
+    }
+    /// Bodies the verification made (the worm's finished solid), meshed
+    /// within `mesh_tolerance`, their exact sections within
+    /// `step_tolerance`.
+    ///
+    /// # Failures
+    /// A body whose mesh fails.
+    fn bodies(
+        &self,
+        _mesh_tolerance: f64,
+        _step_tolerance: f64,
+    ) -> Result<Vec<PartBody>, crate::mesh::SceneError> {
+        Ok(Vec::new())
+    }
+    /// Whether its files come before the family's own charts (the worm's
+    /// pass table and picture lead its page), else after them.
+    fn leads_charts(&self) -> bool {
+        false
+    }
+    /// Adds what the replay found to the family's tables (name to columns).
+    fn extend_tables(
+        &self,
+        _tables: &mut std::collections::BTreeMap<
+            String,
+            std::collections::BTreeMap<String, Vec<f64>>,
+        >,
+    ) {
+    }
+    /// Its files (name, bytes): plots and tables, in order.
+    ///
+    /// # Failures
+    /// A file that cannot be drawn or written, said.
+    fn files(
+        &self,
+        _ctx: &FilesContext<'_>,
+        _tables: &std::collections::BTreeMap<String, std::collections::BTreeMap<String, Vec<f64>>>,
+    ) -> Result<Vec<(String, Vec<u8>)>, String> {
+        Ok(Vec::new())
+    }
+}
+
+impl Clone for Box<dyn Outcome> {
+    fn clone(&self) -> Self {
+        self.clone_box()
+    }
+}
+
+/// A kind of verification as the report page shows it: its key in
+/// `report.json` and the page's section drawn from that entry.
+pub struct OutcomeKind {
+    /// The key.
+    pub key: &'static str,
+    /// The section's HTML from the entry (`control`: the program's dialect,
+    /// for naming blocks).
+    pub section: fn(&serde_json::Value, &str) -> Result<String, String>,
+}
+
 /// The geometry of one of a part's bodies.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub enum PartGeometry {
     /// A body of revolution about Z of this profile `x(z)`.
     Revolution(Profile),
@@ -71,7 +215,7 @@ pub enum PartGeometry {
 }
 
 /// A body swept through its sections, meshed and exact.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct Swept {
     /// Its closed mesh in the part frame (mm).
     pub mesh: TriMesh,
@@ -79,36 +223,51 @@ pub struct Swept {
     pub body: SweptBody,
 }
 
-/// The bodies swept through their sections that families make.
-#[derive(Debug, Clone, PartialEq)]
-pub enum SweptBody {
-    /// The caliber's roll with its groove.
-    Roll(Box<crate::caliber::Roll>),
-    /// A finished worm.
-    Worm(crate::worm::WormSweep),
+/// A body swept through its sections, as the STEP writer fits it: what a
+/// family's body that is not of revolution gives (the caliber's roll, a
+/// finished worm).
+pub trait SweptSolid: std::fmt::Debug + Send + Sync {
+    /// Its sections, as the STEP writer fits them.
+    fn sections(&self) -> &dyn crate::step::Sections;
+    /// How far (mm) its sections already stray from the body they stand
+    /// for (a worm's outline simplified; 0 where they are exact).
+    fn simplified(&self) -> crate::math::Real {
+        0.0
+    }
+    /// A copy.
+    fn clone_box(&self) -> Box<dyn SweptSolid>;
 }
 
+/// A family's body swept through its sections.
+#[derive(Debug)]
+pub struct SweptBody(Box<dyn SweptSolid>);
+
 impl SweptBody {
+    /// The body `solid`.
+    pub fn new(solid: impl SweptSolid + 'static) -> Self {
+        Self(Box::new(solid))
+    }
+
     /// Its sections, as the STEP writer fits them.
     pub fn sections(&self) -> &dyn crate::step::Sections {
-        match self {
-            Self::Roll(r) => r.as_ref(),
-            Self::Worm(w) => w,
-        }
+        self.0.sections()
     }
 
     /// How far (mm) its sections already stray from the body they stand
-    /// for (a worm's outline simplified; 0 for the roll).
+    /// for.
     pub fn simplified(&self) -> crate::math::Real {
-        match self {
-            Self::Roll(_) => 0.0,
-            Self::Worm(w) => w.simplified(),
-        }
+        self.0.simplified()
+    }
+}
+
+impl Clone for SweptBody {
+    fn clone(&self) -> Self {
+        Self(self.0.clone_box())
     }
 }
 
 /// One named body of the part (`part`, `blank`, ...), for 3-D export.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct PartBody {
     /// Its name: a plain name (letters, digits, `_`, `-`), which becomes a
     /// file name.

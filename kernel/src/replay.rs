@@ -53,6 +53,10 @@ pub enum VerifyError {
         /// What went wrong.
         source: ProfileError,
     },
+    /// The family's request does not fit what the run gives it (a
+    /// replay of a wheel given a cutter): the family's contract, said.
+    #[error("{0}")]
+    Contract(String),
     /// Nothing cuts.
     #[error("the program has no cutting pass")]
     NoCuttingPass,

@@ -10,7 +10,6 @@ use crate::math::{fixed, Real};
 use crate::params::ParamValue;
 use crate::program::{block_label, AxisProgram};
 use crate::toolpath::Motion;
-use crate::verify::GrindingCheck;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -80,16 +79,12 @@ pub struct Report {
     /// Each programmed axis's range over the program: [min, max] (mm, deg).
     #[serde(default)]
     pub axis_ranges: BTreeMap<String, [f64; 2]>,
-    /// The program replayed against the nominal part (families that ask).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub verification: Option<GrindingCheck>,
-    /// The caliber program replayed in 3-D against the groove (families
-    /// that ask).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub groove_verification: Option<crate::caliber::GrooveCheck>,
-    /// The worm's cut simulated pass by pass (families that ask).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub worm_verification: Option<crate::worm::WormCheck>,
+    /// What the family's verification found, under its kind's key
+    /// (`verification`, `groove_verification`, `worm_verification`: each
+    /// family's own entry, [`crate::family::Outcome::to_json`]), at the top
+    /// level of `report.json`.
+    #[serde(flatten)]
+    pub verifications: BTreeMap<String, serde_json::Value>,
     /// What the family warned of.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
@@ -169,9 +164,7 @@ impl Report {
             step_tolerance_mm: 0.0,
             solids: Vec::new(),
             axis_ranges: BTreeMap::new(),
-            verification: None,
-            groove_verification: None,
-            worm_verification: None,
+            verifications: BTreeMap::new(),
             warnings: Vec::new(),
             notes: BTreeMap::new(),
             tables: BTreeMap::new(),

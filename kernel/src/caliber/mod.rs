@@ -27,6 +27,7 @@
 
 mod check;
 mod groove;
+mod outcome;
 mod pass;
 mod patch;
 mod plots;
@@ -41,6 +42,7 @@ pub use check::{
     NEIGHBOUR_PASSES,
 };
 pub use groove::{Groove, GrooveError};
+pub use outcome::{GrooveOutcome, KIND};
 pub use pass::{pass_poses, pose_at, step_over, PassPose, SwivelPlane, MAX_PASS_BLOCKS};
 pub use patch::{contact_patch, ContactPatch};
 pub use plots::{deviation_map_svg, section_svg};

@@ -354,3 +354,13 @@ fn max(t: &crate::profile::Profile) -> Real {
 fn min(t: &crate::profile::Profile) -> Real {
     t.x().iter().copied().fold(Real::INFINITY, Real::min)
 }
+
+impl crate::family::SweptSolid for Roll {
+    fn sections(&self) -> &dyn crate::step::Sections {
+        self
+    }
+
+    fn clone_box(&self) -> Box<dyn crate::family::SweptSolid> {
+        Box::new(self.clone())
+    }
+}

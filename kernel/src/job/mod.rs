@@ -23,14 +23,12 @@ pub use solids::SolidFile;
 
 use crate::catalog::OpenMachine;
 use crate::error::Error;
-use crate::family::{PartFamily, PartGeometry, Verification};
+use crate::family::{FilesContext, Outcome, PartFamily, ReplayContext};
 use crate::params::{resolve, ParamSource, ParamValue, Params};
 use crate::program::post::{dialect, CLD};
 use crate::program::{build, AxisProgram};
-use crate::tool::ToolShape;
 use crate::toolpath::Toolpath;
 use crate::verdict::{Finding, Verdict};
-use crate::verify::{replay_grinding, GrindingCheck};
 use serde::Serialize;
 
 /// How a run makes its outputs.
@@ -93,12 +91,9 @@ pub struct JobOutput {
     pub toolpath: Toolpath,
     /// The axis program.
     pub program: AxisProgram,
-    /// The program replayed against the nominal, if the family asked.
-    pub verification: Option<GrindingCheck>,
-    /// The caliber program replayed in 3-D, if the family asked.
-    pub groove: Option<crate::caliber::GrooveCheck>,
-    /// The worm's cut simulated, if the family asked.
-    pub worm: Option<crate::worm::WormCheck>,
+    /// What the family's verification found, if it asked for one (its
+    /// own type: [`JobOutput::check`]).
+    pub outcome: Option<Box<dyn Outcome>>,
     /// The report.
     pub report: Report,
     /// Every file's name and bytes, in the order they were made.
@@ -106,45 +101,21 @@ pub struct JobOutput {
 }
 
 impl JobOutput {
+    /// The verification's outcome as its own type (`None` if the family
+    /// asked for none, or for one of another kind): e.g.
+    /// `out.check::<crate::verify::GrindingOutcome>()`.
+    pub fn check<T: 'static>(&self) -> Option<&T> {
+        self.outcome.as_ref()?.as_any().downcast_ref()
+    }
+
     /// One line saying what the run made: passes, blocks, machine, cycle
     /// time and the verified finish.
     pub fn summary(&self) -> String {
         let r = &self.report;
         let verified = self
-            .verification
+            .outcome
             .as_ref()
-            .and_then(|v| v.passes.last())
-            .map(|p| {
-                format!(
-                    ", finish within {} mm of nominal",
-                    crate::math::fixed(p.deviation.max_abs, 5)
-                )
-            })
-            .or_else(|| {
-                self.groove.as_ref().map(|g| {
-                    format!(
-                        ", groove within {} mm of nominal (material left {} mm, gouge {} mm)",
-                        crate::math::fixed(g.max_abs_mm, 5),
-                        crate::math::fixed(g.max_left.mm, 5),
-                        crate::math::fixed(g.max_gouge.mm, 5)
-                    )
-                })
-            })
-            .or_else(|| {
-                self.worm.as_ref().map(|w| {
-                    let form = w
-                        .starts
-                        .iter()
-                        .map(|s| s.left_form.abs().max(s.right_form.abs()))
-                        .fold(0.0, f64::max);
-                    format!(
-                        ", thread within tolerance (flank form {} mm; chips {:.2} of {:.2} mm^2 of space)",
-                        crate::math::fixed(form, 4),
-                        w.removed_area,
-                        w.space_area
-                    )
-                })
-            })
+            .map(|o| o.summary())
             .unwrap_or_default();
         format!(
             "{}: {} cutting passes ({} in all), {} blocks for {} ({}), about {:.1} min{verified}",
@@ -461,92 +432,36 @@ fn run_on(
     if options.pose_block == Some(0) {
         return Err(Error::Options("--pose-block counts blocks from 1".into()));
     }
-    let needs_wheel = || {
-        Error::Family(crate::family::FamilyError::Contract {
-            family: family.name().to_owned(),
-            message: "fn verify(p) needs a grinding wheel".into(),
-        })
+    let replay_ctx = ReplayContext {
+        family: family.name(),
+        program: &verified,
+        machine: kin,
+        tool: &toolpath.tool,
+        passes: &passes,
     };
-    let (nominal, groove_request, worm_request) = match requested {
-        None => (None, None, None),
-        Some(Verification::Profile(v)) => (Some(v), None, None),
-        Some(Verification::Groove(g)) => (None, Some(g), None),
-        Some(Verification::Worm(w)) => (None, None, Some(w)),
+    // The family's verification, of whatever kind: the replay of the
+    // program as written, and the material as it left it.
+    let contract = |e: crate::replay::VerifyError| match e {
+        crate::replay::VerifyError::Contract(message) => {
+            Error::Family(crate::family::FamilyError::Contract {
+                family: family.name().to_owned(),
+                message,
+            })
+        }
+        e => e.into(),
     };
-    // The material as each verification knows it, for the process's
-    // rules.
-    let mut stock: Option<Box<dyn crate::process::Stock>> = None;
-    // The worm's cut, simulated pass by pass from the program as written.
-    let worm = match &worm_request {
-        None => None,
+    let (mut outcome, stock) = match &requested {
+        None => (None, None),
         Some(r) => {
-            let ToolShape::ThreadCutter(c) = toolpath.tool.shape else {
-                return Err(Error::Family(crate::family::FamilyError::Contract {
-                    family: family.name().to_owned(),
-                    message: "fn verify(p) of a worm needs a thread cutter".into(),
-                }));
-            };
-            let check = crate::worm::simulate(&verified, kin, &toolpath.tool.reference, &c, r)?;
-            stock = Some(Box::new(crate::worm::WormStock::new(&check, r, &c)));
-            Some(check)
-        }
-    };
-    // The caliber's replay.
-    let mut groove = match &groove_request {
-        None => None,
-        Some(g) => {
-            let ToolShape::Wheel(wheel) = toolpath.tool.shape else {
-                return Err(needs_wheel());
-            };
-            if let Some(allowance) = g.stock {
-                stock = Some(Box::new(crate::caliber::GrooveStock::new(
-                    g, allowance, &wheel, &passes,
-                )));
-            }
-            Some(crate::caliber::check_groove(
-                &verified,
-                kin,
-                &toolpath.tool.reference,
-                &wheel,
-                &passes,
-                g,
-            )?)
-        }
-    };
-    let verification = match &nominal {
-        None => None,
-        Some(v) => {
-            let ToolShape::Wheel(w) = toolpath.tool.shape else {
-                return Err(needs_wheel());
-            };
-            let (check, ground) = replay_grinding(
-                &verified,
-                kin,
-                &toolpath.tool.reference,
-                &w,
-                &passes,
-                &v.profile,
-                v.blank.as_deref(),
-                (v.from, v.to),
-                v.tolerance,
-            )?;
-            if let Some(g) = ground {
-                stock = Some(Box::new(g));
-            }
-            Some(check)
+            let v = r.verifier().verify(&replay_ctx).map_err(contract)?;
+            (Some(v.outcome), v.stock)
         }
     };
     // What the verification found: its figures, and what failed.
     let mut figures = Vec::new();
     let mut failures = Vec::new();
-    for (f, x) in [
-        verification.as_ref().map(|v| v.findings(&verified)),
-        groove.as_ref().map(|g| g.findings()),
-        worm.as_ref().map(|w| w.findings()),
-    ]
-    .into_iter()
-    .flatten()
-    {
+    if let Some(o) = &outcome {
+        let (f, x) = o.findings(&verified);
         figures.extend(f);
         failures.extend(x);
     }
@@ -583,22 +498,11 @@ fn run_on(
         (None, None) => default_pose_block(&verified, &passes),
     };
     let pose_index = pose_place.block;
-    // The caliber's contact patch at the scene's block (in the report, and
-    // its mesh in the scene).
-    let patch_mesh = match (&mut groove, &groove_request, toolpath.tool.shape) {
-        (Some(check), Some(g), ToolShape::Wheel(wheel)) => crate::caliber::contact_patch(
-            &crate::replay::as_written(&verified).0,
-            kin,
-            &toolpath.tool.reference,
-            &wheel,
-            g,
-            pose_index,
-        )?
-        .map(|(p, m)| {
-            check.patch = Some(p);
-            m
-        }),
-        _ => None,
+    // What the verification shows at the scene's block (the caliber's
+    // contact patch: in the report, and its mesh in the scene).
+    let overlay = match &mut outcome {
+        Some(o) => o.at_pose(&replay_ctx, pose_index).map_err(contract)?,
+        None => None,
     };
     // A run that failed writes no program a control could load.
     let programs = match posted {
@@ -630,26 +534,9 @@ fn run_on(
         }));
     }
     let tol = options.mesh_tolerance;
-    // The finished worm: the simulated section swept along the helix.
-    if let (Some(w), Some(r)) = (&worm, &worm_request) {
-        let mesh_error = |source| {
-            Error::Scene(SceneError::Mesh {
-                body: "worm".into(),
-                source,
-            })
-        };
-        let mesh = crate::worm::worm_solid(w, r.length, tol).map_err(mesh_error)?;
-        // A quarter of the STEP tolerance for merging the outline's points,
-        // the rest for the fit.
-        let body = crate::worm::WormSweep::new(w, r.length, options.step_tolerance / 4.0)
-            .map_err(mesh_error)?;
-        parts.push(crate::family::PartBody {
-            name: "worm".into(),
-            geometry: PartGeometry::Swept(Box::new(crate::family::Swept {
-                mesh,
-                body: crate::family::SweptBody::Worm(body),
-            })),
-        });
+    // Bodies the verification made (the finished worm).
+    if let Some(o) = &outcome {
+        parts.extend(o.bodies(tol, options.step_tolerance)?);
     }
     let (pose_block, bodies, solids, part_box) = if parts.is_empty() {
         (None, vec![], vec![], None)
@@ -664,7 +551,7 @@ fn run_on(
         let pose = scene::tool_pose(&program, kin, &toolpath.tool, pose_place)?;
         let tool = scene::tool_mesh(&toolpath.tool, &pose, tol)?;
         let others = scene::machine_bodies(kin, &program, pose_place, tol)?;
-        let overlays = patch_mesh
+        let overlays = overlay
             .map(|m| ("contact_patch".to_owned(), m, crate::math::Mat4::identity()))
             .into_iter()
             .collect();
@@ -701,9 +588,12 @@ fn run_on(
         step_tolerance_mm: options.step_tolerance,
         solids,
         axis_ranges: axis_ranges(&program),
-        verification: verification.clone(),
-        groove_verification: groove.clone(),
-        worm_verification: worm.clone(),
+        verifications: match &outcome {
+            Some(o) => {
+                std::iter::once((o.key().to_owned(), o.to_json().map_err(Error::Output)?)).collect()
+            }
+            None => Default::default(),
+        },
         warnings: toolpath.warnings.clone(),
         notes: toolpath.notes.clone(),
         tables: toolpath.tables.clone(),
@@ -711,36 +601,24 @@ fn run_on(
         program_file: text.and(options.program_file.clone()),
         ..Report::of_run(family, machine, info, &values, checks)
     };
-    if let Some(w) = &worm {
-        // The simulated areas beside the plan's, row for row, where the
-        // family's "passes" table has one row per thread block.
-        if let Some(t) = report.tables.get_mut("passes") {
-            if t.values().all(|c| c.len() == w.passes.len()) && !t.is_empty() {
-                t.insert(
-                    "simulated_area".into(),
-                    w.passes.iter().map(|p| p.chip_area).collect(),
-                );
-                t.insert(
-                    "left_area".into(),
-                    w.passes.iter().map(|p| p.left_area).collect(),
-                );
-                t.insert(
-                    "right_area".into(),
-                    w.passes.iter().map(|p| p.right_area).collect(),
-                );
-                t.insert(
-                    "block".into(),
-                    w.passes.iter().map(|p| p.block as f64).collect(),
-                );
+    // The verification's own files: the tables it adds to, then its
+    // plots (before the family's charts where it leads them, else after).
+    let mut later = Vec::new();
+    if let Some(o) = &outcome {
+        o.extend_tables(&mut report.tables);
+        let ctx = FilesContext {
+            replay: ReplayContext { ..replay_ctx },
+            parts: &parts,
+        };
+        let made = o.files(&ctx, &report.tables).map_err(Error::Output)?;
+        if o.leads_charts() {
+            for (name, bytes) in made {
+                report.files.push(name.clone());
+                files.push((name, bytes));
             }
+        } else {
+            later = made;
         }
-        let table =
-            crate::worm::worm_pass_table(w, report.tables.get("passes")).map_err(Error::Output)?;
-        files.push(("passes.csv".into(), table.into_bytes()));
-        report.files.push("passes.csv".into());
-        let svg = crate::worm::worm_passes_svg(w).map_err(Error::Output)?;
-        files.push(("passes.svg".into(), svg.into_bytes()));
-        report.files.push("passes.svg".into());
     }
     let charted = Toolpath {
         tables: report.tables.clone(),
@@ -754,16 +632,7 @@ fn run_on(
             })
         })?;
         let name = format!("{}.svg", plot.file);
-        let reserved = [
-            "profile.svg",
-            "passes.svg",
-            "deviation.svg",
-            "finish.svg",
-            "stock.svg",
-            "deviation_map.svg",
-            "section.svg",
-        ];
-        if files.iter().any(|f| f.0 == name) || reserved.contains(&name.as_str()) {
+        if files.iter().chain(&later).any(|f| f.0 == name) {
             return Err(Error::Family(crate::family::FamilyError::Contract {
                 family: family.name().to_owned(),
                 message: format!("plot {}: a file of that name is written already", plot.file),
@@ -772,45 +641,9 @@ fn run_on(
         files.push((name.clone(), text.into_bytes()));
         report.files.push(name);
     }
-    if let (Some(v), ToolShape::Wheel(w)) = (&nominal, toolpath.tool.shape) {
-        let profiles: Vec<(String, crate::profile::Profile)> = parts
-            .iter()
-            .filter_map(|b| match &b.geometry {
-                PartGeometry::Revolution(p) => Some((b.name.clone(), p.clone())),
-                PartGeometry::Swept(_) => None,
-            })
-            .collect();
-        let text = crate::verify::profile_svg(
-            &profiles,
-            &verified,
-            &passes,
-            kin,
-            &toolpath.tool.reference,
-            &v.profile,
-            w.rounding_radius,
-        )
-        .map_err(|e| Error::Scene(SceneError::Place(e)))?;
-        files.push(("profile.svg".into(), text.into_bytes()));
-        report.files.push("profile.svg".into());
-    }
-    if let (Some(v), Some(n)) = (&verification, &nominal) {
-        // The surface before the first pass: the blank the replay cut into.
-        let start = |z: f64| Some(n.blank.as_deref()?.eval(z).ok()? - n.profile.eval(z).ok()?);
-        for (name, text) in crate::verify::deviation_svgs(v, start).map_err(Error::Output)? {
-            files.push((name.clone(), text.into_bytes()));
-            report.files.push(name);
-        }
-    }
-    if let (Some(g), Some(req), ToolShape::Wheel(w)) =
-        (&groove, &groove_request, toolpath.tool.shape)
-    {
-        let map = crate::caliber::deviation_map_svg(g).map_err(Error::Output)?;
-        let section =
-            crate::caliber::section_svg(g, req, w.rounding_radius).map_err(Error::Output)?;
-        for (name, text) in [("deviation_map.svg", map), ("section.svg", section)] {
-            files.push((name.into(), text.into_bytes()));
-            report.files.push(name.into());
-        }
+    for (name, bytes) in later {
+        report.files.push(name.clone());
+        files.push((name, bytes));
     }
     if report.verdict.failed() {
         return Err(failed_run(report, files, part_box));
@@ -823,9 +656,7 @@ fn run_on(
         params: values,
         toolpath,
         program,
-        verification,
-        groove,
-        worm,
+        outcome,
         report,
         files,
     })

@@ -28,21 +28,7 @@ pub const VIEWER: &str = "@google/model-viewer 4.4.0";
 const HEAD_LINES: usize = 30;
 const TAIL_LINES: usize = 12;
 
-/// Escapes text for HTML (element content and quoted attributes).
-fn escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&#39;"),
-            c => out.push(c),
-        }
-    }
-    out
-}
+use crate::html::{escape, row};
 
 /// What the page is made of besides the report.
 pub struct PageInputs<'a> {
@@ -57,151 +43,24 @@ pub struct PageInputs<'a> {
     pub scene: Option<(&'a [u8], [f64; 3], [f64; 3])>,
 }
 
-/// A table row of cells (already escaped).
-fn row(out: &mut String, cells: &[String]) {
-    out.push_str("<tr>");
-    for c in cells {
-        let _ = write!(out, "<td>{c}</td>");
-    }
-    out.push_str("</tr>\n");
-}
-
-/// The verification's figures, and where the worst is.
+/// The verification's figures, and where the worst is: each entry of the
+/// report drawn by its kind ([`crate::families`]); an entry of a kind the
+/// kernel does not carry has its figures in the verdict only.
 fn verification(out: &mut String, r: &Report) {
-    if let Some(v) = &r.verification {
-        let _ = write!(
-            out,
-            "<h2>Verification: the program replayed</h2>\n<p>Tolerance {} mm; {} generatrices; values read at {} mm as written.</p>\n",
-            fixed(v.tolerance, 4),
-            v.generatrices,
-            fixed(v.resolution_mm, 4)
-        );
-        if let Some(f) = v.passes.last() {
-            // The block counts from 1 (the program's and report.csv's).
-            let block = f.deviation.block.map_or_else(String::new, |b| {
-                format!(
-                    ", {}",
-                    escape(&crate::program::block_label(&r.control, b - 1))
-                )
-            });
-            let _ = writeln!(
-                out,
-                "<p class=\"verdict\">Finish ({}) within <b>{} mm</b> of the nominal; the worst at z = {} mm{block}.</p>",
-                escape(&f.name),
-                fixed(f.deviation.max_abs, 5),
-                fixed(f.deviation.at_z, 3)
-            );
+    for (key, entry) in &r.verifications {
+        if let Some(kind) = crate::families::kind(key) {
+            match (kind.section)(entry, &r.control) {
+                Ok(html) => out.push_str(&html),
+                Err(e) => {
+                    let _ = writeln!(
+                        out,
+                        "<p>The {} entry could not be read: {}</p>",
+                        escape(key),
+                        escape(&e)
+                    );
+                }
+            }
         }
-        out.push_str("<table><tr><th>pass</th><th>feed, mm/min</th><th>feed a rev, mm</th><th>ridge, um</th><th>highest, um (z)</th><th>lowest, um (z)</th></tr>\n");
-        for p in &v.passes {
-            row(
-                out,
-                &[
-                    escape(&p.name),
-                    fixed(p.feed_mm_min, 1),
-                    fixed(p.feed_per_rev_mm, 3),
-                    fixed(p.ridge_mm * 1e3, 2),
-                    format!(
-                        "{} ({})",
-                        fixed(p.deviation.max_above * 1e3, 2),
-                        fixed(p.deviation.above_z, 2)
-                    ),
-                    format!(
-                        "{} ({})",
-                        fixed(p.deviation.max_below * 1e3, 2),
-                        fixed(p.deviation.below_z, 2)
-                    ),
-                ],
-            );
-        }
-        out.push_str("</table>\n");
-    }
-    if let Some(g) = &r.groove_verification {
-        let place = |p: &crate::caliber::GroovePlace| {
-            format!(
-                "{} mm at theta {} deg, psi {} deg ({})",
-                fixed(p.mm, 5),
-                fixed(p.theta_deg, 2),
-                fixed(p.psi_deg, 2),
-                escape(&p.block)
-            )
-        };
-        let _ = write!(
-            out,
-            "<h2>Verification: the groove replayed in 3-D</h2>\n<p class=\"verdict\">Within <b>{} mm</b> of the groove (tolerance {} mm), edge to edge (psi {} to {} deg), on {} samples.</p>\n<table>\n",
-            fixed(g.max_abs_mm, 5),
-            fixed(g.tolerance, 4),
-            fixed(g.psi_range_deg[0], 0),
-            fixed(g.psi_range_deg[1], 0),
-            g.samples
-        );
-        row(out, &["most material left".into(), place(&g.max_left)]);
-        row(out, &["deepest gouge".into(), place(&g.max_gouge)]);
-        row(
-            out,
-            &[
-                "deepest cut into the periphery beside it".into(),
-                format!(
-                    "{}, {} mm beyond the edge",
-                    place(&g.periphery_cut),
-                    fixed(g.periphery_cut.beyond_edge_mm, 3)
-                ),
-            ],
-        );
-        out.push_str("</table>\n");
-    }
-    if let Some(w) = &r.worm_verification {
-        let _ = write!(
-            out,
-            "<h2>Verification: the thread cut simulated</h2>\n<p class=\"verdict\">Chips {} of {} mm<sup>2</sup> of space; flank loads {} / {} mm<sup>2</sup>; lead error {} mm.</p>\n",
-            fixed(w.removed_area, 3),
-            fixed(w.space_area, 3),
-            fixed(w.flank_loads[0], 1),
-            fixed(w.flank_loads[1], 1),
-            fixed(w.lead_error, 5)
-        );
-        let worst = |f: fn(&crate::worm::SimulatedPass) -> f64| {
-            w.passes
-                .iter()
-                .max_by(|a, b| f(a).total_cmp(&f(b)))
-                .map_or_else(String::new, |p| {
-                    format!("{}% ({})", fixed(100.0 * f(p), 3), escape(&p.name))
-                })
-        };
-        let _ = writeln!(
-            out,
-            "<p>The lead where each pass's cutting edges meet the worm's face (S1 from the edges): at most {}; where they leave its far end (S2): at most {}; allowed {}%.</p>",
-            worst(|p| p.face_lead_error),
-            worst(|p| p.end_lead_error),
-            fixed(100.0 * w.tolerances.lead, 3)
-        );
-        out.push_str("<table><tr><th>start</th><th>flank angles, deg</th><th>form, um</th><th>thickness, mm</th><th>root / tip, mm</th><th>place, um</th></tr>\n");
-        for s in &w.starts {
-            row(
-                out,
-                &[
-                    s.start.to_string(),
-                    format!(
-                        "{} / {}",
-                        fixed(s.left_angle_deg, 4),
-                        fixed(s.right_angle_deg, 4)
-                    ),
-                    format!(
-                        "{} / {}",
-                        fixed(s.left_form * 1e3, 2),
-                        fixed(s.right_form * 1e3, 2)
-                    ),
-                    fixed(s.thickness, 4),
-                    format!(
-                        "{} / {}",
-                        fixed(s.root_diameter, 3),
-                        fixed(s.tip_diameter, 3)
-                    ),
-                    fixed(s.position_error * 1e3, 2),
-                ],
-            );
-        }
-        out.push_str("</table>\n");
     }
 }
 

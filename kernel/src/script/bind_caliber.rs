@@ -291,7 +291,7 @@ pub mod caliber_api {
         let mesh = kernel(roll.mesh(tol))?;
         Ok(Solid {
             mesh,
-            body: crate::family::SweptBody::Roll(Box::new(roll)),
+            body: crate::family::SweptBody::new(roll),
         })
     }
 

@@ -730,24 +730,22 @@ impl PartFamily for ScriptFamily {
                     ))
                 })
             };
-            return Ok(Some(Verification::Worm(Box::new(
-                crate::worm::WormRequest {
-                    sizes,
-                    length: num("length")?,
-                    space_centre: num("space_centre")?,
-                    tolerances: crate::worm::WormTolerances {
-                        form: tnum("form")?,
-                        thickness: tnum("thickness")?,
-                        diameter: tnum("diameter")?,
-                        position: tnum("position")?,
-                        flank_angle: tnum("flank_angle_deg")?.to_radians(),
-                        lead: match t.get("lead") {
-                            None => crate::worm::LEAD_ERROR,
-                            Some(_) => tnum("lead")?,
-                        },
+            return Ok(Some(Verification::new(crate::worm::WormRequest {
+                sizes,
+                length: num("length")?,
+                space_centre: num("space_centre")?,
+                tolerances: crate::worm::WormTolerances {
+                    form: tnum("form")?,
+                    thickness: tnum("thickness")?,
+                    diameter: tnum("diameter")?,
+                    position: tnum("position")?,
+                    flank_angle: tnum("flank_angle_deg")?.to_radians(),
+                    lead: match t.get("lead") {
+                        None => crate::worm::LEAD_ERROR,
+                        Some(_) => tnum("lead")?,
                     },
                 },
-            ))));
+            })));
         }
         if let Some(g) = m.get("groove") {
             let groove = g
@@ -764,22 +762,20 @@ impl PartFamily for ScriptFamily {
                     "fn verify(p): grid_per_step = {per} must be from 1 to 1000"
                 )));
             }
-            return Ok(Some(Verification::Groove(Box::new(
-                crate::caliber::GrooveRequest {
-                    groove,
-                    psi: psi.to_vec(),
-                    tolerance: num("tolerance")?,
-                    grid_theta: num("grid_theta")?,
-                    grid_per_step: per as usize,
-                    patch_gap: num("patch_gap")?,
-                    stock: match m.get("stock") {
-                        None => None,
-                        Some(_) => Some(num("stock")?),
-                    },
+            return Ok(Some(Verification::new(crate::caliber::GrooveRequest {
+                groove,
+                psi: psi.to_vec(),
+                tolerance: num("tolerance")?,
+                grid_theta: num("grid_theta")?,
+                grid_per_step: per as usize,
+                patch_gap: num("patch_gap")?,
+                stock: match m.get("stock") {
+                    None => None,
+                    Some(_) => Some(num("stock")?),
                 },
-            ))));
+            })));
         }
-        Ok(Some(Verification::Profile(VerifyRequest {
+        Ok(Some(Verification::new(VerifyRequest {
             profile: m
                 .get("profile")
                 .and_then(|p| p.clone().try_cast::<Profile>())

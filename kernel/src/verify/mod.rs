@@ -31,8 +31,11 @@ pub use crate::replay::{as_written, passes_in, replay, replay_blocks, VerifyErro
 pub use plots::deviation_svgs;
 pub use profile_svg::profile_svg;
 
+mod outcome;
 mod plots;
 mod profile_svg;
+
+pub use outcome::{GrindingOutcome, KIND};
 
 /// How far a surface strays from the nominal profile over a range.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

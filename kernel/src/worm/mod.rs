@@ -19,6 +19,7 @@
 //! radial. The thread is right-handed.
 
 mod blade;
+mod outcome;
 mod plan;
 mod plots;
 mod servo;
@@ -28,6 +29,7 @@ mod solid;
 
 pub use crate::tool::{ThreadCutter, ARC_TOLERANCE};
 pub use blade::{cutter_outline, ThreadBlade, BLADE_RELIEF_DEG, BLADE_THICKNESS};
+pub use outcome::{WormOutcome, KIND};
 pub use plan::{
     axial_offset, plan, rational_passes, roughing_depths, Flank, FlankOrder, PassKind,
     PlanSettings, PlannedPass, MAX_PASSES,

@@ -182,3 +182,17 @@ impl crate::step::Sections for WormSweep {
         (8.0 * self.length / self.lead).ceil() as usize + 1
     }
 }
+
+impl crate::family::SweptSolid for WormSweep {
+    fn sections(&self) -> &dyn crate::step::Sections {
+        self
+    }
+
+    fn simplified(&self) -> crate::math::Real {
+        WormSweep::simplified(self)
+    }
+
+    fn clone_box(&self) -> Box<dyn crate::family::SweptSolid> {
+        Box::new(self.clone())
+    }
+}

@@ -1,0 +1,177 @@
+//! A caliber's verification as the run uses it: the request
+//! ([`GrooveRequest`]) replays a program in 3-D with [`check_groove`]; the
+//! outcome gives the verdict's figures, the report's
+//! `groove_verification`, the contact patch at the scene's block, the
+//! plots (`deviation_map.svg`, `section.svg`) and the page's section.
+
+use super::{check_groove, contact_patch, GrooveCheck, GroovePlace, GrooveRequest, GrooveStock};
+use crate::family::{FilesContext, Outcome, OutcomeKind, ReplayContext, Verified, Verifier};
+use crate::html::{escape, row};
+use crate::math::fixed;
+use crate::program::AxisProgram;
+use crate::replay::VerifyError;
+use crate::tool::{ToolShape, Wheel};
+use crate::verdict::{Figure, Finding};
+use std::collections::BTreeMap;
+use std::fmt::Write;
+
+/// The wheel of `ctx`, which a groove's replay needs.
+fn wheel_of(ctx: &ReplayContext<'_>) -> Result<Wheel, VerifyError> {
+    match ctx.tool.shape {
+        ToolShape::Wheel(w) => Ok(w),
+        _ => Err(VerifyError::Contract(
+            "fn verify(p) needs a grinding wheel".into(),
+        )),
+    }
+}
+
+impl Verifier for GrooveRequest {
+    fn verify(&self, ctx: &ReplayContext<'_>) -> Result<Verified, VerifyError> {
+        let wheel = wheel_of(ctx)?;
+        let stock = self.stock.map(|allowance| {
+            Box::new(GrooveStock::new(self, allowance, &wheel, ctx.passes))
+                as Box<dyn crate::process::Stock>
+        });
+        let check = check_groove(
+            ctx.program,
+            ctx.machine,
+            &ctx.tool.reference,
+            &wheel,
+            ctx.passes,
+            self,
+        )?;
+        Ok(Verified {
+            outcome: Box::new(GrooveOutcome {
+                check,
+                request: self.clone(),
+                wheel,
+            }),
+            stock,
+        })
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
+
+/// A caliber program replayed against its groove.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GrooveOutcome {
+    /// What the replay found.
+    pub check: GrooveCheck,
+    /// What it was held to.
+    pub request: GrooveRequest,
+    /// The wheel.
+    pub wheel: Wheel,
+}
+
+impl Outcome for GrooveOutcome {
+    fn key(&self) -> &'static str {
+        KIND.key
+    }
+
+    fn to_json(&self) -> Result<serde_json::Value, String> {
+        serde_json::to_value(&self.check).map_err(|e| e.to_string())
+    }
+
+    fn findings(&self, _program: &AxisProgram) -> (Vec<Figure>, Vec<Finding>) {
+        self.check.findings()
+    }
+
+    fn summary(&self) -> String {
+        let g = &self.check;
+        format!(
+            ", groove within {} mm of nominal (material left {} mm, gouge {} mm)",
+            fixed(g.max_abs_mm, 5),
+            fixed(g.max_left.mm, 5),
+            fixed(g.max_gouge.mm, 5)
+        )
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+
+    fn clone_box(&self) -> Box<dyn Outcome> {
+        Box::new(self.clone())
+    }
+
+    fn at_pose(
+        &mut self,
+        ctx: &ReplayContext<'_>,
+        block: usize,
+    ) -> Result<Option<crate::mesh::TriMesh>, VerifyError> {
+        Ok(contact_patch(
+            &crate::replay::as_written(ctx.program).0,
+            ctx.machine,
+            &ctx.tool.reference,
+            &self.wheel,
+            &self.request,
+            block,
+        )?
+        .map(|(p, m)| {
+            self.check.patch = Some(p);
+            m
+        }))
+    }
+
+    fn files(
+        &self,
+        _ctx: &FilesContext<'_>,
+        _tables: &BTreeMap<String, BTreeMap<String, Vec<f64>>>,
+    ) -> Result<Vec<(String, Vec<u8>)>, String> {
+        let map = super::deviation_map_svg(&self.check)?;
+        let section = super::section_svg(&self.check, &self.request, self.wheel.rounding_radius)?;
+        Ok(vec![
+            ("deviation_map.svg".into(), map.into_bytes()),
+            ("section.svg".into(), section.into_bytes()),
+        ])
+    }
+}
+
+/// The groove's replay in `report.json` (`groove_verification`) and on
+/// the page.
+pub const KIND: OutcomeKind = OutcomeKind {
+    key: "groove_verification",
+    section,
+};
+
+/// The page's section: the groove's extremes and where they are.
+fn section(entry: &serde_json::Value, _control: &str) -> Result<String, String> {
+    let g: GrooveCheck = serde_json::from_value(entry.clone()).map_err(|e| e.to_string())?;
+    let mut out = String::new();
+    let place = |p: &GroovePlace| {
+        format!(
+            "{} mm at theta {} deg, psi {} deg ({})",
+            fixed(p.mm, 5),
+            fixed(p.theta_deg, 2),
+            fixed(p.psi_deg, 2),
+            escape(&p.block)
+        )
+    };
+    let _ = write!(
+        out,
+        "<h2>Verification: the groove replayed in 3-D</h2>\n<p class=\"verdict\">Within <b>{} mm</b> of the groove (tolerance {} mm), edge to edge (psi {} to {} deg), on {} samples.</p>\n<table>\n",
+        fixed(g.max_abs_mm, 5),
+        fixed(g.tolerance, 4),
+        fixed(g.psi_range_deg[0], 0),
+        fixed(g.psi_range_deg[1], 0),
+        g.samples
+    );
+    row(&mut out, &["most material left".into(), place(&g.max_left)]);
+    row(&mut out, &["deepest gouge".into(), place(&g.max_gouge)]);
+    row(
+        &mut out,
+        &[
+            "deepest cut into the periphery beside it".into(),
+            format!(
+                "{}, {} mm beyond the edge",
+                place(&g.periphery_cut),
+                fixed(g.periphery_cut.beyond_edge_mm, 3)
+            ),
+        ],
+    );
+    out.push_str("</table>\n");
+    Ok(out)
+}

@@ -1,0 +1,20 @@
+//! The families the kernel carries, registered once: each kind of
+//! verification with its key in `report.json` and its section of the
+//! report page. The run, the report and the page know no family by name;
+//! a family with its own verification adds its line here (a family written
+//! outside the kernel needs none: its verification's figures reach the
+//! report and the page's verdict through [`crate::family::Outcome`]).
+
+use crate::family::OutcomeKind;
+
+/// Every kind of verification the kernel carries.
+pub const KINDS: [&OutcomeKind; 3] = [
+    &crate::verify::KIND,
+    &crate::caliber::KIND,
+    &crate::worm::KIND,
+];
+
+/// The kind whose report key is `key`.
+pub fn kind(key: &str) -> Option<&'static OutcomeKind> {
+    KINDS.into_iter().find(|k| k.key == key)
+}

@@ -1,0 +1,186 @@
+//! A body of revolution's verification as the run uses it: the request
+//! ([`crate::family::VerifyRequest`]) replays a program with
+//! [`super::replay_grinding`]; the outcome gives the verdict's figures, the
+//! report's `verification`, the plots (`profile.svg`, `deviation.svg`,
+//! `finish.svg`, `stock.svg`) and the page's section.
+
+use super::GrindingCheck;
+use crate::family::{
+    FilesContext, Outcome, OutcomeKind, PartGeometry, ReplayContext, Verified, Verifier,
+    VerifyRequest,
+};
+use crate::html::{escape, row};
+use crate::math::fixed;
+use crate::program::AxisProgram;
+use crate::replay::VerifyError;
+use crate::tool::ToolShape;
+use crate::verdict::{Figure, Finding};
+use std::fmt::Write;
+
+impl Verifier for VerifyRequest {
+    fn verify(&self, ctx: &ReplayContext<'_>) -> Result<Verified, VerifyError> {
+        let ToolShape::Wheel(wheel) = ctx.tool.shape else {
+            return Err(VerifyError::Contract(
+                "fn verify(p) needs a grinding wheel".into(),
+            ));
+        };
+        let (check, ground) = super::replay_grinding(
+            ctx.program,
+            ctx.machine,
+            &ctx.tool.reference,
+            &wheel,
+            ctx.passes,
+            &self.profile,
+            self.blank.as_deref(),
+            (self.from, self.to),
+            self.tolerance,
+        )?;
+        Ok(Verified {
+            outcome: Box::new(GrindingOutcome {
+                check,
+                request: self.clone(),
+                rounding: wheel.rounding_radius,
+            }),
+            stock: ground.map(|g| Box::new(g) as Box<dyn crate::process::Stock>),
+        })
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
+
+/// A grinding program replayed against its body of revolution.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GrindingOutcome {
+    /// What the replay found.
+    pub check: GrindingCheck,
+    /// What it was held to.
+    pub request: VerifyRequest,
+    /// The wheel's rounding radius (mm), for the curvature's panel.
+    pub rounding: f64,
+}
+
+impl Outcome for GrindingOutcome {
+    fn key(&self) -> &'static str {
+        KIND.key
+    }
+
+    fn to_json(&self) -> Result<serde_json::Value, String> {
+        serde_json::to_value(&self.check).map_err(|e| e.to_string())
+    }
+
+    fn findings(&self, program: &AxisProgram) -> (Vec<Figure>, Vec<Finding>) {
+        self.check.findings(program)
+    }
+
+    fn summary(&self) -> String {
+        self.check
+            .passes
+            .last()
+            .map(|p| {
+                format!(
+                    ", finish within {} mm of nominal",
+                    fixed(p.deviation.max_abs, 5)
+                )
+            })
+            .unwrap_or_default()
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+
+    fn clone_box(&self) -> Box<dyn Outcome> {
+        Box::new(self.clone())
+    }
+
+    fn files(
+        &self,
+        ctx: &FilesContext<'_>,
+        _tables: &std::collections::BTreeMap<String, std::collections::BTreeMap<String, Vec<f64>>>,
+    ) -> Result<Vec<(String, Vec<u8>)>, String> {
+        let profiles: Vec<(String, crate::profile::Profile)> = ctx
+            .parts
+            .iter()
+            .filter_map(|b| match &b.geometry {
+                PartGeometry::Revolution(p) => Some((b.name.clone(), p.clone())),
+                PartGeometry::Swept(_) => None,
+            })
+            .collect();
+        let r = &ctx.replay;
+        let text = super::profile_svg(
+            &profiles,
+            r.program,
+            r.passes,
+            r.machine,
+            &r.tool.reference,
+            &self.request.profile,
+            self.rounding,
+        )?;
+        let mut files = vec![("profile.svg".to_owned(), text.into_bytes())];
+        // The surface before the first pass: the blank the replay cut into.
+        let n = &self.request;
+        let start = |z: f64| Some(n.blank.as_deref()?.eval(z).ok()? - n.profile.eval(z).ok()?);
+        for (name, text) in super::deviation_svgs(&self.check, start)? {
+            files.push((name, text.into_bytes()));
+        }
+        Ok(files)
+    }
+}
+
+/// The grinding replay in `report.json` (`verification`) and on the page.
+pub const KIND: OutcomeKind = OutcomeKind {
+    key: "verification",
+    section,
+};
+
+/// The page's section: the finish and every pass's figures.
+fn section(entry: &serde_json::Value, control: &str) -> Result<String, String> {
+    let v: GrindingCheck = serde_json::from_value(entry.clone()).map_err(|e| e.to_string())?;
+    let mut out = String::new();
+    let _ = write!(
+        out,
+        "<h2>Verification: the program replayed</h2>\n<p>Tolerance {} mm; {} generatrices; values read at {} mm as written.</p>\n",
+        fixed(v.tolerance, 4),
+        v.generatrices,
+        fixed(v.resolution_mm, 4)
+    );
+    if let Some(f) = v.passes.last() {
+        // The block counts from 1 (the program's and report.csv's).
+        let block = f.deviation.block.map_or_else(String::new, |b| {
+            format!(", {}", escape(&crate::program::block_label(control, b - 1)))
+        });
+        let _ = writeln!(
+            out,
+            "<p class=\"verdict\">Finish ({}) within <b>{} mm</b> of the nominal; the worst at z = {} mm{block}.</p>",
+            escape(&f.name),
+            fixed(f.deviation.max_abs, 5),
+            fixed(f.deviation.at_z, 3)
+        );
+    }
+    out.push_str("<table><tr><th>pass</th><th>feed, mm/min</th><th>feed a rev, mm</th><th>ridge, um</th><th>highest, um (z)</th><th>lowest, um (z)</th></tr>\n");
+    for p in &v.passes {
+        row(
+            &mut out,
+            &[
+                escape(&p.name),
+                fixed(p.feed_mm_min, 1),
+                fixed(p.feed_per_rev_mm, 3),
+                fixed(p.ridge_mm * 1e3, 2),
+                format!(
+                    "{} ({})",
+                    fixed(p.deviation.max_above * 1e3, 2),
+                    fixed(p.deviation.above_z, 2)
+                ),
+                format!(
+                    "{} ({})",
+                    fixed(p.deviation.max_below * 1e3, 2),
+                    fixed(p.deviation.below_z, 2)
+                ),
+            ],
+        );
+    }
+    out.push_str("</table>\n");
+    Ok(out)
+}

@@ -1,0 +1,224 @@
+//! A worm's verification as the run uses it: the request ([`WormRequest`])
+//! simulates a program's cut pass by pass with [`simulate`]; the outcome
+//! gives the verdict's figures, the report's `worm_verification`, the
+//! finished worm's solid, the simulated areas in the family's `passes`
+//! table, `passes.csv`, `passes.svg` and the page's section.
+
+use super::{
+    simulate, worm_pass_table, worm_passes_svg, worm_solid, SimulatedPass, WormCheck, WormRequest,
+    WormStock, WormSweep,
+};
+use crate::family::{
+    FilesContext, Outcome, OutcomeKind, PartBody, PartGeometry, ReplayContext, Swept, SweptBody,
+    Verified, Verifier,
+};
+use crate::html::{escape, row};
+use crate::math::fixed;
+use crate::mesh::SceneError;
+use crate::program::AxisProgram;
+use crate::replay::VerifyError;
+use crate::tool::ToolShape;
+use crate::verdict::{Figure, Finding};
+use std::collections::BTreeMap;
+use std::fmt::Write;
+
+impl Verifier for WormRequest {
+    fn verify(&self, ctx: &ReplayContext<'_>) -> Result<Verified, VerifyError> {
+        let ToolShape::ThreadCutter(c) = ctx.tool.shape else {
+            return Err(VerifyError::Contract(
+                "fn verify(p) of a worm needs a thread cutter".into(),
+            ));
+        };
+        let check = simulate(ctx.program, ctx.machine, &ctx.tool.reference, &c, self)?;
+        let stock = WormStock::new(&check, self, &c);
+        Ok(Verified {
+            outcome: Box::new(WormOutcome {
+                check,
+                request: self.clone(),
+            }),
+            stock: Some(Box::new(stock)),
+        })
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
+
+/// A worm's cut simulated against its thread.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WormOutcome {
+    /// What the simulation found.
+    pub check: WormCheck,
+    /// What it was held to.
+    pub request: WormRequest,
+}
+
+impl Outcome for WormOutcome {
+    fn key(&self) -> &'static str {
+        KIND.key
+    }
+
+    fn to_json(&self) -> Result<serde_json::Value, String> {
+        serde_json::to_value(&self.check).map_err(|e| e.to_string())
+    }
+
+    fn findings(&self, _program: &AxisProgram) -> (Vec<Figure>, Vec<Finding>) {
+        self.check.findings()
+    }
+
+    fn summary(&self) -> String {
+        let w = &self.check;
+        let form = w
+            .starts
+            .iter()
+            .map(|s| s.left_form.abs().max(s.right_form.abs()))
+            .fold(0.0, f64::max);
+        format!(
+            ", thread within tolerance (flank form {} mm; chips {:.2} of {:.2} mm^2 of space)",
+            fixed(form, 4),
+            w.removed_area,
+            w.space_area
+        )
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+
+    fn clone_box(&self) -> Box<dyn Outcome> {
+        Box::new(self.clone())
+    }
+
+    fn bodies(
+        &self,
+        mesh_tolerance: f64,
+        step_tolerance: f64,
+    ) -> Result<Vec<PartBody>, SceneError> {
+        // The finished worm: the simulated section swept along the helix.
+        let mesh_error = |source| SceneError::Mesh {
+            body: "worm".into(),
+            source,
+        };
+        let (w, length) = (&self.check, self.request.length);
+        let mesh = worm_solid(w, length, mesh_tolerance).map_err(mesh_error)?;
+        // A quarter of the STEP tolerance for merging the outline's points,
+        // the rest for the fit.
+        let body = WormSweep::new(w, length, step_tolerance / 4.0).map_err(mesh_error)?;
+        Ok(vec![PartBody {
+            name: "worm".into(),
+            geometry: PartGeometry::Swept(Box::new(Swept {
+                mesh,
+                body: SweptBody::new(body),
+            })),
+        }])
+    }
+
+    fn extend_tables(&self, tables: &mut BTreeMap<String, BTreeMap<String, Vec<f64>>>) {
+        // The simulated areas beside the plan's, row for row, where the
+        // family's "passes" table has one row per thread block.
+        let w = &self.check;
+        if let Some(t) = tables.get_mut("passes") {
+            if t.values().all(|c| c.len() == w.passes.len()) && !t.is_empty() {
+                t.insert(
+                    "simulated_area".into(),
+                    w.passes.iter().map(|p| p.chip_area).collect(),
+                );
+                t.insert(
+                    "left_area".into(),
+                    w.passes.iter().map(|p| p.left_area).collect(),
+                );
+                t.insert(
+                    "right_area".into(),
+                    w.passes.iter().map(|p| p.right_area).collect(),
+                );
+                t.insert(
+                    "block".into(),
+                    w.passes.iter().map(|p| p.block as f64).collect(),
+                );
+            }
+        }
+    }
+
+    fn leads_charts(&self) -> bool {
+        true
+    }
+
+    fn files(
+        &self,
+        _ctx: &FilesContext<'_>,
+        tables: &BTreeMap<String, BTreeMap<String, Vec<f64>>>,
+    ) -> Result<Vec<(String, Vec<u8>)>, String> {
+        let table = worm_pass_table(&self.check, tables.get("passes"))?;
+        let svg = worm_passes_svg(&self.check)?;
+        Ok(vec![
+            ("passes.csv".into(), table.into_bytes()),
+            ("passes.svg".into(), svg.into_bytes()),
+        ])
+    }
+}
+
+/// The worm's simulation in `report.json` (`worm_verification`) and on
+/// the page.
+pub const KIND: OutcomeKind = OutcomeKind {
+    key: "worm_verification",
+    section,
+};
+
+/// The page's section: chips, loads, leads and each start's figures.
+fn section(entry: &serde_json::Value, _control: &str) -> Result<String, String> {
+    let w: WormCheck = serde_json::from_value(entry.clone()).map_err(|e| e.to_string())?;
+    let mut out = String::new();
+    let _ = write!(
+        out,
+        "<h2>Verification: the thread cut simulated</h2>\n<p class=\"verdict\">Chips {} of {} mm<sup>2</sup> of space; flank loads {} / {} mm<sup>2</sup>; lead error {} mm.</p>\n",
+        fixed(w.removed_area, 3),
+        fixed(w.space_area, 3),
+        fixed(w.flank_loads[0], 1),
+        fixed(w.flank_loads[1], 1),
+        fixed(w.lead_error, 5)
+    );
+    let worst = |f: fn(&SimulatedPass) -> f64| {
+        w.passes
+            .iter()
+            .max_by(|a, b| f(a).total_cmp(&f(b)))
+            .map_or_else(String::new, |p| {
+                format!("{}% ({})", fixed(100.0 * f(p), 3), escape(&p.name))
+            })
+    };
+    let _ = writeln!(
+        out,
+        "<p>The lead where each pass's cutting edges meet the worm's face (S1 from the edges): at most {}; where they leave its far end (S2): at most {}; allowed {}%.</p>",
+        worst(|p| p.face_lead_error),
+        worst(|p| p.end_lead_error),
+        fixed(100.0 * w.tolerances.lead, 3)
+    );
+    out.push_str("<table><tr><th>start</th><th>flank angles, deg</th><th>form, um</th><th>thickness, mm</th><th>root / tip, mm</th><th>place, um</th></tr>\n");
+    for s in &w.starts {
+        row(
+            &mut out,
+            &[
+                s.start.to_string(),
+                format!(
+                    "{} / {}",
+                    fixed(s.left_angle_deg, 4),
+                    fixed(s.right_angle_deg, 4)
+                ),
+                format!(
+                    "{} / {}",
+                    fixed(s.left_form * 1e3, 2),
+                    fixed(s.right_form * 1e3, 2)
+                ),
+                fixed(s.thickness, 4),
+                format!(
+                    "{} / {}",
+                    fixed(s.root_diameter, 3),
+                    fixed(s.tip_diameter, 3)
+                ),
+                fixed(s.position_error * 1e3, 2),
+            ],
+        );
+    }
+    out.push_str("</table>\n");
+    Ok(out)
+}
