@@ -18,6 +18,7 @@ mod machine_files;
 mod mandrel;
 mod mandrel_fidelity;
 mod plugins;
+mod ring;
 mod sdk;
 mod trust;
 mod verify;
