@@ -16,6 +16,70 @@ fn links(text: &str) -> Vec<String> {
         .collect()
 }
 
+/// Every command of the README's `sh` blocks that names real files runs
+/// as written (`cargo run --release -- ARGS` is `pilgrim ARGS`, in the
+/// repository's root), in order, exit 0: its outputs go to a scratch
+/// directory instead of `out/`. Lines with placeholders (`FAMILY.rhai`,
+/// `SHOP.MPF`, `[--plugin LIB]`, alternatives `a|b`), the plugin check of a
+/// library the release build makes and `api-docs` (which writes into
+/// `docs/`) are left out, and counted.
+#[test]
+fn the_readmes_commands_run() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let out = crate::common::scratch("docs", "readme");
+    let mut in_sh = false;
+    let (mut ran, mut left) = (0, 0);
+    for line in readme.lines() {
+        if line.starts_with("```") {
+            in_sh = line == "```sh";
+            continue;
+        }
+        let Some(command) = in_sh
+            .then(|| line.strip_prefix("cargo run --release -- "))
+            .flatten()
+        else {
+            continue;
+        };
+        let command = command.split(" #").next().unwrap().trim();
+        let placeholder = [
+            "FAMILY",
+            "SHOP",
+            "LIB",
+            "|",
+            "[",
+            "plugin-check",
+            "api-docs",
+        ];
+        if placeholder.iter().any(|p| command.contains(p)) {
+            left += 1;
+            continue;
+        }
+        // The outputs into the scratch directory, never the repository's.
+        let mut args: Vec<String> = command
+            .split_whitespace()
+            .map(|a| match a.strip_prefix("out/") {
+                Some(rest) => out.join(rest).to_str().unwrap().to_owned(),
+                None => a.to_owned(),
+            })
+            .collect();
+        if args[0] == "run" && !args.iter().any(|a| a == "--out") {
+            let stem = std::path::Path::new(&args[1])
+                .file_stem()
+                .unwrap()
+                .to_owned();
+            args.extend([
+                "--out".to_owned(),
+                out.join(stem).to_str().unwrap().to_owned(),
+            ]);
+        }
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (code, _, err) = crate::common::pilgrim(&args);
+        assert_eq!(code, 0, "README: {command}\n{err}");
+        ran += 1;
+    }
+    assert!(ran >= 6 && left <= 6, "{ran} commands ran, {left} left out");
+}
+
 #[test]
 fn the_readme_is_short_and_the_docs_link_both_ways() {
     let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
