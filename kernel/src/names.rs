@@ -129,7 +129,7 @@ pub fn check_text(what: &str, value: &str) -> Result<(), InputError> {
 /// (a formula to Excel, LibreOffice and Google Sheets; a pass may be named
 /// `=HYPERLINK(...)`) gets a leading `'`, the OWASP rule for CSV
 /// injection. Numbers are written by the caller and never pass here.
-pub(crate) fn spreadsheet_text(text: &str) -> String {
+pub fn spreadsheet_text(text: &str) -> String {
     if text.starts_with(['=', '+', '-', '@', '\t', '\r']) {
         format!("'{text}")
     } else {

@@ -329,7 +329,7 @@ pub struct SolidFile {
 /// What a failed run leaves to look at: its report marked FAILED (with
 /// the verdict: what failed, where, and every figure), `report.html`, the
 /// plots and the scene at the place it failed, the data files; no program
-/// a control could load. [`Error::Failed`] carries it.
+/// a control could load. [`crate::Error::Failed`] carries it.
 #[derive(Clone, PartialEq)]
 pub struct FailedRun {
     /// The report.

@@ -292,7 +292,7 @@ pub const CREST_STEP: Real = 0.1;
 pub const CREST_LINEAR_ERROR: Real = 1e-4;
 
 /// The most grid points a [`PhaseCrest`] may have.
-const MAX_CREST_POINTS: usize = 5_000_000;
+pub const MAX_CREST_POINTS: usize = 5_000_000;
 
 /// A pass's [`crest_at`] on an even grid over its reach, with the first
 /// and last times the wheel covers each grid point (for a pass still in
