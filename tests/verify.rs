@@ -161,6 +161,39 @@ fn a_hand_edited_program_is_verified_as_it_stands() {
     assert!(!out.with_extension("verify").exists());
 }
 
+/// A pass in which the steady rest moves while the wheel stands: the
+/// first pass's comment taken out, the rest's approach (U alone, at rapid
+/// and at its approach feed) opens the first cutting pass. The replay
+/// times the wheel along that pass; the rest's moves add nothing to the
+/// wheel's path, and the finish is the one the run verified.
+#[test]
+fn a_pass_where_only_the_rest_moves_is_replayed() {
+    let out = default_run("mandrel", "rest-only");
+    let text = std::fs::read_to_string(out.join("program.mpf")).unwrap();
+    let first = text
+        .lines()
+        .find(|l| l.starts_with("; pass 1"))
+        .unwrap()
+        .to_owned();
+    let merged = out.parent().unwrap().join("MERGED.MPF");
+    std::fs::write(&merged, text.replacen(&format!("{first}\n"), "", 1)).unwrap();
+    let (code, said, err) = pilgrim(&["verify", s(&merged), "--family", "scripts/mandrel.rhai"]);
+    assert_eq!(code, 0, "{err}");
+    let finish = |r: &Value| {
+        r["verification"]["passes"]
+            .as_array()
+            .unwrap()
+            .last()
+            .unwrap()["deviation"]["max_abs"]
+            .clone()
+    };
+    assert_eq!(
+        finish(&report(&out.parent().unwrap().join("MERGED.MPF.verify"))),
+        finish(&report(&out)),
+        "{said}"
+    );
+}
+
 /// A program file pilgrim did not write (its own name, a machine and a
 /// family named on the command line) is verified; one whose blocks no
 /// comment groups into passes is refused, saying what to add; a program
