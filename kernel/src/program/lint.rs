@@ -125,19 +125,53 @@ pub fn read(
             message: "a CL file is not a program a control runs: read the control's program".into(),
         });
     }
-    let read = lint_gcode(text, frame, d, axes, Mode::Read)?;
-    let mut program = AxisProgram {
-        name: read.name.unwrap_or_else(|| frame.name.clone()),
-        number: read.number.unwrap_or(frame.number),
-        tool_number: read.tool.unwrap_or(frame.tool_number),
-        spindle_rpm: read.rpm.unwrap_or(frame.spindle_rpm),
-        blocks: Vec::new(),
-        ..frame.clone()
-    };
+    Ok(assemble(
+        lint_gcode(text, frame, d, axes, Mode::Read)?,
+        frame,
+    ))
+}
+
+/// Lints `text`, the program `program` written in `d`, as [`lint`] does,
+/// and returns the program as the control reads it: its values as the
+/// text writes them, each pass named as `program` names it (the text
+/// carries the names as its dialect's comments allow: Fanuc's in capitals).
+/// What a run verifies is this, read in the same pass as its lint.
+///
+/// # Failures
+/// As [`lint`]; a CL file, which no control runs.
+pub fn lint_read(
+    text: &str,
+    program: &AxisProgram,
+    d: &Dialect,
+    axes: &[Axis],
+) -> Result<AxisProgram, LintError> {
+    if d.style != Style::GCode {
+        return Err(not_a_control_program(d));
+    }
+    let mut read = assemble(lint_gcode(text, program, d, axes, Mode::Lint)?, program);
+    for (r, b) in read.blocks.iter_mut().zip(&program.blocks) {
+        r.comment.clone_from(&b.comment);
+    }
+    Ok(read)
+}
+
+/// The refusal of a CL file where a control's program is wanted.
+fn not_a_control_program(d: &Dialect) -> LintError {
+    LintError {
+        dialect: d.name.to_owned(),
+        place: "line 1".into(),
+        message: "a CL file is not a program a control runs: read the control's program".into(),
+    }
+}
+
+/// The program `read` holds, for the machine's `frame` (its axes, setup,
+/// decimals; its name, number, tool and speed where the text writes none).
+/// Axes the text never writes are left out; an axis not yet written is
+/// kept where it stands until its first value.
+fn assemble(read: ReadText, frame: &AxisProgram) -> AxisProgram {
     let written: Vec<usize> = (0..frame.axes.len())
         .filter(|&i| read.blocks.iter().any(|b| b.values[i].is_some()))
         .collect();
-    program.axes = written.iter().map(|&i| frame.axes[i].clone()).collect();
     // Each axis's first value, for the blocks before it moves.
     let first: Vec<Real> = written
         .iter()
@@ -148,7 +182,7 @@ pub fn read(
                 .unwrap_or_default()
         })
         .collect();
-    program.blocks = read
+    let blocks = read
         .blocks
         .into_iter()
         .map(|b| {
@@ -172,7 +206,19 @@ pub fn read(
             }
         })
         .collect();
-    Ok(program)
+    AxisProgram {
+        name: read.name.unwrap_or_else(|| frame.name.clone()),
+        number: read.number.unwrap_or(frame.number),
+        machine: frame.machine.clone(),
+        control: frame.control.clone(),
+        tool_number: read.tool.unwrap_or(frame.tool_number),
+        tool_name: frame.tool_name.clone(),
+        spindle_rpm: read.rpm.unwrap_or(frame.spindle_rpm),
+        decimals: frame.decimals,
+        axes: written.iter().map(|&i| frame.axes[i].clone()).collect(),
+        blocks,
+        setup: frame.setup.clone(),
+    }
 }
 
 /// Whether a G-code text is held to an axis program (the lint of a
@@ -194,8 +240,8 @@ struct ReadBlock {
     number: Option<u32>,
 }
 
-/// What a G-code text read as: the lint's count, and in [`Mode::Read`] the
-/// moves and what the text says of the program.
+/// What a G-code text read as: the lint's count, the moves and what the
+/// text says of the program.
 struct ReadText {
     linted: Linted,
     blocks: Vec<ReadBlock>,
@@ -709,13 +755,12 @@ fn lint_gcode(
                 Some(program.spindle_rpm)
             }
             .map(Real::round);
-            if reading {
-                if k == 0 && !moves {
-                    out.rpm = Some(v);
-                } else {
-                    speed_next = Some(v);
-                }
-            } else if want != Some(v) {
+            if k == 0 && !moves {
+                out.rpm = Some(v);
+            } else {
+                speed_next = Some(v);
+            }
+            if !reading && want != Some(v) {
                 return Err(fault(
                     place(k),
                     format!(
@@ -916,7 +961,8 @@ fn lint_gcode(
                 }
             }
         }
-        if reading {
+        // The move as read (a lint reads it too: what a run verifies).
+        {
             let comment = comments[comment_from.min(line)..line]
                 .iter()
                 .rev()
@@ -1227,6 +1273,18 @@ mod tests {
                 assert_eq!(a.number, n, "{what}");
             }
             assert!(r.blocks[4].motion == written.blocks[4].motion);
+            // A lint reads the same program, its passes named as the axis
+            // program names them.
+            let l = lint_read(&text, &p, d, &axes()).unwrap();
+            for (k, (a, b)) in l.blocks.iter().zip(&written.blocks).enumerate() {
+                assert_eq!(
+                    (&a.values, a.motion),
+                    (&b.values, b.motion),
+                    "{} {k}",
+                    d.name
+                );
+                assert_eq!(a.comment, b.comment, "{} {k}", d.name);
+            }
         }
         // A CL file is no control's program.
         let cld = post(&p, &CLD).unwrap();
