@@ -161,20 +161,21 @@ fn report_json(report: &Report) -> Result<Vec<u8>, Error> {
 /// Posts `program` in the control's dialect, as a CL file and in the
 /// dialects `also` names, and lints each ([`crate::program::lint`]):
 /// nothing is kept that does not read back as the axis program. The
-/// programs as files (name, bytes) in that order.
+/// programs as files (name, bytes) in that order, and the control's
+/// program as its lint read it: what the run verifies.
 fn post_all(
     machine: &OpenMachine,
     info: &crate::machine::MachineInfo,
     program: &AxisProgram,
     also: &[String],
-) -> Result<scene::Files, Error> {
+) -> Result<(scene::Files, AxisProgram), Error> {
     let control = dialect(&info.control).ok_or_else(|| Error::UnknownControl {
         machine: info.name.clone(),
         control: info.control.clone(),
     })?;
     let control_text = machine.post.post(program, control.name)?;
     let cld_text = machine.post.post(program, CLD.name)?;
-    crate::program::lint::lint(&control_text, program, control, &info.axes)?;
+    let read = crate::program::lint::lint_read(&control_text, program, control, &info.axes)?;
     crate::program::lint::lint(&cld_text, program, &CLD, &info.axes)?;
     let mut files = vec![
         (
@@ -194,7 +195,7 @@ fn post_all(
         crate::program::lint::lint(&text, program, d, &info.axes)?;
         files.push((format!("program.{}", d.extension), text.into_bytes()));
     }
-    Ok(files)
+    Ok((files, read))
 }
 
 /// The failed run of `report` with the `files` made so far: the page and
@@ -359,10 +360,11 @@ fn run_on(
         machine: info.name.clone(),
         control: info.control.clone(),
     })?;
-    // The program, the program the verification replays (the text a
-    // control reads, read back), its passes, the posted programs (or why
-    // none) and the data files.
-    let (program, verified, passes, posted, data) = match text {
+    // The program; the program the verification replays, where it is
+    // not the program itself (the text a control reads, as the lint read
+    // it back); its passes; the posted programs (or why none); the data
+    // files.
+    let (program, read_back, passes, posted, data) = match text {
         None => {
             let mut program = build(&toolpath, kin, &options.program_name)?;
             program.number = options.program_number.unwrap_or(0);
@@ -387,24 +389,11 @@ fn run_on(
                 ("program.json".into(), program_json),
                 ("report.csv".into(), csv),
             ];
-            let verified = match &posted {
-                Ok(files) => {
-                    let frame = AxisProgram {
-                        blocks: Vec::new(),
-                        ..program.clone()
-                    };
-                    let text = String::from_utf8_lossy(&files[0].1);
-                    let mut read = crate::program::lint::read(&text, &frame, control, &info.axes)?;
-                    // The passes' names as the family gave them (the text
-                    // writes them as its comments allow: Fanuc's in capitals).
-                    for (r, b) in read.blocks.iter_mut().zip(&program.blocks) {
-                        r.comment.clone_from(&b.comment);
-                    }
-                    read
-                }
-                Err(_) => program.clone(),
+            let (posted, read_back) = match posted {
+                Ok((files, read)) => (Ok(files), Some(read)),
+                Err(e) => (Err(e), None),
             };
-            (program, verified, passes, posted, data)
+            (program, read_back, passes, posted, data)
         }
         Some(text) => {
             let frame = crate::program::frame(info);
@@ -419,14 +408,17 @@ fn run_on(
             })?;
             let passes = crate::replay::passes_in(&read, kin, &toolpath.tool.reference)?;
             stage(STAGES[3]);
-            let [_, program_json, csv] = data_files(&toolpath, &read)?;
             let data = vec![
-                ("program.json".into(), program_json),
-                ("report.csv".into(), csv),
+                ("program.json".into(), json(&read)?),
+                (
+                    "report.csv".into(),
+                    block_table(&read).map_err(Error::Output)?.into_bytes(),
+                ),
             ];
-            (read.clone(), read, passes, Ok(Vec::new()), data)
+            (read, None, passes, Ok(Vec::new()), data)
         }
     };
+    let verified = read_back.as_ref().unwrap_or(&program);
     let requested = family.verification(&values)?;
     let requested_any = requested.is_some();
     if options.pose_block == Some(0) {
@@ -434,7 +426,7 @@ fn run_on(
     }
     let replay_ctx = ReplayContext {
         family: family.name(),
-        program: &verified,
+        program: verified,
         machine: kin,
         tool: &toolpath.tool,
         passes: &passes,
@@ -461,7 +453,7 @@ fn run_on(
     let mut figures = Vec::new();
     let mut failures = Vec::new();
     if let Some(o) = &outcome {
-        let (f, x) = o.findings(&verified);
+        let (f, x) = o.findings(verified);
         figures.extend(f);
         failures.extend(x);
     }
@@ -472,7 +464,7 @@ fn run_on(
         .collect();
     // The process, checked as well as the geometry.
     let process = crate::process::check(
-        &verified,
+        verified,
         kin,
         &toolpath.tool.reference,
         stock.as_deref(),
@@ -495,7 +487,7 @@ fn run_on(
     ) {
         (Some(n), _) => scene::PosePlace::at_end(n - 1),
         (None, Some(b)) => scene::PosePlace::at_end(b - 1),
-        (None, None) => default_pose_block(&verified, &passes),
+        (None, None) => default_pose_block(verified, &passes),
     };
     let pose_index = pose_place.block;
     // What the verification shows at the scene's block (the caliber's
@@ -571,8 +563,8 @@ fn run_on(
         (Some(index + 1), bodies, solids, part_box)
     };
     let mut report = Report {
-        passes: toolpath.passes.len(),
-        cutting_passes: toolpath.passes.iter().filter(|p| p.cuts()).count(),
+        passes: passes.len(),
+        cutting_passes: passes.iter().filter(|p| p.cuts).count(),
         points: toolpath.point_count(),
         blocks: program.blocks.len(),
         cycle_time_min: (cycle_time(&program, info) * 1e4).round() / 1e4,
