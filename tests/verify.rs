@@ -101,7 +101,7 @@ fn move_after(text: &str, pass: &str, n: usize) -> (String, f64) {
 /// A run's program edited by hand: a value past the tolerance is refused,
 /// naming its block; a feed changed is verified at the new feed; a word the
 /// verification cannot simulate is refused, naming the word and its block,
-/// and nothing is verified (no report).
+/// and nothing is verified (its report says so).
 #[test]
 fn a_hand_edited_program_is_verified_as_it_stands() {
     let out = default_run("mandrel", "edited");
@@ -158,7 +158,15 @@ fn a_hand_edited_program_is_verified_as_it_stands() {
         )),
         "{err}"
     );
-    assert!(!out.with_extension("verify").exists());
+    // Nothing verified: the report says what was refused and where.
+    let refused = report(&out.with_extension("verify"));
+    assert_eq!(refused["verdict"]["status"], "failed");
+    assert!(refused.get("verification").is_none());
+    let failures = refused["verdict"]["failures"].as_array().unwrap();
+    assert!(failures[0]["message"]
+        .as_str()
+        .unwrap()
+        .contains(&format!("{block}: G2")));
 }
 
 /// A pass in which the steady rest moves while the wheel stands: the
@@ -242,6 +250,10 @@ fn a_program_file_is_verified_for_a_machine_and_a_family() {
     assert!(
         err.contains("one pass") && err.contains("put a comment"),
         "{err}"
+    );
+    assert_eq!(
+        report(&dir.join("BARE.MPF.verify"))["verdict"]["status"],
+        "failed"
     );
     let (code, _, err) = pilgrim(&["verify", s(&theirs)]);
     assert_eq!(code, 1, "{err}");

@@ -396,17 +396,26 @@ fn run_on(
             (program, read_back, passes, posted, data)
         }
         Some(text) => {
+            // A text the verification cannot take leaves its report: what
+            // was refused and where, every parameter; nothing verified.
+            let refused = |message: String| {
+                let mut report = Report::of_run(family, machine, info, &values, checks.clone());
+                report.program_file.clone_from(&options.program_file);
+                report.verdict = Verdict::of(
+                    true,
+                    vec![Finding::new("the program's text", message)],
+                    Vec::new(),
+                    Vec::new(),
+                );
+                failed_run(report, Vec::new(), None)
+            };
             let frame = crate::program::frame(info);
-            let read = crate::program::lint::read(text, &frame, control, &info.axes)?;
+            let read = crate::program::lint::read(text, &frame, control, &info.axes)
+                .map_err(|e| refused(e.to_string()))?;
             // No more blocks than a run writes: the replays' work is bounded.
-            crate::program::check_shape(&read).map_err(|message| {
-                crate::program::lint::LintError {
-                    dialect: control.name.to_owned(),
-                    place: "the program".into(),
-                    message,
-                }
-            })?;
-            let passes = crate::replay::passes_in(&read, kin, &toolpath.tool.reference)?;
+            crate::program::check_shape(&read).map_err(|m| refused(format!("the program: {m}")))?;
+            let passes = crate::replay::passes_in(&read, kin, &toolpath.tool.reference)
+                .map_err(|e| refused(e.to_string()))?;
             stage(STAGES[3]);
             let data = vec![
                 ("program.json".into(), json(&read)?),
