@@ -238,6 +238,30 @@ fn a_program_file_is_verified_for_a_machine_and_a_family() {
         report(&out)["verification"],
         "the same program under another name"
     );
+    // Numbered its own way (N110, N120, ...): its blocks are named as it
+    // numbers them, in the report, the block table and the page.
+    let renumbered = dir.join("RENUMBERED.MPF");
+    std::fs::write(&renumbered, text.replace("\nN", "\nN1")).unwrap();
+    let (code, _, err) = pilgrim(&["verify", s(&renumbered), "--family", "scripts/mandrel.rhai"]);
+    assert_eq!(code, 0, "{err}");
+    let out_dir = dir.join("RENUMBERED.MPF.verify");
+    let numbered = report(&out_dir);
+    assert_eq!(numbered["block_numbers"][0], 110);
+    let table = std::fs::read_to_string(out_dir.join("report.csv")).unwrap();
+    assert!(
+        table.lines().nth(1).unwrap().starts_with("1,N110,"),
+        "{table:.300}"
+    );
+    let worst = numbered["verification"]["passes"]
+        .as_array()
+        .unwrap()
+        .last()
+        .unwrap()["deviation"]["block"]
+        .as_u64()
+        .unwrap() as usize;
+    let n = numbered["block_numbers"][worst - 1].as_u64().unwrap();
+    let page = std::fs::read_to_string(out_dir.join("report.html")).unwrap();
+    assert!(page.contains(&format!("N{n}.</p>")), "N{n}");
     let bare = dir.join("BARE.MPF");
     let uncommented: String = text
         .lines()

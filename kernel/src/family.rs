@@ -194,14 +194,18 @@ impl Clone for Box<dyn Outcome> {
     }
 }
 
+/// A kind's section of the report page: the HTML of its `report.json`
+/// entry, given each block's label (from its index from 0).
+pub type SectionFn = fn(&serde_json::Value, &dyn Fn(usize) -> String) -> Result<String, String>;
+
 /// A kind of verification as the report page shows it: its key in
 /// `report.json` and the page's section drawn from that entry.
 pub struct OutcomeKind {
     /// The key.
     pub key: &'static str,
-    /// The section's HTML from the entry (`control`: the program's dialect,
-    /// for naming blocks).
-    pub section: fn(&serde_json::Value, &str) -> Result<String, String>,
+    /// The section's HTML from the entry (`label`: a block's label, from
+    /// its index from 0, as the program numbers it).
+    pub section: SectionFn,
 }
 
 /// The geometry of one of a part's bodies.

@@ -8,7 +8,7 @@ use crate::family::Check;
 use crate::machine::{feed_length, Axis, MachineInfo};
 use crate::math::{fixed, Real};
 use crate::params::ParamValue;
-use crate::program::{block_label, AxisProgram};
+use crate::program::{block_label, label_in, AxisProgram};
 use crate::toolpath::Motion;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -40,6 +40,10 @@ pub struct Report {
     /// in messages; none for a run, whose program is its own.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub program_file: Option<String>,
+    /// Each block's `N` as the file a verification read numbers it; empty
+    /// where the writer numbers the blocks ([`block_label`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub block_numbers: Vec<u32>,
     /// Every parameter's value as used, with its unit.
     pub parameters: BTreeMap<String, ReportParam>,
     /// Passes in all.
@@ -101,6 +105,14 @@ pub struct Report {
 }
 
 impl Report {
+    /// The label of block `index` (from 0) as the program numbers it.
+    pub fn block_label(&self, index: usize) -> String {
+        match self.block_numbers.get(index) {
+            Some(n) => format!("N{n}"),
+            None => block_label(&self.control, index),
+        }
+    }
+
     /// The parameter values the run used, as a source a run or a
     /// verification takes (`label`: where they come from, for messages).
     ///
@@ -135,6 +147,7 @@ impl Report {
             machine: info.name.clone(),
             machine_spec: machine.spec.clone(),
             program_file: None,
+            block_numbers: Vec::new(),
             control: info.control.clone(),
             parameters: family
                 .params()
@@ -274,7 +287,7 @@ pub fn block_table(program: &AxisProgram) -> Result<String, String> {
         };
         let mut row = vec![
             (i + 1).to_string(),
-            block_label(&program.control, i),
+            label_in(&program.control, &program.blocks, i),
             crate::names::spreadsheet_text(pass),
             motion.to_owned(),
         ];

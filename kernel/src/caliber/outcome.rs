@@ -138,7 +138,7 @@ pub const KIND: OutcomeKind = OutcomeKind {
 };
 
 /// The page's section: the groove's extremes and where they are.
-fn section(entry: &serde_json::Value, _control: &str) -> Result<String, String> {
+fn section(entry: &serde_json::Value, _label: &dyn Fn(usize) -> String) -> Result<String, String> {
     let g: GrooveCheck = serde_json::from_value(entry.clone()).map_err(|e| e.to_string())?;
     let mut out = String::new();
     let place = |p: &GroovePlace| {

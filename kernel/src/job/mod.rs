@@ -600,6 +600,12 @@ fn run_on(
         tables: toolpath.tables.clone(),
         verdict: Verdict::of(requested_any, failures, warnings, figures),
         program_file: text.and(options.program_file.clone()),
+        block_numbers: program
+            .blocks
+            .iter()
+            .map(|b| b.number)
+            .collect::<Option<Vec<u32>>>()
+            .unwrap_or_default(),
         ..Report::of_run(family, machine, info, &values, checks)
     };
     // The verification's own files: the tables it adds to, then its

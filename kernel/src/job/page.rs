@@ -49,7 +49,7 @@ pub struct PageInputs<'a> {
 fn verification(out: &mut String, r: &Report) {
     for (key, entry) in &r.verifications {
         if let Some(kind) = crate::families::kind(key) {
-            match (kind.section)(entry, &r.control) {
+            match (kind.section)(entry, &|b| r.block_label(b)) {
                 Ok(html) => out.push_str(&html),
                 Err(e) => {
                     let _ = writeln!(
@@ -178,7 +178,7 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
                     } else {
                         String::new()
                     },
-                    crate::program::block_label(&r.control, b - 1)
+                    r.block_label(b - 1)
                 )
             }),
         ),

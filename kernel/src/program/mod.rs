@@ -315,6 +315,16 @@ pub fn block_label(control: &str, index: usize) -> String {
     }
 }
 
+/// The label block `index` (from 0) of `blocks` has in a program in the
+/// dialect `control`: the `N` its text gives it where it was read from a
+/// file ([`Block::number`]), else the writer's ([`block_label`]).
+pub fn label_in(control: &str, blocks: &[Block], index: usize) -> String {
+    match blocks.get(index).and_then(|b| b.number) {
+        Some(n) => format!("N{n}"),
+        None => block_label(control, index),
+    }
+}
+
 /// Block `index` (from 0) of `program` as the program names it: its label
 /// ([`block_label`]) and the pass it is in (the last comment at or before
 /// it): `N570 in "pass 1, stock 225.0 um"`.
@@ -323,10 +333,7 @@ pub fn block_name(program: &AxisProgram, index: usize) -> String {
 }
 
 pub(crate) fn name_in(control: &str, blocks: &[Block], index: usize) -> String {
-    let label = match blocks.get(index).and_then(|b| b.number) {
-        Some(n) => format!("N{n}"),
-        None => block_label(control, index),
-    };
+    let label = label_in(control, blocks, index);
     let pass = blocks
         .get(..=index.min(blocks.len().saturating_sub(1)))
         .and_then(|b| b.iter().rev().find_map(|b| b.comment.as_deref()));

@@ -136,7 +136,7 @@ pub const KIND: OutcomeKind = OutcomeKind {
 };
 
 /// The page's section: the finish and every pass's figures.
-fn section(entry: &serde_json::Value, control: &str) -> Result<String, String> {
+fn section(entry: &serde_json::Value, label: &dyn Fn(usize) -> String) -> Result<String, String> {
     let v: GrindingCheck = serde_json::from_value(entry.clone()).map_err(|e| e.to_string())?;
     let mut out = String::new();
     let _ = write!(
@@ -148,9 +148,10 @@ fn section(entry: &serde_json::Value, control: &str) -> Result<String, String> {
     );
     if let Some(f) = v.passes.last() {
         // The block counts from 1 (the program's and report.csv's).
-        let block = f.deviation.block.map_or_else(String::new, |b| {
-            format!(", {}", escape(&crate::program::block_label(control, b - 1)))
-        });
+        let block = f
+            .deviation
+            .block
+            .map_or_else(String::new, |b| format!(", {}", escape(&label(b - 1))));
         let _ = writeln!(
             out,
             "<p class=\"verdict\">Finish ({}) within <b>{} mm</b> of the nominal; the worst at z = {} mm{block}.</p>",

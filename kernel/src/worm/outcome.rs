@@ -166,7 +166,7 @@ pub const KIND: OutcomeKind = OutcomeKind {
 };
 
 /// The page's section: chips, loads, leads and each start's figures.
-fn section(entry: &serde_json::Value, _control: &str) -> Result<String, String> {
+fn section(entry: &serde_json::Value, _label: &dyn Fn(usize) -> String) -> Result<String, String> {
     let w: WormCheck = serde_json::from_value(entry.clone()).map_err(|e| e.to_string())?;
     let mut out = String::new();
     let _ = write!(
