@@ -74,7 +74,10 @@ fn marker_text(files: &[&str], failed: bool) -> String {
 /// The files a marker lists (plain names only: a line that is not one is
 /// not pilgrim's and lists nothing).
 fn marked_files(text: &str) -> Vec<&str> {
-    text.lines().skip(1).filter(|l| plain(l)).collect()
+    text.lines()
+        .skip(1)
+        .filter(|l| is_plain_file_name(l))
+        .collect()
 }
 
 /// Whether a marker's text says its run failed.
@@ -83,7 +86,7 @@ fn says_failed(text: &str) -> bool {
 }
 
 /// Whether `name` may be written in an output directory: a plain file name.
-fn plain(name: &str) -> bool {
+pub fn is_plain_file_name(name: &str) -> bool {
     !name.is_empty()
         && name.len() <= 255
         && name != "."
@@ -411,7 +414,7 @@ fn create_file(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
 /// [`write_dir`]'s writing, the marker saying whether the run failed.
 fn write_marked(out: &Path, files: &[(String, Vec<u8>)], failed: bool) -> Result<(), OutputError> {
     let (parent, base) = parent_and_base(out)?;
-    if let Some((bad, _)) = files.iter().find(|(n, _)| !plain(n)) {
+    if let Some((bad, _)) = files.iter().find(|(n, _)| !is_plain_file_name(n)) {
         return Err(err(
             out,
             format!("'{}' is not a plain file name", crate::names::quoted(bad)),
@@ -607,10 +610,10 @@ mod tests {
     #[test]
     fn only_plain_names_are_written() {
         for bad in ["../x", "/etc/passwd", "a/b", ".hidden", "..", ""] {
-            assert!(!plain(bad), "{bad}");
+            assert!(!is_plain_file_name(bad), "{bad}");
         }
         for good in ["part.stl", "scene.glb", "report-2.csv"] {
-            assert!(plain(good), "{good}");
+            assert!(is_plain_file_name(good), "{good}");
         }
     }
 

@@ -20,9 +20,10 @@ use std::collections::BTreeMap;
 use crate::common::root;
 
 /// The ring family: the demo's script for everything but the
-/// verification, which is this file's.
+/// verification, which is this file's; `picture` names its plot's file.
 struct Ring {
     script: ScriptFamily,
+    picture: &'static str,
 }
 
 impl PartFamily for Ring {
@@ -53,6 +54,7 @@ impl PartFamily for Ring {
             radius: num("radius") + num("tool_diameter") / 2.0,
             depth: num("depth"),
             tolerance: 0.002,
+            picture: self.picture,
         })))
     }
 }
@@ -63,6 +65,7 @@ struct RingRequest {
     radius: f64,
     depth: f64,
     tolerance: f64,
+    picture: &'static str,
 }
 
 impl Verifier for RingRequest {
@@ -80,6 +83,7 @@ impl Verifier for RingRequest {
             outcome: Box::new(RingOutcome {
                 errors,
                 tolerance: self.tolerance,
+                picture: self.picture,
             }),
             stock: None,
         })
@@ -96,6 +100,7 @@ struct RingOutcome {
     /// (block from 0, radius error mm).
     errors: Vec<(usize, f64)>,
     tolerance: f64,
+    picture: &'static str,
 }
 
 impl RingOutcome {
@@ -172,18 +177,22 @@ impl Outcome for RingOutcome {
             self.errors.len().max(1),
             points.join(" ")
         );
-        Ok(vec![("ring.svg".into(), svg.into_bytes())])
+        Ok(vec![(self.picture.into(), svg.into_bytes())])
     }
 }
 
 fn ring() -> Ring {
+    ring_drawing("ring.svg")
+}
+
+fn ring_drawing(picture: &'static str) -> Ring {
     let script = ScriptFamily::load(
         &root().join("scripts/examples/mill_circle.rhai"),
         &Limits::default(),
         &Access::default(),
     )
     .unwrap();
-    Ring { script }
+    Ring { script, picture }
 }
 
 /// The ring's run: its verification's figure in the verdict, its entry in
@@ -260,4 +269,18 @@ fn a_family_of_its_own_verifies_and_draws_through_the_traits() {
         "{}",
         failed.report.verdict.message()
     );
+    // A verification draws; it never writes a program (past the lint) or
+    // the run's own files.
+    for name in ["program.nc", "report.json", "../ring.svg"] {
+        let err = job::run(
+            &ring_drawing(name),
+            &machine,
+            &[],
+            &JobOptions::default(),
+            &mut |_| {},
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(err.contains("is not a name it may write"), "{name}: {err}");
+    }
 }

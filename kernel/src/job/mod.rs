@@ -618,6 +618,22 @@ fn run_on(
             parts: &parts,
         };
         let made = o.files(&ctx, &report.tables).map_err(Error::Output)?;
+        // A verification draws and tabulates; the programs, the report and
+        // the data files are the run's own, and every name is a file's.
+        if let Some((name, _)) = made.iter().find(|(n, _)| {
+            !crate::output::is_plain_file_name(n)
+                || n.starts_with("program.")
+                || n.starts_with("report.")
+                || files.iter().any(|f| &f.0 == n)
+        }) {
+            return Err(Error::Family(crate::family::FamilyError::Contract {
+                family: family.name().to_owned(),
+                message: format!(
+                    "its verification's file {} is not a name it may write: the programs, the report and the data files are the run's own",
+                    crate::names::quoted(name)
+                ),
+            }));
+        }
         if o.leads_charts() {
             for (name, bytes) in made {
                 report.files.push(name.clone());
