@@ -118,7 +118,8 @@ pub struct FilesContext<'a> {
 /// overlays.
 pub trait Outcome: std::fmt::Debug + Send + Sync {
     /// Its key in `report.json` (one per kind: `verification`,
-    /// `groove_verification`, ...).
+    /// `groove_verification`, ...): a plain name ending in `verification`,
+    /// which no field of the report's own is.
     fn key(&self) -> &'static str;
     /// Its entry in `report.json`.
     ///

@@ -591,7 +591,19 @@ fn run_on(
         axis_ranges: axis_ranges(&program),
         verifications: match &outcome {
             Some(o) => {
-                std::iter::once((o.key().to_owned(), o.to_json().map_err(Error::Output)?)).collect()
+                // Its entry sits among the report's own fields: a key that
+                // names a verification cannot be one of them.
+                let key = o.key();
+                if !(key.ends_with("verification") && crate::files::is_plain_name(key)) {
+                    return Err(Error::Family(crate::family::FamilyError::Contract {
+                        family: family.name().to_owned(),
+                        message: format!(
+                            "its verification's report key {} must be a plain name ending in 'verification'",
+                            crate::names::quoted(key)
+                        ),
+                    }));
+                }
+                std::iter::once((key.to_owned(), o.to_json().map_err(Error::Output)?)).collect()
             }
             None => Default::default(),
         },
