@@ -69,6 +69,7 @@ impl Verification {
 
 /// What a verification replays: the program as its control reads it, on
 /// the machine the run uses, with the family's tool, in its passes.
+#[derive(Clone, Copy)]
 pub struct ReplayContext<'a> {
     /// The family's name, for messages.
     pub family: &'a str,

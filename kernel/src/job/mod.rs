@@ -626,7 +626,7 @@ fn run_on(
     if let Some(o) = &outcome {
         o.extend_tables(&mut report.tables);
         let ctx = FilesContext {
-            replay: ReplayContext { ..replay_ctx },
+            replay: replay_ctx,
             parts: &parts,
         };
         let made = o.files(&ctx, &report.tables).map_err(Error::Output)?;
