@@ -50,7 +50,7 @@ fn chain_fk(c: &mut Criterion) {
 
 /// Reachable Mannesmann poses along a path: a wheel winding round the roll.
 fn mannesmann_targets(n: usize) -> (Machine, ToolFrame, Vec<Target>) {
-    let m = Machine::builtin("Mannesmann").unwrap();
+    let m = Machine::from_info(mannesmann::describe()).unwrap();
     let tool = ToolFrame {
         point: Point3::new(-60.0, 0.0, 0.0),
         ..ToolFrame::default()

@@ -10,7 +10,7 @@ mod run;
 use clap::{Parser, Subcommand};
 use pilgrim_kernel::catalog::{Catalog, CompiledPlugin, Origin};
 use pilgrim_kernel::job::Formats;
-use pilgrim_kernel::machine::{AxisKind, MachineInfo};
+use pilgrim_kernel::machine::{machine_file, AxisKind, MachineInfo};
 use pilgrim_kernel::plugin::PluginMachine;
 use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
 use pilgrim_kernel::PartFamily;
@@ -23,24 +23,20 @@ use std::process::ExitCode;
 #[global_allocator]
 static ALLOCATOR: counting::Counting = counting::Counting;
 
-/// The machine plugins compiled into the program.
-const COMPILED_PLUGINS: [CompiledPlugin; 4] = [
-    CompiledPlugin {
-        symbol: "pilgrim_plugin_grinder_3k152vf20",
-        entry: grinder_3k152vf20::pilgrim_plugin_grinder_3k152vf20,
-    },
-    CompiledPlugin {
-        symbol: "pilgrim_plugin_lz_250",
-        entry: lz_250::pilgrim_plugin_lz_250,
-    },
-    CompiledPlugin {
-        symbol: "pilgrim_plugin_mannesmann",
-        entry: mannesmann::pilgrim_plugin_mannesmann,
-    },
-    CompiledPlugin {
-        symbol: "pilgrim_plugin_fanuc_0i_tc",
-        entry: fanuc_0i_tc::pilgrim_plugin_fanuc_0i_tc,
-    },
+/// `crate::entry` of each plugin compiled in, as its entry symbol.
+macro_rules! compiled {
+    ($($krate:ident :: $entry:ident),* $(,)?) => {
+        [$(CompiledPlugin { symbol: stringify!($entry), entry: $krate::$entry }),*]
+    };
+}
+
+/// The machine plugins compiled into the program: a machine crate under
+/// `plugins/` (its dependency in Cargo.toml) and one line here.
+const COMPILED_PLUGINS: &[CompiledPlugin] = &compiled![
+    grinder_3k152vf20::pilgrim_plugin_grinder_3k152vf20,
+    lz_250::pilgrim_plugin_lz_250,
+    mannesmann::pilgrim_plugin_mannesmann,
+    fanuc_0i_tc::pilgrim_plugin_fanuc_0i_tc,
 ];
 
 /// CAM for special grinders and lathes: cold-pilger mandrels and calibers,
@@ -183,6 +179,10 @@ enum Command {
         /// Only the machines from --plugin and --file.
         #[arg(long)]
         only_files: bool,
+        /// Print this machine (a built-in's name, a plugin or a file) as a
+        /// machine file instead: the start of a shop's own.
+        #[arg(long, value_name = "MACHINE", conflicts_with_all = ["plugins", "files", "only_files"])]
+        toml: Option<String>,
     },
     /// List a family's parameters: name, default, unit, description.
     Params {
@@ -355,7 +355,7 @@ fn main() -> ExitCode {
             call: seconds,
         },
     );
-    let catalog = match Catalog::new(&COMPILED_PLUGINS) {
+    let catalog = match Catalog::new(COMPILED_PLUGINS) {
         Ok(c) => c,
         Err(e) => {
             eprintln!("pilgrim: a compiled-in machine plugin is broken: {e}");
@@ -406,9 +406,22 @@ fn main() -> ExitCode {
         )
         .map(|s| s + "\n"),
         Command::Machines {
+            toml: Some(spec), ..
+        } => catalog
+            .open(spec)
+            .map(|m| {
+                let origin = match m.origin.to_string() {
+                    o if o.is_empty() => format!("the built-in {spec}"),
+                    o => format!("{spec}, {o}"),
+                };
+                machine_file(m.kinematics.info(), &origin)
+            })
+            .map_err(|e| e.to_string()),
+        Command::Machines {
             plugins,
             files,
             only_files,
+            toml: None,
         } => list_machines(&catalog, plugins, files, *only_files),
         Command::Export {
             dir,

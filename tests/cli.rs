@@ -11,13 +11,12 @@ fn scratch(name: &str) -> PathBuf {
     common::scratch("cli", name)
 }
 
-/// The TOML text of the built-in data machine `name`.
-fn builtin_source(name: &str) -> &'static str {
-    pilgrim_kernel::machine::BUILTIN_SOURCES
-        .iter()
-        .find(|(n, _)| *n == name)
-        .unwrap()
-        .1
+/// The machine file of the built-in `name`, as `pilgrim machines --toml`
+/// writes it.
+fn builtin_source(name: &str) -> String {
+    let (code, out, err) = pilgrim(&["machines", "--toml", name]);
+    assert_eq!(code, 0, "{err}");
+    out
 }
 
 const DEMO: &str = "scripts/examples/mill_circle.rhai";

@@ -915,8 +915,21 @@ fn a_heavy_finish_fails_and_tall_ridges_are_reported() {
 /// number, not the constant) is refused naming the chain's value.
 #[test]
 fn the_rests_place_comes_from_the_machines_chain() {
-    let file = common::root().join("tests/fixtures/grinder-rest-literal.toml");
     let dir = common::scratch("mandrel", "rest-literal");
+    // The 3K152VF20 written as a machine file, its rest placed by a
+    // literal -180 mm while its constant says -150 mm.
+    let (code, grinder, err) = common::pilgrim(&["machines", "--toml", "3K152VF20"]);
+    assert_eq!(code, 0, "{err}");
+    let mut text = grinder.clone();
+    for (from, to) in [
+        ("constant = \"rest_offset_b\"", "value = -180.0"),
+        ("rest_offset_b = -180.0", "rest_offset_b = -150.0"),
+    ] {
+        assert!(text.contains(from), "{from} not in\n{grinder}");
+        text = text.replacen(from, to, 1);
+    }
+    let file = dir.join("grinder-rest-literal.toml");
+    std::fs::write(&file, &text).unwrap();
     let out = dir.join("run");
     let run = |machine: &Path, sets: &[&str]| {
         let mut args = vec![
@@ -942,7 +955,6 @@ fn the_rests_place_comes_from_the_machines_chain() {
     );
     assert!(!out.join("program.mpf").exists());
     // Without the constant: the chain's -180 mm.
-    let text = std::fs::read_to_string(&file).unwrap();
     let plain = dir.join("grinder.toml");
     std::fs::write(&plain, text.replace("rest_offset_b = -150.0\n", "")).unwrap();
     let (code, _, err) = run(&plain, &[]);

@@ -555,14 +555,18 @@ fn killed_runs_leave_the_old_output_whole() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// A lathe (the Fanuc 0i-TC's file) whose control is `control` and whose
-/// name or description is `name` / `description`.
+/// A lathe (the Fanuc 0i-TC's machine file, written from its plugin's
+/// descriptor) whose control is `control` and whose name or description
+/// is `name` / `description`.
 fn lathe(control: &str, name: &str, description: &str) -> String {
-    let text = pilgrim_kernel::machine::BUILTIN_SOURCES
-        .iter()
-        .find(|(n, _)| *n == "fanuc-0i-tc")
-        .unwrap()
-        .1;
+    let text = pilgrim_kernel::machine::machine_file(&fanuc_0i_tc::describe(), "its crate");
+    for key in [
+        "name = \"fanuc-0i-tc\"",
+        "description = \"two-axis CNC lathe, Fanuc 0i-TC, X on diameter\"",
+        "control = \"fanuc\"",
+    ] {
+        assert!(text.contains(key), "{key} not in\n{text}");
+    }
     // A TOML basic string, control characters as \uXXXX.
     let quote = |t: &str| {
         let body: String = t

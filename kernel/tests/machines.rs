@@ -1,15 +1,27 @@
-//! The built-in machines: each loads (which checks its stated signs against
-//! its chain), their geometry is the seeds', and bad files are refused with
-//! the key and line named.
+//! The seeds' machines (their plugin crates' descriptors) and the data
+//! built-in: each loads (which checks its stated signs against its chain),
+//! their geometry is the seeds', and bad files (the lathe's, written from
+//! its descriptor) are refused with the key and line named.
 
-use pilgrim_kernel::machine::{BUILTIN_MACHINES, BUILTIN_SOURCES};
+use pilgrim_kernel::machine::{machine_file, BUILTIN_MACHINES};
 use pilgrim_kernel::{assert_near, AxisKind, Machine, MachineError, Point3, ToolFrame};
 
 #[test]
-fn every_builtin_loads_and_states_every_sign() {
-    for name in BUILTIN_MACHINES {
-        let m = Machine::builtin(name).unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert_eq!(m.name(), name);
+fn every_machine_loads_and_states_every_sign() {
+    let mut machines: Vec<Machine> = BUILTIN_MACHINES
+        .iter()
+        .map(|name| Machine::builtin(name).unwrap_or_else(|e| panic!("{name}: {e}")))
+        .collect();
+    for info in [
+        grinder_3k152vf20::describe(),
+        lz_250::describe(),
+        mannesmann::describe(),
+        fanuc_0i_tc::describe(),
+    ] {
+        machines.push(Machine::from_info(info).unwrap());
+    }
+    for m in &machines {
+        let name = m.name();
         for a in m.axes() {
             match a.kind {
                 AxisKind::Linear => assert!(a.moves.is_some(), "{name} {}", a.name),
@@ -18,19 +30,15 @@ fn every_builtin_loads_and_states_every_sign() {
             }
         }
     }
-    assert!(Machine::builtin("lz-250").is_ok());
+    assert!(Machine::builtin("Vertical-Mill").is_ok());
     let e = Machine::builtin("planer").unwrap_err();
-    assert!(
-        e.to_string()
-            .contains("built-ins: LZ-250, Mannesmann, fanuc-0i-tc, vertical-mill"),
-        "{e}"
-    );
+    assert!(e.to_string().contains("built-ins: vertical-mill"), "{e}");
 }
 
 #[test]
 fn caliber_grinders_turn_the_roll_and_swivel_the_wheel_as_stated() {
-    for name in ["LZ-250", "Mannesmann"] {
-        let m = Machine::builtin(name).unwrap();
+    for info in [lz_250::describe(), mannesmann::describe()] {
+        let m = Machine::from_info(info).unwrap();
         let c = m.chain();
         let mut q = vec![0.0; c.dof()];
         q[c.axis_index("Z").unwrap()] = 200.0;
@@ -45,25 +53,22 @@ fn caliber_grinders_turn_the_roll_and_swivel_the_wheel_as_stated() {
         let p = c.pose(&q, &ToolFrame::default()).unwrap();
         assert_near!(p.axis.y, -(10f64.to_radians().sin()), 1e-12);
     }
-    assert!(Machine::builtin("LZ-250").unwrap().axis("Y").is_none());
-    assert!(Machine::builtin("Mannesmann").unwrap().axis("Y").is_some());
+    assert!(lz_250::describe().axes.iter().all(|a| a.name != "Y"));
+    assert!(mannesmann::describe().axes.iter().any(|a| a.name == "Y"));
 }
 
 #[test]
 fn lathe_programs_diameter() {
-    let m = Machine::builtin("fanuc-0i-tc").unwrap();
+    let m = Machine::from_info(fanuc_0i_tc::describe()).unwrap();
     assert_eq!(m.chain().axis_names(), ["X", "Z"]);
     let p = m.chain().apply(&[100.0, -30.0], &Point3::origin()).unwrap();
     assert_eq!(p, Point3::new(50.0, 0.0, -30.0));
     assert_eq!(m.control(), "fanuc");
 }
 
-fn lathe_text() -> &'static str {
-    BUILTIN_SOURCES
-        .iter()
-        .find(|(n, _)| *n == "fanuc-0i-tc")
-        .unwrap()
-        .1
+/// The Fanuc lathe's machine file, written from its plugin's descriptor.
+fn lathe_text() -> String {
+    machine_file(&fanuc_0i_tc::describe(), "the fanuc-0i-tc crate")
 }
 
 /// Line (from 1) of the first line of `text` containing `needle`.

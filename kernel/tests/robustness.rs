@@ -1,7 +1,7 @@
 //! Random input, including NaN, infinities and huge values, never makes the
 //! kernel panic: every bad value comes back as an error.
 
-use pilgrim_kernel::machine::BUILTIN_SOURCES;
+use pilgrim_kernel::machine::{machine_file, BUILTIN_SOURCES};
 use pilgrim_kernel::{
     drop_circle, equidistant, read_table_str, rest, Bulge, CircleEnvelope, EllipseSection,
     IkOptions, Machine, MandrelLaw, Point3, Profile, ProfileBuilder, Side, Target, ToolFrame, Vec3,
@@ -91,7 +91,7 @@ proptest! {
 
     #[test]
     fn inverse_kinematics_never_panics(p in prop::collection::vec(real(), 6), restarts in any::<bool>()) {
-        let m = Machine::builtin("Mannesmann").unwrap();
+        let m = Machine::from_info(mannesmann::describe()).unwrap();
         let opts = IkOptions { restarts, max_iter: 30, ..IkOptions::default() };
         let target = Target::pose(Point3::new(p[0], p[1], p[2]), Vec3::new(p[3], p[4], p[5]));
         let _ = m.inverse(&target, &ToolFrame::default(), None, &opts);
@@ -109,8 +109,13 @@ proptest! {
     }
 
     #[test]
-    fn machine_files_never_panic(cut in 0usize..4000, insert in "\\PC{0,12}", which in 0usize..BUILTIN_SOURCES.len()) {
-        let base = BUILTIN_SOURCES[which].1;
+    fn machine_files_never_panic(cut in 0usize..4000, insert in "\\PC{0,12}", which in 0usize..3) {
+        let base = match which {
+            0 => BUILTIN_SOURCES[0].1.to_owned(),
+            1 => machine_file(&mannesmann::describe(), "the mannesmann crate"),
+            _ => machine_file(&grinder_3k152vf20::describe(), "the 3K152VF20 crate"),
+        };
+        let base = base.as_str();
         let mut at = cut.min(base.len());
         while !base.is_char_boundary(at) {
             at -= 1;

@@ -141,7 +141,7 @@ fn lcg(state: &mut u64) -> f64 {
 /// machine's home finds axis values whose pose is the target's.
 #[test]
 fn ik_round_trips_fk_on_the_mannesmann_chain() {
-    let m = Machine::builtin("Mannesmann").unwrap();
+    let m = Machine::from_info(mannesmann::describe()).unwrap();
     let chain = m.chain();
     assert_eq!(chain.axis_names(), ["X", "Z", "Y", "A", "B"]);
     // The rounding centre of a wheel of radius 60, in the wheel's plane.
@@ -215,7 +215,7 @@ fn ik_round_trips_fk_on_the_vertical_mill() {
 /// refused with the error naming why.
 #[test]
 fn ik_refuses_unreachable_and_out_of_travel_targets() {
-    let m = Machine::builtin("LZ-250").unwrap();
+    let m = Machine::from_info(lz_250::describe()).unwrap();
     let tool = ToolFrame::default();
     // The LZ-250 has no Y: a wheel axis tilted about X with the centre at
     // A = 0 needs Y = 0; asking for a wheel axis along the radius is impossible.

@@ -1,34 +1,23 @@
-//! The machines of the seeds, embedded so they work with no files around.
+//! The data machine built into the kernel, embedded so it works with no
+//! files around. The seeds' own machines (the 3K152VF20, LZ-250,
+//! Mannesmann and Fanuc 0i-TC) are plugin crates compiled into the
+//! program, described there once; [`super::machine_file`] writes any of
+//! them as a machine file.
 
 use super::{Machine, MachineError};
 
-/// `(name, TOML text)` of every built-in data machine. (The 3K152VF20 is
-/// a plugin crate, `plugins/grinder-3k152vf20`, compiled into the program.)
-pub const BUILTIN_SOURCES: [(&str, &str); 4] = [
-    ("LZ-250", include_str!("../../machines/lz-250.toml")),
-    ("Mannesmann", include_str!("../../machines/mannesmann.toml")),
-    (
-        "fanuc-0i-tc",
-        include_str!("../../machines/fanuc-0i-tc.toml"),
-    ),
-    (
-        "vertical-mill",
-        include_str!("../../machines/vertical-mill.toml"),
-    ),
-];
+/// `(name, TOML text)` of every built-in data machine: the vertical mill
+/// of MATH §1's example, the universal chain with only the mill's axes.
+pub const BUILTIN_SOURCES: [(&str, &str); 1] = [(
+    "vertical-mill",
+    include_str!("../../machines/vertical-mill.toml"),
+)];
 
 /// The names of the built-in data machines.
-pub const BUILTIN_MACHINES: [&str; 4] = [
-    BUILTIN_SOURCES[0].0,
-    BUILTIN_SOURCES[1].0,
-    BUILTIN_SOURCES[2].0,
-    BUILTIN_SOURCES[3].0,
-];
+pub const BUILTIN_MACHINES: [&str; 1] = [BUILTIN_SOURCES[0].0];
 
 impl Machine {
-    /// A built-in data machine by name (case-insensitive): `LZ-250` and
-    /// `Mannesmann` (caliber grinders), `fanuc-0i-tc` (lathe),
-    /// `vertical-mill` (MATH §1's example).
+    /// A built-in data machine by name (case-insensitive): `vertical-mill`.
     ///
     /// # Failures
     /// [`MachineError::UnknownMachine`] listing the built-ins.

@@ -4,9 +4,9 @@
 //! A machine is described as data, a [`MachineInfo`] (the type the plugin
 //! ABI carries): its axes, constants, the chains of the tool and of other
 //! moving bodies, and its capabilities. It comes from a TOML file (see
-//! [`Machine::from_toml_str`] for the format), one of the data built-ins of
-//! the seeds ([`Machine::builtin`]), or a plugin's descriptor
-//! ([`Machine::from_info`]). Units in files are millimetres and degrees
+//! [`Machine::from_toml_str`] for the format), the data built-in
+//! ([`Machine::builtin`]), or a plugin's descriptor ([`Machine::from_info`]);
+//! [`machine_file`] writes any description as a file. Units in files are millimetres and degrees
 //! (`_deg` keys); inside, millimetres and radians.
 //!
 //! The runtime uses a machine through [`MachineKinematics`]: inverse and
@@ -15,15 +15,15 @@
 //!
 //! ```
 //! use pilgrim_kernel::machine::Machine;
-//! let m = Machine::builtin("fanuc-0i-tc").unwrap();
-//! assert_eq!(m.chain().axis_names(), ["X", "Z"]);
-//! assert!(m.axis("S").is_some());
+//! let m = Machine::builtin("vertical-mill").unwrap();
+//! assert_eq!(m.chain().axis_names(), ["X", "Y", "Z", "C"]);
 //! ```
 
 mod builtin;
 mod file;
 mod info;
 mod kinematics;
+mod write;
 
 pub use builtin::{BUILTIN_MACHINES, BUILTIN_SOURCES};
 pub use info::{bodies_of, body_offset, check_description, Body, AXIS_LETTERS};
@@ -32,6 +32,7 @@ pub use kinematics::{batch_rows, ChainMachine, KinematicsError, MachineKinematic
 pub use pilgrim_plugin_abi::types::{
     Axis, AxisKind, BodyShape, BodySpec, FactorSpec, MachineInfo, Quantity, ToolSpec,
 };
+pub use write::machine_file;
 
 use crate::math::Real;
 use crate::transform::{Chain, IkOptions, IkSolution, Target, ToolFrame, TransformError};
@@ -480,7 +481,7 @@ mod tests {
     /// it moves, the linear path where it does not.
     #[test]
     fn feed_lengths_follow_the_control() {
-        let m = Machine::builtin("LZ-250").unwrap();
+        let m = Machine::from_info(lz_250::describe()).unwrap();
         let axes: Vec<&Axis> = ["X", "Z", "A", "B"]
             .iter()
             .map(|n| m.info().axis(n).unwrap())
@@ -499,7 +500,7 @@ mod tests {
 
     #[test]
     fn travel_and_feed_errors_name_point_and_axis() {
-        let m = Machine::builtin("fanuc-0i-tc").unwrap();
+        let m = Machine::from_info(fanuc_0i_tc::describe()).unwrap();
         let rows = [10.0, 0.0, 20.0, -5.0, 30.0, -900.0];
         let e = m.check_travel(&["X", "Z"], &rows).unwrap_err();
         assert!(
@@ -528,7 +529,7 @@ mod tests {
 
     #[test]
     fn rotary_limits_are_reported_in_degrees() {
-        let m = Machine::builtin("LZ-250").unwrap();
+        let m = Machine::from_info(lz_250::describe()).unwrap();
         let b = m.axis("B").unwrap();
         let too_far = b.max + 0.1;
         let e = m.check_travel(&["B"], &[too_far]).unwrap_err();

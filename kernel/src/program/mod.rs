@@ -927,7 +927,7 @@ mod tests {
     fn rotary_feeds_follow_the_program_as_written() {
         use crate::machine::{ChainMachine, Machine};
         use crate::toolpath::{ClPoint, Pass};
-        let lz = ChainMachine::new(Machine::builtin("LZ-250").unwrap());
+        let lz = ChainMachine::new(Machine::from_info(lz_250::describe()).unwrap());
         let wheel = crate::tool::Wheel::new(250.0, 8.0, 16.0).unwrap();
         let at = |deg: Real, z: Real| {
             let t = deg.to_radians();

@@ -3,9 +3,9 @@
 //! spindle; worm threads cut in many passes with single thread blocks
 //! (G32). The host's writer posts its programs in the `fanuc` dialect.
 //!
-//! Its description ([`describe`]) is the one definition of the machine;
-//! the kernel's data file `kernel/machines/fanuc-0i-tc.toml` says the same
-//! (a test holds them equal). Part frame: Z along the spindle's axis, X
+//! Its description ([`describe`]) is the one definition of the machine
+//! (`pilgrim machines --toml fanuc-0i-tc` writes it as a machine file).
+//! Part frame: Z along the spindle's axis, X
 //! radial (ARCHITECTURE §3). Signs:
 //!
 //! - `X` on diameter: +1 mm moves the tool 0.5 mm away from the axis;
@@ -160,12 +160,6 @@ mod tests {
     use pilgrim_kernel::machine::{ChainMachine, Machine, MachineKinematics};
     use pilgrim_kernel::math::{Point3, Vec3};
     use pilgrim_kernel::transform::ToolFrame;
-
-    /// The plugin describes the machine the kernel's machine file does.
-    #[test]
-    fn the_plugin_is_the_machine_file() {
-        assert_eq!(Machine::builtin(NAME).unwrap().info(), &describe());
-    }
 
     /// The closed form agrees with the description's chain solved
     /// numerically, both ways; X is twice the radius.

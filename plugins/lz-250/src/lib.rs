@@ -206,16 +206,3 @@ impl<const CROSS: bool> Plugin for CaliberGrinder<CROSS> {
 }
 
 export_plugin!(pilgrim_plugin_lz_250, CaliberGrinder<false>);
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use pilgrim_kernel::machine::Machine;
-
-    /// The plugin describes the machine the kernel's machine file does:
-    /// one machine, whichever way it is opened.
-    #[test]
-    fn the_plugin_is_the_machine_file() {
-        assert_eq!(Machine::builtin(NAME).unwrap().info(), &describe());
-    }
-}

@@ -23,15 +23,3 @@ pub fn describe() -> MachineInfo {
 }
 
 export_plugin!(pilgrim_plugin_mannesmann, CaliberGrinder<true>);
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use pilgrim_kernel::machine::Machine;
-
-    /// The plugin describes the machine the kernel's machine file does.
-    #[test]
-    fn the_plugin_is_the_machine_file() {
-        assert_eq!(Machine::builtin(NAME).unwrap().info(), &describe());
-    }
-}
