@@ -90,5 +90,5 @@ fn the_kernels_modules_form_no_circle() {
         })
         .map(|(m, _)| m.as_str())
         .collect();
-    assert_eq!(naming, ["families", "job", "script"]);
+    assert_eq!(naming, ["families", "job"]);
 }

@@ -5,6 +5,7 @@
 //! outside the kernel needs none: its verification's figures reach the
 //! report and the page's verdict through [`crate::family::Outcome`]).
 
+use crate::binding::ApiGroup;
 use crate::family::OutcomeKind;
 
 /// Every kind of verification the kernel carries.
@@ -13,6 +14,12 @@ pub const KINDS: [&OutcomeKind; 3] = [
     &crate::caliber::KIND,
     &crate::worm::KIND,
 ];
+
+/// The script API of the families that have their own, listed in the
+/// reference after the generic groups (numbers, profiles, paths,
+/// equidistants) and before the transforms, tools and toolpaths.
+pub(crate) const SCRIPT_API: [&ApiGroup; 2] =
+    [&crate::caliber::SCRIPT_API, &crate::worm::SCRIPT_API];
 
 /// The kind whose report key is `key`.
 pub fn kind(key: &str) -> Option<&'static OutcomeKind> {

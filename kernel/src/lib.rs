@@ -42,6 +42,7 @@
 //! assert!(dev >= -1e-9 && dev < 0.1 * 0.1 / (8.0 * 20.0) + 1e-5);
 //! ```
 
+mod binding;
 pub mod budget;
 pub mod caliber;
 pub mod catalog;

@@ -399,3 +399,34 @@ fn tables_are_read_column_by_column() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A script's `fn verify(p)` map is read by the family whose key it has
+/// (the families' readers are registered from their folders): a map of no
+/// form names every form, and a family's map names what is wrong in it.
+#[test]
+fn a_verify_map_names_what_is_wrong_with_it() {
+    let message = |body: &str| {
+        let src = format!("{HEAD}fn toolpath(p) {{ 0 }}\nfn verify(p) {{ {body} }}\n");
+        let fam = family(&src).unwrap();
+        fam.verification(&values(&fam, None, &[]).unwrap())
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default()
+    };
+    let e = message("#{ depth: 1.0 }");
+    assert!(
+        e.contains("must return #{ profile, from, to, tolerance }")
+            && e.contains(", #{ groove, psi,")
+            && e.contains(" or #{ worm, length,"),
+        "{e}"
+    );
+    let e = message(
+        "#{ worm: worm(4.0, 1, 40.0, 0.2, 20.0, 0.0), length: 50.0, space_centre: 0.0, tolerance: #{ form: \"x\" } }",
+    );
+    assert!(
+        e.contains("fn verify(p): tolerance.form must be a number"),
+        "{e}"
+    );
+    let e = message("#{ worm: 1.0 }");
+    assert!(e.contains("must return #{ profile"), "{e}");
+}

@@ -2,7 +2,8 @@
 //! family builds pass by pass.
 
 use super::bind_offset::rounding_radius;
-use super::floats::{err, kernel, len_of, number, Column};
+use crate::binding::floats::{err, kernel, len_of, number, Column};
+use crate::binding::tool_number;
 use crate::math::Real;
 use crate::tool::{Tool, ToolShape, Wheel};
 use crate::toolpath::{ClPoint, Motion, Pass, Toolpath};
@@ -13,13 +14,6 @@ use std::rc::Rc;
 
 /// A toolpath under construction, shared by handle.
 pub type ToolpathHandle = Rc<RefCell<Toolpath>>;
-
-/// A tool's number, its name checked first: the name reaches the program
-/// ([`crate::names::check_name`]).
-pub(super) fn tool_number(name: &str, number: i64) -> Result<u32, Box<EvalAltResult>> {
-    kernel(crate::names::check_name("tool name", name))?;
-    u32::try_from(number).map_err(|_| format!("tool number {number} is out of range").into())
-}
 
 /// Tools.
 #[export_module]
@@ -148,7 +142,7 @@ pub mod toolpath_api {
         let mut len = None;
         for (k, v) in columns {
             kernel(crate::names::check_name("column name", &k))?;
-            let col = crate::script::floats::numbers(&v, &format!("table {name}, column {k}"))?;
+            let col = crate::binding::floats::numbers(&v, &format!("table {name}, column {k}"))?;
             if let Some(v) = col.iter().find(|v| !v.is_finite()) {
                 return Err(format!("table {name}, column {k}: {v} is not a finite number").into());
             }

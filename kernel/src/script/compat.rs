@@ -55,10 +55,10 @@ fn gone(old: &str, new: &str, why: &str) -> Box<EvalAltResult> {
 #[export_module]
 pub mod compat_api {
     use super::*;
+    use crate::binding::floats::floats_api;
     use crate::script::bind_offset::offset_api;
     use crate::script::bind_profile::{path_api, profile_api};
     use crate::script::bind_transform::{transform_api, Transform};
-    use crate::script::floats::floats_api;
 
     /// Earlier form of `raised(p, z_from, z_to, dx)`.
     #[rhai_fn(return_raw)]

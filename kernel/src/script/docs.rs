@@ -1,7 +1,7 @@
 //! The script API's reference, generated from the doc comments of the
 //! functions registered (rhai's `metadata`), group by group.
 
-use super::{register_types, Access, API};
+use super::{api, register_types, Access};
 use rhai::Engine;
 
 /// A signature in the script writer's terms: script type names, no Rust
@@ -99,7 +99,7 @@ pub fn api_reference() -> String {
          numbers; unary `-` negates. The naming scheme and the family contract are in\n\
          `scripts/README.md`.\n",
     );
-    for group in &API {
+    for group in api() {
         let mut engine = Engine::new_raw();
         register_types(&mut engine);
         (group.register)(&mut engine, &Access::default());

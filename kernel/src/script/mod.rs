@@ -21,19 +21,17 @@
 //! doc comments, by [`api_reference`] (`docs/script-api.md`). A machine may
 //! be a script too ([`machine_from_script`]).
 
-mod bind_caliber;
 mod bind_offset;
 mod bind_profile;
 mod bind_table;
 mod bind_toolpath;
 mod bind_transform;
-mod bind_worm;
 mod compat;
 mod docs;
-mod floats;
 
+use crate::binding::{floats, ApiGroup};
+pub use crate::binding::{Access, Floats};
 pub use docs::api_reference;
-pub use floats::Floats;
 
 use crate::family::{
     Check, FamilyError, PartBody, PartFamily, PartGeometry, Verification, VerifyRequest,
@@ -43,7 +41,7 @@ use crate::params::{ParamSpec, ParamValue, Params};
 use crate::profile::Profile;
 use crate::toolpath::Toolpath;
 use rhai::{Dynamic, Engine, EvalAltResult, Map, Position, Scope, AST};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The engine's limits.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -113,13 +111,6 @@ fn resident_mb() -> Option<u64> {
     Some(pages * u64::try_from(page).ok()? / (1 << 20))
 }
 
-/// Where scripts may read files.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub struct Access {
-    /// Directories scripts may read tables from (and below).
-    pub input_dirs: Vec<PathBuf>,
-}
-
 /// A part family written in Rhai: a script as a [`PartFamily`].
 pub struct ScriptFamily {
     engine: Engine,
@@ -180,7 +171,7 @@ pub fn engine(limits: &Limits, access: &Access) -> Engine {
         )
     });
     register_types(&mut e);
-    for group in API {
+    for group in api() {
         (group.register)(&mut e, access);
     }
     e
@@ -207,91 +198,109 @@ fn register_types(e: &mut Engine) {
         .register_type_with_name::<bind_transform::Points>("Points")
         .register_type_with_name::<Table>("Table")
         .register_type_with_name::<bind_toolpath::ToolpathHandle>("Toolpath")
-        .register_type_with_name::<crate::caliber::Groove>("Groove")
-        .register_type_with_name::<crate::caliber::SeedPose>("SeedPose")
-        .register_type_with_name::<crate::family::Swept>("Solid")
-        .register_type_with_name::<crate::worm::WormSizes>("Worm");
+        .register_type_with_name::<crate::family::Swept>("Solid");
+    for group in crate::families::SCRIPT_API {
+        (group.types)(e);
+    }
 }
 
-/// A group of the script API: its heading and what it registers.
-struct Group {
-    title: &'static str,
-    register: fn(&mut Engine, &Access),
+/// No types of its own.
+fn no_types(_: &mut Engine) {}
+
+/// The script API, group by group, as the reference lists it: the generic
+/// groups that come before the families', the families', the rest.
+fn api() -> impl Iterator<Item = &'static ApiGroup> {
+    BEFORE_FAMILIES
+        .iter()
+        .chain(crate::families::SCRIPT_API)
+        .chain(AFTER_FAMILIES.iter())
 }
 
-/// The script API, group by group, as the reference lists it.
-const API: [Group; 12] = [
-    Group {
+/// The generic groups listed before the families' own.
+const BEFORE_FAMILIES: [ApiGroup; 5] = [
+    ApiGroup {
         title: "Numbers (`Floats`)",
+        types: no_types,
+        verify: None,
         register: |e, _| {
             e.register_global_module(rhai::exported_module!(floats::floats_api).into());
             floats::register_arithmetic(e);
         },
     },
-    Group {
+    ApiGroup {
         title: "Profiles (`Profile`, `MandrelLaw`, `Smoothing`)",
+        types: no_types,
+        verify: None,
         register: |e, _| {
             e.register_global_module(rhai::exported_module!(bind_profile::profile_api).into());
         },
     },
-    Group {
+    ApiGroup {
         title: "Whole parts from segments (`ProfileBuilder`)",
+        types: no_types,
+        verify: None,
         register: |e, _| {
             e.register_global_module(rhai::exported_module!(bind_profile::builder_api).into());
         },
     },
-    Group {
+    ApiGroup {
         title: "Paths of tool centres (`Path`)",
+        types: no_types,
+        verify: None,
         register: |e, _| {
             e.register_global_module(rhai::exported_module!(bind_profile::path_api).into());
         },
     },
-    Group {
+    ApiGroup {
         title:
             "Equidistants, envelopes, the steady rest (`Equidistant`, `SteadyRest`, `RestTrack`)",
+        types: no_types,
+        verify: None,
         register: |e, _| {
             e.register_global_module(rhai::exported_module!(bind_offset::offset_api).into());
         },
     },
-    Group {
-        title: "Calibers: the groove, passes, the seed's pose (`Groove`, `SeedPose`)",
-        register: |e, _| {
-            e.register_global_module(rhai::exported_module!(bind_caliber::caliber_api).into());
-        },
-    },
-    Group {
-        title: "Worm threads: sizes, cutter, S1 and S2, passes (`Worm`)",
-        register: |e, _| {
-            e.register_global_module(rhai::exported_module!(bind_worm::worm_api).into());
-        },
-    },
-    Group {
+];
+
+/// The generic groups listed after the families' own.
+const AFTER_FAMILIES: [ApiGroup; 5] = [
+    ApiGroup {
         title: "Transforms (`Transform`, `Points`)",
+        types: no_types,
+        verify: None,
         register: |e, _| {
             e.register_global_module(rhai::exported_module!(bind_transform::transform_api).into());
         },
     },
-    Group {
+    ApiGroup {
         title: "Tools (`Tool`)",
+        types: no_types,
+        verify: None,
         register: |e, _| {
             e.register_global_module(rhai::exported_module!(bind_toolpath::tool_api).into());
         },
     },
-    Group {
+    ApiGroup {
         title: "Toolpaths (`Toolpath`)",
+        types: no_types,
+        verify: None,
         register: |e, _| {
             e.register_global_module(rhai::exported_module!(bind_toolpath::toolpath_api).into());
         },
     },
-    Group {
+    ApiGroup {
         title: "Tables (`Table`)",
+        types: no_types,
+        verify: None,
         register: |e, access| {
             e.register_global_module(rhai::exported_module!(bind_table::table_api).into());
             bind_table::register(e, access);
         },
     },
-    Group {
+    ApiGroup {
         title: "Earlier releases' forms (callable for a release more, with a warning naming the replacement)",
+        types: no_types,
+        verify: None,
         register: |e, _| {
             e.register_global_module(rhai::exported_module!(compat::compat_api).into());
         },
@@ -699,82 +708,41 @@ impl PartFamily for ScriptFamily {
     }
 
     /// `fn verify(p)`, if the script has it: `#{ profile, from, to,
-    /// tolerance }` (a body of revolution), `#{ groove, psi,
-    /// tolerance, grid_theta, grid_per_step, patch_gap }` (a caliber) or
-    /// `#{ worm, length, space_centre, tolerance }` (a worm thread).
+    /// tolerance }` (a body of revolution), or the map of a family with
+    /// its own verification (`#{ groove, ... }` a caliber, `#{ worm, ... }`
+    /// a worm thread: [`crate::families::SCRIPT_API`]).
     fn verification(&self, values: &Params) -> Result<Option<Verification>, FamilyError> {
         if !self.has_fn("verify", 1) {
             return Ok(None);
         }
         let d = self.call_with_params("verify", values)?;
         let shape = || {
-            self.contract(
-                "fn verify(p) must return #{ profile, from, to, tolerance } (and optionally blank, a profile), #{ groove, psi, tolerance, grid_theta, grid_per_step, patch_gap } (and optionally stock, the allowance) or #{ worm, length, space_centre, tolerance: #{ form, thickness, diameter, position, flank_angle_deg, lead (optional) } }".into(),
-            )
+            let mut forms =
+                vec!["#{ profile, from, to, tolerance } (and optionally blank, a profile)"];
+            forms.extend(
+                crate::families::SCRIPT_API
+                    .iter()
+                    .filter_map(|g| g.verify.as_ref().map(|v| v.form)),
+            );
+            let last = forms.pop().unwrap_or_default();
+            self.contract(format!(
+                "fn verify(p) must return {} or {last}",
+                forms.join(", ")
+            ))
         };
         let m = d.try_cast::<Map>().ok_or_else(shape)?;
-        let num = |k: &str| m.get(k).and_then(floats::number).ok_or_else(shape);
-        if let Some(w) = m.get("worm") {
-            let sizes = w
-                .clone()
-                .try_cast::<crate::worm::WormSizes>()
-                .ok_or_else(shape)?;
-            let t = m
-                .get("tolerance")
-                .and_then(|t| t.clone().try_cast::<Map>())
-                .ok_or_else(shape)?;
-            let tnum = |k: &str| {
-                t.get(k).and_then(floats::number).ok_or_else(|| {
-                    self.contract(format!(
-                        "fn verify(p): tolerance.{k} must be a number (tolerance: form, thickness, diameter, position, flank_angle_deg)"
-                    ))
-                })
-            };
-            return Ok(Some(Verification::new(crate::worm::WormRequest {
-                sizes,
-                length: num("length")?,
-                space_centre: num("space_centre")?,
-                tolerances: crate::worm::WormTolerances {
-                    form: tnum("form")?,
-                    thickness: tnum("thickness")?,
-                    diameter: tnum("diameter")?,
-                    position: tnum("position")?,
-                    flank_angle: tnum("flank_angle_deg")?.to_radians(),
-                    lead: match t.get("lead") {
-                        None => crate::worm::LEAD_ERROR,
-                        Some(_) => tnum("lead")?,
-                    },
-                },
-            })));
-        }
-        if let Some(g) = m.get("groove") {
-            let groove = g
-                .clone()
-                .try_cast::<crate::caliber::Groove>()
-                .ok_or_else(shape)?;
-            let psi = m
-                .get("psi")
-                .and_then(|d| floats::numbers(d, "psi").ok())
-                .ok_or_else(shape)?;
-            let per = num("grid_per_step")?;
-            if !(1.0..=1000.0).contains(&per) {
-                return Err(self.contract(format!(
-                    "fn verify(p): grid_per_step = {per} must be from 1 to 1000"
-                )));
+        for form in crate::families::SCRIPT_API
+            .iter()
+            .filter_map(|g| g.verify.as_ref())
+        {
+            if m.contains_key(form.key) {
+                return (form.read)(&m).map(Some).map_err(|e| match e {
+                    Some(message) => self.contract(message),
+                    None => shape(),
+                });
             }
-            return Ok(Some(Verification::new(crate::caliber::GrooveRequest {
-                groove,
-                psi: psi.to_vec(),
-                tolerance: num("tolerance")?,
-                grid_theta: num("grid_theta")?,
-                grid_per_step: per as usize,
-                patch_gap: num("patch_gap")?,
-                stock: match m.get("stock") {
-                    None => None,
-                    Some(_) => Some(num("stock")?),
-                },
-            })));
         }
+        let num = |k: &str| m.get(k).and_then(floats::number).ok_or_else(shape);
         Ok(Some(Verification::new(VerifyRequest {
             profile: m
                 .get("profile")

@@ -22,6 +22,7 @@ mod blade;
 mod outcome;
 mod plan;
 mod plots;
+mod script;
 mod servo;
 mod simulate;
 mod sizes;
@@ -35,6 +36,7 @@ pub use plan::{
     PlanSettings, PlannedPass, MAX_PASSES,
 };
 pub use plots::{worm_pass_table, worm_passes_svg};
+pub(crate) use script::SCRIPT_API;
 pub use servo::{approach_error, approach_length, runout_error, runout_length};
 pub use simulate::{
     simulate, SimulatedPass, StartProfile, WormCheck, WormRequest, WormStock, WormTolerances,

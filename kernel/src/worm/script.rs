@@ -2,7 +2,9 @@
 //! cutter, the acceleration and deceleration lengths, the plan of passes.
 //! Angles are degrees here (as a process sheet gives them); lengths mm.
 
-use super::floats::{kernel, number, Floats};
+use crate::binding::floats::{kernel, number, Floats};
+use crate::binding::{ApiGroup, VerifyForm};
+use crate::family::Verification;
 use crate::math::Real;
 use crate::tool::{Tool, ToolShape};
 use crate::worm::{self, FlankOrder, PlanSettings, ThreadCutter, WormSizes};
@@ -112,7 +114,7 @@ pub mod worm_api {
         right_deg: Real,
         height: Real,
     ) -> Result<Tool, Box<EvalAltResult>> {
-        let number = crate::script::bind_toolpath::tool_number(name, number)?;
+        let number = crate::binding::tool_number(name, number)?;
         let c = kernel(ThreadCutter::new(
             tip_width,
             nose_radius,
@@ -267,4 +269,56 @@ pub mod worm_api {
         m.insert("planned_area".into(), col(&|p| p.planned_area));
         Ok(m)
     }
+}
+
+/// The worm's part of the script API, as the reference lists it.
+pub(crate) const SCRIPT_API: ApiGroup = ApiGroup {
+    title: "Worm threads: sizes, cutter, S1 and S2, passes (`Worm`)",
+    types: |e| {
+        e.register_type_with_name::<WormSizes>("Worm");
+    },
+    register: |e, _| {
+        e.register_global_module(rhai::exported_module!(worm_api).into());
+    },
+    verify: Some(VerifyForm {
+        key: "worm",
+        form: "#{ worm, length, space_centre, tolerance: #{ form, thickness, diameter, position, flank_angle_deg, lead (optional) } }",
+        read: verification,
+    }),
+};
+
+/// The worm's request from the map of a script's `fn verify(p)`.
+fn verification(m: &Map) -> Result<Verification, Option<String>> {
+    let num = |k: &str| m.get(k).and_then(number).ok_or(None);
+    let sizes = m
+        .get("worm")
+        .and_then(|w| w.clone().try_cast::<WormSizes>())
+        .ok_or(None)?;
+    let t = m
+        .get("tolerance")
+        .and_then(|t| t.clone().try_cast::<Map>())
+        .ok_or(None)?;
+    let tnum = |k: &str| {
+        t.get(k).and_then(number).ok_or_else(|| {
+            Some(format!(
+                "fn verify(p): tolerance.{k} must be a number (tolerance: form, thickness, diameter, position, flank_angle_deg)"
+            ))
+        })
+    };
+    Ok(Verification::new(worm::WormRequest {
+        sizes,
+        length: num("length")?,
+        space_centre: num("space_centre")?,
+        tolerances: worm::WormTolerances {
+            form: tnum("form")?,
+            thickness: tnum("thickness")?,
+            diameter: tnum("diameter")?,
+            position: tnum("position")?,
+            flank_angle: tnum("flank_angle_deg")?.to_radians(),
+            lead: match t.get("lead") {
+                None => worm::LEAD_ERROR,
+                Some(_) => tnum("lead")?,
+            },
+        },
+    }))
 }

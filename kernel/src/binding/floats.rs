@@ -29,12 +29,12 @@ pub const MAX_FLOATS: usize = 10_000_000;
 pub type Numbers = Dynamic;
 
 /// A binding's failure, as the message Rhai places in the script.
-pub(super) fn err<T>(message: impl Into<String>) -> Result<T, Box<EvalAltResult>> {
+pub(crate) fn err<T>(message: impl Into<String>) -> Result<T, Box<EvalAltResult>> {
     Err(message.into().into())
 }
 
 /// A kernel result in a binding: its error as the script's message.
-pub(super) fn kernel<T, E: std::fmt::Display>(r: Result<T, E>) -> Result<T, Box<EvalAltResult>> {
+pub(crate) fn kernel<T, E: std::fmt::Display>(r: Result<T, E>) -> Result<T, Box<EvalAltResult>> {
     r.map_err(|e| e.to_string().into())
 }
 
@@ -47,7 +47,7 @@ pub(crate) fn number(d: &Dynamic) -> Option<Real> {
 
 /// Reads `d` as numbers: `Floats` (shared, not copied) or an array of
 /// numbers; `what` names it in errors.
-pub(super) fn numbers(d: &Dynamic, what: &str) -> Result<Rc<Vec<Real>>, Box<EvalAltResult>> {
+pub(crate) fn numbers(d: &Dynamic, what: &str) -> Result<Rc<Vec<Real>>, Box<EvalAltResult>> {
     if let Some(f) = d.read_lock::<Floats>() {
         return Ok(f.0.clone());
     }
@@ -72,14 +72,14 @@ pub(super) fn numbers(d: &Dynamic, what: &str) -> Result<Rc<Vec<Real>>, Box<Eval
 
 /// A column of `n` values: shared numbers (not copied), or one number for
 /// all.
-pub(super) enum Column {
+pub(crate) enum Column {
     Shared(Rc<Vec<Real>>),
     Scalar(Real),
 }
 
 impl Column {
     #[inline]
-    pub(super) fn at(&self, i: usize) -> Real {
+    pub(crate) fn at(&self, i: usize) -> Real {
         match self {
             Column::Shared(v) => v[i],
             Column::Scalar(x) => *x,
@@ -87,7 +87,7 @@ impl Column {
     }
 
     /// Reads `d` as a column of `n` values: numbers, or one number for all.
-    pub(super) fn read(d: &Dynamic, n: usize, what: &str) -> Result<Self, Box<EvalAltResult>> {
+    pub(crate) fn read(d: &Dynamic, n: usize, what: &str) -> Result<Self, Box<EvalAltResult>> {
         if let Some(x) = number(d) {
             return Ok(Column::Scalar(x));
         }
@@ -103,7 +103,7 @@ impl Column {
 }
 
 /// How many numbers `d` holds, if it holds numbers.
-pub(super) fn len_of(d: &Dynamic) -> Option<usize> {
+pub(crate) fn len_of(d: &Dynamic) -> Option<usize> {
     if let Some(f) = d.read_lock::<Floats>() {
         Some(f.0.len())
     } else {
@@ -285,7 +285,7 @@ pub mod floats_api {
 
 /// `+ - * /` between Floats (elementwise, equal lengths) and numbers; unary
 /// `-`.
-pub(super) fn register_arithmetic(engine: &mut Engine) {
+pub(crate) fn register_arithmetic(engine: &mut Engine) {
     fn zip(
         a: &Floats,
         b: &Floats,

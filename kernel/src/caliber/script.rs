@@ -3,8 +3,10 @@
 //! angles, and the seed's wheel pose. Angles are radians, as everywhere in
 //! the script API; the tables give theta in degrees.
 
-use super::floats::{kernel, Floats};
+use crate::binding::floats::{kernel, number, numbers, Floats};
+use crate::binding::{ApiGroup, VerifyForm};
 use crate::caliber::{self, EdgeKind, Groove, SeedPose};
+use crate::family::Verification;
 // The Rhai `Solid`: a mesh and the exact body it was meshed from.
 use crate::family::Swept as Solid;
 use crate::math::Real;
@@ -179,7 +181,7 @@ pub mod caliber_api {
         r_k0: Real,
         r_k: Real,
     ) -> Result<Tool, Box<EvalAltResult>> {
-        let number = crate::script::bind_toolpath::tool_number(name, number)?;
+        let number = crate::binding::tool_number(name, number)?;
         let w = kernel(Wheel::new(2.0 * r_k0, r_k, 2.0 * r_k))?;
         Ok(Tool::wheel_at_centre(name, number, w))
     }
@@ -552,4 +554,52 @@ fn swivel_plane(cross: bool) -> caliber::SwivelPlane {
     } else {
         caliber::SwivelPlane::Wheel
     }
+}
+
+/// The caliber's part of the script API, as the reference lists it.
+pub(crate) const SCRIPT_API: ApiGroup = ApiGroup {
+    title: "Calibers: the groove, passes, the seed's pose (`Groove`, `SeedPose`)",
+    types: |e| {
+        e.register_type_with_name::<Groove>("Groove")
+            .register_type_with_name::<SeedPose>("SeedPose");
+    },
+    register: |e, _| {
+        e.register_global_module(rhai::exported_module!(caliber_api).into());
+    },
+    verify: Some(VerifyForm {
+        key: "groove",
+        form: "#{ groove, psi, tolerance, grid_theta, grid_per_step, patch_gap } (and optionally stock, the allowance)",
+        read: verification,
+    }),
+};
+
+/// The groove's request from the map of a script's `fn verify(p)`.
+fn verification(m: &rhai::Map) -> Result<Verification, Option<String>> {
+    let num = |k: &str| m.get(k).and_then(number).ok_or(None);
+    let groove = m
+        .get("groove")
+        .and_then(|g| g.clone().try_cast::<Groove>())
+        .ok_or(None)?;
+    let psi = m
+        .get("psi")
+        .and_then(|d| numbers(d, "psi").ok())
+        .ok_or(None)?;
+    let per = num("grid_per_step")?;
+    if !(1.0..=1000.0).contains(&per) {
+        return Err(Some(format!(
+            "fn verify(p): grid_per_step = {per} must be from 1 to 1000"
+        )));
+    }
+    Ok(Verification::new(caliber::GrooveRequest {
+        groove,
+        psi: psi.to_vec(),
+        tolerance: num("tolerance")?,
+        grid_theta: num("grid_theta")?,
+        grid_per_step: per as usize,
+        patch_gap: num("patch_gap")?,
+        stock: match m.get("stock") {
+            None => None,
+            Some(_) => Some(num("stock")?),
+        },
+    }))
 }
