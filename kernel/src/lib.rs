@@ -6,7 +6,7 @@
 //! The modules, in the order data flows through them (ARCHITECTURE §1;
 //! `docs/architecture.md` says where each stage lives):
 //!
-//! - [`math`], [`input`], [`files`], [`names`]: the numbers, the one
+//! - [`math`], [`InputError`], [`files`], [`names`]: the numbers, the one
 //!   validation error, reading outside files (regular files only,
 //!   bounded), and the names and texts that come from outside;
 //! - [`transform`]: elementary factors, the [`Chain`] of a machine, the
@@ -24,6 +24,11 @@
 //! - [`script`] (part families in Rhai), [`plugin`] (machine plugins),
 //!   [`catalog`] (machines by name);
 //! - [`job`]: a run as one call; [`Error`]: any stage's error.
+//!
+//! What only the run itself uses is private: the charts the plots share,
+//! the report page's HTML, the report's tables and rows (their types are
+//! public through [`job`]), the families' registry and the input checks
+//! behind [`InputError`].
 //!
 //! Conventions (ARCHITECTURE §3): right-handed frames, millimetres and
 //! radians inside (degrees only in files, named `_deg`), the part frame's Z
@@ -46,13 +51,13 @@ mod binding;
 pub mod budget;
 pub mod caliber;
 pub mod catalog;
-pub mod chart;
+mod chart;
 pub mod error;
-pub mod families;
+mod families;
 pub mod family;
 pub mod files;
-pub mod html;
-pub mod input;
+mod html;
+mod input;
 pub mod job;
 pub mod machine;
 pub mod math;
@@ -66,7 +71,7 @@ pub mod process;
 pub mod profile;
 pub mod program;
 pub mod replay;
-pub mod report;
+mod report;
 pub mod script;
 pub mod step;
 pub mod tool;

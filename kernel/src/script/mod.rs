@@ -710,7 +710,7 @@ impl PartFamily for ScriptFamily {
     /// `fn verify(p)`, if the script has it: `#{ profile, from, to,
     /// tolerance }` (a body of revolution), or the map of a family with
     /// its own verification (`#{ groove, ... }` a caliber, `#{ worm, ... }`
-    /// a worm thread: [`crate::families::SCRIPT_API`]).
+    /// a worm thread: `families::SCRIPT_API`).
     fn verification(&self, values: &Params) -> Result<Option<Verification>, FamilyError> {
         if !self.has_fn("verify", 1) {
             return Ok(None);
