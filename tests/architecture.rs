@@ -82,7 +82,7 @@ fn the_kernels_modules_form_no_circle() {
     }
     // The generic modules that name a family: the registry (by design),
     // and each of the others in the page's list of arrows still to go.
-    let families = ["verify", "caliber", "worm"];
+    let families = ["revolution", "caliber", "worm"];
     let naming: Vec<&str> = g
         .iter()
         .filter(|(m, names)| {

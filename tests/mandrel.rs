@@ -1,8 +1,8 @@
 //! The mandrel family (seed 000) checked from the program text it writes.
 
 use pilgrim_kernel::program::{block_label, build, AxisProgram, PostProcessor, SharedPost};
+use pilgrim_kernel::revolution::GrindingCheck;
 use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
-use pilgrim_kernel::verify::GrindingCheck;
 use pilgrim_kernel::{MandrelLaw, Params, PartFamily, Profile, Side, Toolpath};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -302,7 +302,7 @@ fn job(
         panic!("the mandrel's tool is a wheel")
     };
     let check = move |program: &AxisProgram| {
-        pilgrim_kernel::verify::check_grinding(
+        pilgrim_kernel::revolution::check_grinding(
             program,
             &grinder,
             &reference,
@@ -373,7 +373,7 @@ fn verification_catches_a_corrupted_block() {
             "{}",
             p.name
         );
-        assert!(p.along_z.len() <= pilgrim_kernel::verify::PROFILE_BUCKETS);
+        assert!(p.along_z.len() <= pilgrim_kernel::revolution::PROFILE_BUCKETS);
     }
     // Block 40 of the finishing pass goes 5 um too deep.
     let k = finish.first_block - 1 + 40;
@@ -739,7 +739,7 @@ fn process_errors(
     let pilgrim_kernel::ToolShape::Wheel(wheel) = tp.tool.shape else {
         panic!("the mandrel's tool is a wheel")
     };
-    let (_, stock) = pilgrim_kernel::verify::replay_grinding(
+    let (_, stock) = pilgrim_kernel::revolution::replay_grinding(
         program,
         &grinder,
         &tp.tool.reference,

@@ -505,7 +505,7 @@ fn the_rest_rides_the_large_mandrel() {
 fn verified(
     sets: &[(&str, &str)],
     tolerance: Option<f64>,
-) -> (pilgrim_kernel::verify::GrindingCheck, String, Params) {
+) -> (pilgrim_kernel::revolution::GrindingCheck, String, Params) {
     let fam = family();
     let values = params(&fam, None, sets);
     let tp = fam.toolpath(&values).unwrap();
@@ -520,7 +520,7 @@ fn verified(
     let pilgrim_kernel::ToolShape::Wheel(wheel) = tp.tool.shape else {
         panic!("a wheel")
     };
-    let check = pilgrim_kernel::verify::check_grinding(
+    let check = pilgrim_kernel::revolution::check_grinding(
         &program,
         &machine,
         &tp.tool.reference,

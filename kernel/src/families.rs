@@ -10,7 +10,7 @@ use crate::family::OutcomeKind;
 
 /// Every kind of verification the kernel carries.
 pub const KINDS: [&OutcomeKind; 3] = [
-    &crate::verify::KIND,
+    &crate::revolution::KIND,
     &crate::caliber::KIND,
     &crate::worm::KIND,
 ];
@@ -18,8 +18,11 @@ pub const KINDS: [&OutcomeKind; 3] = [
 /// The script API of the families that have their own, listed in the
 /// reference after the generic groups (numbers, profiles, paths,
 /// equidistants) and before the transforms, tools and toolpaths.
-pub(crate) const SCRIPT_API: [&ApiGroup; 2] =
-    [&crate::caliber::SCRIPT_API, &crate::worm::SCRIPT_API];
+pub(crate) const SCRIPT_API: [&ApiGroup; 3] = [
+    &crate::revolution::SCRIPT_API,
+    &crate::caliber::SCRIPT_API,
+    &crate::worm::SCRIPT_API,
+];
 
 /// The kind whose report key is `key`.
 pub fn kind(key: &str) -> Option<&'static OutcomeKind> {

@@ -15,12 +15,16 @@
 //!   type), [`Machine`]s compiled from it or read from TOML, the
 //!   [`MachineKinematics`] trait;
 //! - [`profile`], [`offset`], [`tool`]: profiles ("digital arrays"),
-//!   equidistants, envelopes, the steady-rest models, wheels and cutters;
+//!   equidistants, envelopes, wheels and cutters;
 //! - [`params`], [`family`]: a part family's parameters and the
 //!   [`PartFamily`] trait;
 //! - [`toolpath`] (CL data), [`program`] (the axis program and its
-//!   post-processors), [`verify`] (the replay), [`mesh`] (3-D models),
+//!   post-processors), [`replay`] (the replays' machinery), [`mesh`] (3-D models),
 //!   [`step`] (exact solids for CAD);
+//! - the families, each in its folder with its geometry, verification,
+//!   plots and script bindings: [`revolution`] (mandrels and other bodies
+//!   of revolution ground with a wheel and a steady rest), [`caliber`],
+//!   [`worm`];
 //! - [`script`] (part families in Rhai), [`plugin`] (machine plugins),
 //!   [`catalog`] (machines by name);
 //! - [`job`]: a run as one call; [`Error`]: any stage's error.
@@ -72,13 +76,13 @@ pub mod profile;
 pub mod program;
 pub mod replay;
 mod report;
+pub mod revolution;
 pub mod script;
 pub mod step;
 pub mod tool;
 pub mod toolpath;
 pub mod transform;
 pub mod verdict;
-pub mod verify;
 pub mod worm;
 
 pub use catalog::{Catalog, OpenMachine};
@@ -90,7 +94,7 @@ pub use machine::{
 };
 pub use math::{Mat3, Mat4, Point3, Real, Vec3};
 pub use offset::{
-    curvature_violations, drop_circle, equidistant, rest, CircleEnvelope, Drop, Equidistant, Side,
+    curvature_violations, drop_circle, equidistant, CircleEnvelope, Drop, Equidistant, Side,
 };
 pub use params::{ParamSource, ParamSpec, ParamValue, Params};
 pub use profile::{

@@ -3,7 +3,7 @@
 //! its control does (every value at the decimals written), [`replay`]
 //! moves the tool through the machine's forward kinematics block by block,
 //! [`passes_in`] finds the passes of a program read from its text; each
-//! family's replay ([`crate::verify`] for bodies of revolution,
+//! family's replay ([`crate::revolution`] for bodies of revolution,
 //! [`crate::caliber`], [`crate::worm`]) builds on them and reports through
 //! [`VerifyError`].
 

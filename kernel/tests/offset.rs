@@ -1,7 +1,8 @@
 //! Equidistants, envelopes and the steady rest, checked by geometry.
+use pilgrim_kernel::revolution::rest;
 
 use pilgrim_kernel::{
-    assert_near, equidistant, rest, Bulge, CircleEnvelope, MandrelLaw, Profile, ProfileBuilder,
+    assert_near, equidistant, Bulge, CircleEnvelope, MandrelLaw, Profile, ProfileBuilder,
     ProfileError, Side,
 };
 

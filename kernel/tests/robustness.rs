@@ -2,9 +2,10 @@
 //! kernel panic: every bad value comes back as an error.
 
 use pilgrim_kernel::machine::{machine_file, BUILTIN_SOURCES};
+use pilgrim_kernel::revolution::rest;
 use pilgrim_kernel::{
-    drop_circle, equidistant, read_table_str, rest, Bulge, CircleEnvelope, EllipseSection,
-    IkOptions, Machine, MandrelLaw, Point3, Profile, ProfileBuilder, Side, Target, ToolFrame, Vec3,
+    drop_circle, equidistant, read_table_str, Bulge, CircleEnvelope, EllipseSection, IkOptions,
+    Machine, MandrelLaw, Point3, Profile, ProfileBuilder, Side, Target, ToolFrame, Vec3,
 };
 use proptest::prelude::*;
 

@@ -10,8 +10,9 @@ pub(crate) mod floats;
 pub use floats::Floats;
 
 use crate::family::Verification;
-use floats::kernel;
+use floats::{err, kernel};
 use rhai::{Engine, EvalAltResult, Map};
+use std::cell::RefCell;
 use std::path::PathBuf;
 
 /// Where scripts may read files.
@@ -52,4 +53,43 @@ pub(crate) struct VerifyForm {
 pub(crate) fn tool_number(name: &str, number: i64) -> Result<u32, Box<EvalAltResult>> {
     kernel(crate::names::check_name("tool name", name))?;
     u32::try_from(number).map_err(|_| format!("tool number {number} is out of range").into())
+}
+
+/// The wheel of a wheel tool.
+pub(crate) fn wheel_of(tool: &crate::tool::Tool) -> Result<crate::tool::Wheel, Box<EvalAltResult>> {
+    match tool.shape {
+        crate::tool::ToolShape::Wheel(w) => Ok(w),
+        _ => err(format!("tool '{}' is not a grinding wheel", tool.name)),
+    }
+}
+
+// Earlier releases' forms (the script host's `compat` and a family's
+// own) note their calls here; the run takes the warnings.
+thread_local! {
+    /// The old forms called since the last [`take_warnings`], each once.
+    static CALLED: RefCell<Vec<String>> = const { RefCell::new(Vec::new()) };
+}
+
+/// Notes that the old form `old` was called; `new` replaces it.
+pub(crate) fn deprecated(old: &str, new: &str) {
+    let text = format!(
+        "the script calls {old}, an earlier release's form: it still works, but use {new} (the old form goes in a later release; CHANGELOG.md)"
+    );
+    CALLED.with(|c| {
+        let mut c = c.borrow_mut();
+        if !c.contains(&text) {
+            c.push(text);
+        }
+    });
+}
+
+/// The warnings for the old forms called since the last time, in the
+/// order first called.
+pub fn take_warnings() -> Vec<String> {
+    CALLED.with(|c| std::mem::take(&mut *c.borrow_mut()))
+}
+
+/// An old form no longer callable: the error naming its replacement.
+pub(crate) fn gone(old: &str, new: &str, why: &str) -> Box<EvalAltResult> {
+    format!("{old} is an earlier release's form and no longer callable ({why}): use {new}").into()
 }

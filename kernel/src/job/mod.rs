@@ -103,7 +103,7 @@ pub struct JobOutput {
 impl JobOutput {
     /// The verification's outcome as its own type (`None` if the family
     /// asked for none, or for one of another kind): e.g.
-    /// `out.check::<crate::verify::GrindingOutcome>()`.
+    /// `out.check::<crate::revolution::GrindingOutcome>()`.
     pub fn check<T: 'static>(&self) -> Option<&T> {
         self.outcome.as_ref()?.as_any().downcast_ref()
     }

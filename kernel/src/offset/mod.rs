@@ -6,16 +6,13 @@
 //! ([`equidistant`]); the surface it leaves is the envelope of its positions
 //! ([`CircleEnvelope`]); the lowest position of a circle resting on a
 //! surface is its "drop" ([`drop_circle`]), which is also the exact model of
-//! the steady rest ([`rest`]). The envelope and the drop are computed
+//! the steady rest ([`crate::revolution::rest`]). The envelope and the drop are computed
 //! exactly on the sampled data and are the independent check of every
 //! offset.
 
 mod capsule;
 mod drop;
 mod envelope;
-pub mod phases;
-pub mod rest;
-pub mod surface;
 
 pub use capsule::{flat_path, CapsuleEnvelope};
 pub use drop::{drop_circle, Drop};

@@ -13,41 +13,13 @@
 //! `cut(Profile, Path, Tool, float)`. Calling them is an error naming the
 //! replacement, not "function not found".
 
-use super::floats::{err, kernel, Floats, Numbers};
+use crate::binding::floats::{err, kernel, Floats, Numbers};
+pub use crate::binding::take_warnings;
+use crate::binding::{deprecated, gone};
 use crate::math::Real;
 use crate::profile::{MandrelLaw, Polyline, Profile};
 use rhai::plugin::*;
 use rhai::{EvalAltResult, Map};
-use std::cell::RefCell;
-
-thread_local! {
-    /// The old forms called since the last [`take_warnings`], each once.
-    static CALLED: RefCell<Vec<String>> = const { RefCell::new(Vec::new()) };
-}
-
-/// Notes that the old form `old` was called; `new` replaces it.
-fn deprecated(old: &str, new: &str) {
-    let text = format!(
-        "the script calls {old}, an earlier release's form: it still works, but use {new} (the old form goes in a later release; CHANGELOG.md)"
-    );
-    CALLED.with(|c| {
-        let mut c = c.borrow_mut();
-        if !c.contains(&text) {
-            c.push(text);
-        }
-    });
-}
-
-/// The warnings for the old forms called since the last time, in the
-/// order first called.
-pub fn take_warnings() -> Vec<String> {
-    CALLED.with(|c| std::mem::take(&mut *c.borrow_mut()))
-}
-
-/// An old form no longer callable: the error naming its replacement.
-fn gone(old: &str, new: &str, why: &str) -> Box<EvalAltResult> {
-    format!("{old} is an earlier release's form and no longer callable ({why}): use {new}").into()
-}
 
 /// Earlier releases' names and shapes of today's functions: each says so
 /// and calls today's binding, reshaping only what the old form took or
@@ -171,30 +143,6 @@ pub mod compat_api {
     pub fn universal(q: Numbers) -> Result<Transform, Box<EvalAltResult>> {
         deprecated("universal(q)", "universal_deg(q)");
         transform_api::universal_deg(q)
-    }
-
-    /// Earlier form of the steady rest's seed formula at `z_r`.
-    #[rhai_fn(return_raw)]
-    pub fn rest_seed_u(surface: Profile, z_r: Real, r_o: Real) -> Result<Real, Box<EvalAltResult>> {
-        deprecated(
-            "rest_seed_u(surface, z_r, r_o)",
-            "rest_track(...).seed_centre_x",
-        );
-        kernel(crate::offset::rest::seed_u(&surface, z_r, r_o))
-    }
-
-    /// Earlier form of the steady rest's exact drop at `z_r`.
-    #[rhai_fn(return_raw)]
-    pub fn rest_exact_u(
-        surface: Profile,
-        z_r: Real,
-        r_o: Real,
-    ) -> Result<Real, Box<EvalAltResult>> {
-        deprecated(
-            "rest_exact_u(surface, z_r, r_o)",
-            "rest_track(...).centre_x",
-        );
-        Ok(kernel(crate::offset::rest::exact_u(&surface, z_r, r_o))?.centre_x)
     }
 
     /// Earlier form of `cut(ground_surface(previous), path(cz, cx), wheel,

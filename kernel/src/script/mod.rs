@@ -179,7 +179,6 @@ pub fn engine(limits: &Limits, access: &Access) -> Engine {
 
 /// The script types, by the names scripts and the reference use.
 fn register_types(e: &mut Engine) {
-    use crate::offset::rest::{RestSetup, RestTrack};
     use crate::offset::Equidistant;
     use crate::profile::{MandrelLaw, Polyline, ProfileBuilder, Smoothing, Table};
     e.register_type_with_name::<Floats>("Floats")
@@ -189,10 +188,6 @@ fn register_types(e: &mut Engine) {
         .register_type_with_name::<Smoothing>("Smoothing")
         .register_type_with_name::<Polyline>("Path")
         .register_type_with_name::<Equidistant>("Equidistant")
-        .register_type_with_name::<RestSetup>("SteadyRest")
-        .register_type_with_name::<RestTrack>("RestTrack")
-        .register_type_with_name::<crate::offset::phases::Infeed>("Infeed")
-        .register_type_with_name::<crate::offset::surface::GroundSurface>("GroundSurface")
         .register_type_with_name::<crate::tool::Tool>("Tool")
         .register_type_with_name::<bind_transform::Transform>("Transform")
         .register_type_with_name::<bind_transform::Points>("Points")
@@ -252,8 +247,7 @@ const BEFORE_FAMILIES: [ApiGroup; 5] = [
         },
     },
     ApiGroup {
-        title:
-            "Equidistants, envelopes, the steady rest (`Equidistant`, `SteadyRest`, `RestTrack`)",
+        title: "Equidistants, envelopes, wheel paths, ridges (`Equidistant`)",
         types: no_types,
         verify: None,
         register: |e, _| {

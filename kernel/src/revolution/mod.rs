@@ -15,27 +15,30 @@
 
 use crate::machine::MachineKinematics;
 use crate::math::{positive, Real};
-use crate::offset::phases::{Infeed, TimedPath};
-use crate::offset::surface::{
-    touches, GroundSurface, PartLayer, PassLayer, WheelSection, GENERATRICES,
-};
 use crate::offset::{CapsuleEnvelope, Side};
 use crate::profile::{Profile, ProfileError};
 use crate::program::{AxisProgram, ProgramPass};
 use crate::tool::Wheel;
 use crate::transform::ToolFrame;
 use crate::verdict::{Figure, Finding};
+use phases::{Infeed, TimedPath};
 use serde::{Deserialize, Serialize};
+use surface::{touches, GroundSurface, PartLayer, PassLayer, WheelSection, GENERATRICES};
 
 pub use crate::replay::{as_written, passes_in, replay, replay_blocks, VerifyError};
 pub use plots::deviation_svgs;
 pub use profile_svg::profile_svg;
 
 mod outcome;
+pub mod phases;
 mod plots;
 mod profile_svg;
+pub mod rest;
+mod script;
+pub mod surface;
 
 pub use outcome::{GrindingOutcome, KIND};
+pub(crate) use script::SCRIPT_API;
 
 /// How far a surface strays from the nominal profile over a range.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -78,7 +81,7 @@ pub struct PassCheck {
     /// (blocks from 1): ridges included.
     pub deviation: Deviation,
     /// How far the highest surface any spindle phase leaves (what the
-    /// steady rest rides on: [`crate::offset::phases`]) stands above the
+    /// steady rest rides on: [`crate::revolution::phases`]) stands above the
     /// highest generatrix simulated, after this pass (mm): the stand-off
     /// the spindle's unknown phase allows the rest.
     pub phase_stand_off_mm: Real,

@@ -12,7 +12,7 @@
 //!   highest surface any spindle phase leaves ([`super::phases`]), what a
 //!   steady rest's support riding the turning part meets. The verification
 //!   cuts the same section at the same moments on each generatrix
-//!   ([`crate::verify::check_grinding`]) and reports how far the crest
+//!   ([`crate::revolution::check_grinding`]) and reports how far the crest
 //!   stands above its own highest generatrix.
 //! - [`GroundSurface`] is the blank (a polyline: a step stays a step)
 //!   lowered by each pass's crest.
@@ -282,14 +282,14 @@ impl GroundSurface {
         radius: Real,
         step: Real,
         extra: Option<&PartLayer<'_>>,
-    ) -> Result<Option<super::Drop>, ProfileError> {
+    ) -> Result<Option<crate::offset::Drop>, ProfileError> {
         let (lo, hi) = self.z_range();
         let (a, b) = ((z - radius).max(lo), (z + radius).min(hi));
         if a >= b {
             return Ok(None);
         }
         let window = self.window(a, b, step, extra)?;
-        super::drop_circle(&window, z, radius, super::Side::Outside).map(Some)
+        crate::offset::drop_circle(&window, z, radius, crate::offset::Side::Outside).map(Some)
     }
 
     /// The surface over `[a, b]` (within the blank's range) as a polyline:

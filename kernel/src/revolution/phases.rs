@@ -509,12 +509,12 @@ mod tests {
         let t = super::super::surface::touches(&path, rpm, m).unwrap();
         let envs: Vec<_> = (0..m)
             .map(|g| {
-                super::super::CapsuleEnvelope::new(
+                crate::offset::CapsuleEnvelope::new(
                     &t.z[g],
                     &t.x[g],
                     r,
                     1.5,
-                    super::super::Side::Outside,
+                    crate::offset::Side::Outside,
                 )
                 .unwrap()
             })

@@ -7,7 +7,7 @@
 //! first pass).
 
 use crate::chart::{tick_decimals, COLOURS};
-use crate::verify::{GrindingCheck, PassCheck};
+use crate::revolution::{GrindingCheck, PassCheck};
 use plotters::prelude::*;
 
 /// One chart of `passes`' deviations (um) along z, with the tolerance
@@ -191,7 +191,7 @@ pub fn deviation_svgs(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::verify::Deviation;
+    use crate::revolution::Deviation;
 
     fn pass(name: &str, along_z: Vec<[f64; 3]>) -> PassCheck {
         let d = Deviation {

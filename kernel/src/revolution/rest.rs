@@ -26,8 +26,8 @@
 use super::phases::Infeed;
 pub use super::surface::WheelSection;
 use super::surface::{GroundSurface, PassLayer};
-use super::{drop_circle, Drop, Side};
 use crate::math::{finite, positive, Real};
+use crate::offset::{drop_circle, Drop, Side};
 use crate::profile::{Polyline, Profile, ProfileError};
 use serde::{Deserialize, Serialize};
 
@@ -60,7 +60,8 @@ impl RestModel {
 /// A non-positive `R_o`; `z_r` outside the surface's range.
 ///
 /// ```
-/// use pilgrim_kernel::{rest, Profile};
+/// use pilgrim_kernel::revolution::rest;
+/// use pilgrim_kernel::Profile;
 /// let cone = Profile::new(vec![0.0, 10.0, 20.0], vec![10.0, 11.0, 12.0]).unwrap();
 /// let u = rest::seed_u(&cone, 5.0, 3.0).unwrap();
 /// assert!((u - (10.5 + 3.0 * (1.0_f64 + 0.01).sqrt())).abs() < 1e-12);
