@@ -1,8 +1,9 @@
 //! The kernel's module graph as `docs/architecture.md` describes it: the
 //! top-level modules (a folder counts as one) and the arrows their code's
 //! `crate::<module>` paths draw (comments and unit tests left out). No
-//! circle; the generic modules that name a family are the registry and the
-//! ones the page lists, and no other.
+//! circle; every arrow runs up the page's layer list; the generic modules
+//! that name a family are the registry and the ones the page lists, and no
+//! other.
 
 use crate::common::root;
 use std::collections::{BTreeMap, BTreeSet};
@@ -91,4 +92,60 @@ fn the_kernels_modules_form_no_circle() {
         .map(|(m, _)| m.as_str())
         .collect();
     assert_eq!(naming, ["families", "job"]);
+}
+
+/// The layers `docs/architecture.md` lists ("Dependencies go one way, down
+/// this list"), top first: each a set of modules, a name ending in a comma
+/// going on to the next line's.
+fn documented_layers() -> Vec<Vec<String>> {
+    let page = std::fs::read_to_string(root().join("docs/architecture.md")).unwrap();
+    let start = page
+        .find("Dependencies go one way, down this list")
+        .expect("the page's layer list");
+    let mut layers: Vec<Vec<String>> = vec![];
+    let mut open = false;
+    for line in page[start..].lines().skip(2) {
+        let Some(row) = line.strip_prefix("    ") else {
+            break;
+        };
+        let names = row.get(..23).unwrap_or(row).trim();
+        if names.is_empty() {
+            continue;
+        }
+        let these: Vec<String> = names
+            .split(',')
+            .map(|n| n.trim().to_owned())
+            .filter(|n| !n.is_empty())
+            .collect();
+        match layers.last_mut() {
+            Some(last) if open => last.extend(these),
+            _ => layers.push(these),
+        }
+        open = names.ends_with(',');
+    }
+    layers
+}
+
+/// Every module is in the page's list, and every arrow of the code runs
+/// up it (to a module listed above, or beside it on its line): the page is
+/// the code's order, not a wish.
+#[test]
+fn the_kernels_modules_keep_the_pages_order() {
+    let g = graph();
+    let layers = documented_layers();
+    let level = |m: &str| layers.iter().position(|l| l.iter().any(|n| n == m));
+    let unlisted: Vec<&String> = g.keys().filter(|m| level(m).is_none()).collect();
+    assert!(unlisted.is_empty(), "not in the page's list: {unlisted:?}");
+    let mut down = vec![];
+    for (m, names) in &g {
+        for n in names {
+            if level(n) > level(m) {
+                down.push(format!("{m} -> {n}"));
+            }
+        }
+    }
+    assert!(
+        down.is_empty(),
+        "arrows down the page's list (move the module or the code): {down:?}"
+    );
 }

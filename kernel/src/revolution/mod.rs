@@ -1,17 +1,28 @@
-//! Verifying a program by replaying it (ARCHITECTURE §1's VERIFY stage).
+//! The family of bodies of revolution ground with a wheel and a steady
+//! rest: the cold-pilger mandrel, and any drawing plug or shaft a script
+//! describes. Its pieces, one folder:
 //!
-//! [`check_grinding`] reads a grinding program as a control does (its
-//! values as written, [`as_written`]), replays every block through the
-//! machine's forward kinematics, and simulates what the machine makes of
-//! it: the part turning while the wheel moves in straight lines between
-//! blocks, the wheel's true section (flat and roundings) where each of
-//! [`GENERATRICES`] generatrices meets it. Each pass's surface is compared
-//! with the nominal profile, the helical ridge included, and the worst
-//! place is named by z, block and pass.
+//! - [`surface`]: the surface the passes leave, the wheel's true section
+//!   (flat and roundings) on each generatrix, and [`phases`]: the crest
+//!   over every spindle phase the program leaves open;
+//! - [`rest`]: the steady rest riding that surface (U at every block and
+//!   between blocks), the seed's formula beside it;
+//! - the replay (this module): [`check_grinding`] reads a grinding program
+//!   as a control does (its values as written, [`as_written`]), replays
+//!   every block through the machine's forward kinematics, and simulates
+//!   what the machine makes of it: the part turning while the wheel moves
+//!   in straight lines between blocks, the wheel's section where each of
+//!   [`GENERATRICES`] generatrices meets it. Each pass's surface is
+//!   compared with the nominal profile, the helical ridge included, and
+//!   the worst place is named by z, block and pass;
+//! - its outcome in the report ([`GrindingOutcome`]), its plots
+//!   ([`profile_svg`], [`deviation_svgs`]) and its script bindings.
 //!
-//! The replay's generic machinery (the program as written, forward
-//! kinematics block by block, its passes, [`VerifyError`]) is
-//! [`crate::replay`]'s, re-exported here where it has always been.
+//! The profile law of a mandrel (`profile::MandrelLaw`) stays with the
+//! profiles (the profile builder's `law` segment uses it). The replay's
+//! generic machinery (the program as written, forward kinematics block by
+//! block, its passes, [`VerifyError`]) is [`crate::replay`]'s, re-exported
+//! here.
 
 use crate::machine::MachineKinematics;
 use crate::math::{positive, Real};
