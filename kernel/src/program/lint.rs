@@ -49,35 +49,6 @@ pub struct Linted {
     pub lines: usize,
 }
 
-/// The G and M codes each G-code dialect writes.
-fn codes(d: &Dialect) -> (&'static [u32], &'static [u32]) {
-    match d.name {
-        "sinumerik" => (
-            &[0, 1, 17, 18, 19, 33, 54, 55, 56, 57, 58, 59, 71, 90, 94],
-            &[3, 5, 8, 9, 30],
-        ),
-        "fanuc" => (
-            &[0, 1, 18, 17, 19, 21, 32, 40, 54, 55, 56, 57, 58, 59, 97, 98],
-            &[3, 5, 8, 9, 30],
-        ),
-        _ => (
-            &[
-                0, 1, 7, 8, 17, 18, 19, 21, 33, 40, 54, 55, 56, 57, 58, 59, 90, 94, 97,
-            ],
-            &[2, 3, 5, 8, 9],
-        ),
-    }
-}
-
-/// The word ending a program in `d`.
-fn end_code(d: &Dialect) -> u32 {
-    if d.name == "linuxcnc" {
-        2
-    } else {
-        30
-    }
-}
-
 /// Lints `text`, the program `program` written in `d`, against the
 /// machine's `axes` (their travel in program units).
 ///
@@ -300,7 +271,12 @@ fn read_line(d: &Dialect, i: usize, line: &str) -> Result<(String, Option<String
         ));
     }
     let check = |comment: &str| -> Result<(), String> {
-        if d.name == "sinumerik" && i == 1 && comment == "$PATH=/_N_MPF_DIR" {
+        // A header line with nothing filled in is the dialect's own at its
+        // place (Sinumerik's `;$PATH=/_N_MPF_DIR`), whatever it holds.
+        if d.header
+            .get(i)
+            .is_some_and(|h| !h.contains('{') && *h == line)
+        {
             return Ok(());
         }
         let text = comment.strip_prefix(' ').unwrap_or(comment);
@@ -392,8 +368,14 @@ fn lint_gcode(
     let at_line = |l: usize| format!("line {}", l + 1);
     let decimals = super::written_decimals(program.decimals, d.name);
     let half = 0.5 * 10f64.powi(-(decimals as i32)) + 1e-9;
-    let (g_ok, m_ok) = codes(d);
+    let (g_ok, m_ok) = (d.reading.g_codes, d.reading.m_codes);
     let lead_letter = d.lead.chars().next().unwrap_or('K');
+    // A start angle by a one-letter address (Fanuc's Q, in 0.001 deg) is
+    // an ISO word, read with the block's others.
+    let (start_letter, start_scale) = match d.thread_start {
+        Some(t) if t.address.len() == 1 => (t.address.chars().next(), t.scale),
+        _ => (None, 1.0),
+    };
     let names: Vec<char> = program
         .axes
         .iter()
@@ -434,12 +416,14 @@ fn lint_gcode(
         if l.trim().is_empty() {
             comments[i] = said;
         }
-        let header_name = format!("%_N_{}_MPF", program.name);
         let program_number = format!("O{:04}", program.number % 10000);
-        // A program read as it stands names itself.
-        let own_name = line
-            .strip_prefix("%_N_")
-            .and_then(|n| n.strip_suffix("_MPF"))
+        // The line naming the program, and a program read as it stands
+        // naming itself.
+        let name_line = d.reading.name_line;
+        let header_name =
+            name_line.map(|(before, after)| format!("{before}{}{after}", program.name));
+        let own_name = name_line
+            .and_then(|(before, after)| line.strip_prefix(before)?.strip_suffix(after))
             .filter(|n| {
                 reading && !n.is_empty() && n.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
             });
@@ -447,12 +431,12 @@ fn lint_gcode(
             .and_then(|w| w.strip_prefix('O'))
             .filter(|n| reading && n.len() == 4)
             .and_then(|n| n.parse::<u32>().ok());
-        if d.name == "sinumerik" && i == 0 && (*line == header_name || own_name.is_some()) {
+        if i == 0 && (header_name.as_deref() == Some(*line) || own_name.is_some()) {
             out.name = own_name.map(str::to_owned);
             l = " ".repeat(line.len());
         } else if framed && *line == "%" && (i == 0 || i + 1 == lines.len()) {
             l = " ".into();
-        } else if d.name == "fanuc"
+        } else if d.reading.number_line
             && framed
             && i == 1
             && (first_code(&l).is_some_and(|w| w == program_number) || own_number.is_some())
@@ -461,18 +445,25 @@ fn lint_gcode(
             // Fanuc's program number, `O0001`, is not an ISO word.
             let n = l.find('O').unwrap_or(0);
             l.replace_range(n..n + 5, "     ");
-        } else if d.name == "sinumerik" {
+        } else {
+            // The dialect's own words, which are no ISO words: radius and
+            // diameter programming by name (DIAMOF/DIAMON, not G8/G7), the
+            // feed's group (FGROUP(..)), a start angle by an address of
+            // more than a letter (SF=).
+            let radial = d.radial_words.filter(|(r, _)| !is_g_code(r));
+            let start = d.thread_start.map(|t| t.address).filter(|a| a.len() > 1);
             let code_part = l.clone();
             for word in code_part.split_whitespace() {
                 let w =
-                    if matches!(word, "DIAMON" | "DIAMOF") {
-                        OwnWord::Radial(word == "DIAMON")
-                    } else if let Some(list) = word
-                        .strip_prefix("FGROUP(")
-                        .and_then(|w| w.strip_suffix(')'))
+                    if let Some((_, diameter)) = radial.filter(|(r, dm)| word == *r || word == *dm)
+                    {
+                        OwnWord::Radial(word == diameter)
+                    } else if let Some(list) = d
+                        .feed_group
+                        .and_then(|g| word.strip_prefix(g)?.strip_prefix('(')?.strip_suffix(')'))
                     {
                         OwnWord::FeedGroup(list.to_owned())
-                    } else if let Some(v) = word.strip_prefix("SF=") {
+                    } else if let Some(v) = start.and_then(|a| word.strip_prefix(a)) {
                         OwnWord::StartAngle(v.parse().map_err(|_| {
                             fault(at_line(i), format!("'{word}' is not a start angle"))
                         })?)
@@ -613,7 +604,7 @@ fn lint_gcode(
                         5 => st.spindle_on = false,
                         8 => st.coolant = true,
                         9 => st.coolant = false,
-                        n if n == end_code(d) => st.ended = true,
+                        n if n == d.reading.end_code => st.ended = true,
                         _ => {}
                     }
                     words.extend(m.args.iter().map(|a| (a.letter, a)));
@@ -627,7 +618,7 @@ fn lint_gcode(
                     }
                     // A lathe's T names the tool and its offset (`T0303`).
                     let n = number(&t.number.to_string());
-                    out.tool = Some(if d.name == "fanuc" && n >= 100 {
+                    out.tool = Some(if d.reading.tool_and_offset && n >= 100 {
                         n / 100
                     } else {
                         n
@@ -715,8 +706,8 @@ fn lint_gcode(
                     st.f = Some(v);
                 }
                 'S' => s_here = Some(v),
-                'D' if d.name == "sinumerik" => {}
-                'Q' if d.name == "fanuc" => st.start_deg = v / 1000.0,
+                c if d.reading.offset_word == Some(c) => {}
+                c if start_letter == Some(c) => st.start_deg = v / start_scale,
                 '@' => st.start_deg = v,
                 c if c == lead_letter => lead_here = Some(v),
                 c if reading => {
@@ -727,7 +718,7 @@ fn lint_gcode(
                             d.name,
                             program.machine,
                             names.iter().collect::<String>(),
-                            if d.name == "fanuc" { ", Q" } else { "" }
+                            start_letter.map(|c| format!(", {c}")).unwrap_or_default()
                         ),
                     ))
                 }
@@ -895,7 +886,7 @@ fn lint_gcode(
                     format!("a thread block without its lead {}", d.lead),
                 ));
             }
-            if d.name != "sinumerik" && !st.constant_speed {
+            if d.reading.thread_needs_constant_speed && !st.constant_speed {
                 return Err(fault(
                     place(k),
                     "a thread before constant spindle speed (G97)".into(),
@@ -922,8 +913,8 @@ fn lint_gcode(
                     ));
                 }
             }
-            if d.name == "fanuc" {
-                st.start_deg = 0.0; // Q holds for its block only
+            if d.thread_start.is_some_and(|t| !t.modal) {
+                st.start_deg = 0.0; // Fanuc's Q holds for its block only
             }
         }
         for (i, name) in program.axes.iter().enumerate() {
@@ -1005,7 +996,7 @@ fn lint_gcode(
     if !st.ended {
         return Err(fault(
             at_line(lines.len().saturating_sub(1)),
-            format!("the program does not end (M{})", end_code(d)),
+            format!("the program does not end (M{})", d.reading.end_code),
         ));
     }
     if reading && k == 0 {
@@ -1022,7 +1013,7 @@ fn lint_gcode(
 /// pilgrim wrote, a word its dialect does not write; in a program read as
 /// it stands, a word the verification cannot simulate.
 fn not_read(reading: bool, d: &Dialect, letter: char, number: &dyn std::fmt::Display) -> String {
-    let (g, m) = codes(d);
+    let (g, m) = (d.reading.g_codes, d.reading.m_codes);
     if reading {
         let list = |l: char, c: &[u32]| {
             c.iter()
@@ -1039,6 +1030,12 @@ fn not_read(reading: bool, d: &Dialect, letter: char, number: &dyn std::fmt::Dis
     } else {
         format!("{letter}{number} is not a word of {}", d.name)
     }
+}
+
+/// Whether `word` is an ISO G code (`G8`), not a dialect's own word.
+fn is_g_code(word: &str) -> bool {
+    word.strip_prefix('G')
+        .is_some_and(|n| !n.is_empty() && n.chars().all(|c| c.is_ascii_digit()))
 }
 
 /// The first word of a line (before a comment).
@@ -1232,6 +1229,38 @@ mod tests {
             Axis::linear("X", -10.0, 400.0, 1e4, [0.5, 0.0, 0.0], ""),
             Axis::linear("Z", -700.0, 10.0, 1e4, [0.0, 0.0, 1.0], ""),
         ]
+    }
+
+    /// The lint knows no control by name: each dialect's quirks are its
+    /// `Dialect` value's data. The same values under another name write,
+    /// lint and read the same program.
+    #[test]
+    fn a_dialect_is_its_data_not_its_name() {
+        let p = program();
+        let mut frame = p.clone();
+        frame.blocks.clear();
+        for d in [&SINUMERIK, &FANUC, &LINUXCNC] {
+            let acme = Dialect { name: "acme", ..*d };
+            let text = post(&p, d).unwrap();
+            assert_eq!(post(&p, &acme).unwrap(), text, "{}", d.name);
+            assert_eq!(
+                lint(&text, &p, &acme, &axes()).unwrap(),
+                lint(&text, &p, d, &axes()).unwrap(),
+                "{}",
+                d.name
+            );
+            let (ours, theirs) = (
+                read(&text, &frame, &acme, &axes()).unwrap(),
+                read(&text, &frame, d, &axes()).unwrap(),
+            );
+            assert_eq!(
+                (ours.name, ours.number, ours.tool_number),
+                (theirs.name, theirs.number, theirs.tool_number),
+                "{}",
+                d.name
+            );
+            assert_eq!(ours.blocks, theirs.blocks, "{}", d.name);
+        }
     }
 
     /// The reader takes a program's text as the control reads it: what

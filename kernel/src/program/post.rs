@@ -119,6 +119,37 @@ pub struct Dialect {
     /// control has no word for it (then a program with one is refused,
     /// and a multi-start thread shifts its starts along Z instead).
     pub thread_start: Option<ThreadStart>,
+    /// What the lint reads in a program of this dialect beyond the words
+    /// above: the codes it writes, how the program names itself, the
+    /// tool word's form.
+    pub reading: Reading,
+}
+
+/// The quirks of a dialect a reader of its programs must know, as data:
+/// a new control is a [`Dialect`] value, and the lint (`lint.rs`) holds no
+/// control's name.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reading {
+    /// The G codes the dialect writes; the lint refuses any other.
+    pub g_codes: &'static [u32],
+    /// The M codes it writes.
+    pub m_codes: &'static [u32],
+    /// The M code that ends a program (M30; LinuxCNC's M2).
+    pub end_code: u32,
+    /// How the program's first line names it, before and after the name
+    /// (`%_N_` and `_MPF` on Sinumerik), if it does.
+    pub name_line: Option<(&'static str, &'static str)>,
+    /// Whether a whole program's second line is its number, `O` and four
+    /// digits, which is not an ISO word (Fanuc).
+    pub number_line: bool,
+    /// Whether the tool word carries the offset's number after the tool's,
+    /// two digits each (Fanuc's `T0303`).
+    pub tool_and_offset: bool,
+    /// The word selecting the tool's offset, written with the tool call
+    /// and passed over by the reader (Sinumerik's `D1`), if any.
+    pub offset_word: Option<char>,
+    /// Whether a thread block needs constant spindle speed (G97) in force.
+    pub thread_needs_constant_speed: bool,
 }
 
 /// The word of a thread block's spindle start angle.
@@ -175,6 +206,16 @@ pub const SINUMERIK: Dialect = Dialect {
         decimals: 3,
         modal: true,
     }),
+    reading: Reading {
+        g_codes: &[0, 1, 17, 18, 19, 33, 54, 55, 56, 57, 58, 59, 71, 90, 94],
+        m_codes: &[3, 5, 8, 9, 30],
+        end_code: 30,
+        name_line: Some(("%_N_", "_MPF")),
+        number_line: false,
+        tool_and_offset: false,
+        offset_word: Some('D'),
+        thread_needs_constant_speed: false,
+    },
 };
 
 /// Fanuc 0i (lathe, G-code system A: absolute by axis address, feed per
@@ -221,6 +262,16 @@ pub const FANUC: Dialect = Dialect {
         decimals: 0,
         modal: false,
     }),
+    reading: Reading {
+        g_codes: &[0, 1, 18, 17, 19, 21, 32, 40, 54, 55, 56, 57, 58, 59, 97, 98],
+        m_codes: &[3, 5, 8, 9, 30],
+        end_code: 30,
+        name_line: None,
+        number_line: true,
+        tool_and_offset: true,
+        offset_word: None,
+        thread_needs_constant_speed: true,
+    },
 };
 
 /// LinuxCNC (lathe configuration): `%`-framed, spindle-synchronised `G33`
@@ -254,6 +305,18 @@ pub const LINUXCNC: Dialect = Dialect {
     feed_group: None,
     lead_every_block: true,
     thread_start: None,
+    reading: Reading {
+        g_codes: &[
+            0, 1, 7, 8, 17, 18, 19, 21, 33, 40, 54, 55, 56, 57, 58, 59, 90, 94, 97,
+        ],
+        m_codes: &[2, 3, 5, 8, 9],
+        end_code: 2,
+        name_line: None,
+        number_line: false,
+        tool_and_offset: false,
+        offset_word: None,
+        thread_needs_constant_speed: true,
+    },
 };
 
 /// APT-style cutter-location file (ISO 4343 flavour) in machine coordinates.
@@ -288,6 +351,17 @@ pub const CLD: Dialect = Dialect {
     feed_group: None,
     lead_every_block: false,
     thread_start: None,
+    // Records, not G-code: the lint reads them by their own rules.
+    reading: Reading {
+        g_codes: &[],
+        m_codes: &[],
+        end_code: 0,
+        name_line: None,
+        number_line: false,
+        tool_and_offset: false,
+        offset_word: None,
+        thread_needs_constant_speed: false,
+    },
 };
 
 /// Every dialect.
