@@ -10,6 +10,7 @@ mod common;
 
 mod architecture;
 
+mod bodies;
 mod caliber;
 mod cli;
 mod containment;

@@ -3,7 +3,7 @@
 //! placed by their chains, as STL files and one glTF scene.
 
 use crate::family::{PartBody, PartGeometry};
-use crate::machine::{bodies_of, BodyShape, MachineKinematics};
+use crate::machine::{bodies_of, MachineKinematics, Solid};
 use crate::math::{Mat4, Point3, Vec3};
 pub use crate::mesh::SceneError;
 use crate::mesh::{self, frame_from_pose, MeshError, Scene, StlFormat, TriMesh};
@@ -115,29 +115,20 @@ pub fn machine_bodies(
     let bodies = bodies_of(info).map_err(|e| SceneError::Place(e.to_string()))?;
     let mut out = Vec::new();
     for body in bodies {
-        let Some(BodyShape::Roller { radius, length }) = &body.spec().shape else {
+        let Some(shape) = &body.spec().shape else {
             continue;
         };
         let Ok(q) = axis_rows(program, info, body.chain().axis_names(), index..index + 1) else {
             continue; // the program does not drive the body
         };
-        let size = |q: &crate::machine::Quantity| {
-            q.resolve(&info.constants)
-                .map_err(|m| SceneError::Place(format!("body {}: {m}", body.name())))
-        };
-        let (radius, length) = (size(radius)?, size(length)?);
-        // The roller along Y, centred on the body's origin.
-        let roller = mesh::cylinder(radius, length, tol)
-            .map_err(mesh_err(body.name()))?
-            .transformed(
-                &(Mat4::from_axis_angle(&Vec3::x_axis(), std::f64::consts::FRAC_PI_2)
-                    * Mat4::new_translation(&Vec3::new(0.0, 0.0, -length / 2.0))),
-            );
+        let solid = Solid::of(shape, &info.constants)
+            .map_err(|m| SceneError::Place(format!("body {}: {m}", body.name())))?;
+        let mesh = mesh::body_mesh(&solid, tol).map_err(mesh_err(body.name()))?;
         let pose = body
             .chain()
             .matrix(&q)
             .map_err(|e| SceneError::Place(e.to_string()))?;
-        out.push((body.name().to_owned(), roller, pose));
+        out.push((body.name().to_owned(), mesh, pose));
     }
     Ok(out)
 }

@@ -139,7 +139,8 @@ impl Machine {
 
     /// Reads a machine from TOML text; `source` names it in errors.
     ///
-    /// The format (the built-ins in `kernel/machines/` are full examples):
+    /// The format (`pilgrim machines --toml NAME` writes any machine pilgrim
+    /// knows as a full example):
     ///
     /// ```toml
     /// name = "lathe"
@@ -175,9 +176,15 @@ impl Machine {
     ///
     /// Other moving bodies have their own chains (`[[bodies.rest.chain]]`),
     /// a `label` (how reports name the point the body's origin tracks) and a
-    /// `shape` to draw (`shape = { kind = "roller", radius = "rest_radius",
-    /// length = 40.0 }`: a number, or a constant's name), and an axis that
-    /// moves one says so (`body = "rest"`). `[constants]` holds named machine
+    /// `shape` in the body's own frame, each size a number (mm) or a
+    /// constant's name: `{ kind = "roller", radius = "rest_radius", length =
+    /// 40.0 }` (a cylinder along Y, a steady rest's), `{ kind = "cylinder",
+    /// radius, length }` (along Z: a chuck, a quill, an arbor), `{ kind =
+    /// "box", size = [x, y, z] }` (a wheelhead, a turret, a holder), `{ kind
+    /// = "guard", inner, outer, width, cover_deg }` (a tube round Z over
+    /// `cover_deg` centred on +X, open toward -X: a wheel's guard); each is
+    /// centred on the body's origin ([`crate::machine::Solid`]). An axis that
+    /// moves a body says so (`body = "rest"`). `[constants]` holds named machine
     /// constants (mm; a `_deg` key is stored in radians without the suffix);
     /// a constant factor may take one (`constant = "rest_offset_b"`).
     /// `driven_axes` lists programmed axes the machine takes from the
@@ -304,9 +311,17 @@ fn span_of(file: &MachineFile, e: &Invalid) -> Range<usize> {
             }
         }
         Place::Chain(None) => file.chain.span(),
-        Place::Chain(Some(b)) | Place::Body(b, _) => {
-            file.bodies.get(b).map_or(0..0, |body| body.chain.span())
-        }
+        Place::Chain(Some(b)) => file.bodies.get(b).map_or(0..0, |body| body.chain.span()),
+        // A body's shape or approach feed where the file gives it, else
+        // its chain.
+        Place::Body(b, k) => file.bodies.get(b).map_or(0..0, |body| {
+            let at = match *k {
+                "shape" => body.shape.as_ref().map(Spanned::span),
+                "approach_feed" => body.approach_feed.as_ref().map(Spanned::span),
+                _ => None,
+            };
+            at.unwrap_or_else(|| body.chain.span())
+        }),
         Place::Factor(owner, i, k) => {
             let chain = match owner {
                 None => Some(file.chain.get_ref()),

@@ -347,23 +347,103 @@ fn check_body(info: &MachineInfo, b: &BodySpec) -> Result<(), Invalid> {
     }
     match &b.shape {
         None => Ok(()),
-        Some(BodyShape::Roller { radius, length }) => {
-            for (q, what) in [(radius, "radius"), (length, "length")] {
-                let v = q.resolve(&info.constants).map_err(|m| {
-                    invalid(
-                        Place::Body(b.name.clone(), "shape"),
-                        format!("body {}: {what}: {m}", b.name),
-                    )
-                })?;
-                if !(v.is_finite() && v > 0.0) {
-                    return Err(invalid(
-                        Place::Body(b.name.clone(), "shape"),
-                        format!("body {}: {what} = {v} must be > 0", b.name),
+        Some(shape) => Solid::of(shape, &info.constants).map(|_| ()).map_err(|m| {
+            invalid(
+                Place::Body(b.name.clone(), "shape"),
+                format!("body {}: {m}", b.name),
+            )
+        }),
+    }
+}
+
+/// A body's solid with its sizes resolved (mm; the guard's cover in
+/// radians), checked: every size finite and above 0, a guard's inner
+/// radius below its outer and its cover within the turn.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Solid {
+    /// A cylinder along the frame's Y, centred on the origin.
+    Roller {
+        /// Radius (mm).
+        radius: Real,
+        /// Length (mm).
+        length: Real,
+    },
+    /// A cylinder along the frame's Z, centred on the origin.
+    Cylinder {
+        /// Radius (mm).
+        radius: Real,
+        /// Length (mm).
+        length: Real,
+    },
+    /// A box centred on the origin, edges along the frame's axes.
+    Block {
+        /// Its edges along X, Y and Z (mm).
+        size: [Real; 3],
+    },
+    /// A tube round Z over `cover` about +X, centred on the origin.
+    Guard {
+        /// Inner radius (mm).
+        inner: Real,
+        /// Outer radius (mm).
+        outer: Real,
+        /// Width along Z (mm).
+        width: Real,
+        /// The angle covered (rad).
+        cover: Real,
+    },
+}
+
+impl Solid {
+    /// `shape` with its sizes taken from `constants` where it names them.
+    ///
+    /// # Failures
+    /// A constant the machine lacks, a size not above 0, a guard whose
+    /// inner radius is not below its outer or whose cover is not within
+    /// (0, 360) deg: the message names the key.
+    pub fn of(shape: &BodyShape, constants: &BTreeMap<String, Real>) -> Result<Solid, String> {
+        let size = |q: &super::Quantity, what: &str| -> Result<Real, String> {
+            let v = q.resolve(constants).map_err(|m| format!("{what}: {m}"))?;
+            if v.is_finite() && v > 0.0 {
+                Ok(v)
+            } else {
+                Err(format!("{what} = {v} must be > 0"))
+            }
+        };
+        Ok(match shape {
+            BodyShape::Roller { radius, length } => Solid::Roller {
+                radius: size(radius, "radius")?,
+                length: size(length, "length")?,
+            },
+            BodyShape::Cylinder { radius, length } => Solid::Cylinder {
+                radius: size(radius, "radius")?,
+                length: size(length, "length")?,
+            },
+            BodyShape::Block { size: [x, y, z] } => Solid::Block {
+                size: [size(x, "size x")?, size(y, "size y")?, size(z, "size z")?],
+            },
+            BodyShape::Guard {
+                inner,
+                outer,
+                width,
+                cover_deg,
+            } => {
+                let (inner, outer) = (size(inner, "inner")?, size(outer, "outer")?);
+                if inner >= outer {
+                    return Err(format!("inner = {inner} must be below outer = {outer}"));
+                }
+                if !(cover_deg.is_finite() && *cover_deg > 0.0 && *cover_deg < 360.0) {
+                    return Err(format!(
+                        "cover_deg = {cover_deg} must be above 0 and below 360"
                     ));
                 }
+                Solid::Guard {
+                    inner,
+                    outer,
+                    width: size(width, "width")?,
+                    cover: cover_deg.to_radians(),
+                }
             }
-            Ok(())
-        }
+        })
     }
 }
 

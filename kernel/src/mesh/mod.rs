@@ -12,12 +12,14 @@
 //! - [`Scene`]: named bodies with poses; STL ([`write_stl`]) and glTF
 //!   ([`write_glb`], [`write_gltf`]) writers.
 
+mod bodies;
 mod gltf_writer;
 mod revolve;
 mod scene;
 mod stl_writer;
 mod sweep;
 
+pub use bodies::body_mesh;
 pub use gltf_writer::{write_glb, write_gltf};
 pub use revolve::{body_of_revolution, cylinder, revolve, wheel};
 pub use scene::{frame_from_pose, Node, Scene};

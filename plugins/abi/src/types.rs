@@ -278,6 +278,37 @@ pub enum BodyShape {
         /// Length (mm), or the constant that gives it.
         length: Quantity,
     },
+    /// Since 1.6: a cylinder of `radius` and `length`, its axis along the
+    /// body frame's Z, centred on the body's origin: a chuck, a
+    /// tailstock's quill, a spindle's nose, a roll's arbor.
+    Cylinder {
+        /// Radius (mm), or the constant that gives it.
+        radius: Quantity,
+        /// Length (mm), or the constant that gives it.
+        length: Quantity,
+    },
+    /// Since 1.6: a box of `size` (along the body frame's X, Y and Z),
+    /// centred on the body's origin: a wheelhead, a turret, a holder, a
+    /// rest's arm. (`kind = "box"` in files.)
+    #[serde(rename = "box")]
+    Block {
+        /// Its edges (mm), or the constants that give them.
+        size: [Quantity; 3],
+    },
+    /// Since 1.6: a wheel's guard: a tube round the body frame's Z
+    /// (`inner` and `outer` radius, `width` along Z, centred on the
+    /// origin) over `cover_deg` of the turn, centred on the frame's +X;
+    /// the open side faces -X (where the wheel meets the part).
+    Guard {
+        /// Inner radius (mm), or the constant that gives it.
+        inner: Quantity,
+        /// Outer radius (mm), or the constant that gives it.
+        outer: Quantity,
+        /// Width along Z (mm), or the constant that gives it.
+        width: Quantity,
+        /// The angle it covers (deg, above 0 and below 360).
+        cover_deg: f64,
+    },
 }
 
 /// A moving body of the machine other than the tool (a steady rest).
