@@ -203,8 +203,55 @@ mod tests {
     use super::*;
     use crate::machine::Machine;
 
-    /// Every compiled-in machine's descriptor, written and read back, is
-    /// the same description.
+    /// The mill with a body of each shape (sizes as numbers and as a
+    /// constant).
+    fn mill_with_bodies() -> MachineInfo {
+        use crate::machine::{BodyShape, Quantity};
+        use pilgrim_plugin_abi::types::FactorKind;
+        let mut info = Machine::builtin("vertical-mill").unwrap().info().clone();
+        info.constants.insert("guard_width".into(), 60.0);
+        let v = Quantity::Value;
+        for (name, shape) in [
+            (
+                "column",
+                BodyShape::Cylinder {
+                    radius: v(150.0),
+                    length: v(800.0),
+                },
+            ),
+            (
+                "head",
+                BodyShape::Block {
+                    size: [v(200.0), v(160.0), v(300.0)],
+                },
+            ),
+            (
+                "hood",
+                BodyShape::Guard {
+                    inner: v(30.0),
+                    outer: v(34.0),
+                    width: Quantity::Constant("guard_width".into()),
+                    cover_deg: 270.0,
+                },
+            ),
+        ] {
+            info.bodies.push(BodySpec {
+                name: name.into(),
+                description: String::new(),
+                label: String::new(),
+                chain: vec![
+                    FactorSpec::axis(FactorKind::Tz, "Z"),
+                    FactorSpec::value(FactorKind::Rz, 90f64.to_radians()),
+                ],
+                shape: Some(shape),
+                approach_feed: None,
+            });
+        }
+        info
+    }
+
+    /// Every compiled-in machine's descriptor, and the mill with a body of
+    /// each shape, written and read back, is the same description.
     #[test]
     fn descriptors_survive_the_file() {
         for info in [
@@ -213,6 +260,7 @@ mod tests {
             mannesmann::describe(),
             fanuc_0i_tc::describe(),
             Machine::builtin("vertical-mill").unwrap().info().clone(),
+            mill_with_bodies(),
         ] {
             let text = machine_file(&info, "a test");
             let again = Machine::from_toml_str(&text, "written")
