@@ -85,7 +85,7 @@ pub struct ReplayContext<'a> {
 
 /// A family's request for a verification of its own kind: the replay it
 /// makes of a program.
-pub trait Verifier: std::fmt::Debug {
+pub trait Verifier: AnyVerifier + std::fmt::Debug {
     /// Replays `ctx`'s program: the outcome, and the material as the replay
     /// left it (for the process's rules), where it knows it.
     ///
@@ -93,9 +93,19 @@ pub trait Verifier: std::fmt::Debug {
     /// The replay failing; a tool of the wrong kind
     /// ([`crate::replay::VerifyError::Replay`], naming what it needs).
     fn verify(&self, ctx: &ReplayContext<'_>) -> Result<Verified, crate::replay::VerifyError>;
+}
 
-    /// The request as [`std::any::Any`], for callers that know its type.
+/// A request as [`std::any::Any`], for callers that know its type: every
+/// [`Verifier`] has it.
+pub trait AnyVerifier {
+    /// The request as [`std::any::Any`].
     fn as_any(&self) -> &dyn std::any::Any;
+}
+
+impl<T: Verifier + 'static> AnyVerifier for T {
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
 }
 
 /// What a verification found and the material it knows.
@@ -117,7 +127,7 @@ pub struct FilesContext<'a> {
 /// What a verification found, as the run uses it: figures and failures
 /// for the verdict, its entry in the report, and its own files, bodies and
 /// overlays.
-pub trait Outcome: std::fmt::Debug + Send + Sync {
+pub trait Outcome: AnyOutcome + std::fmt::Debug + Send + Sync {
     /// Its key in `report.json` (one per kind: `verification`,
     /// `groove_verification`, ...): a plain name ending in `verification`,
     /// which no field of the report's own is.
@@ -135,9 +145,6 @@ pub trait Outcome: std::fmt::Debug + Send + Sync {
     /// What the run's one-line summary says of it (from `, `).
     fn summary(&self) -> String;
     /// The outcome as [`std::any::Any`], for callers that know its type.
-    fn as_any(&self) -> &dyn std::any::Any;
-    /// A copy.
-    fn clone_box(&self) -> Box<dyn Outcome>;
     /// A mesh to show at block `block` (from 0) in the scene, recording
     /// what it shows in the outcome (the caliber's contact patch).
     ///
@@ -190,6 +197,25 @@ pub trait Outcome: std::fmt::Debug + Send + Sync {
     }
 }
 
+/// An outcome as [`std::any::Any`] (for [`crate::job::JobOutput::check`])
+/// and boxed copies: every [`Outcome`] that is `Clone` has them.
+pub trait AnyOutcome {
+    /// The outcome as [`std::any::Any`], for callers that know its type.
+    fn as_any(&self) -> &dyn std::any::Any;
+    /// A copy.
+    fn clone_box(&self) -> Box<dyn Outcome>;
+}
+
+impl<T: Outcome + Clone + 'static> AnyOutcome for T {
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+
+    fn clone_box(&self) -> Box<dyn Outcome> {
+        Box::new(self.clone())
+    }
+}
+
 impl Clone for Box<dyn Outcome> {
     fn clone(&self) -> Self {
         self.clone_box()
@@ -232,7 +258,7 @@ pub struct Swept {
 /// A body swept through its sections, as the STEP writer fits it: what a
 /// family's body that is not of revolution gives (the caliber's roll, a
 /// finished worm).
-pub trait SweptSolid: std::fmt::Debug + Send + Sync {
+pub trait SweptSolid: CloneSwept + std::fmt::Debug + Send + Sync {
     /// Its sections, as the STEP writer fits them.
     fn sections(&self) -> &dyn crate::step::Sections;
     /// How far (mm) its sections already stray from the body they stand
@@ -240,8 +266,19 @@ pub trait SweptSolid: std::fmt::Debug + Send + Sync {
     fn simplified(&self) -> crate::math::Real {
         0.0
     }
+}
+
+/// Boxed copies of a swept solid: every [`SweptSolid`] that is `Clone`
+/// has them.
+pub trait CloneSwept {
     /// A copy.
     fn clone_box(&self) -> Box<dyn SweptSolid>;
+}
+
+impl<T: SweptSolid + Clone + 'static> CloneSwept for T {
+    fn clone_box(&self) -> Box<dyn SweptSolid> {
+        Box::new(self.clone())
+    }
 }
 
 /// A family's body swept through its sections.

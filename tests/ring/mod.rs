@@ -88,10 +88,6 @@ impl Verifier for RingRequest {
             stock: None,
         })
     }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
 }
 
 /// The cutter's distance from the circle at each block of the contour.
@@ -156,14 +152,6 @@ impl Outcome for RingOutcome {
 
     fn summary(&self) -> String {
         format!(", ring within {:.4} mm of its circle", self.worst().1.abs())
-    }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
-
-    fn clone_box(&self) -> Box<dyn Outcome> {
-        Box::new(self.clone())
     }
 
     fn files(

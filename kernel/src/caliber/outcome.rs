@@ -49,10 +49,6 @@ impl Verifier for GrooveRequest {
             stock,
         })
     }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
 }
 
 /// A caliber program replayed against its groove.
@@ -87,14 +83,6 @@ impl Outcome for GrooveOutcome {
             fixed(g.max_left.mm, 5),
             fixed(g.max_gouge.mm, 5)
         )
-    }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
-
-    fn clone_box(&self) -> Box<dyn Outcome> {
-        Box::new(self.clone())
     }
 
     fn at_pose(

@@ -359,8 +359,4 @@ impl crate::family::SweptSolid for Roll {
     fn sections(&self) -> &dyn crate::step::Sections {
         self
     }
-
-    fn clone_box(&self) -> Box<dyn crate::family::SweptSolid> {
-        Box::new(self.clone())
-    }
 }

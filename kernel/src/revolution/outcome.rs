@@ -44,10 +44,6 @@ impl Verifier for VerifyRequest {
             stock: ground.map(|g| Box::new(g) as Box<dyn crate::process::Stock>),
         })
     }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
 }
 
 /// A grinding program replayed against its body of revolution.
@@ -85,14 +81,6 @@ impl Outcome for GrindingOutcome {
                 )
             })
             .unwrap_or_default()
-    }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
-
-    fn clone_box(&self) -> Box<dyn Outcome> {
-        Box::new(self.clone())
     }
 
     fn files(

@@ -39,10 +39,6 @@ impl Verifier for WormRequest {
             stock: Some(Box::new(stock)),
         })
     }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
 }
 
 /// A worm's cut simulated against its thread.
@@ -80,14 +76,6 @@ impl Outcome for WormOutcome {
             w.removed_area,
             w.space_area
         )
-    }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
-
-    fn clone_box(&self) -> Box<dyn Outcome> {
-        Box::new(self.clone())
     }
 
     fn bodies(

@@ -191,8 +191,4 @@ impl crate::family::SweptSolid for WormSweep {
     fn simplified(&self) -> crate::math::Real {
         WormSweep::simplified(self)
     }
-
-    fn clone_box(&self) -> Box<dyn crate::family::SweptSolid> {
-        Box::new(self.clone())
-    }
 }
