@@ -60,84 +60,11 @@ pub enum VerifyError {
     /// Nothing cuts.
     #[error("the program has no cutting pass")]
     NoCuttingPass,
-    /// The finished surface strays from the nominal beyond the tolerance.
-    #[error(
-        "verification failed: the finished surface strays {} mm from the nominal profile at z = {}, \
-         where {} cuts it ({pass}: {} mm per revolution, a ridge of {} mm) (tolerance {tolerance} mm)",
-        crate::math::fixed(*deviation, 5),
-        crate::math::fixed(*z, 3),
-        block.as_deref().unwrap_or("an unknown block"),
-        crate::math::fixed(*feed_per_rev, 4),
-        crate::math::fixed(*ridge, 5)
-    )]
-    Deviation {
-        /// The signed deviation (mm; negative: a gouge).
-        deviation: Real,
-        /// Where (z, mm).
-        z: Real,
-        /// The block whose move formed the surface there, as the program
-        /// names it (`N1130 in "pass 4, ..."`).
-        block: Option<String>,
-        /// The finishing pass.
-        pass: String,
-        /// Its feed per revolution (mm).
-        feed_per_rev: Real,
-        /// The ridge that feed leaves (mm).
-        ridge: Real,
-        /// The tolerance (mm).
-        tolerance: Real,
-    },
-    /// The finished groove strays from the nominal beyond the tolerance.
-    #[error(
-        "verification failed: the finished groove strays {} mm from the nominal at theta = {} deg, psi = {} deg, \
-         where {block} leaves it (tolerance {tolerance} mm; positive: material left, negative: a gouge){why}",
-        crate::math::fixed(*deviation, 5),
-        crate::math::fixed(*theta_deg, 3),
-        crate::math::fixed(*psi_deg, 3)
-    )]
-    Groove {
-        /// The signed deviation (mm).
-        deviation: Real,
-        /// Where: theta (deg).
-        theta_deg: Real,
-        /// Where: psi (deg).
-        psi_deg: Real,
-        /// The block whose wheel is nearest there, as the program names it.
-        block: String,
-        /// The tolerance (mm).
-        tolerance: Real,
-        /// Why, where the check can tell, and what to change (from `: `;
-        /// empty if it cannot).
-        why: String,
-    },
-    /// The wheel cuts the roll's periphery beside the groove, which is not
-    /// to be ground.
-    #[error(
-        "verification failed: the wheel cuts the roll's periphery {} mm deep at theta = {} deg, {} mm beyond the groove's edge at psi = {} deg, \
-         where {block} reaches it (tolerance {tolerance} mm): the periphery beside the groove is not ground",
-        crate::math::fixed(*deviation, 5),
-        crate::math::fixed(*theta_deg, 3),
-        crate::math::fixed(*beyond_mm, 3),
-        crate::math::fixed(*psi_deg, 0)
-    )]
-    Periphery {
-        /// The cut (mm, negative).
-        deviation: Real,
-        /// Where: theta (deg).
-        theta_deg: Real,
-        /// The edge's side: psi (deg), -90 or 90.
-        psi_deg: Real,
-        /// How far beyond the edge along the roll's axis (mm).
-        beyond_mm: Real,
-        /// The block whose wheel cuts it, as the program names it.
-        block: String,
-        /// The tolerance (mm).
-        tolerance: Real,
-    },
-    /// The worm's simulated cut fails a check (the message names the block,
-    /// or the start and flank, and the tolerance).
+    /// The program verified, and the part it makes fails the family's
+    /// check: the family's own words (where, by how much, the block, what
+    /// to change).
     #[error("verification failed: {0}")]
-    Worm(String),
+    Failed(String),
     /// A tolerance finer than the program can carry.
     #[error("a verification tolerance of {tolerance} mm is finer than twice the program's resolution ({resolution} mm steps): the program cannot hold it")]
     Resolution {

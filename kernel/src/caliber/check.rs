@@ -674,6 +674,59 @@ fn explain(g: &Groove, worst: &GroovePlace, pass_range: [Real; 2]) -> Result<Str
     Ok(String::new())
 }
 
+/// The groove's failure (with `verification failed: ` before it, the
+/// check's [`VerifyError::Failed`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GrooveFailure {
+    /// The finished groove strays from the nominal beyond the tolerance.
+    #[error(
+        "the finished groove strays {} mm from the nominal at theta = {} deg, psi = {} deg, \
+         where {block} leaves it (tolerance {tolerance} mm; positive: material left, negative: a gouge){why}",
+        crate::math::fixed(*deviation, 5),
+        crate::math::fixed(*theta_deg, 3),
+        crate::math::fixed(*psi_deg, 3)
+    )]
+    Groove {
+        /// The signed deviation (mm).
+        deviation: Real,
+        /// Where: theta (deg).
+        theta_deg: Real,
+        /// Where: psi (deg).
+        psi_deg: Real,
+        /// The block whose wheel is nearest there, as the program names it.
+        block: String,
+        /// The tolerance (mm).
+        tolerance: Real,
+        /// Why, where the check can tell, and what to change (from `: `;
+        /// empty if it cannot).
+        why: String,
+    },
+    /// The wheel cuts the roll's periphery beside the groove, which is not
+    /// to be ground.
+    #[error(
+        "the wheel cuts the roll's periphery {} mm deep at theta = {} deg, {} mm beyond the groove's edge at psi = {} deg, \
+         where {block} reaches it (tolerance {tolerance} mm): the periphery beside the groove is not ground",
+        crate::math::fixed(*deviation, 5),
+        crate::math::fixed(*theta_deg, 3),
+        crate::math::fixed(*beyond_mm, 3),
+        crate::math::fixed(*psi_deg, 0)
+    )]
+    Periphery {
+        /// The cut (mm, negative).
+        deviation: Real,
+        /// Where: theta (deg).
+        theta_deg: Real,
+        /// The edge's side: psi (deg), -90 or 90.
+        psi_deg: Real,
+        /// How far beyond the edge along the roll's axis (mm).
+        beyond_mm: Real,
+        /// The block whose wheel cuts it, as the program names it.
+        block: String,
+        /// The tolerance (mm).
+        tolerance: Real,
+    },
+}
+
 impl GrooveCheck {
     /// The larger of the most material left and the deepest gouge.
     fn worst(&self) -> &GroovePlace {
@@ -695,12 +748,12 @@ impl GrooveCheck {
     }
 
     /// The groove's failure, if it strays more than the tolerance from the
-    /// nominal ([`VerifyError::Groove`]), or the wheel cuts the periphery
-    /// beside it more than that ([`VerifyError::Periphery`]).
-    pub fn failure(&self) -> Option<VerifyError> {
+    /// nominal ([`GrooveFailure::Groove`]), or the wheel cuts the periphery
+    /// beside it more than that ([`GrooveFailure::Periphery`]).
+    pub fn failure(&self) -> Option<GrooveFailure> {
         let place = self.failed_place()?;
         Some(if place.beyond_edge_mm > 0.0 {
-            VerifyError::Periphery {
+            GrooveFailure::Periphery {
                 deviation: place.mm,
                 theta_deg: place.theta_deg,
                 psi_deg: place.psi_deg,
@@ -709,7 +762,7 @@ impl GrooveCheck {
                 tolerance: self.tolerance,
             }
         } else {
-            VerifyError::Groove {
+            GrooveFailure::Groove {
                 deviation: place.mm,
                 theta_deg: place.theta_deg,
                 psi_deg: place.psi_deg,
@@ -726,7 +779,7 @@ impl GrooveCheck {
     /// [`Self::failure`].
     pub fn verified(self) -> Result<Self, VerifyError> {
         match self.failure() {
-            Some(e) => Err(e),
+            Some(e) => Err(VerifyError::Failed(e.to_string())),
             None => Ok(self),
         }
     }
@@ -773,8 +826,11 @@ impl GrooveCheck {
             .failure()
             .zip(self.failed_place())
             .map(|(e, at)| {
-                Finding::new("verification", e.to_string())
-                    .at(at.block_index.saturating_sub(1), at.block.clone())
+                Finding::new(
+                    "verification",
+                    VerifyError::Failed(e.to_string()).to_string(),
+                )
+                .at(at.block_index.saturating_sub(1), at.block.clone())
             })
             .into_iter()
             .collect();
@@ -868,7 +924,7 @@ mod failure_tests {
         assert!(check(0.005, -0.005).failure().is_none());
         let c = check(0.005, -0.03);
         let e = c.failure().expect("the periphery is cut 30 um");
-        assert!(matches!(e, VerifyError::Periphery { .. }), "{e}");
+        assert!(matches!(e, GrooveFailure::Periphery { .. }), "{e}");
         let text = e.to_string();
         assert!(
             text.contains("periphery") && text.contains("N90") && text.contains("1.250 mm beyond"),
@@ -878,6 +934,6 @@ mod failure_tests {
         assert_eq!(failures.len(), 1);
         assert_eq!(failures[0].block_index, Some(9));
         let both = check(0.02, -0.03).failure().unwrap();
-        assert!(matches!(both, VerifyError::Groove { .. }), "{both}");
+        assert!(matches!(both, GrooveFailure::Groove { .. }), "{both}");
     }
 }

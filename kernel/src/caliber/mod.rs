@@ -39,8 +39,8 @@ mod solid;
 mod stock;
 
 pub use check::{
-    check_groove, wheel_distance, DeviationMap, GrooveCheck, GroovePlace, GrooveRequest, MAP_CELLS,
-    NEIGHBOUR_PASSES,
+    check_groove, wheel_distance, DeviationMap, GrooveCheck, GrooveFailure, GroovePlace,
+    GrooveRequest, MAP_CELLS, NEIGHBOUR_PASSES,
 };
 pub use groove::{Groove, GrooveError};
 pub use outcome::{GrooveOutcome, KIND};

@@ -685,14 +685,45 @@ impl crate::process::Stock for GroundStock {
     }
 }
 
+/// The finishing pass's failure: its surface strays from the nominal
+/// beyond the tolerance (with `verification failed: ` before it, the
+/// check's [`VerifyError::Failed`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "the finished surface strays {} mm from the nominal profile at z = {}, \
+     where {} cuts it ({pass}: {} mm per revolution, a ridge of {} mm) (tolerance {tolerance} mm)",
+    crate::math::fixed(*deviation, 5),
+    crate::math::fixed(*z, 3),
+    block.as_deref().unwrap_or("an unknown block"),
+    crate::math::fixed(*feed_per_rev, 4),
+    crate::math::fixed(*ridge, 5)
+)]
+pub struct FinishFailure {
+    /// The signed deviation (mm; negative: a gouge).
+    deviation: Real,
+    /// Where (z, mm).
+    z: Real,
+    /// The block whose move formed the surface there, as the program
+    /// names it (`N1130 in "pass 4, ..."`).
+    block: Option<String>,
+    /// The finishing pass.
+    pass: String,
+    /// Its feed per revolution (mm).
+    feed_per_rev: Real,
+    /// The ridge that feed leaves (mm).
+    ridge: Real,
+    /// The tolerance (mm).
+    tolerance: Real,
+}
+
 impl GrindingCheck {
     /// The finishing pass's failure, if it strays more than the tolerance
-    /// from the nominal ([`VerifyError::Deviation`], its block named as
-    /// `program`, the one replayed, numbers it).
-    pub fn failure(&self, program: &AxisProgram) -> Option<VerifyError> {
+    /// from the nominal ([`FinishFailure`], its block named as `program`, the
+    /// one replayed, numbers it).
+    pub fn failure(&self, program: &AxisProgram) -> Option<FinishFailure> {
         let finish = self.passes.last()?;
         let d = finish.deviation;
-        (d.max_abs > self.tolerance).then(|| VerifyError::Deviation {
+        (d.max_abs > self.tolerance).then(|| FinishFailure {
             deviation: if d.max_above.abs() >= d.max_below.abs() {
                 d.max_above
             } else {
@@ -713,7 +744,7 @@ impl GrindingCheck {
     /// [`Self::failure`].
     pub fn verified(self, program: &AxisProgram) -> Result<Self, VerifyError> {
         match self.failure(program) {
-            Some(e) => Err(e),
+            Some(e) => Err(VerifyError::Failed(e.to_string())),
             None => Ok(self),
         }
     }
@@ -743,7 +774,10 @@ impl GrindingCheck {
             place,
         );
         let failure = self.failure(program).map(|e| {
-            let f = Finding::new("verification", e.to_string());
+            let f = Finding::new(
+                "verification",
+                VerifyError::Failed(e.to_string()).to_string(),
+            );
             match d.block {
                 Some(b) => f.at(b - 1, crate::program::block_name(program, b - 1)),
                 None => f,

@@ -175,11 +175,11 @@ impl WormCheck {
     /// The check, or its first failure as an error.
     ///
     /// # Failures
-    /// What the simulation found beyond a tolerance ([`VerifyError::Worm`],
+    /// What the simulation found beyond a tolerance ([`VerifyError::Failed`],
     /// naming the block or the start and flank).
     pub fn verified(self) -> Result<Self, VerifyError> {
         match self.failures.first() {
-            Some(f) => Err(VerifyError::Worm(
+            Some(f) => Err(VerifyError::Failed(
                 f.message
                     .strip_prefix("verification failed: ")
                     .unwrap_or(&f.message)
@@ -414,7 +414,7 @@ fn nominal_spaces(w: &WormSizes, c0: Real) -> Vec<[[Real; 2]; 4]> {
 /// that does not run over the whole thread; a move other than a thread
 /// that crosses the blank; any cut deeper than the form tolerance beyond
 /// the nominal space (named by block); the finished profile beyond a
-/// tolerance (named by start and flank). Each a [`VerifyError::Worm`].
+/// tolerance (named by start and flank). Each a [`VerifyError::Failed`].
 pub fn simulate(
     program: &AxisProgram,
     machine: &dyn MachineKinematics,
@@ -424,7 +424,7 @@ pub fn simulate(
 ) -> Result<WormCheck, VerifyError> {
     let w = &req.sizes;
     let tol = &req.tolerances;
-    let fail = |m: String| VerifyError::Worm(m);
+    let fail = |m: String| VerifyError::Failed(m);
     let (written, _) = as_written(program);
     let poses = replay(&written, machine, tool)?;
     let at = |i: usize| (poses[6 * i], poses[6 * i + 2]);
@@ -788,7 +788,7 @@ fn measure(
     tol: &WormTolerances,
 ) -> (Vec<StartProfile>, Vec<Finding>) {
     let mut failures = Vec::new();
-    let fail = |m: String| Finding::new("verification", VerifyError::Worm(m).to_string());
+    let fail = |m: String| Finding::new("verification", VerifyError::Failed(m).to_string());
     let (px, r_a, r_f, r1) = (
         w.axial_pitch(),
         w.tip_radius(),
