@@ -407,6 +407,15 @@ fn lint_gcode(
     };
     let framed = d.header.first().is_some_and(|h| *h == "%")
         || (d.header.first().is_some_and(|h| *h == "{WHOLE}%") && whole);
+    // What the header's lines hold, and the dialect's own words (no ISO
+    // words): radius and diameter programming by name (DIAMOF/DIAMON, not
+    // G8/G7), the feed's group (FGROUP(..)), a start angle by an address
+    // of more than a letter (SF=).
+    let program_number = format!("O{:04}", program.number % 10000);
+    let name_line = d.reading.name_line;
+    let header_name = name_line.map(|(before, after)| format!("{before}{}{after}", program.name));
+    let radial = d.radial_words.filter(|(r, _)| !is_g_code(r));
+    let start = d.thread_start.map(|t| t.address).filter(|a| a.len() > 1);
     let mut ticker = crate::budget::Ticker::new("the program's lint", 1024);
     for (i, line) in lines.iter().enumerate() {
         ticker
@@ -416,12 +425,7 @@ fn lint_gcode(
         if l.trim().is_empty() {
             comments[i] = said;
         }
-        let program_number = format!("O{:04}", program.number % 10000);
-        // The line naming the program, and a program read as it stands
-        // naming itself.
-        let name_line = d.reading.name_line;
-        let header_name =
-            name_line.map(|(before, after)| format!("{before}{}{after}", program.name));
+        // A program read as it stands names itself.
         let own_name = name_line
             .and_then(|(before, after)| line.strip_prefix(before)?.strip_suffix(after))
             .filter(|n| {
@@ -446,12 +450,6 @@ fn lint_gcode(
             let n = l.find('O').unwrap_or(0);
             l.replace_range(n..n + 5, "     ");
         } else {
-            // The dialect's own words, which are no ISO words: radius and
-            // diameter programming by name (DIAMOF/DIAMON, not G8/G7), the
-            // feed's group (FGROUP(..)), a start angle by an address of
-            // more than a letter (SF=).
-            let radial = d.radial_words.filter(|(r, _)| !is_g_code(r));
-            let start = d.thread_start.map(|t| t.address).filter(|a| a.len() > 1);
             let code_part = l.clone();
             for word in code_part.split_whitespace() {
                 let w =
