@@ -86,6 +86,7 @@ struct BodyFile {
     chain: Spanned<Vec<FactorFile>>,
     shape: Option<Spanned<BodyShape>>,
     approach_feed: Option<Spanned<crate::machine::Quantity>>,
+    mount: Option<Spanned<crate::machine::Mount>>,
 }
 
 /// Turns byte spans into `file:line:column` errors.
@@ -220,6 +221,11 @@ impl Machine {
                 chain: read_chain(&src, body.chain.get_ref())?,
                 shape: body.shape.as_ref().map(|s| s.get_ref().clone()),
                 approach_feed: body.approach_feed.as_ref().map(|s| s.get_ref().clone()),
+                mount: body
+                    .mount
+                    .as_ref()
+                    .map(|m| *m.get_ref())
+                    .unwrap_or_default(),
             });
         }
         let tool = match &file.tool {
@@ -318,6 +324,7 @@ fn span_of(file: &MachineFile, e: &Invalid) -> Range<usize> {
             let at = match *k {
                 "shape" => body.shape.as_ref().map(Spanned::span),
                 "approach_feed" => body.approach_feed.as_ref().map(Spanned::span),
+                "mount" => body.mount.as_ref().map(Spanned::span),
                 _ => None,
             };
             at.unwrap_or_else(|| body.chain.span())
@@ -490,8 +497,20 @@ fn read_chain(src: &Source<'_>, factors: &[FactorFile]) -> Result<Vec<FactorSpec
                 FactorSpec::value(kind, conv(src.finite("value", v)?))
             }
             (None, None, Some(c)) => {
-                no_scale_or_offset(src, f, offset_key)?;
-                FactorSpec::constant(kind, c.get_ref())
+                // A constant may be scaled (half a length: a body centred
+                // on its face), not offset.
+                if let Some(s) = offset_key {
+                    return Err(
+                        src.err(s.span(), "offset applies only to a factor bound to an axis")
+                    );
+                }
+                FactorSpec {
+                    scale: match &f.scale {
+                        Some(s) => src.finite("scale", s)?,
+                        None => 1.0,
+                    },
+                    ..FactorSpec::constant(kind, c.get_ref())
+                }
             }
             (Some(name), Some(_), _) => {
                 return Err(src.err(

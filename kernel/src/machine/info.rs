@@ -164,7 +164,8 @@ fn compile_chain(
                         format!("factor {word}: no machine constant '{c}'"),
                     )
                 })?;
-                b = b.constant(kind, finite(v, "constant")?);
+                let scale = finite(f.scale, "scale")?;
+                b = b.constant(kind, finite(scale * v, "constant")?);
             }
             (None, None) => b = b.constant(kind, finite(f.offset, "value")?),
             (Some(_), Some(_)) => {
@@ -330,6 +331,37 @@ fn check_body(info: &MachineInfo, b: &BodySpec) -> Result<(), Invalid> {
                 b.name
             ),
         ));
+    }
+    if !b.mount.is_part() {
+        if let Some(i) = b.chain.iter().position(|f| f.axis.is_some()) {
+            return Err(invalid(
+                Place::Factor(Some(b.name.clone()), i, "axis"),
+                format!(
+                    "body {} is mounted on the {}: its chain takes constants only (its mount moves it)",
+                    b.name,
+                    b.mount.word()
+                ),
+            ));
+        }
+        if b.mount == super::Mount::Tool && info.chain.is_empty() {
+            return Err(invalid(
+                Place::Body(b.name.clone(), "mount"),
+                format!(
+                    "body {} is mounted on the tool, but the machine states no tool chain to carry it",
+                    b.name
+                ),
+            ));
+        }
+        if b.approach_feed.is_some() {
+            return Err(invalid(
+                Place::Body(b.name.clone(), "approach_feed"),
+                format!(
+                    "body {} is mounted on the {}: only a body on the part frame rides the part",
+                    b.name,
+                    b.mount.word()
+                ),
+            ));
+        }
     }
     if let Some(q) = &b.approach_feed {
         let v = q.resolve(&info.constants).map_err(|m| {
@@ -646,7 +678,8 @@ fn described(info: &MachineInfo, e: Invalid) -> MachineError {
 
 /// Where a machine's chains put the origin of its body `body` relative to
 /// the tool's programmed point, every axis at zero, along the part frame's
-/// axis `along` (0: x, 1: y, 2: z); `None` when it has no such body.
+/// axis `along` (0: x, 1: y, 2: z); `None` when it has no such body on
+/// the part frame.
 ///
 /// A family whose parameter restates a body's place (the steady rest's
 /// offset along the part) compares its value with this: the chain is what
@@ -668,7 +701,11 @@ pub fn body_offset(
             ),
         ));
     }
-    let Some(spec) = info.bodies.iter().find(|b| b.name == body) else {
+    let Some(spec) = info
+        .bodies
+        .iter()
+        .find(|b| b.name == body && b.mount.is_part())
+    else {
         return Ok(None);
     };
     let origin = |chain: &Chain| -> Result<Real, MachineError> {

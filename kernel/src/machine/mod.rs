@@ -30,7 +30,7 @@ pub use info::{bodies_of, body_offset, check_description, Body, Solid, AXIS_LETT
 pub(crate) use kinematics::overridden as kinematics_overridden;
 pub use kinematics::{batch_rows, ChainMachine, KinematicsError, MachineKinematics};
 pub use pilgrim_plugin_abi::types::{
-    Axis, AxisKind, BodyShape, BodySpec, FactorSpec, MachineInfo, Quantity, ToolSpec,
+    Axis, AxisKind, BodyShape, BodySpec, FactorSpec, MachineInfo, Mount, Quantity, ToolSpec,
 };
 pub use write::machine_file;
 

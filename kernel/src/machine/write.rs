@@ -168,6 +168,9 @@ fn factor(f: &FactorSpec) -> Value {
         }
         (None, Some(c)) => {
             t.insert("constant".into(), c.clone().into());
+            if f.scale != 1.0 {
+                t.insert("scale".into(), f.scale.into());
+            }
         }
         (None, None) => {
             t.insert(format!("value{suffix}"), length(f.offset));
@@ -194,6 +197,9 @@ fn body(b: &BodySpec) -> Value {
     {
         t.insert("approach_feed".into(), feed);
     }
+    if !b.mount.is_part() {
+        t.insert("mount".into(), b.mount.word().into());
+    }
     t.insert("chain".into(), chain(&b.chain));
     t.into()
 }
@@ -202,6 +208,7 @@ fn body(b: &BodySpec) -> Value {
 mod tests {
     use super::*;
     use crate::machine::Machine;
+    use crate::machine::Mount;
 
     /// The mill with a body of each shape (sizes as numbers and as a
     /// constant).
@@ -245,6 +252,22 @@ mod tests {
                 ],
                 shape: Some(shape),
                 approach_feed: None,
+                mount: Mount::Part,
+            });
+        }
+        // A body on the tool, and one where the part begins.
+        for (name, mount) in [("collar", Mount::Tool), ("chuck", Mount::PartStart)] {
+            info.bodies.push(BodySpec {
+                name: name.into(),
+                description: String::new(),
+                label: String::new(),
+                chain: vec![FactorSpec::value(FactorKind::Tz, -50.0)],
+                shape: Some(BodyShape::Cylinder {
+                    radius: v(40.0),
+                    length: v(60.0),
+                }),
+                approach_feed: None,
+                mount,
             });
         }
         info
@@ -265,6 +288,10 @@ mod tests {
             let text = machine_file(&info, "a test");
             let again = Machine::from_toml_str(&text, "written")
                 .unwrap_or_else(|e| panic!("{}: {e}\n{text}", info.name));
+            // A file's bodies are a table by name: they read back in
+            // their names' order.
+            let mut info = info;
+            info.bodies.sort_by(|a, b| a.name.cmp(&b.name));
             assert_eq!(again.info(), &info, "{text}");
         }
     }

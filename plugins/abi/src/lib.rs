@@ -95,8 +95,8 @@ pub const ABI_MAJOR: u32 = 1;
 /// descriptor's and the program's `setup`, a block's `keep`; 1.3: the
 /// setup's `feed_group`; 1.4: a thread block's `start_deg`; 1.5: a body's
 /// `approach_feed`, a block's `number`; 1.6: the body shapes `cylinder`,
-/// `box` and `guard`).
-pub const ABI_MINOR: u32 = 6;
+/// `box` and `guard`; 1.7: a body's `mount`).
+pub const ABI_MINOR: u32 = 7;
 
 /// The call succeeded.
 pub const STATUS_OK: i32 = 0;

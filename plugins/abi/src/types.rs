@@ -206,14 +206,15 @@ pub struct FactorSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub axis: Option<String>,
     /// Multiplies the axis value (+1 or -1 for the sign, 0.5 for a
-    /// diameter-programmed lathe X).
+    /// diameter-programmed lathe X); since 1.7, also a constant's value
+    /// (-0.5 to stand a body centred on its face).
     #[serde(default = "one", skip_serializing_if = "is_one")]
     pub scale: f64,
     /// Added after scaling (mm or rad); for a constant factor, its value.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub offset: f64,
-    /// A constant factor whose value is this machine constant (the offset
-    /// is then unused).
+    /// A constant factor whose value is this machine constant, times
+    /// `scale` (the offset is then unused).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub constant: Option<String>,
 }
@@ -261,6 +262,15 @@ impl FactorSpec {
             scale: 1.0,
             offset: 0.0,
             constant: Some(name.to_owned()),
+        }
+    }
+
+    /// Since 1.7: a constant factor of `scale` times the machine constant
+    /// `name`.
+    pub fn scaled(factor: FactorKind, name: &str, scale: f64) -> Self {
+        Self {
+            scale,
+            ..Self::constant(factor, name)
         }
     }
 }
@@ -311,7 +321,47 @@ pub enum BodyShape {
     },
 }
 
-/// A moving body of the machine other than the tool (a steady rest).
+/// Since 1.7: the frame a body's chain starts from.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Mount {
+    /// The part frame: the chain places the body in it, its axes moving it
+    /// (a steady rest).
+    #[default]
+    Part,
+    /// The tool's spindle: the tool frame moved to the tool's centre (a
+    /// wheel's centre on its axis, which the run knows from the wheel's
+    /// size; the tool frame's origin for other tools), its axes the tool
+    /// frame's. The body rides with the tool (a guard, a wheelhead, a
+    /// holder, a turret).
+    Tool,
+    /// The part's end at its least z (the part frame turned by nothing,
+    /// moved along Z to where the part's solids begin): a chuck, a
+    /// headstock's centre, a roll's arbor on that side.
+    PartStart,
+    /// The part's end at its greatest z: a tailstock.
+    PartEnd,
+}
+
+impl Mount {
+    /// Whether this is the default, [`Mount::Part`].
+    pub fn is_part(&self) -> bool {
+        *self == Self::Part
+    }
+
+    /// `part`, `tool`, `part_start` or `part_end`.
+    pub fn word(self) -> &'static str {
+        match self {
+            Self::Part => "part",
+            Self::Tool => "tool",
+            Self::PartStart => "part_start",
+            Self::PartEnd => "part_end",
+        }
+    }
+}
+
+/// A body of the machine other than the tool: moving (a steady rest), on
+/// the tool (a guard), or standing where the part is held (a chuck).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BodySpec {
     /// Its name (a scene node and file name: letters, digits, `_`, `-`).
@@ -323,8 +373,13 @@ pub struct BodySpec {
     /// `steady rest: support centre`).
     #[serde(default)]
     pub label: String,
-    /// The chain placing the body's frame in the part frame, left to right.
+    /// The chain placing the body's frame in its mount's frame (the part
+    /// frame unless [`Self::mount`] says otherwise), left to right. A body
+    /// not mounted on the part takes constants only: its mount moves it.
     pub chain: Vec<FactorSpec>,
+    /// Since 1.7: what the body is mounted on.
+    #[serde(default, skip_serializing_if = "Mount::is_part")]
+    pub mount: Mount,
     /// Its solid, if it is drawn.
     #[serde(default)]
     pub shape: Option<BodyShape>,
