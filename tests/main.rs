@@ -13,6 +13,7 @@ mod architecture;
 mod bodies;
 mod caliber;
 mod cli;
+mod collisions;
 mod containment;
 mod docs;
 mod machine_files;

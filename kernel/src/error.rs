@@ -95,6 +95,10 @@ pub enum Error {
         /// The family.
         family: String,
     },
+    /// The collision check could not run (a chain or a program it cannot
+    /// place the bodies by).
+    #[error("{0}")]
+    Collision(String),
     /// An option of the run that cannot be used.
     #[error("{0}")]
     Options(String),

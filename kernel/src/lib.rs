@@ -56,6 +56,7 @@ pub mod budget;
 pub mod caliber;
 pub mod catalog;
 mod chart;
+pub mod collision;
 pub mod error;
 mod families;
 pub mod family;

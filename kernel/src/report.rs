@@ -102,6 +102,10 @@ pub struct Report {
     /// against its tolerance, what failed and where, what it warns of.
     #[serde(default)]
     pub verdict: crate::verdict::Verdict,
+    /// The collision check: every pair's smallest clearance along the
+    /// program; `None` where the run checked none (a refused program).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub collisions: Option<crate::collision::Collisions>,
 }
 
 impl Report {
@@ -182,6 +186,7 @@ impl Report {
             notes: BTreeMap::new(),
             tables: BTreeMap::new(),
             verdict: crate::verdict::Verdict::default(),
+            collisions: None,
         }
     }
 }

@@ -156,6 +156,17 @@ impl WheelOrigin {
 }
 
 impl Tool {
+    /// The centre of the tool's spindle in the tool frame: a wheel's centre
+    /// (on its axis, in its middle plane), the tool frame's origin for other
+    /// tools. The machine's bodies mounted on the tool (a guard, a holder)
+    /// are placed from it, so they follow the wheel's size.
+    pub fn spindle_centre(&self) -> Vec3 {
+        match (self.shape, self.origin) {
+            (ToolShape::Wheel(w), WheelOrigin::Periphery) => Vec3::new(w.diameter / 2.0, 0.0, 0.0),
+            _ => Vec3::zeros(),
+        }
+    }
+
     /// A wheel whose programmed point is the lowest point of its rounding
     /// (as the seed programs it) and whose tracked point is the rounding's
     /// centre, R_s above it; the wheel's axis along +Z.

@@ -220,6 +220,44 @@ fn failed_run(
     Error::Failed(Box::new(FailedRun { report, files }))
 }
 
+/// The collision check of `program` on `machine`: the tool's solid at
+/// the mesh tolerance `tol` in its own frame, the part at its largest (the
+/// body of `parts` of the greatest volume).
+///
+/// # Failures
+/// The tool's mesh failing; the check's own ([`crate::collision::check`]).
+fn collisions(
+    program: &AxisProgram,
+    machine: &dyn crate::machine::MachineKinematics,
+    tool: &crate::tool::Tool,
+    parts: &[(String, crate::mesh::TriMesh)],
+    tol: f64,
+) -> Result<crate::collision::Collisions, Error> {
+    let (written, _) = crate::replay::as_written(program);
+    let unplaced = scene::ToolAt {
+        pose: crate::math::Mat4::identity(),
+        lead: 0.0,
+    };
+    let tool_mesh = scene::tool_mesh(tool, &unplaced, tol)?;
+    let part = parts
+        .iter()
+        .max_by(|a, b| a.1.volume().total_cmp(&b.1.volume()))
+        .map(|(n, m)| (n.as_str(), m));
+    crate::collision::check(
+        &written,
+        machine,
+        crate::collision::Solids {
+            tool: tool_mesh.as_ref().map(|(m, n)| (*n, tool, Some(m))),
+            part,
+            tolerance: tol,
+        },
+    )
+    .map_err(|e| match e {
+        crate::collision::CollisionError::OverTime(o) => Error::OverTime(o),
+        e => Error::Collision(e.to_string()),
+    })
+}
+
 /// The run's data files, made of the toolpath and the program alone:
 /// `toolpath.json`, `program.json` and the block table `report.csv`.
 fn data_files(toolpath: &Toolpath, program: &AxisProgram) -> Result<[Vec<u8>; 3], Error> {
@@ -488,6 +526,29 @@ fn run_on(
             "the rules that need the material (rapids through air only, into the stock at the infeed feed, the steady rest's approach, the finishing stock) were not checked: the family's verification gives no blank",
         ));
     }
+    let mut parts = family.part(&values)?;
+    if let Some(b) = parts.iter().find(|b| !crate::files::is_plain_name(&b.name)) {
+        return Err(Error::Family(crate::family::FamilyError::Contract {
+            family: family.name().to_owned(),
+            message: format!(
+                "fn part(p): the body name '{}' is not a plain name (letters, digits, _ or -, at most 64): it becomes a file name",
+                crate::files::excerpt(&b.name)
+            ),
+        }));
+    }
+    let tol = options.mesh_tolerance;
+    // Bodies the verification made (the finished worm).
+    if let Some(o) = &outcome {
+        parts.extend(o.bodies(tol, options.step_tolerance)?);
+    }
+    let meshes = scene::part_meshes(&parts, tol).map_err(|source| Error::Part {
+        family: family.name().to_owned(),
+        source,
+    })?;
+    // The machine's bodies, the tool and the part clear of each other
+    // along the whole program.
+    let collisions = collisions(verified, kin, &toolpath.tool, &meshes, tol)?;
+    failures.extend(collisions.findings.iter().cloned());
     // The scene shows the tool where asked; a failed run's, where it
     // failed; else the middle of the last cutting pass.
     let pose_place = match (
@@ -524,28 +585,9 @@ fn run_on(
     files.extend(programs);
     files.extend(table);
     stage(STAGES[4]);
-    let mut parts = family.part(&values)?;
-    if let Some(b) = parts.iter().find(|b| !crate::files::is_plain_name(&b.name)) {
-        return Err(Error::Family(crate::family::FamilyError::Contract {
-            family: family.name().to_owned(),
-            message: format!(
-                "fn part(p): the body name '{}' is not a plain name (letters, digits, _ or -, at most 64): it becomes a file name",
-                crate::files::excerpt(&b.name)
-            ),
-        }));
-    }
-    let tol = options.mesh_tolerance;
-    // Bodies the verification made (the finished worm).
-    if let Some(o) = &outcome {
-        parts.extend(o.bodies(tol, options.step_tolerance)?);
-    }
     let (pose_block, bodies, solids, part_box) = if parts.is_empty() {
         (None, vec![], vec![], None)
     } else {
-        let meshes = scene::part_meshes(&parts, tol).map_err(|source| Error::Part {
-            family: family.name().to_owned(),
-            source,
-        })?;
         // Where the report page's camera points: the part's middle.
         let part_box = scene::bounds_of(meshes.iter().map(|(_, m)| m));
         let index = pose_index;
@@ -611,6 +653,7 @@ fn run_on(
         notes: toolpath.notes.clone(),
         tables: toolpath.tables.clone(),
         verdict: Verdict::of(requested_any, failures, warnings, figures),
+        collisions: Some(collisions),
         program_file: text.and(options.program_file.clone()),
         block_numbers: program
             .blocks

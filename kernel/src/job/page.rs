@@ -108,6 +108,35 @@ fn banner(out: &mut String, r: &Report) {
 }
 
 /// A list of findings, each its rule, its block and what it says.
+/// The collision check: each pair's smallest clearance, nearest first.
+fn clearances(out: &mut String, r: &Report) {
+    let Some(c) = &r.collisions else {
+        return;
+    };
+    out.push_str(&format!(
+        "<h2>Clearances</h2>\n<p>Every pair of bodies the program moves relative to each other, checked along every move ({} places; measured again before two bodies can close {:.0} % of the last distance or {} mm; the part as its envelope of revolution at its largest). The smallest clearance of each pair, nearest first:</p>\n<table><tr><th>bodies</th><th>clearance (mm)</th><th>at block</th></tr>\n",
+        c.samples,
+        100.0 * crate::collision::REMEASURE,
+        c.step_mm
+    ));
+    let mut pairs: Vec<_> = c.clearances.iter().collect();
+    pairs.sort_by(|a, b| a.clearance_mm.total_cmp(&b.clearance_mm));
+    for p in pairs {
+        row(
+            out,
+            &[
+                format!("{} / {}", escape(&p.bodies[0]), escape(&p.bodies[1])),
+                crate::math::fixed(p.clearance_mm, 3),
+                escape(&p.block),
+            ],
+        );
+    }
+    out.push_str("</table>\n");
+    for n in &c.notes {
+        out.push_str(&format!("<p class=\"warn\">{}</p>\n", escape(n)));
+    }
+}
+
 fn findings(out: &mut String, class: &str, prefix: &str, list: &[crate::verdict::Finding]) {
     if list.is_empty() {
         return;
@@ -207,6 +236,7 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
         );
     }
     out.push_str("</table>\n");
+    clearances(&mut out, r);
     if !inputs.plots.is_empty() {
         out.push_str("<h2>Plots</h2>\n");
         for (name, svg) in &inputs.plots {

@@ -20,7 +20,8 @@
 //! (MATH §4.2); its Z axis's `max_feed` bounds lead x rpm of a thread.
 
 use pilgrim_plugin_abi::types::{
-    Axis, AxisKind, FactorKind, FactorSpec, MachineInfo, Plane, ProgramSetup, Radial, ToolSpec,
+    Axis, AxisKind, BodyShape, BodySpec, FactorKind, FactorSpec, MachineInfo, Mount, Plane,
+    ProgramSetup, Quantity, Radial, ToolSpec,
 };
 use pilgrim_plugin_abi::{check_axial_section, export_plugin, Plugin, PluginError};
 
@@ -101,17 +102,127 @@ pub fn describe() -> MachineInfo {
             ("infeed_feed".to_owned(), 100.0),
             ("rapid_clearance".to_owned(), 1.0),
             ("finish_stock".to_owned(), 0.2),
+            // The machine's bodies (mm), a 0i-TC turning centre's: a
+            // 25 mm square holder whose shank starts `holder_gap` behind
+            // the tip (a blade that reaches a module-5 worm's 11 mm
+            // depth, and 5 mm more), the turret's disc behind it, a 200 mm chuck whose
+            // jaws stand `chuck_gap` beyond the part's start (room for the
+            // thread's run-out and the holder), the tailstock's centre and
+            // quill at the part's end.
+            ("holder_gap".to_owned(), 16.0),
+            ("holder_length".to_owned(), 80.0),
+            ("holder_section".to_owned(), 25.0),
+            ("turret_radius".to_owned(), 120.0),
+            ("turret_width".to_owned(), 90.0),
+            ("chuck_radius".to_owned(), 100.0),
+            ("chuck_length".to_owned(), 100.0),
+            ("chuck_gap".to_owned(), 30.0),
+            ("centre_radius".to_owned(), 10.0),
+            ("centre_length".to_owned(), 40.0),
+            ("quill_radius".to_owned(), 35.0),
+            ("quill_length".to_owned(), 150.0),
         ]
         .into_iter()
         .collect(),
         program_decimals: None,
         driven_axes: vec![],
         setup: setup(),
-        bodies: vec![],
+        bodies: bodies(),
         chain: vec![FactorSpec::axis(FactorKind::Tz, "Z"), tx],
         tool: ToolSpec::default(),
         min_feed: Some(1.0),
     }
+}
+
+/// A body of `shape` on `mount`, placed there by the constant `chain`.
+fn body(
+    name: &str,
+    what: &str,
+    mount: Mount,
+    chain: Vec<FactorSpec>,
+    shape: BodyShape,
+) -> BodySpec {
+    BodySpec {
+        name: name.into(),
+        description: what.into(),
+        label: String::new(),
+        chain,
+        shape: Some(shape),
+        approach_feed: None,
+        mount,
+    }
+}
+
+/// The lathe's bodies: the holder and the turret (on the tool, from its
+/// tip outward), the chuck at the part's start, the tailstock at its end.
+fn bodies() -> Vec<BodySpec> {
+    let c = |name: &str| Quantity::Constant(name.into());
+    let k = |f: FactorKind, name: &str| FactorSpec::constant(f, name);
+    let half = |f: FactorKind, name: &str, sign: f64| FactorSpec::scaled(f, name, 0.5 * sign);
+    vec![
+        body(
+            "holder",
+            "the cutter's holder, its shank radial behind the tip",
+            Mount::Tool,
+            vec![
+                k(FactorKind::Tx, "holder_gap"),
+                half(FactorKind::Tx, "holder_length", 1.0),
+            ],
+            BodyShape::Block {
+                size: [c("holder_length"), c("holder_section"), c("holder_section")],
+            },
+        ),
+        body(
+            "turret",
+            "the turret's disc carrying the holder",
+            Mount::Tool,
+            vec![
+                k(FactorKind::Tx, "holder_gap"),
+                k(FactorKind::Tx, "holder_length"),
+                k(FactorKind::Tx, "turret_radius"),
+            ],
+            BodyShape::Cylinder {
+                radius: c("turret_radius"),
+                length: c("turret_width"),
+            },
+        ),
+        body(
+            "chuck",
+            "the chuck, its jaws chuck_gap beyond the part's start",
+            Mount::PartStart,
+            vec![
+                FactorSpec::scaled(FactorKind::Tz, "chuck_gap", -1.0),
+                half(FactorKind::Tz, "chuck_length", -1.0),
+            ],
+            BodyShape::Cylinder {
+                radius: c("chuck_radius"),
+                length: c("chuck_length"),
+            },
+        ),
+        body(
+            "tailstock_centre",
+            "the tailstock's centre in the part's end",
+            Mount::PartEnd,
+            vec![half(FactorKind::Tz, "centre_length", 1.0)],
+            BodyShape::Cylinder {
+                radius: c("centre_radius"),
+                length: c("centre_length"),
+            },
+        ),
+        body(
+            "tailstock_quill",
+            "the tailstock's quill behind its centre",
+            Mount::PartEnd,
+            vec![
+                k(FactorKind::Tz, "centre_length"),
+                half(FactorKind::Tz, "quill_length", 1.0),
+            ],
+            BodyShape::Cylinder {
+                radius: c("quill_radius"),
+                length: c("quill_length"),
+            },
+        ),
+    ]
 }
 
 /// The Fanuc lathe.

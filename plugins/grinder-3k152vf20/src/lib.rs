@@ -29,8 +29,8 @@
 //! library's); built as a cdylib it is `libgrinder_3k152vf20.so`.
 
 use pilgrim_plugin_abi::types::{
-    Axis, AxisKind, BodyShape, BodySpec, FactorKind, FactorSpec, MachineInfo, Plane, ProgramSetup,
-    Quantity, Radial, ToolSpec,
+    Axis, AxisKind, BodyShape, BodySpec, FactorKind, FactorSpec, MachineInfo, Mount, Plane,
+    ProgramSetup, Quantity, Radial, ToolSpec,
 };
 use pilgrim_plugin_abi::{check_axial_section, export_plugin, Plugin, PluginError};
 
@@ -130,6 +130,27 @@ pub fn describe() -> MachineInfo {
             ("rapid_clearance".to_owned(), 0.5),
             ("finish_stock".to_owned(), 0.03),
             ("rest_approach_feed".to_owned(), 100.0),
+            // The machine's bodies (mm), a 3K152VF20's as built for a
+            // wheel of up to 600 x 80 mm: the guard over 200 degrees of
+            // the wheel, its inner radius clear of the largest wheel; the
+            // flanges that clamp the wheel; the wheelhead behind them; the
+            // rest's arm behind its roller; a 250 mm chuck gripping the
+            // mandrel's tail over `chuck_grip`; the tailstock's centre and
+            // quill beyond the part's far end.
+            ("guard_inner".to_owned(), 310.0),
+            ("guard_outer".to_owned(), 330.0),
+            ("guard_width".to_owned(), 110.0),
+            ("hub_radius".to_owned(), 160.0),
+            ("hub_width".to_owned(), 100.0),
+            ("rest_arm_length".to_owned(), 300.0),
+            ("rest_arm_width".to_owned(), 40.0),
+            ("chuck_radius".to_owned(), 125.0),
+            ("chuck_length".to_owned(), 110.0),
+            ("chuck_grip".to_owned(), 40.0),
+            ("centre_radius".to_owned(), 10.0),
+            ("centre_length".to_owned(), 50.0),
+            ("quill_radius".to_owned(), 40.0),
+            ("quill_length".to_owned(), 150.0),
         ]
         .into_iter()
         .collect(),
@@ -139,7 +160,49 @@ pub fn describe() -> MachineInfo {
         program_decimals: Some(4),
         driven_axes: vec!["U".into()],
         setup: setup(),
-        bodies: vec![BodySpec {
+        bodies: bodies(),
+        chain: vec![
+            FactorSpec::axis(FactorKind::Tz, "Z"),
+            FactorSpec::axis(FactorKind::Tx, "X"),
+        ],
+        tool: ToolSpec::default(),
+        // The 840D's feeds below 1 mm/min are not a grinding feed.
+        min_feed: Some(1.0),
+    }
+}
+
+/// A body of `shape` on `mount`, placed there by the constant `chain`.
+fn body(
+    name: &str,
+    what: &str,
+    mount: Mount,
+    chain: Vec<FactorSpec>,
+    shape: BodyShape,
+) -> BodySpec {
+    BodySpec {
+        name: name.into(),
+        description: what.into(),
+        label: String::new(),
+        chain,
+        shape: Some(shape),
+        approach_feed: None,
+        mount,
+    }
+}
+
+fn c(name: &str) -> Quantity {
+    Quantity::Constant(name.into())
+}
+
+/// The machine's bodies: the steady rest (its roller rides the part, its
+/// arm behind it), the wheel's guard, flanges and wheelhead (on the
+/// wheel's spindle, at the wheel's centre), the chuck at the part's start
+/// and the tailstock at its end.
+fn bodies() -> Vec<BodySpec> {
+    let tz = |v: f64| FactorSpec::value(FactorKind::Tz, v);
+    let tx = |v: f64| FactorSpec::value(FactorKind::Tx, v);
+    vec![
+        BodySpec {
             name: "rest".into(),
             description: "steady rest support (circle of radius rest_radius in the axial section)"
                 .into(),
@@ -160,15 +223,105 @@ pub fn describe() -> MachineInfo {
             // The rest rides the part: it comes onto the turning part at
             // this speed, never at rapid.
             approach_feed: Some(Quantity::Constant("rest_approach_feed".into())),
-        }],
-        chain: vec![
-            FactorSpec::axis(FactorKind::Tz, "Z"),
-            FactorSpec::axis(FactorKind::Tx, "X"),
-        ],
-        tool: ToolSpec::default(),
-        // The 840D's feeds below 1 mm/min are not a grinding feed.
-        min_feed: Some(1.0),
-    }
+            mount: Mount::Part,
+        },
+        // The arm carrying the roller: from the roller's back, away from
+        // the part (the rest's frame has +X away from the axis).
+        BodySpec {
+            name: "rest_arm".into(),
+            description: "steady rest's arm behind its roller".into(),
+            label: String::new(),
+            chain: vec![
+                FactorSpec::axis(FactorKind::Tz, "Z"),
+                FactorSpec::constant(FactorKind::Tz, "rest_offset_b"),
+                FactorSpec::value(FactorKind::Rz, 180f64.to_radians()),
+                FactorSpec::axis(FactorKind::Tx, "U"),
+                FactorSpec::constant(FactorKind::Tx, "rest_radius"),
+                tx(5.0),
+                FactorSpec::scaled(FactorKind::Tx, "rest_arm_length", 0.5),
+            ],
+            shape: Some(BodyShape::Block {
+                size: [
+                    c("rest_arm_length"),
+                    Quantity::Value(60.0),
+                    c("rest_arm_width"),
+                ],
+            }),
+            approach_feed: None,
+            mount: Mount::Part,
+        },
+        body(
+            "guard",
+            "wheel guard over 200 degrees, open toward the part",
+            Mount::Tool,
+            vec![tz(0.0)],
+            BodyShape::Guard {
+                inner: c("guard_inner"),
+                outer: c("guard_outer"),
+                width: c("guard_width"),
+                cover_deg: 200.0,
+            },
+        ),
+        body(
+            "hub",
+            "wheel flanges clamping the wheel on its spindle",
+            Mount::Tool,
+            vec![tz(0.0)],
+            BodyShape::Cylinder {
+                radius: c("hub_radius"),
+                length: c("hub_width"),
+            },
+        ),
+        body(
+            "wheelhead",
+            "wheelhead housing behind the wheel, carrying its spindle",
+            Mount::Tool,
+            vec![tx(560.0), tz(0.0)],
+            BodyShape::Block {
+                size: [
+                    Quantity::Value(400.0),
+                    Quantity::Value(500.0),
+                    Quantity::Value(400.0),
+                ],
+            },
+        ),
+        body(
+            "chuck",
+            "headstock chuck gripping the mandrel's tail over chuck_grip",
+            Mount::PartStart,
+            vec![
+                FactorSpec::constant(FactorKind::Tz, "chuck_grip"),
+                FactorSpec::scaled(FactorKind::Tz, "chuck_length", -0.5),
+            ],
+            BodyShape::Cylinder {
+                radius: c("chuck_radius"),
+                length: c("chuck_length"),
+            },
+        ),
+        body(
+            "tailstock_centre",
+            "tailstock centre in the mandrel's end",
+            Mount::PartEnd,
+            vec![FactorSpec::scaled(FactorKind::Tz, "centre_length", 0.5)],
+            BodyShape::Cylinder {
+                radius: c("centre_radius"),
+                length: c("centre_length"),
+            },
+        ),
+        body(
+            "tailstock_quill",
+            "tailstock quill behind its centre",
+            Mount::PartEnd,
+            vec![
+                FactorSpec::constant(FactorKind::Tz, "centre_length"),
+                FactorSpec::scaled(FactorKind::Tz, "quill_length", 0.5),
+            ],
+            BodyShape::Cylinder {
+                radius: c("quill_radius"),
+                length: c("quill_length"),
+            },
+        ),
+    ]
 }
 
 /// The 3K152VF20.

@@ -37,7 +37,8 @@ pub mod kinematics;
 pub use kinematics::CaliberKinematics;
 
 use pilgrim_plugin_abi::types::{
-    Axis, AxisKind, FactorKind, FactorSpec, MachineInfo, Plane, ProgramSetup, Radial, ToolSpec,
+    Axis, AxisKind, BodyShape, BodySpec, FactorKind, FactorSpec, MachineInfo, Mount, Plane,
+    ProgramSetup, Quantity, Radial, ToolSpec,
 };
 use pilgrim_plugin_abi::{export_plugin, Plugin, PluginError};
 
@@ -138,12 +139,27 @@ pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInf
             ("infeed_feed".to_owned(), 2.0),
             ("rapid_clearance".to_owned(), 0.5),
             ("finish_stock".to_owned(), 0.1),
+            // The machine's bodies (mm), as built for wheels of up to
+            // 280 mm and rolls of up to 400 mm: the guard over half the
+            // wheel, open toward the roll; the spindle's housing beside the
+            // wheel; the arbor through the roll and the collars clamping
+            // it at both faces.
+            ("guard_inner".to_owned(), 145.0),
+            ("guard_outer".to_owned(), 160.0),
+            ("guard_width".to_owned(), 50.0),
+            ("housing_radius".to_owned(), 60.0),
+            ("housing_length".to_owned(), 200.0),
+            ("housing_gap".to_owned(), 35.0),
+            ("arbor_radius".to_owned(), 70.0),
+            ("arbor_length".to_owned(), 800.0),
+            ("collar_radius".to_owned(), 100.0),
+            ("collar_length".to_owned(), 40.0),
         ]
         .into_iter()
         .collect(),
         program_decimals: None,
         driven_axes: vec![],
-        bodies: vec![],
+        bodies: bodies(),
         chain,
         tool: ToolSpec::default(),
         min_feed: Some(1.0),
@@ -165,6 +181,88 @@ pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInf
             feed_group: vec!["A".into()],
         },
     }
+}
+
+/// A body of `shape` on `mount`, placed there by the constant `chain`.
+fn body(
+    name: &str,
+    what: &str,
+    mount: Mount,
+    chain: Vec<FactorSpec>,
+    shape: BodyShape,
+) -> BodySpec {
+    BodySpec {
+        name: name.into(),
+        description: what.into(),
+        label: String::new(),
+        chain,
+        shape: Some(shape),
+        approach_feed: None,
+        mount,
+    }
+}
+
+/// A caliber grinder's bodies: the wheel's guard and its spindle's
+/// housing (on the wheel's centre, the tool frame), the arbor through the
+/// roll, the collars at the roll's faces.
+fn bodies() -> Vec<BodySpec> {
+    let c = |name: &str| Quantity::Constant(name.into());
+    let centred = vec![FactorSpec::value(FactorKind::Tz, 0.0)];
+    let collar = BodyShape::Cylinder {
+        radius: c("collar_radius"),
+        length: c("collar_length"),
+    };
+    vec![
+        body(
+            "guard",
+            "wheel guard over half the wheel, open toward the roll",
+            Mount::Tool,
+            centred.clone(),
+            BodyShape::Guard {
+                inner: c("guard_inner"),
+                outer: c("guard_outer"),
+                width: c("guard_width"),
+                cover_deg: 180.0,
+            },
+        ),
+        body(
+            "housing",
+            "wheel spindle's housing beside the wheel",
+            Mount::Tool,
+            vec![
+                FactorSpec::constant(FactorKind::Tz, "housing_gap"),
+                FactorSpec::scaled(FactorKind::Tz, "housing_length", 0.5),
+            ],
+            BodyShape::Cylinder {
+                radius: c("housing_radius"),
+                length: c("housing_length"),
+            },
+        ),
+        body(
+            "arbor",
+            "arbor through the roll",
+            Mount::Part,
+            centred,
+            BodyShape::Cylinder {
+                radius: c("arbor_radius"),
+                length: c("arbor_length"),
+            },
+        ),
+        body(
+            "collar_front",
+            "collar clamping the roll at its front face",
+            Mount::PartStart,
+            vec![FactorSpec::scaled(FactorKind::Tz, "collar_length", -0.5)],
+            collar.clone(),
+        ),
+        body(
+            "collar_back",
+            "collar clamping the roll at its back face",
+            Mount::PartEnd,
+            vec![FactorSpec::scaled(FactorKind::Tz, "collar_length", 0.5)],
+            collar,
+        ),
+    ]
 }
 
 /// The LZ-250's description.

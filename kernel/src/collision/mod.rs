@@ -1,0 +1,534 @@
+//! The machine's bodies checked for collisions along the whole program:
+//! the tool, the bodies the machine describes (a guard, a wheelhead, a
+//! steady rest's arm, a chuck, a tailstock) and the part, each placed by
+//! its chain at every sample of every move as the control interpolates it
+//! (the axes in straight lines from one block's end to the next), and the
+//! distance of every pair that must not touch measured with parry's
+//! queries (GJK on convex shapes, a bounding-volume tree on the part's
+//! mesh).
+//!
+//! **Which pairs.** Two bodies are checked when the program can move one
+//! relative to the other: when the axes that move them differ. So a guard
+//! and its wheel (both moved by the wheel's axes), a rest's roller and its
+//! arm, a chuck and the part it holds (moved by none) are not; the wheel
+//! and the rest's arm, the guard and the part, the cutter and the chuck
+//! are. Two pairs touch by design and are left to other checks: the tool
+//! and the part (the family's verification measures the cut), and a body
+//! that rides the part (a steady rest's roller, which has an approach feed:
+//! the process checks keep it on the surface).
+//!
+//! **The part** is taken at its largest: the part body of the greatest
+//! volume (the blank where the family gives one), as its envelope of
+//! revolution about its axis (a stack of cylinders as wide as the mesh,
+//! [`shapes::envelope`]). A clearance to it is smaller than to the part at
+//! that moment by at most the stock, the groove or thread not yet cut, and
+//! twice the mesh tolerance.
+//!
+//! **Along the moves.** Each move is cut into pieces that turn any body by
+//! at most [`MAX_TURN`], so that a piece's ends bound how far each body's
+//! farthest point moves over it (its shift and its turn at its reach, to
+//! first order). A pair is measured again before the two can have closed
+//! [`REMEASURE`] of the distance measured last, or [`STEP`] mm, never all
+//! of it: so no contact is missed, and between measurements the pair
+//! stayed at least 98 % of the last distance less one step. Inside a
+//! piece, a pair is measured at places at most [`STEP`] mm of motion
+//! apart. The smallest clearance reported is the smallest measured.
+//!
+//! Written here rather than taken whole from a library: the pairs, the
+//! sampling and the kinematic placement are the kernel's own (its chains
+//! and its programs); the geometric queries are parry's.
+
+pub mod shapes;
+
+use crate::machine::{bodies_of, Machine, MachineKinematics, Mount, Solid};
+use crate::math::{Mat4, Real, Vec3};
+use crate::mesh::TriMesh;
+use crate::program::{axis_rows, block_name, AxisProgram};
+use crate::tool::Tool;
+use crate::transform::Chain;
+use crate::verdict::Finding;
+use serde::{Deserialize, Serialize};
+use shapes::Shaped;
+
+/// The rule a collision breaks.
+pub const COLLISION: &str = "bodies clear of each other";
+
+/// The most any body moves between two samples of a move (mm).
+pub const STEP: Real = 1.0;
+
+/// The most any body turns between two samples of a move (rad).
+pub const MAX_TURN: Real = 0.02;
+
+/// The most samples of one move: a move longer than `STEP * MAX_SAMPLES`
+/// is sampled coarser, and the report's largest step says so.
+pub const MAX_SAMPLES: usize = 20_000;
+
+/// Share of the last distance two bodies may close before it is measured
+/// again.
+pub const REMEASURE: Real = 0.25;
+
+/// The solids the run gives the check besides the machine's bodies.
+#[derive(Debug, Clone, Copy)]
+pub struct Solids<'a> {
+    /// The tool: its name, itself, and its mesh in its own frame (the
+    /// machine's tool frame) if it has one.
+    pub tool: Option<(&'a str, &'a Tool, Option<&'a TriMesh>)>,
+    /// The part at its largest: its name and mesh in the part frame.
+    pub part: Option<(&'a str, &'a TriMesh)>,
+    /// The meshes' chordal tolerance (mm): the part's envelope is as much
+    /// wider.
+    pub tolerance: Real,
+}
+
+/// The smallest clearance of one pair along the program.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Clearance {
+    /// The two bodies.
+    pub bodies: [String; 2],
+    /// The smallest distance measured between them (mm; 0 where they
+    /// touch or overlap).
+    pub clearance_mm: Real,
+    /// The block where it is, as the program numbers it.
+    pub block: String,
+    /// That block's index (from 1).
+    pub block_index: usize,
+}
+
+/// What the collision check found (in `report.json` as `collisions`).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Collisions {
+    /// Every pair checked, with its smallest clearance, in the order the
+    /// bodies are declared (the tool, the machine's bodies, the part).
+    pub clearances: Vec<Clearance>,
+    /// A collision of each pair that has one, at its first block (the
+    /// report's verdict carries them).
+    #[serde(skip)]
+    pub findings: Vec<Finding>,
+    /// The most any body moves between two places where a pair is
+    /// measured (mm).
+    pub step_mm: Real,
+    /// How much wider than the part its envelope is, at most (mm).
+    pub part_envelope_mm: Real,
+    /// Places along the program the bodies were put at.
+    pub samples: usize,
+    /// Distance queries made.
+    pub queries: usize,
+    /// Bodies left out, and why.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
+}
+
+/// Why the check could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum CollisionError {
+    /// The machine's description failed to compile (it did when loaded).
+    #[error("the collision check: {0}")]
+    Machine(String),
+    /// The program lacks an axis a chain needs.
+    #[error("the collision check: {0}")]
+    Program(String),
+    /// The check ran past the run's time budget.
+    #[error(transparent)]
+    OverTime(#[from] crate::budget::OverTime),
+}
+
+/// What places a body at a sample.
+#[derive(Debug, Clone)]
+enum Carrier {
+    /// The tool's chain, then this constant motion.
+    Tool(Mat4),
+    /// Its own chain, over these columns of the sample's axis values.
+    Chain(Chain, Vec<usize>),
+    /// Nothing: it stands here in the part frame.
+    Fixed(Mat4),
+}
+
+#[derive(Debug, Clone)]
+struct Entity {
+    name: String,
+    shaped: Shaped,
+    reach: Real,
+    carrier: Carrier,
+    /// The axes that move it, sorted.
+    moved_by: Vec<String>,
+    /// It cuts the part (the tool) or rides it (a steady rest's roller).
+    touches_part: bool,
+    is_part: bool,
+}
+
+/// One pair's record along the program.
+#[derive(Debug, Clone)]
+struct PairState {
+    /// The smallest distance measured, and its block (from 0).
+    min: Real,
+    min_block: usize,
+    /// The first block where the two touch.
+    hit: Option<usize>,
+    /// The distance measured last, and how far the two may have closed
+    /// since (infinite before the first measurement).
+    last: Real,
+    closed: Real,
+}
+
+impl PairState {
+    fn new() -> Self {
+        Self {
+            min: Real::INFINITY,
+            min_block: 0,
+            hit: None,
+            last: 0.0,
+            closed: Real::INFINITY,
+        }
+    }
+
+    /// How far the two may close before they are measured again: a share
+    /// of the last distance, or a step, never all of it.
+    fn threshold(&self) -> Real {
+        self.last.min((REMEASURE * self.last).max(STEP))
+    }
+
+    fn record(&mut self, d: Real, block: usize) {
+        self.last = d;
+        self.closed = 0.0;
+        if d < self.min {
+            self.min = d;
+            self.min_block = block;
+        }
+        if d <= 0.0 && self.hit.is_none() {
+            self.hit = Some(block);
+        }
+    }
+}
+
+/// The largest distance a point of a body of `reach` moves between the
+/// frames `a` and `b`, to first order in the turn; and the turn (rad).
+fn motion(a: &Mat4, b: &Mat4, reach: Real) -> (Real, Real) {
+    let ra = a.fixed_view::<3, 3>(0, 0);
+    let rb = b.fixed_view::<3, 3>(0, 0);
+    let cos = (((ra.transpose() * rb).trace() - 1.0) / 2.0).clamp(-1.0, 1.0);
+    let turn = cos.acos();
+    let shift = (b.fixed_view::<3, 1>(0, 3) - a.fixed_view::<3, 1>(0, 3)).norm();
+    (shift + turn * reach, turn)
+}
+
+/// Checks `program` (as the control reads it) on `machine` for
+/// collisions between its bodies, the tool and the part: see the
+/// [module docs](self).
+///
+/// # Failures
+/// A chain the machine cannot compile, a program without an axis a chain
+/// needs, the time budget.
+pub fn check(
+    program: &AxisProgram,
+    machine: &dyn MachineKinematics,
+    solids: Solids<'_>,
+) -> Result<Collisions, CollisionError> {
+    let info = machine.info();
+    let mut out = Collisions {
+        step_mm: STEP,
+        part_envelope_mm: 2.0 * solids.tolerance,
+        ..Collisions::default()
+    };
+    let tool_chain = if info.chain.is_empty() {
+        None
+    } else {
+        Some(
+            Machine::from_info(info.clone())
+                .map_err(|e| CollisionError::Machine(e.to_string()))?
+                .chain()
+                .clone(),
+        )
+    };
+    let bodies = bodies_of(info).map_err(|e| CollisionError::Machine(e.to_string()))?;
+    let part_z = solids.part.map(|(_, m)| {
+        let (lo, hi) = m.bounds();
+        (lo[2], hi[2])
+    });
+    let tool_axes: Vec<String> = tool_chain
+        .as_ref()
+        .map(|c| c.axis_names().to_vec())
+        .unwrap_or_default();
+    let sorted = |names: &[String]| {
+        let mut v = names.to_vec();
+        v.sort();
+        v
+    };
+    let mut entities: Vec<Entity> = Vec::new();
+    let entity = |name: &str, shaped: Shaped, carrier, moved_by, touches_part, is_part| Entity {
+        name: name.to_owned(),
+        reach: shaped.reach(),
+        shaped,
+        carrier,
+        moved_by,
+        touches_part,
+        is_part,
+    };
+    match (solids.tool, &tool_chain) {
+        (Some((name, tool, mesh)), Some(_)) => {
+            match shapes::tool(tool, mesh, tool.spindle_centre()) {
+                Some(shaped) => entities.push(entity(
+                    name,
+                    shaped,
+                    Carrier::Tool(Mat4::identity()),
+                    sorted(&tool_axes),
+                    true,
+                    false,
+                )),
+                None => out
+                    .notes
+                    .push(format!("the {name} has no solid: not checked")),
+            }
+        }
+        (Some((name, ..)), None) => out.notes.push(format!(
+            "the {name} is not checked: the machine states no tool chain to place it"
+        )),
+        (None, _) => {}
+    }
+    let mut used_axes: Vec<String> = tool_axes.clone();
+    for body in &bodies {
+        let spec = body.spec();
+        let Some(shape) = &spec.shape else {
+            continue;
+        };
+        let solid =
+            Solid::of(shape, &info.constants).map_err(|m| CollisionError::Machine(m.clone()))?;
+        let own = body
+            .chain()
+            .matrix(&vec![0.0; body.chain().dof()])
+            .map_err(|e| CollisionError::Machine(e.to_string()));
+        let (carrier, moved_by) = match spec.mount {
+            Mount::Part => {
+                let names = body.chain().axis_names().to_vec();
+                if let Some(a) = names
+                    .iter()
+                    .find(|a| !program.axes.iter().any(|p| &p.name == *a))
+                {
+                    out.notes.push(format!(
+                        "body {}: the program does not drive its axis {a}: not checked",
+                        spec.name
+                    ));
+                    continue;
+                }
+                used_axes.extend(names.iter().cloned());
+                (
+                    Carrier::Chain(body.chain().clone(), Vec::new()),
+                    sorted(&names),
+                )
+            }
+            Mount::Tool => (
+                Carrier::Tool(
+                    Mat4::new_translation(
+                        &solids.tool.map_or(Vec3::zeros(), |t| t.1.spindle_centre()),
+                    ) * own?,
+                ),
+                sorted(&tool_axes),
+            ),
+            Mount::PartStart | Mount::PartEnd => {
+                let Some((lo, hi)) = part_z else {
+                    out.notes.push(format!(
+                        "body {} stands at the part's end, and the run has no part: not checked",
+                        spec.name
+                    ));
+                    continue;
+                };
+                let z = if spec.mount == Mount::PartStart {
+                    lo
+                } else {
+                    hi
+                };
+                (
+                    Carrier::Fixed(Mat4::new_translation(&Vec3::new(0.0, 0.0, z)) * own?),
+                    Vec::new(),
+                )
+            }
+        };
+        entities.push(entity(
+            &spec.name,
+            shapes::solid(&solid),
+            carrier,
+            moved_by,
+            spec.approach_feed.is_some(),
+            false,
+        ));
+    }
+    if let Some((name, mesh)) = solids.part {
+        if let Some(shaped) = shapes::envelope(mesh, solids.tolerance) {
+            entities.push(entity(
+                name,
+                shaped,
+                Carrier::Fixed(Mat4::identity()),
+                Vec::new(),
+                false,
+                true,
+            ));
+        }
+    }
+    // The axis values every carrier reads, in the machine's order.
+    let names: Vec<String> = info
+        .axes
+        .iter()
+        .filter(|a| used_axes.contains(&a.name))
+        .map(|a| a.name.clone())
+        .collect();
+    let col = |n: &String| names.iter().position(|m| m == n).unwrap_or(0);
+    let tool_cols: Vec<usize> = tool_axes.iter().map(col).collect();
+    for e in &mut entities {
+        if let Carrier::Chain(chain, cols) = &mut e.carrier {
+            *cols = chain.axis_names().iter().map(col).collect();
+        }
+    }
+    let pairs: Vec<(usize, usize)> = (0..entities.len())
+        .flat_map(|i| (i + 1..entities.len()).map(move |j| (i, j)))
+        .filter(|&(i, j)| {
+            let (a, b) = (&entities[i], &entities[j]);
+            a.moved_by != b.moved_by
+                && !((a.is_part && b.touches_part) || (b.is_part && a.touches_part))
+        })
+        .collect();
+    if pairs.is_empty() || program.blocks.is_empty() {
+        return Ok(out);
+    }
+    let n = program.blocks.len();
+    let w = names.len();
+    let rows = axis_rows(program, info, &names, 0..n).map_err(CollisionError::Program)?;
+    let frames = |q: &[Real]| -> Result<Vec<Mat4>, CollisionError> {
+        let tool = match &tool_chain {
+            Some(c) => {
+                let tq: Vec<Real> = tool_cols.iter().map(|&c| q[c]).collect();
+                c.matrix(&tq)
+                    .map_err(|e| CollisionError::Program(e.to_string()))?
+            }
+            None => Mat4::identity(),
+        };
+        entities
+            .iter()
+            .map(|e| {
+                let f = match &e.carrier {
+                    Carrier::Tool(m) => tool * m,
+                    Carrier::Chain(chain, cols) => {
+                        let bq: Vec<Real> = cols.iter().map(|&c| q[c]).collect();
+                        chain
+                            .matrix(&bq)
+                            .map_err(|e| CollisionError::Program(e.to_string()))?
+                    }
+                    Carrier::Fixed(m) => *m,
+                };
+                Ok(f * e.shaped.local)
+            })
+            .collect()
+    };
+    let lerp = |a: &[Real], b: &[Real], t: Real| -> Vec<Real> {
+        a.iter().zip(b).map(|(x, y)| x + (y - x) * t).collect()
+    };
+    let mut state: Vec<PairState> = pairs.iter().map(|_| PairState::new()).collect();
+    let mut queries = 0usize;
+    let mut measure = |(i, j): (usize, usize), f: &[Mat4], block: usize, s: &mut PairState| {
+        queries += 1;
+        let d = parry3d_f64::query::distance(
+            &shapes::pose(&f[i]),
+            &*entities[i].shaped.shape,
+            &shapes::pose(&f[j]),
+            &*entities[j].shaped.shape,
+        )
+        .map_or(0.0, |d| d.distance);
+        s.record(d, block);
+    };
+    let mut before = frames(&rows[0..w])?;
+    for (&pair, s) in pairs.iter().zip(state.iter_mut()) {
+        measure(pair, &before, 0, s);
+    }
+    let mut samples = 1usize;
+    let mut ticker = crate::budget::Ticker::new("the collision check", 64);
+    for k in 1..n {
+        let (a, b) = (&rows[(k - 1) * w..k * w], &rows[k * w..(k + 1) * w]);
+        if a == b {
+            continue;
+        }
+        let end = frames(b)?;
+        samples += 1;
+        // Pieces of the move that turn little, so that a piece's motion is
+        // bounded by its ends to first order.
+        let turn = entities
+            .iter()
+            .zip(before.iter().zip(&end))
+            .map(|(e, (f0, f1))| motion(f0, f1, e.reach).1)
+            .fold(0.0, Real::max);
+        let pieces = ((turn / MAX_TURN).ceil() as usize).clamp(1, MAX_SAMPLES);
+        let mut piece_end = Some(end);
+        for p in 1..=pieces {
+            ticker.tick()?;
+            let (t0, t1) = ((p - 1) as Real / pieces as Real, p as Real / pieces as Real);
+            let after = if p == pieces {
+                piece_end.take().unwrap_or_default()
+            } else {
+                samples += 1;
+                frames(&lerp(a, b, t1))?
+            };
+            let moved: Vec<Real> = entities
+                .iter()
+                .zip(before.iter().zip(&after))
+                .map(|(e, (f0, f1))| motion(f0, f1, e.reach).0)
+                .collect();
+            // The piece cut into steps of at most STEP, their frames made
+            // once for the pairs that need to be measured inside it.
+            let steps = ((moved.iter().fold(0.0, |m: Real, v| m.max(*v)) / STEP).ceil() as usize)
+                .clamp(1, MAX_SAMPLES);
+            let mut inside: Vec<Option<Vec<Mat4>>> = vec![None; steps];
+            for (&(i, j), s) in pairs.iter().zip(state.iter_mut()) {
+                let closing = moved[i] + moved[j];
+                if s.closed + closing < s.threshold() {
+                    s.closed += closing;
+                    continue;
+                }
+                // The two cannot touch within the piece: measured at its end.
+                if s.closed + closing < s.last {
+                    measure((i, j), &after, k, s);
+                    continue;
+                }
+                for (m, slot) in inside.iter_mut().enumerate() {
+                    s.closed += closing / steps as Real;
+                    if s.closed < s.threshold() {
+                        continue;
+                    }
+                    let f = match slot {
+                        Some(f) => f,
+                        None if m + 1 == steps => &after,
+                        None => {
+                            samples += 1;
+                            let t = t0 + (t1 - t0) * (m + 1) as Real / steps as Real;
+                            slot.insert(frames(&lerp(a, b, t))?)
+                        }
+                    };
+                    measure((i, j), f, k, s);
+                }
+            }
+            before = after;
+        }
+    }
+    out.samples = samples;
+    out.queries = queries;
+    for (&(i, j), s) in pairs.iter().zip(&state) {
+        let bodies = [entities[i].name.clone(), entities[j].name.clone()];
+        out.clearances.push(Clearance {
+            bodies: bodies.clone(),
+            clearance_mm: s.min.max(0.0),
+            block: block_name(program, s.min_block),
+            block_index: s.min_block + 1,
+        });
+        if let Some(k) = s.hit {
+            out.findings.push(
+                Finding::new(
+                    COLLISION,
+                    format!(
+                        "{}: the {} and the {} collide (clearance 0 mm: they touch or overlap); change the machine's body sizes or where it holds the part (its constants), or the program's positions",
+                        block_name(program, k),
+                        bodies[0],
+                        bodies[1]
+                    ),
+                )
+                .at(k, block_name(program, k)),
+            );
+        }
+    }
+    Ok(out)
+}

@@ -1,0 +1,263 @@
+//! The kernel's solids as parry's shapes, and its poses as parry's.
+//!
+//! Each body's shape is a convex primitive where the body is one (a
+//! roller, a cylinder, a box, a wheel), a compound of convex sectors for a
+//! guard, the convex hull of another tool's mesh (a cutter's blade is
+//! convex; a tool that is not is taken at its hull, which holds it), and
+//! the part as its envelope of revolution, a stack of cylinders. Convex
+//! primitives answer parry's queries through their support maps in
+//! constant time, whatever the meshes' tolerance.
+
+use crate::machine::Solid;
+use crate::math::{Mat4, Real, Vec3};
+use crate::mesh::TriMesh;
+use parry3d_f64::math::{Pose, Rot3, Vector};
+use parry3d_f64::shape::SharedShape;
+
+/// Sectors a guard is split into: each is convex (the hull of its arcs),
+/// and fills the guard's inner side by at most `inner * (1 - cos(cover /
+/// 2 / SECTORS))` (0.07 mm for a 300 mm guard over 240 degrees).
+const GUARD_SECTORS: usize = 96;
+
+/// Points on each arc of a guard's sector.
+const ARC_POINTS: usize = 3;
+
+/// A shape and where it stands in its body's frame.
+#[derive(Clone)]
+pub struct Shaped {
+    /// The shape, in its own frame.
+    pub shape: SharedShape,
+    /// Its frame in the body's.
+    pub local: Mat4,
+}
+
+impl std::fmt::Debug for Shaped {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Shaped")
+            .field("local", &self.local)
+            .finish()
+    }
+}
+
+impl Shaped {
+    /// How far the shape reaches from its body's origin (mm): the radius
+    /// of a ball about the origin that holds it.
+    pub fn reach(&self) -> Real {
+        let s = self.shape.compute_local_bounding_sphere();
+        let c = self.local.transform_point(&crate::math::Point3::new(
+            s.center.x, s.center.y, s.center.z,
+        ));
+        c.coords.norm() + s.radius
+    }
+}
+
+/// The shape of a machine body's solid.
+pub fn solid(s: &Solid) -> Shaped {
+    let here = |shape| Shaped {
+        shape,
+        local: Mat4::identity(),
+    };
+    match *s {
+        // parry's cylinders stand along Y, as a roller does.
+        Solid::Roller { radius, length } => here(SharedShape::cylinder(length / 2.0, radius)),
+        Solid::Cylinder { radius, length } => Shaped {
+            shape: SharedShape::cylinder(length / 2.0, radius),
+            local: along_z(),
+        },
+        Solid::Block { size } => here(SharedShape::cuboid(
+            size[0] / 2.0,
+            size[1] / 2.0,
+            size[2] / 2.0,
+        )),
+        Solid::Guard {
+            inner,
+            outer,
+            width,
+            cover,
+        } => {
+            let pieces = (0..GUARD_SECTORS)
+                .filter_map(|i| {
+                    let at = |k: usize| {
+                        -cover / 2.0
+                            + cover * (i * (ARC_POINTS - 1) + k) as Real
+                                / (GUARD_SECTORS * (ARC_POINTS - 1)) as Real
+                    };
+                    let points: Vec<Vector> = (0..ARC_POINTS)
+                        .flat_map(|k| {
+                            let (s, c) = at(k).sin_cos();
+                            [inner, outer].into_iter().flat_map(move |r| {
+                                [-width / 2.0, width / 2.0].map(|z| Vector::new(r * c, r * s, z))
+                            })
+                        })
+                        .collect();
+                    SharedShape::convex_hull(&points).map(|h| (Pose::identity(), h))
+                })
+                .collect();
+            here(SharedShape::compound(pieces))
+        }
+    }
+}
+
+/// The tool's solid in the tool frame: a wheel exactly, as a round
+/// cylinder (its section a rectangle with its corners rounded at the
+/// rounding radius) about its axis, centred at `centre`; another tool as
+/// the convex hull of its mesh (`None` for a tool with no mesh, or a flat
+/// one).
+pub fn tool(tool: &crate::tool::Tool, mesh: Option<&TriMesh>, centre: Vec3) -> Option<Shaped> {
+    match tool.shape {
+        crate::tool::ToolShape::Wheel(w) => {
+            let r = w.rounding_radius;
+            Some(Shaped {
+                shape: SharedShape::round_cylinder(
+                    (w.width / 2.0 - r).max(0.0),
+                    (w.diameter / 2.0 - r).max(0.0),
+                    r,
+                ),
+                local: Mat4::new_translation(&centre) * along_z(),
+            })
+        }
+        _ => {
+            let points: Vec<Vector> = mesh?
+                .positions
+                .iter()
+                .map(|p| Vector::new(p[0], p[1], p[2]))
+                .collect();
+            SharedShape::convex_hull(&points).map(|shape| Shaped {
+                shape,
+                local: Mat4::identity(),
+            })
+        }
+    }
+}
+
+/// parry's cylinders stand along Y: this turns one to stand along Z.
+fn along_z() -> Mat4 {
+    Mat4::from_axis_angle(&Vec3::x_axis(), std::f64::consts::FRAC_PI_2)
+}
+
+/// The most slabs of a part's envelope.
+const MAX_SLABS: usize = 64;
+
+/// The part at its largest about its axis (the part frame's Z): a stack of
+/// cylinders, each as wide as the mesh's farthest vertex from the axis
+/// over its length (and the ring of vertices on either side, which bound
+/// the surface between them), plus `tol` for the chords between vertices.
+/// A slab runs on while the envelope's radius varies by at most `tol`
+/// (coarser if that would take more than [`MAX_SLABS`]). Conservative for
+/// any part; exact to `2 tol` for a body of revolution (a mandrel, a roll's
+/// blank, a thread's outer cylinder). `None` for an empty mesh.
+pub fn envelope(mesh: &TriMesh, tol: Real) -> Option<Shaped> {
+    let mut rings: Vec<(Real, Real)> = mesh
+        .positions
+        .iter()
+        .map(|p| (p[2], p[0].hypot(p[1])))
+        .collect();
+    if rings.is_empty() {
+        return None;
+    }
+    rings.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // One ring per z, its largest radius.
+    let mut merged: Vec<(Real, Real)> = Vec::new();
+    for (z, r) in rings {
+        match merged.last_mut() {
+            Some(last) if z - last.0 <= 1e-9 => last.1 = last.1.max(r),
+            _ => merged.push((z, r)),
+        }
+    }
+    let slabs = |band: Real| -> Vec<(Real, Real, Real)> {
+        let mut out: Vec<(Real, Real, Real)> = Vec::new();
+        let (mut lo, mut hi) = (Real::INFINITY, Real::NEG_INFINITY);
+        let mut start = merged[0].0;
+        for w in merged.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            let (nlo, nhi) = (lo.min(a.1).min(b.1), hi.max(a.1).max(b.1));
+            if nhi - nlo > band && hi.is_finite() {
+                out.push((start, a.0, hi));
+                start = a.0;
+                (lo, hi) = (a.1.min(b.1), a.1.max(b.1));
+            } else {
+                (lo, hi) = (nlo, nhi);
+            }
+        }
+        let last = merged[merged.len() - 1];
+        out.push((start, last.0, hi.max(last.1)));
+        out
+    };
+    let mut band = tol;
+    let mut stack = slabs(band);
+    while stack.len() > MAX_SLABS {
+        band *= 2.0;
+        stack = slabs(band);
+    }
+    let pieces = stack
+        .into_iter()
+        .map(|(z0, z1, r)| {
+            let half = ((z1 - z0) / 2.0).max(1e-6);
+            let place = Mat4::new_translation(&Vec3::new(0.0, 0.0, (z0 + z1) / 2.0)) * along_z();
+            (pose(&place), SharedShape::cylinder(half, r + tol))
+        })
+        .collect();
+    Some(Shaped {
+        shape: SharedShape::compound(pieces),
+        local: Mat4::identity(),
+    })
+}
+
+/// A rigid motion (rotation and translation only) as parry's pose.
+pub fn pose(m: &Mat4) -> Pose {
+    let r = m.fixed_view::<3, 3>(0, 0);
+    let cols = |j: usize| Vector::new(r[(0, j)], r[(1, j)], r[(2, j)]);
+    let rot = Rot3::from_mat3(&parry3d_f64::math::Mat3::from_cols(
+        cols(0),
+        cols(1),
+        cols(2),
+    ));
+    Pose::from_parts(Vector::new(m[(0, 3)], m[(1, 3)], m[(2, 3)]), rot)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two unit-free checks of the conversions: a box 100 mm long along X
+    /// turned a quarter about Z stands 50 mm along Y; a guard's compound
+    /// is as far from a point on its axis as its inner radius.
+    #[test]
+    fn shapes_stand_where_the_kernel_puts_them() {
+        let bar = solid(&Solid::Block {
+            size: [100.0, 10.0, 10.0],
+        });
+        let turned =
+            Mat4::from_axis_angle(&crate::math::Vec3::z_axis(), std::f64::consts::FRAC_PI_2);
+        let ball = SharedShape::ball(1.0);
+        let probe = Mat4::new_translation(&crate::math::Vec3::new(0.0, 60.0, 0.0));
+        let d = parry3d_f64::query::distance(
+            &pose(&(turned * bar.local)),
+            &*bar.shape,
+            &pose(&probe),
+            &*ball,
+        )
+        .unwrap()
+        .distance;
+        assert!((d - 9.0).abs() < 1e-9, "{d}");
+        let guard = solid(&Solid::Guard {
+            inner: 200.0,
+            outer: 220.0,
+            width: 50.0,
+            cover: 240f64.to_radians(),
+        });
+        let d = parry3d_f64::query::distance(
+            &pose(&guard.local),
+            &*guard.shape,
+            &Pose::identity(),
+            &*ball,
+        )
+        .unwrap()
+        .distance;
+        // The sectors' chords stand inside the inner arc by 0.048 mm at
+        // most: 200 (1 - cos(240 / 2 / 96 deg)).
+        assert!(d > 199.0 - 0.048 && d < 199.0 + 1e-9, "{d}");
+        // Its reach holds it.
+        assert!(guard.reach() >= 220.0, "{}", guard.reach());
+    }
+}
