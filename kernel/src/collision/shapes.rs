@@ -14,10 +14,13 @@ use crate::mesh::TriMesh;
 use parry3d_f64::math::{Pose, Rot3, Vector};
 use parry3d_f64::shape::SharedShape;
 
-/// Sectors a guard is split into: each is convex (the hull of its arcs),
-/// and fills the guard's inner side by at most `inner * (1 - cos(cover /
-/// 2 / SECTORS))` (0.07 mm for a 300 mm guard over 240 degrees).
-const GUARD_SECTORS: usize = 96;
+/// How far a guard's convex sectors may fill its inner side, toward the
+/// wheel (mm): the sectors are as many as that takes (at most
+/// [`MAX_SECTORS`]).
+pub const GUARD_FILL: Real = 0.5;
+
+/// The most sectors of a guard.
+const MAX_SECTORS: usize = 96;
 
 /// Points on each arc of a guard's sector.
 const ARC_POINTS: usize = 3;
@@ -75,17 +78,21 @@ pub fn solid(s: &Solid) -> Shaped {
             width,
             cover,
         } => {
-            let pieces = (0..GUARD_SECTORS)
+            // Each sector is the hull of its inner arc's ends (a chord
+            // inside the arc by at most GUARD_FILL) and of its outer arc's
+            // points pushed out so that the hull's edges touch the arc:
+            // the sectors hold the guard.
+            let per = 2.0 * (1.0 - GUARD_FILL / inner).clamp(-1.0, 1.0).acos();
+            let sectors = ((cover / per).ceil() as usize).clamp(1, MAX_SECTORS);
+            let spacing = cover / (sectors * (ARC_POINTS - 1)) as Real;
+            let out = outer / (spacing / 2.0).cos();
+            let pieces = (0..sectors)
                 .filter_map(|i| {
-                    let at = |k: usize| {
-                        -cover / 2.0
-                            + cover * (i * (ARC_POINTS - 1) + k) as Real
-                                / (GUARD_SECTORS * (ARC_POINTS - 1)) as Real
-                    };
+                    let at = |k: usize| -cover / 2.0 + spacing * (i * (ARC_POINTS - 1) + k) as Real;
                     let points: Vec<Vector> = (0..ARC_POINTS)
                         .flat_map(|k| {
                             let (s, c) = at(k).sin_cos();
-                            [inner, outer].into_iter().flat_map(move |r| {
+                            [inner, out].into_iter().flat_map(move |r| {
                                 [-width / 2.0, width / 2.0].map(|z| Vector::new(r * c, r * s, z))
                             })
                         })
@@ -254,9 +261,21 @@ mod tests {
         )
         .unwrap()
         .distance;
-        // The sectors' chords stand inside the inner arc by 0.048 mm at
-        // most: 200 (1 - cos(240 / 2 / 96 deg)).
-        assert!(d > 199.0 - 0.048 && d < 199.0 + 1e-9, "{d}");
+        // The sectors' chords stand inside the inner arc by GUARD_FILL at
+        // most.
+        assert!(d > 199.0 - GUARD_FILL - 1e-9 && d < 199.0 + 1e-9, "{d}");
+        // And they hold its outer side: a ball on the outer arc, midway
+        // between two of the outer points, touches a sector.
+        let outside = Mat4::new_translation(&crate::math::Vec3::new(221.0, 0.0, 0.0));
+        let d = parry3d_f64::query::distance(
+            &pose(&guard.local),
+            &*guard.shape,
+            &pose(&outside),
+            &*ball,
+        )
+        .unwrap()
+        .distance;
+        assert!(d < 1e-9, "{d}");
         // Its reach holds it.
         assert!(guard.reach() >= 220.0, "{}", guard.reach());
     }
