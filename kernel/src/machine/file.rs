@@ -50,6 +50,8 @@ struct AxisFile {
     max_deg: Option<Spanned<Real>>,
     max_feed_deg: Option<Spanned<Real>>,
     max_rpm: Option<Spanned<Real>>,
+    max_accel: Option<Spanned<Real>>,
+    max_accel_deg: Option<Spanned<Real>>,
     #[serde(default = "yes")]
     programmed: bool,
     #[serde(default)]
@@ -310,6 +312,7 @@ fn span_of(file: &MachineFile, e: &Invalid) -> Range<usize> {
                         .as_ref(),
                     name,
                 ),
+                "max_accel" => key(span(&a.max_accel).or(span(&a.max_accel_deg)).as_ref(), name),
                 "moves" => key(a.moves.as_ref().map(Spanned::span).as_ref(), name),
                 "turns" => key(a.turns.as_ref().map(Spanned::span).as_ref(), name),
                 "body" => key(a.body.as_ref().map(Spanned::span).as_ref(), name),
@@ -390,6 +393,7 @@ fn read_axis(src: &Source<'_>, a: &AxisFile) -> Result<Axis, MachineError> {
                 (&a.max_deg, "max_deg"),
                 (&a.max_feed_deg, "max_feed_deg"),
                 (&a.max_rpm, "max_rpm"),
+                (&a.max_accel_deg, "max_accel_deg"),
             ] {
                 forbid(v, k)?;
             }
@@ -405,6 +409,7 @@ fn read_axis(src: &Source<'_>, a: &AxisFile) -> Result<Axis, MachineError> {
                 (&a.max, "max"),
                 (&a.max_feed, "max_feed"),
                 (&a.max_rpm, "max_rpm"),
+                (&a.max_accel, "max_accel"),
             ] {
                 forbid(v, k)?;
             }
@@ -422,6 +427,8 @@ fn read_axis(src: &Source<'_>, a: &AxisFile) -> Result<Axis, MachineError> {
                 (&a.min_deg, "min_deg"),
                 (&a.max_deg, "max_deg"),
                 (&a.max_feed_deg, "max_feed_deg"),
+                (&a.max_accel, "max_accel"),
+                (&a.max_accel_deg, "max_accel_deg"),
             ] {
                 forbid(v, k)?;
             }
@@ -440,6 +447,11 @@ fn read_axis(src: &Source<'_>, a: &AxisFile) -> Result<Axis, MachineError> {
         programmed: a.programmed && kind != AxisKind::Spindle,
         description: a.description.clone(),
         body: a.body.as_ref().map(|b| b.get_ref().clone()),
+        max_accel: match (&a.max_accel, &a.max_accel_deg) {
+            (Some(v), _) => Some(src.finite("max_accel", v)?),
+            (None, Some(v)) => Some(src.finite("max_accel_deg", v)?.to_radians()),
+            (None, None) => None,
+        },
     })
 }
 

@@ -257,6 +257,14 @@ fn check_axes(info: &MachineInfo) -> Result<ToolFrame, Invalid> {
                 format!("axis {name}: travel max must exceed min"),
             ));
         }
+        if let Some(v) = a.max_accel {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(invalid(
+                    at("max_accel"),
+                    format!("axis {name}: max_accel = {v} must be a number > 0"),
+                ));
+            }
+        }
         if a.max_feed <= 0.0 {
             return Err(invalid(
                 at("name"),

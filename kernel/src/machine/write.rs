@@ -112,11 +112,17 @@ fn axis(a: &Axis) -> Value {
             t.insert("min".into(), a.min.into());
             t.insert("max".into(), a.max.into());
             t.insert("max_feed".into(), a.max_feed.into());
+            if let Some(v) = a.max_accel {
+                t.insert("max_accel".into(), v.into());
+            }
         }
         AxisKind::Rotary => {
             t.insert("min_deg".into(), degrees(a.min));
             t.insert("max_deg".into(), degrees(a.max));
             t.insert("max_feed_deg".into(), degrees(a.max_feed));
+            if let Some(v) = a.max_accel {
+                t.insert("max_accel_deg".into(), degrees(v));
+            }
         }
         AxisKind::Spindle => {
             t.insert("max_rpm".into(), a.max.into());

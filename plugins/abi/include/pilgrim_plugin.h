@@ -21,7 +21,8 @@
 // descriptor's and the program's `setup`, a block's `keep`; 1.3: the
 // setup's `feed_group`; 1.4: a thread block's `start_deg`; 1.5: a body's
 // `approach_feed`, a block's `number`; 1.6: the body shapes `cylinder`,
-// `box` and `guard`; 1.7: a body's `mount`).
+// `box` and `guard`; 1.7: a body's `mount`, a constant factor's `scale`,
+// an axis's `max_accel`).
 #define PILGRIM_ABI_MINOR 7
 
 // The call succeeded.

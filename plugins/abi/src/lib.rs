@@ -48,7 +48,7 @@
 //!         let axis = |name: &str| Axis {
 //!             name: name.into(), kind: AxisKind::Linear, min: -500.0, max: 500.0,
 //!             max_feed: 8000.0, programmed: true, description: String::new(),
-//!             moves: None, turns: None, body: None,
+//!             moves: None, turns: None, body: None, max_accel: None,
 //!         };
 //!         MachineInfo {
 //!             name: "lathe".into(), description: String::new(), control: "fanuc".into(),
@@ -95,7 +95,8 @@ pub const ABI_MAJOR: u32 = 1;
 /// descriptor's and the program's `setup`, a block's `keep`; 1.3: the
 /// setup's `feed_group`; 1.4: a thread block's `start_deg`; 1.5: a body's
 /// `approach_feed`, a block's `number`; 1.6: the body shapes `cylinder`,
-/// `box` and `guard`; 1.7: a body's `mount`).
+/// `box` and `guard`; 1.7: a body's `mount`, a constant factor's `scale`,
+/// an axis's `max_accel`).
 pub const ABI_MINOR: u32 = 7;
 
 /// The call succeeded.

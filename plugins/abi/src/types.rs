@@ -63,6 +63,11 @@ pub struct Axis {
     /// The body it moves: `None` for the tool, else a body's name.
     #[serde(default)]
     pub body: Option<String>,
+    /// Since 1.7: the most the axis accelerates (mm/s², rad/s² for a
+    /// rotary axis), if the machine states it: the cycle time's model
+    /// ramps every move's speed within it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_accel: Option<f64>,
 }
 
 impl Axis {
@@ -88,6 +93,7 @@ impl Axis {
             moves: Some(moves),
             turns: None,
             body: None,
+            max_accel: None,
         }
     }
 
@@ -106,7 +112,19 @@ impl Axis {
             moves: None,
             turns: Some(turns),
             body: None,
+            max_accel: None,
         }
+    }
+
+    /// The same, accelerating at most `accel` (mm/s², or deg/s² for a
+    /// rotary axis, held in rad/s²).
+    pub fn accelerating(mut self, accel: f64) -> Self {
+        self.max_accel = Some(if self.kind == AxisKind::Rotary {
+            accel.to_radians()
+        } else {
+            accel
+        });
+        self
     }
 
     /// A value in file/program units (mm, deg) from kernel units (mm, rad).
@@ -696,6 +714,7 @@ mod tests {
             moves: None,
             turns: Some([0.0, 0.0, 1.0]),
             body: None,
+            max_accel: None,
         };
         assert!((a.from_user(a.to_user(0.3)) - 0.3).abs() < 1e-15);
         assert_eq!(a.unit(), "deg");

@@ -61,7 +61,9 @@ pub fn describe() -> MachineInfo {
         12000.0,
         [0.5, 0.0, 0.0],
         "cross slide, on diameter",
-    );
+    )
+    // A turning centre's slides at 0.3 g: 3 m/s² radially, 6 on diameter.
+    .accelerating(6000.0);
     let mut tx = FactorSpec::axis(FactorKind::Tx, "X");
     tx.scale = 0.5;
     MachineInfo {
@@ -77,7 +79,8 @@ pub fn describe() -> MachineInfo {
                 10000.0,
                 [0.0, 0.0, 1.0],
                 "carriage, along the spindle's axis (program zero at the part's face)",
-            ),
+            )
+            .accelerating(3000.0),
             Axis {
                 name: "S".into(),
                 kind: AxisKind::Spindle,
@@ -89,6 +92,7 @@ pub fn describe() -> MachineInfo {
                 moves: None,
                 turns: None,
                 body: None,
+                max_accel: None,
             },
         ],
         solved_axes: vec!["X".into(), "Z".into()],

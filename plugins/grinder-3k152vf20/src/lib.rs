@@ -76,6 +76,9 @@ pub fn describe() -> MachineInfo {
         "steady rest: radial position of the support's centre, opposite the wheel",
     );
     u.body = Some("rest".into());
+    // A cylindrical grinder's slides accelerate gently: the table (Z) and
+    // the wheelhead (X) at 0.5 m/s², the rest's light slide at 1 m/s².
+    let u = u.accelerating(1000.0);
     MachineInfo {
         name: NAME.into(),
         description:
@@ -90,7 +93,8 @@ pub fn describe() -> MachineInfo {
                 6000.0,
                 [0.0, 0.0, 1.0],
                 "table, along the part's axis (wheel relative to part)",
-            ),
+            )
+            .accelerating(500.0),
             Axis::linear(
                 "X",
                 -5.0,
@@ -98,7 +102,8 @@ pub fn describe() -> MachineInfo {
                 3000.0,
                 [1.0, 0.0, 0.0],
                 "wheelhead infeed: radial position of the wheel's programmed point",
-            ),
+            )
+            .accelerating(500.0),
             u,
             Axis {
                 name: "S".into(),
@@ -111,6 +116,7 @@ pub fn describe() -> MachineInfo {
                 moves: None,
                 turns: None,
                 body: None,
+                max_accel: None,
             },
         ],
         solved_axes: vec!["Z".into(), "X".into()],

@@ -48,6 +48,8 @@ pub const NAME: &str = "LZ-250";
 /// The axes and chain of a caliber grinder, with the cross axis Y if
 /// `cross`: the one definition both machines' descriptions use.
 pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInfo {
+    // The slides accelerate at 0.8 m/s², the roll's turn (a heavy roll on
+    // its arbor) at 720 deg/s², the wheel's swivel at 360 deg/s².
     let mut axes = vec![
         Axis::linear(
             "X",
@@ -56,7 +58,8 @@ pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInf
             3000.0,
             [0.0, 0.0, 1.0],
             "along the roll's axis (wheel relative to roll)",
-        ),
+        )
+        .accelerating(800.0),
         Axis::linear(
             "Z",
             0.0,
@@ -64,32 +67,42 @@ pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInf
             2000.0,
             [1.0, 0.0, 0.0],
             "radial: the wheel centre's distance from the roll's axis",
-        ),
+        )
+        .accelerating(800.0),
     ];
     if cross {
-        axes.push(Axis::linear(
-            "Y",
-            -60.0,
-            60.0,
-            2000.0,
-            [0.0, 1.0, 0.0],
-            "across: perpendicular to the roll's axis and radius",
-        ));
+        axes.push(
+            Axis::linear(
+                "Y",
+                -60.0,
+                60.0,
+                2000.0,
+                [0.0, 1.0, 0.0],
+                "across: perpendicular to the roll's axis and radius",
+            )
+            .accelerating(800.0),
+        );
     }
-    axes.push(Axis::rotary_deg(
-        "A",
-        370.0,
-        3600.0,
-        [0.0, 0.0, -1.0],
-        "roll turn theta about its axis",
-    ));
-    axes.push(Axis::rotary_deg(
-        "B",
-        45.0,
-        1800.0,
-        [1.0, 0.0, 0.0],
-        "wheel swivel epsilon about the radial axis",
-    ));
+    axes.push(
+        Axis::rotary_deg(
+            "A",
+            370.0,
+            3600.0,
+            [0.0, 0.0, -1.0],
+            "roll turn theta about its axis",
+        )
+        .accelerating(720.0),
+    );
+    axes.push(
+        Axis::rotary_deg(
+            "B",
+            45.0,
+            1800.0,
+            [1.0, 0.0, 0.0],
+            "wheel swivel epsilon about the radial axis",
+        )
+        .accelerating(360.0),
+    );
     axes.push(Axis {
         name: "S".into(),
         kind: AxisKind::Spindle,
@@ -101,6 +114,7 @@ pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInf
         moves: None,
         turns: None,
         body: None,
+        max_accel: None,
     });
     let solved: Vec<String> = axes
         .iter()
