@@ -22,6 +22,7 @@ mod mandrel_fidelity;
 mod plugins;
 mod ring;
 mod sdk;
+mod times;
 mod trust;
 mod verify;
 mod worm;

@@ -5,8 +5,8 @@
 //! failed run.
 
 use crate::family::Check;
-use crate::machine::{feed_length, Axis, MachineInfo};
-use crate::math::{fixed, Real};
+use crate::machine::MachineInfo;
+use crate::math::fixed;
 use crate::params::ParamValue;
 use crate::program::{block_label, label_in, AxisProgram};
 use crate::toolpath::Motion;
@@ -55,7 +55,9 @@ pub struct Report {
     pub points: usize,
     /// Program blocks.
     pub blocks: usize,
-    /// Minutes of cutting and rapid moves.
+    /// Minutes the program runs, its moves ramped within the axes'
+    /// acceleration ([`crate::timing`]; at the programmed feeds where the
+    /// machine states no acceleration).
     pub cycle_time_min: f64,
     /// The files written.
     pub files: Vec<String>,
@@ -106,6 +108,10 @@ pub struct Report {
     /// program; `None` where the run checked none (a refused program).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub collisions: Option<crate::collision::Collisions>,
+    /// The program's times: at its programmed feeds and with the axes'
+    /// acceleration, in all and per pass ([`crate::timing`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub times: Option<crate::timing::Times>,
 }
 
 impl Report {
@@ -187,6 +193,7 @@ impl Report {
             tables: BTreeMap::new(),
             verdict: crate::verdict::Verdict::default(),
             collisions: None,
+            times: None,
         }
     }
 }
@@ -212,45 +219,6 @@ pub fn axis_ranges(program: &AxisProgram) -> BTreeMap<String, [f64; 2]> {
             Some((a.name.clone(), [lo, hi]))
         })
         .collect()
-}
-
-/// Minutes of cutting and rapid moves: a feed move lasts its length
-/// ([`feed_length`], the model the feed checks use) over its feed; a rapid
-/// as long as its slowest axis at that axis's maximum speed.
-pub fn cycle_time(program: &AxisProgram, info: &MachineInfo) -> Real {
-    let axes: Vec<Option<&Axis>> = program.axes.iter().map(|a| info.axis(&a.name)).collect();
-    let known: Vec<&Axis> = axes.iter().flatten().copied().collect();
-    let mut minutes = 0.0;
-    // As the control reads the program: its values as written.
-    let decimals = crate::program::written_decimals(program.decimals, &program.control);
-    let w = |v: &Real| crate::program::written(*v, decimals);
-    for pair in program.blocks.windows(2) {
-        let (a, b) = (&pair[0], &pair[1]);
-        let deltas: Vec<Real> = a
-            .values
-            .iter()
-            .zip(&b.values)
-            .map(|(x, y)| w(y) - w(x))
-            .collect();
-        minutes += match b.motion {
-            Motion::Rapid => axes
-                .iter()
-                .zip(&deltas)
-                .filter_map(|(ax, d)| ax.map(|a| d.abs() / a.to_user(a.max_feed)))
-                .fold(0.0, f64::max),
-            _ if b.feed > 0.0 => {
-                let known_deltas: Vec<Real> = axes
-                    .iter()
-                    .zip(&deltas)
-                    .filter(|(ax, _)| ax.is_some())
-                    .map(|(_, d)| *d)
-                    .collect();
-                feed_length(&known, &known_deltas, &info.setup.feed_group) / b.feed
-            }
-            _ => 0.0,
-        };
-    }
-    minutes
 }
 
 /// `report.csv`: one row per block of the program, the start's and the

@@ -16,7 +16,7 @@ mod page;
 mod scene;
 mod solids;
 
-pub use crate::report::{axis_ranges, block_table, cycle_time, FailedRun, Report, ReportParam};
+pub use crate::report::{axis_ranges, block_table, FailedRun, Report, ReportParam};
 pub use export::{export, run_machine, Exported};
 pub use scene::{default_pose_block, BodyFile, Formats, PosePlace, SceneError};
 pub use solids::SolidFile;
@@ -613,12 +613,13 @@ fn run_on(
         };
         (Some(index + 1), bodies, solids, part_box)
     };
+    let times = crate::timing::times(&program, info, &passes);
     let mut report = Report {
         passes: passes.len(),
         cutting_passes: passes.iter().filter(|p| p.cuts).count(),
         points: toolpath.point_count(),
         blocks: program.blocks.len(),
-        cycle_time_min: (cycle_time(&program, info) * 1e4).round() / 1e4,
+        cycle_time_min: (times.accelerated_min * 1e4).round() / 1e4,
         files: files
             .iter()
             .map(|f| f.0.clone())
@@ -654,6 +655,7 @@ fn run_on(
         tables: toolpath.tables.clone(),
         verdict: Verdict::of(requested_any, failures, warnings, figures),
         collisions: Some(collisions),
+        times: Some(times),
         program_file: text.and(options.program_file.clone()),
         block_numbers: program
             .blocks

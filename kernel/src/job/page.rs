@@ -108,6 +108,39 @@ fn banner(out: &mut String, r: &Report) {
 }
 
 /// A list of findings, each its rule, its block and what it says.
+/// Each pass's time at its feeds and with the axes' acceleration.
+fn pass_times(out: &mut String, r: &Report) {
+    let Some(t) = &r.times else {
+        return;
+    };
+    if t.passes.is_empty() {
+        return;
+    }
+    out.push_str(&format!(
+        "<h2>Times</h2>\n<p>Each pass at its programmed feeds and with every move ramped within the axes' acceleration, blending corners as far as one interpolation cycle ({} ms) of acceleration allows.{}</p>\n<table><tr><th>pass</th><th>at the feeds (s)</th><th>with acceleration (s)</th></tr>\n",
+        fixed(1000.0 * t.ipo_cycle_s, 1),
+        if t.unramped_axes.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " The machine states no acceleration for {}: taken as reaching its speed at once.",
+                escape(&t.unramped_axes.join(", "))
+            )
+        }
+    ));
+    for p in &t.passes {
+        row(
+            out,
+            &[
+                escape(&p.pass),
+                fixed(60.0 * p.programmed_min, 1),
+                fixed(60.0 * p.accelerated_min, 1),
+            ],
+        );
+    }
+    out.push_str("</table>\n");
+}
+
 /// The collision check: each pair's smallest clearance, nearest first.
 fn clearances(out: &mut String, r: &Report) {
     let Some(c) = &r.collisions else {
@@ -196,7 +229,22 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
         ),
         ("toolpath points", r.points.to_string()),
         ("blocks", r.blocks.to_string()),
-        ("cycle time", format!("{} min", fixed(r.cycle_time_min, 2))),
+        (
+            "cycle time",
+            match &r.times {
+                Some(t) => format!(
+                    "{} min with the axes' acceleration ({} min at the programmed feeds, {:+.1} %)",
+                    fixed(t.accelerated_min, 2),
+                    fixed(t.programmed_min, 2),
+                    if t.programmed_min > 0.0 {
+                        100.0 * (t.accelerated_min / t.programmed_min - 1.0)
+                    } else {
+                        0.0
+                    }
+                ),
+                None => format!("{} min", fixed(r.cycle_time_min, 2)),
+            },
+        ),
         (
             "3-D pose",
             r.pose_block.map_or("none".into(), |b| {
@@ -237,6 +285,7 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
     }
     out.push_str("</table>\n");
     clearances(&mut out, r);
+    pass_times(&mut out, r);
     if !inputs.plots.is_empty() {
         out.push_str("<h2>Plots</h2>\n");
         for (name, svg) in &inputs.plots {
