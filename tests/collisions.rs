@@ -201,3 +201,47 @@ fn a_chuck_too_close_to_the_threads_run_out_is_refused() {
     assert!(f["block"].as_str().unwrap().starts_with("block "), "{f}");
     assert_eq!(clearance(&r, "cutter", "chuck"), 0.0);
 }
+
+/// The scene stands each body where the collision check does: the guard
+/// and the flanges on the wheel's centre (its radius from the programmed
+/// point), the chuck gripping the blank's start, the tailstock's centre at
+/// its end.
+#[test]
+fn the_scene_places_each_body_as_the_check_does() {
+    let out = scratch("collisions", "scene").join("out");
+    let (code, _, err) = pilgrim(&["run", "scripts/mandrel.rhai", "--out", s(&out), "--quiet"]);
+    assert_eq!(code, 0, "{err}");
+    let doc = gltf::Gltf::from_slice(&std::fs::read(out.join("scene.glb")).unwrap()).unwrap();
+    let at = |name: &str| {
+        doc.nodes()
+            .find(|n| n.name() == Some(name))
+            .unwrap_or_else(|| panic!("no node {name}"))
+            .transform()
+            .decomposed()
+            .0
+    };
+    let wheel = at("wheel");
+    for body in ["guard", "hub"] {
+        let b = at(body);
+        let d: Vec<f32> = (0..3).map(|k| b[k] - wheel[k]).collect();
+        // The default wheel is 500 mm across.
+        assert!(
+            (d[0] - 250.0).abs() < 1e-3 && d[1].abs() < 1e-3 && d[2].abs() < 1e-3,
+            "{body}: {d:?}"
+        );
+    }
+    let r = report(&out);
+    let blank = r["bodies"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|b| b["name"] == "blank")
+        .unwrap()
+        .clone();
+    assert_eq!(blank["kind"], "part");
+    // The blank runs from z = -303 (the tail) to 440 (the cone's end):
+    // the chuck (110 long) grips 40 of it, the centre (50 long) stands
+    // beyond its end.
+    assert!((at("chuck")[2] - (-303.0 + 40.0 - 55.0)).abs() < 1e-3);
+    assert!((at("tailstock_centre")[2] - (440.0 + 25.0)).abs() < 1e-3);
+}

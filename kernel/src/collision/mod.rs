@@ -38,14 +38,16 @@
 //! sampling and the kinematic placement are the kernel's own (its chains
 //! and its programs); the geometric queries are parry's.
 
+pub mod place;
 pub mod shapes;
 
-use crate::machine::{bodies_of, Machine, MachineKinematics, Mount, Solid};
+pub use place::{PlacedBody, Placement};
+
+use crate::machine::MachineKinematics;
 use crate::math::{Mat4, Real, Vec3};
 use crate::mesh::TriMesh;
 use crate::program::{axis_rows, block_name, AxisProgram};
 use crate::tool::Tool;
-use crate::transform::Chain;
 use crate::verdict::Finding;
 use serde::{Deserialize, Serialize};
 use shapes::Shaped;
@@ -132,15 +134,15 @@ pub enum CollisionError {
     OverTime(#[from] crate::budget::OverTime),
 }
 
-/// What places a body at a sample.
-#[derive(Debug, Clone)]
-enum Carrier {
-    /// The tool's chain, then this constant motion.
-    Tool(Mat4),
-    /// Its own chain, over these columns of the sample's axis values.
-    Chain(Chain, Vec<usize>),
-    /// Nothing: it stands here in the part frame.
-    Fixed(Mat4),
+/// Which solid an entity of the check is.
+#[derive(Debug, Clone, Copy)]
+enum Which {
+    /// The tool, on the tool frame.
+    Tool,
+    /// The placement's body of this index.
+    Body(usize),
+    /// The part, on the part frame.
+    Part,
 }
 
 #[derive(Debug, Clone)]
@@ -148,12 +150,28 @@ struct Entity {
     name: String,
     shaped: Shaped,
     reach: Real,
-    carrier: Carrier,
+    which: Which,
     /// The axes that move it, sorted.
     moved_by: Vec<String>,
     /// It cuts the part (the tool) or rides it (a steady rest's roller).
     touches_part: bool,
     is_part: bool,
+}
+
+/// The part at its largest: of `parts`, the body of the greatest volume
+/// (the blank where the family gives one).
+pub fn part_at_largest(parts: &[(String, TriMesh)]) -> Option<(&str, &TriMesh)> {
+    parts
+        .iter()
+        .max_by(|a, b| a.1.volume().total_cmp(&b.1.volume()))
+        .map(|(n, m)| (n.as_str(), m))
+}
+
+/// Where a part's solid begins and ends along its axis (the part frame's
+/// Z): where bodies on its ends stand.
+pub fn part_z(mesh: &TriMesh) -> (Real, Real) {
+    let (lo, hi) = mesh.bounds();
+    (lo[2], hi[2])
 }
 
 /// One pair's record along the program.
@@ -229,51 +247,25 @@ pub fn check(
         part_envelope_mm: 2.0 * solids.tolerance,
         ..Collisions::default()
     };
-    let tool_chain = if info.chain.is_empty() {
-        None
-    } else {
-        Some(
-            Machine::from_info(info.clone())
-                .map_err(|e| CollisionError::Machine(e.to_string()))?
-                .chain()
-                .clone(),
-        )
-    };
-    let bodies = bodies_of(info).map_err(|e| CollisionError::Machine(e.to_string()))?;
-    let part_z = solids.part.map(|(_, m)| {
-        let (lo, hi) = m.bounds();
-        (lo[2], hi[2])
-    });
-    let tool_axes: Vec<String> = tool_chain
-        .as_ref()
-        .map(|c| c.axis_names().to_vec())
-        .unwrap_or_default();
-    let sorted = |names: &[String]| {
-        let mut v = names.to_vec();
-        v.sort();
-        v
-    };
+    let part_z = solids.part.map(|(_, m)| part_z(m));
+    let program_axes: Vec<String> = program.axes.iter().map(|a| a.name.clone()).collect();
+    let centre = solids.tool.map_or(Vec3::zeros(), |t| t.1.spindle_centre());
+    let placement = Placement::new(info, &program_axes, centre, part_z)?;
+    out.notes.extend(placement.notes.iter().cloned());
     let mut entities: Vec<Entity> = Vec::new();
-    let entity = |name: &str, shaped: Shaped, carrier, moved_by, touches_part, is_part| Entity {
+    let entity = |name: &str, shaped: Shaped, which, moved_by, touches_part, is_part| Entity {
         name: name.to_owned(),
         reach: shaped.reach(),
         shaped,
-        carrier,
+        which,
         moved_by,
         touches_part,
         is_part,
     };
-    match (solids.tool, &tool_chain) {
-        (Some((name, tool, mesh)), Some(_)) => {
+    match (solids.tool, placement.tool_axes()) {
+        (Some((name, tool, mesh)), Some(axes)) => {
             match shapes::tool(tool, mesh, tool.spindle_centre()) {
-                Some(shaped) => entities.push(entity(
-                    name,
-                    shaped,
-                    Carrier::Tool(Mat4::identity()),
-                    sorted(&tool_axes),
-                    true,
-                    false,
-                )),
+                Some(shaped) => entities.push(entity(name, shaped, Which::Tool, axes, true, false)),
                 None => out
                     .notes
                     .push(format!("the {name} has no solid: not checked")),
@@ -284,97 +276,19 @@ pub fn check(
         )),
         (None, _) => {}
     }
-    let mut used_axes: Vec<String> = tool_axes.clone();
-    for body in &bodies {
-        let spec = body.spec();
-        let Some(shape) = &spec.shape else {
-            continue;
-        };
-        let solid =
-            Solid::of(shape, &info.constants).map_err(|m| CollisionError::Machine(m.clone()))?;
-        let own = body
-            .chain()
-            .matrix(&vec![0.0; body.chain().dof()])
-            .map_err(|e| CollisionError::Machine(e.to_string()));
-        let (carrier, moved_by) = match spec.mount {
-            Mount::Part => {
-                let names = body.chain().axis_names().to_vec();
-                if let Some(a) = names
-                    .iter()
-                    .find(|a| !program.axes.iter().any(|p| &p.name == *a))
-                {
-                    out.notes.push(format!(
-                        "body {}: the program does not drive its axis {a}: not checked",
-                        spec.name
-                    ));
-                    continue;
-                }
-                used_axes.extend(names.iter().cloned());
-                (
-                    Carrier::Chain(body.chain().clone(), Vec::new()),
-                    sorted(&names),
-                )
-            }
-            Mount::Tool => (
-                Carrier::Tool(
-                    Mat4::new_translation(
-                        &solids.tool.map_or(Vec3::zeros(), |t| t.1.spindle_centre()),
-                    ) * own?,
-                ),
-                sorted(&tool_axes),
-            ),
-            Mount::PartStart | Mount::PartEnd => {
-                let Some((lo, hi)) = part_z else {
-                    out.notes.push(format!(
-                        "body {} stands at the part's end, and the run has no part: not checked",
-                        spec.name
-                    ));
-                    continue;
-                };
-                let z = if spec.mount == Mount::PartStart {
-                    lo
-                } else {
-                    hi
-                };
-                (
-                    Carrier::Fixed(Mat4::new_translation(&Vec3::new(0.0, 0.0, z)) * own?),
-                    Vec::new(),
-                )
-            }
-        };
+    for (i, b) in placement.bodies.iter().enumerate() {
         entities.push(entity(
-            &spec.name,
-            shapes::solid(&solid),
-            carrier,
-            moved_by,
-            spec.approach_feed.is_some(),
+            &b.name,
+            shapes::solid(&b.solid),
+            Which::Body(i),
+            b.moved_by.clone(),
+            b.rides,
             false,
         ));
     }
     if let Some((name, mesh)) = solids.part {
         if let Some(shaped) = shapes::envelope(mesh, solids.tolerance) {
-            entities.push(entity(
-                name,
-                shaped,
-                Carrier::Fixed(Mat4::identity()),
-                Vec::new(),
-                false,
-                true,
-            ));
-        }
-    }
-    // The axis values every carrier reads, in the machine's order.
-    let names: Vec<String> = info
-        .axes
-        .iter()
-        .filter(|a| used_axes.contains(&a.name))
-        .map(|a| a.name.clone())
-        .collect();
-    let col = |n: &String| names.iter().position(|m| m == n).unwrap_or(0);
-    let tool_cols: Vec<usize> = tool_axes.iter().map(col).collect();
-    for e in &mut entities {
-        if let Carrier::Chain(chain, cols) = &mut e.carrier {
-            *cols = chain.axis_names().iter().map(col).collect();
+            entities.push(entity(name, shaped, Which::Part, Vec::new(), false, true));
         }
     }
     let pairs: Vec<(usize, usize)> = (0..entities.len())
@@ -389,29 +303,18 @@ pub fn check(
         return Ok(out);
     }
     let n = program.blocks.len();
+    let names = placement.axes();
     let w = names.len();
-    let rows = axis_rows(program, info, &names, 0..n).map_err(CollisionError::Program)?;
+    let rows = axis_rows(program, info, names, 0..n).map_err(CollisionError::Program)?;
     let frames = |q: &[Real]| -> Result<Vec<Mat4>, CollisionError> {
-        let tool = match &tool_chain {
-            Some(c) => {
-                let tq: Vec<Real> = tool_cols.iter().map(|&c| q[c]).collect();
-                c.matrix(&tq)
-                    .map_err(|e| CollisionError::Program(e.to_string()))?
-            }
-            None => Mat4::identity(),
-        };
+        let tool = placement.tool_frame(q)?;
         entities
             .iter()
             .map(|e| {
-                let f = match &e.carrier {
-                    Carrier::Tool(m) => tool * m,
-                    Carrier::Chain(chain, cols) => {
-                        let bq: Vec<Real> = cols.iter().map(|&c| q[c]).collect();
-                        chain
-                            .matrix(&bq)
-                            .map_err(|e| CollisionError::Program(e.to_string()))?
-                    }
-                    Carrier::Fixed(m) => *m,
+                let f = match e.which {
+                    Which::Tool => tool,
+                    Which::Body(i) => placement.body_frame(i, q, &tool)?,
+                    Which::Part => Mat4::identity(),
                 };
                 Ok(f * e.shaped.local)
             })

@@ -156,7 +156,14 @@ pub fn export(
         .collect::<Result<Vec<_>, _>>()?;
     let pose = scene::tool_pose(&program, kin, &toolpath.tool, place)?;
     let tool = scene::tool_mesh(&toolpath.tool, &pose, report.mesh_tolerance_mm)?;
-    let others = scene::machine_bodies(kin, &program, place, report.mesh_tolerance_mm)?;
+    let others = scene::machine_bodies(
+        kin,
+        &program,
+        place,
+        (&toolpath.tool, &pose),
+        &parts,
+        report.mesh_tolerance_mm,
+    )?;
     let (files, bodies) = scene::files(&parts, tool, pose.pose, others, vec![], formats)?;
     report.pose_block = Some(index + 1);
     report.pose_along = place.along;

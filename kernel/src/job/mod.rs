@@ -237,12 +237,10 @@ fn collisions(
     let unplaced = scene::ToolAt {
         pose: crate::math::Mat4::identity(),
         lead: 0.0,
+        turn: 0.0,
     };
     let tool_mesh = scene::tool_mesh(tool, &unplaced, tol)?;
-    let part = parts
-        .iter()
-        .max_by(|a, b| a.1.volume().total_cmp(&b.1.volume()))
-        .map(|(n, m)| (n.as_str(), m));
+    let part = crate::collision::part_at_largest(parts);
     crate::collision::check(
         &written,
         machine,
@@ -593,7 +591,14 @@ fn run_on(
         let index = pose_index;
         let pose = scene::tool_pose(&program, kin, &toolpath.tool, pose_place)?;
         let tool = scene::tool_mesh(&toolpath.tool, &pose, tol)?;
-        let others = scene::machine_bodies(kin, &program, pose_place, tol)?;
+        let others = scene::machine_bodies(
+            kin,
+            &program,
+            pose_place,
+            (&toolpath.tool, &pose),
+            &meshes,
+            tol,
+        )?;
         let overlays = overlay
             .map(|m| ("contact_patch".to_owned(), m, crate::math::Mat4::identity()))
             .into_iter()

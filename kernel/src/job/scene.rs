@@ -3,7 +3,7 @@
 //! placed by their chains, as STL files and one glTF scene.
 
 use crate::family::{PartBody, PartGeometry};
-use crate::machine::{bodies_of, MachineKinematics, Solid};
+use crate::machine::MachineKinematics;
 use crate::math::{Mat4, Point3, Vec3};
 pub use crate::mesh::SceneError;
 use crate::mesh::{self, frame_from_pose, MeshError, Scene, StlFormat, TriMesh};
@@ -97,9 +97,12 @@ pub fn thread_blade(c: &crate::worm::ThreadCutter, at: &ToolAt) -> crate::worm::
 /// A body placed in the part frame: name, mesh in its own frame, pose.
 pub type Placed = (String, TriMesh, Mat4);
 
-/// The machine's other moving bodies that have a shape, placed by their
-/// chains at `place`; a body whose chain needs an axis the program does
-/// not drive is left out.
+/// The machine's bodies that have a shape, placed at `place` as the
+/// collision check places them ([`crate::collision::Placement`]: on the
+/// part frame by their chains, on the tool from its spindle centre, at
+/// the ends of `parts`' largest body), turned with the tool where it
+/// stands in a thread ([`ToolAt::turn`]); a body the program or the run
+/// cannot place is left out.
 ///
 /// # Failures
 /// A body's description or mesh failing.
@@ -107,30 +110,32 @@ pub fn machine_bodies(
     machine: &dyn MachineKinematics,
     program: &AxisProgram,
     place: PosePlace,
+    tool: (&Tool, &ToolAt),
+    parts: &[(String, TriMesh)],
     tol: f64,
 ) -> Result<Vec<Placed>, SceneError> {
     let program = &at_place(program, place)?;
-    let index = 0;
     let info = machine.info();
-    let bodies = bodies_of(info).map_err(|e| SceneError::Place(e.to_string()))?;
-    let mut out = Vec::new();
-    for body in bodies {
-        let Some(shape) = &body.spec().shape else {
-            continue;
-        };
-        let Ok(q) = axis_rows(program, info, body.chain().axis_names(), index..index + 1) else {
-            continue; // the program does not drive the body
-        };
-        let solid = Solid::of(shape, &info.constants)
-            .map_err(|m| SceneError::Place(format!("body {}: {m}", body.name())))?;
-        let mesh = mesh::body_mesh(&solid, tol).map_err(mesh_err(body.name()))?;
-        let pose = body
-            .chain()
-            .matrix(&q)
-            .map_err(|e| SceneError::Place(e.to_string()))?;
-        out.push((body.name().to_owned(), mesh, pose));
-    }
-    Ok(out)
+    let placing = |e: crate::collision::CollisionError| SceneError::Place(e.to_string());
+    let axes: Vec<String> = program.axes.iter().map(|a| a.name.clone()).collect();
+    let part_z = crate::collision::part_at_largest(parts).map(|(_, m)| crate::collision::part_z(m));
+    let (tool, at) = tool;
+    let placement = crate::collision::Placement::new(info, &axes, tool.spindle_centre(), part_z)
+        .map_err(placing)?;
+    // In a thread the machine is shown turned with the tool.
+    let turned = Mat4::from_axis_angle(&Vec3::z_axis(), at.turn);
+    let q = axis_rows(program, info, placement.axes(), 0..1).map_err(SceneError::Place)?;
+    let tool_frame = placement.tool_frame(&q).map_err(placing)?;
+    placement
+        .bodies
+        .iter()
+        .enumerate()
+        .map(|(i, body)| {
+            let mesh = mesh::body_mesh(&body.solid, tol).map_err(mesh_err(&body.name))?;
+            let pose = placement.body_frame(i, &q, &tool_frame).map_err(placing)?;
+            Ok((body.name.clone(), mesh, turned * pose))
+        })
+        .collect()
 }
 
 /// Where the scene shows the tool and the machine's bodies: `along` of
@@ -218,6 +223,10 @@ pub struct ToolAt {
     pub pose: Mat4,
     /// The lead of the thread it cuts there (mm; 0 outside a thread block).
     pub lead: f64,
+    /// How far the part has turned since the thread's start (rad; 0
+    /// outside a thread block): the scene shows the machine turned by it
+    /// about the part's axis, so the tool stands in the thread it cuts.
+    pub turn: f64,
 }
 
 /// The tool at `place`, in the part frame: the machine's forward
@@ -247,6 +256,7 @@ pub fn tool_pose(
     let flat = ToolAt {
         pose: frame,
         lead: 0.0,
+        turn: 0.0,
     };
     let crate::toolpath::Motion::Thread { lead, start_deg } = b.motion else {
         return Ok(flat);
@@ -265,6 +275,7 @@ pub fn tool_pose(
     Ok(ToolAt {
         pose: Mat4::from_axis_angle(&Vec3::z_axis(), angle) * frame,
         lead,
+        turn: angle,
     })
 }
 

@@ -1,0 +1,218 @@
+//! Where the machine's bodies stand for given axis values: the one
+//! placement the collision check and the scene share. A body on the part
+//! frame by its own chain; a body on the tool by the tool's chain, then
+//! from the tool's spindle centre by its chain of constants; a body at one
+//! of the part's ends from there.
+
+use super::CollisionError;
+use crate::machine::{bodies_of, Machine, MachineInfo, Mount, Solid};
+use crate::math::{Mat4, Real, Vec3};
+use crate::transform::Chain;
+
+/// What places a body.
+#[derive(Debug, Clone)]
+pub(super) enum Carrier {
+    /// The tool's chain, then this constant motion.
+    Tool(Mat4),
+    /// Its own chain, over these columns of the axis values.
+    Chain(Chain, Vec<usize>),
+    /// Nothing: it stands here in the part frame.
+    Fixed(Mat4),
+}
+
+/// A body of the machine with a solid, and how it is placed.
+#[derive(Debug, Clone)]
+pub struct PlacedBody {
+    /// Its name.
+    pub name: String,
+    /// Its solid, sizes resolved.
+    pub solid: Solid,
+    /// It rides the part (it has an approach feed: a steady rest).
+    pub rides: bool,
+    /// The axes that move it relative to the part, sorted.
+    pub moved_by: Vec<String>,
+    pub(super) carrier: Carrier,
+}
+
+/// The machine's bodies placed for axis values (a row over
+/// [`Placement::axes`]).
+#[derive(Debug, Clone)]
+pub struct Placement {
+    axes: Vec<String>,
+    tool: Option<(Chain, Vec<usize>)>,
+    /// The bodies that have a solid and can be placed.
+    pub bodies: Vec<PlacedBody>,
+    /// Bodies left out, and why.
+    pub notes: Vec<String>,
+}
+
+impl Placement {
+    /// The bodies of the machine `info` with a solid, for a program over
+    /// `program_axes`: the tool's spindle centre at `tool_centre` in the
+    /// tool frame, the part's solids from `part_z.0` to `part_z.1` along
+    /// its axis (none: bodies at its ends are left out).
+    ///
+    /// # Failures
+    /// A description that does not compile (it did when loaded).
+    pub fn new(
+        info: &MachineInfo,
+        program_axes: &[String],
+        tool_centre: Vec3,
+        part_z: Option<(Real, Real)>,
+    ) -> Result<Self, CollisionError> {
+        let machine = |e: crate::machine::MachineError| CollisionError::Machine(e.to_string());
+        let tool_chain = if info.chain.is_empty() {
+            None
+        } else {
+            Some(
+                Machine::from_info(info.clone())
+                    .map_err(machine)?
+                    .chain()
+                    .clone(),
+            )
+        };
+        let tool_axes: Vec<String> = tool_chain
+            .as_ref()
+            .map(|c| c.axis_names().to_vec())
+            .unwrap_or_default();
+        let mut used = tool_axes.clone();
+        let mut bodies = Vec::new();
+        let mut notes = Vec::new();
+        for body in bodies_of(info).map_err(machine)? {
+            let spec = body.spec();
+            let Some(shape) = &spec.shape else {
+                continue;
+            };
+            let solid = Solid::of(shape, &info.constants).map_err(CollisionError::Machine)?;
+            let own = || {
+                body.chain()
+                    .matrix(&vec![0.0; body.chain().dof()])
+                    .map_err(|e| CollisionError::Machine(e.to_string()))
+            };
+            let (carrier, moved_by) = match spec.mount {
+                Mount::Part => {
+                    let names = body.chain().axis_names().to_vec();
+                    if let Some(a) = names.iter().find(|a| !program_axes.contains(a)) {
+                        notes.push(format!(
+                            "body {}: the program does not drive its axis {a}: left out",
+                            spec.name
+                        ));
+                        continue;
+                    }
+                    used.extend(names.iter().cloned());
+                    (Carrier::Chain(body.chain().clone(), Vec::new()), names)
+                }
+                Mount::Tool => {
+                    if tool_chain.is_none() {
+                        notes.push(format!(
+                            "body {}: the machine states no tool chain to carry it: left out",
+                            spec.name
+                        ));
+                        continue;
+                    }
+                    (
+                        Carrier::Tool(Mat4::new_translation(&tool_centre) * own()?),
+                        tool_axes.clone(),
+                    )
+                }
+                Mount::PartStart | Mount::PartEnd => {
+                    let Some((lo, hi)) = part_z else {
+                        notes.push(format!(
+                            "body {} stands at the part's end, and the run has no part: left out",
+                            spec.name
+                        ));
+                        continue;
+                    };
+                    let z = if spec.mount == Mount::PartStart {
+                        lo
+                    } else {
+                        hi
+                    };
+                    (
+                        Carrier::Fixed(Mat4::new_translation(&Vec3::new(0.0, 0.0, z)) * own()?),
+                        Vec::new(),
+                    )
+                }
+            };
+            bodies.push(PlacedBody {
+                name: spec.name.clone(),
+                solid,
+                rides: spec.approach_feed.is_some(),
+                moved_by: sorted(&moved_by),
+                carrier,
+            });
+        }
+        // The axis values every carrier reads, in the machine's order.
+        let axes: Vec<String> = info
+            .axes
+            .iter()
+            .filter(|a| used.contains(&a.name))
+            .map(|a| a.name.clone())
+            .collect();
+        let col = |n: &String| axes.iter().position(|m| m == n).unwrap_or(0);
+        for b in &mut bodies {
+            if let Carrier::Chain(chain, cols) = &mut b.carrier {
+                *cols = chain.axis_names().iter().map(col).collect();
+            }
+        }
+        let tool = tool_chain.map(|c| {
+            let cols = c.axis_names().iter().map(col).collect();
+            (c, cols)
+        });
+        Ok(Self {
+            axes,
+            tool,
+            bodies,
+            notes,
+        })
+    }
+
+    /// The axes a row of values gives, in order.
+    pub fn axes(&self) -> &[String] {
+        &self.axes
+    }
+
+    /// The axes that move the tool, sorted; `None` when the machine states
+    /// no tool chain.
+    pub fn tool_axes(&self) -> Option<Vec<String>> {
+        self.tool.as_ref().map(|(c, _)| sorted(c.axis_names()))
+    }
+
+    /// The tool frame for the axis values `q` (identity without a chain).
+    ///
+    /// # Failures
+    /// A value that is not finite.
+    pub fn tool_frame(&self, q: &[Real]) -> Result<Mat4, CollisionError> {
+        match &self.tool {
+            Some((c, cols)) => {
+                let tq: Vec<Real> = cols.iter().map(|&i| q[i]).collect();
+                c.matrix(&tq)
+                    .map_err(|e| CollisionError::Program(e.to_string()))
+            }
+            None => Ok(Mat4::identity()),
+        }
+    }
+
+    /// Body `i`'s frame in the part frame, the tool frame being `tool`.
+    ///
+    /// # Failures
+    /// A value that is not finite.
+    pub fn body_frame(&self, i: usize, q: &[Real], tool: &Mat4) -> Result<Mat4, CollisionError> {
+        Ok(match &self.bodies[i].carrier {
+            Carrier::Tool(m) => tool * m,
+            Carrier::Chain(chain, cols) => {
+                let bq: Vec<Real> = cols.iter().map(|&c| q[c]).collect();
+                chain
+                    .matrix(&bq)
+                    .map_err(|e| CollisionError::Program(e.to_string()))?
+            }
+            Carrier::Fixed(m) => *m,
+        })
+    }
+}
+
+fn sorted(names: &[String]) -> Vec<String> {
+    let mut v = names.to_vec();
+    v.sort();
+    v
+}
