@@ -46,15 +46,7 @@ fn a_machine_files_bodies_are_drawn_where_their_chains_put_them() {
         s(&out),
     ]);
     assert_eq!(code, 0, "{err}");
-    let doc = gltf::Gltf::from_slice(&std::fs::read(out.join("scene.glb")).unwrap()).unwrap();
-    let at = |name: &str| {
-        doc.nodes()
-            .find(|n| n.name() == Some(name))
-            .unwrap_or_else(|| panic!("no node {name}"))
-            .transform()
-            .decomposed()
-            .0
-    };
+    let at = common::scene_nodes(&out);
     // The head and the guard ride the tool along its axis (+Z); the
     // column stands where its constant chain puts it.
     let (tool, head, hood, column) = (at("cutter"), at("head"), at("hood"), at("column"));

@@ -211,15 +211,7 @@ fn the_scene_places_each_body_as_the_check_does() {
     let out = scratch("collisions", "scene").join("out");
     let (code, _, err) = pilgrim(&["run", "scripts/mandrel.rhai", "--out", s(&out), "--quiet"]);
     assert_eq!(code, 0, "{err}");
-    let doc = gltf::Gltf::from_slice(&std::fs::read(out.join("scene.glb")).unwrap()).unwrap();
-    let at = |name: &str| {
-        doc.nodes()
-            .find(|n| n.name() == Some(name))
-            .unwrap_or_else(|| panic!("no node {name}"))
-            .transform()
-            .decomposed()
-            .0
-    };
+    let at = common::scene_nodes(&out);
     let wheel = at("wheel");
     for body in ["guard", "hub"] {
         let b = at(body);

@@ -191,6 +191,21 @@ pub fn golden_min(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64, iterations: us
     0.5 * (a + b)
 }
 
+/// Where each named node of a run's `scene.glb` stands: a function of the
+/// node's name giving its translation (panics naming a node it lacks).
+#[allow(dead_code)]
+pub fn scene_nodes(dir: &Path) -> impl Fn(&str) -> [f32; 3] {
+    let doc = gltf::Gltf::from_slice(&std::fs::read(dir.join("scene.glb")).unwrap()).unwrap();
+    move |name: &str| {
+        doc.nodes()
+            .find(|n| n.name() == Some(name))
+            .unwrap_or_else(|| panic!("no node {name}"))
+            .transform()
+            .decomposed()
+            .0
+    }
+}
+
 /// Leaves a run's models for the external checkers of `.ci/run`.
 #[allow(dead_code)]
 pub fn leave_for_checkers(dir: &Path, tag: &str) {

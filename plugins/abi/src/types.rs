@@ -408,6 +408,28 @@ pub struct BodySpec {
     pub approach_feed: Option<Quantity>,
 }
 
+impl BodySpec {
+    /// A body of `shape` on `mount`, placed there by `chain`, described as
+    /// `description`; no label, riding nothing.
+    pub fn mounted(
+        name: &str,
+        description: &str,
+        mount: Mount,
+        chain: Vec<FactorSpec>,
+        shape: BodyShape,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            description: description.into(),
+            label: String::new(),
+            chain,
+            shape: Some(shape),
+            approach_feed: None,
+            mount,
+        }
+    }
+}
+
 /// The tool's tracked point and axis in the tool's own frame, as the
 /// machine's chain defines that frame.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

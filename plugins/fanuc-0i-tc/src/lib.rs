@@ -138,25 +138,6 @@ pub fn describe() -> MachineInfo {
     }
 }
 
-/// A body of `shape` on `mount`, placed there by the constant `chain`.
-fn body(
-    name: &str,
-    what: &str,
-    mount: Mount,
-    chain: Vec<FactorSpec>,
-    shape: BodyShape,
-) -> BodySpec {
-    BodySpec {
-        name: name.into(),
-        description: what.into(),
-        label: String::new(),
-        chain,
-        shape: Some(shape),
-        approach_feed: None,
-        mount,
-    }
-}
-
 /// The lathe's bodies: the holder and the turret (on the tool, from its
 /// tip outward), the chuck at the part's start, the tailstock at its end.
 fn bodies() -> Vec<BodySpec> {
@@ -164,7 +145,7 @@ fn bodies() -> Vec<BodySpec> {
     let k = |f: FactorKind, name: &str| FactorSpec::constant(f, name);
     let half = |f: FactorKind, name: &str, sign: f64| FactorSpec::scaled(f, name, 0.5 * sign);
     vec![
-        body(
+        BodySpec::mounted(
             "holder",
             "the cutter's holder, its shank radial behind the tip",
             Mount::Tool,
@@ -176,7 +157,7 @@ fn bodies() -> Vec<BodySpec> {
                 size: [c("holder_length"), c("holder_section"), c("holder_section")],
             },
         ),
-        body(
+        BodySpec::mounted(
             "turret",
             "the turret's disc carrying the holder",
             Mount::Tool,
@@ -190,7 +171,7 @@ fn bodies() -> Vec<BodySpec> {
                 length: c("turret_width"),
             },
         ),
-        body(
+        BodySpec::mounted(
             "chuck",
             "the chuck, its jaws chuck_gap beyond the part's start",
             Mount::PartStart,
@@ -203,7 +184,7 @@ fn bodies() -> Vec<BodySpec> {
                 length: c("chuck_length"),
             },
         ),
-        body(
+        BodySpec::mounted(
             "tailstock_centre",
             "the tailstock's centre in the part's end",
             Mount::PartEnd,
@@ -213,7 +194,7 @@ fn bodies() -> Vec<BodySpec> {
                 length: c("centre_length"),
             },
         ),
-        body(
+        BodySpec::mounted(
             "tailstock_quill",
             "the tailstock's quill behind its centre",
             Mount::PartEnd,

@@ -177,25 +177,6 @@ pub fn describe() -> MachineInfo {
     }
 }
 
-/// A body of `shape` on `mount`, placed there by the constant `chain`.
-fn body(
-    name: &str,
-    what: &str,
-    mount: Mount,
-    chain: Vec<FactorSpec>,
-    shape: BodyShape,
-) -> BodySpec {
-    BodySpec {
-        name: name.into(),
-        description: what.into(),
-        label: String::new(),
-        chain,
-        shape: Some(shape),
-        approach_feed: None,
-        mount,
-    }
-}
-
 fn c(name: &str) -> Quantity {
     Quantity::Constant(name.into())
 }
@@ -256,7 +237,7 @@ fn bodies() -> Vec<BodySpec> {
             approach_feed: None,
             mount: Mount::Part,
         },
-        body(
+        BodySpec::mounted(
             "guard",
             "wheel guard over 200 degrees, open toward the part",
             Mount::Tool,
@@ -268,7 +249,7 @@ fn bodies() -> Vec<BodySpec> {
                 cover_deg: 200.0,
             },
         ),
-        body(
+        BodySpec::mounted(
             "hub",
             "wheel flanges clamping the wheel on its spindle",
             Mount::Tool,
@@ -278,7 +259,7 @@ fn bodies() -> Vec<BodySpec> {
                 length: c("hub_width"),
             },
         ),
-        body(
+        BodySpec::mounted(
             "wheelhead",
             "wheelhead housing behind the wheel, carrying its spindle",
             Mount::Tool,
@@ -291,7 +272,7 @@ fn bodies() -> Vec<BodySpec> {
                 ],
             },
         ),
-        body(
+        BodySpec::mounted(
             "chuck",
             "headstock chuck gripping the mandrel's tail over chuck_grip",
             Mount::PartStart,
@@ -304,7 +285,7 @@ fn bodies() -> Vec<BodySpec> {
                 length: c("chuck_length"),
             },
         ),
-        body(
+        BodySpec::mounted(
             "tailstock_centre",
             "tailstock centre in the mandrel's end",
             Mount::PartEnd,
@@ -314,7 +295,7 @@ fn bodies() -> Vec<BodySpec> {
                 length: c("centre_length"),
             },
         ),
-        body(
+        BodySpec::mounted(
             "tailstock_quill",
             "tailstock quill behind its centre",
             Mount::PartEnd,

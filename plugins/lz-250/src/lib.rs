@@ -197,25 +197,6 @@ pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInf
     }
 }
 
-/// A body of `shape` on `mount`, placed there by the constant `chain`.
-fn body(
-    name: &str,
-    what: &str,
-    mount: Mount,
-    chain: Vec<FactorSpec>,
-    shape: BodyShape,
-) -> BodySpec {
-    BodySpec {
-        name: name.into(),
-        description: what.into(),
-        label: String::new(),
-        chain,
-        shape: Some(shape),
-        approach_feed: None,
-        mount,
-    }
-}
-
 /// A caliber grinder's bodies: the wheel's guard and its spindle's
 /// housing (on the wheel's centre, the tool frame), the arbor through the
 /// roll, the collars at the roll's faces.
@@ -227,7 +208,7 @@ fn bodies() -> Vec<BodySpec> {
         length: c("collar_length"),
     };
     vec![
-        body(
+        BodySpec::mounted(
             "guard",
             "wheel guard over half the wheel, open toward the roll",
             Mount::Tool,
@@ -239,7 +220,7 @@ fn bodies() -> Vec<BodySpec> {
                 cover_deg: 180.0,
             },
         ),
-        body(
+        BodySpec::mounted(
             "housing",
             "wheel spindle's housing beside the wheel",
             Mount::Tool,
@@ -252,7 +233,7 @@ fn bodies() -> Vec<BodySpec> {
                 length: c("housing_length"),
             },
         ),
-        body(
+        BodySpec::mounted(
             "arbor",
             "arbor through the roll",
             Mount::Part,
@@ -262,14 +243,14 @@ fn bodies() -> Vec<BodySpec> {
                 length: c("arbor_length"),
             },
         ),
-        body(
+        BodySpec::mounted(
             "collar_front",
             "collar clamping the roll at its front face",
             Mount::PartStart,
             vec![FactorSpec::scaled(FactorKind::Tz, "collar_length", -0.5)],
             collar.clone(),
         ),
-        body(
+        BodySpec::mounted(
             "collar_back",
             "collar clamping the roll at its back face",
             Mount::PartEnd,
