@@ -237,3 +237,54 @@ fn the_scene_places_each_body_as_the_check_does() {
     assert!((at("chuck")[2] - (-303.0 + 40.0 - 55.0)).abs() < 1e-3);
     assert!((at("tailstock_centre")[2] - (440.0 + 25.0)).abs() < 1e-3);
 }
+
+/// The scene plays the program: `scene.glb` carries one animation whose
+/// keys are the blocks' ends at the times the machine reaches them, the
+/// wheel where the chain puts it for the block's X and Z, the rest where
+/// its chain puts it for Z and U, the last key at the cycle time.
+#[test]
+fn the_scene_plays_the_program_block_by_block() {
+    let out = scratch("collisions", "playback").join("out");
+    let (code, _, err) = pilgrim(&["run", "scripts/mandrel.rhai", "--out", s(&out), "--quiet"]);
+    assert_eq!(code, 0, "{err}");
+    let glb = std::fs::read(out.join("scene.glb")).unwrap();
+    let doc = gltf::Gltf::from_slice(&glb).unwrap();
+    let blob = doc.blob.clone().unwrap();
+    let animation = doc.animations().next().expect("an animation");
+    let program: Value =
+        serde_json::from_slice(&std::fs::read(out.join("program.json")).unwrap()).unwrap();
+    let blocks = program["blocks"].as_array().unwrap();
+    let last = &blocks[blocks.len() - 1]["values"];
+    let (z, x, u) = (
+        last[0].as_f64().unwrap(),
+        last[1].as_f64().unwrap(),
+        last[2].as_f64().unwrap(),
+    );
+    let r = report(&out);
+    let cycle_s = 60.0 * r["times"]["accelerated_min"].as_f64().unwrap();
+    let mut tracks = std::collections::BTreeMap::new();
+    for channel in animation.channels() {
+        let node = channel.target().node().name().unwrap().to_owned();
+        let reader = channel.reader(|_| Some(&blob[..]));
+        let times: Vec<f32> = reader.read_inputs().unwrap().collect();
+        assert!(
+            times.len() > 100 && times.len() <= blocks.len(),
+            "{}",
+            times.len()
+        );
+        assert!(((*times.last().unwrap() as f64) - cycle_s).abs() < 1e-3 * cycle_s);
+        if let gltf::animation::util::ReadOutputs::Translations(t) = reader.read_outputs().unwrap()
+        {
+            tracks.insert(node, t.last().unwrap());
+        }
+    }
+    // The wheel's programmed point is the tool frame's origin: (X, 0, Z).
+    let wheel = tracks["wheel"];
+    assert!((wheel[0] as f64 - x).abs() < 1e-3 && (wheel[2] as f64 - z).abs() < 1e-3);
+    // The rest's support centre: U on the far side, B = -180 mm along Z.
+    let rest = tracks["rest"];
+    assert!((rest[0] as f64 + u).abs() < 1e-3 && (rest[2] as f64 - (z - 180.0)).abs() < 1e-3);
+    // The guard rides the wheel's centre; the chuck stands still.
+    assert!((tracks["guard"][0] as f64 - (x + 250.0)).abs() < 1e-3);
+    assert!(!tracks.contains_key("chuck"));
+}

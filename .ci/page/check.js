@@ -89,6 +89,38 @@ async function check(browser, file) {
     view = `3-D view ${(100 * d.share).toFixed(1)}% drawn, middle ${(100 * d.centre).toFixed(0)}% (${path.basename(shot)})`;
     if (d.share < 0.01) problems.push("the 3-D view is blank");
     if (d.centre < 0.5) problems.push("nothing drawn where the camera points");
+    // The player: the slider at its start, middle and end puts the
+    // program's bodies in three places, the viewer at each key's time.
+    if (await page.$("#scrub")) {
+      const shots = [];
+      const max = await page.$eval("#scrub", (s) => +s.max);
+      for (const i of [0, max >> 1, max]) {
+        const ok = await page.evaluate((i) => {
+          const s = document.getElementById("scrub");
+          s.value = i;
+          s.dispatchEvent(new Event("input"));
+          const keys = JSON.parse(document.getElementById("keys").textContent);
+          const mv = document.getElementById("scene");
+          return Math.abs(mv.currentTime - keys[i][1]) < 1e-3;
+        }, i);
+        if (!ok) problems.push(`player: the viewer is not at key ${i}'s time`);
+        await page.evaluate(
+          () => new Promise((ok) => requestAnimationFrame(() => requestAnimationFrame(() => setTimeout(ok, 300))))
+        );
+        const png = file.replace(/\.html$/, `-key${i}.png`);
+        await el.screenshot({ path: png });
+        shots.push(PNG.sync.read(fs.readFileSync(png)));
+      }
+      const differ = (a, b) => {
+        let n = 0;
+        for (let k = 0; k < a.data.length; k += 4)
+          if (Math.abs(a.data[k] - b.data[k]) + Math.abs(a.data[k + 1] - b.data[k + 1]) + Math.abs(a.data[k + 2] - b.data[k + 2]) > 24) n++;
+        return n / (a.width * a.height);
+      };
+      const d1 = differ(shots[0], shots[1]), d2 = differ(shots[1], shots[2]);
+      view += `; player: ${max + 1} keys, the bodies moved ${(100 * d1).toFixed(1)}% and ${(100 * d2).toFixed(1)}% of the view`;
+      if (d1 < 0.001 || d2 < 0.001) problems.push("player: the view did not change along the program");
+    }
   }
   await page.close();
   console.log(

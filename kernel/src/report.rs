@@ -112,6 +112,11 @@ pub struct Report {
     /// acceleration, in all and per pass ([`crate::timing`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub times: Option<crate::timing::Times>,
+    /// The scene's animation keys for the page's player: each key's block
+    /// (from 0) and time (s). Not in `report.json`: the run and the
+    /// export make it with the scene.
+    #[serde(skip)]
+    pub playback: Vec<(usize, f32)>,
 }
 
 impl Report {
@@ -194,6 +199,7 @@ impl Report {
             verdict: crate::verdict::Verdict::default(),
             collisions: None,
             times: None,
+            playback: Vec::new(),
         }
     }
 }

@@ -66,6 +66,10 @@ pub struct Times {
     pub unramped_axes: Vec<String>,
     /// The interpolation cycle the blends were planned with (s).
     pub ipo_cycle_s: Real,
+    /// Each block's seconds with the axes' acceleration (the first, the
+    /// start, 0): the scene's animation runs on them.
+    #[serde(skip)]
+    pub block_s: Vec<Real>,
 }
 
 /// One block's move, as the planner sees it.
@@ -210,6 +214,7 @@ pub fn times(program: &AxisProgram, info: &MachineInfo, passes: &[ProgramPass]) 
             .map(|a| a.name.clone())
             .collect(),
         ipo_cycle_s: ipo,
+        block_s: accelerated,
     }
 }
 

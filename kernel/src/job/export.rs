@@ -164,7 +164,30 @@ pub fn export(
         &parts,
         report.mesh_tolerance_mm,
     )?;
-    let (files, bodies) = scene::files(&parts, tool, pose.pose, others, vec![], formats)?;
+    // The scene moves as the run's did: the same program, the same times.
+    let times = crate::timing::times(
+        &program,
+        kin.info(),
+        &crate::program::pass_blocks(&program, &toolpath.passes),
+    );
+    let motion = scene::motion(
+        kin,
+        &program,
+        (&toolpath.tool, tool.as_ref().map(|(_, name)| *name)),
+        &parts,
+        &times.block_s,
+    )?;
+    report.playback = motion
+        .as_ref()
+        .map(|m| {
+            m.keys
+                .iter()
+                .copied()
+                .zip(m.times.iter().copied())
+                .collect()
+        })
+        .unwrap_or_default();
+    let (files, bodies) = scene::files(&parts, tool, pose.pose, others, vec![], motion, formats)?;
     report.pose_block = Some(index + 1);
     report.pose_along = place.along;
     report.bodies = bodies;

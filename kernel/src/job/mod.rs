@@ -583,6 +583,8 @@ fn run_on(
     files.extend(programs);
     files.extend(table);
     stage(STAGES[4]);
+    let times = crate::timing::times(&program, info, &passes);
+    let mut playback = Vec::new();
     let (pose_block, bodies, solids, part_box) = if parts.is_empty() {
         (None, vec![], vec![], None)
     } else {
@@ -603,8 +605,32 @@ fn run_on(
             .map(|m| ("contact_patch".to_owned(), m, crate::math::Mat4::identity()))
             .into_iter()
             .collect();
-        let (mesh_files, bodies) =
-            scene::files(&meshes, tool, pose.pose, others, overlays, options.formats)?;
+        let motion = scene::motion(
+            kin,
+            &program,
+            (&toolpath.tool, tool.as_ref().map(|(_, name)| *name)),
+            &meshes,
+            &times.block_s,
+        )?;
+        playback = motion
+            .as_ref()
+            .map(|m| {
+                m.keys
+                    .iter()
+                    .copied()
+                    .zip(m.times.iter().copied())
+                    .collect()
+            })
+            .unwrap_or_default();
+        let (mesh_files, bodies) = scene::files(
+            &meshes,
+            tool,
+            pose.pose,
+            others,
+            overlays,
+            motion,
+            options.formats,
+        )?;
         files.extend(mesh_files);
         // A failed run's scene shows where it failed; its exact solids,
         // for checking a program in CAD, would check none.
@@ -618,7 +644,6 @@ fn run_on(
         };
         (Some(index + 1), bodies, solids, part_box)
     };
-    let times = crate::timing::times(&program, info, &passes);
     let mut report = Report {
         passes: passes.len(),
         cutting_passes: passes.iter().filter(|p| p.cuts).count(),
@@ -661,6 +686,7 @@ fn run_on(
         verdict: Verdict::of(requested_any, failures, warnings, figures),
         collisions: Some(collisions),
         times: Some(times),
+        playback,
         program_file: text.and(options.program_file.clone()),
         block_numbers: program
             .blocks

@@ -108,6 +108,64 @@ fn banner(out: &mut String, r: &Report) {
 }
 
 /// A list of findings, each its rule, its block and what it says.
+/// The player of the scene's animation: play and pause, a speed, and a
+/// slider over its keys (the blocks' ends, sampled where there are many),
+/// the block and time shown. It starts at the pose block.
+fn player(out: &mut String, r: &Report) {
+    if r.playback.is_empty() {
+        return;
+    }
+    let keys: Vec<String> = r
+        .playback
+        .iter()
+        .map(|(k, t)| {
+            format!(
+                "[{},{}]",
+                // A JSON string that cannot end the script: no '<'.
+                serde_json::to_string(&r.block_label(*k))
+                    .unwrap_or_default()
+                    .replace('<', "\\u003c"),
+                fixed(f64::from(*t), 3)
+            )
+        })
+        .collect();
+    let pose = r.pose_block.map_or(0, |b| b - 1);
+    let start = r
+        .playback
+        .iter()
+        .rposition(|(k, _)| *k <= pose)
+        .unwrap_or(0);
+    let _ = writeln!(
+        out,
+        "<div class=\"player\"><button id=\"play\" type=\"button\">play</button> <label>speed <select id=\"speed\"><option value=\"1\">1x</option><option value=\"10\">10x</option><option value=\"100\" selected>100x</option><option value=\"1000\">1000x</option></select></label> <input id=\"scrub\" type=\"range\" min=\"0\" max=\"{}\" value=\"{start}\" step=\"1\" aria-label=\"the program's blocks\"> <span id=\"at\"></span></div>\n<script type=\"application/json\" id=\"keys\">[{}]</script>\n<script>{PLAYER}</script>",
+        keys.len() - 1,
+        keys.join(",")
+    );
+}
+
+/// The player's script: the keys' blocks and times from the page, the
+/// animation played, paused and sought through `<model-viewer>`'s API.
+const PLAYER: &str = "(() => {
+  const mv = document.getElementById('scene');
+  const keys = JSON.parse(document.getElementById('keys').textContent);
+  const scrub = document.getElementById('scrub');
+  const at = document.getElementById('at');
+  const play = document.getElementById('play');
+  const speed = document.getElementById('speed');
+  const show = i => { at.textContent = keys[i][0] + ', ' + keys[i][1].toFixed(1) + ' s'; };
+  const keyAt = t => { let lo = 0, hi = keys.length - 1; while (lo < hi) { const m = (lo + hi + 1) >> 1; if (keys[m][1] <= t + 1e-6) lo = m; else hi = m - 1; } return lo; };
+  const seek = i => { mv.currentTime = keys[i][1]; show(i); };
+  const tick = () => { const i = keyAt(mv.currentTime); scrub.value = i; show(i); if (!mv.paused) requestAnimationFrame(tick); else play.textContent = 'play'; };
+  scrub.addEventListener('input', () => { mv.pause(); play.textContent = 'play'; seek(+scrub.value); });
+  speed.addEventListener('change', () => { mv.timeScale = +speed.value; });
+  play.addEventListener('click', () => {
+    if (mv.paused) { mv.timeScale = +speed.value; mv.play({repetitions: 1}); play.textContent = 'pause'; requestAnimationFrame(tick); }
+    else { mv.pause(); play.textContent = 'play'; }
+  });
+  mv.addEventListener('load', () => { mv.animationName = 'the program'; mv.pause(); seek(+scrub.value); });
+  show(+scrub.value);
+})();";
+
 /// Each pass's time at its feeds and with the axes' acceleration.
 fn pass_times(out: &mut String, r: &Report) {
     let Some(t) = &r.times else {
@@ -317,6 +375,7 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
                 "<h2>3-D: part, tool and machine at the pose block</h2>\n<p>Drag to orbit, wheel or pinch to zoom, right-drag to pan; the camera points at the middle of the part. {VIEWER}.</p>\n<model-viewer id=\"scene\" alt=\"the part, the tool and the machine's bodies at the pose block\" src=\"data:model/gltf-binary;base64,{}\" loading=\"eager\" camera-controls interaction-prompt=\"none\" camera-target=\"{target}\" camera-orbit=\"0deg 75deg auto\" shadow-intensity=\"0\"></model-viewer>",
                 b64.encode(glb)
             );
+            player(&mut out, r);
         }
         None => out.push_str(
             "<h2>3-D</h2>\n<p>No 3-D models: the family has no <code>fn part(p)</code>.</p>\n",
@@ -429,9 +488,11 @@ figure { margin: 12px 0; }
 figure img { max-width: 100%; height: auto; border: 1px solid #ddd; }
 figcaption { color: #556; font-size: 12px; }
 model-viewer { width: 100%; height: 520px; background: #20262e; display: block; }
+.player { margin: 6px 0; display: flex; gap: 10px; align-items: center; }
+.player input[type=range] { flex: 1; }
 pre { background: #f6f7f9; border: 1px solid #dde; padding: 8px; overflow-x: auto; font-size: 12px; }
 .gap { color: #889; }
-@media print { model-viewer { display: none; } body { max-width: none; } }
+@media print { model-viewer, .player { display: none; } body { max-width: none; } }
 ";
 
 #[cfg(test)]

@@ -138,6 +138,80 @@ pub fn machine_bodies(
         .collect()
 }
 
+/// The most keys of the scene's animation: a longer program is sampled
+/// every so many blocks (the page's listing stays exact).
+pub const MAX_KEYS: usize = 2000;
+
+/// The program's motion for the scene: the tool (its node `tool_name`)
+/// and every machine body that moves, placed as
+/// [`machine_bodies`] places them, at the end of each block (of every k-th
+/// block where there are more than [`MAX_KEYS`]), at the time the program
+/// reaches it as the machine moves it (`block_s`: each block's seconds,
+/// [`crate::timing::Times::block_s`]). `None` when nothing moves.
+///
+/// # Failures
+/// A body's description failing; the program lacking an axis.
+pub fn motion(
+    machine: &dyn MachineKinematics,
+    program: &AxisProgram,
+    tool: (&Tool, Option<&str>),
+    parts: &[(String, TriMesh)],
+    block_s: &[f64],
+) -> Result<Option<mesh::Motion>, SceneError> {
+    let info = machine.info();
+    let placing = |e: crate::collision::CollisionError| SceneError::Place(e.to_string());
+    let axes: Vec<String> = program.axes.iter().map(|a| a.name.clone()).collect();
+    let part_z = crate::collision::part_at_largest(parts).map(|(_, m)| crate::collision::part_z(m));
+    let placement = crate::collision::Placement::new(info, &axes, tool.0.spindle_centre(), part_z)
+        .map_err(placing)?;
+    let n = program.blocks.len();
+    let moving: Vec<usize> = (0..placement.bodies.len())
+        .filter(|&i| !placement.bodies[i].moved_by.is_empty())
+        .collect();
+    let tool_name = tool.1.filter(|_| placement.tool_axes().is_some());
+    if n == 0 || (moving.is_empty() && tool_name.is_none()) {
+        return Ok(None);
+    }
+    let rows = axis_rows(program, info, placement.axes(), 0..n).map_err(SceneError::Place)?;
+    let w = placement.axes().len();
+    let every = n.div_ceil(MAX_KEYS).max(1);
+    let (mut times, mut keys) = (Vec::new(), Vec::new());
+    let mut tracks: Vec<(String, Vec<Mat4>)> = tool_name
+        .into_iter()
+        .map(str::to_owned)
+        .chain(moving.iter().map(|&i| placement.bodies[i].name.clone()))
+        .map(|name| (name, Vec::new()))
+        .collect();
+    let mut clock = 0.0;
+    for k in 0..n {
+        clock += block_s.get(k).copied().unwrap_or(0.0);
+        let key = k % every == 0 || k + 1 == n;
+        let t = clock as f32;
+        if !key || times.last().is_some_and(|&last| t <= last) {
+            continue;
+        }
+        times.push(t);
+        keys.push(k);
+        let q = &rows[k * w..(k + 1) * w];
+        let frame = placement.tool_frame(q).map_err(placing)?;
+        let mut track = tracks.iter_mut();
+        if tool_name.is_some() {
+            if let Some((_, poses)) = track.next() {
+                poses.push(frame);
+            }
+        }
+        for (&i, (_, poses)) in moving.iter().zip(track) {
+            poses.push(placement.body_frame(i, q, &frame).map_err(placing)?);
+        }
+    }
+    Ok(Some(mesh::Motion {
+        name: "the program".into(),
+        times,
+        keys,
+        tracks,
+    }))
+}
+
 /// Where the scene shows the tool and the machine's bodies: `along` of
 /// the way through block `block`'s move (from 0; 1 is the block's end, its
 /// axis values), the axes interpolated in straight lines from the block
@@ -304,6 +378,7 @@ pub fn files(
     tool_pose: Mat4,
     others: Vec<Placed>,
     overlays: Vec<Placed>,
+    motion: Option<mesh::Motion>,
     formats: Formats,
 ) -> Result<(Files, Vec<BodyFile>), SceneError> {
     // The scene as a whole is bounded as each mesh is.
@@ -362,6 +437,7 @@ pub fn files(
     for (name, m, pose) in overlays {
         scene.add(&name, m, pose, OVERLAY_COLOR);
     }
+    scene.motion = motion;
     let mut glb = Vec::new();
     mesh::write_glb(&scene, &mut glb).map_err(mesh_err("scene"))?;
     out.push(("scene.glb".into(), glb));

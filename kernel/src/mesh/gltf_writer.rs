@@ -33,7 +33,10 @@ fn build(scene: &Scene, uri: Option<String>) -> Result<(json::Root, Vec<u8>), Me
         .nodes
         .iter()
         .map(|n| n.mesh.positions.len() * 24 + n.mesh.triangles.len() * 12)
-        .sum();
+        .sum::<usize>()
+        + scene.motion.as_ref().map_or(0, |m| {
+            m.times.len() * 4 + m.tracks.len() * m.times.len() * (12 + 16)
+        });
     let mut bin: Vec<u8> = Vec::with_capacity(size);
     let buffer = root.push(json::Buffer {
         byte_length: USize64(size as u64),
@@ -180,11 +183,7 @@ fn build(scene: &Scene, uri: Option<String>) -> Result<(json::Root, Vec<u8>), Me
             extensions: None,
             extras: Default::default(),
         });
-        let r = node.pose.fixed_view::<3, 3>(0, 0).into_owned();
-        let t = node.pose.fixed_view::<3, 1>(0, 3).into_owned();
-        let q = nalgebra::UnitQuaternion::from_rotation_matrix(
-            &nalgebra::Rotation3::from_matrix_unchecked(r),
-        );
+        let (t, q) = parts_of(&node.pose);
         let identity_turn = q.angle() == 0.0;
         children.push(root.push(json::Node {
             name: Some(node.name.clone()),
@@ -195,6 +194,9 @@ fn build(scene: &Scene, uri: Option<String>) -> Result<(json::Root, Vec<u8>), Me
             }),
             ..Default::default()
         }));
+    }
+    if let Some(motion) = &scene.motion {
+        animate(&mut root, &mut bin, buffer, motion, scene, &children)?;
     }
     let half = std::f32::consts::FRAC_1_SQRT_2;
     let top = root.push(json::Node {
@@ -212,6 +214,131 @@ fn build(scene: &Scene, uri: Option<String>) -> Result<(json::Root, Vec<u8>), Me
     });
     root.scene = Some(scene_index);
     Ok((root, bin))
+}
+
+/// A rigid motion's translation and rotation.
+fn parts_of(pose: &crate::math::Mat4) -> (nalgebra::Vector3<f64>, nalgebra::UnitQuaternion<f64>) {
+    let r = pose.fixed_view::<3, 3>(0, 0).into_owned();
+    let t = pose.fixed_view::<3, 1>(0, 3).into_owned();
+    let q = nalgebra::UnitQuaternion::from_rotation_matrix(
+        &nalgebra::Rotation3::from_matrix_unchecked(r),
+    );
+    (t, q)
+}
+
+/// Appends `motion` to `root` as one animation: a sampler of the key
+/// times and each track's translations and rotations (each quaternion on
+/// the side of the one before, so that the player turns the short way).
+///
+/// # Failures
+/// A track of a body the scene lacks, or of another length than the
+/// times; times that do not increase.
+fn animate(
+    root: &mut json::Root,
+    bin: &mut Vec<u8>,
+    buffer: json::Index<json::Buffer>,
+    motion: &crate::mesh::scene::Motion,
+    scene: &Scene,
+    nodes: &[json::Index<json::Node>],
+) -> Result<(), MeshError> {
+    use json::accessor::{ComponentType, Type};
+    let bad = |m: String| MeshError::Degenerate(format!("animation '{}': {m}", motion.name));
+    if motion.times.is_empty() || motion.times.windows(2).any(|w| w[1] <= w[0]) {
+        return Err(bad("its key times must be given and increase".into()));
+    }
+    let mut push = |root: &mut json::Root, values: &[f32], ty: Type, bounds: bool| {
+        let start = bin.len();
+        for v in values {
+            bin.extend_from_slice(&v.to_le_bytes());
+        }
+        let view = root.push(json::buffer::View {
+            buffer,
+            byte_length: USize64((bin.len() - start) as u64),
+            byte_offset: Some(USize64(start as u64)),
+            byte_stride: None,
+            name: None,
+            target: None,
+            extensions: None,
+            extras: Default::default(),
+        });
+        let per = match ty {
+            Type::Scalar => 1,
+            Type::Vec3 => 3,
+            _ => 4,
+        };
+        let (lo, hi) = (values[0], values[values.len() - 1]);
+        root.push(json::Accessor {
+            buffer_view: Some(view),
+            byte_offset: None,
+            count: USize64((values.len() / per) as u64),
+            component_type: Valid(json::accessor::GenericComponentType(ComponentType::F32)),
+            extensions: None,
+            extras: Default::default(),
+            type_: Valid(ty),
+            min: bounds.then(|| json::Value::from(vec![lo])),
+            max: bounds.then(|| json::Value::from(vec![hi])),
+            name: None,
+            normalized: false,
+            sparse: None,
+        })
+    };
+    let input = push(root, &motion.times, Type::Scalar, true);
+    let (mut samplers, mut channels) = (Vec::new(), Vec::new());
+    for (name, poses) in &motion.tracks {
+        let Some(i) = scene.nodes.iter().position(|n| &n.name == name) else {
+            return Err(bad(format!("no body '{name}' in the scene")));
+        };
+        if poses.len() != motion.times.len() {
+            return Err(bad(format!(
+                "body '{name}' has {} poses for {} key times",
+                poses.len(),
+                motion.times.len()
+            )));
+        }
+        let (mut shifts, mut turns) = (Vec::new(), Vec::new());
+        let mut last: Option<nalgebra::UnitQuaternion<f64>> = None;
+        for pose in poses {
+            let (t, mut q) = parts_of(pose);
+            if last.is_some_and(|l| l.coords.dot(&q.coords) < 0.0) {
+                q = nalgebra::UnitQuaternion::new_unchecked(-q.into_inner());
+            }
+            last = Some(q);
+            shifts.extend([t.x as f32, t.y as f32, t.z as f32]);
+            turns.extend([q.i as f32, q.j as f32, q.k as f32, q.w as f32]);
+        }
+        for (values, ty, path) in [
+            (shifts, Type::Vec3, json::animation::Property::Translation),
+            (turns, Type::Vec4, json::animation::Property::Rotation),
+        ] {
+            let output = push(root, &values, ty, false);
+            channels.push(json::animation::Channel {
+                sampler: json::Index::new(samplers.len() as u32),
+                target: json::animation::Target {
+                    node: nodes[i],
+                    path: Valid(path),
+                    extensions: None,
+                    extras: Default::default(),
+                },
+                extensions: None,
+                extras: Default::default(),
+            });
+            samplers.push(json::animation::Sampler {
+                input,
+                interpolation: Valid(json::animation::Interpolation::Linear),
+                output,
+                extensions: None,
+                extras: Default::default(),
+            });
+        }
+    }
+    root.push(json::Animation {
+        name: Some(motion.name.clone()),
+        channels,
+        samplers,
+        extensions: None,
+        extras: Default::default(),
+    });
+    Ok(())
 }
 
 /// Writes the scene as one binary glTF (`.glb`).
@@ -252,4 +379,77 @@ pub fn write_gltf<J: Write, B: Write>(
         .write_all(text.as_bytes())
         .map_err(|e| err(e.to_string()))?;
     bin_out.write_all(&bin).map_err(|e| err(e.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::machine::Solid;
+    use crate::math::{Mat4, Vec3};
+    use crate::mesh::Motion;
+
+    /// A box that slides 10 mm along X and turns a quarter about Z at each
+    /// key reads back, through the gltf crate's reader, as the keys it was
+    /// given: times, translations, and rotations each on the side of the
+    /// one before (the turn from 180 to 270 degrees the short way).
+    #[test]
+    fn a_scenes_motion_reads_back_key_by_key() {
+        let mesh = crate::mesh::body_mesh(
+            &Solid::Block {
+                size: [10.0, 20.0, 30.0],
+            },
+            0.01,
+        )
+        .unwrap();
+        let mut scene = Scene::new();
+        scene.add("box", mesh, Mat4::identity(), [1.0; 4]);
+        let pose = |k: usize| {
+            Mat4::new_translation(&Vec3::new(10.0 * k as f64, 0.0, 0.0))
+                * Mat4::from_axis_angle(&Vec3::z_axis(), std::f64::consts::FRAC_PI_2 * k as f64)
+        };
+        scene.motion = Some(Motion {
+            name: "slide".into(),
+            times: vec![0.0, 0.5, 1.0, 2.0],
+            keys: vec![0, 1, 2, 3],
+            tracks: vec![("box".into(), (0..4).map(pose).collect())],
+        });
+        let mut glb = Vec::new();
+        write_glb(&scene, &mut glb).unwrap();
+        let doc = gltf::Gltf::from_slice(&glb).unwrap();
+        let blob = doc.blob.clone().unwrap();
+        let animation = doc.animations().next().unwrap();
+        assert_eq!(animation.name(), Some("slide"));
+        let mut seen = 0;
+        for channel in animation.channels() {
+            let reader = channel.reader(|_| Some(&blob[..]));
+            let times: Vec<f32> = reader.read_inputs().unwrap().collect();
+            assert_eq!(times, vec![0.0, 0.5, 1.0, 2.0]);
+            match reader.read_outputs().unwrap() {
+                gltf::animation::util::ReadOutputs::Translations(t) => {
+                    let xs: Vec<f32> = t.map(|v| v[0]).collect();
+                    assert_eq!(xs, vec![0.0, 10.0, 20.0, 30.0]);
+                    seen += 1;
+                }
+                gltf::animation::util::ReadOutputs::Rotations(r) => {
+                    let q: Vec<[f32; 4]> = r.into_f32().collect();
+                    for (k, w) in q.windows(2).enumerate() {
+                        let dot: f32 = (0..4).map(|i| w[0][i] * w[1][i]).sum();
+                        assert!(
+                            (dot - std::f32::consts::FRAC_1_SQRT_2).abs() < 1e-6,
+                            "{k}: {q:?}"
+                        );
+                    }
+                    // A quarter turn about +Z at the second key.
+                    let h = std::f32::consts::FRAC_1_SQRT_2;
+                    assert!((q[1][2] - h).abs() < 1e-6 && (q[1][3] - h).abs() < 1e-6);
+                    seen += 1;
+                }
+                _ => panic!("a channel of another kind"),
+            }
+        }
+        assert_eq!(seen, 2);
+        // Times that do not increase are refused.
+        scene.motion.as_mut().unwrap().times = vec![0.0, 0.5, 0.5, 2.0];
+        assert!(write_glb(&scene, &mut Vec::new()).is_err());
+    }
 }

@@ -17,11 +17,29 @@ pub struct Node {
     pub color: [f32; 4],
 }
 
-/// Named bodies with poses, in the part frame (mm, Z up).
+/// How a scene's bodies move: each named body's pose at key times, played
+/// as one glTF animation (linear between keys).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Motion {
+    /// The animation's name.
+    pub name: String,
+    /// The key times (s from the start), increasing.
+    pub times: Vec<f32>,
+    /// What each key stands for, for people (the program's block, from
+    /// 0, whose end it is).
+    pub keys: Vec<usize>,
+    /// For each moving body (by its node's name), its pose at each key.
+    pub tracks: Vec<(String, Vec<Mat4>)>,
+}
+
+/// Named bodies with poses, in the part frame (mm, Z up), and how they
+/// move, if they do.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Scene {
     /// The bodies, in order.
     pub nodes: Vec<Node>,
+    /// Their motion along the program.
+    pub motion: Option<Motion>,
 }
 
 impl Scene {
