@@ -125,7 +125,9 @@ fn player(out: &mut String, r: &Report) {
                 serde_json::to_string(&r.block_label(*k))
                     .unwrap_or_default()
                     .replace('<', "\\u003c"),
-                fixed(f64::from(*t), 3)
+                // As the animation holds it (seeking past its end would
+                // start it again).
+                t
             )
         })
         .collect();
@@ -154,7 +156,9 @@ const PLAYER: &str = "(() => {
   const speed = document.getElementById('speed');
   const show = i => { at.textContent = keys[i][0] + ', ' + keys[i][1].toFixed(1) + ' s'; };
   const keyAt = t => { let lo = 0, hi = keys.length - 1; while (lo < hi) { const m = (lo + hi + 1) >> 1; if (keys[m][1] <= t + 1e-6) lo = m; else hi = m - 1; } return lo; };
-  const seek = i => { mv.currentTime = keys[i][1]; show(i); };
+  // The viewer's clock wraps at the animation's end: the last key is shown
+  // a tenth of a millisecond before it.
+  const seek = i => { mv.currentTime = Math.min(keys[i][1], mv.duration > 0 ? mv.duration - 1e-4 : Infinity); show(i); };
   const tick = () => { const i = keyAt(mv.currentTime); scrub.value = i; show(i); if (!mv.paused) requestAnimationFrame(tick); else play.textContent = 'play'; };
   scrub.addEventListener('input', () => { mv.pause(); play.textContent = 'play'; seek(+scrub.value); });
   speed.addEventListener('change', () => { mv.timeScale = +speed.value; });
