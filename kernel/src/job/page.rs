@@ -361,8 +361,9 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
     }
     match inputs.scene {
         Some((glb, lo, hi)) => {
-            // The scene's root turns the part frame's Z up to glTF's Y up
-            // and scales mm to m: (X, Y, Z) -> (X, Z, -Y) / 1000.
+            // The scene's root lays the part's axis horizontal (its Z to
+            // glTF's X, its X away from the viewer) and scales mm to m:
+            // (X, Y, Z) -> (Z, Y, -X) / 1000.
             let c = [
                 0.5 * (lo[0] + hi[0]),
                 0.5 * (lo[1] + hi[1]),
@@ -370,9 +371,9 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
             ];
             let target = format!(
                 "{}m {}m {}m",
-                fixed(c[0] / 1e3, 6),
                 fixed(c[2] / 1e3, 6),
-                fixed(-c[1] / 1e3, 6)
+                fixed(c[1] / 1e3, 6),
+                fixed(-c[0] / 1e3, 6)
             );
             let _ = writeln!(
                 out,

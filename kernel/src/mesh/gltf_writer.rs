@@ -1,8 +1,10 @@
 //! glTF 2.0 scenes (`.glb`, or `.gltf` with a `.bin`), built with `gltf-json`.
 //!
-//! Mesh data stay in the part's millimetres with Z up; the root node alone
-//! carries the unit scale (0.001, to metres) and the turn of Z up to glTF's
-//! Y up (-90 degrees about X). Each body is a node with its own mesh
+//! Mesh data stay in the part frame's millimetres; the root node alone
+//! carries the unit scale (0.001, to metres) and the turn that lays the
+//! machine out as its operator sees it (90 degrees about glTF's Y): the
+//! part's axis (Z) horizontal to the right, its X (toward the tool) away
+//! from the viewer, its Y up. Each body is a node with its own mesh
 //! (positions, normals, indices) and material.
 
 use super::{MeshError, Scene};
@@ -200,10 +202,12 @@ fn build(scene: &Scene, uri: Option<String>) -> Result<(json::Root, Vec<u8>), Me
     }
     let half = std::f32::consts::FRAC_1_SQRT_2;
     let top = root.push(json::Node {
-        name: Some("pilgrim part frame (mm, Z up)".into()),
+        name: Some(
+            "pilgrim part frame (mm; its axis Z to the right, X away from the viewer)".into(),
+        ),
         children: Some(children),
         scale: Some([0.001; 3]),
-        rotation: Some(json::scene::UnitQuaternion([-half, 0.0, 0.0, half])),
+        rotation: Some(json::scene::UnitQuaternion([0.0, half, 0.0, half])),
         ..Default::default()
     });
     let scene_index = root.push(json::Scene {
