@@ -154,40 +154,24 @@ pub fn export(
                 .map_err(|e| Error::Read(e.to_string()))
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let pose = scene::tool_pose(&program, kin, &toolpath.tool, place)?;
-    let tool = scene::tool_mesh(&toolpath.tool, &pose, report.mesh_tolerance_mm)?;
-    let others = scene::machine_bodies(
-        kin,
-        &program,
-        place,
-        (&toolpath.tool, &pose),
-        &parts,
-        report.mesh_tolerance_mm,
-    )?;
     // The scene moves as the run's did: the same program, the same times.
     let times = crate::timing::times(
         &program,
         kin.info(),
         &crate::program::pass_blocks(&program, &toolpath.passes),
     );
-    let motion = scene::motion(
+    let staged = scene::stage(
         kin,
         &program,
-        (&toolpath.tool, tool.as_ref().map(|(_, name)| *name)),
+        &toolpath.tool,
         &parts,
+        place,
         &times.block_s,
+        vec![],
+        (report.mesh_tolerance_mm, formats),
     )?;
-    report.playback = motion
-        .as_ref()
-        .map(|m| {
-            m.keys
-                .iter()
-                .copied()
-                .zip(m.times.iter().copied())
-                .collect()
-        })
-        .unwrap_or_default();
-    let (files, bodies) = scene::files(&parts, tool, pose.pose, others, vec![], motion, formats)?;
+    let (files, bodies, pose) = (staged.files, staged.bodies, staged.pose);
+    report.playback = staged.playback;
     report.pose_block = Some(index + 1);
     report.pose_along = place.along;
     report.bodies = bodies;

@@ -591,46 +591,22 @@ fn run_on(
         // Where the report page's camera points: the part's middle.
         let part_box = scene::bounds_of(meshes.iter().map(|(_, m)| m));
         let index = pose_index;
-        let pose = scene::tool_pose(&program, kin, &toolpath.tool, pose_place)?;
-        let tool = scene::tool_mesh(&toolpath.tool, &pose, tol)?;
-        let others = scene::machine_bodies(
-            kin,
-            &program,
-            pose_place,
-            (&toolpath.tool, &pose),
-            &meshes,
-            tol,
-        )?;
         let overlays = overlay
             .map(|m| ("contact_patch".to_owned(), m, crate::math::Mat4::identity()))
             .into_iter()
             .collect();
-        let motion = scene::motion(
+        let staged = scene::stage(
             kin,
             &program,
-            (&toolpath.tool, tool.as_ref().map(|(_, name)| *name)),
+            &toolpath.tool,
             &meshes,
+            pose_place,
             &times.block_s,
-        )?;
-        playback = motion
-            .as_ref()
-            .map(|m| {
-                m.keys
-                    .iter()
-                    .copied()
-                    .zip(m.times.iter().copied())
-                    .collect()
-            })
-            .unwrap_or_default();
-        let (mesh_files, bodies) = scene::files(
-            &meshes,
-            tool,
-            pose.pose,
-            others,
             overlays,
-            motion,
-            options.formats,
+            (tol, options.formats),
         )?;
+        let (mesh_files, bodies, pose) = (staged.files, staged.bodies, staged.pose);
+        playback = staged.playback;
         files.extend(mesh_files);
         // A failed run's scene shows where it failed; its exact solids,
         // for checking a program in CAD, would check none.

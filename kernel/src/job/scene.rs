@@ -353,6 +353,67 @@ pub fn tool_pose(
     })
 }
 
+/// A run's scene, staged: its files and bodies, where the tool stands, the
+/// player's keys (each key's block, from 0, and time, s).
+#[derive(Debug, Clone)]
+pub struct Staged {
+    /// The files (STL, `scene.glb`, and the `.gltf` asked for).
+    pub files: Files,
+    /// The bodies written.
+    pub bodies: Vec<BodyFile>,
+    /// Where the tool stands.
+    pub pose: ToolAt,
+    /// The animation's keys, for the page's player.
+    pub playback: Vec<(usize, f32)>,
+}
+
+/// The scene of `program` on `machine` at `place`: the part's bodies
+/// `parts`, the tool, the machine's bodies, the `overlays`, and the
+/// program's motion at the blocks' times `block_s`; one definition for the
+/// run and for `pilgrim export`.
+///
+/// # Failures
+/// The replay, a body's placement or mesh, a writer failing.
+#[allow(clippy::too_many_arguments)]
+pub fn stage(
+    machine: &dyn MachineKinematics,
+    program: &AxisProgram,
+    tool: &Tool,
+    parts: &[(String, TriMesh)],
+    place: PosePlace,
+    block_s: &[f64],
+    overlays: Vec<Placed>,
+    (tol, formats): (f64, Formats),
+) -> Result<Staged, SceneError> {
+    let pose = tool_pose(program, machine, tool, place)?;
+    let solid = tool_mesh(tool, &pose, tol)?;
+    let others = machine_bodies(machine, program, place, (tool, &pose), parts, tol)?;
+    let motion = motion(
+        machine,
+        program,
+        (tool, solid.as_ref().map(|(_, name)| *name)),
+        parts,
+        block_s,
+    )?;
+    let playback = motion
+        .as_ref()
+        .map(|m| {
+            m.keys
+                .iter()
+                .copied()
+                .zip(m.times.iter().copied())
+                .collect()
+        })
+        .unwrap_or_default();
+    let (files, bodies) = files(parts, solid, pose.pose, others, overlays, motion, formats)?;
+    Ok(Staged {
+        files,
+        bodies,
+        pose,
+        playback,
+    })
+}
+
 /// Which 3-D files to write beside the default binary STL and `.glb`.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Formats {
