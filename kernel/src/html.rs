@@ -22,7 +22,19 @@ pub fn escape(s: &str) -> String {
 
 /// A table row of cells (already escaped).
 pub fn row(out: &mut String, cells: &[String]) {
-    out.push_str("<tr>");
+    row_at(out, None, cells);
+}
+
+/// A table row of cells (already escaped) that names the program's block
+/// `block` (from 0) where it has one: the page's player goes there when
+/// the row is clicked.
+pub fn row_at(out: &mut String, block: Option<usize>, cells: &[String]) {
+    match block {
+        Some(b) => {
+            let _ = write!(out, "<tr data-block=\"{b}\">");
+        }
+        None => out.push_str("<tr>"),
+    }
     for c in cells {
         let _ = write!(out, "<td>{c}</td>");
     }

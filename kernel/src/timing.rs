@@ -46,6 +46,8 @@ pub const IPO_CYCLE_CONSTANT: &str = "ipo_cycle";
 pub struct PassTime {
     /// The pass, as the program names it.
     pub pass: String,
+    /// Its first block (from 0).
+    pub first_block: usize,
     /// At the programmed feeds (min).
     pub programmed_min: Real,
     /// With the axes' acceleration (min).
@@ -204,6 +206,7 @@ pub fn times(program: &AxisProgram, info: &MachineInfo, passes: &[ProgramPass]) 
             .iter()
             .map(|p| PassTime {
                 pass: p.name.clone(),
+                first_block: p.blocks.start,
                 programmed_min: minutes(&programmed[p.blocks.clone()]),
                 accelerated_min: minutes(&accelerated[p.blocks.clone()]),
             })

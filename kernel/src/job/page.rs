@@ -28,7 +28,7 @@ pub const VIEWER: &str = "@google/model-viewer 4.4.0";
 const HEAD_LINES: usize = 30;
 const TAIL_LINES: usize = 12;
 
-use crate::html::{escape, row};
+use crate::html::{escape, row, row_at};
 
 /// What the page is made of besides the report.
 pub struct PageInputs<'a> {
@@ -120,7 +120,7 @@ fn player(out: &mut String, r: &Report) {
         .iter()
         .map(|(k, t)| {
             format!(
-                "[{},{}]",
+                "[{},{},{k}]",
                 // A JSON string that cannot end the script: no '<'.
                 serde_json::to_string(&r.block_label(*k))
                     .unwrap_or_default()
@@ -167,6 +167,15 @@ const PLAYER: &str = "(() => {
     else { mv.pause(); play.textContent = 'play'; }
   });
   mv.addEventListener('load', () => { mv.animationName = 'the program'; mv.pause(); seek(+scrub.value); });
+  // A row that names a block (a pass, a pair's nearest place) takes the
+  // player to the first key at or after it.
+  document.querySelectorAll('tr[data-block]').forEach(tr => tr.addEventListener('click', () => {
+    const b = +tr.dataset.block;
+    let i = keys.findIndex(k => k[2] >= b);
+    if (i < 0) i = keys.length - 1;
+    mv.pause(); play.textContent = 'play'; scrub.value = i; seek(i);
+    mv.scrollIntoView({block: 'center'});
+  }));
   show(+scrub.value);
 })();";
 
@@ -179,7 +188,7 @@ fn pass_times(out: &mut String, r: &Report) {
         return;
     }
     out.push_str(&format!(
-        "<h2>Times</h2>\n<p>Each pass at its programmed feeds and with every move ramped within the axes' acceleration, blending corners as far as one interpolation cycle ({} ms) of acceleration allows.{}</p>\n<table><tr><th>pass</th><th>at the feeds (s)</th><th>with acceleration (s)</th></tr>\n",
+        "<h2>Times</h2>\n<p>Click a pass to see its start. Each pass at its programmed feeds and with every move ramped within the axes' acceleration, blending corners as far as one interpolation cycle ({} ms) of acceleration allows.{}</p>\n<table><tr><th>pass</th><th>at the feeds (s)</th><th>with acceleration (s)</th></tr>\n",
         fixed(1000.0 * t.ipo_cycle_s, 1),
         if t.unramped_axes.is_empty() {
             String::new()
@@ -191,8 +200,9 @@ fn pass_times(out: &mut String, r: &Report) {
         }
     ));
     for p in &t.passes {
-        row(
+        row_at(
             out,
+            Some(p.first_block),
             &[
                 escape(&p.pass),
                 fixed(60.0 * p.programmed_min, 1),
@@ -209,7 +219,7 @@ fn clearances(out: &mut String, r: &Report) {
         return;
     };
     out.push_str(&format!(
-        "<h2>Clearances</h2>\n<p>Every pair of bodies the program moves relative to each other, checked along every move ({} places; measured again before two bodies can close {:.0} % of the last distance or {} mm; the part as its envelope of revolution at its largest). The smallest clearance of each pair, nearest first:</p>\n<table><tr><th>bodies</th><th>clearance (mm)</th><th>at block</th></tr>\n",
+        "<h2>Clearances</h2>\n<p>Click a row to see its block. Every pair of bodies the program moves relative to each other, checked along every move ({} places; measured again before two bodies can close {:.0} % of the last distance or {} mm; the part as its envelope of revolution at its largest). The smallest clearance of each pair, nearest first:</p>\n<table id=\"clearances\"><tr><th>bodies</th><th>clearance (mm)</th><th>at block</th></tr>\n",
         c.samples,
         100.0 * crate::collision::REMEASURE,
         c.step_mm
@@ -217,8 +227,9 @@ fn clearances(out: &mut String, r: &Report) {
     let mut pairs: Vec<_> = c.clearances.iter().collect();
     pairs.sort_by(|a, b| a.clearance_mm.total_cmp(&b.clearance_mm));
     for p in pairs {
-        row(
+        row_at(
             out,
+            Some(p.block_index - 1),
             &[
                 format!("{} / {}", escape(&p.bodies[0]), escape(&p.bodies[1])),
                 crate::math::fixed(p.clearance_mm, 3),
@@ -495,6 +506,8 @@ figcaption { color: #556; font-size: 12px; }
 model-viewer { width: 100%; height: 520px; background: #20262e; display: block; }
 .player { margin: 6px 0; display: flex; gap: 10px; align-items: center; }
 .player input[type=range] { flex: 1; }
+tr[data-block] { cursor: pointer; }
+tr[data-block]:hover td { background: #eef3ff; }
 pre { background: #f6f7f9; border: 1px solid #dde; padding: 8px; overflow-x: auto; font-size: 12px; }
 .gap { color: #889; }
 @media print { model-viewer, .player { display: none; } body { max-width: none; } }
