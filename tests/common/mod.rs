@@ -212,18 +212,19 @@ pub fn leave_for_checkers(dir: &Path, tag: &str) {
     let exe = std::env::current_exe().unwrap();
     let check = exe.ancestors().nth(3).unwrap().join("mesh-check");
     std::fs::create_dir_all(&check).unwrap();
-    for f in [
-        "part.stl",
-        "caliber.stl",
-        "worm.stl",
-        "blank.stl",
-        "cutter.stl",
-        "wheel.stl",
-        "rest.stl",
-        "scene.glb",
-    ] {
-        if dir.join(f).exists() {
-            std::fs::copy(dir.join(f), check.join(format!("{tag}-{f}"))).unwrap();
+    // Every body the run wrote (the part's, the tool's, the machine's), as
+    // its report lists them, and the scene.
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
+    let files = report["bodies"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|b| b["file"].as_str().map(str::to_owned))
+        .chain(["scene.glb".to_owned()]);
+    for f in files {
+        if dir.join(&f).exists() {
+            std::fs::copy(dir.join(&f), check.join(format!("{tag}-{f}"))).unwrap();
         }
     }
 }
