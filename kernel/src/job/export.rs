@@ -213,8 +213,9 @@ pub fn export(
         shown.push((name.clone(), read(name)?.into_bytes()));
     }
     shown.extend(all.iter().filter(|f| f.0 == "scene.glb").cloned());
-    let part_box = scene::bounds_of(parts.iter().map(|(_, m)| m));
-    let html = super::page::page_of(&report, &shown, control.extension, part_box);
+    let view = scene::bounds_of(parts.iter().map(|(_, m)| m))
+        .map(|b| scene::contact_box(b, &toolpath.tool, &pose));
+    let html = super::page::page_of(&report, &shown, control.extension, view);
     all.push(("report.html".into(), html.into_bytes()));
     all.push(("report.json".into(), super::report_json(&report)?));
     Ok(Exported {

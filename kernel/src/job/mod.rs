@@ -588,7 +588,8 @@ fn run_on(
     let (pose_block, bodies, solids, part_box) = if parts.is_empty() {
         (None, vec![], vec![], None)
     } else {
-        // Where the report page's camera points: the part's middle.
+        // The part's extent: the page's camera frames its contact with the
+        // tool.
         let part_box = scene::bounds_of(meshes.iter().map(|(_, m)| m));
         let index = pose_index;
         let overlays = overlay
@@ -618,7 +619,12 @@ fn run_on(
         } else {
             Vec::new()
         };
-        (Some(index + 1), bodies, solids, part_box)
+        (
+            Some(index + 1),
+            bodies,
+            solids,
+            part_box.map(|b| scene::contact_box(b, &toolpath.tool, &pose)),
+        )
     };
     let mut report = Report {
         passes: passes.len(),

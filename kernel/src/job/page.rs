@@ -386,9 +386,12 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
                 fixed(c[1] / 1e3, 6),
                 fixed(-c[0] / 1e3, 6)
             );
+            // Far enough that the box fills the view.
+            let size = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+            let radius = fixed(1.2 * size / 1e3, 4);
             let _ = writeln!(
                 out,
-                "<h2>3-D: part, tool and machine at the pose block</h2>\n<p>Drag to orbit, wheel or pinch to zoom, right-drag to pan; the camera points at the middle of the part. {VIEWER}.</p>\n<model-viewer id=\"scene\" alt=\"the part, the tool and the machine's bodies at the pose block\" src=\"data:model/gltf-binary;base64,{}\" loading=\"eager\" camera-controls interaction-prompt=\"none\" camera-target=\"{target}\" camera-orbit=\"0deg 75deg auto\" shadow-intensity=\"0\"></model-viewer>",
+                "<h2>3-D: part, tool and machine at the pose block</h2>\n<p>Drag to orbit, wheel or pinch to zoom, right-drag to pan; the camera frames the tool where it meets the part, seen from the operator's side. {VIEWER}.</p>\n<model-viewer id=\"scene\" alt=\"the part, the tool and the machine's bodies at the pose block\" src=\"data:model/gltf-binary;base64,{}\" loading=\"eager\" camera-controls interaction-prompt=\"none\" camera-target=\"{target}\" camera-orbit=\"0deg 75deg {radius}m\" min-camera-orbit=\"auto auto 0.01m\" shadow-intensity=\"0\"></model-viewer>",
                 b64.encode(glb)
             );
             player(&mut out, r);
@@ -460,7 +463,7 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
 
 /// The page of a run from its files (name, bytes): the plots (`.svg`), the
 /// control's program (`program.<extension>`) and `scene.glb`, the camera
-/// on `part_box` (the part's bounding box, mm).
+/// framing `part_box` (mm: [`super::scene::contact_box`]).
 pub(super) fn page_of(
     report: &Report,
     files: &[(String, Vec<u8>)],

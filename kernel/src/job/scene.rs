@@ -42,6 +42,29 @@ pub fn part_meshes(parts: &[PartBody], tol: f64) -> Result<Vec<(String, TriMesh)
         .collect()
 }
 
+/// What the page's camera frames: a box about the tool's programmed point
+/// at the pose (where it meets the part), reaching each way two of the
+/// part's radii or the wheel's radius, whichever is more (at least 20
+/// mm): the contact, the tool and the part round it, not the machine's
+/// far bodies. `part_box` is the part's bounding box.
+pub fn contact_box(
+    part_box: ([f64; 3], [f64; 3]),
+    tool: &Tool,
+    at: &ToolAt,
+) -> ([f64; 3], [f64; 3]) {
+    let (lo, hi) = part_box;
+    let radius = [lo[0], hi[0], lo[1], hi[1]]
+        .iter()
+        .fold(0.0_f64, |m, v| m.max(v.abs()));
+    let wheel = match tool.shape {
+        ToolShape::Wheel(w) => w.diameter / 2.0,
+        _ => 0.0,
+    };
+    let h = (2.0 * radius).max(wheel).max(20.0);
+    let c = [at.pose[(0, 3)], at.pose[(1, 3)], at.pose[(2, 3)]];
+    (c.map(|v| v - h), c.map(|v| v + h))
+}
+
 /// The bounding box of `meshes` together (`None` for none).
 pub fn bounds_of<'a>(meshes: impl Iterator<Item = &'a TriMesh>) -> Option<([f64; 3], [f64; 3])> {
     meshes.map(TriMesh::bounds).reduce(|a, b| {
