@@ -120,34 +120,49 @@ pub fn thread_blade(c: &crate::worm::ThreadCutter, at: &ToolAt) -> crate::worm::
 /// A body placed in the part frame: name, mesh in its own frame, pose.
 pub type Placed = (String, TriMesh, Mat4);
 
-/// The machine's bodies that have a shape, placed at `place` as the
-/// collision check places them ([`crate::collision::Placement`]: on the
-/// part frame by their chains, on the tool from its spindle centre, at
-/// the ends of `parts`' largest body), turned with the tool where it
-/// stands in a thread ([`ToolAt::turn`]); a body the program or the run
-/// cannot place is left out.
+/// The machine's bodies placed as the collision check places them
+/// ([`crate::collision::Placement`]: on the part frame by their chains, on
+/// the tool from its spindle centre, at the ends of `parts`' largest
+/// body), for `program` and `tool`.
 ///
 /// # Failures
-/// A body's description or mesh failing.
-pub fn machine_bodies(
+/// A body's description failing.
+fn placement(
+    machine: &dyn MachineKinematics,
+    program: &AxisProgram,
+    tool: &Tool,
+    parts: &[(String, TriMesh)],
+) -> Result<crate::collision::Placement, SceneError> {
+    let axes: Vec<String> = program.axes.iter().map(|a| a.name.clone()).collect();
+    let part_z = crate::collision::part_at_largest(parts).map(|(_, m)| crate::collision::part_z(m));
+    crate::collision::Placement::new(machine.info(), &axes, tool.spindle_centre(), part_z)
+        .map_err(placing)
+}
+
+fn placing(e: crate::collision::CollisionError) -> SceneError {
+    SceneError::Place(e.to_string())
+}
+
+/// The machine's bodies that have a shape, placed by `placement` at
+/// `place`, turned with the tool where it stands in a thread
+/// ([`ToolAt::turn`]); a body the program or the run cannot place is left
+/// out.
+///
+/// # Failures
+/// A body's mesh failing.
+fn machine_bodies(
     machine: &dyn MachineKinematics,
     program: &AxisProgram,
     place: PosePlace,
-    tool: (&Tool, &ToolAt),
-    parts: &[(String, TriMesh)],
+    at: &ToolAt,
+    placement: &crate::collision::Placement,
     tol: f64,
 ) -> Result<Vec<Placed>, SceneError> {
     let program = &at_place(program, place)?;
-    let info = machine.info();
-    let placing = |e: crate::collision::CollisionError| SceneError::Place(e.to_string());
-    let axes: Vec<String> = program.axes.iter().map(|a| a.name.clone()).collect();
-    let part_z = crate::collision::part_at_largest(parts).map(|(_, m)| crate::collision::part_z(m));
-    let (tool, at) = tool;
-    let placement = crate::collision::Placement::new(info, &axes, tool.spindle_centre(), part_z)
-        .map_err(placing)?;
     // In a thread the machine is shown turned with the tool.
     let turned = Mat4::from_axis_angle(&Vec3::z_axis(), at.turn);
-    let q = axis_rows(program, info, placement.axes(), 0..1).map_err(SceneError::Place)?;
+    let q =
+        axis_rows(program, machine.info(), placement.axes(), 0..1).map_err(SceneError::Place)?;
     let tool_frame = placement.tool_frame(&q).map_err(placing)?;
     placement
         .bodies
@@ -166,32 +181,26 @@ pub fn machine_bodies(
 pub const MAX_KEYS: usize = 2000;
 
 /// The program's motion for the scene: the tool (its node `tool_name`)
-/// and every machine body that moves, placed as
-/// [`machine_bodies`] places them, at the end of each block (of every k-th
+/// and every machine body that moves, placed by `placement`, at the end of each block (of every k-th
 /// block where there are more than [`MAX_KEYS`]), at the time the program
 /// reaches it as the machine moves it (`block_s`: each block's seconds,
 /// [`crate::timing::Times::block_s`]). `None` when nothing moves.
 ///
 /// # Failures
 /// A body's description failing; the program lacking an axis.
-pub fn motion(
+fn motion(
     machine: &dyn MachineKinematics,
     program: &AxisProgram,
-    tool: (&Tool, Option<&str>),
-    parts: &[(String, TriMesh)],
+    tool_name: Option<&str>,
+    placement: &crate::collision::Placement,
     block_s: &[f64],
 ) -> Result<Option<mesh::Motion>, SceneError> {
     let info = machine.info();
-    let placing = |e: crate::collision::CollisionError| SceneError::Place(e.to_string());
-    let axes: Vec<String> = program.axes.iter().map(|a| a.name.clone()).collect();
-    let part_z = crate::collision::part_at_largest(parts).map(|(_, m)| crate::collision::part_z(m));
-    let placement = crate::collision::Placement::new(info, &axes, tool.0.spindle_centre(), part_z)
-        .map_err(placing)?;
     let n = program.blocks.len();
     let moving: Vec<usize> = (0..placement.bodies.len())
         .filter(|&i| !placement.bodies[i].moved_by.is_empty())
         .collect();
-    let tool_name = tool.1.filter(|_| placement.tool_axes().is_some());
+    let tool_name = tool_name.filter(|_| placement.tool_axes().is_some());
     if n == 0 || (moving.is_empty() && tool_name.is_none()) {
         return Ok(None);
     }
@@ -410,12 +419,15 @@ pub fn stage(
 ) -> Result<Staged, SceneError> {
     let pose = tool_pose(program, machine, tool, place)?;
     let solid = tool_mesh(tool, &pose, tol)?;
-    let others = machine_bodies(machine, program, place, (tool, &pose), parts, tol)?;
+    // One placement of the machine's bodies for the still scene and its
+    // motion.
+    let placement = placement(machine, program, tool, parts)?;
+    let others = machine_bodies(machine, program, place, &pose, &placement, tol)?;
     let motion = motion(
         machine,
         program,
-        (tool, solid.as_ref().map(|(_, name)| *name)),
-        parts,
+        solid.as_ref().map(|(_, name)| *name),
+        &placement,
         block_s,
     )?;
     let playback = motion
