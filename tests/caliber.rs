@@ -267,8 +267,7 @@ fn the_default_job_holds_its_tolerance_read_back_from_the_program() {
     common::leave_for_checkers(&out, "caliber");
     // The heat map marks the report's worst places with their figures; the
     // section draws the wheel's rounding once per cutting pass.
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    let report: serde_json::Value = common::report_of(&out);
     let g = &report["groove_verification"];
     let map = std::fs::read_to_string(out.join("deviation_map.svg")).unwrap();
     for (key, name) in [("max_left", "most left"), ("max_gouge", "deepest gouge")] {
@@ -357,8 +356,7 @@ fn the_four_axis_machine_reports_its_figure_and_refuses_what_it_cannot_do() {
     // The failed run leaves what it found: the report marked FAILED with
     // the figure and its place, the heat map and the section, the scene at
     // the block that gouged; no program.
-    let r: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(bad.join("report.json")).unwrap()).unwrap();
+    let r: serde_json::Value = common::report_of(&bad);
     assert_eq!(r["verdict"]["status"], "failed");
     let failure = &r["verdict"]["failures"][0];
     assert_eq!(r["pose_block"], failure["block_index"]);

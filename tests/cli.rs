@@ -123,8 +123,7 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
         ) && mpf.ends_with("; end\nN3680 Z50.000\nN3690 M9\nN3700 M5\nN3710 M30\n"),
         "{mpf}"
     );
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(a.join("report.json")).unwrap()).unwrap();
+    let report: serde_json::Value = common::report_of(&a);
     assert_eq!(report["blocks"], 368);
     // The demo declares no verification, and its page says so first.
     assert_eq!(report["verdict"]["status"], "not_verified");
@@ -191,8 +190,7 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
         std::fs::read(a.join("part.stl")).unwrap(),
         std::fs::read(b.join("part.stl")).unwrap()
     );
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(a.join("report.json")).unwrap()).unwrap();
+    let report: serde_json::Value = common::report_of(&a);
     assert_eq!(report["pose_block"], 202);
     // The cutter's solid moved with it; the part's did not.
     let step = |d: &std::path::Path, f: &str| std::fs::read(d.join(f)).unwrap();
@@ -441,8 +439,7 @@ fn scripts_of_the_first_release_still_run() {
         let script = fixtures.join(format!("{name}.rhai"));
         let (code, _, err) = pilgrim(&["run", s(&script), "--out", s(&out), "--quiet"]);
         assert_eq!(code, 0, "{name}: {err}");
-        let r: serde_json::Value =
-            serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+        let r: serde_json::Value = common::report_of(&out);
         r
     };
     let (old, today) = (run("first-release"), run("today"));

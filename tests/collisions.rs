@@ -23,10 +23,6 @@ fn machine_with(machine: &str, edits: &[(&str, &str)]) -> String {
     text
 }
 
-fn report(dir: &std::path::Path) -> Value {
-    serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap()
-}
-
 /// The pair's smallest clearance in a report.
 fn clearance(r: &Value, a: &str, b: &str) -> f64 {
     r["collisions"]["clearances"]
@@ -82,7 +78,7 @@ fn the_default_jobs_are_clear_and_report_each_pairs_clearance() {
             "--quiet",
         ]);
         assert_eq!(code, 0, "{job}: {err}");
-        let r = report(&out);
+        let r = common::report_of(&out);
         let all = r["collisions"]["clearances"].as_array().unwrap();
         // Every pair checked is clear, and the ones named are among them.
         assert!(all.len() >= pairs.len(), "{job}: {all:?}");
@@ -126,7 +122,7 @@ fn refused(tag: &str, script: &str, text: &str) -> (Value, String) {
     assert_ne!(code, 0, "{tag}: {err}");
     // A first run that fails leaves its report where it was asked to.
     let failed = out;
-    let r = report(&failed);
+    let r = common::report_of(&failed);
     assert_eq!(r["verdict"]["status"], "failed", "{tag}");
     for program in ["program.mpf", "program.nc", "program.cld"] {
         assert!(!failed.join(program).exists(), "{tag}: {program}");
@@ -222,7 +218,7 @@ fn the_scene_places_each_body_as_the_check_does() {
             "{body}: {d:?}"
         );
     }
-    let r = report(&out);
+    let r = common::report_of(&out);
     let blank = r["bodies"]
         .as_array()
         .unwrap()
@@ -260,7 +256,7 @@ fn the_scene_plays_the_program_block_by_block() {
         last[1].as_f64().unwrap(),
         last[2].as_f64().unwrap(),
     );
-    let r = report(&out);
+    let r = common::report_of(&out);
     let cycle_s = 60.0 * r["times"]["accelerated_min"].as_f64().unwrap();
     let mut tracks = std::collections::BTreeMap::new();
     for channel in animation.channels() {

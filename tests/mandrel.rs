@@ -215,8 +215,7 @@ fn bad_mandrel_parameters_are_refused_and_nothing_is_written() {
             && err.contains("(the last run that succeeded) is as it was"),
         "{err}"
     );
-    let r: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(failed.join("report.json")).unwrap()).unwrap();
+    let r: serde_json::Value = common::report_of(&failed);
     assert_eq!(r["verdict"]["status"], "failed");
     let at = r["verdict"]["failures"][0]["block_index"].clone();
     assert!(
@@ -249,8 +248,7 @@ fn bad_mandrel_parameters_are_refused_and_nothing_is_written() {
 /// the machine's offset `b` put it: its top on the far side at
 /// -(U - R_o), touching the part, its middle at z = Z + B.
 fn rest_stands_where_u_puts_it(out: &Path, b: f64) {
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    let report: serde_json::Value = common::report_of(out);
     let block = report["pose_block"].as_u64().unwrap() as usize;
     let mut csv = csv::Reader::from_path(out.join("report.csv")).unwrap();
     let header = csv.headers().unwrap().clone();
@@ -472,8 +470,7 @@ fn step_solids_and_page_are_the_runs() {
         common::s(&out),
     ]);
     assert_eq!(code, 0, "{err}");
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    let report: serde_json::Value = common::report_of(&out);
     let tol = report["step_tolerance_mm"].as_f64().unwrap();
     assert_eq!(tol, 1e-3);
     // The page opens with the verdict: passed, the finish as a share of
@@ -875,8 +872,7 @@ fn a_heavy_finish_fails_and_tall_ridges_are_reported() {
             && err.contains("more than the finishing stock 0.03 mm"),
         "{err}"
     );
-    let r: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    let r: serde_json::Value = common::report_of(&out);
     let warnings: Vec<&str> = r["verdict"]["warnings"]
         .as_array()
         .unwrap()

@@ -24,8 +24,7 @@ fn worm_times(tag: &str, text: Option<String>) -> Value {
     }
     let (code, _, err) = pilgrim(&args);
     assert_eq!(code, 0, "{tag}: {err}");
-    let r: Value =
-        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    let r: Value = common::report_of(&out);
     assert_eq!(r["cycle_time_min"].as_f64().unwrap(), {
         let t = r["times"]["accelerated_min"].as_f64().unwrap();
         (t * 1e4).round() / 1e4

@@ -365,8 +365,7 @@ fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
     // and shrunk about the profile's top by 1 - c (y/3)^2, c such that the
     // tip stands back 3 degrees at the faces: the area times the integral
     // of the shrink squared.
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    let report: serde_json::Value = common::report_of(&out);
     let tip = report["notes"]["root_space_mm"].as_f64().unwrap();
     let (a, h, r) = (20f64.to_radians(), 13.0, 0.3);
     let phi = std::f64::consts::FRAC_PI_2 - a;

@@ -206,6 +206,12 @@ pub fn scene_nodes(dir: &Path) -> impl Fn(&str) -> [f32; 3] {
     }
 }
 
+/// A run's `report.json`, read.
+#[allow(dead_code)]
+pub fn report_of(dir: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap()
+}
+
 /// Leaves a run's models for the external checkers of `.ci/run`.
 #[allow(dead_code)]
 pub fn leave_for_checkers(dir: &Path, tag: &str) {
@@ -214,8 +220,7 @@ pub fn leave_for_checkers(dir: &Path, tag: &str) {
     std::fs::create_dir_all(&check).unwrap();
     // Every body the run wrote (the part's, the tool's, the machine's), as
     // its report lists them, and the scene.
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
+    let report: serde_json::Value = report_of(dir);
     let files = report["bodies"]
         .as_array()
         .into_iter()
@@ -251,8 +256,7 @@ pub fn leave_page_for_chromium(dir: &Path, tag: &str) {
 pub fn check_page(dir: &Path, program_file: &str) {
     use base64::Engine;
     let page = std::fs::read_to_string(dir.join("report.html")).unwrap();
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
+    let report: serde_json::Value = report_of(dir);
     let b64 = base64::engine::general_purpose::STANDARD;
     // The data URI after `marker`, decoded.
     let uri = |marker: &str| -> Vec<u8> {
@@ -330,8 +334,7 @@ pub fn leave_step_for_freecad(dir: &Path, tag: &str, name: &str, volume: f64, al
 /// file for FreeCAD with the same figure.
 #[allow(dead_code)]
 pub fn check_fitted_solid(dir: &Path, tag: &str, name: &str, want: f64, area: f64) {
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
+    let report: serde_json::Value = report_of(dir);
     let solid = report["solids"]
         .as_array()
         .unwrap()
