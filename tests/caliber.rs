@@ -281,7 +281,7 @@ fn the_default_job_holds_its_tolerance_read_back_from_the_program() {
             .count(),
         report["cutting_passes"].as_u64().unwrap() as usize
     );
-    common::check_page(&out, "program.mpf");
+    common::check_page(&out, "program.mpf", 8.0);
     assert!(std::fs::read_to_string(out.join("report.html"))
         .unwrap()
         .contains("Verification: the groove replayed in 3-D"));

@@ -200,7 +200,7 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
     common::leave_for_checkers(&a, "demo-block200");
     // The page shows the scene as exported (its data URI is the new
     // scene.glb).
-    common::check_page(&a, "program.mpf");
+    common::check_page(&a, "program.mpf", 6.0);
     common::leave_page_for_chromium(&a, "demo-block202");
     // On request: ASCII STL, and .gltf with its .bin.
     let c = dir.join("c");

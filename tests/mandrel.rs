@@ -566,7 +566,7 @@ fn step_solids_and_page_are_the_runs() {
         .iter()
         .any(|f| f == "rest_gap.svg"));
     // The page of the same run: its figures are the run's files.
-    common::check_page(&out, "program.mpf");
+    common::check_page(&out, "program.mpf", 6.0);
     let page = std::fs::read_to_string(out.join("report.html")).unwrap();
     let finish = &report["verification"]["passes"][3]["deviation"];
     assert!(page.contains(&format!(

@@ -429,7 +429,7 @@ fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
         .sum();
     let area = std::f64::consts::TAU * 30.0 * 60.0 * (run + 30.0) / lead;
     common::check_fitted_solid(&out, "worm", "worm", want, area);
-    common::check_page(&out, "program.nc");
+    common::check_page(&out, "program.nc", 4.5);
     let page = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(page.contains("Verification: the thread cut simulated"));
     for f in ["passes.svg", "chip_area.svg"] {

@@ -4,6 +4,9 @@
 // - no console errors, no uncaught exceptions, no network request (the page
 //   must stand alone: everything is inline or a data: URI);
 // - every plot decoded (each <figure> image has a size);
+// - the verdict at the top; the listing opened (every line), its line lit
+//   for the player's block; clicking the worst place (a plot's mark, else
+//   a figure's row) takes the slider to its block;
 // - the 3-D view loaded scene.glb and drew it: a screenshot of the viewer,
 //   kept beside the page as <name>.png, with pixels other than the
 //   background over at least 1% of the view and in the middle, where the
@@ -139,7 +142,42 @@ async function check(browser, file) {
         if (went[0] !== went[1]) problems.push(`player: the nearest pair's row (block ${went[2] + 1}) took the slider to key ${went[0]}, not ${went[1]}`);
         else view += `; a row of block ${went[2] + 1} took it to key ${went[0]}`;
       } else problems.push("player: no row that names a block");
+      // The worst place: a verification's mark over its plot (or, where
+      // it draws none, the verdict's figure that names a block) takes the
+      // slider to its block, and the listing lights that block's line.
+      const target = (await page.$(".marks .place")) ? ".marks .place" : "#figures tr[data-block]";
+      const worst = await page.$(target);
+      if (worst) {
+        await worst.click();
+        await page.evaluate(() => new Promise((ok) => requestAnimationFrame(() => setTimeout(ok, 100))));
+        const went = await page.evaluate((target) => {
+          const keys = JSON.parse(document.getElementById("keys").textContent);
+          const b = +document.querySelector(target).dataset.block;
+          const i = +document.getElementById("scrub").value;
+          const want = keys.findIndex((k) => k[2] >= b);
+          const now = document.querySelector("#listing .rows .now");
+          const pane = document.getElementById("listing").getBoundingClientRect();
+          const lit = now && now.getBoundingClientRect();
+          const shown = +document.getElementById("listing").dataset.block === b;
+          return [i, want < 0 ? keys.length - 1 : want, b, lit ? now.textContent : null, shown && lit ? lit.top >= pane.top && lit.bottom <= pane.bottom : false];
+        }, target);
+        if (went[0] !== went[1]) problems.push(`player: the worst place (block ${went[2] + 1}) took the slider to key ${went[0]}, not ${went[1]}`);
+        else if (!went[4]) problems.push(`listing: block ${went[2] + 1}'s line not lit in view`);
+        else view += `; the worst place (${target.startsWith(".marks") ? "a plot's mark" : "a figure"}, block ${went[2] + 1}) took it to key ${went[0]}, listing at "${went[3].trim().slice(0, 40)}"`;
+      } else problems.push("player: no worst place to click");
+      // A line of the listing clicked takes the slider to its block.
+      const line = await page.$("#listing .rows div:nth-child(8)");
+      if (line) {
+        const before = await page.$eval("#scrub", (s) => +s.value);
+        await line.click();
+        const after = await page.$eval("#scrub", (s) => +s.value);
+        const lit = await page.$eval("#listing .rows div:nth-child(8)", (d) => d.dataset.line);
+        view += `; listing line ${lit} took it from key ${before} to ${after}`;
+      }
     }
+    // The verdict at the top, seen without scrolling.
+    const top = await page.$eval("#verdict", (b) => b.getBoundingClientRect().top + window.scrollY);
+    if (top > 200) problems.push(`the verdict stands ${top} px down the page`);
   }
   await page.close();
   console.log(

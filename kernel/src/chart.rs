@@ -3,6 +3,7 @@
 //! the data (below the chart).
 
 use crate::toolpath::{PlotSpec, Toolpath};
+use plotters::coord::types::RangedCoordf64 as RangedF64;
 use plotters::prelude::*;
 
 /// Line colours, in order (the legend's).
@@ -176,5 +177,90 @@ mod tests {
         spec.y.push("after".into());
         let e = chart_svg(&tp, &spec).unwrap_err();
         assert!(e.contains("no column 'after'"), "{e}");
+    }
+}
+
+/// What the page's player marks over a plot (`report.json` `marks`, by the
+/// plot's file name): each pass's line, lit while the player is in its
+/// blocks, and places (a verification's worst) that take the player to
+/// their block when clicked. In the SVG's pixels, so the page lays them
+/// over the picture as it is drawn.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Marks {
+    /// The SVG's width and height (px).
+    pub size: [u32; 2],
+    /// Each pass's line.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub passes: Vec<PassMark>,
+    /// The places to click.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub places: Vec<PlaceMark>,
+}
+
+/// A pass's line over a plot.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PassMark {
+    /// The blocks it is lit for (from 0: the first, and one past the last).
+    pub blocks: [usize; 2],
+    /// Its points (px); closed where `closed`.
+    pub points: Vec<[f32; 2]>,
+    /// A region's outline (the worm's chip), else an open line.
+    #[serde(default)]
+    pub closed: bool,
+}
+
+/// A place over a plot that takes the player to its block.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PlaceMark {
+    /// Where (px).
+    pub at: [f32; 2],
+    /// Its block (from 0).
+    pub block: usize,
+    /// What it is (`deepest gouge`).
+    pub label: String,
+}
+
+/// A chart's data coordinates to its SVG's pixels, read from plotters'
+/// own mapping at two corners of the data (both axes linear).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PixelMap {
+    scale: [f64; 2],
+    offset: [f64; 2],
+}
+
+impl PixelMap {
+    /// The map of `chart`, whose data spans `x` by `y`.
+    pub fn of<DB: DrawingBackend>(
+        chart: &ChartContext<'_, DB, Cartesian2d<RangedF64, RangedF64>>,
+        x: std::ops::Range<f64>,
+        y: std::ops::Range<f64>,
+    ) -> Self {
+        let (a, b) = (
+            chart.backend_coord(&(x.start, y.start)),
+            chart.backend_coord(&(x.end, y.end)),
+        );
+        let axis = |p0: i32, p1: i32, v0: f64, v1: f64| {
+            let s = if v1 != v0 {
+                f64::from(p1 - p0) / (v1 - v0)
+            } else {
+                0.0
+            };
+            (s, f64::from(p0) - s * v0)
+        };
+        let (sx, ox) = axis(a.0, b.0, x.start, x.end);
+        let (sy, oy) = axis(a.1, b.1, y.start, y.end);
+        Self {
+            scale: [sx, sy],
+            offset: [ox, oy],
+        }
+    }
+
+    /// The pixel of the data point (x, y), to a tenth of a pixel.
+    pub fn at(&self, x: f64, y: f64) -> [f32; 2] {
+        let r = |v: f64| ((v * 10.0).round() / 10.0) as f32;
+        [
+            r(self.scale[0] * x + self.offset[0]),
+            r(self.scale[1] * y + self.offset[1]),
+        ]
     }
 }

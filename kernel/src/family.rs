@@ -124,6 +124,25 @@ pub struct FilesContext<'a> {
     pub parts: &'a [PartBody],
 }
 
+/// A verification's files (name, bytes: plots and tables, in order) and
+/// the marks over its plots (by the plot's file name).
+#[derive(Debug, Clone, Default)]
+pub struct Drawn {
+    /// The files.
+    pub files: Vec<(String, Vec<u8>)>,
+    /// The page's marks over its plots.
+    pub marks: std::collections::BTreeMap<String, crate::chart::Marks>,
+}
+
+impl From<Vec<(String, Vec<u8>)>> for Drawn {
+    fn from(files: Vec<(String, Vec<u8>)>) -> Self {
+        Self {
+            files,
+            marks: Default::default(),
+        }
+    }
+}
+
 /// What a verification found, as the run uses it: figures and failures
 /// for the verdict, its entry in the report, and its own files, bodies and
 /// overlays.
@@ -184,7 +203,8 @@ pub trait Outcome: AnyOutcome + std::fmt::Debug + Send + Sync {
         >,
     ) {
     }
-    /// Its files (name, bytes): plots and tables, in order.
+    /// Its files (name, bytes): plots and tables, in order, and the
+    /// page's marks over its plots.
     ///
     /// # Failures
     /// A file that cannot be drawn or written, said.
@@ -192,8 +212,8 @@ pub trait Outcome: AnyOutcome + std::fmt::Debug + Send + Sync {
         &self,
         _ctx: &FilesContext<'_>,
         _tables: &std::collections::BTreeMap<String, std::collections::BTreeMap<String, Vec<f64>>>,
-    ) -> Result<Vec<(String, Vec<u8>)>, String> {
-        Ok(Vec::new())
+    ) -> Result<Drawn, String> {
+        Ok(Drawn::default())
     }
 }
 

@@ -486,16 +486,19 @@ fn bodies(
         if let Some((g, k)) = worst {
             let name = block_name(program, k);
             let tol = limits.rest_tolerance;
-            out.figures.push(Figure::new(
-                &format!(
-                    "{}: off the part while it rides (+ stand-off, - press)",
-                    spec.name
-                ),
-                g,
-                tol,
-                "mm",
-                name.clone(),
-            ));
+            out.figures.push(
+                Figure::new(
+                    &format!(
+                        "{}: off the part while it rides (+ stand-off, - press)",
+                        spec.name
+                    ),
+                    g,
+                    tol,
+                    "mm",
+                    name.clone(),
+                )
+                .at_block(k),
+            );
             if g.abs() > tol * (1.0 + 1e-9) {
                 out.errors.push(
                     Finding::new(
@@ -564,12 +567,15 @@ fn finishing(
         }
     }
     if let Some(w) = worst {
-        out.figures.push(Figure::new(
-            "the finishing stock",
-            w.cut,
-            limits.finish_stock,
-            "mm",
-            block_name(program, w.first_block),
-        ));
+        out.figures.push(
+            Figure::new(
+                "the finishing stock",
+                w.cut,
+                limits.finish_stock,
+                "mm",
+                block_name(program, w.first_block),
+            )
+            .at_block(w.first_block),
+        );
     }
 }

@@ -112,11 +112,20 @@ pub struct Report {
     /// acceleration, in all and per pass ([`crate::timing`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub times: Option<crate::timing::Times>,
+    /// The page's marks over the verification's plots, by the plot's file
+    /// name: each pass's line, the worst places ([`crate::chart::Marks`]).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub marks: BTreeMap<String, crate::chart::Marks>,
     /// The scene's animation keys for the page's player: each key's block
     /// (from 0) and time (s). Not in `report.json`: the run and the
     /// export make it with the scene.
     #[serde(skip)]
     pub playback: Vec<(usize, f32)>,
+    /// The line (from 1) each block's move stands on in the program the
+    /// page lists, as the lint read it ([`crate::program::lint::TextProgram`]).
+    /// Not in `report.json`: the run and the export read it with the text.
+    #[serde(skip)]
+    pub program_lines: Vec<usize>,
 }
 
 impl Report {
@@ -199,7 +208,9 @@ impl Report {
             verdict: crate::verdict::Verdict::default(),
             collisions: None,
             times: None,
+            marks: BTreeMap::new(),
             playback: Vec::new(),
+            program_lines: Vec::new(),
         }
     }
 }

@@ -25,6 +25,10 @@ pub struct Figure {
     pub unit: String,
     /// Where it is (`z = 212.503 mm, N1130 in "pass 4"`), or empty.
     pub place: String,
+    /// The block where it is (from 0), where it is at one: the page's
+    /// player goes there when the figure is clicked.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub block: Option<usize>,
 }
 
 impl Figure {
@@ -36,7 +40,14 @@ impl Figure {
             tolerance,
             unit: unit.to_owned(),
             place,
+            block: None,
         }
+    }
+
+    /// The figure at block `block` (from 0).
+    pub fn at_block(mut self, block: usize) -> Self {
+        self.block = Some(block);
+        self
     }
 
     /// Its size as a share of its tolerance (1 is the tolerance).

@@ -249,13 +249,19 @@ pub fn leave_page_for_chromium(dir: &Path, tag: &str) {
 }
 
 /// Checks a run's `report.html` against the run's own files: the summary's
-/// figures, every plot (its data URI decoding to the file's bytes), the
-/// program's first and last lines, the 3-D scene (its data URI decoding to
-/// `scene.glb`), and nothing fetched from anywhere.
+/// figures, every plot (its data URI decoding to the file's bytes) with
+/// its marks, the listing (the program's text, every line, and a line
+/// for each block), the 3-D scene (its data URI decoding to `scene.glb`),
+/// nothing fetched from anywhere, and the page within `max_mb` MB.
 #[allow(dead_code)]
-pub fn check_page(dir: &Path, program_file: &str) {
+pub fn check_page(dir: &Path, program_file: &str, max_mb: f64) {
     use base64::Engine;
     let page = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    assert!(
+        page.len() as f64 <= max_mb * 1e6,
+        "the page is {} bytes, more than {max_mb} MB",
+        page.len()
+    );
     let report: serde_json::Value = report_of(dir);
     let b64 = base64::engine::general_purpose::STANDARD;
     // The data URI after `marker`, decoded.
@@ -285,17 +291,47 @@ pub fn check_page(dir: &Path, program_file: &str) {
     assert_eq!(page.matches("<figure>").count(), svgs.len());
     let glb = uri("src=\"data:model/gltf-binary;base64,");
     assert_eq!(glb, std::fs::read(dir.join("scene.glb")).unwrap());
+    // The listing: the program's text as written, and each block's line
+    // a line of the text that holds a move (its N where it has one).
     let program = std::fs::read_to_string(dir.join(program_file)).unwrap();
+    let marker = "<script type=\"application/octet-stream\" id=\"program\">";
+    let at = page.find(marker).expect("a listing") + marker.len();
+    let packed = b64
+        .decode(&page[at..at + page[at..].find('<').unwrap()])
+        .unwrap();
+    let mut json = String::new();
+    std::io::Read::read_to_string(&mut flate2::read::GzDecoder::new(&packed[..]), &mut json)
+        .unwrap();
+    let listing: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(listing["text"].as_str().unwrap(), program);
+    let lines: Vec<&str> = program.lines().collect();
+    let mut line = 0;
+    let steps = listing["steps"].as_array().unwrap();
+    assert_eq!(steps.len() as u64, report["blocks"].as_u64().unwrap());
+    for s in steps {
+        line += s.as_i64().unwrap();
+        assert!(line >= 1 && line as usize <= lines.len(), "line {line}");
+        let text = lines[line as usize - 1];
+        assert!(!text.starts_with(';') && !text.starts_with('('), "{text}");
+    }
+    // Every plot's marks over it.
+    if let Some(marks) = report.get("marks").and_then(|m| m.as_object()) {
+        assert_eq!(page.matches("<svg class=\"marks\"").count(), marks.len());
+        for (file, m) in marks {
+            assert!(svgs.contains(&file.as_str()), "{file}");
+            for p in m["places"].as_array().into_iter().flatten() {
+                assert!(page.contains(&format!(
+                    "<circle class=\"place\" data-block=\"{}\"",
+                    p["block"]
+                )));
+            }
+        }
+    }
     let escape = |l: &str| {
         l.replace('&', "&amp;")
             .replace('<', "&lt;")
             .replace('>', "&gt;")
     };
-    let (first, last) = (
-        program.lines().next().unwrap(),
-        program.lines().last().unwrap(),
-    );
-    assert!(page.contains(&escape(first)) && page.contains(&escape(last)));
     for (name, p) in report["parameters"].as_object().unwrap() {
         assert!(page.contains(&format!("<td>{name}</td>")), "{name}");
         let unit = p["unit"].as_str().unwrap();

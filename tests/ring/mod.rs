@@ -158,7 +158,7 @@ impl Outcome for RingOutcome {
         &self,
         _ctx: &FilesContext<'_>,
         _tables: &BTreeMap<String, BTreeMap<String, Vec<f64>>>,
-    ) -> Result<Vec<(String, Vec<u8>)>, String> {
+    ) -> Result<pilgrim_kernel::family::Drawn, String> {
         // The radius error round the contour, as a polyline.
         let points: Vec<String> = self
             .errors
@@ -171,7 +171,7 @@ impl Outcome for RingOutcome {
             self.errors.len().max(1),
             points.join(" ")
         );
-        Ok(vec![(self.picture.into(), svg.into_bytes())])
+        Ok(vec![(self.picture.into(), svg.into_bytes())].into())
     }
 }
 

@@ -795,31 +795,45 @@ impl GrooveCheck {
                 p.block
             )
         };
+        // A place's block counts from 1; 0 where it has none.
+        let at = |f: Figure, p: &GroovePlace| match p.block_index.checked_sub(1) {
+            Some(b) => f.at_block(b),
+            None => f,
+        };
         let figures = vec![
-            Figure::new(
-                "the groove: most material left",
-                self.max_left.mm,
-                self.tolerance,
-                "mm",
-                place(&self.max_left),
-            ),
-            Figure::new(
-                "the groove: deepest gouge",
-                self.max_gouge.mm,
-                self.tolerance,
-                "mm",
-                place(&self.max_gouge),
-            ),
-            Figure::new(
-                "the roll's periphery beside the groove: deepest cut",
-                self.periphery_cut.mm,
-                self.tolerance,
-                "mm",
-                format!(
-                    "{}, {} mm beyond the edge",
-                    place(&self.periphery_cut),
-                    crate::math::fixed(self.periphery_cut.beyond_edge_mm, 3)
+            at(
+                Figure::new(
+                    "the groove: most material left",
+                    self.max_left.mm,
+                    self.tolerance,
+                    "mm",
+                    place(&self.max_left),
                 ),
+                &self.max_left,
+            ),
+            at(
+                Figure::new(
+                    "the groove: deepest gouge",
+                    self.max_gouge.mm,
+                    self.tolerance,
+                    "mm",
+                    place(&self.max_gouge),
+                ),
+                &self.max_gouge,
+            ),
+            at(
+                Figure::new(
+                    "the roll's periphery beside the groove: deepest cut",
+                    self.periphery_cut.mm,
+                    self.tolerance,
+                    "mm",
+                    format!(
+                        "{}, {} mm beyond the edge",
+                        place(&self.periphery_cut),
+                        crate::math::fixed(self.periphery_cut.beyond_edge_mm, 3)
+                    ),
+                ),
+                &self.periphery_cut,
             ),
         ];
         let failures = self

@@ -106,15 +106,34 @@ impl Outcome for GrooveOutcome {
 
     fn files(
         &self,
-        _ctx: &FilesContext<'_>,
-        _tables: &BTreeMap<String, BTreeMap<String, Vec<f64>>>,
-    ) -> Result<Vec<(String, Vec<u8>)>, String> {
-        let map = super::deviation_map_svg(&self.check)?;
+        ctx: &FilesContext<'_>,
+        tables: &BTreeMap<String, BTreeMap<String, Vec<f64>>>,
+    ) -> Result<crate::family::Drawn, String> {
+        // Each grinding pass's psi, as the family's pass table gives it a
+        // row per cutting pass in order; none where the rows do not match.
+        let cutting: Vec<_> = ctx.replay.passes.iter().filter(|p| p.cuts).collect();
+        let passes: Vec<(std::ops::Range<usize>, f64)> = tables
+            .get("passes")
+            .and_then(|t| t.get("psi_deg"))
+            .filter(|psi| psi.len() == cutting.len())
+            .map(|psi| {
+                cutting
+                    .iter()
+                    .zip(psi)
+                    .filter(|(_, v)| v.is_finite())
+                    .map(|(p, v)| (p.blocks.clone(), *v))
+                    .collect()
+            })
+            .unwrap_or_default();
+        let (map, marks) = super::deviation_map_svg(&self.check, &passes)?;
         let section = super::section_svg(&self.check, &self.request, self.wheel.rounding_radius)?;
-        Ok(vec![
-            ("deviation_map.svg".into(), map.into_bytes()),
-            ("section.svg".into(), section.into_bytes()),
-        ])
+        Ok(crate::family::Drawn {
+            files: vec![
+                ("deviation_map.svg".into(), map.into_bytes()),
+                ("section.svg".into(), section.into_bytes()),
+            ],
+            marks: [("deviation_map.svg".to_owned(), marks)].into(),
+        })
     }
 }
 

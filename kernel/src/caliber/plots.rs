@@ -4,7 +4,7 @@
 //! every pass in the groove's section where the most material is left.
 
 use crate::caliber::{GrooveCheck, GrooveRequest};
-use crate::chart::tick_decimals;
+use crate::chart::{tick_decimals, Marks, PassMark, PixelMap, PlaceMark};
 use plotters::prelude::*;
 
 /// Colour levels of the heat map, an odd number: the middle one is zero.
@@ -44,7 +44,10 @@ fn level(v: f64, limit: f64) -> usize {
 ///
 /// # Failures
 /// An empty map; plotters failing.
-pub fn deviation_map_svg(check: &GrooveCheck) -> Result<String, String> {
+pub fn deviation_map_svg(
+    check: &GrooveCheck,
+    passes: &[(std::ops::Range<usize>, f64)],
+) -> Result<(String, Marks), String> {
     let m = &check.map;
     let (nt, np) = (
         m.theta_deg.len().saturating_sub(1),
@@ -56,6 +59,10 @@ pub fn deviation_map_svg(check: &GrooveCheck) -> Result<String, String> {
     let limit = check.tolerance.max(check.max_abs_mm);
     let e = |e: DrawingAreaErrorKind<std::io::Error>| e.to_string();
     let mut svg = String::new();
+    let mut marks = Marks {
+        size: [1000, 560],
+        ..Marks::default()
+    };
     {
         let root = SVGBackend::with_string(&mut svg, (1000, 560)).into_drawing_area();
         root.fill(&WHITE).map_err(e)?;
@@ -75,6 +82,29 @@ pub fn deviation_map_svg(check: &GrooveCheck) -> Result<String, String> {
             .y_label_area_size(60)
             .build_cartesian_2d(t0..t1, p0..p1)
             .map_err(e)?;
+        let map = PixelMap::of(&chart, t0..t1, p0..p1);
+        // Each pass's line across the map at its psi, and the extremes'
+        // places.
+        marks.passes = passes
+            .iter()
+            .map(|(blocks, psi)| PassMark {
+                blocks: [blocks.start, blocks.end],
+                points: vec![map.at(t0, *psi), map.at(t1, *psi)],
+                closed: false,
+            })
+            .collect();
+        for (place, name) in [
+            (&check.max_left, "most material left"),
+            (&check.max_gouge, "deepest gouge"),
+        ] {
+            if let Some(block) = place.block_index.checked_sub(1).filter(|_| place.mm != 0.0) {
+                marks.places.push(PlaceMark {
+                    at: map.at(place.theta_deg, place.psi_deg),
+                    block,
+                    label: name.into(),
+                });
+            }
+        }
         let (dt, dp) = (tick_decimals(t1 - t0), tick_decimals(p1 - p0));
         chart
             .configure_mesh()
@@ -153,7 +183,7 @@ pub fn deviation_map_svg(check: &GrooveCheck) -> Result<String, String> {
             .map_err(e)?;
         root.present().map_err(e)?;
     }
-    Ok(svg)
+    Ok((svg, marks))
 }
 
 /// `section.svg`: the groove's section at the theta where the most material

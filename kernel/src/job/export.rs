@@ -215,7 +215,16 @@ pub fn export(
     shown.extend(all.iter().filter(|f| f.0 == "scene.glb").cloned());
     let view = scene::bounds_of(parts.iter().map(|(_, m)| m))
         .map(|b| scene::contact_box(b, &toolpath.tool, &pose));
-    let html = super::page::page_of(&report, &shown, control.extension, view);
+    // The listing's lines as the lint reads the program: a text that does
+    // not read back as program.json is not the run's.
+    let listed = super::page::written_program(&shown, control.extension);
+    if let Some((name, text)) = listed {
+        report.program_lines =
+            crate::program::lint::lint_read(text, &program, control, &kin.info().axes)
+                .map_err(|e| bad(name, e.to_string()))?
+                .lines;
+    }
+    let html = super::page::page_of(&report, &shown, listed, view);
     all.push(("report.html".into(), html.into_bytes()));
     all.push(("report.json".into(), super::report_json(&report)?));
     Ok(Exported {

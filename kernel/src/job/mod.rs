@@ -168,7 +168,7 @@ fn post_all(
     info: &crate::machine::MachineInfo,
     program: &AxisProgram,
     also: &[String],
-) -> Result<(scene::Files, AxisProgram), Error> {
+) -> Result<(scene::Files, crate::program::lint::TextProgram), Error> {
     let control = dialect(&info.control).ok_or_else(|| Error::UnknownControl {
         machine: info.name.clone(),
         control: info.control.clone(),
@@ -210,8 +210,7 @@ fn failed_run(
         .map(|f| f.0.clone())
         .chain(["report.html".to_owned(), "report.json".to_owned()])
         .collect();
-    let control = dialect(&report.control).map_or("", |d| d.extension);
-    let html = page::page_of(&report, &files, control, part_box);
+    let html = page::page_of(&report, &files, None, part_box);
     files.push(("report.html".into(), html.into_bytes()));
     match report_json(&report) {
         Ok(json) => files.push(("report.json".into(), json)),
@@ -400,7 +399,7 @@ fn run_on(
     // not the program itself (the text a control reads, as the lint read
     // it back); its passes; the posted programs (or why none); the data
     // files.
-    let (program, read_back, passes, posted, data) = match text {
+    let (program, read_back, passes, posted, data, lines) = match text {
         None => {
             let mut program = build(&toolpath, kin, &options.program_name)?;
             program.number = options.program_number.unwrap_or(0);
@@ -425,11 +424,11 @@ fn run_on(
                 ("program.json".into(), program_json),
                 ("report.csv".into(), csv),
             ];
-            let (posted, read_back) = match posted {
-                Ok((files, read)) => (Ok(files), Some(read)),
-                Err(e) => (Err(e), None),
+            let (posted, read_back, lines) = match posted {
+                Ok((files, read)) => (Ok(files), Some(read.program), read.lines),
+                Err(e) => (Err(e), None, Vec::new()),
             };
-            (program, read_back, passes, posted, data)
+            (program, read_back, passes, posted, data, lines)
         }
         Some(text) => {
             // A text the verification cannot take leaves its report: what
@@ -446,7 +445,10 @@ fn run_on(
                 failed_run(report, Vec::new(), None)
             };
             let frame = crate::program::frame(info);
-            let read = crate::program::lint::read(text, &frame, control, &info.axes)
+            let crate::program::lint::TextProgram {
+                program: read,
+                lines,
+            } = crate::program::lint::read(text, &frame, control, &info.axes)
                 .map_err(|e| refused(e.to_string()))?;
             // No more blocks than a run writes: the replays' work is bounded.
             crate::program::check_shape(&read).map_err(|m| refused(format!("the program: {m}")))?;
@@ -460,7 +462,7 @@ fn run_on(
                     block_table(&read).map_err(Error::Output)?.into_bytes(),
                 ),
             ];
-            (read, None, passes, Ok(Vec::new()), data)
+            (read, None, passes, Ok(Vec::new()), data, lines)
         }
     };
     let verified = read_back.as_ref().unwrap_or(&program);
@@ -670,6 +672,7 @@ fn run_on(
         times: Some(times),
         playback,
         program_file: text.and(options.program_file.clone()),
+        program_lines: lines,
         block_numbers: program
             .blocks
             .iter()
@@ -687,7 +690,13 @@ fn run_on(
             replay: replay_ctx,
             parts: &parts,
         };
-        let made = o.files(&ctx, &report.tables).map_err(Error::Output)?;
+        let crate::family::Drawn { files: made, marks } =
+            o.files(&ctx, &report.tables).map_err(Error::Output)?;
+        // Marks over a plot it drew, by the plot's name.
+        report.marks = marks
+            .into_iter()
+            .filter(|(name, _)| name.ends_with(".svg") && made.iter().any(|f| &f.0 == name))
+            .collect();
         // A verification draws and tabulates; the programs, the report and
         // the data files are the run's own, and every name is a file's.
         if let Some((name, _)) = made.iter().find(|(n, _)| {
@@ -742,7 +751,12 @@ fn run_on(
         return Err(failed_run(report, files, part_box));
     }
     report.files.push("report.html".into());
-    let html = page::page_of(&report, &files, control.extension, part_box);
+    // The page lists the program the run wrote, or the file it verified.
+    let listed = match (text, &options.program_file) {
+        (Some(text), Some(file)) => Some((file.as_str(), text)),
+        _ => page::written_program(&files, control.extension),
+    };
+    let html = page::page_of(&report, &files, listed, part_box);
     files.push(("report.html".into(), html.into_bytes()));
     files.push(("report.json".into(), report_json(&report)?));
     Ok(JobOutput {

@@ -66,6 +66,17 @@ pub fn lint(
     }
 }
 
+/// A program as a control reads its text: its blocks, and where each
+/// stands in the text (the page's listing shows the block the player is
+/// at).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TextProgram {
+    /// The program read.
+    pub program: AxisProgram,
+    /// The line (from 1) of each block's move, in the blocks' order.
+    pub lines: Vec<usize>,
+}
+
 /// Reads `text`, a program in `d` for the machine whose axes (their
 /// travel) are `axes`, as its control reads it: the lint's reader and
 /// rules, the moves taken as they are written instead of held to an axis
@@ -88,7 +99,7 @@ pub fn read(
     frame: &AxisProgram,
     d: &Dialect,
     axes: &[Axis],
-) -> Result<AxisProgram, LintError> {
+) -> Result<TextProgram, LintError> {
     if d.style != Style::GCode {
         return Err(LintError {
             dialect: d.name.to_owned(),
@@ -115,12 +126,12 @@ pub fn lint_read(
     program: &AxisProgram,
     d: &Dialect,
     axes: &[Axis],
-) -> Result<AxisProgram, LintError> {
+) -> Result<TextProgram, LintError> {
     if d.style != Style::GCode {
         return Err(not_a_control_program(d));
     }
     let mut read = assemble(lint_gcode(text, program, d, axes, Mode::Lint)?, program);
-    for (r, b) in read.blocks.iter_mut().zip(&program.blocks) {
+    for (r, b) in read.program.blocks.iter_mut().zip(&program.blocks) {
         r.comment.clone_from(&b.comment);
     }
     Ok(read)
@@ -139,7 +150,8 @@ fn not_a_control_program(d: &Dialect) -> LintError {
 /// decimals; its name, number, tool and speed where the text writes none).
 /// Axes the text never writes are left out; an axis not yet written is
 /// kept where it stands until its first value.
-fn assemble(read: ReadText, frame: &AxisProgram) -> AxisProgram {
+fn assemble(read: ReadText, frame: &AxisProgram) -> TextProgram {
+    let lines = read.blocks.iter().map(|b| b.line + 1).collect();
     let written: Vec<usize> = (0..frame.axes.len())
         .filter(|&i| read.blocks.iter().any(|b| b.values[i].is_some()))
         .collect();
@@ -177,7 +189,7 @@ fn assemble(read: ReadText, frame: &AxisProgram) -> AxisProgram {
             }
         })
         .collect();
-    AxisProgram {
+    let program = AxisProgram {
         name: read.name.unwrap_or_else(|| frame.name.clone()),
         number: read.number.unwrap_or(frame.number),
         machine: frame.machine.clone(),
@@ -189,7 +201,8 @@ fn assemble(read: ReadText, frame: &AxisProgram) -> AxisProgram {
         axes: written.iter().map(|&i| frame.axes[i].clone()).collect(),
         blocks,
         setup: frame.setup.clone(),
-    }
+    };
+    TextProgram { program, lines }
 }
 
 /// Whether a G-code text is held to an axis program (the lint of a
@@ -209,6 +222,8 @@ struct ReadBlock {
     spindle: Option<Real>,
     comment: Option<String>,
     number: Option<u32>,
+    /// The line it stands on (from 0).
+    line: usize,
 }
 
 /// What a G-code text read as: the lint's count, the moves and what the
@@ -968,6 +983,7 @@ fn lint_gcode(
                 spindle: speed_next.take(),
                 comment,
                 number: block.line_number,
+                line,
             });
         }
         k += 1;
@@ -1248,8 +1264,8 @@ mod tests {
                 d.name
             );
             let (ours, theirs) = (
-                read(&text, &frame, &acme, &axes()).unwrap(),
-                read(&text, &frame, d, &axes()).unwrap(),
+                read(&text, &frame, &acme, &axes()).unwrap().program,
+                read(&text, &frame, d, &axes()).unwrap().program,
             );
             assert_eq!(
                 (ours.name, ours.number, ours.tool_number),
@@ -1272,7 +1288,18 @@ mod tests {
         (frame.name, frame.number, frame.spindle_rpm) = ("X".into(), 0, 1.0);
         for d in [&SINUMERIK, &FANUC, &LINUXCNC] {
             let text = post(&p, d).unwrap();
-            let r = read(&text, &frame, d, &axes()).unwrap_or_else(|e| panic!("{e}\n{text}"));
+            let read = read(&text, &frame, d, &axes()).unwrap_or_else(|e| panic!("{e}\n{text}"));
+            // Each block's line holds its move: its N where the dialect
+            // numbers blocks, and no other block's.
+            let lines: Vec<&str> = text.lines().collect();
+            assert_eq!(read.lines.len(), read.program.blocks.len(), "{}", d.name);
+            assert!(read.lines.windows(2).all(|w| w[0] < w[1]), "{}", d.name);
+            for (b, &l) in read.program.blocks.iter().zip(&read.lines) {
+                if let Some(n) = b.number {
+                    assert!(lines[l - 1].starts_with(&format!("N{n} ")), "{}", d.name);
+                }
+            }
+            let r = read.program;
             // Sinumerik names the program in its header; Fanuc numbers it.
             let number = if d.name == "fanuc" { 7 } else { 0 };
             let name = if d.name == "sinumerik" { "DEMO" } else { "X" };
@@ -1302,7 +1329,7 @@ mod tests {
             assert!(r.blocks[4].motion == written.blocks[4].motion);
             // A lint reads the same program, its passes named as the axis
             // program names them.
-            let l = lint_read(&text, &p, d, &axes()).unwrap();
+            let l = lint_read(&text, &p, d, &axes()).unwrap().program;
             for (k, (a, b)) in l.blocks.iter().zip(&written.blocks).enumerate() {
                 assert_eq!(
                     (&a.values, a.motion),
@@ -1345,7 +1372,10 @@ mod tests {
         }
         let renamed = text.replacen("%_N_DEMO_MPF", "%_N_OTHER_MPF", 1);
         assert_eq!(
-            read(&renamed, &frame, &SINUMERIK, &axes()).unwrap().name,
+            read(&renamed, &frame, &SINUMERIK, &axes())
+                .unwrap()
+                .program
+                .name,
             "OTHER"
         );
     }

@@ -766,13 +766,14 @@ impl GrindingCheck {
             crate::math::fixed(d.at_z, 3),
             block.as_ref().map_or(String::new(), |b| format!(", {b}"))
         );
-        let figure = Figure::new(
+        let mut figure = Figure::new(
             &format!("{}: the surface from the nominal", finish.name),
             value,
             self.tolerance,
             "mm",
             place,
         );
+        figure.block = d.block.and_then(|b| b.checked_sub(1));
         let failure = self.failure(program).map(|e| {
             let f = Finding::new(
                 "verification",

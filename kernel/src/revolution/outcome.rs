@@ -87,7 +87,7 @@ impl Outcome for GrindingOutcome {
         &self,
         ctx: &FilesContext<'_>,
         _tables: &std::collections::BTreeMap<String, std::collections::BTreeMap<String, Vec<f64>>>,
-    ) -> Result<Vec<(String, Vec<u8>)>, String> {
+    ) -> Result<crate::family::Drawn, String> {
         let profiles: Vec<(String, crate::profile::Profile)> = ctx
             .parts
             .iter()
@@ -106,14 +106,18 @@ impl Outcome for GrindingOutcome {
             &self.request.profile,
             self.rounding,
         )?;
-        let mut files = vec![("profile.svg".to_owned(), text.into_bytes())];
+        let mut drawn =
+            crate::family::Drawn::from(vec![("profile.svg".to_owned(), text.into_bytes())]);
         // The surface before the first pass: the blank the replay cut into.
         let n = &self.request;
         let start = |z: f64| Some(n.blank.as_deref()?.eval(z).ok()? - n.profile.eval(z).ok()?);
-        for (name, text) in super::deviation_svgs(&self.check, start)? {
-            files.push((name, text.into_bytes()));
+        for (name, text, marks) in
+            super::deviation_svgs(&self.check, start, r.program.blocks.len())?
+        {
+            drawn.marks.insert(name.clone(), marks);
+            drawn.files.push((name, text.into_bytes()));
         }
-        Ok(files)
+        Ok(drawn)
     }
 }
 

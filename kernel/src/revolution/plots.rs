@@ -6,17 +6,18 @@
 //! (the surface before it minus the surface it left: the blank's for the
 //! first pass).
 
-use crate::chart::{tick_decimals, COLOURS};
+use crate::chart::{tick_decimals, Marks, PassMark, PixelMap, PlaceMark, COLOURS};
 use crate::revolution::{GrindingCheck, PassCheck};
 use plotters::prelude::*;
 
 /// One chart of `passes`' deviations (um) along z, with the tolerance
-/// band's lines where `band` is given (mm).
+/// band's lines where `band` is given (mm); its map from (z, um) to the
+/// picture's pixels.
 fn draw(
     passes: &[&PassCheck],
     (title, y_desc): (&str, &str),
     band: Option<f64>,
-) -> Result<String, String> {
+) -> Result<(String, Marks, PixelMap), String> {
     let (mut z0, mut z1, mut y0, mut y1) = (
         f64::INFINITY,
         f64::NEG_INFINITY,
@@ -42,8 +43,10 @@ fn draw(
     let (y0, y1) = (y0 - pad, y1 + pad);
     let rows = (passes.len() + usize::from(band.is_some())).div_ceil(2) as u32;
     let mut svg = String::new();
+    let size = (1100, 600 + 24 * rows);
+    let map;
     {
-        let root = SVGBackend::with_string(&mut svg, (1100, 600 + 24 * rows)).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
         let e = |e: DrawingAreaErrorKind<_>| format!("{title}: {e:?}");
         root.fill(&WHITE).map_err(e)?;
         let (top, bottom) = root.split_vertically(600);
@@ -54,6 +57,7 @@ fn draw(
             .y_label_area_size(90)
             .build_cartesian_2d(z0..z1, y0..y1)
             .map_err(e)?;
+        map = PixelMap::of(&chart, z0..z1, y0..y1);
         chart
             .configure_mesh()
             .x_desc("z along the part, mm")
@@ -97,7 +101,55 @@ fn draw(
         crate::chart::legend(&bottom, &legend, (60, 520, 2), 14).map_err(e)?;
         root.present().map_err(e)?;
     }
-    Ok(svg)
+    let marks = Marks {
+        size: [size.0, size.1],
+        ..Marks::default()
+    };
+    Ok((svg, marks, map))
+}
+
+/// The most points a pass's mark over a plot keeps (every k-th beyond).
+const MARK_POINTS: usize = 400;
+
+/// Each pass's line over a plot of `passes` (its highest surface, um),
+/// lit from its first block to the next pass's (`blocks`: the program's
+/// count, where the last ends).
+fn pass_marks(passes: &[PassCheck], map: &PixelMap, blocks: usize) -> Vec<PassMark> {
+    passes
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let every = p.along_z.len().div_ceil(MARK_POINTS).max(1);
+            let end = passes
+                .get(k + 1)
+                .map_or(blocks, |n| n.first_block.saturating_sub(1));
+            PassMark {
+                blocks: [p.first_block.saturating_sub(1), end],
+                points: p
+                    .along_z
+                    .iter()
+                    .step_by(every)
+                    .map(|b| map.at(b[0], 1e3 * b[2]))
+                    .collect(),
+                closed: false,
+            }
+        })
+        .collect()
+}
+
+/// The finish's worst place over a plot, where it is at a block.
+fn worst_place(finish: &PassCheck, map: &PixelMap) -> Option<PlaceMark> {
+    let d = &finish.deviation;
+    let value = if d.max_above.abs() >= d.max_below.abs() {
+        d.max_above
+    } else {
+        d.max_below
+    };
+    Some(PlaceMark {
+        at: map.at(d.at_z, 1e3 * value),
+        block: d.block?.checked_sub(1)?,
+        label: format!("the worst of {}", finish.name),
+    })
 }
 
 /// The stock each pass removed along z (mm): its `along_z` replaced by
@@ -140,51 +192,52 @@ pub fn removed(passes: &[PassCheck], start: impl Fn(f64) -> Option<f64>) -> Vec<
 
 /// `deviation.svg`, `finish.svg` and `stock.svg` of a grinding replay,
 /// `start` the blank's surface minus the nominal at z (mm) where there is
-/// a blank.
+/// a blank, with the page's marks: the finish's worst place on the first
+/// two, each pass's line on the stock (the program having `blocks`).
 ///
 /// # Failures
 /// A replay with no pass drawn; drawing failing.
 pub fn deviation_svgs(
     check: &GrindingCheck,
     start: impl Fn(f64) -> Option<f64>,
-) -> Result<[(String, String); 3], String> {
+    blocks: usize,
+) -> Result<[(String, String, Marks); 3], String> {
     let all: Vec<&PassCheck> = check.passes.iter().collect();
     let finish = all.last().copied().ok_or("the replay has no pass")?;
     let stock = removed(&check.passes, start);
+    let at_worst = |(svg, mut marks, map): (String, Marks, PixelMap)| {
+        marks.places.extend(worst_place(finish, &map));
+        (svg, marks)
+    };
+    let (deviation, deviation_marks) = at_worst(draw(
+        &all,
+        (
+            "Each pass's surface minus the nominal (lowest and highest over the generatrices)",
+            "surface minus nominal, um",
+        ),
+        None,
+    )?);
+    let (finish_svg, finish_marks) = at_worst(draw(
+        &[finish],
+        (
+            "The finish against the tolerance (ridges included)",
+            "surface minus nominal, um",
+        ),
+        Some(check.tolerance),
+    )?);
+    let (stock_svg, mut stock_marks, map) = draw(
+        &stock.iter().collect::<Vec<_>>(),
+        (
+            "The stock each pass removed, at the valleys and at the ridges' tops",
+            "stock removed, um",
+        ),
+        None,
+    )?;
+    stock_marks.passes = pass_marks(&stock, &map, blocks);
     Ok([
-        (
-            "deviation.svg".into(),
-            draw(
-                &all,
-                (
-                    "Each pass's surface minus the nominal (lowest and highest over the generatrices)",
-                    "surface minus nominal, um",
-                ),
-                None,
-            )?,
-        ),
-        (
-            "finish.svg".into(),
-            draw(
-                &[finish],
-                (
-                    "The finish against the tolerance (ridges included)",
-                    "surface minus nominal, um",
-                ),
-                Some(check.tolerance),
-            )?,
-        ),
-        (
-            "stock.svg".into(),
-            draw(
-                &stock.iter().collect::<Vec<_>>(),
-                (
-                    "The stock each pass removed, at the valleys and at the ridges' tops",
-                    "stock removed, um",
-                ),
-                None,
-            )?,
-        ),
+        ("deviation.svg".into(), deviation, deviation_marks),
+        ("finish.svg".into(), finish_svg, finish_marks),
+        ("stock.svg".into(), stock_svg, stock_marks),
     ])
 }
 

@@ -134,15 +134,18 @@ impl Outcome for WormOutcome {
 
     fn files(
         &self,
-        _ctx: &FilesContext<'_>,
+        ctx: &FilesContext<'_>,
         tables: &BTreeMap<String, BTreeMap<String, Vec<f64>>>,
-    ) -> Result<Vec<(String, Vec<u8>)>, String> {
+    ) -> Result<crate::family::Drawn, String> {
         let table = worm_pass_table(&self.check, tables.get("passes"))?;
-        let svg = worm_passes_svg(&self.check)?;
-        Ok(vec![
-            ("passes.csv".into(), table.into_bytes()),
-            ("passes.svg".into(), svg.into_bytes()),
-        ])
+        let (svg, marks) = worm_passes_svg(&self.check, ctx.replay.program.blocks.len())?;
+        Ok(crate::family::Drawn {
+            files: vec![
+                ("passes.csv".into(), table.into_bytes()),
+                ("passes.svg".into(), svg.into_bytes()),
+            ],
+            marks: [("passes.svg".to_owned(), marks)].into(),
+        })
     }
 }
 

@@ -3,6 +3,7 @@
 //! "distribution" view), drawn with plotters; `passes.csv`, one row per
 //! thread pass, written with the csv crate.
 
+use crate::chart::{Marks, PassMark, PixelMap};
 use crate::worm::WormCheck;
 use plotters::prelude::*;
 use std::collections::BTreeMap;
@@ -19,11 +20,13 @@ fn pass_colour(k: usize, n: usize) -> HSLColor {
 
 /// `passes.svg`: one lead of the axial section, the finished worm grey,
 /// each pass's chip in its colour, a colour strip below naming the first
-/// and the last pass.
+/// and the last pass; and the page's marks, each pass's chip outlined
+/// from its thread block to the next pass's (the program having
+/// `blocks`).
 ///
 /// # Failures
 /// Drawing failing.
-pub fn worm_passes_svg(check: &WormCheck) -> Result<String, String> {
+pub fn worm_passes_svg(check: &WormCheck, blocks: usize) -> Result<(String, Marks), String> {
     let (w0, lead) = check.window;
     let (mut r0, mut r1) = (f64::INFINITY, f64::NEG_INFINITY);
     for chip in check.chips.iter().flatten().flatten() {
@@ -36,6 +39,10 @@ pub fn worm_passes_svg(check: &WormCheck) -> Result<String, String> {
     let (r0, r1) = (r0 - 3.0 * pad, r1 + pad);
     let n = check.chips.len();
     let mut svg = String::new();
+    let mut marks = Marks {
+        size: [1100, 700],
+        ..Marks::default()
+    };
     {
         let root = SVGBackend::with_string(&mut svg, (1100, 700)).into_drawing_area();
         let e = |e: DrawingAreaErrorKind<_>| format!("passes.svg: {e:?}");
@@ -53,6 +60,7 @@ pub fn worm_passes_svg(check: &WormCheck) -> Result<String, String> {
             .y_label_area_size(80)
             .build_cartesian_2d(w0..w0 + lead, r0..r1)
             .map_err(e)?;
+        let map = PixelMap::of(&chart, w0..w0 + lead, r0..r1);
         chart
             .configure_mesh()
             .x_desc("z along the worm's axis, mm")
@@ -76,6 +84,17 @@ pub fn worm_passes_svg(check: &WormCheck) -> Result<String, String> {
                     .iter()
                     .map(|p| (p[0].clamp(w0, w0 + lead), p[1]))
                     .collect();
+                if let Some(p) = check.passes.get(k) {
+                    let end = check
+                        .passes
+                        .get(k + 1)
+                        .map_or(blocks, |n| n.block.saturating_sub(1));
+                    marks.passes.push(PassMark {
+                        blocks: [p.block.saturating_sub(1), end],
+                        points: pts.iter().map(|q| map.at(q.0, q.1)).collect(),
+                        closed: true,
+                    });
+                }
                 chart
                     .draw_series(std::iter::once(Polygon::new(pts, c.filled())))
                     .map_err(e)?;
@@ -100,7 +119,7 @@ pub fn worm_passes_svg(check: &WormCheck) -> Result<String, String> {
         }
         root.present().map_err(e)?;
     }
-    Ok(svg)
+    Ok((svg, marks))
 }
 
 /// `passes.csv`: one row per simulated thread pass (block, its name,

@@ -266,7 +266,7 @@ impl WormCheck {
             self.passes
                 .iter()
                 .max_by(|a, b| f(a).total_cmp(&f(b)))
-                .map(|p| (f(p), p.name.clone()))
+                .map(|p| (f(p), p.name.clone(), p.block))
         };
         for (name, f, tol, unit) in [
             (
@@ -288,8 +288,12 @@ impl WormCheck {
                 "%",
             ),
         ] {
-            if let Some((v, place)) = pass(f) {
-                figures.push(Figure::new(name, v, tol, unit, place));
+            if let Some((v, place, block)) = pass(f) {
+                let figure = Figure::new(name, v, tol, unit, place);
+                figures.push(match block.checked_sub(1) {
+                    Some(b) => figure.at_block(b),
+                    None => figure,
+                });
             }
         }
         (figures, self.failures.clone())
