@@ -164,16 +164,34 @@ async function check(browser, file) {
         if (went[0] !== went[1]) problems.push(`player: the worst place (block ${went[2] + 1}) took the slider to key ${went[0]}, not ${went[1]}`);
         else if (!went[4]) problems.push(`listing: block ${went[2] + 1}'s line not lit in view`);
         else view += `; the worst place (${target.startsWith(".marks") ? "a plot's mark" : "a figure"}, block ${went[2] + 1}) took it to key ${went[0]}, listing at "${went[3].trim().slice(0, 40)}"`;
+      } else if (await page.$(".banner.unverified")) {
+        view += "; not verified: no worst place";
       } else problems.push("player: no worst place to click");
       // A line of the listing clicked takes the slider to its block.
-      const line = await page.$("#listing .rows div:nth-child(8)");
+      // (By the mouse where the line stands: the pane redraws its lines as
+      // the player moves, so a handle to one would not last.)
+      const line = await page.evaluate(() => {
+        // From the last key, so that any line before it moves the slider.
+        const s = document.getElementById("scrub");
+        s.value = s.max;
+        s.dispatchEvent(new Event("input"));
+        const pane = document.getElementById("listing");
+        pane.scrollIntoView({ block: "center" });
+        pane.scrollTop = Math.max(0, pane.scrollTop - 100);
+        const r = pane.getBoundingClientRect();
+        const [x, y] = [r.left + 30, r.top + r.height / 3];
+        const d = document.elementFromPoint(x, y);
+        return d && d.dataset.line ? [x, y, +d.dataset.line] : null;
+      });
+      await page.evaluate(() => new Promise((ok) => requestAnimationFrame(() => setTimeout(ok, 50))));
       if (line) {
         const before = await page.$eval("#scrub", (s) => +s.value);
-        await line.click();
+        await page.mouse.click(line[0], line[1]);
         const after = await page.$eval("#scrub", (s) => +s.value);
-        const lit = await page.$eval("#listing .rows div:nth-child(8)", (d) => d.dataset.line);
-        view += `; listing line ${lit} took it from key ${before} to ${after}`;
-      }
+        const block = await page.$eval("#listing", (p) => +p.dataset.block);
+        if (before === after) problems.push(`listing: line ${line[2]} left the slider at key ${after}`);
+        view += `; listing line ${line[2]} (block ${block + 1}) took it from key ${before} to ${after}`;
+      } else problems.push("listing: no line drawn");
     }
     // The verdict at the top, seen without scrolling.
     const top = await page.$eval("#verdict", (b) => b.getBoundingClientRect().top + window.scrollY);
