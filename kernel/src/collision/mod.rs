@@ -30,7 +30,7 @@
 //! first order). A pair is measured again before the two can have closed
 //! [`REMEASURE`] of the distance measured last, or [`STEP`] mm, never all
 //! of it: so no contact is missed, and between measurements the pair
-//! stayed at least 98 % of the last distance less one step. Inside a
+//! stayed at least 75 % of the last distance less one step. Inside a
 //! piece, a pair is measured at places at most [`STEP`] mm of motion
 //! apart. The smallest clearance reported is the smallest measured.
 //!
@@ -44,7 +44,7 @@ pub mod shapes;
 pub use place::{PlacedBody, Placement};
 
 use crate::machine::MachineKinematics;
-use crate::math::{Mat4, Real, Vec3};
+use crate::math::{Mat4, Real};
 use crate::mesh::TriMesh;
 use crate::program::{axis_rows, block_name, AxisProgram};
 use crate::tool::Tool;
@@ -229,16 +229,17 @@ fn motion(a: &Mat4, b: &Mat4, reach: Real) -> (Real, Real) {
     (shift + turn * reach, turn)
 }
 
-/// Checks `program` (as the control reads it) on `machine` for
-/// collisions between its bodies, the tool and the part: see the
+/// Checks `program` (as the control reads it) on `machine`, its bodies
+/// placed by `placement` (the one the scene shows), for collisions
+/// between its bodies, the tool and the part: see the
 /// [module docs](self).
 ///
 /// # Failures
-/// A chain the machine cannot compile, a program without an axis a chain
-/// needs, the time budget.
+/// A program without an axis a chain needs, the time budget.
 pub fn check(
     program: &AxisProgram,
     machine: &dyn MachineKinematics,
+    placement: &Placement,
     solids: Solids<'_>,
 ) -> Result<Collisions, CollisionError> {
     let info = machine.info();
@@ -247,10 +248,6 @@ pub fn check(
         part_envelope_mm: 2.0 * solids.tolerance,
         ..Collisions::default()
     };
-    let part_z = solids.part.map(|(_, m)| part_z(m));
-    let program_axes: Vec<String> = program.axes.iter().map(|a| a.name.clone()).collect();
-    let centre = solids.tool.map_or(Vec3::zeros(), |t| t.1.spindle_centre());
-    let placement = Placement::new(info, &program_axes, centre, part_z)?;
     out.notes.extend(placement.notes.iter().cloned());
     let mut entities: Vec<Entity> = Vec::new();
     let entity = |name: &str, shaped: Shaped, which, moved_by, touches_part, is_part| Entity {

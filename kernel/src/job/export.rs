@@ -160,11 +160,12 @@ pub fn export(
         kin.info(),
         &crate::program::pass_blocks(&program, &toolpath.passes),
     );
+    let placement = scene::placement(kin, &program, &toolpath.tool, &parts)?;
     let staged = scene::stage(
         kin,
         &program,
         &toolpath.tool,
-        &parts,
+        (&parts, &placement),
         place,
         &times.block_s,
         vec![],

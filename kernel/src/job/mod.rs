@@ -219,15 +219,17 @@ fn failed_run(
     Error::Failed(Box::new(FailedRun { report, files }))
 }
 
-/// The collision check of `program` on `machine`: the tool's solid at
-/// the mesh tolerance `tol` in its own frame, the part at its largest (the
-/// body of `parts` of the greatest volume).
+/// The collision check of `program` on `machine`, its bodies placed by
+/// `placement`: the tool's solid at the mesh tolerance `tol` in its own
+/// frame, the part at its largest (the body of `parts` of the greatest
+/// volume).
 ///
 /// # Failures
 /// The tool's mesh failing; the check's own ([`crate::collision::check`]).
 fn collisions(
     program: &AxisProgram,
     machine: &dyn crate::machine::MachineKinematics,
+    placement: &crate::collision::Placement,
     tool: &crate::tool::Tool,
     parts: &[(String, crate::mesh::TriMesh)],
     tol: f64,
@@ -243,6 +245,7 @@ fn collisions(
     crate::collision::check(
         &written,
         machine,
+        placement,
         crate::collision::Solids {
             tool: tool_mesh.as_ref().map(|(m, n)| (*n, tool, Some(m))),
             part,
@@ -547,7 +550,9 @@ fn run_on(
     })?;
     // The machine's bodies, the tool and the part clear of each other
     // along the whole program.
-    let collisions = collisions(verified, kin, &toolpath.tool, &meshes, tol)?;
+    // One placement of the machine's bodies for the check and the scene.
+    let placement = scene::placement(kin, &program, &toolpath.tool, &meshes)?;
+    let collisions = collisions(verified, kin, &placement, &toolpath.tool, &meshes, tol)?;
     failures.extend(collisions.findings.iter().cloned());
     // The scene shows the tool where asked; a failed run's, where it
     // failed; else the middle of the last cutting pass.
@@ -602,7 +607,7 @@ fn run_on(
             kin,
             &program,
             &toolpath.tool,
-            &meshes,
+            (&meshes, &placement),
             pose_place,
             &times.block_s,
             overlays,

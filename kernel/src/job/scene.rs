@@ -120,14 +120,15 @@ pub fn thread_blade(c: &crate::worm::ThreadCutter, at: &ToolAt) -> crate::worm::
 /// A body placed in the part frame: name, mesh in its own frame, pose.
 pub type Placed = (String, TriMesh, Mat4);
 
-/// The machine's bodies placed as the collision check places them
+/// The machine's bodies placed for `program` and `tool`
 /// ([`crate::collision::Placement`]: on the part frame by their chains, on
 /// the tool from its spindle centre, at the ends of `parts`' largest
-/// body), for `program` and `tool`.
+/// body): one placement for the collision check, the still scene and its
+/// motion.
 ///
 /// # Failures
 /// A body's description failing.
-fn placement(
+pub fn placement(
     machine: &dyn MachineKinematics,
     program: &AxisProgram,
     tool: &Tool,
@@ -400,9 +401,10 @@ pub struct Staged {
 }
 
 /// The scene of `program` on `machine` at `place`: the part's bodies
-/// `parts`, the tool, the machine's bodies, the `overlays`, and the
-/// program's motion at the blocks' times `block_s`; one definition for the
-/// run and for `pilgrim export`.
+/// `parts`, the tool, the machine's bodies as `placement` places them
+/// ([`placement`]), the `overlays`, and the program's motion at the
+/// blocks' times `block_s`; one definition for the run and for `pilgrim
+/// export`.
 ///
 /// # Failures
 /// The replay, a body's placement or mesh, a writer failing.
@@ -411,7 +413,7 @@ pub fn stage(
     machine: &dyn MachineKinematics,
     program: &AxisProgram,
     tool: &Tool,
-    parts: &[(String, TriMesh)],
+    (parts, placement): (&[(String, TriMesh)], &crate::collision::Placement),
     place: PosePlace,
     block_s: &[f64],
     overlays: Vec<Placed>,
@@ -419,15 +421,12 @@ pub fn stage(
 ) -> Result<Staged, SceneError> {
     let pose = tool_pose(program, machine, tool, place)?;
     let solid = tool_mesh(tool, &pose, tol)?;
-    // One placement of the machine's bodies for the still scene and its
-    // motion.
-    let placement = placement(machine, program, tool, parts)?;
-    let others = machine_bodies(machine, program, place, &pose, &placement, tol)?;
+    let others = machine_bodies(machine, program, place, &pose, placement, tol)?;
     let motion = motion(
         machine,
         program,
         solid.as_ref().map(|(_, name)| *name),
-        &placement,
+        placement,
         block_s,
     )?;
     let playback = motion
