@@ -54,6 +54,11 @@ fn the_default_runs_verify_with_their_own_figures() {
                 "{job}: {key} differs"
             );
         }
+        // The run times its program as its control reads it (feeds and
+        // positions as written): the times of the verification of its text.
+        for key in ["programmed_min", "accelerated_min"] {
+            assert_eq!(run["times"][key], verified["times"][key], "{job}: {key}");
+        }
         let figures = &run["verdict"]["figures"];
         assert!(figures.as_array().is_some_and(|f| !f.is_empty()), "{job}");
         assert_eq!(

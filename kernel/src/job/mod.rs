@@ -590,7 +590,9 @@ fn run_on(
     files.extend(programs);
     files.extend(table);
     stage(STAGES[4]);
-    let times = crate::timing::times(&program, info, &passes);
+    // The times of the program as its control reads it (feeds and
+    // positions as written), as every other check takes it.
+    let times = crate::timing::times(verified, info, &passes);
     let mut playback = Vec::new();
     let (pose_block, bodies, solids, part_box) = if parts.is_empty() {
         (None, vec![], vec![], None)
