@@ -20,6 +20,9 @@
 //! backward and a forward pass over the blocks (each block's entry speed no
 //! more than lets it stop in time), as a control's look-ahead plans them.
 //!
+//! The run times its program as its control reads it (the text read back:
+//! feeds and positions as written), as its checks take it.
+//!
 //! An axis whose acceleration the machine does not state is taken as
 //! reaching its speed at once; the report names such axes. Left out: jerk
 //! limits, the control's smoothing of corners (which is faster than

@@ -111,7 +111,6 @@ fn banner(out: &mut String, r: &Report) {
     out.push_str("</div>\n");
 }
 
-/// A list of findings, each its rule, its block and what it says.
 /// The player of the scene's animation: play and pause, a speed, and a
 /// slider over its keys (the blocks' ends, sampled where there are many),
 /// the block and time shown. It starts at the pose block.
@@ -255,6 +254,7 @@ fn clearances(out: &mut String, r: &Report) {
     }
 }
 
+/// A list of findings, each its rule, its block and what it says.
 fn findings(out: &mut String, class: &str, prefix: &str, list: &[crate::verdict::Finding]) {
     if list.is_empty() {
         return;
