@@ -244,6 +244,7 @@ fn describe(info: &MachineInfo, origin: &Origin) -> String {
             .body
             .as_deref()
             .map(|b| format!(" [moves the {b}]"))
+            .or_else(|| a.turns_part.then(|| " [turns the part]".to_owned()))
             .unwrap_or_default();
         s += &format!(
             "  {:<3} {:<8} {range}{body}",

@@ -59,6 +59,7 @@ struct AxisFile {
     moves: Option<Spanned<[Real; 3]>>,
     turns: Option<Spanned<[Real; 3]>>,
     body: Option<Spanned<String>>,
+    turns_part: Option<Spanned<bool>>,
 }
 
 fn yes() -> bool {
@@ -190,6 +191,9 @@ impl Machine {
     /// moves a body says so (`body = "rest"`). `[constants]` holds named machine
     /// constants (mm; a `_deg` key is stored in radians without the suffix);
     /// a constant factor may take one (`constant = "rest_offset_b"`).
+    /// An axis that turns the part on the machine says so (`turns_part =
+    /// true`): a spindle carrying the part, or a rotary axis whose Rz leads
+    /// the chain (a roll's turn); the page's player turns the part by it.
     /// `driven_axes` lists programmed axes the machine takes from the
     /// toolpath rather than solving; `min_feed` is the least feed of a
     /// cutting move (mm/min). Every linear axis states `moves` and
@@ -316,6 +320,7 @@ fn span_of(file: &MachineFile, e: &Invalid) -> Range<usize> {
                 "moves" => key(a.moves.as_ref().map(Spanned::span).as_ref(), name),
                 "turns" => key(a.turns.as_ref().map(Spanned::span).as_ref(), name),
                 "body" => key(a.body.as_ref().map(Spanned::span).as_ref(), name),
+                "turns_part" => key(a.turns_part.as_ref().map(Spanned::span).as_ref(), name),
                 _ => name,
             }
         }
@@ -452,6 +457,7 @@ fn read_axis(src: &Source<'_>, a: &AxisFile) -> Result<Axis, MachineError> {
             (None, Some(v)) => Some(src.finite("max_accel_deg", v)?.to_radians()),
             (None, None) => None,
         },
+        turns_part: a.turns_part.as_ref().is_some_and(|t| *t.get_ref()),
     })
 }
 

@@ -300,6 +300,22 @@ fn check_axes(info: &MachineInfo) -> Result<ToolFrame, Invalid> {
                 (None, false) => {}
             }
         }
+        if a.turns_part {
+            let why = match (a.kind, &a.body) {
+                (AxisKind::Linear, _) => Some("a linear axis moves the part, it does not turn it"),
+                (_, Some(_)) => Some("it moves a body, not the tool"),
+                (AxisKind::Rotary, None) if info.chain.is_empty() => {
+                    Some("the machine states no tool chain for its turn to lead")
+                }
+                _ => None,
+            };
+            if let Some(why) = why {
+                return Err(invalid(
+                    at("turns_part"),
+                    format!("axis {name}: turns_part cannot be set: {why}"),
+                ));
+            }
+        }
         if a.kind == AxisKind::Spindle && a.programmed {
             return Err(invalid(
                 at("name"),
@@ -565,6 +581,46 @@ fn sign_error(m: &Machine, a: &Axis) -> Result<(), (&'static str, String)> {
     Ok(())
 }
 
+/// A rotary axis that turns the part must be the part's own turn in the
+/// tool chain: its factor an Rz among the chain's leading factors that
+/// turn about or move along Z (which commute with it). The chain is then
+/// the part's turn times the rest: the part stands on the machine turned
+/// by the inverse of its turns, and the rest places the tool there.
+fn part_turn_error(m: &Machine, a: &Axis) -> Result<(), String> {
+    if !a.turns_part || a.kind != AxisKind::Rotary {
+        return Ok(());
+    }
+    let lead = part_turn_lead(&m.chain);
+    let at = m.chain.axis_index(&a.name).and_then(|i| {
+        m.chain.factors().iter().position(
+            |f| matches!(f.value, crate::transform::FactorValue::Axis { axis, .. } if axis == i),
+        )
+    });
+    match at {
+        Some(k) if k < lead && m.chain.factors()[k].kind == FactorKind::Rz => Ok(()),
+        Some(k) => Err(format!(
+            "axis {}: turns_part, but its factor is the tool chain's number {}, {:?}: the part's turn must be an Rz with only Rz and Tz factors before it (those commute with it)",
+            a.name,
+            k + 1,
+            m.chain.factors()[k].kind
+        )),
+        None => Err(format!(
+            "axis {}: turns_part, but the tool chain does not bind it",
+            a.name
+        )),
+    }
+}
+
+/// How many of `chain`'s leading factors turn about or move along Z: those
+/// commute with a turn of the part about Z.
+pub fn part_turn_lead(chain: &crate::transform::Chain) -> usize {
+    chain
+        .factors()
+        .iter()
+        .take_while(|f| matches!(f.kind, FactorKind::Rz | FactorKind::Tz))
+        .count()
+}
+
 /// Checks the bodies and compiles their chains.
 fn compile_bodies(info: &MachineInfo) -> Result<BTreeMap<String, Body>, Invalid> {
     let mut bodies = BTreeMap::new();
@@ -777,6 +833,7 @@ impl Machine {
         };
         for (i, a) in machine.info.axes.iter().enumerate() {
             sign_error(&machine, a).map_err(|(key, m)| invalid(Place::Axis(i, key), m))?;
+            part_turn_error(&machine, a).map_err(|m| invalid(Place::Axis(i, "turns_part"), m))?;
         }
         Ok(machine)
     }

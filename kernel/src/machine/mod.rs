@@ -26,7 +26,9 @@ mod kinematics;
 mod write;
 
 pub use builtin::{BUILTIN_MACHINES, BUILTIN_SOURCES};
-pub use info::{bodies_of, body_offset, check_description, Body, Solid, AXIS_LETTERS};
+pub use info::{
+    bodies_of, body_offset, check_description, part_turn_lead, Body, Solid, AXIS_LETTERS,
+};
 pub(crate) use kinematics::overridden as kinematics_overridden;
 pub use kinematics::{batch_rows, ChainMachine, KinematicsError, MachineKinematics};
 pub use pilgrim_plugin_abi::types::{

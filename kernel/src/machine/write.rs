@@ -137,6 +137,9 @@ fn axis(a: &Axis) -> Value {
     if let Some(r) = a.turns {
         t.insert("turns".into(), triple(r));
     }
+    if a.turns_part {
+        t.insert("turns_part".into(), true.into());
+    }
     if let Some(b) = &a.body {
         t.insert("body".into(), b.clone().into());
     }

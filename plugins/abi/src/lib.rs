@@ -49,6 +49,7 @@
 //!             name: name.into(), kind: AxisKind::Linear, min: -500.0, max: 500.0,
 //!             max_feed: 8000.0, programmed: true, description: String::new(),
 //!             moves: None, turns: None, body: None, max_accel: None,
+//!             turns_part: false,
 //!         };
 //!         MachineInfo {
 //!             name: "lathe".into(), description: String::new(), control: "fanuc".into(),
@@ -96,8 +97,8 @@ pub const ABI_MAJOR: u32 = 1;
 /// setup's `feed_group`; 1.4: a thread block's `start_deg`; 1.5: a body's
 /// `approach_feed`, a block's `number`; 1.6: the body shapes `cylinder`,
 /// `box` and `guard`; 1.7: a body's `mount`, a constant factor's `scale`,
-/// an axis's `max_accel`).
-pub const ABI_MINOR: u32 = 7;
+/// an axis's `max_accel`; 1.8: an axis's `turns_part`).
+pub const ABI_MINOR: u32 = 8;
 
 /// The call succeeded.
 pub const STATUS_OK: i32 = 0;

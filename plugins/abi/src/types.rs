@@ -68,6 +68,15 @@ pub struct Axis {
     /// ramps every move's speed within it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_accel: Option<f64>,
+    /// Since 1.8: the axis turns the part about the part's axis (Z) on the
+    /// machine, the rest of the machine standing still: a spindle that
+    /// carries the part (a lathe's, a grinder's work spindle; the
+    /// program's S, M3 turning the part about +Z), or a rotary axis bound
+    /// as the tool chain's leading factor, an Rz (a caliber grinder's roll
+    /// turn). The page's player turns the part by it; the geometry is the
+    /// chain's either way.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub turns_part: bool,
 }
 
 impl Axis {
@@ -94,6 +103,7 @@ impl Axis {
             turns: None,
             body: None,
             max_accel: None,
+            turns_part: false,
         }
     }
 
@@ -113,6 +123,7 @@ impl Axis {
             turns: Some(turns),
             body: None,
             max_accel: None,
+            turns_part: false,
         }
     }
 
@@ -124,6 +135,12 @@ impl Axis {
         } else {
             accel
         });
+        self
+    }
+
+    /// The same, turning the part ([`Self::turns_part`]).
+    pub fn turning_part(mut self) -> Self {
+        self.turns_part = true;
         self
     }
 
@@ -737,6 +754,7 @@ mod tests {
             turns: Some([0.0, 0.0, 1.0]),
             body: None,
             max_accel: None,
+            turns_part: false,
         };
         assert!((a.from_user(a.to_user(0.3)) - 0.3).abs() < 1e-15);
         assert_eq!(a.unit(), "deg");

@@ -93,6 +93,7 @@ pub fn describe() -> MachineInfo {
                 turns: None,
                 body: None,
                 max_accel: None,
+                turns_part: true,
             },
         ],
         solved_axes: vec!["X".into(), "Z".into()],

@@ -117,6 +117,7 @@ pub fn describe() -> MachineInfo {
                 turns: None,
                 body: None,
                 max_accel: None,
+                turns_part: true,
             },
         ],
         solved_axes: vec!["Z".into(), "X".into()],

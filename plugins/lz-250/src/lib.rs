@@ -91,7 +91,8 @@ pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInf
             [0.0, 0.0, -1.0],
             "roll turn theta about its axis",
         )
-        .accelerating(720.0),
+        .accelerating(720.0)
+        .turning_part(),
     );
     axes.push(
         Axis::rotary_deg(
@@ -115,6 +116,7 @@ pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInf
         turns: None,
         body: None,
         max_accel: None,
+        turns_part: false,
     });
     let solved: Vec<String> = axes
         .iter()
