@@ -243,10 +243,7 @@ fn the_scene_plays_the_program_block_by_block() {
     let out = scratch("collisions", "playback").join("out");
     let (code, _, err) = pilgrim(&["run", "scripts/mandrel.rhai", "--out", s(&out), "--quiet"]);
     assert_eq!(code, 0, "{err}");
-    let glb = std::fs::read(out.join("scene.glb")).unwrap();
-    let doc = gltf::Gltf::from_slice(&glb).unwrap();
-    let blob = doc.blob.clone().unwrap();
-    let animation = doc.animations().next().expect("an animation");
+    let play = common::Playback::of(&out);
     let program: Value =
         serde_json::from_slice(&std::fs::read(out.join("program.json")).unwrap()).unwrap();
     let blocks = program["blocks"].as_array().unwrap();
@@ -259,28 +256,223 @@ fn the_scene_plays_the_program_block_by_block() {
     let r = common::report_of(&out);
     let cycle_s = 60.0 * r["times"]["accelerated_min"].as_f64().unwrap();
     let mut tracks = std::collections::BTreeMap::new();
-    for channel in animation.channels() {
-        let node = channel.target().node().name().unwrap().to_owned();
-        let reader = channel.reader(|_| Some(&blob[..]));
-        let times: Vec<f32> = reader.read_inputs().unwrap().collect();
+    for ((node, path), (times, values)) in &play.channels {
+        assert!(((*times.last().unwrap() as f64) - cycle_s).abs() < 1e-3 * cycle_s);
+        if node == "part turn" {
+            continue;
+        }
         assert!(
             times.len() > 100 && times.len() <= blocks.len(),
             "{}",
             times.len()
         );
-        assert!(((*times.last().unwrap() as f64) - cycle_s).abs() < 1e-3 * cycle_s);
-        if let gltf::animation::util::ReadOutputs::Translations(t) = reader.read_outputs().unwrap()
-        {
-            tracks.insert(node, t.last().unwrap());
+        if path == "translation" {
+            tracks.insert(node.clone(), values.last().unwrap().clone());
         }
     }
     // The wheel's programmed point is the tool frame's origin: (X, 0, Z).
-    let wheel = tracks["wheel"];
+    let wheel = &tracks["wheel"];
     assert!((wheel[0] as f64 - x).abs() < 1e-3 && (wheel[2] as f64 - z).abs() < 1e-3);
     // The rest's support centre: U on the far side, B = -180 mm along Z.
-    let rest = tracks["rest"];
+    let rest = &tracks["rest"];
     assert!((rest[0] as f64 + u).abs() < 1e-3 && (rest[2] as f64 - (z - 180.0)).abs() < 1e-3);
-    // The guard rides the wheel's centre; the chuck stands still.
+    // The guard rides the wheel's centre; the chuck turns with the part.
     assert!((tracks["guard"][0] as f64 - (x + 250.0)).abs() < 1e-3);
     assert!(!tracks.contains_key("chuck"));
+    for body in ["blank", "part", "chuck", "tailstock_centre"] {
+        assert!(
+            play.turning.iter().any(|b| b == body),
+            "{body}: {:?}",
+            play.turning
+        );
+    }
+    for body in ["wheel", "rest", "guard"] {
+        assert!(!play.turning.iter().any(|b| b == body), "{body}");
+    }
+    // The work spindle turns the part at the program's S, M3 (about +Z),
+    // each key a third of a turn or less from the one before.
+    let (times, angles) = play.spin();
+    let steps: Vec<f64> = angles.windows(2).map(|w| w[1] - w[0]).collect();
+    assert!(steps
+        .iter()
+        .all(|d| (0.0..=std::f64::consts::TAU / 3.0 + 1e-6).contains(d)));
+    let rpm = program["spindle_rpm"].as_f64().unwrap();
+    let turned = (angles.last().unwrap() - angles[0]) / std::f64::consts::TAU;
+    let spun = rpm / 60.0 * (*times.last().unwrap() - times[0]) as f64;
+    assert!(
+        (turned - spun).abs() < 1e-4 * spun,
+        "{turned} turns for {spun}"
+    );
+}
+
+/// The caliber's roll turns as its A turns it, the rest of the machine in
+/// its own frame: at each key the part's turn is the block's A, and the
+/// wheel's centre stands where the slides put it, (Z, Y, X), whatever A is
+/// (the chain `Rz(-A) Tz(X) Tx(Z) Ty(Y) Rx(B)` with its first factor
+/// taken by the roll).
+#[test]
+fn the_roll_turns_as_its_axis_turns_it() {
+    let out = scratch("collisions", "roll-turn").join("out");
+    let (code, _, err) = pilgrim(&["run", "scripts/caliber.rhai", "--out", s(&out), "--quiet"]);
+    assert_eq!(code, 0, "{err}");
+    let play = common::Playback::of(&out);
+    let program: Value =
+        serde_json::from_slice(&std::fs::read(out.join("program.json")).unwrap()).unwrap();
+    let names: Vec<&str> = program["axes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a["name"].as_str().unwrap())
+        .collect();
+    let col = |n: &str| names.iter().position(|&m| m == n).unwrap();
+    let blocks = program["blocks"].as_array().unwrap();
+    let (times, centres) = play.channel("wheel", "translation");
+    assert_eq!(times.len(), play.keys.len());
+    let (mut worst_turn, mut worst_centre, mut swept) = (0.0_f64, 0.0_f64, (f64::MAX, f64::MIN));
+    for (i, &(k, t)) in play.keys.iter().enumerate() {
+        assert_eq!(times[i], t);
+        let v = |n: &str| blocks[k]["values"][col(n)].as_f64().unwrap();
+        let a = v("A").to_radians();
+        let turn = play.spin_at(t);
+        let off = (turn - a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+            - std::f64::consts::PI;
+        worst_turn = worst_turn.max(off.abs());
+        let want = [v("Z"), v("Y"), v("X")];
+        for j in 0..3 {
+            worst_centre = worst_centre.max((centres[i][j] as f64 - want[j]).abs());
+        }
+        swept = (swept.0.min(a), swept.1.max(a));
+    }
+    assert!(
+        worst_turn < 1e-5,
+        "the roll's turn strays {worst_turn} rad from A"
+    );
+    assert!(
+        worst_centre < 1e-3,
+        "the wheel strays {worst_centre} mm from its slides"
+    );
+    // The roll does turn: A sweeps the groove.
+    assert!(swept.1 - swept.0 > 1.0, "{swept:?}");
+    for body in ["caliber", "arbor", "collar_front", "collar_back"] {
+        assert!(
+            play.turning.iter().any(|b| b == body),
+            "{body}: {:?}",
+            play.turning
+        );
+    }
+}
+
+/// The worm turns with its spindle, M3, and in every thread block the
+/// cutter's point stays on one helix of the worm as the lead ties the turn
+/// to the travel: the point in the part frame (the machine frame turned
+/// back by the part's turn) keeps `z - lead * phi / 2 pi` from the block's
+/// start to its end, a right-hand thread.
+#[test]
+fn the_worm_turns_under_the_cutter_as_the_lead_ties_them() {
+    let out = scratch("collisions", "worm-turn").join("out");
+    let (code, _, err) = pilgrim(&["run", "scripts/worm.rhai", "--out", s(&out), "--quiet"]);
+    assert_eq!(code, 0, "{err}");
+    let play = common::Playback::of(&out);
+    let program: Value =
+        serde_json::from_slice(&std::fs::read(out.join("program.json")).unwrap()).unwrap();
+    let blocks = program["blocks"].as_array().unwrap();
+    let (times, points) = play.channel("cutter", "translation");
+    let (_, angles) = play.spin();
+    assert!(
+        angles.windows(2).all(|w| w[1] >= w[0]),
+        "the spindle turns M3 throughout"
+    );
+    let at_key: std::collections::BTreeMap<usize, usize> = play
+        .keys
+        .iter()
+        .enumerate()
+        .map(|(i, &(k, t))| {
+            assert_eq!(times[i], t);
+            (k, i)
+        })
+        .collect();
+    let tau = std::f64::consts::TAU;
+    let helix = |i: usize, lead: f64| {
+        let p = &points[i];
+        let turn = play.spin_at(times[i]);
+        // The point turned back by the part's turn.
+        let (s, c) = (-turn).sin_cos();
+        let (x, y) = (
+            c * p[0] as f64 - s * p[1] as f64,
+            s * p[0] as f64 + c * p[1] as f64,
+        );
+        p[2] as f64 - lead * y.atan2(x) / tau
+    };
+    let (mut threads, mut worst) = (0, 0.0_f64);
+    for (k, b) in blocks.iter().enumerate() {
+        let Some(lead) = b["motion"]["lead"].as_f64() else {
+            continue;
+        };
+        let (Some(&i0), Some(&i1)) = (at_key.get(&(k - 1)), at_key.get(&k)) else {
+            panic!("thread block {} has no keys at its ends", k + 1);
+        };
+        let d = helix(i1, lead) - helix(i0, lead);
+        worst = worst.max(((d + lead / 2.0).rem_euclid(lead) - lead / 2.0).abs());
+        threads += 1;
+    }
+    assert!(threads > 10, "{threads}");
+    assert!(worst < 1e-3, "the cutter leaves its helix by {worst} mm");
+}
+
+/// Which axis turns the part is the machine's data: the caliber grinders'
+/// A, the grinder's work spindle and the lathe's spindle say so, and a
+/// machine file is held to it where it is read: a linear axis cannot, and
+/// a rotary axis only as an Rz that nothing but turns and moves along Z
+/// stand before in the chain (then the part's turn leads it); a chain that
+/// only commutes those factors is the same machine and loads.
+#[test]
+fn an_axis_turns_the_part_only_as_the_chain_allows() {
+    let (code, list, err) = pilgrim(&["machines"]);
+    assert_eq!(code, 0, "{err}");
+    for line in [
+        "A   rotary   [-370, 370] deg, up to 3600 deg/min [turns the part]",
+        "S   spindle  up to 630 rpm [turns the part]",
+        "S   spindle  up to 3500 rpm [turns the part]",
+        "S   spindle  up to 3000 rpm  wheel spindle",
+    ] {
+        assert!(list.contains(line), "{line}\n{list}");
+    }
+    let dir = scratch("collisions", "turns-part");
+    let load = |name: &str, text: &str| {
+        let file = dir.join(name);
+        std::fs::write(&file, text).unwrap();
+        pilgrim(&["machines", "--file", s(&file)])
+    };
+    let linear = machine_with(
+        "LZ-250",
+        &[(
+            "moves = [0.0, 0.0, 1.0]\n",
+            "moves = [0.0, 0.0, 1.0]\nturns_part = true\n",
+        )],
+    );
+    let (code, _, err) = load("linear.toml", &linear);
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("axis X: turns_part cannot be set: a linear axis moves the part"),
+        "{err}"
+    );
+    // Tz(X) Tx(Z) Rz(-A): the turn no longer leads.
+    let rz = "[[chain]]\nfactor = \"rz\"\naxis = \"A\"\nscale = -1.0\n\n";
+    let (tz, tx) = (
+        "[[chain]]\nfactor = \"tz\"\naxis = \"X\"\n\n",
+        "[[chain]]\nfactor = \"tx\"\naxis = \"Z\"\n\n",
+    );
+    let behind = machine_with(
+        "LZ-250",
+        &[(&format!("{rz}{tz}{tx}"), &format!("{tz}{tx}{rz}"))],
+    );
+    let (code, _, err) = load("behind.toml", &behind);
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("axis A: turns_part, but its factor is the tool chain's number 3, Rz"),
+        "{err}"
+    );
+    let commuted = machine_with("LZ-250", &[(&format!("{rz}{tz}"), &format!("{tz}{rz}"))]);
+    let (code, _, err) = load("commuted.toml", &commuted);
+    assert_eq!(code, 0, "{err}");
 }

@@ -492,3 +492,110 @@ pub fn measured(
         std::thread::sleep(std::time::Duration::from_millis(20));
     }
 }
+
+/// A channel of an animation: its key times and the values at them.
+pub type Channel = (Vec<f32>, Vec<Vec<f32>>);
+
+/// A run's animation, as `scene.glb` holds it and the page plays it.
+#[allow(dead_code)]
+pub struct Playback {
+    /// Per node and channel path (`translation`, `rotation`): the key times
+    /// and the values at them.
+    pub channels: std::collections::BTreeMap<(String, String), Channel>,
+    /// The page's player keys: each key's block (from 0) and time (s).
+    pub keys: Vec<(usize, f32)>,
+    /// The bodies that turn with the part (the children of its turn's node).
+    pub turning: Vec<String>,
+}
+
+#[allow(dead_code)]
+impl Playback {
+    /// The animation of the run in `dir` (its `scene.glb` and the keys of
+    /// its `report.html`).
+    pub fn of(dir: &Path) -> Self {
+        use gltf::animation::util::ReadOutputs;
+        let glb = std::fs::read(dir.join("scene.glb")).unwrap();
+        let doc = gltf::Gltf::from_slice(&glb).unwrap();
+        let blob = doc.blob.clone().unwrap();
+        let animation = doc.animations().next().expect("an animation");
+        let mut channels = std::collections::BTreeMap::new();
+        for channel in animation.channels() {
+            let node = channel.target().node().name().unwrap().to_owned();
+            let reader = channel.reader(|_| Some(&blob[..]));
+            let times: Vec<f32> = reader.read_inputs().unwrap().collect();
+            let (path, values): (&str, Vec<Vec<f32>>) = match reader.read_outputs().unwrap() {
+                ReadOutputs::Translations(t) => ("translation", t.map(|v| v.to_vec()).collect()),
+                ReadOutputs::Rotations(r) => {
+                    ("rotation", r.into_f32().map(|v| v.to_vec()).collect())
+                }
+                _ => panic!("a channel of another kind"),
+            };
+            channels.insert((node, path.to_owned()), (times, values));
+        }
+        let turning = doc
+            .nodes()
+            .find(|n| n.name() == Some("part turn"))
+            .map(|n| n.children().map(|c| c.name().unwrap().to_owned()).collect())
+            .unwrap_or_default();
+        let page = std::fs::read_to_string(dir.join("report.html")).unwrap();
+        let start = page
+            .find("<script type=\"application/json\" id=\"keys\">")
+            .expect("the player's keys");
+        let text = &page[start..];
+        let text = &text[text.find('>').unwrap() + 1..text.find("</script>").unwrap()];
+        let rows: Vec<serde_json::Value> = serde_json::from_str(text).unwrap();
+        let keys = rows
+            .iter()
+            .map(|r| {
+                (
+                    r[2].as_u64().unwrap() as usize,
+                    r[1].as_f64().unwrap() as f32,
+                )
+            })
+            .collect();
+        Self {
+            channels,
+            keys,
+            turning,
+        }
+    }
+
+    /// A node's channel (`translation` or `rotation`): times and values.
+    pub fn channel(&self, node: &str, path: &str) -> &Channel {
+        self.channels
+            .get(&(node.to_owned(), path.to_owned()))
+            .unwrap_or_else(|| panic!("no {path} of {node} in the animation"))
+    }
+
+    /// The part's turn at its keys: times, and angles about +Z (rad),
+    /// unwrapped from the quaternions (each step the short way).
+    pub fn spin(&self) -> (Vec<f32>, Vec<f64>) {
+        let (times, q) = self.channel("part turn", "rotation");
+        let mut angles: Vec<f64> = Vec::with_capacity(q.len());
+        for v in q {
+            assert!(
+                v[0].abs() < 1e-6 && v[1].abs() < 1e-6,
+                "a turn not about Z: {v:?}"
+            );
+            let a = 2.0 * (v[2] as f64).atan2(v[3] as f64);
+            let a = match angles.last() {
+                Some(&last) => last + (a - last + PI).rem_euclid(TAU) - PI,
+                None => a,
+            };
+            angles.push(a);
+        }
+        (times.clone(), angles)
+    }
+
+    /// The part's turn at the time `t` of one of its keys (rad).
+    pub fn spin_at(&self, t: f32) -> f64 {
+        let (times, angles) = self.spin();
+        let i = times
+            .iter()
+            .position(|&s| s == t)
+            .unwrap_or_else(|| panic!("no key of the part's turn at {t} s"));
+        angles[i]
+    }
+}
+
+use std::f64::consts::{PI, TAU};

@@ -40,6 +40,12 @@ pub struct PlacedBody {
 pub struct Placement {
     axes: Vec<String>,
     tool: Option<(Chain, Vec<usize>)>,
+    /// The tool chain's factors that are the part's own turn (Rz of axes
+    /// that turn the part, [`crate::machine::Axis::turns_part`], among the
+    /// factors that commute with them at the chain's lead).
+    part_turn: Vec<usize>,
+    /// A spindle carries the part: it turns at the program's S.
+    pub spindle_turns_part: bool,
     /// The bodies that have a solid and can be placed.
     pub bodies: Vec<PlacedBody>,
     /// Bodies left out, and why.
@@ -159,9 +165,29 @@ impl Placement {
             let cols = c.axis_names().iter().map(col).collect();
             (c, cols)
         });
+        // The factors that turn the part: Rz of its turning axes among the
+        // chain's leading factors that commute with them (the machine's
+        // check holds every such axis there).
+        let part_turn = tool.as_ref().map_or_else(Vec::new, |(c, _)| {
+            let lead = crate::machine::part_turn_lead(c);
+            (0..lead)
+                .filter(|&k| {
+                    let f = &c.factors()[k];
+                    f.kind == crate::transform::FactorKind::Rz
+                        && matches!(f.value, crate::transform::FactorValue::Axis { axis, .. }
+                            if info.axis(&c.axis_names()[axis]).is_some_and(|a| a.turns_part))
+                })
+                .collect()
+        });
+        let spindle_turns_part = info
+            .axes
+            .iter()
+            .any(|a| a.kind == crate::machine::AxisKind::Spindle && a.turns_part);
         Ok(Self {
             axes,
             tool,
+            part_turn,
+            spindle_turns_part,
             bodies,
             notes,
         })
@@ -191,6 +217,28 @@ impl Placement {
             }
             None => Ok(Mat4::identity()),
         }
+    }
+
+    /// How far the machine's axes have turned the part about its axis
+    /// (Z) at the axis values `q` (rad, right-handed, from where the part
+    /// frame stands on the machine at zero): the inverse of the tool
+    /// chain's leading turns of the part; 0 when none. The spindle's turn
+    /// is not in `q` ([`Self::spindle_turns_part`]).
+    pub fn part_turn(&self, q: &[Real]) -> Real {
+        let Some((c, cols)) = &self.tool else {
+            return 0.0;
+        };
+        self.part_turn
+            .iter()
+            .map(|&k| match c.factors()[k].value {
+                crate::transform::FactorValue::Axis {
+                    axis,
+                    scale,
+                    offset,
+                } => -(scale * q[cols[axis]] + offset),
+                crate::transform::FactorValue::Const(v) => -v,
+            })
+            .sum()
     }
 
     /// Body `i`'s frame in the part frame, the tool frame being `tool`.

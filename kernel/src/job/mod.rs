@@ -15,6 +15,7 @@ mod export;
 mod page;
 mod scene;
 mod solids;
+mod spin;
 
 pub use crate::report::{axis_ranges, block_table, FailedRun, Report, ReportParam};
 pub use export::{export, run_machine, Exported};

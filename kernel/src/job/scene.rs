@@ -181,20 +181,26 @@ fn machine_bodies(
 /// every so many blocks (the page's listing stays exact).
 pub const MAX_KEYS: usize = 2000;
 
-/// The program's motion for the scene: the tool (its node `tool_name`)
-/// and every machine body that moves, placed by `placement`, at the end of each block (of every k-th
-/// block where there are more than [`MAX_KEYS`]), at the time the program
-/// reaches it as the machine moves it (`block_s`: each block's seconds,
-/// [`crate::timing::Times::block_s`]). `None` when nothing moves.
+/// The program's motion for the scene, on the machine: the tool (its node
+/// `tool_name`) and every machine body that moves, placed by `placement`,
+/// at the end of each block (of every k-th block where there are more than
+/// [`MAX_KEYS`]), at the time the program reaches it as the machine moves
+/// it (`block_s`: each block's seconds,
+/// [`crate::timing::Times::block_s`]); and the part turning with the bodies
+/// fixed to it (`turning`) as the machine's axes turn it
+/// ([`super::spin`]). The tool and the moving bodies are placed on the
+/// machine: the part frame turned by the rotary axes' turn of the part.
+/// `None` when nothing moves.
 ///
 /// # Failures
 /// A body's description failing; the program lacking an axis.
 fn motion(
     machine: &dyn MachineKinematics,
     program: &AxisProgram,
-    tool_name: Option<&str>,
+    (tool, tool_name): (&Tool, Option<&str>),
     placement: &crate::collision::Placement,
     block_s: &[f64],
+    turning: Vec<String>,
 ) -> Result<Option<mesh::Motion>, SceneError> {
     let info = machine.info();
     let n = program.blocks.len();
@@ -202,12 +208,36 @@ fn motion(
         .filter(|&i| !placement.bodies[i].moved_by.is_empty())
         .collect();
     let tool_name = tool_name.filter(|_| placement.tool_axes().is_some());
-    if n == 0 || (moving.is_empty() && tool_name.is_none()) {
+    if n == 0 {
         return Ok(None);
     }
     let rows = axis_rows(program, info, placement.axes(), 0..n).map_err(SceneError::Place)?;
     let w = placement.axes().len();
+    let rotary: Vec<f64> = (0..n)
+        .map(|k| placement.part_turn(&rows[k * w..(k + 1) * w]))
+        .collect();
     let every = n.div_ceil(MAX_KEYS).max(1);
+    let keyed = |k: usize| k.is_multiple_of(every) || k + 1 == n;
+    let turns = super::spin::part_turns(
+        machine,
+        program,
+        tool,
+        &rotary,
+        placement.spindle_turns_part,
+        block_s,
+    )?;
+    let spin = if turns.iter().all(|&a| a == 0.0) || turning.is_empty() {
+        None
+    } else {
+        super::spin::spin_keys(&turns, block_s, keyed).map(|(times, angles)| mesh::Spin {
+            members: turning,
+            times,
+            angles,
+        })
+    };
+    if moving.is_empty() && tool_name.is_none() && spin.is_none() {
+        return Ok(None);
+    }
     let (mut times, mut keys) = (Vec::new(), Vec::new());
     let mut tracks: Vec<(String, Vec<Mat4>)> = tool_name
         .into_iter()
@@ -218,23 +248,23 @@ fn motion(
     let mut clock = 0.0;
     for k in 0..n {
         clock += block_s.get(k).copied().unwrap_or(0.0);
-        let key = k % every == 0 || k + 1 == n;
         let t = clock as f32;
-        if !key || times.last().is_some_and(|&last| t <= last) {
+        if !keyed(k) || times.last().is_some_and(|&last| t <= last) {
             continue;
         }
         times.push(t);
         keys.push(k);
         let q = &rows[k * w..(k + 1) * w];
+        let on_machine = Mat4::from_axis_angle(&Vec3::z_axis(), rotary[k]);
         let frame = placement.tool_frame(q).map_err(placing)?;
         let mut track = tracks.iter_mut();
         if tool_name.is_some() {
             if let Some((_, poses)) = track.next() {
-                poses.push(frame);
+                poses.push(on_machine * frame);
             }
         }
         for (&i, (_, poses)) in moving.iter().zip(track) {
-            poses.push(placement.body_frame(i, q, &frame).map_err(placing)?);
+            poses.push(on_machine * placement.body_frame(i, q, &frame).map_err(placing)?);
         }
     }
     Ok(Some(mesh::Motion {
@@ -242,6 +272,7 @@ fn motion(
         times,
         keys,
         tracks,
+        spin,
     }))
 }
 
@@ -376,9 +407,7 @@ pub fn tool_pose(
     let start = at_place(program, PosePlace::at_end(place.block - 1))?;
     let from = crate::replay::replay_blocks(&start, machine, &tool.reference, 0..1)
         .map_err(|e| SceneError::Place(e.to_string()))?;
-    let dir = (pose[2] - from[2]).signum();
-    let z_section = from[2] - dir * lead * start_deg / 360.0;
-    let angle = std::f64::consts::TAU * (pose[2] - z_section) / lead;
+    let angle = super::spin::thread_turn(from[2], pose[2], lead, start_deg, pose[2]);
     Ok(ToolAt {
         pose: Mat4::from_axis_angle(&Vec3::z_axis(), angle) * frame,
         lead,
@@ -422,12 +451,28 @@ pub fn stage(
     let pose = tool_pose(program, machine, tool, place)?;
     let solid = tool_mesh(tool, &pose, tol)?;
     let others = machine_bodies(machine, program, place, &pose, placement, tol)?;
+    // What turns with the part: its bodies, the overlays on it, and the
+    // machine's bodies that stand still in its frame (a chuck, an arbor),
+    // as the collision check holds them.
+    let turning = parts
+        .iter()
+        .map(|(name, _)| name.clone())
+        .chain(overlays.iter().map(|o| o.0.clone()))
+        .chain(
+            placement
+                .bodies
+                .iter()
+                .filter(|b| b.moved_by.is_empty())
+                .map(|b| b.name.clone()),
+        )
+        .collect();
     let motion = motion(
         machine,
         program,
-        solid.as_ref().map(|(_, name)| *name),
+        (tool, solid.as_ref().map(|(_, name)| *name)),
         placement,
         block_s,
+        turning,
     )?;
     let playback = motion
         .as_ref()

@@ -37,7 +37,9 @@ fn build(scene: &Scene, uri: Option<String>) -> Result<(json::Root, Vec<u8>), Me
         .map(|n| n.mesh.positions.len() * 24 + n.mesh.triangles.len() * 12)
         .sum::<usize>()
         + scene.motion.as_ref().map_or(0, |m| {
-            m.times.len() * 4 + m.tracks.len() * m.times.len() * (12 + 16)
+            m.times.len() * 4
+                + m.tracks.len() * m.times.len() * (12 + 16)
+                + m.spin.as_ref().map_or(0, |s| s.times.len() * (4 + 16))
         });
     let mut bin: Vec<u8> = Vec::with_capacity(size);
     let buffer = root.push(json::Buffer {
@@ -197,15 +199,39 @@ fn build(scene: &Scene, uri: Option<String>) -> Result<(json::Root, Vec<u8>), Me
             ..Default::default()
         }));
     }
+    // The bodies that turn with the part hang from one node the spin turns.
+    let mut top_children = children.clone();
+    let mut spin_node = None;
+    if let Some(spin) = scene.motion.as_ref().and_then(|m| m.spin.as_ref()) {
+        let mut members = Vec::new();
+        for name in &spin.members {
+            let Some(i) = scene.nodes.iter().position(|n| &n.name == name) else {
+                return Err(MeshError::Degenerate(format!(
+                    "the part's turn: no body '{name}' in the scene"
+                )));
+            };
+            members.push(children[i]);
+        }
+        top_children.retain(|c| !members.contains(c));
+        let node = root.push(json::Node {
+            name: Some(SPIN_NODE.into()),
+            children: Some(members),
+            ..Default::default()
+        });
+        top_children.push(node);
+        spin_node = Some(node);
+    }
     if let Some(motion) = &scene.motion {
-        animate(&mut root, &mut bin, buffer, motion, scene, &children)?;
+        animate(
+            &mut root, &mut bin, buffer, motion, scene, &children, spin_node,
+        )?;
     }
     let half = std::f32::consts::FRAC_1_SQRT_2;
     let top = root.push(json::Node {
         name: Some(
             "pilgrim part frame (mm; its axis Z to the right, X away from the viewer)".into(),
         ),
-        children: Some(children),
+        children: Some(top_children),
         scale: Some([0.001; 3]),
         rotation: Some(json::scene::UnitQuaternion([0.0, half, 0.0, half])),
         ..Default::default()
@@ -220,6 +246,9 @@ fn build(scene: &Scene, uri: Option<String>) -> Result<(json::Root, Vec<u8>), Me
     Ok((root, bin))
 }
 
+/// The name of the node that turns the part's bodies about its axis.
+pub const SPIN_NODE: &str = "part turn";
+
 /// A rigid motion's translation and rotation.
 fn parts_of(pose: &crate::math::Mat4) -> (nalgebra::Vector3<f64>, nalgebra::UnitQuaternion<f64>) {
     let r = pose.fixed_view::<3, 3>(0, 0).into_owned();
@@ -232,11 +261,12 @@ fn parts_of(pose: &crate::math::Mat4) -> (nalgebra::Vector3<f64>, nalgebra::Unit
 
 /// Appends `motion` to `root` as one animation: a sampler of the key
 /// times and each track's translations and rotations (each quaternion on
-/// the side of the one before, so that the player turns the short way).
+/// the side of the one before, so that the player turns the short way);
+/// the part's turn, if any, on its own key times, turning `spin_node`.
 ///
 /// # Failures
 /// A track of a body the scene lacks, or of another length than the
-/// times; times that do not increase.
+/// times; times that do not increase; a spin's keys too far apart.
 fn animate(
     root: &mut json::Root,
     bin: &mut Vec<u8>,
@@ -244,6 +274,7 @@ fn animate(
     motion: &crate::mesh::scene::Motion,
     scene: &Scene,
     nodes: &[json::Index<json::Node>],
+    spin_node: Option<json::Index<json::Node>>,
 ) -> Result<(), MeshError> {
     use json::accessor::{ComponentType, Type};
     let bad = |m: String| MeshError::Degenerate(format!("animation '{}': {m}", motion.name));
@@ -288,6 +319,26 @@ fn animate(
     };
     let input = push(root, &motion.times, Type::Scalar, true);
     let (mut samplers, mut channels) = (Vec::new(), Vec::new());
+    let mut channel = |samplers: &mut Vec<json::animation::Sampler>, input, output, node, path| {
+        channels.push(json::animation::Channel {
+            sampler: json::Index::new(samplers.len() as u32),
+            target: json::animation::Target {
+                node,
+                path: Valid(path),
+                extensions: None,
+                extras: Default::default(),
+            },
+            extensions: None,
+            extras: Default::default(),
+        });
+        samplers.push(json::animation::Sampler {
+            input,
+            interpolation: Valid(json::animation::Interpolation::Linear),
+            output,
+            extensions: None,
+            extras: Default::default(),
+        });
+    };
     for (name, poses) in &motion.tracks {
         let Some(i) = scene.nodes.iter().position(|n| &n.name == name) else {
             return Err(bad(format!("no body '{name}' in the scene")));
@@ -315,25 +366,48 @@ fn animate(
             (turns, Type::Vec4, json::animation::Property::Rotation),
         ] {
             let output = push(root, &values, ty, false);
-            channels.push(json::animation::Channel {
-                sampler: json::Index::new(samplers.len() as u32),
-                target: json::animation::Target {
-                    node: nodes[i],
-                    path: Valid(path),
-                    extensions: None,
-                    extras: Default::default(),
-                },
-                extensions: None,
-                extras: Default::default(),
-            });
-            samplers.push(json::animation::Sampler {
-                input,
-                interpolation: Valid(json::animation::Interpolation::Linear),
-                output,
-                extensions: None,
-                extras: Default::default(),
-            });
+            channel(&mut samplers, input, output, nodes[i], path);
         }
+    }
+    if let (Some(spin), Some(node)) = (&motion.spin, spin_node) {
+        let n = spin.times.len();
+        if n == 0 || spin.angles.len() != n || spin.times.windows(2).any(|w| w[1] <= w[0]) {
+            return Err(bad(
+                "the part's turn needs increasing key times, an angle each".into(),
+            ));
+        }
+        if let Some(k) = spin
+            .angles
+            .windows(2)
+            .position(|w| !((w[1] - w[0]).abs() <= crate::mesh::MAX_SPIN_STEP))
+        {
+            return Err(bad(format!(
+                "the part's turn goes {:.1} deg between its keys {} and {}, more than a player can show",
+                (spin.angles[k + 1] - spin.angles[k]).to_degrees(),
+                k + 1,
+                k + 2
+            )));
+        }
+        let input = push(root, &spin.times, Type::Scalar, true);
+        let turns: Vec<f32> = spin
+            .angles
+            .iter()
+            .flat_map(|a| {
+                let (s, c) = (0.5 * a).sin_cos();
+                [0.0, 0.0, s as f32, c as f32]
+            })
+            .collect();
+        // Consecutive angles within a third of a turn keep each quaternion
+        // on the side of the one before (their dot product is cos of half
+        // the step).
+        let output = push(root, &turns, Type::Vec4, false);
+        channel(
+            &mut samplers,
+            input,
+            output,
+            node,
+            json::animation::Property::Rotation,
+        );
     }
     root.push(json::Animation {
         name: Some(motion.name.clone()),
@@ -416,6 +490,7 @@ mod tests {
             times: vec![0.0, 0.5, 1.0, 2.0],
             keys: vec![0, 1, 2, 3],
             tracks: vec![("box".into(), (0..4).map(pose).collect())],
+            spin: None,
         });
         let mut glb = Vec::new();
         write_glb(&scene, &mut glb).unwrap();
@@ -455,5 +530,58 @@ mod tests {
         // Times that do not increase are refused.
         scene.motion.as_mut().unwrap().times = vec![0.0, 0.5, 0.5, 2.0];
         assert!(write_glb(&scene, &mut Vec::new()).is_err());
+    }
+
+    /// A spin hangs its members from one node it turns about Z, on its own
+    /// key times; a step a player would show turning back is refused.
+    #[test]
+    fn a_spin_turns_its_members_on_its_own_keys() {
+        let mesh = crate::mesh::body_mesh(&Solid::Block { size: [1.0; 3] }, 0.01).unwrap();
+        let mut scene = Scene::new();
+        scene.add("box", mesh.clone(), Mat4::identity(), [1.0; 4]);
+        scene.add("tool", mesh, Mat4::identity(), [1.0; 4]);
+        let spin = |angles: Vec<f64>| crate::mesh::Spin {
+            members: vec!["box".into()],
+            times: (0..angles.len()).map(|k| k as f32 * 0.25).collect(),
+            angles,
+        };
+        scene.motion = Some(Motion {
+            name: "turn".into(),
+            times: vec![0.0, 1.0],
+            keys: vec![0, 1],
+            tracks: vec![("tool".into(), vec![Mat4::identity(); 2])],
+            spin: Some(spin(vec![0.0, 2.0, 4.0, 6.0, 8.0])),
+        });
+        let mut glb = Vec::new();
+        write_glb(&scene, &mut glb).unwrap();
+        let doc = gltf::Gltf::from_slice(&glb).unwrap();
+        let blob = doc.blob.clone().unwrap();
+        let turn = doc.nodes().find(|n| n.name() == Some(SPIN_NODE)).unwrap();
+        let members: Vec<_> = turn
+            .children()
+            .map(|c| c.name().unwrap().to_owned())
+            .collect();
+        assert_eq!(members, vec!["box".to_owned()]);
+        let channel = doc
+            .animations()
+            .next()
+            .unwrap()
+            .channels()
+            .find(|c| c.target().node().index() == turn.index())
+            .unwrap();
+        let reader = channel.reader(|_| Some(&blob[..]));
+        assert_eq!(reader.read_inputs().unwrap().count(), 5);
+        let gltf::animation::util::ReadOutputs::Rotations(r) = reader.read_outputs().unwrap()
+        else {
+            panic!("the turn is a rotation");
+        };
+        for (k, q) in r.into_f32().enumerate() {
+            let a = 2.0 * k as f64;
+            assert!((q[2] as f64 - (a / 2.0).sin()).abs() < 1e-6);
+            assert!((q[3] as f64 - (a / 2.0).cos()).abs() < 1e-6);
+        }
+        scene.motion.as_mut().unwrap().spin = Some(spin(vec![0.0, 2.2]));
+        let e = write_glb(&scene, &mut Vec::new()).unwrap_err();
+        assert!(e.to_string().contains("126.1 deg"), "{e}");
     }
 }

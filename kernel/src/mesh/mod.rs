@@ -22,7 +22,7 @@ mod sweep;
 pub use bodies::body_mesh;
 pub use gltf_writer::{write_glb, write_gltf};
 pub use revolve::{body_of_revolution, cylinder, revolve, wheel};
-pub use scene::{frame_from_pose, Motion, Node, Scene};
+pub use scene::{frame_from_pose, Motion, Node, Scene, Spin, MAX_SPIN_STEP};
 pub use stl_writer::{read_stl, read_stl_bytes, write_stl, StlFormat};
 pub use sweep::sweep;
 

@@ -30,7 +30,29 @@ pub struct Motion {
     pub keys: Vec<usize>,
     /// For each moving body (by its node's name), its pose at each key.
     pub tracks: Vec<(String, Vec<Mat4>)>,
+    /// The part's turn about its axis, on its own keys.
+    pub spin: Option<Spin>,
 }
+
+/// Bodies turning together about the part's axis (Z) on keys of their own
+/// (a spindle turns many times between the motion's keys): played as one
+/// group node of the scene, turned right-handed by the angle.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Spin {
+    /// The bodies that turn (by their nodes' names): the part and what is
+    /// fixed to it.
+    pub members: Vec<String>,
+    /// The key times (s from the start), increasing.
+    pub times: Vec<f32>,
+    /// The angle at each key (rad), each within [`MAX_SPIN_STEP`] of the
+    /// one before, so that the player turns the way the part turns.
+    pub angles: Vec<f64>,
+}
+
+/// The most a spin turns between two keys (a third of a turn): well below
+/// the half turn at which a player's interpolation would turn it the other
+/// way.
+pub const MAX_SPIN_STEP: f64 = std::f64::consts::TAU / 3.0;
 
 /// Named bodies with poses, in the part frame (mm, Z up), and how they
 /// move, if they do.
