@@ -16,7 +16,9 @@
 //! [`IPO_CYCLE`] where it states none): so a straight run of short blocks
 //! flows at its feed, and a corner slows to what its axes can turn. A
 //! thread starts and ends at rest (its feed is tied to the spindle), and so
-//! do the program's start and end. The speeds at the corners come from a
+//! do the program's start and end; a thread waits at its start for the
+//! spindle's one-revolution signal, half a turn on average at the speed it
+//! runs at (chained threads wait once). The speeds at the corners come from a
 //! backward and a forward pass over the blocks (each block's entry speed no
 //! more than lets it stop in time), as a control's look-ahead plans them.
 //!
@@ -71,6 +73,11 @@ pub struct Times {
     pub unramped_axes: Vec<String>,
     /// The interpolation cycle the blends were planned with (s).
     pub ipo_cycle_s: Real,
+    /// The seconds the threads wait in all for the spindle's
+    /// one-revolution signal before they start (half a turn each on
+    /// average), in [`Self::accelerated_min`].
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub thread_sync_s: Real,
     /// Each block's seconds with the axes' acceleration (the first, the
     /// start, 0): the scene's animation runs on them.
     #[serde(skip)]
@@ -199,7 +206,25 @@ pub fn times(program: &AxisProgram, info: &MachineInfo, passes: &[ProgramPass]) 
         let (v0, v1) = (if k > 0 { corner[k - 1] } else { 0.0 }, corner[k]);
         trapezoid(v0, v1, m.speed, m.accel, m.length)
     };
-    let accelerated: Vec<Real> = (0..n).map(block_time).collect();
+    let mut accelerated: Vec<Real> = (0..n).map(block_time).collect();
+    // A thread starts on the spindle's one-revolution signal (its feed is
+    // tied to the turn): the carriage waits at the thread's start for it,
+    // half a turn on average (where the spindle stands when the carriage
+    // arrives is not known to a turn). A thread chained to a thread before
+    // it runs on without a wait.
+    let mut rpm = program.spindle_rpm;
+    let mut thread_sync_s = 0.0;
+    for k in 0..n {
+        let b = &program.blocks[k];
+        rpm = b.spindle.unwrap_or(rpm);
+        let thread = |m: &Motion| matches!(m, Motion::Thread { .. });
+        let chained = k > 0 && thread(&program.blocks[k - 1].motion);
+        if thread(&b.motion) && !chained && rpm > 0.0 {
+            let wait = 30.0 / rpm;
+            accelerated[k.saturating_sub(1)] += wait;
+            thread_sync_s += wait;
+        }
+    }
     let minutes = |t: &[Real]| t.iter().sum::<Real>() / 60.0;
     let programmed: Vec<Real> = moves.iter().map(|m| m.programmed).collect();
     Times {
@@ -220,8 +245,13 @@ pub fn times(program: &AxisProgram, info: &MachineInfo, passes: &[ProgramPass]) 
             .map(|a| a.name.clone())
             .collect(),
         ipo_cycle_s: ipo,
+        thread_sync_s,
         block_s: accelerated,
     }
+}
+
+fn is_zero(v: &Real) -> bool {
+    *v == 0.0
 }
 
 /// The time (s) to run `length` entering at `v0`, leaving at `v1`, never
@@ -258,5 +288,32 @@ mod tests {
         let t = trapezoid(50.0, 50.0, 50.0, 1000.0, 10.0);
         assert!((t - 0.2).abs() < 1e-12, "{t}");
         assert_eq!(trapezoid(0.0, 0.0, 50.0, Real::INFINITY, 10.0), 0.2);
+    }
+
+    /// A thread waits at its start for the spindle's one-revolution
+    /// signal, half a turn on average at the speed it runs at; the wait
+    /// ends the block before it (the carriage stands at the thread's
+    /// start); a thread chained to one before it does not wait again.
+    #[test]
+    fn a_thread_waits_half_a_turn_for_the_spindles_index() {
+        let info = fanuc_0i_tc::describe();
+        let mut p = crate::program::test_program();
+        let t = times(&p, &info, &[]);
+        let half = 30.0 / p.spindle_rpm;
+        assert!(
+            (t.thread_sync_s - half).abs() < 1e-12,
+            "{}",
+            t.thread_sync_s
+        );
+        // Block 4 (from 1) does not move: its time is the wait.
+        assert!((t.block_s[3] - half).abs() < 1e-12, "{:?}", t.block_s);
+        let sum: Real = t.block_s.iter().sum();
+        assert!((sum / 60.0 - t.accelerated_min).abs() < 1e-12);
+        let mut chained = p.blocks[4].clone();
+        chained.values = vec![40.0, -70.0];
+        p.blocks.insert(5, chained);
+        assert!((times(&p, &info, &[]).thread_sync_s - half).abs() < 1e-12);
+        p.blocks[1].spindle = Some(100.0);
+        assert!((times(&p, &info, &[]).thread_sync_s - 0.3).abs() < 1e-12);
     }
 }

@@ -199,8 +199,16 @@ fn pass_times(out: &mut String, r: &Report) {
         return;
     }
     out.push_str(&format!(
-        "<h2>Times</h2>\n<p>Click a pass to see its start. Each pass at its programmed feeds and with every move ramped within the axes' acceleration, blending corners as far as one interpolation cycle ({} ms) of acceleration allows.{}</p>\n<table><tr><th>pass</th><th>at the feeds (s)</th><th>with acceleration (s)</th></tr>\n",
+        "<h2>Times</h2>\n<p>Click a pass to see its start. Each pass at its programmed feeds and with every move ramped within the axes' acceleration, blending corners as far as one interpolation cycle ({} ms) of acceleration allows.{}{}</p>\n<table><tr><th>pass</th><th>at the feeds (s)</th><th>with acceleration (s)</th></tr>\n",
         fixed(1000.0 * t.ipo_cycle_s, 1),
+        if t.thread_sync_s > 0.0 {
+            format!(
+                " Each thread waits at its start for the spindle's one-revolution signal, half a turn on average: {} s in all.",
+                fixed(t.thread_sync_s, 1)
+            )
+        } else {
+            String::new()
+        },
         if t.unramped_axes.is_empty() {
             String::new()
         } else {

@@ -5,13 +5,14 @@
 //!   A): the part's turn is the inverse of those factors at the block's
 //!   axis values ([`crate::collision::Placement::part_turn`]).
 //! - A spindle carrying the part (a lathe's, a grinder's work spindle): it
-//!   turns at the program's S, M3 about +Z, every post writing M3. In a
+//!   turns at the program's S (as the blocks set it), M3 about +Z, every
+//!   post writing M3. In a
 //!   thread block the lead ties the part's turn to the tool's travel, the
 //!   part placed as the worm's simulation places each cut
 //!   ([`thread_turn`]); the control's index pulse starts each thread at its
-//!   start angle, which the player shows as the spindle reaching that
-//!   angle over the stretch before the thread (the cycle time has no wait
-//!   for the pulse).
+//!   start angle: the cycle time has the carriage wait half a turn for it
+//!   on average ([`crate::timing`]), and the player shows the spindle
+//!   reaching that angle over the stretch before the thread.
 //!
 //! The angles are sampled on keys of their own ([`spin_keys`]): a spindle
 //! turns many times between two blocks' ends, and a player turns the short
@@ -62,7 +63,7 @@ pub fn part_turns(
     if !spindle {
         return Ok(rotary.to_vec());
     }
-    let omega = program.spindle_rpm.max(0.0) * TAU / 60.0;
+    let mut rpm = program.spindle_rpm;
     let z_at = |k: usize| -> Result<f64, SceneError> {
         crate::replay::replay_blocks(program, machine, &tool.reference, k..k + 1)
             .map(|p| p[2])
@@ -74,6 +75,7 @@ pub fn part_turns(
     let (mut stretch, mut stretch_t0) = (0, 0.0);
     for (k, b) in program.blocks.iter().enumerate() {
         let dt = block_s.get(k).copied().unwrap_or(0.0);
+        rpm = b.spindle.unwrap_or(rpm);
         match b.motion {
             Motion::Thread { lead, start_deg } if k > 0 => {
                 let (from, to) = (z_at(k - 1)?, z_at(k)?);
@@ -95,7 +97,7 @@ pub fn part_turns(
                 stretch = k + 1;
                 stretch_t0 = clock + dt;
             }
-            _ => theta += omega * dt,
+            _ => theta += rpm.max(0.0) * TAU / 60.0 * dt,
         }
         ends.push(theta);
         clock += dt;
@@ -112,7 +114,8 @@ pub fn part_turns(
 /// and where the turn would otherwise go more than [`MAX_SPIN_STEP`]
 /// between keys (a block that turns more is cut into equal parts, the
 /// turn linear in time within it). Times as the motion's (f32 seconds),
-/// increasing; `None` when the turn needs more than [`MAX_SPIN_KEYS`].
+/// increasing; `None` when the turn needs more than [`MAX_SPIN_KEYS`], or
+/// when blocks of no time turn it further than a key's step.
 pub fn spin_keys(
     turns: &[f64],
     block_s: &[f64],
