@@ -80,6 +80,7 @@ mod report;
 pub mod revolution;
 pub mod script;
 pub mod step;
+pub mod thread;
 pub mod timing;
 pub mod tool;
 pub mod toolpath;

@@ -1,0 +1,177 @@
+//! A thread's axial section as data: what every profile (ISO metric,
+//! trapezoidal, ACME, buttress, the worms) gives the planning and the
+//! verification, whatever standard it comes from.
+//!
+//! The section is a rack along the part's axis: each space (the groove a
+//! cutter makes) has two straight flanks, each at its own angle from the
+//! radial direction (a buttress's differ), a width at the pitch diameter,
+//! and a root. An external thread's space opens outwards, from its root
+//! (the minor diameter) to its crest (the major, the blank's); an internal
+//! thread's opens inwards, from its root (the major) to its crest (the
+//! minor, the bore). Lengths in mm, angles in radians.
+
+use crate::math::Real;
+use serde::Serialize;
+
+/// The way the thread winds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Hand {
+    /// Right-handed: advancing along +Z as it turns about +Z.
+    Right,
+    /// Left-handed.
+    Left,
+}
+
+/// A diameter's limits (mm).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Limits {
+    /// The least.
+    pub min: Real,
+    /// The most.
+    pub max: Real,
+}
+
+impl Limits {
+    /// Whether `v` lies within, `slack` either side.
+    pub fn holds(&self, v: Real, slack: Real) -> bool {
+        v >= self.min - slack && v <= self.max + slack
+    }
+
+    /// The width of the band.
+    pub fn width(&self) -> Real {
+        self.max - self.min
+    }
+}
+
+/// What the finished thread must hold, and whose limits they are.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ThreadLimits {
+    /// The pitch diameter (for a worm: the diameter where its thickness is
+    /// measured).
+    pub pitch_diameter: Limits,
+    /// The crest: an external thread's major diameter, an internal
+    /// thread's minor (the blank's or bore's, before the cut).
+    pub crest: Limits,
+    /// The root the cut makes: an external thread's minor diameter, an
+    /// internal thread's major.
+    pub root: Limits,
+    /// Where the limits come from: a standard's class (`ISO 965-1 6g`) or
+    /// `stated` (the user's, or pilgrim's stated default).
+    pub source: String,
+}
+
+/// A thread's axial section and sizes: see the module's docs.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ThreadProfile {
+    /// How the standard names it (`M20x2.5-6g`, `Tr40x7`, `1-5 ACME-2G`).
+    pub designation: String,
+    /// The standards its form and limits come from.
+    pub standard: String,
+    /// An internal thread (a nut's, cut inside a bore).
+    pub internal: bool,
+    /// The axial pitch P between neighbouring threads.
+    pub pitch: Real,
+    /// The number of starts.
+    pub starts: u32,
+    /// Right- or left-handed.
+    pub hand: Hand,
+    /// The basic major diameter (the nominal: d, D).
+    pub major: Real,
+    /// The basic pitch diameter (d2, D2, E).
+    pub pitch_diameter: Real,
+    /// The basic diameter of the root the cut makes (external: d3;
+    /// internal: the major the nut's root reaches).
+    pub root_diameter: Real,
+    /// The basic diameter of the crest (external: the major; internal: the
+    /// minor, D1).
+    pub crest_diameter: Real,
+    /// The flanks' angles from the radial direction: the space's flank
+    /// towards -Z, then towards +Z (a symmetric thread's are equal, half
+    /// its included angle).
+    pub flanks: [Real; 2],
+    /// The space's width along the axis at the pitch diameter (basic: P/2
+    /// for every standard thread, the pitch less the thread's thickness).
+    pub space_at_pitch: Real,
+    /// The root's rounding (0: a flat root with sharp corners).
+    pub root_radius: Real,
+    /// The limits of the finished thread.
+    pub limits: ThreadLimits,
+}
+
+impl ThreadProfile {
+    /// The lead: the starts' pitches.
+    pub fn lead(&self) -> Real {
+        Real::from(self.starts) * self.pitch
+    }
+
+    /// Which way the space opens from its root: +1 outwards (external),
+    /// -1 inwards (internal).
+    pub fn opening(&self) -> Real {
+        if self.internal {
+            -1.0
+        } else {
+            1.0
+        }
+    }
+
+    /// The thread's depth: root to crest, radially.
+    pub fn depth(&self) -> Real {
+        (self.crest_diameter - self.root_diameter).abs() / 2.0
+    }
+
+    /// The space's width along the axis at radius `r` (its flanks
+    /// extended beyond the root and crest).
+    pub fn space_at(&self, r: Real) -> Real {
+        let spread = self.flanks[0].tan() + self.flanks[1].tan();
+        self.space_at_pitch + self.opening() * (r - self.pitch_diameter / 2.0) * spread
+    }
+
+    /// The space's width at its root (before the root's rounding): the
+    /// widest tip a cutter may have.
+    pub fn root_space(&self) -> Real {
+        self.space_at(self.root_diameter / 2.0)
+    }
+
+    /// The space's area in the axial section, root to crest (a trapezoid).
+    pub fn space_area(&self) -> Real {
+        0.5 * (self.root_space() + self.space_at(self.crest_diameter / 2.0)) * self.depth()
+    }
+
+    /// The space's outline in the axial section, its root centred on
+    /// `centre` (z): four corners `[z, r]`, root first, the -Z flank's
+    /// root corner first.
+    pub fn space_outline(&self, centre: Real) -> [[Real; 2]; 4] {
+        let (root, crest) = (self.root_diameter / 2.0, self.crest_diameter / 2.0);
+        let half = self.root_space() / 2.0;
+        let depth = crest - root;
+        [
+            [centre - half, root],
+            [centre + half, root],
+            [centre + half + depth.abs() * self.flanks[1].tan(), crest],
+            [centre - half - depth.abs() * self.flanks[0].tan(), crest],
+        ]
+    }
+
+    /// The measurement over wires (external) or between balls (internal)
+    /// of diameter `wire` laid in opposite spaces, the pitch diameter at
+    /// `pitch_diameter`: each wire touches both flanks of its space, its
+    /// centre `wire / 2 / sin(b)` from the flanks' meeting point (`b` the
+    /// half-angle). Symmetric profiles only (`None` otherwise); the lead
+    /// angle's small correction left out.
+    pub fn over_wires(&self, wire: Real, pitch_diameter: Real) -> Option<Real> {
+        if (self.flanks[0] - self.flanks[1]).abs() > 1e-12 {
+            return None;
+        }
+        let b = self.flanks[0];
+        let s = self.opening();
+        Some(pitch_diameter + s * (wire * (1.0 + 1.0 / b.sin()) - self.space_at_pitch / b.tan()))
+    }
+
+    /// The best wire of a symmetric profile: the one that touches its
+    /// flanks at the pitch diameter.
+    pub fn best_wire(&self) -> Option<Real> {
+        ((self.flanks[0] - self.flanks[1]).abs() <= 1e-12)
+            .then(|| self.space_at_pitch / self.flanks[0].cos())
+    }
+}

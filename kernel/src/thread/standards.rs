@@ -1,0 +1,723 @@
+//! Thread profiles from the standards' formulas, with their limits.
+//!
+//! - **ISO metric** (ISO 68-1 basic profile, ISO 965-1 tolerances): 60
+//!   degrees, `H = sqrt(3)/2 P`; `d2 = d - 3/4 H` (0.649519 P), `d1 = d -
+//!   5/4 H` (1.082532 P); an external thread's rounded root `d3 = d1 - H/6` (radius `H/6`).
+//!   Grade 6 pitch-diameter tolerance `90 P^0.4 d^0.1` um (d the
+//!   geometric mean of the standard's diameter range), the internal thread's
+//!   1.32 times it, major `180 P^(2/3) - 3.15 / sqrt(P)`, internal minor
+//!   `230 P^0.7` (P >= 1), each rounded to the R40 series; other grades
+//!   scaled by ISO 965-1's factors (4: 0.63, 5: 0.8, 7: 1.25, 8: 1.6). The
+//!   fundamental deviations of positions e, f, g, h (external) and G, H
+//!   (internal) are ISO 965-1's table, by pitch.
+//! - **Trapezoidal** (ISO 2904): 30 degrees, `H1 = P/2`, the crest
+//!   clearance `ac` by pitch, `h3 = H4 = H1 + ac`; `d2 = d - P/2`, `d3 = d
+//!   - 2 h3`, `D1 = d - P`, `D4 = d + 2 ac`. Limits stated (see
+//!   [`StatedLimits`]).
+//! - **ACME** general purpose (ASME B1.5), inch: 29 degrees, `h = P/2`,
+//!   basic pitch diameter `D - P/2`; class 2G: the external pitch
+//!   diameter's allowance `0.008 sqrt(D)`, its tolerance `0.030 sqrt(P) +
+//!   0.006 sqrt(D)`, the major's tolerance `0.05 P`, the minor at most `D -
+//!   (P + 0.020)` (`0.010` finer than 10 tpi) with 1.5 times the pitch
+//!   diameter's tolerance; the internal thread's pitch diameter from the
+//!   basic up by the same tolerance, its minor from `D - P` up by `0.05 P`.
+//!   Checked against B1.5's published 2G sizes; 3G and 4G are not offered
+//!   until theirs are.
+//! - **Buttress 7/45** (ASME B1.9), inch: the load flank at 7 degrees, the
+//!   other at 45, `h = 0.6 P` of engagement, the external thread's depth
+//!   `0.66271 P`, root radius `0.07141 P`. Limits stated.
+//!
+//! Hand-written: these are tables and one-line formulas of the standards,
+//! with no crate that holds them.
+
+use super::profile::{Hand, Limits, ThreadLimits, ThreadProfile};
+use crate::input::InputError;
+use crate::math::{positive, Real};
+
+/// The mm of an inch.
+pub const INCH: Real = 25.4;
+
+/// ISO 965-1's fundamental deviations (um) by pitch (mm): e, f, g (the
+/// external thread's upper deviations, negative) and G (the internal
+/// thread's lower, positive, the same size as g's).
+const DEVIATIONS: [(Real, [Real; 3]); 19] = [
+    (0.5, [50.0, 36.0, 20.0]),
+    (0.6, [53.0, 36.0, 21.0]),
+    (0.7, [56.0, 38.0, 22.0]),
+    (0.75, [56.0, 38.0, 22.0]),
+    (0.8, [60.0, 38.0, 24.0]),
+    (1.0, [60.0, 40.0, 26.0]),
+    (1.25, [63.0, 42.0, 28.0]),
+    (1.5, [67.0, 45.0, 32.0]),
+    (1.75, [71.0, 48.0, 34.0]),
+    (2.0, [71.0, 52.0, 38.0]),
+    (2.5, [80.0, 58.0, 42.0]),
+    (3.0, [85.0, 63.0, 48.0]),
+    (3.5, [90.0, 70.0, 53.0]),
+    (4.0, [95.0, 75.0, 60.0]),
+    (4.5, [100.0, 80.0, 63.0]),
+    (5.0, [106.0, 85.0, 71.0]),
+    (5.5, [112.0, 90.0, 75.0]),
+    (6.0, [118.0, 95.0, 80.0]),
+    (8.0, [140.0, 118.0, 100.0]),
+];
+
+/// ISO 965-1's diameter ranges (mm) over which the tolerances are
+/// computed at the range's geometric mean.
+const RANGES: [Real; 9] = [0.99, 1.4, 2.8, 5.6, 11.2, 22.4, 45.0, 90.0, 180.0];
+
+/// ISO 965-1's grade factors on grade 6.
+const GRADES: [(u32, Real); 5] = [(4, 0.63), (5, 0.8), (6, 1.0), (7, 1.25), (8, 1.6)];
+
+/// The R40 preferred numbers of a decade.
+const R40: [Real; 40] = [
+    100.0, 106.0, 112.0, 118.0, 125.0, 132.0, 140.0, 150.0, 160.0, 170.0, 180.0, 190.0, 200.0,
+    212.0, 224.0, 236.0, 250.0, 265.0, 280.0, 300.0, 315.0, 335.0, 355.0, 375.0, 400.0, 425.0,
+    450.0, 475.0, 500.0, 530.0, 560.0, 600.0, 630.0, 670.0, 710.0, 750.0, 800.0, 850.0, 900.0,
+    950.0,
+];
+
+/// `v` rounded to the nearest R40 number.
+fn r40(v: Real) -> Real {
+    let decade = 10.0_f64.powf((v / 100.0).log10().floor());
+    let x = v / decade;
+    let mut best = R40[0];
+    for c in R40.iter().copied().chain([1000.0]) {
+        if (c - x).abs() < (best - x).abs() {
+            best = c;
+        }
+    }
+    best * decade
+}
+
+/// An ISO metric thread `M d x P`, external or internal, of tolerance
+/// class `class` (grade and position: `6g`, `6H`, `4h`, ...), `starts`
+/// starts (P the pitch between neighbouring threads).
+///
+/// # Failures
+/// A size that is not positive; a pitch outside ISO 965-1's table, a
+/// diameter outside 1 to 180 mm, a class it does not name.
+pub fn metric(
+    d: Real,
+    pitch: Real,
+    internal: bool,
+    class: &str,
+    starts: u32,
+    hand: Hand,
+) -> Result<ThreadProfile, InputError> {
+    positive("major diameter d", d)?;
+    positive("pitch P", pitch)?;
+    let bad_class = || {
+        InputError::out_of_range(
+            format!("tolerance class '{class}'"),
+            0.0,
+            if internal {
+                "a grade 4 to 8 and G or H, as 6H"
+            } else {
+                "a grade 4 to 8 and e, f, g or h, as 6g"
+            },
+        )
+    };
+    let mut chars = class.chars();
+    let grade = chars
+        .next()
+        .and_then(|c| c.to_digit(10))
+        .ok_or_else(bad_class)?;
+    let position = chars.as_str();
+    let factor = GRADES
+        .iter()
+        .find(|g| g.0 == grade)
+        .map(|g| g.1)
+        .ok_or_else(bad_class)?;
+    let Some(&(_, dev)) = DEVIATIONS.iter().find(|(p, _)| (p - pitch).abs() < 1e-9) else {
+        return Err(InputError::out_of_range(
+            "pitch P",
+            pitch,
+            "a pitch of ISO 965-1's table: 0.5 to 6 mm or 8 mm",
+        ));
+    };
+    let Some(range) = RANGES.windows(2).find(|w| d > w[0] && d <= w[1]) else {
+        return Err(InputError::out_of_range(
+            "major diameter d",
+            d,
+            "above 1 and at most 180 mm (ISO 965-1's ranges)",
+        ));
+    };
+    let mean = (range[0] * range[1]).sqrt();
+    let um = 1e-3;
+    let td2 = r40(factor * 90.0 * pitch.powf(0.4) * mean.powf(0.1));
+    let h = 3.0_f64.sqrt() / 2.0 * pitch;
+    // 3/8 and 5/8 of the fundamental triangle's height H from the major.
+    let d2 = d - 0.75 * h;
+    let d1 = d - 1.25 * h;
+    let limits = if internal {
+        let ei = match position {
+            "H" => 0.0,
+            "G" => dev[2],
+            _ => return Err(bad_class()),
+        } * um;
+        let td2 = r40(1.32 * factor * 90.0 * pitch.powf(0.4) * mean.powf(0.1)) * um;
+        let td1 = r40(factor * 230.0 * pitch.powf(0.7)) * um;
+        ThreadLimits {
+            pitch_diameter: Limits {
+                min: d2 + ei,
+                max: d2 + ei + td2,
+            },
+            crest: Limits {
+                min: d1 + ei,
+                max: d1 + ei + td1,
+            },
+            // The nut's root: at least the major; its rounding free.
+            root: Limits {
+                min: d + ei,
+                max: d + ei + h / 8.0,
+            },
+            source: format!("ISO 965-1 {class}"),
+        }
+    } else {
+        let es = -match position {
+            "h" => 0.0,
+            "g" => dev[2],
+            "f" => dev[1],
+            "e" => dev[0],
+            _ => return Err(bad_class()),
+        } * um;
+        let td = r40(factor * (180.0 * pitch.powf(2.0 / 3.0) - 3.15 / pitch.sqrt())) * um;
+        let d3 = d1 - h / 6.0;
+        ThreadLimits {
+            pitch_diameter: Limits {
+                min: d2 + es - td2 * um,
+                max: d2 + es,
+            },
+            crest: Limits {
+                min: d + es - td,
+                max: d + es,
+            },
+            // The bolt's root below the nut's crest by its rounding:
+            // at most d3 shifted by the deviation, at least a pitch
+            // diameter's tolerance below it.
+            root: Limits {
+                min: d3 + es - td2 * um,
+                max: d3 + es,
+            },
+            source: format!("ISO 965-1 {class}"),
+        }
+    };
+    let fine = if (pitch - coarse_pitch(d)).abs() < 1e-9 {
+        format!("M{}", number(d))
+    } else {
+        format!("M{}x{}", number(d), number(pitch))
+    };
+    Ok(ThreadProfile {
+        designation: format!("{fine}-{class}"),
+        standard: "ISO 68-1, ISO 965-1".into(),
+        internal,
+        pitch,
+        starts,
+        hand,
+        major: d,
+        pitch_diameter: d2,
+        root_diameter: if internal { d } else { d1 - h / 6.0 },
+        crest_diameter: if internal { d1 } else { d },
+        flanks: [30.0_f64.to_radians(); 2],
+        space_at_pitch: pitch / 2.0,
+        root_radius: if internal { 0.0 } else { h / 6.0 },
+        limits,
+    })
+}
+
+/// ISO 261's coarse pitch of the diameters it names (0 for others): the
+/// designation leaves a coarse pitch out.
+fn coarse_pitch(d: Real) -> Real {
+    const COARSE: [(Real, Real); 16] = [
+        (3.0, 0.5),
+        (4.0, 0.7),
+        (5.0, 0.8),
+        (6.0, 1.0),
+        (8.0, 1.25),
+        (10.0, 1.5),
+        (12.0, 1.75),
+        (16.0, 2.0),
+        (20.0, 2.5),
+        (24.0, 3.0),
+        (30.0, 3.5),
+        (36.0, 4.0),
+        (42.0, 4.5),
+        (48.0, 5.0),
+        (56.0, 5.5),
+        (64.0, 6.0),
+    ];
+    COARSE
+        .iter()
+        .find(|(n, _)| (n - d).abs() < 1e-9)
+        .map_or(0.0, |c| c.1)
+}
+
+/// A size as a designation writes it: no trailing zeros.
+pub(crate) fn number(v: Real) -> String {
+    let s = format!("{v:.4}");
+    s.trim_end_matches('0').trim_end_matches('.').to_owned()
+}
+
+/// Limits a standard leaves to the drawing, stated: the pitch diameter's
+/// band below the basic (external) or above it (internal), the crest's and
+/// the root's bands.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StatedLimits {
+    /// The pitch diameter's deviation from the basic, towards the
+    /// clearance (mm, at least 0).
+    pub pitch_allowance: Real,
+    /// The pitch diameter's tolerance (mm).
+    pub pitch_tolerance: Real,
+    /// The crest's tolerance (mm).
+    pub crest_tolerance: Real,
+    /// The root's tolerance (mm).
+    pub root_tolerance: Real,
+}
+
+impl StatedLimits {
+    /// The limits about basic pitch, crest and root diameters.
+    fn limits(&self, internal: bool, pitch: Real, crest: Real, root: Real) -> ThreadLimits {
+        let s = if internal { 1.0 } else { -1.0 };
+        let band = |basic: Real, tol: Real| {
+            let near = basic + s * self.pitch_allowance;
+            let far = near + s * tol;
+            Limits {
+                min: near.min(far),
+                max: near.max(far),
+            }
+        };
+        ThreadLimits {
+            pitch_diameter: band(pitch, self.pitch_tolerance),
+            crest: band(crest, self.crest_tolerance),
+            root: band(root, self.root_tolerance),
+            source: "stated".into(),
+        }
+    }
+}
+
+/// ISO 2904's crest clearance `ac` by pitch.
+fn trapezoidal_clearance(pitch: Real) -> Real {
+    match pitch {
+        p if p <= 1.5 => 0.15,
+        p if p <= 5.0 => 0.25,
+        p if p <= 12.0 => 0.5,
+        _ => 1.0,
+    }
+}
+
+/// A trapezoidal thread `Tr d x P` (ISO 2904), its limits `stated`.
+///
+/// # Failures
+/// A size that is not positive; a pitch outside ISO 2904's 1.5 to 44 mm; a
+/// diameter that leaves no core.
+pub fn trapezoidal(
+    d: Real,
+    pitch: Real,
+    internal: bool,
+    starts: u32,
+    hand: Hand,
+    stated: StatedLimits,
+) -> Result<ThreadProfile, InputError> {
+    positive("major diameter d", d)?;
+    positive("pitch P", pitch)?;
+    if !(1.5..=44.0).contains(&pitch) {
+        return Err(InputError::out_of_range(
+            "pitch P",
+            pitch,
+            "1.5 to 44 mm (ISO 2904)",
+        ));
+    }
+    let ac = trapezoidal_clearance(pitch);
+    let h3 = 0.5 * pitch + ac;
+    if d <= 2.0 * h3 {
+        return Err(InputError::out_of_range(
+            "major diameter d",
+            d,
+            format!("above 2 h3 = {} (a core)", 2.0 * h3),
+        ));
+    }
+    let d2 = d - 0.5 * pitch;
+    let (root, crest) = if internal {
+        (d + 2.0 * ac, d - pitch)
+    } else {
+        (d - 2.0 * h3, d)
+    };
+    Ok(ThreadProfile {
+        designation: format!("Tr{}x{}", number(d), number(pitch)),
+        standard: "ISO 2904".into(),
+        internal,
+        pitch,
+        starts,
+        hand,
+        major: d,
+        pitch_diameter: d2,
+        root_diameter: root,
+        crest_diameter: crest,
+        flanks: [15.0_f64.to_radians(); 2],
+        space_at_pitch: pitch / 2.0,
+        root_radius: 0.0,
+        limits: stated.limits(internal, d2, crest, root),
+    })
+}
+
+/// A general-purpose ACME thread (ASME B1.5) of `d_in` inches and `tpi`
+/// threads per inch, class 2G (`grade` 2), in mm.
+///
+/// # Failures
+/// A size that is not positive; a class other than 2.
+pub fn acme(
+    d_in: Real,
+    tpi: Real,
+    internal: bool,
+    grade: u32,
+    starts: u32,
+    hand: Hand,
+) -> Result<ThreadProfile, InputError> {
+    positive("major diameter D (in)", d_in)?;
+    positive("threads per inch", tpi)?;
+    // B1.5's class 2G; the finer classes' factors are not checked here.
+    let (allowance, scale) = match grade {
+        2 => (0.008, 1.0),
+        _ => {
+            return Err(InputError::out_of_range(
+                "ACME class",
+                Real::from(grade),
+                "2 (2G; 3G and 4G are not offered yet)",
+            ))
+        }
+    };
+    // B1.5 rounds each term to 4 decimals of the inch before adding them
+    // (its tables: 3/4-6's minimum pitch diameter 0.6667 - 0.0069 -
+    // 0.0174 = 0.6424, not 0.6423).
+    let r4 = |v: Real| (v * 1e4).round() / 1e4;
+    let p = 1.0 / tpi;
+    let e = r4(d_in - 0.5 * p);
+    let es = r4(allowance * d_in.sqrt());
+    let exact_td2 = scale * (0.030 * p.sqrt() + 0.006 * d_in.sqrt());
+    let td2 = r4(exact_td2);
+    let (td1, tmajor) = (r4(1.5 * exact_td2), r4(0.05 * p));
+    let minor_clearance = if tpi <= 10.0 { 0.020 } else { 0.010 };
+    let (pitch_l, crest, root, root_basic, crest_basic) = if internal {
+        let minor = r4(d_in - p);
+        let major = r4(d_in + minor_clearance);
+        (
+            (e, e + td2),
+            (minor, minor + tmajor),
+            (major, major + td1),
+            major,
+            minor,
+        )
+    } else {
+        let minor = r4(d_in - (p + minor_clearance));
+        (
+            (e - es - td2, e - es),
+            (d_in - tmajor, d_in),
+            (minor - td1, minor),
+            minor,
+            d_in,
+        )
+    };
+    let mm = |(a, b): (Real, Real)| Limits {
+        min: a * INCH,
+        max: b * INCH,
+    };
+    Ok(ThreadProfile {
+        designation: format!("{}-{} ACME-{grade}G", number(d_in), number(tpi)),
+        standard: "ASME B1.5".into(),
+        internal,
+        pitch: p * INCH,
+        starts,
+        hand,
+        major: d_in * INCH,
+        pitch_diameter: e * INCH,
+        root_diameter: root_basic * INCH,
+        crest_diameter: crest_basic * INCH,
+        flanks: [14.5_f64.to_radians(); 2],
+        space_at_pitch: p * INCH / 2.0,
+        root_radius: 0.0,
+        limits: ThreadLimits {
+            pitch_diameter: mm(pitch_l),
+            crest: mm(crest),
+            root: mm(root),
+            source: format!("ASME B1.5 {grade}G"),
+        },
+    })
+}
+
+/// Which side a buttress thread's load flank faces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LoadFlank {
+    /// The load is taken towards -Z (the chuck): the space's flank towards
+    /// +Z is the thread's load flank.
+    TowardsChuck,
+    /// The load is taken towards +Z.
+    AwayFromChuck,
+}
+
+/// A 7/45 buttress thread (ASME B1.9) of `d_in` inches and `tpi` threads
+/// per inch, in mm, its limits `stated` (mm).
+///
+/// # Failures
+/// A size that is not positive, or that leaves no core.
+pub fn buttress(
+    d_in: Real,
+    tpi: Real,
+    internal: bool,
+    load: LoadFlank,
+    starts: u32,
+    hand: Hand,
+    stated: StatedLimits,
+) -> Result<ThreadProfile, InputError> {
+    positive("major diameter D (in)", d_in)?;
+    positive("threads per inch", tpi)?;
+    let p = 1.0 / tpi * INCH;
+    let d = d_in * INCH;
+    let depth = 0.66271 * p;
+    if d <= 2.0 * depth {
+        return Err(InputError::out_of_range(
+            "major diameter D (in)",
+            d_in,
+            "larger than twice the thread's depth",
+        ));
+    }
+    let e = d - 0.6 * p;
+    let (root, crest) = if internal {
+        (d + 2.0 * (depth - 0.6 * p), d - 1.2 * p)
+    } else {
+        (d - 2.0 * depth, d)
+    };
+    let (seven, fortyfive) = (7.0_f64.to_radians(), 45.0_f64.to_radians());
+    let flanks = match load {
+        LoadFlank::TowardsChuck => [fortyfive, seven],
+        LoadFlank::AwayFromChuck => [seven, fortyfive],
+    };
+    Ok(ThreadProfile {
+        designation: format!("{}-{} BUTT 7/45", number(d_in), number(tpi)),
+        standard: "ASME B1.9".into(),
+        internal,
+        pitch: p,
+        starts,
+        hand,
+        major: d,
+        pitch_diameter: e,
+        root_diameter: root,
+        crest_diameter: crest,
+        flanks,
+        space_at_pitch: p / 2.0,
+        root_radius: 0.07141 * p,
+        limits: stated.limits(internal, e, crest, root),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Within half a unit of the last decimal the standard prints.
+    fn near(got: Real, want: Real, decimals: i32) {
+        let tol = 0.5 * 10.0_f64.powi(-decimals) + 1e-12;
+        assert!(
+            (got - want).abs() <= tol,
+            "{got} vs {want} (to {decimals} decimals)"
+        );
+    }
+
+    const STATED: StatedLimits = StatedLimits {
+        pitch_allowance: 0.0,
+        pitch_tolerance: 0.1,
+        crest_tolerance: 0.2,
+        root_tolerance: 0.3,
+    };
+
+    /// ISO 724's and ISO 965-2's printed sizes (mm, to 3 decimals): M20
+    /// (coarse, 2.5) 6g and M30x2 6H.
+    #[test]
+    fn metric_sizes_are_the_standards_printed_ones() {
+        let m20 = metric(20.0, 2.5, false, "6g", 1, Hand::Right).unwrap();
+        assert_eq!(m20.designation, "M20-6g");
+        near(m20.pitch_diameter, 18.376, 3);
+        near(m20.root_diameter, 16.933, 3);
+        let l = &m20.limits;
+        near(l.crest.max, 19.958, 3);
+        near(l.crest.min, 19.623, 3);
+        near(l.pitch_diameter.max, 18.334, 3);
+        near(l.pitch_diameter.min, 18.164, 3);
+        let m30 = metric(30.0, 2.0, true, "6H", 1, Hand::Right).unwrap();
+        assert_eq!(m30.designation, "M30x2-6H");
+        near(m30.crest_diameter, 27.835, 3);
+        let l = &m30.limits;
+        near(l.pitch_diameter.min, 28.701, 3);
+        near(l.pitch_diameter.max, 28.925, 3);
+        near(l.crest.min, 27.835, 3);
+        near(l.crest.max, 28.210, 3);
+        near(l.root.min, 30.0, 3);
+        // The basic profile's geometry: the external crest's flat P/8 and
+        // the internal crest's P/4 (ISO 68-1) where the spaces meet them.
+        near(m20.space_at(10.0), 2.5 * 7.0 / 8.0, 9);
+        near(m20.space_at(17.294 / 2.0), 2.5 / 4.0, 3);
+        near(m30.space_at(15.0), 2.0 / 8.0, 9);
+        for (d, p, class) in [
+            (20.0, 3.3, "6g"),
+            (200.0, 2.0, "6g"),
+            (20.0, 2.5, "6x"),
+            (20.0, 2.5, "9g"),
+        ] {
+            assert!(
+                metric(d, p, false, class, 1, Hand::Right).is_err(),
+                "{d} {p} {class}"
+            );
+        }
+    }
+
+    /// ISO 2904's Tr 40x7: d2 36.5, d3 32, D1 33, D4 41; the crest's flat
+    /// 0.366 P.
+    #[test]
+    fn trapezoidal_sizes_are_the_standards_printed_ones() {
+        let bolt = trapezoidal(40.0, 7.0, false, 1, Hand::Right, STATED).unwrap();
+        let nut = trapezoidal(40.0, 7.0, true, 1, Hand::Right, STATED).unwrap();
+        assert_eq!(bolt.designation, "Tr40x7");
+        near(bolt.pitch_diameter, 36.5, 3);
+        near(bolt.root_diameter, 32.0, 3);
+        near(nut.crest_diameter, 33.0, 3);
+        near(nut.root_diameter, 41.0, 3);
+        near(7.0 - bolt.space_at(20.0), 0.366 * 7.0, 3);
+        // Stated limits lie below the basic on a bolt, above it in a nut.
+        assert!(bolt.limits.pitch_diameter.max <= 36.5 && nut.limits.pitch_diameter.min >= 36.5);
+        assert_eq!(bolt.limits.source, "stated");
+        assert!(trapezoidal(40.0, 50.0, false, 1, Hand::Right, STATED).is_err());
+    }
+
+    /// ASME B1.5's printed class 2G limits (inch, to 4 decimals) of 1-5 and
+    /// 3/4-6 ACME, and its basic crest flat 0.3707 P.
+    #[test]
+    fn acme_2g_sizes_are_the_standards_printed_ones() {
+        for (d, tpi, major, pitch, minor) in [
+            (1.0, 5.0, (0.99, 1.0), (0.8726, 0.892), (0.7509, 0.78)),
+            (
+                0.75,
+                6.0,
+                (0.7417, 0.75),
+                (0.6424, 0.6598),
+                (0.5371, 0.5633),
+            ),
+        ] {
+            let t = acme(d, tpi, false, 2, 1, Hand::Right).unwrap();
+            let l = &t.limits;
+            for (got, want) in [
+                (l.crest.min, major.0),
+                (l.crest.max, major.1),
+                (l.pitch_diameter.min, pitch.0),
+                (l.pitch_diameter.max, pitch.1),
+                (l.root.min, minor.0),
+                (l.root.max, minor.1),
+            ] {
+                near(got / INCH, want, 4);
+            }
+            let p = 1.0 / tpi;
+            near((p - t.space_at(d * INCH / 2.0) / INCH) / p, 0.3707, 4);
+        }
+        assert_eq!(
+            acme(1.0, 5.0, false, 2, 1, Hand::Right)
+                .unwrap()
+                .designation,
+            "1-5 ACME-2G"
+        );
+        assert!(acme(1.0, 5.0, false, 3, 1, Hand::Right).is_err());
+    }
+
+    /// ASME B1.9's 7/45 form: the sharp V's height from its flanks is
+    /// 0.89064 P, the basic engagement 0.6 P, the bolt's depth 0.66271 P;
+    /// the load flank faces the side asked.
+    #[test]
+    fn buttress_7_45_has_the_standards_form() {
+        let t = buttress(
+            2.0,
+            8.0,
+            false,
+            LoadFlank::TowardsChuck,
+            1,
+            Hand::Right,
+            STATED,
+        )
+        .unwrap();
+        let p = INCH / 8.0;
+        let v = p / (t.flanks[0].tan() + t.flanks[1].tan());
+        near(v / p, 0.89064, 5);
+        near(t.depth() / p, 0.66271, 5);
+        near((t.major - t.pitch_diameter) / 2.0 / p, 0.3, 9);
+        assert!(t.flanks[1] < t.flanks[0]);
+        let other = buttress(
+            2.0,
+            8.0,
+            false,
+            LoadFlank::AwayFromChuck,
+            1,
+            Hand::Right,
+            STATED,
+        )
+        .unwrap();
+        assert!(other.flanks[0] < other.flanks[1]);
+    }
+
+    /// The measurement over wires against the wire placed by geometry: a
+    /// circle whose centre, on the space's middle, stands half the wire
+    /// from each flank line of the outline; M20x2.5's best wire 1.443 mm
+    /// gives the handbook's M = d2 + 3 w - 0.866025 P.
+    #[test]
+    fn over_wires_is_where_the_wire_touches_both_flanks() {
+        for t in [
+            metric(20.0, 2.5, false, "6g", 1, Hand::Right).unwrap(),
+            metric(30.0, 2.0, true, "6H", 1, Hand::Right).unwrap(),
+            trapezoidal(40.0, 7.0, false, 1, Hand::Right, STATED).unwrap(),
+            acme(1.0, 5.0, false, 2, 1, Hand::Right).unwrap(),
+        ] {
+            for w in [t.best_wire().unwrap(), 1.1 * t.best_wire().unwrap()] {
+                let m = t.over_wires(w, t.pitch_diameter).unwrap();
+                // The flank towards +Z, root corner to crest corner.
+                let o = t.space_outline(0.0);
+                let (a, b) = (o[1], o[2]);
+                let dist = |r: Real| {
+                    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+                    ((0.0 - a[0]) * dy - (r - a[1]) * dx).abs() / dx.hypot(dy)
+                };
+                // The centre's radius by bisection between the root and far
+                // past the crest, where the distance grows.
+                let (mut lo, mut hi) = (
+                    t.root_diameter / 2.0,
+                    t.root_diameter / 2.0 + t.opening() * 5.0 * t.pitch,
+                );
+                for _ in 0..200 {
+                    let mid = 0.5 * (lo + hi);
+                    if dist(mid) < w / 2.0 {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                let centre = 0.5 * (lo + hi);
+                let want = 2.0 * centre + t.opening() * w;
+                near(m, want, 9);
+            }
+        }
+        let m20 = metric(20.0, 2.5, false, "6g", 1, Hand::Right).unwrap();
+        let w = m20.best_wire().unwrap();
+        near(w, 1.443, 3);
+        near(
+            m20.over_wires(w, 18.376).unwrap(),
+            18.376 + 3.0 * w - 0.866025 * 2.5,
+            5,
+        );
+        let b = buttress(
+            2.0,
+            8.0,
+            false,
+            LoadFlank::TowardsChuck,
+            1,
+            Hand::Right,
+            STATED,
+        )
+        .unwrap();
+        assert!(b.over_wires(1.0, b.pitch_diameter).is_none());
+    }
+}
