@@ -5,4 +5,4 @@
 mod profile;
 pub mod standards;
 
-pub use profile::{Hand, Limits, ThreadLimits, ThreadProfile};
+pub use profile::{Hand, Limits, ThreadLimits, ThreadProfile, ThreadSection};

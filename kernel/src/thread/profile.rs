@@ -61,13 +61,24 @@ pub struct ThreadLimits {
     pub source: String,
 }
 
-/// A thread's axial section and sizes: see the module's docs.
+/// A thread as a standard names it: its section and the limits of the
+/// finished thread.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ThreadProfile {
     /// How the standard names it (`M20x2.5-6g`, `Tr40x7`, `1-5 ACME-2G`).
     pub designation: String,
     /// The standards its form and limits come from.
     pub standard: String,
+    /// Its axial section and basic sizes.
+    pub section: ThreadSection,
+    /// The limits of the finished thread.
+    pub limits: ThreadLimits,
+}
+
+/// A thread's axial section and basic sizes: see the module's docs. What
+/// the planning and the simulation take.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ThreadSection {
     /// An internal thread (a nut's, cut inside a bore).
     pub internal: bool,
     /// The axial pitch P between neighbouring threads.
@@ -95,11 +106,9 @@ pub struct ThreadProfile {
     pub space_at_pitch: Real,
     /// The root's rounding (0: a flat root with sharp corners).
     pub root_radius: Real,
-    /// The limits of the finished thread.
-    pub limits: ThreadLimits,
 }
 
-impl ThreadProfile {
+impl ThreadSection {
     /// The lead: the starts' pitches.
     pub fn lead(&self) -> Real {
         Real::from(self.starts) * self.pitch

@@ -30,7 +30,7 @@
 //! Hand-written: these are tables and one-line formulas of the standards,
 //! with no crate that holds them.
 
-use super::profile::{Hand, Limits, ThreadLimits, ThreadProfile};
+use super::profile::{Hand, Limits, ThreadLimits, ThreadProfile, ThreadSection};
 use crate::input::InputError;
 use crate::math::{positive, Real};
 
@@ -211,17 +211,19 @@ pub fn metric(
     Ok(ThreadProfile {
         designation: format!("{fine}-{class}"),
         standard: "ISO 68-1, ISO 965-1".into(),
-        internal,
-        pitch,
-        starts,
-        hand,
-        major: d,
-        pitch_diameter: d2,
-        root_diameter: if internal { d } else { d1 - h / 6.0 },
-        crest_diameter: if internal { d1 } else { d },
-        flanks: [30.0_f64.to_radians(); 2],
-        space_at_pitch: pitch / 2.0,
-        root_radius: if internal { 0.0 } else { h / 6.0 },
+        section: ThreadSection {
+            internal,
+            pitch,
+            starts,
+            hand,
+            major: d,
+            pitch_diameter: d2,
+            root_diameter: if internal { d } else { d1 - h / 6.0 },
+            crest_diameter: if internal { d1 } else { d },
+            flanks: [30.0_f64.to_radians(); 2],
+            space_at_pitch: pitch / 2.0,
+            root_radius: if internal { 0.0 } else { h / 6.0 },
+        },
         limits,
     })
 }
@@ -346,17 +348,19 @@ pub fn trapezoidal(
     Ok(ThreadProfile {
         designation: format!("Tr{}x{}", number(d), number(pitch)),
         standard: "ISO 2904".into(),
-        internal,
-        pitch,
-        starts,
-        hand,
-        major: d,
-        pitch_diameter: d2,
-        root_diameter: root,
-        crest_diameter: crest,
-        flanks: [15.0_f64.to_radians(); 2],
-        space_at_pitch: pitch / 2.0,
-        root_radius: 0.0,
+        section: ThreadSection {
+            internal,
+            pitch,
+            starts,
+            hand,
+            major: d,
+            pitch_diameter: d2,
+            root_diameter: root,
+            crest_diameter: crest,
+            flanks: [15.0_f64.to_radians(); 2],
+            space_at_pitch: pitch / 2.0,
+            root_radius: 0.0,
+        },
         limits: stated.limits(internal, d2, crest, root),
     })
 }
@@ -425,17 +429,19 @@ pub fn acme(
     Ok(ThreadProfile {
         designation: format!("{}-{} ACME-{grade}G", number(d_in), number(tpi)),
         standard: "ASME B1.5".into(),
-        internal,
-        pitch: p * INCH,
-        starts,
-        hand,
-        major: d_in * INCH,
-        pitch_diameter: e * INCH,
-        root_diameter: root_basic * INCH,
-        crest_diameter: crest_basic * INCH,
-        flanks: [14.5_f64.to_radians(); 2],
-        space_at_pitch: p * INCH / 2.0,
-        root_radius: 0.0,
+        section: ThreadSection {
+            internal,
+            pitch: p * INCH,
+            starts,
+            hand,
+            major: d_in * INCH,
+            pitch_diameter: e * INCH,
+            root_diameter: root_basic * INCH,
+            crest_diameter: crest_basic * INCH,
+            flanks: [14.5_f64.to_radians(); 2],
+            space_at_pitch: p * INCH / 2.0,
+            root_radius: 0.0,
+        },
         limits: ThreadLimits {
             pitch_diameter: mm(pitch_l),
             crest: mm(crest),
@@ -495,17 +501,19 @@ pub fn buttress(
     Ok(ThreadProfile {
         designation: format!("{}-{} BUTT 7/45", number(d_in), number(tpi)),
         standard: "ASME B1.9".into(),
-        internal,
-        pitch: p,
-        starts,
-        hand,
-        major: d,
-        pitch_diameter: e,
-        root_diameter: root,
-        crest_diameter: crest,
-        flanks,
-        space_at_pitch: p / 2.0,
-        root_radius: 0.07141 * p,
+        section: ThreadSection {
+            internal,
+            pitch: p,
+            starts,
+            hand,
+            major: d,
+            pitch_diameter: e,
+            root_diameter: root,
+            crest_diameter: crest,
+            flanks,
+            space_at_pitch: p / 2.0,
+            root_radius: 0.07141 * p,
+        },
         limits: stated.limits(internal, e, crest, root),
     })
 }
@@ -536,8 +544,8 @@ mod tests {
     fn metric_sizes_are_the_standards_printed_ones() {
         let m20 = metric(20.0, 2.5, false, "6g", 1, Hand::Right).unwrap();
         assert_eq!(m20.designation, "M20-6g");
-        near(m20.pitch_diameter, 18.376, 3);
-        near(m20.root_diameter, 16.933, 3);
+        near(m20.section.pitch_diameter, 18.376, 3);
+        near(m20.section.root_diameter, 16.933, 3);
         let l = &m20.limits;
         near(l.crest.max, 19.958, 3);
         near(l.crest.min, 19.623, 3);
@@ -545,7 +553,7 @@ mod tests {
         near(l.pitch_diameter.min, 18.164, 3);
         let m30 = metric(30.0, 2.0, true, "6H", 1, Hand::Right).unwrap();
         assert_eq!(m30.designation, "M30x2-6H");
-        near(m30.crest_diameter, 27.835, 3);
+        near(m30.section.crest_diameter, 27.835, 3);
         let l = &m30.limits;
         near(l.pitch_diameter.min, 28.701, 3);
         near(l.pitch_diameter.max, 28.925, 3);
@@ -554,9 +562,9 @@ mod tests {
         near(l.root.min, 30.0, 3);
         // The basic profile's geometry: the external crest's flat P/8 and
         // the internal crest's P/4 (ISO 68-1) where the spaces meet them.
-        near(m20.space_at(10.0), 2.5 * 7.0 / 8.0, 9);
-        near(m20.space_at(17.294 / 2.0), 2.5 / 4.0, 3);
-        near(m30.space_at(15.0), 2.0 / 8.0, 9);
+        near(m20.section.space_at(10.0), 2.5 * 7.0 / 8.0, 9);
+        near(m20.section.space_at(17.294 / 2.0), 2.5 / 4.0, 3);
+        near(m30.section.space_at(15.0), 2.0 / 8.0, 9);
         for (d, p, class) in [
             (20.0, 3.3, "6g"),
             (200.0, 2.0, "6g"),
@@ -577,11 +585,11 @@ mod tests {
         let bolt = trapezoidal(40.0, 7.0, false, 1, Hand::Right, STATED).unwrap();
         let nut = trapezoidal(40.0, 7.0, true, 1, Hand::Right, STATED).unwrap();
         assert_eq!(bolt.designation, "Tr40x7");
-        near(bolt.pitch_diameter, 36.5, 3);
-        near(bolt.root_diameter, 32.0, 3);
-        near(nut.crest_diameter, 33.0, 3);
-        near(nut.root_diameter, 41.0, 3);
-        near(7.0 - bolt.space_at(20.0), 0.366 * 7.0, 3);
+        near(bolt.section.pitch_diameter, 36.5, 3);
+        near(bolt.section.root_diameter, 32.0, 3);
+        near(nut.section.crest_diameter, 33.0, 3);
+        near(nut.section.root_diameter, 41.0, 3);
+        near(7.0 - bolt.section.space_at(20.0), 0.366 * 7.0, 3);
         // Stated limits lie below the basic on a bolt, above it in a nut.
         assert!(bolt.limits.pitch_diameter.max <= 36.5 && nut.limits.pitch_diameter.min >= 36.5);
         assert_eq!(bolt.limits.source, "stated");
@@ -615,7 +623,7 @@ mod tests {
                 near(got / INCH, want, 4);
             }
             let p = 1.0 / tpi;
-            near((p - t.space_at(d * INCH / 2.0) / INCH) / p, 0.3707, 4);
+            near((p - t.section.space_at(d * INCH / 2.0) / INCH) / p, 0.3707, 4);
         }
         assert_eq!(
             acme(1.0, 5.0, false, 2, 1, Hand::Right)
@@ -642,11 +650,11 @@ mod tests {
         )
         .unwrap();
         let p = INCH / 8.0;
-        let v = p / (t.flanks[0].tan() + t.flanks[1].tan());
+        let v = p / (t.section.flanks[0].tan() + t.section.flanks[1].tan());
         near(v / p, 0.89064, 5);
-        near(t.depth() / p, 0.66271, 5);
-        near((t.major - t.pitch_diameter) / 2.0 / p, 0.3, 9);
-        assert!(t.flanks[1] < t.flanks[0]);
+        near(t.section.depth() / p, 0.66271, 5);
+        near((t.section.major - t.section.pitch_diameter) / 2.0 / p, 0.3, 9);
+        assert!(t.section.flanks[1] < t.section.flanks[0]);
         let other = buttress(
             2.0,
             8.0,
@@ -657,7 +665,7 @@ mod tests {
             STATED,
         )
         .unwrap();
-        assert!(other.flanks[0] < other.flanks[1]);
+        assert!(other.section.flanks[0] < other.section.flanks[1]);
     }
 
     /// The measurement over wires against the wire placed by geometry: a
@@ -672,10 +680,10 @@ mod tests {
             trapezoidal(40.0, 7.0, false, 1, Hand::Right, STATED).unwrap(),
             acme(1.0, 5.0, false, 2, 1, Hand::Right).unwrap(),
         ] {
-            for w in [t.best_wire().unwrap(), 1.1 * t.best_wire().unwrap()] {
-                let m = t.over_wires(w, t.pitch_diameter).unwrap();
+            for w in [t.section.best_wire().unwrap(), 1.1 * t.section.best_wire().unwrap()] {
+                let m = t.section.over_wires(w, t.section.pitch_diameter).unwrap();
                 // The flank towards +Z, root corner to crest corner.
-                let o = t.space_outline(0.0);
+                let o = t.section.space_outline(0.0);
                 let (a, b) = (o[1], o[2]);
                 let dist = |r: Real| {
                     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
@@ -684,8 +692,8 @@ mod tests {
                 // The centre's radius by bisection between the root and far
                 // past the crest, where the distance grows.
                 let (mut lo, mut hi) = (
-                    t.root_diameter / 2.0,
-                    t.root_diameter / 2.0 + t.opening() * 5.0 * t.pitch,
+                    t.section.root_diameter / 2.0,
+                    t.section.root_diameter / 2.0 + t.section.opening() * 5.0 * t.section.pitch,
                 );
                 for _ in 0..200 {
                     let mid = 0.5 * (lo + hi);
@@ -696,15 +704,15 @@ mod tests {
                     }
                 }
                 let centre = 0.5 * (lo + hi);
-                let want = 2.0 * centre + t.opening() * w;
+                let want = 2.0 * centre + t.section.opening() * w;
                 near(m, want, 9);
             }
         }
         let m20 = metric(20.0, 2.5, false, "6g", 1, Hand::Right).unwrap();
-        let w = m20.best_wire().unwrap();
+        let w = m20.section.best_wire().unwrap();
         near(w, 1.443, 3);
         near(
-            m20.over_wires(w, 18.376).unwrap(),
+            m20.section.over_wires(w, 18.376).unwrap(),
             18.376 + 3.0 * w - 0.866025 * 2.5,
             5,
         );
@@ -718,6 +726,6 @@ mod tests {
             STATED,
         )
         .unwrap();
-        assert!(b.over_wires(1.0, b.pitch_diameter).is_none());
+        assert!(b.section.over_wires(1.0, b.section.pitch_diameter).is_none());
     }
 }

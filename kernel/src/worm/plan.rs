@@ -3,7 +3,8 @@
 //! each pass cuts on, the finishing passes, the universal cutter's axial
 //! steps, and the order of the starts.
 
-use super::{ThreadCutter, WormSizes};
+use super::ThreadCutter;
+use crate::thread::ThreadSection;
 use crate::input::InputError;
 use crate::math::Real;
 use serde::Serialize;
@@ -71,11 +72,12 @@ pub fn rational_passes(h_r: Real, a_min: Real) -> usize {
 }
 
 /// The universal cutter's axial offset to each flank (MATH §4.4):
-/// `a_1z = (P_z / z1 - S_a1 - S_a1r) / 2`, `S_a1r` the cutter's width at
-/// the worm's pitch line when its tip is at the root.
-pub fn axial_offset(w: &WormSizes, c: &ThreadCutter) -> Real {
-    let s_a1r = c.width_at(w.pitch_radius() - w.root_radius());
-    (w.lead() / Real::from(w.starts) - w.thickness - s_a1r) / 2.0
+/// `a_1z = (P_z / z1 - S_a1 - S_a1r) / 2`, the space at the pitch line
+/// less `S_a1r`, the cutter's width at the pitch line when its tip is at
+/// the root.
+pub fn axial_offset(t: &ThreadSection, c: &ThreadCutter) -> Real {
+    let s_a1r = c.width_at((t.pitch_diameter / 2.0 - t.root_diameter / 2.0).abs());
+    (t.space_at_pitch - s_a1r) / 2.0
 }
 
 /// Each side step's planned area, the area it removes: the planned
@@ -84,14 +86,15 @@ pub fn axial_offset(w: &WormSizes, c: &ThreadCutter) -> Real {
 /// the program ([`super::simulate`]); a side step of a universal cutter
 /// takes only what the passes before it left at the root's corners and on
 /// the flanks, not its width times the depth.
-fn side_step_areas(w: &WormSizes, c: &ThreadCutter, steps: &mut [PlannedPass]) {
+fn side_step_areas(t: &ThreadSection, c: &ThreadCutter, steps: &mut [PlannedPass]) {
     use geo::{Area, BooleanOps, MultiPolygon};
     if !steps.iter().any(|p| p.kind == PassKind::Side) {
         return;
     }
-    let r_a = w.tip_radius();
+    // In depth below the crest: the areas are an internal thread's too.
+    let r_a = t.crest_diameter / 2.0;
     let deepest = steps.iter().map(|p| p.cumulative).fold(0.0, Real::max);
-    let half = w.axial_pitch() / 2.0;
+    let half = t.pitch / 2.0;
     let mut material = MultiPolygon::new(vec![super::simulate::rect(
         -half,
         half,
@@ -220,11 +223,11 @@ pub struct PlanSettings {
 /// that cannot be laid out ([`roughing_depths`]); a non-positive axial
 /// step; more passes than [`MAX_PASSES`].
 pub fn plan(
-    w: &WormSizes,
+    t: &ThreadSection,
     c: &ThreadCutter,
     s: &PlanSettings,
 ) -> Result<Vec<PlannedPass>, InputError> {
-    let h = w.height();
+    let h = t.depth();
     crate::math::finite("finishing depth", s.finish_depth)?;
     let stock = s.finish_depth * s.finish_passes as Real;
     if s.finish_depth < 0.0 || !(stock < h) {
@@ -235,7 +238,11 @@ pub fn plan(
         ));
     }
     let rough = roughing_depths(h - stock, s.roughing_passes, s.min_depth)?;
-    let tan = w.alpha.tan();
+    // On a flank the cutter's edge stands on that flank's final line.
+    let tan = |flank: Flank| match flank {
+        Flank::Left => t.flanks[0].tan(),
+        Flank::Right | Flank::Radial => t.flanks[1].tan(),
+    };
     let area = |d0: Real, d1: Real| {
         c.tip_width * (d1 - d0)
             + 0.5 * (c.left_angle.tan() + c.right_angle.tan()) * (d1 * d1 - d0 * d0)
@@ -250,7 +257,7 @@ pub fn plan(
             FlankOrder::Left => Flank::Left,
             FlankOrder::Radial => Flank::Radial,
         };
-        let e = (h - d) * tan;
+        let e = (h - d) * tan(flank);
         steps.push(PlannedPass {
             kind: PassKind::Rough,
             start: 0,
@@ -266,7 +273,7 @@ pub fn plan(
         });
         last = d;
     }
-    let a1z = axial_offset(w, c);
+    let a1z = axial_offset(t, c);
     let sides = if a1z > 1e-9 {
         crate::math::positive("axial step of the universal cutter", s.axial_step)?;
         let n = (a1z / s.axial_step).ceil();
@@ -317,8 +324,8 @@ pub fn plan(
     if s.finish_passes == 0 {
         side_steps(&mut steps, last);
     }
-    side_step_areas(w, c, &mut steps);
-    let z1 = w.starts;
+    side_step_areas(t, c, &mut steps);
+    let z1 = t.starts;
     if steps.len() * z1 as usize > MAX_PASSES {
         return Err(InputError::out_of_range(
             "passes (all starts)",
@@ -342,6 +349,7 @@ pub fn plan(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::worm::WormSizes;
 
     /// D_i = h sqrt(i / n) where no pass falls below a_min.
     #[test]
@@ -406,8 +414,8 @@ mod tests {
         let c = ThreadCutter::new(2.0, 0.2, a, a, 15.0).unwrap();
         let s_a1r = 2.0 + 2.0 * 6.0 * a.tan();
         let by_formula = (w.lead() / 2.0 - w.thickness - s_a1r) / 2.0;
-        assert!((axial_offset(&w, &c) - by_formula).abs() < 1e-12);
-        assert!((axial_offset(&w, &c) - (w.root_space() - 2.0) / 2.0).abs() < 1e-12);
+        assert!((axial_offset(&w.section(), &c) - by_formula).abs() < 1e-12);
+        assert!((axial_offset(&w.section(), &c) - (w.root_space() - 2.0) / 2.0).abs() < 1e-12);
         let s = PlanSettings {
             roughing_passes: Some(20),
             min_depth: 0.1,
@@ -417,13 +425,13 @@ mod tests {
             axial_step: 0.2,
             starts_by_depth: true,
         };
-        let p = plan(&w, &c, &s).unwrap();
+        let p = plan(&w.section(), &c, &s).unwrap();
         let side: Vec<_> = p.iter().filter(|p| p.kind == PassKind::Side).collect();
         // ceil(0.743 / 0.2) = 4 steps each way, at both finishing depths, both starts.
         assert_eq!(side.len(), 4 * 2 * 2 * 2);
         assert!(side
             .iter()
-            .all(|p| p.offset.abs() <= axial_offset(&w, &c) + 1e-12));
+            .all(|p| p.offset.abs() <= axial_offset(&w.section(), &c) + 1e-12));
         assert!(side.windows(2).all(|q| q[0].start != q[1].start
             || (q[0].offset - q[1].offset).abs() <= 0.2 + 1e-12
             || q[1].offset.abs() <= 0.2 + 1e-12));

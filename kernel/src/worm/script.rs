@@ -151,7 +151,7 @@ pub mod worm_api {
     /// The universal cutter's axial offset to each flank, `a_1z` (mm).
     #[rhai_fn(pure, return_raw)]
     pub fn axial_offset(w: &mut WormSizes, tool: Tool) -> Result<Real, Box<EvalAltResult>> {
-        Ok(worm::axial_offset(w, &cutter_of(&tool)?))
+        Ok(worm::axial_offset(&w.section(), &cutter_of(&tool)?))
     }
 
     /// The approach S1 = T V (-1 - ln a + a) (mm): servo time constant
@@ -234,7 +234,7 @@ pub mod worm_api {
             axial_step: num("axial_step")?,
             starts_by_depth: by_depth,
         };
-        let passes = kernel(worm::plan(w, &cutter_of(&tool)?, &s))?;
+        let passes = kernel(worm::plan(&w.section(), &cutter_of(&tool)?, &s))?;
         let col = |f: &dyn Fn(&worm::PlannedPass) -> Real| {
             Dynamic::from(Floats::new(passes.iter().map(f).collect()))
         };

@@ -3,7 +3,7 @@
 
 use crate::input::InputError;
 use crate::math::{positive, Real};
-use crate::thread::{Hand, Limits, ThreadLimits, ThreadProfile};
+use crate::thread::{Hand, Limits, ThreadLimits, ThreadProfile, ThreadSection};
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -168,12 +168,30 @@ impl WormSizes {
         0.5 * (self.root_space() + self.space_at(self.tip_radius())) * self.height()
     }
 
-    /// The worm's ZA profile (straight flanks in the axial section) as a
-    /// thread profile: the axial pitch `pi m`, the flanks at the profile
-    /// angle, the space at the pitch diameter the pitch less the thread's
-    /// thickness there; its diameters within `diameter` either side, its
-    /// pitch diameter (where the thickness is measured) within the
-    /// thickness's tolerance over the flanks' spread.
+    /// The worm's ZA section (straight flanks in the axial section) as a
+    /// thread's: the axial pitch `pi m`, the flanks at the profile angle,
+    /// the space at the pitch diameter the pitch less the thread's
+    /// thickness there.
+    pub fn section(&self) -> ThreadSection {
+        ThreadSection {
+            internal: false,
+            pitch: self.axial_pitch(),
+            starts: self.starts,
+            hand: Hand::Right,
+            major: self.tip_diameter(),
+            pitch_diameter: self.pitch_diameter,
+            root_diameter: self.root_diameter(),
+            crest_diameter: self.tip_diameter(),
+            flanks: [self.alpha; 2],
+            space_at_pitch: self.axial_pitch() - self.thickness,
+            root_radius: 0.0,
+        }
+    }
+
+    /// The worm as a thread profile: its [`Self::section`], its diameters
+    /// within `diameter` either side, its pitch diameter (where the
+    /// thickness is measured) within the thickness's tolerance `thickness`
+    /// over the flanks' spread.
     pub fn profile(&self, diameter: Real, thickness: Real) -> ThreadProfile {
         let band = |v: Real, t: Real| Limits {
             min: v - t,
@@ -188,17 +206,7 @@ impl WormSizes {
                 number(self.pitch_diameter)
             ),
             standard: "MATH §4.1 (ZA worm)".into(),
-            internal: false,
-            pitch: self.axial_pitch(),
-            starts: self.starts,
-            hand: Hand::Right,
-            major: self.tip_diameter(),
-            pitch_diameter: self.pitch_diameter,
-            root_diameter: self.root_diameter(),
-            crest_diameter: self.tip_diameter(),
-            flanks: [self.alpha; 2],
-            space_at_pitch: self.axial_pitch() - self.thickness,
-            root_radius: 0.0,
+            section: self.section(),
             limits: ThreadLimits {
                 pitch_diameter: band(self.pitch_diameter, thickness / (2.0 * self.alpha.tan())),
                 crest: band(self.tip_diameter(), diameter),
@@ -261,11 +269,11 @@ mod tests {
         let t = w.profile(0.05, 0.02);
         let near = |a: Real, b: Real| assert!((a - b).abs() < 1e-12, "{a} vs {b}");
         for r in [w.root_radius(), 22.0, w.pitch_radius(), w.tip_radius()] {
-            near(t.space_at(r), w.space_at(r));
+            near(t.section.space_at(r), w.space_at(r));
         }
-        near(t.root_space(), w.root_space());
-        near(t.space_area(), w.space_area());
-        near(t.lead(), w.lead());
-        near(t.depth(), w.height());
+        near(t.section.root_space(), w.root_space());
+        near(t.section.space_area(), w.space_area());
+        near(t.section.lead(), w.lead());
+        near(t.section.depth(), w.height());
     }
 }
