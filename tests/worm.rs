@@ -309,6 +309,9 @@ fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
         csv.starts_with("block,name,start,x_mm,offset_mm,chip_area_mm2"),
         "{csv}"
     );
+    // The same per pass in passes.xlsx, numbers as numbers with their
+    // units; each start's finished profile; the verification's figures.
+    check_workbook(&out);
     for f in [
         "passes.svg",
         "chip_area.svg",
@@ -885,4 +888,59 @@ fn a_rapid_through_the_stock_is_refused() {
         found.errors
     );
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `passes.xlsx` read back with calamine: a sheet of passes (one row each,
+/// the report's figures as numbers, units in the header), one of starts
+/// (each start's finished profile against its nominal) and one of the
+/// verification's figures.
+fn check_workbook(out: &std::path::Path) {
+    use calamine::{open_workbook, Data, Reader, Xlsx};
+    let report = common::report_of(out);
+    let v = &report["worm_verification"];
+    let mut book: Xlsx<_> = open_workbook(out.join("passes.xlsx")).unwrap();
+    assert_eq!(book.sheet_names(), ["passes", "starts", "figures"]);
+    let number = |d: &Data| match d {
+        Data::Float(f) => *f,
+        Data::Int(i) => *i as f64,
+        other => panic!("not a number: {other:?}"),
+    };
+    let passes = book.worksheet_range("passes").unwrap();
+    let rows: Vec<&[Data]> = passes.rows().collect();
+    let head: Vec<String> = rows[0].iter().map(|c| c.to_string()).collect();
+    let col = |name: &str| {
+        head.iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("no column {name} in {head:?}"))
+    };
+    let want = v["passes"].as_array().unwrap();
+    assert_eq!(rows.len(), want.len() + 1);
+    for (row, p) in rows[1..].iter().zip(want) {
+        assert_eq!(number(&row[col("block")]), p["block"].as_f64().unwrap());
+        assert_eq!(row[col("name")].to_string(), p["name"].as_str().unwrap());
+        for (name, key) in [
+            ("chip area (mm²)", "chip_area"),
+            ("left flank load (mm²)", "left_area"),
+            ("X (mm)", "x"),
+            ("lead error at the face", "face_lead_error"),
+        ] {
+            assert_eq!(number(&row[col(name)]), p[key].as_f64().unwrap(), "{name}");
+        }
+    }
+    let starts = book.worksheet_range("starts").unwrap();
+    let rows: Vec<&[Data]> = starts.rows().collect();
+    let want = v["starts"].as_array().unwrap();
+    assert_eq!(rows.len(), want.len() + 1);
+    let head: Vec<String> = rows[0].iter().map(|c| c.to_string()).collect();
+    let t = head.iter().position(|h| h == "thickness (mm)").unwrap();
+    for (row, s) in rows[1..].iter().zip(want) {
+        assert_eq!(number(&row[t]), s["thickness"].as_f64().unwrap());
+    }
+    let figures = book.worksheet_range("figures").unwrap();
+    let removed = figures
+        .rows()
+        .find(|r| r[0] == "area removed")
+        .expect("the area removed");
+    assert_eq!(number(&removed[1]), v["removed_area"].as_f64().unwrap());
+    assert_eq!(removed[2].to_string(), "mm²");
 }

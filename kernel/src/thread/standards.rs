@@ -623,7 +623,11 @@ mod tests {
                 near(got / INCH, want, 4);
             }
             let p = 1.0 / tpi;
-            near((p - t.section.space_at(d * INCH / 2.0) / INCH) / p, 0.3707, 4);
+            near(
+                (p - t.section.space_at(d * INCH / 2.0) / INCH) / p,
+                0.3707,
+                4,
+            );
         }
         assert_eq!(
             acme(1.0, 5.0, false, 2, 1, Hand::Right)
@@ -653,7 +657,11 @@ mod tests {
         let v = p / (t.section.flanks[0].tan() + t.section.flanks[1].tan());
         near(v / p, 0.89064, 5);
         near(t.section.depth() / p, 0.66271, 5);
-        near((t.section.major - t.section.pitch_diameter) / 2.0 / p, 0.3, 9);
+        near(
+            (t.section.major - t.section.pitch_diameter) / 2.0 / p,
+            0.3,
+            9,
+        );
         assert!(t.section.flanks[1] < t.section.flanks[0]);
         let other = buttress(
             2.0,
@@ -680,7 +688,10 @@ mod tests {
             trapezoidal(40.0, 7.0, false, 1, Hand::Right, STATED).unwrap(),
             acme(1.0, 5.0, false, 2, 1, Hand::Right).unwrap(),
         ] {
-            for w in [t.section.best_wire().unwrap(), 1.1 * t.section.best_wire().unwrap()] {
+            for w in [
+                t.section.best_wire().unwrap(),
+                1.1 * t.section.best_wire().unwrap(),
+            ] {
                 let m = t.section.over_wires(w, t.section.pitch_diameter).unwrap();
                 // The flank towards +Z, root corner to crest corner.
                 let o = t.section.space_outline(0.0);
@@ -726,6 +737,9 @@ mod tests {
             STATED,
         )
         .unwrap();
-        assert!(b.section.over_wires(1.0, b.section.pitch_diameter).is_none());
+        assert!(b
+            .section
+            .over_wires(1.0, b.section.pitch_diameter)
+            .is_none());
     }
 }

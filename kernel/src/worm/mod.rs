@@ -12,7 +12,8 @@
 //! - [`simulate`]: the program replayed in the axial section, pass by
 //!   pass, with polygon booleans: chips, flank loads, the finished profile
 //!   against the nominal;
-//! - [`worm_solid`]: the finished worm as a closed mesh.
+//! - [`worm_solid`]: the finished worm as a closed mesh;
+//! - [`worm_pass_workbook`]: the per-pass report as an Excel workbook.
 //!
 //! The part frame: Z along the worm's axis, the thread from z = 0 (the
 //! face towards the tailstock) to z = -b1, cut towards the chuck (-Z); X
@@ -27,6 +28,7 @@ mod servo;
 mod simulate;
 mod sizes;
 mod solid;
+mod workbook;
 
 pub use crate::tool::{ThreadCutter, ARC_TOLERANCE};
 pub use blade::{cutter_outline, ThreadBlade, BLADE_RELIEF_DEG, BLADE_THICKNESS};
@@ -44,3 +46,4 @@ pub use simulate::{
 };
 pub use sizes::WormSizes;
 pub use solid::{worm_solid, WormSweep, MAX_AROUND};
+pub use workbook::worm_pass_workbook;

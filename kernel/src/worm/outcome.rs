@@ -2,7 +2,7 @@
 //! simulates a program's cut pass by pass with [`simulate`]; the outcome
 //! gives the verdict's figures, the report's `worm_verification`, the
 //! finished worm's solid, the simulated areas in the family's `passes`
-//! table, `passes.csv`, `passes.svg` and the page's section.
+//! table, `passes.csv`, `passes.xlsx`, `passes.svg` and the page's section.
 
 use super::{
     simulate, worm_pass_table, worm_passes_svg, worm_solid, SimulatedPass, WormCheck, WormRequest,
@@ -138,10 +138,12 @@ impl Outcome for WormOutcome {
         tables: &BTreeMap<String, BTreeMap<String, Vec<f64>>>,
     ) -> Result<crate::family::Drawn, String> {
         let table = worm_pass_table(&self.check, tables.get("passes"))?;
+        let workbook = super::worm_pass_workbook(&self.check, tables.get("passes"))?;
         let (svg, marks) = worm_passes_svg(&self.check, ctx.replay.program.blocks.len())?;
         Ok(crate::family::Drawn {
             files: vec![
                 ("passes.csv".into(), table.into_bytes()),
+                ("passes.xlsx".into(), workbook),
                 ("passes.svg".into(), svg.into_bytes()),
             ],
             marks: [("passes.svg".to_owned(), marks)].into(),

@@ -4,9 +4,9 @@
 //! steps, and the order of the starts.
 
 use super::ThreadCutter;
-use crate::thread::ThreadSection;
 use crate::input::InputError;
 use crate::math::Real;
+use crate::thread::ThreadSection;
 use serde::Serialize;
 
 /// The most passes a plan may have (all starts together): beyond it the
