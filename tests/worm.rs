@@ -138,11 +138,11 @@ fn cutter(dir: &Path) -> pilgrim_kernel::worm::ThreadCutter {
 /// `z1` starts, pitch diameter `d1`, `b1` long, placed as the run's report
 /// `r` says: the family's default tolerances.
 fn request(r: &serde_json::Value, m: f64, z1: i64, d1: f64, b1: f64) -> WormRequest {
-    WormRequest {
-        sizes: WormSizes::new(m, z1, d1, 0.2, 20f64.to_radians(), None).unwrap(),
-        length: b1,
-        space_centre: r["notes"]["space_centre_mm"].as_f64().unwrap(),
-        tolerances: WormTolerances {
+    WormRequest::worm(
+        &WormSizes::new(m, z1, d1, 0.2, 20f64.to_radians(), None).unwrap(),
+        b1,
+        r["notes"]["space_centre_mm"].as_f64().unwrap(),
+        WormTolerances {
             form: 0.01,
             thickness: 0.02,
             diameter: 0.02,
@@ -150,7 +150,7 @@ fn request(r: &serde_json::Value, m: f64, z1: i64, d1: f64, b1: f64) -> WormRequ
             flank_angle: 0.05f64.to_radians(),
             lead: 0.01,
         },
-    }
+    )
 }
 
 /// The run in `dir` simulated again from its `program.nc`.

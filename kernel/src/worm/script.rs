@@ -305,11 +305,11 @@ fn verification(m: &Map) -> Result<Verification, Option<String>> {
             ))
         })
     };
-    Ok(Verification::new(worm::WormRequest {
-        sizes,
-        length: num("length")?,
-        space_centre: num("space_centre")?,
-        tolerances: worm::WormTolerances {
+    Ok(Verification::new(worm::WormRequest::worm(
+        &sizes,
+        num("length")?,
+        num("space_centre")?,
+        worm::WormTolerances {
             form: tnum("form")?,
             thickness: tnum("thickness")?,
             diameter: tnum("diameter")?,
@@ -320,5 +320,5 @@ fn verification(m: &Map) -> Result<Verification, Option<String>> {
                 Some(_) => tnum("lead")?,
             },
         },
-    }))
+    )))
 }

@@ -21,6 +21,7 @@
 //! the cutter in the axial plane), deflection and wear.
 
 use super::{ThreadCutter, WormSizes};
+use crate::thread::ThreadSection;
 use crate::machine::MachineKinematics;
 use crate::math::Real;
 use crate::program::{block_name, AxisProgram};
@@ -58,8 +59,12 @@ pub const LEAD_ERROR: Real = 0.01;
 /// What the family asks the simulation to check.
 #[derive(Debug, Clone, PartialEq)]
 pub struct WormRequest {
-    /// The worm.
-    pub sizes: WormSizes,
+    /// The thread's section (external: an internal thread is not
+    /// simulated yet).
+    pub section: ThreadSection,
+    /// How far inside the root and the crest the flanks are measured (mm,
+    /// beside the cutter's nose radius at the root).
+    pub flank_margin: Real,
     /// The thread's length: from z = 0 to z = -length (mm).
     pub length: Real,
     /// Where start 0's space is centred in the section at part angle 0
@@ -67,6 +72,25 @@ pub struct WormRequest {
     pub space_centre: Real,
     /// The tolerances.
     pub tolerances: WormTolerances,
+}
+
+impl WormRequest {
+    /// The request for the worm `sizes`: its section, the flanks measured
+    /// a tenth of the module inside the root and the tip.
+    pub fn worm(
+        sizes: &WormSizes,
+        length: Real,
+        space_centre: Real,
+        tolerances: WormTolerances,
+    ) -> Self {
+        Self {
+            section: sizes.section(),
+            flank_margin: 0.1 * sizes.module,
+            length,
+            space_centre,
+            tolerances,
+        }
+    }
 }
 
 /// One thread block as simulated.
@@ -166,9 +190,14 @@ pub struct WormCheck {
     /// The nominal thickness at the pitch line, root and tip diameters (mm).
     #[serde(default)]
     pub nominal: (Real, Real, Real),
-    /// The nominal flank angle (deg).
+    /// The nominal flank angle (deg; the flank towards -Z's where they
+    /// differ).
     #[serde(default)]
     pub nominal_alpha_deg: Real,
+    /// The nominal flank angles (deg): the space's flank towards -Z (the
+    /// left), then +Z.
+    #[serde(default)]
+    pub nominal_flanks_deg: [Real; 2],
 }
 
 impl WormCheck {
@@ -390,19 +419,26 @@ fn segment_distance(p: [Real; 2], a: [Real; 2], b: [Real; 2]) -> Real {
     ((p[0] - a[0] - t * dx).powi(2) + (p[1] - a[1] - t * dy).powi(2)).sqrt()
 }
 
+/// How far the nominal space reaches from its centre at radius `r`:
+/// towards -Z, then +Z (each flank at its own angle).
+fn space_reach(t: &ThreadSection, r: Real) -> [Real; 2] {
+    let up = t.opening() * (r - t.pitch_diameter / 2.0);
+    [0, 1].map(|k| t.space_at_pitch / 2.0 + up * t.flanks[k].tan())
+}
+
 /// The nominal spaces of one lead's window (and one either side), each a
-/// trapezoid from the root to above the tip.
-fn nominal_spaces(w: &WormSizes, c0: Real) -> Vec<[[Real; 2]; 4]> {
-    let top = w.tip_radius() + 2.0;
-    let (bottom, upper) = (w.root_space() / 2.0, w.space_at(top) / 2.0);
-    (-1..=i64::from(w.starts))
+/// trapezoid from the root to above the crest.
+fn nominal_spaces(t: &ThreadSection, c0: Real) -> Vec<[[Real; 2]; 4]> {
+    let (root, top) = (t.root_diameter / 2.0, t.crest_diameter / 2.0 + 2.0);
+    let (bottom, upper) = (space_reach(t, root), space_reach(t, top));
+    (-1..=i64::from(t.starts))
         .map(|k| {
-            let c = c0 + k as Real * w.axial_pitch();
+            let c = c0 + k as Real * t.pitch;
             [
-                [c - bottom, w.root_radius()],
-                [c + bottom, w.root_radius()],
-                [c + upper, top],
-                [c - upper, top],
+                [c - bottom[0], root],
+                [c + bottom[1], root],
+                [c + upper[1], top],
+                [c - upper[0], top],
             ]
         })
         .collect()
@@ -426,15 +462,21 @@ pub fn simulate(
     cutter: &ThreadCutter,
     req: &WormRequest,
 ) -> Result<WormCheck, VerifyError> {
-    let w = &req.sizes;
+    let w = &req.section;
     let tol = &req.tolerances;
     let fail = |m: String| VerifyError::Failed(m);
+    if w.internal {
+        return Err(fail(
+            "an internal thread's cut is not simulated yet: only external threads are verified"
+                .into(),
+        ));
+    }
     let (written, _) = as_written(program);
     let poses = replay(&written, machine, tool)?;
     let at = |i: usize| (poses[6 * i], poses[6 * i + 2]);
     let lead = w.lead();
-    let (px, z1) = (w.axial_pitch(), w.starts);
-    let (r_a, r_f) = (w.tip_radius(), w.root_radius());
+    let (px, z1) = (w.pitch, w.starts);
+    let (r_a, r_f) = (w.crest_diameter / 2.0, w.root_diameter / 2.0);
     let r_core = r_f - (2.0f64).min(r_f / 2.0);
     let c0 = req.space_centre;
     let w0 = c0 - px / 2.0;
@@ -667,12 +709,13 @@ pub fn simulate(
     if passes.is_empty() {
         return Err(VerifyError::NoCuttingPass);
     }
-    let (starts, unmeasured) = measure(&material, w, c0, cutter, tol);
+    let (starts, unmeasured) = measure(&material, req, cutter);
     failures.extend(unmeasured);
     Ok(WormCheck {
         failures,
-        nominal: (w.thickness, w.root_diameter(), w.tip_diameter()),
-        nominal_alpha_deg: w.alpha.to_degrees(),
+        nominal: (w.pitch - w.space_at_pitch, w.root_diameter, w.crest_diameter),
+        nominal_alpha_deg: w.flanks[0].to_degrees(),
+        nominal_flanks_deg: w.flanks.map(Real::to_degrees),
         removed_area: passes.iter().map(|p| p.chip_area).sum(),
         flank_loads: [
             passes.iter().map(|p| p.left_area).sum(),
@@ -735,7 +778,7 @@ impl WormStock {
             })
             .collect();
         Self {
-            tip_radius: req.sizes.tip_radius(),
+            tip_radius: req.section.crest_diameter / 2.0,
             length: req.length,
             outline,
             passes,
@@ -786,22 +829,22 @@ fn slope(samples: &[(Real, Real)]) -> Real {
 /// nominal (a start whose space is not there is not measured further).
 fn measure(
     m: &MultiPolygon<Real>,
-    w: &WormSizes,
-    c0: Real,
+    req: &WormRequest,
     cutter: &ThreadCutter,
-    tol: &WormTolerances,
 ) -> (Vec<StartProfile>, Vec<Finding>) {
+    let (w, tol) = (&req.section, &req.tolerances);
     let mut failures = Vec::new();
     let fail = |m: String| Finding::new("verification", VerifyError::Failed(m).to_string());
     let (px, r_a, r_f, r1) = (
-        w.axial_pitch(),
-        w.tip_radius(),
-        w.root_radius(),
-        w.pitch_radius(),
+        w.pitch,
+        w.crest_diameter / 2.0,
+        w.root_diameter / 2.0,
+        w.pitch_diameter / 2.0,
     );
     // The flanks are measured clear of the root's fillet and the tip's edge.
-    let r_lo = r_f + 2.0 * cutter.nose_radius + 0.1 * w.module;
-    let r_hi = r_a - 0.1 * w.module;
+    let r_lo = r_f + 2.0 * cutter.nose_radius + req.flank_margin;
+    let r_hi = r_a - req.flank_margin;
+    let c0 = req.space_centre;
     let samples = 21;
     let mut out = Vec::new();
     'starts: for k in 0..w.starts {
@@ -829,9 +872,9 @@ fn measure(
             };
             left.push((r, zl));
             right.push((r, zr));
-            let half = w.space_at(r) / 2.0;
-            let dl = (zl - (c - half)) * w.alpha.cos();
-            let dr = ((c + half) - zr) * w.alpha.cos();
+            let reach = space_reach(w, r);
+            let dl = (zl - (c - reach[0])) * w.flanks[0].cos();
+            let dr = ((c + reach[1]) - zr) * w.flanks[1].cos();
             if dl.abs() > left_form.abs() {
                 left_form = dl;
                 worst_at[0] = r;
@@ -875,20 +918,22 @@ fn measure(
             tip_diameter: 2.0 * vertical_top(m, c + px / 2.0 - 1e-3).unwrap_or(0.0),
         };
         let s = k + 1;
-        let alpha = w.alpha.to_degrees();
         for (flank, form, r) in [
             ("left", p.left_form, worst_at[0]),
             ("right", p.right_form, worst_at[1]),
         ] {
             if form.abs() > tol.form {
                 failures.push(fail(format!(
-                    "start {s}, {flank} flank: {} {:.4} mm from the nominal ZA flank at diameter {:.3} (tolerance {} mm)",
+                    "start {s}, {flank} flank: {} {:.4} mm from the nominal flank at diameter {:.3} (tolerance {} mm)",
                     if form > 0.0 { "material left" } else { "cut too deep" },
                     form.abs(), 2.0 * r, tol.form
                 )));
             }
         }
-        for (flank, a) in [("left", p.left_angle_deg), ("right", p.right_angle_deg)] {
+        for (flank, a, alpha) in [
+            ("left", p.left_angle_deg, w.flanks[0].to_degrees()),
+            ("right", p.right_angle_deg, w.flanks[1].to_degrees()),
+        ] {
             if (a - alpha).abs() > tol.flank_angle.to_degrees() {
                 failures.push(fail(format!(
                     "start {s}, {flank} flank: angle {a:.4} deg, nominal {alpha:.4} deg (tolerance {:.4} deg)",
@@ -896,15 +941,16 @@ fn measure(
                 )));
             }
         }
-        if (p.thickness - w.thickness).abs() > tol.thickness {
+        let thickness = w.pitch - w.space_at_pitch;
+        if (p.thickness - thickness).abs() > tol.thickness {
             failures.push(fail(format!(
                 "start {s}: axial thickness at the pitch line {:.4} mm, nominal {:.4} mm (tolerance {} mm)",
-                p.thickness, w.thickness, tol.thickness
+                p.thickness, thickness, tol.thickness
             )));
         }
         for (what, d, nominal) in [
-            ("root diameter", p.root_diameter, w.root_diameter()),
-            ("tip diameter", p.tip_diameter, w.tip_diameter()),
+            ("root diameter", p.root_diameter, w.root_diameter),
+            ("tip diameter", p.tip_diameter, w.crest_diameter),
         ] {
             if (d - nominal).abs() > tol.diameter {
                 failures.push(fail(format!(
