@@ -531,6 +531,11 @@ mod tests {
         );
     }
 
+    /// 2-8 7/45 buttress, its load flank as asked.
+    fn butt_2_8(load: LoadFlank) -> ThreadProfile {
+        buttress(2.0, 8.0, false, load, 1, Hand::Right, STATED).unwrap()
+    }
+
     const STATED: StatedLimits = StatedLimits {
         pitch_allowance: 0.0,
         pitch_tolerance: 0.1,
@@ -643,16 +648,7 @@ mod tests {
     /// the load flank faces the side asked.
     #[test]
     fn buttress_7_45_has_the_standards_form() {
-        let t = buttress(
-            2.0,
-            8.0,
-            false,
-            LoadFlank::TowardsChuck,
-            1,
-            Hand::Right,
-            STATED,
-        )
-        .unwrap();
+        let t = butt_2_8(LoadFlank::TowardsChuck);
         let p = INCH / 8.0;
         let v = p / (t.section.flanks[0].tan() + t.section.flanks[1].tan());
         near(v / p, 0.89064, 5);
@@ -663,16 +659,7 @@ mod tests {
             9,
         );
         assert!(t.section.flanks[1] < t.section.flanks[0]);
-        let other = buttress(
-            2.0,
-            8.0,
-            false,
-            LoadFlank::AwayFromChuck,
-            1,
-            Hand::Right,
-            STATED,
-        )
-        .unwrap();
+        let other = butt_2_8(LoadFlank::AwayFromChuck);
         assert!(other.section.flanks[0] < other.section.flanks[1]);
     }
 
@@ -727,16 +714,7 @@ mod tests {
             18.376 + 3.0 * w - 0.866025 * 2.5,
             5,
         );
-        let b = buttress(
-            2.0,
-            8.0,
-            false,
-            LoadFlank::TowardsChuck,
-            1,
-            Hand::Right,
-            STATED,
-        )
-        .unwrap();
+        let b = butt_2_8(LoadFlank::TowardsChuck);
         assert!(b
             .section
             .over_wires(1.0, b.section.pitch_diameter)

@@ -122,6 +122,26 @@ pub fn worm_passes_svg(check: &WormCheck, blocks: usize) -> Result<(String, Mark
     Ok((svg, marks))
 }
 
+/// The plan's columns of the family's pass table `planned` that hold one
+/// value per simulated pass, less those the simulation's own columns
+/// repeat.
+pub(super) fn plan_columns<'a>(
+    check: &WormCheck,
+    planned: Option<&'a BTreeMap<String, Vec<f64>>>,
+) -> Vec<(&'a String, &'a Vec<f64>)> {
+    planned
+        .map(|t| {
+            t.iter()
+                .filter(|(k, c)| {
+                    c.len() == check.passes.len()
+                        && !["simulated_area", "left_area", "right_area", "block"]
+                            .contains(&k.as_str())
+                })
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
 /// `passes.csv`: one row per simulated thread pass (block, its name,
 /// start from 1, X, axial offset, chip area, left and right loads, gouge,
 /// the approach and run-out from the cutting edges with the lead's error
@@ -135,17 +155,7 @@ pub fn worm_pass_table(
     check: &WormCheck,
     planned: Option<&BTreeMap<String, Vec<f64>>>,
 ) -> Result<String, String> {
-    let plan: Vec<(&String, &Vec<f64>)> = planned
-        .map(|t| {
-            t.iter()
-                .filter(|(k, c)| {
-                    c.len() == check.passes.len()
-                        && !["simulated_area", "left_area", "right_area", "block"]
-                            .contains(&k.as_str())
-                })
-                .collect()
-        })
-        .unwrap_or_default();
+    let plan = plan_columns(check, planned);
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut head: Vec<String> = [
         "block",

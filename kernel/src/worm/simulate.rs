@@ -21,11 +21,11 @@
 //! the cutter in the axial plane), deflection and wear.
 
 use super::{ThreadCutter, WormSizes};
-use crate::thread::ThreadSection;
 use crate::machine::MachineKinematics;
 use crate::math::Real;
 use crate::program::{block_name, AxisProgram};
 use crate::replay::{as_written, replay, VerifyError};
+use crate::thread::ThreadSection;
 use crate::toolpath::Motion;
 use crate::transform::ToolFrame;
 use crate::verdict::{Figure, Finding};
@@ -713,7 +713,11 @@ pub fn simulate(
     failures.extend(unmeasured);
     Ok(WormCheck {
         failures,
-        nominal: (w.pitch - w.space_at_pitch, w.root_diameter, w.crest_diameter),
+        nominal: (
+            w.pitch - w.space_at_pitch,
+            w.root_diameter,
+            w.crest_diameter,
+        ),
         nominal_alpha_deg: w.flanks[0].to_degrees(),
         nominal_flanks_deg: w.flanks.map(Real::to_degrees),
         removed_area: passes.iter().map(|p| p.chip_area).sum(),

@@ -61,17 +61,7 @@ fn build(
             .set_title("pilgrim: the thread's passes, simulated")
             .set_creation_datetime(&ExcelDateTime::from_ymd(2000, 1, 1)?),
     );
-    let plan: Vec<(&String, &Vec<f64>)> = planned
-        .map(|t| {
-            t.iter()
-                .filter(|(k, c)| {
-                    c.len() == check.passes.len()
-                        && !["simulated_area", "left_area", "right_area", "block"]
-                            .contains(&k.as_str())
-                })
-                .collect()
-        })
-        .unwrap_or_default();
+    let plan = super::plots::plan_columns(check, planned);
     let plan_names: Vec<String> = plan.iter().map(|(k, _)| format!("plan: {k}")).collect();
     let mut columns: Vec<Column<'_>> = vec![
         ("block", None),
