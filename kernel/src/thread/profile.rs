@@ -109,6 +109,19 @@ pub struct ThreadSection {
 }
 
 impl ThreadSection {
+    /// The same form cut to the pitch diameter `pitch_diameter` (a
+    /// tolerance class's aim, the middle of its band): the flanks moved
+    /// radially with it, the root as much deeper or shallower, the crest
+    /// (the blank's, the bore's) where it was.
+    pub fn aimed(&self, pitch_diameter: Real) -> ThreadSection {
+        let shift = pitch_diameter - self.pitch_diameter;
+        ThreadSection {
+            pitch_diameter,
+            root_diameter: self.root_diameter + shift,
+            ..self.clone()
+        }
+    }
+
     /// The lead: the starts' pitches.
     pub fn lead(&self) -> Real {
         Real::from(self.starts) * self.pitch

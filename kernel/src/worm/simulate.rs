@@ -72,6 +72,10 @@ pub struct WormRequest {
     pub space_centre: Real,
     /// The tolerances.
     pub tolerances: WormTolerances,
+    /// A standard's limits the finished thread must hold besides: each
+    /// start's pitch diameter within `pitch_diameter` (`None`: the
+    /// tolerances alone).
+    pub limits: Option<crate::thread::ThreadLimits>,
 }
 
 impl WormRequest {
@@ -89,6 +93,7 @@ impl WormRequest {
             length,
             space_centre,
             tolerances,
+            limits: None,
         }
     }
 }
@@ -136,7 +141,7 @@ pub struct SimulatedPass {
 pub struct StartProfile {
     /// The start (from 0).
     pub start: u32,
-    /// The space's centre at the pitch line, less the nominal (mm).
+    /// The space's middle at the pitch line, less the nominal's (mm).
     pub position_error: Real,
     /// The axial thickness at the pitch line of the thread after this
     /// space (mm).
@@ -154,6 +159,12 @@ pub struct StartProfile {
     pub root_diameter: Real,
     /// The diameter at the middle of the thread after it (mm).
     pub tip_diameter: Real,
+    /// The pitch diameter as a thread gauge takes it: where the space is
+    /// as wide as the basic section's at its pitch diameter (P/2 for a
+    /// standard thread), the space's own flanks measured (mm; 0 where the
+    /// space is nowhere that wide between the flanks' measured band).
+    #[serde(default)]
+    pub pitch_diameter: Real,
 }
 
 /// The simulation's result (`report.json`'s `worm_verification`; the
@@ -419,11 +430,22 @@ fn segment_distance(p: [Real; 2], a: [Real; 2], b: [Real; 2]) -> Real {
     ((p[0] - a[0] - t * dx).powi(2) + (p[1] - a[1] - t * dy).powi(2)).sqrt()
 }
 
-/// How far the nominal space reaches from its centre at radius `r`:
-/// towards -Z, then +Z (each flank at its own angle).
+/// How far the nominal space reaches at radius `r` from its centre, the
+/// middle of its root (where a radial pass puts the cutter's tip): towards
+/// -Z, then +Z, each flank at its own angle.
 fn space_reach(t: &ThreadSection, r: Real) -> [Real; 2] {
-    let up = t.opening() * (r - t.pitch_diameter / 2.0);
-    [0, 1].map(|k| t.space_at_pitch / 2.0 + up * t.flanks[k].tan())
+    let up = t.opening() * (r - t.root_diameter / 2.0);
+    [0, 1].map(|k| t.root_space() / 2.0 + up * t.flanks[k].tan())
+}
+
+/// How far the middles of the threads' crests either side of a space
+/// stand from its centre (the root's middle): before it (towards -Z), then
+/// after it. Below the crest the thread is wider, so a line there stays in
+/// the thread (a buttress's too).
+fn thread_middle(t: &ThreadSection) -> [Real; 2] {
+    let reach = space_reach(t, t.crest_diameter / 2.0);
+    let half = (t.pitch - reach[0] - reach[1]) / 2.0;
+    [reach[0] + half, reach[1] + half]
 }
 
 /// The nominal spaces of one lead's window (and one either side), each a
@@ -479,7 +501,9 @@ pub fn simulate(
     let (r_a, r_f) = (w.crest_diameter / 2.0, w.root_diameter / 2.0);
     let r_core = r_f - (2.0f64).min(r_f / 2.0);
     let c0 = req.space_centre;
-    let w0 = c0 - px / 2.0;
+    // The window starts in the middle of the crest before start 0's
+    // space.
+    let w0 = c0 - thread_middle(w)[0];
     let mut material = MultiPolygon::new(vec![rect(w0, w0 + lead, r_core, r_a)]);
     let spaces = nominal_spaces(w, c0);
     let nominal = MultiPolygon::new(spaces.iter().map(|s| poly(s)).collect());
@@ -815,6 +839,32 @@ impl crate::process::Stock for WormStock {
     }
 }
 
+/// The diameter where the space round `c` is as wide as the basic
+/// section's at its pitch diameter, between the radii `band` (bisection on
+/// the space's width, which grows towards the crest; 0 if it is not
+/// within the band).
+fn pitch_diameter(m: &MultiPolygon<Real>, t: &ThreadSection, c: Real, band: (Real, Real)) -> Real {
+    let width = |r: Real| space_edges(m, r, c).map(|(a, b)| b - a);
+    let (mut lo, mut hi) = band;
+    let (Some(w_lo), Some(w_hi)) = (width(lo), width(hi)) else {
+        return 0.0;
+    };
+    let want = t.space_at_pitch;
+    if !(w_lo <= want && want <= w_hi) {
+        return 0.0;
+    }
+    // 50 halvings take a band of millimetres below 1e-12 mm.
+    for _ in 0..50 {
+        let mid = 0.5 * (lo + hi);
+        match width(mid) {
+            Some(w) if w < want => lo = mid,
+            Some(_) => hi = mid,
+            None => return 0.0,
+        }
+    }
+    lo + hi
+}
+
 /// The least-squares slope `b` of `z = a + b r`.
 fn slope(samples: &[(Real, Real)]) -> Real {
     let n = samples.len() as Real;
@@ -910,7 +960,12 @@ fn measure(
         };
         let p = StartProfile {
             start: k,
-            position_error: 0.5 * (zl + zr) - c,
+            // The pitch line's middle stands off the root's by half the
+            // flanks' difference over the depth between them.
+            position_error: 0.5 * (zl + zr) - c - {
+                let reach = space_reach(w, r1);
+                0.5 * (reach[1] - reach[0])
+            },
             thickness: next - zr,
             left_angle_deg: (-slope(&left)).atan().to_degrees(),
             right_angle_deg: slope(&right).atan().to_degrees(),
@@ -919,7 +974,8 @@ fn measure(
             root_diameter: 2.0 * vertical_top(m, c).unwrap_or(0.0),
             // The thread's middle (the last start's at the window's end:
             // 1 um inside it).
-            tip_diameter: 2.0 * vertical_top(m, c + px / 2.0 - 1e-3).unwrap_or(0.0),
+            tip_diameter: 2.0 * vertical_top(m, c + thread_middle(w)[1] - 1e-3).unwrap_or(0.0),
+            pitch_diameter: pitch_diameter(m, w, c, (r_lo, r_hi)),
         };
         let s = k + 1;
         for (flank, form, r) in [
@@ -963,6 +1019,15 @@ fn measure(
                 )));
             }
         }
+        if let Some(l) = &req.limits {
+            let d = &l.pitch_diameter;
+            if !d.holds(p.pitch_diameter, 0.0) {
+                failures.push(fail(format!(
+                    "start {s}: pitch diameter {:.4} mm, outside {:.4} to {:.4} mm ({})",
+                    p.pitch_diameter, d.min, d.max, l.source
+                )));
+            }
+        }
         if p.position_error.abs() > tol.position {
             failures.push(fail(format!(
                 "start {s}: its space is {:.4} mm from its place (tolerance {} mm)",
@@ -972,4 +1037,180 @@ fn measure(
         out.push(p);
     }
     (out, failures)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::machine::{ChainMachine, Machine};
+    use crate::program::{Block, ProgramAxis};
+    use crate::thread::{standards, Hand, ThreadProfile};
+    use crate::worm::{plan, FlankOrder, PlanSettings};
+
+    /// An external M20 6g cut with a 60 degree cutter to the plan's depths,
+    /// the section aimed `aim` mm below the basic pitch diameter: the
+    /// lathe's program of plain thread blocks.
+    fn cut_m20(aim: Real) -> Result<WormCheck, VerifyError> {
+        let profile = standards::metric(20.0, 2.5, false, "6g", 1, Hand::Right).unwrap();
+        cut(&profile, aim, FlankOrder::Alternating)
+    }
+
+    /// `profile` cut `aim` mm below its basic pitch diameter by a cutter of
+    /// its own flanks and root space, the roughing passes on `order`'s
+    /// flanks.
+    fn cut(
+        profile: &ThreadProfile,
+        aim: Real,
+        order: FlankOrder,
+    ) -> Result<WormCheck, VerifyError> {
+        let t = &profile.section.aimed(profile.section.pitch_diameter - aim);
+        let cutter =
+            ThreadCutter::new(t.root_space(), 0.15, t.flanks[0], t.flanks[1], 3.0).unwrap();
+        let settings = PlanSettings {
+            roughing_passes: None,
+            min_depth: 0.05,
+            finish_depth: 0.03,
+            finish_passes: 2,
+            order,
+            axial_step: 0.5,
+            starts_by_depth: true,
+        };
+        let passes = plan(t, &cutter, &settings).unwrap();
+        let (length, c0, rpm) = (30.0, 5.0, 300.0);
+        let r_crest = t.crest_diameter / 2.0;
+        let mut blocks = Vec::new();
+        let block = |motion, x: Real, z: Real, feed: Real| Block {
+            motion,
+            values: vec![2.0 * x, z],
+            feed,
+            spindle: None,
+            comment: None,
+            keep: vec![],
+            number: None,
+        };
+        let clear = r_crest + 1.0;
+        for p in &passes {
+            let r = r_crest - p.cumulative;
+            let zs = c0 + p.offset;
+            let ze = -length - 5.0;
+            blocks.push(block(Motion::Rapid, clear, zs, 0.0));
+            blocks.push(block(Motion::Rapid, r, zs, 0.0));
+            blocks.push(block(
+                Motion::Thread {
+                    lead: t.lead(),
+                    start_deg: 0.0,
+                },
+                r,
+                ze,
+                t.lead() * rpm,
+            ));
+            blocks.push(block(Motion::Rapid, clear, ze, 0.0));
+        }
+        let axis = |n: &str| ProgramAxis {
+            name: n.into(),
+            unit: "mm".into(),
+        };
+        let program = AxisProgram {
+            name: "THREAD".into(),
+            number: 1,
+            machine: "fanuc-0i-tc".into(),
+            control: "fanuc".into(),
+            tool_number: 1,
+            tool_name: "thread insert 60".into(),
+            spindle_rpm: rpm,
+            decimals: None,
+            axes: vec![axis("X"), axis("Z")],
+            blocks,
+            setup: Default::default(),
+        };
+        let lathe = ChainMachine::new(Machine::from_info(fanuc_0i_tc::describe()).unwrap());
+        let req = WormRequest {
+            section: t.clone(),
+            flank_margin: 0.1,
+            length,
+            space_centre: c0,
+            tolerances: WormTolerances {
+                form: 0.01,
+                thickness: 1.0,
+                diameter: 1.0,
+                position: 0.01,
+                flank_angle: 0.1f64.to_radians(),
+                lead: 0.01,
+            },
+            limits: Some(profile.limits.clone()),
+        };
+        simulate(&program, &lathe, &Default::default(), &cutter, &req)
+    }
+
+    /// A metric thread simulated from its program: cut to the basic
+    /// profile its pitch diameter is the basic 18.376 mm and beyond 6g's
+    /// upper limit (18.334), named; aimed into the band (0.1 mm down: the
+    /// cutter's pitch line as much deeper) it measures 0.1 mm less and
+    /// holds; its flanks at 30 degrees.
+    #[test]
+    fn a_metric_thread_is_held_to_its_pitch_diameter() {
+        let basic = cut_m20(0.0).unwrap();
+        let d2 = basic.starts[0].pitch_diameter;
+        assert!((d2 - 18.376).abs() < 2e-3, "{d2}");
+        assert!(basic
+            .verified()
+            .is_err_and(|e| e.to_string().contains("start 1: pitch diameter 18.37")
+                && e.to_string().contains("(ISO 965-1 6g)")));
+        let aimed = cut_m20(0.1).unwrap();
+        let d2 = aimed.starts[0].pitch_diameter;
+        assert!((d2 - 18.276).abs() < 2e-3, "{d2}");
+        let held = aimed.verified().unwrap();
+        for a in [
+            held.starts[0].left_angle_deg,
+            held.starts[0].right_angle_deg,
+        ] {
+            assert!((a - 30.0).abs() < 0.05, "{a}");
+        }
+    }
+
+    /// A 7/45 buttress (1-8, its load flank the space's towards +Z), its
+    /// roughing passes on the load flank: each flank holds its own angle,
+    /// 45 and 7 degrees, and the pitch diameter its aim within its stated
+    /// band.
+    #[test]
+    fn a_buttress_holds_its_two_flank_angles() {
+        let stated = standards::StatedLimits {
+            pitch_allowance: 0.0,
+            pitch_tolerance: 0.1,
+            crest_tolerance: 0.2,
+            root_tolerance: 0.3,
+        };
+        let profile = standards::buttress(
+            1.0,
+            8.0,
+            false,
+            standards::LoadFlank::TowardsChuck,
+            1,
+            Hand::Right,
+            stated,
+        )
+        .unwrap();
+        let check = cut(&profile, 0.05, FlankOrder::Right)
+            .unwrap()
+            .verified()
+            .unwrap();
+        let s = &check.starts[0];
+        assert!(
+            (s.left_angle_deg - 45.0).abs() < 0.05,
+            "{}",
+            s.left_angle_deg
+        );
+        assert!(
+            (s.right_angle_deg - 7.0).abs() < 0.05,
+            "{}",
+            s.right_angle_deg
+        );
+        let want = profile.section.pitch_diameter - 0.05;
+        assert!(
+            (s.pitch_diameter - want).abs() < 2e-3,
+            "{} vs {want}",
+            s.pitch_diameter
+        );
+        assert_eq!(check.nominal_flanks_deg.map(Real::round), [45.0, 7.0]);
+    }
 }
