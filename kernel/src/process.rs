@@ -338,11 +338,8 @@ fn spindle_and_coolant(program: &AxisProgram, info: &MachineInfo, out: &mut Proc
         .find(|a| a.kind == crate::machine::AxisKind::Spindle)
         .map_or(0.0, |a| a.min)
         .max(1.0);
-    let mut rpm = program.spindle_rpm.round();
-    for (k, b) in program.blocks.iter().enumerate() {
-        if let Some(s) = b.spindle {
-            rpm = s.round();
-        }
+    let speeds = crate::program::spindle_speeds(program).map(Real::round);
+    for (k, (b, rpm)) in program.blocks.iter().zip(speeds).enumerate() {
         if b.motion == Motion::Rapid {
             continue;
         }

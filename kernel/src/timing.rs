@@ -212,11 +212,9 @@ pub fn times(program: &AxisProgram, info: &MachineInfo, passes: &[ProgramPass]) 
     // half a turn on average (where the spindle stands when the carriage
     // arrives is not known to a turn). A thread chained to a thread before
     // it runs on without a wait.
-    let mut rpm = program.spindle_rpm;
     let mut thread_sync_s = 0.0;
-    for k in 0..n {
+    for (k, rpm) in crate::program::spindle_speeds(program).enumerate() {
         let b = &program.blocks[k];
-        rpm = b.spindle.unwrap_or(rpm);
         let thread = |m: &Motion| matches!(m, Motion::Thread { .. });
         let chained = k > 0 && thread(&program.blocks[k - 1].motion);
         if thread(&b.motion) && !chained && rpm > 0.0 {

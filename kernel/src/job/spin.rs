@@ -63,7 +63,6 @@ pub fn part_turns(
     if !spindle {
         return Ok(rotary.to_vec());
     }
-    let mut rpm = program.spindle_rpm;
     let z_at = |k: usize| -> Result<f64, SceneError> {
         crate::replay::replay_blocks(program, machine, &tool.reference, k..k + 1)
             .map(|p| p[2])
@@ -73,9 +72,9 @@ pub fn part_turns(
     let (mut theta, mut clock) = (0.0, 0.0);
     // The stretch since the last thread: its first block and start time.
     let (mut stretch, mut stretch_t0) = (0, 0.0);
-    for (k, b) in program.blocks.iter().enumerate() {
+    let speeds = crate::program::spindle_speeds(program);
+    for (k, (b, rpm)) in program.blocks.iter().zip(speeds).enumerate() {
         let dt = block_s.get(k).copied().unwrap_or(0.0);
-        rpm = b.spindle.unwrap_or(rpm);
         match b.motion {
             Motion::Thread { lead, start_deg } if k > 0 => {
                 let (from, to) = (z_at(k - 1)?, z_at(k)?);

@@ -525,7 +525,6 @@ pub fn simulate(
                 machine.info().name
             ))
         })?;
-    let mut rpm = written.spindle_rpm;
     // What fails is found and the simulation goes on, so that a failed run
     // shows every pass and the profile it leaves.
     let mut failures: Vec<Finding> = Vec::new();
@@ -534,12 +533,10 @@ pub fn simulate(
             .push(Finding::new("verification", fail(m).to_string()).at(i, block_name(&written, i)));
     };
     let mut ticker = crate::budget::Ticker::new("the thread's simulation", 16);
+    let speeds: Vec<Real> = crate::program::spindle_speeds(&written).collect();
     for i in 1..written.blocks.len() {
         ticker.tick()?;
-        let b = &written.blocks[i];
-        if let Some(s) = b.spindle {
-            rpm = s;
-        }
+        let (b, rpm) = (&written.blocks[i], speeds[i]);
         let name = || block_name(&written, i);
         let ((r0, z0), (r1, z1e)) = (at(i - 1), at(i));
         let Motion::Thread { lead: l, start_deg } = b.motion else {
