@@ -50,7 +50,7 @@ pub fn thread_turn(from_z: f64, to_z: f64, lead: f64, start_deg: f64, z: f64) ->
 /// thread blocks.
 ///
 /// # Failures
-/// The replay of a thread block failing.
+/// The replay of a program that threads failing.
 pub fn part_turns(
     machine: &dyn MachineKinematics,
     program: &AxisProgram,
@@ -63,11 +63,20 @@ pub fn part_turns(
     if !spindle {
         return Ok(rotary.to_vec());
     }
-    let z_at = |k: usize| -> Result<f64, SceneError> {
-        crate::replay::replay_blocks(program, machine, &tool.reference, k..k + 1)
-            .map(|p| p[2])
-            .map_err(|e| SceneError::Place(e.to_string()))
+    // Where the tool's point stands along the axis at each block's end:
+    // one batch through the machine's kinematics, where the program
+    // threads at all.
+    let threads = program
+        .blocks
+        .iter()
+        .any(|b| matches!(b.motion, Motion::Thread { .. }));
+    let poses = if threads {
+        crate::replay::replay(program, machine, &tool.reference)
+            .map_err(|e| SceneError::Place(e.to_string()))?
+    } else {
+        Vec::new()
     };
+    let z_at = |k: usize| poses[6 * k + 2];
     let mut ends = Vec::with_capacity(n);
     let (mut theta, mut clock) = (0.0, 0.0);
     // The stretch since the last thread: its first block and start time.
@@ -77,7 +86,7 @@ pub fn part_turns(
         let dt = block_s.get(k).copied().unwrap_or(0.0);
         match b.motion {
             Motion::Thread { lead, start_deg } if k > 0 => {
-                let (from, to) = (z_at(k - 1)?, z_at(k)?);
+                let (from, to) = (z_at(k - 1), z_at(k));
                 let turn = |z| thread_turn(from, to, lead, start_deg, z);
                 // The part stands at minus the tool's turn relative to it.
                 let (start, end) = (-turn(from), -turn(to));
