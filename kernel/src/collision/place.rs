@@ -165,19 +165,8 @@ impl Placement {
             let cols = c.axis_names().iter().map(col).collect();
             (c, cols)
         });
-        // The factors that turn the part: Rz of its turning axes among the
-        // chain's leading factors that commute with them (the machine's
-        // check holds every such axis there).
         let part_turn = tool.as_ref().map_or_else(Vec::new, |(c, _)| {
-            let lead = crate::machine::part_turn_lead(c);
-            (0..lead)
-                .filter(|&k| {
-                    let f = &c.factors()[k];
-                    f.kind == crate::transform::FactorKind::Rz
-                        && matches!(f.value, crate::transform::FactorValue::Axis { axis, .. }
-                            if info.axis(&c.axis_names()[axis]).is_some_and(|a| a.turns_part))
-                })
-                .collect()
+            crate::machine::part_turn_factors(c, info)
         });
         let spindle_turns_part = info
             .axes

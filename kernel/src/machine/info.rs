@@ -590,35 +590,44 @@ fn part_turn_error(m: &Machine, a: &Axis) -> Result<(), String> {
     if !a.turns_part || a.kind != AxisKind::Rotary {
         return Ok(());
     }
-    let lead = part_turn_lead(&m.chain);
-    let at = m.chain.axis_index(&a.name).and_then(|i| {
-        m.chain.factors().iter().position(
-            |f| matches!(f.value, crate::transform::FactorValue::Axis { axis, .. } if axis == i),
-        )
-    });
-    match at {
-        Some(k) if k < lead && m.chain.factors()[k].kind == FactorKind::Rz => Ok(()),
-        Some(k) => Err(format!(
+    let Some(i) = m.chain.axis_index(&a.name) else {
+        return Err(format!(
+            "axis {}: turns_part, but the tool chain does not bind it",
+            a.name
+        ));
+    };
+    let binds = |k: &usize| matches!(m.chain.factors()[*k].value, crate::transform::FactorValue::Axis { axis, .. } if axis == i);
+    let turning = part_turn_factors(&m.chain, &m.info);
+    match (0..m.chain.factors().len()).find(binds) {
+        Some(k) if !turning.contains(&k) => Err(format!(
             "axis {}: turns_part, but its factor is the tool chain's number {}, {:?}: the part's turn must be an Rz with only Rz and Tz factors before it (those commute with it)",
             a.name,
             k + 1,
             m.chain.factors()[k].kind
         )),
-        None => Err(format!(
-            "axis {}: turns_part, but the tool chain does not bind it",
-            a.name
-        )),
+        _ => Ok(()),
     }
 }
 
-/// How many of `chain`'s leading factors turn about or move along Z: those
-/// commute with a turn of the part about Z.
-pub fn part_turn_lead(chain: &crate::transform::Chain) -> usize {
+/// The factors of the tool chain `chain` that are the part's own turn:
+/// the Rz factors of axes that turn the part (`info`'s
+/// [`Axis::turns_part`]) among the chain's leading factors that turn about
+/// or move along Z, which commute with a turn of the part about Z. The
+/// chain is their product times the rest: the part stands on the machine
+/// turned by their inverse.
+pub fn part_turn_factors(chain: &crate::transform::Chain, info: &MachineInfo) -> Vec<usize> {
     chain
         .factors()
         .iter()
         .take_while(|f| matches!(f.kind, FactorKind::Rz | FactorKind::Tz))
-        .count()
+        .enumerate()
+        .filter(|(_, f)| {
+            f.kind == FactorKind::Rz
+                && matches!(f.value, crate::transform::FactorValue::Axis { axis, .. }
+                    if info.axis(&chain.axis_names()[axis]).is_some_and(|a| a.turns_part))
+        })
+        .map(|(k, _)| k)
+        .collect()
 }
 
 /// Checks the bodies and compiles their chains.

@@ -346,13 +346,10 @@ pub(crate) fn name_in(control: &str, blocks: &[Block], index: usize) -> String {
 /// The spindle speed (rpm) in force at each block of `program`: the
 /// program's, then each block's `spindle` from that block on.
 pub fn spindle_speeds(program: &AxisProgram) -> impl Iterator<Item = Real> + '_ {
-    program
-        .blocks
-        .iter()
-        .scan(program.spindle_rpm, |rpm, b| {
-            *rpm = b.spindle.unwrap_or(*rpm);
-            Some(*rpm)
-        })
+    program.blocks.iter().scan(program.spindle_rpm, |rpm, b| {
+        *rpm = b.spindle.unwrap_or(*rpm);
+        Some(*rpm)
+    })
 }
 
 /// The decimals a program writes its axis values with: its own
