@@ -61,16 +61,7 @@ fn build(scene: &Scene, uri: Option<String>) -> Result<(json::Root, Vec<u8>), Me
         let mut view = |bin: &mut Vec<u8>, bytes: &dyn Fn(&mut Vec<u8>), target| {
             let start = bin.len();
             bytes(bin);
-            root.push(json::buffer::View {
-                buffer,
-                byte_length: USize64((bin.len() - start) as u64),
-                byte_offset: Some(USize64(start as u64)),
-                byte_stride: None,
-                name: None,
-                target: Some(Valid(target)),
-                extensions: None,
-                extras: Default::default(),
-            })
+            view_of(&mut root, buffer, bin, start, Some(target))
         };
         let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
         let pos_view = view(
@@ -113,26 +104,9 @@ fn build(scene: &Scene, uri: Option<String>) -> Result<(json::Root, Vec<u8>), Me
             },
             json::buffer::Target::ElementArrayBuffer,
         );
-        let accessor = |root: &mut json::Root,
-                        view,
-                        count: usize,
-                        kind,
-                        ty,
-                        bounds: Option<([f32; 3], [f32; 3])>| {
-            root.push(json::Accessor {
-                buffer_view: Some(view),
-                byte_offset: None,
-                count: USize64(count as u64),
-                component_type: Valid(json::accessor::GenericComponentType(kind)),
-                extensions: None,
-                extras: Default::default(),
-                type_: Valid(ty),
-                min: bounds.map(|b| json::Value::from(b.0.to_vec())),
-                max: bounds.map(|b| json::Value::from(b.1.to_vec())),
-                name: None,
-                normalized: false,
-                sparse: None,
-            })
+        let bounds = |b: Option<([f32; 3], [f32; 3])>| b.map(|(lo, hi)| (lo.to_vec(), hi.to_vec()));
+        let accessor = |root: &mut json::Root, view, count, kind, ty, b| {
+            accessor_of(root, view, count, kind, ty, bounds(b))
         };
         use json::accessor::{ComponentType, Type};
         let pos = accessor(
@@ -246,6 +220,56 @@ fn build(scene: &Scene, uri: Option<String>) -> Result<(json::Root, Vec<u8>), Me
     Ok((root, bin))
 }
 
+/// Records the bytes `bin[start..]` as a view of `buffer`, for `target`
+/// where it has one (mesh data; an animation's have none).
+fn view_of(
+    root: &mut json::Root,
+    buffer: json::Index<json::Buffer>,
+    bin: &[u8],
+    start: usize,
+    target: Option<json::buffer::Target>,
+) -> json::Index<json::buffer::View> {
+    root.push(json::buffer::View {
+        buffer,
+        byte_length: USize64((bin.len() - start) as u64),
+        byte_offset: Some(USize64(start as u64)),
+        byte_stride: None,
+        name: None,
+        target: target.map(Valid),
+        extensions: None,
+        extras: Default::default(),
+    })
+}
+
+/// An accessor of `count` elements of `ty` (components of `kind`) in
+/// `view`, with their least and greatest components where given.
+fn accessor_of(
+    root: &mut json::Root,
+    view: json::Index<json::buffer::View>,
+    count: usize,
+    kind: json::accessor::ComponentType,
+    ty: json::accessor::Type,
+    bounds: Option<(Vec<f32>, Vec<f32>)>,
+) -> json::Index<json::Accessor> {
+    let (min, max) = bounds.map_or((None, None), |(lo, hi)| {
+        (Some(json::Value::from(lo)), Some(json::Value::from(hi)))
+    });
+    root.push(json::Accessor {
+        buffer_view: Some(view),
+        byte_offset: None,
+        count: USize64(count as u64),
+        component_type: Valid(json::accessor::GenericComponentType(kind)),
+        extensions: None,
+        extras: Default::default(),
+        type_: Valid(ty),
+        min,
+        max,
+        name: None,
+        normalized: false,
+        sparse: None,
+    })
+}
+
 /// The name of the node that turns the part's bodies about its axis.
 pub const SPIN_NODE: &str = "part turn";
 
@@ -286,36 +310,21 @@ fn animate(
         for v in values {
             bin.extend_from_slice(&v.to_le_bytes());
         }
-        let view = root.push(json::buffer::View {
-            buffer,
-            byte_length: USize64((bin.len() - start) as u64),
-            byte_offset: Some(USize64(start as u64)),
-            byte_stride: None,
-            name: None,
-            target: None,
-            extensions: None,
-            extras: Default::default(),
-        });
+        let view = view_of(root, buffer, bin, start, None);
         let per = match ty {
             Type::Scalar => 1,
             Type::Vec3 => 3,
             _ => 4,
         };
-        let (lo, hi) = (values[0], values[values.len() - 1]);
-        root.push(json::Accessor {
-            buffer_view: Some(view),
-            byte_offset: None,
-            count: USize64((values.len() / per) as u64),
-            component_type: Valid(json::accessor::GenericComponentType(ComponentType::F32)),
-            extensions: None,
-            extras: Default::default(),
-            type_: Valid(ty),
-            min: bounds.then(|| json::Value::from(vec![lo])),
-            max: bounds.then(|| json::Value::from(vec![hi])),
-            name: None,
-            normalized: false,
-            sparse: None,
-        })
+        let range = (vec![values[0]], vec![values[values.len() - 1]]);
+        accessor_of(
+            root,
+            view,
+            values.len() / per,
+            ComponentType::F32,
+            ty,
+            bounds.then_some(range),
+        )
     };
     let input = push(root, &motion.times, Type::Scalar, true);
     let (mut samplers, mut channels) = (Vec::new(), Vec::new());
