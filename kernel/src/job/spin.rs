@@ -130,43 +130,39 @@ pub fn spin_keys(
     keyed: impl Fn(usize) -> bool,
 ) -> Option<(Vec<f32>, Vec<f64>)> {
     let n = turns.len();
-    let (mut times, mut angles): (Vec<f32>, Vec<f64>) = (Vec::new(), Vec::new());
-    let emit = |t: f64, a: f64, times: &mut Vec<f32>, angles: &mut Vec<f64>| {
+    // The keys (s, rad), their times increasing as f32 holds them.
+    let mut keys: Vec<(f32, f64)> = Vec::new();
+    let emit = |keys: &mut Vec<(f32, f64)>, t: f64, a: f64| {
         let t = t as f32;
-        if times.last().is_none_or(|&last| t > last) {
-            times.push(t);
-            angles.push(a);
+        if keys.last().is_none_or(|last| t > last.0) {
+            keys.push((t, a));
         }
     };
-    let (mut clock, mut last) = (0.0, 0.0);
+    let last = |keys: &[(f32, f64)]| keys.last().map_or(0.0, |k| k.1);
+    let mut clock = 0.0;
     for k in 0..n {
         let (t0, a0) = (clock, if k == 0 { 0.0 } else { turns[k - 1] });
         clock += block_s.get(k).copied().unwrap_or(0.0);
         let a1 = turns[k];
-        if (a1 - last).abs() > MAX_SPIN_STEP {
-            emit(t0, a0, &mut times, &mut angles);
+        if (a1 - last(&keys)).abs() > MAX_SPIN_STEP {
+            emit(&mut keys, t0, a0);
             let m = ((a1 - a0).abs() / (0.9 * MAX_SPIN_STEP)).ceil();
             for j in 1..m as usize {
                 let f = j as f64 / m;
-                emit(
-                    t0 + f * (clock - t0),
-                    a0 + f * (a1 - a0),
-                    &mut times,
-                    &mut angles,
-                );
+                emit(&mut keys, t0 + f * (clock - t0), a0 + f * (a1 - a0));
             }
         }
-        let far_next = turns.get(k + 1).is_some_and(|next| {
-            (next - angles.last().copied().unwrap_or(a1)).abs() > 0.9 * MAX_SPIN_STEP
-        });
+        let far_next = turns
+            .get(k + 1)
+            .is_some_and(|next| (next - last(&keys)).abs() > 0.9 * MAX_SPIN_STEP);
         if keyed(k) || k + 1 == n || far_next {
-            emit(clock, a1, &mut times, &mut angles);
+            emit(&mut keys, clock, a1);
         }
-        last = angles.last().copied().unwrap_or(0.0);
-        if times.len() > MAX_SPIN_KEYS {
+        if keys.len() > MAX_SPIN_KEYS {
             return None;
         }
     }
+    let (times, angles): (Vec<f32>, Vec<f64>) = keys.into_iter().unzip();
     // Blocks of no time can leave a step a player would show turning back.
     let even = angles
         .windows(2)
