@@ -113,6 +113,13 @@ fn is_zero(x: &Real) -> bool {
     *x == 0.0
 }
 
+impl GroovePlace {
+    /// Its block from 0 (the page's count), where it is at one.
+    pub fn block_from_0(&self) -> Option<usize> {
+        self.block_index.checked_sub(1)
+    }
+}
+
 /// The replayed caliber program against the nominal groove.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GrooveCheck {
@@ -795,8 +802,7 @@ impl GrooveCheck {
                 p.block
             )
         };
-        // A place's block counts from 1; 0 where it has none.
-        let at = |f: Figure, p: &GroovePlace| match p.block_index.checked_sub(1) {
+        let at = |f: Figure, p: &GroovePlace| match p.block_from_0() {
             Some(b) => f.at_block(b),
             None => f,
         };

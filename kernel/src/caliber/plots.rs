@@ -97,7 +97,7 @@ pub fn deviation_map_svg(
             (&check.max_left, "most material left"),
             (&check.max_gouge, "deepest gouge"),
         ] {
-            if let Some(block) = place.block_index.checked_sub(1).filter(|_| place.mm != 0.0) {
+            if let Some(block) = place.block_from_0().filter(|_| place.mm != 0.0) {
                 marks.places.push(PlaceMark {
                     at: map.at(place.theta_deg, place.psi_deg),
                     block,
