@@ -201,6 +201,9 @@ fn demo_writes_every_file_and_the_same_bytes_twice() {
     // The page shows the scene as exported (its data URI is the new
     // scene.glb).
     common::check_page(&a, "program.mpf", 6.0);
+    // It plays the run's program at the run's times: the program as its
+    // control reads it.
+    assert_eq!(common::Playback::of(&a).keys, common::Playback::of(&b).keys);
     common::leave_page_for_chromium(&a, "demo-block202");
     // On request: ASCII STL, and .gltf with its .bin.
     let c = dir.join("c");

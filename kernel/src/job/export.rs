@@ -154,9 +154,29 @@ pub fn export(
                 .map_err(|e| Error::Read(e.to_string()))
         })
         .collect::<Result<Vec<_>, _>>()?;
-    // The scene moves as the run's did: the same program, the same times.
+    // The program's text as its control reads it, which the run timed: a
+    // text that does not read back as program.json is not the run's.
+    let control = crate::program::post::dialect(&report.control).ok_or_else(|| {
+        Error::Read(format!(
+            "{shown}: report.json names the control '{}', which pilgrim does not know",
+            crate::files::excerpt(&report.control)
+        ))
+    })?;
+    let program_file = format!("program.{}", control.extension);
+    let text = match report.files.contains(&program_file) {
+        true => Some(read(&program_file)?),
+        false => None,
+    };
+    let as_read = match &text {
+        Some(t) => Some(
+            crate::program::lint::lint_read(t, &program, control, &kin.info().axes)
+                .map_err(|e| bad(&program_file, e.to_string()))?,
+        ),
+        None => None,
+    };
+    // The scene moves as the run's did: the same program, timed as read.
     let times = crate::timing::times(
-        &program,
+        as_read.as_ref().map_or(&program, |r| &r.program),
         kin.info(),
         &crate::program::pass_blocks(&program, &toolpath.passes),
     );
@@ -193,38 +213,24 @@ pub fn export(
     report.solids.extend(tool_solids);
     all.extend(tool_steps);
     // The page shows the new scene, with the run's plots and program.
-    let control = crate::program::post::dialect(&report.control).ok_or_else(|| {
-        Error::Read(format!(
-            "{shown}: report.json names the control '{}', which pilgrim does not know",
-            crate::files::excerpt(&report.control)
-        ))
-    })?;
-    let program_file = format!("program.{}", control.extension);
     let mut shown: Vec<(String, Vec<u8>)> = Vec::new();
     // Only plots the run names by plain names, and its program.
     let plot = |n: &str| {
         n.strip_suffix(".svg")
             .is_some_and(crate::files::is_plain_name)
     };
-    for name in report
-        .files
-        .iter()
-        .filter(|n| plot(n) || **n == program_file)
-    {
+    for name in report.files.iter().filter(|n| plot(n)) {
         shown.push((name.clone(), read(name)?.into_bytes()));
+    }
+    if let Some(t) = &text {
+        shown.push((program_file.clone(), t.clone().into_bytes()));
     }
     shown.extend(all.iter().filter(|f| f.0 == "scene.glb").cloned());
     let view = scene::bounds_of(parts.iter().map(|(_, m)| m))
         .map(|b| scene::contact_box(b, &toolpath.tool, &pose));
-    // The listing's lines as the lint reads the program: a text that does
-    // not read back as program.json is not the run's.
+    // The listing's lines as the lint read the program.
     let listed = super::page::written_program(&shown, control.extension);
-    if let Some((name, text)) = listed {
-        report.program_lines =
-            crate::program::lint::lint_read(text, &program, control, &kin.info().axes)
-                .map_err(|e| bad(name, e.to_string()))?
-                .lines;
-    }
+    report.program_lines = as_read.map(|r| r.lines).unwrap_or_default();
     let html = super::page::page_of(&report, &shown, listed, view);
     all.push(("report.html".into(), html.into_bytes()));
     all.push(("report.json".into(), super::report_json(&report)?));
