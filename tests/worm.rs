@@ -614,7 +614,7 @@ fn bad_input_is_refused_with_no_output() {
     // their diagnostic.
     let failed = [
         "tip_width=5",
-        "m=0.1 z1=1 nose_r=0.01 a_min=0.01 finish_depth=0.01",
+        "m=0.1 b1=2 z1=1 nose_r=0.01 a_min=0.01 finish_depth=0.01",
     ];
     for (set, says) in [
         ("z1=0", "z1"),
@@ -632,9 +632,11 @@ fn bad_input_is_refused_with_no_output() {
             "m=0.1 b1=700 z1=1 nose_r=0.01 a_min=0.01 finish_depth=0.01 tol_angle_deg=1 tol_position=0.1",
             "worm: the mesh would have 55900544 triangles",
         ),
-        // Its flanks, 0.2 mm high, cannot hold 0.05 deg at 0.001 mm steps.
+        // Its flanks, 0.2 mm high, cannot hold 0.05 deg at 0.001 mm steps
+        // (2 mm of it: its failed run's diagnostic is some 18 MB, as the
+        // 60 mm default's would be 490 MB).
         (
-            "m=0.1 z1=1 nose_r=0.01 a_min=0.01 finish_depth=0.01",
+            "m=0.1 b1=2 z1=1 nose_r=0.01 a_min=0.01 finish_depth=0.01",
             "flank: angle",
         ),
     ] {

@@ -31,6 +31,11 @@ pub const VIEWER: &str = "@google/model-viewer 4.4.0";
 
 use crate::html::{escape, row, row_at};
 
+/// The largest `scene.glb` a page embeds (bytes). Past it the page would
+/// take tens of seconds to open, or fail to, in a browser; the scene is
+/// written beside it at its full resolution all the same.
+pub const MAX_EMBEDDED_SCENE_BYTES: usize = 32 << 20;
+
 /// What the page is made of besides the report.
 pub struct PageInputs<'a> {
     /// The run's report.
@@ -44,6 +49,14 @@ pub struct PageInputs<'a> {
     /// `scene.glb`, and the part's bounding box in the part frame (mm),
     /// where the camera points.
     pub scene: Option<(&'a [u8], [f64; 3], [f64; 3])>,
+}
+
+impl<'a> PageInputs<'a> {
+    /// The scene the page embeds: [`Self::scene`] within
+    /// [`MAX_EMBEDDED_SCENE_BYTES`].
+    fn embedded_scene(&self) -> Option<(&'a [u8], [f64; 3], [f64; 3])> {
+        self.scene.filter(|s| s.0.len() <= MAX_EMBEDDED_SCENE_BYTES)
+    }
 }
 
 /// The verification's figures, and where the worst is: each entry of the
@@ -289,7 +302,7 @@ fn findings(out: &mut String, class: &str, prefix: &str, list: &[crate::verdict:
 fn twin(out: &mut String, inputs: &PageInputs<'_>) {
     let r = inputs.report;
     out.push_str("<section class=\"twin\">\n<div class=\"view\">\n");
-    match inputs.scene {
+    match inputs.embedded_scene() {
         Some((glb, lo, hi)) => {
             // The scene's root lays the part's axis horizontal (its Z to
             // glTF's X, its X away from the viewer) and scales mm to m:
@@ -319,9 +332,19 @@ fn twin(out: &mut String, inputs: &PageInputs<'_>) {
                 "<p class=\"hint\">Drag to orbit, wheel or pinch to zoom, right-drag to pan; the camera frames the tool where it meets the part, from the operator's side. {VIEWER}.</p>"
             );
         }
-        None => out.push_str(
-            "<h2>3-D</h2>\n<p>No 3-D models: the family has no <code>fn part(p)</code>.</p>\n",
-        ),
+        None => match inputs.scene {
+            Some((glb, _, _)) => {
+                let _ = writeln!(
+                    out,
+                    "<h2>3-D</h2>\n<p>The 3-D view is left out of this page: scene.glb is {:.1} MB, more than the {} MB a page embeds. Open scene.glb beside it in a glTF viewer, or give the part a coarser mesh tolerance.</p>",
+                    glb.len() as f64 / (1024.0 * 1024.0),
+                    MAX_EMBEDDED_SCENE_BYTES >> 20
+                );
+            }
+            None => out.push_str(
+                "<h2>3-D</h2>\n<p>No 3-D models: the family has no <code>fn part(p)</code>.</p>\n",
+            ),
+        },
     }
     out.push_str("</div>\n<div class=\"program\">\n");
     listing(out, r, inputs.program);
@@ -461,7 +484,7 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
     let r = inputs.report;
     let b64 = base64::engine::general_purpose::STANDARD;
     let mut out = String::with_capacity(
-        MODEL_VIEWER.len() + inputs.scene.map_or(0, |s| s.0.len() * 4 / 3) + 200_000,
+        MODEL_VIEWER.len() + inputs.embedded_scene().map_or(0, |s| s.0.len() * 4 / 3) + 200_000,
     );
     let title = format!(
         "pilgrim: {}{} on {}{}",
@@ -581,7 +604,7 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
     // Whatever names a block (a table's row, a plot's mark) takes the
     // player there, and the view to the machine.
     out.push_str("<script>\ndocument.querySelectorAll('[data-block]').forEach(el => el.addEventListener('click', () => {\n  document.dispatchEvent(new CustomEvent('pilgrim-go', {detail: +el.dataset.block}));\n  document.querySelector('.twin').scrollIntoView({block: 'start'});\n}));\n// The pass the player is in, lit on the plots that mark passes.\nconst passMarks = [...document.querySelectorAll('.marks .pass')];\ndocument.addEventListener('pilgrim-block', e => passMarks.forEach(m => m.classList.toggle('now', +m.dataset.first <= e.detail && e.detail < +m.dataset.end)));\n</script>\n");
-    if inputs.scene.is_some() {
+    if inputs.embedded_scene().is_some() {
         // The state of the 3-D view for whoever watches the page (and the
         // headless check): data-model on <body> becomes "loaded" or "error".
         out.push_str(
@@ -682,6 +705,42 @@ tr[data-block]:hover td { background: #eef3ff; }
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A report with nothing in it but what `report.json` must hold.
+    fn bare_report() -> Report {
+        serde_json::from_value(serde_json::json!({
+            "pilgrim": "0", "script": "s.rhai", "machine": "m", "machine_spec": "m",
+            "control": "fanuc", "parameters": {}, "passes": 0, "points": 0, "blocks": 0,
+            "cycle_time_min": 0.0, "files": [], "checks": [], "mesh_tolerance_mm": 0.01
+        }))
+        .unwrap()
+    }
+
+    /// A scene past the page's bound is left out of the page, which says
+    /// so, how large it is and where the full one is; one within it is
+    /// embedded with its viewer.
+    #[test]
+    fn a_scene_too_large_for_a_page_is_named_not_embedded() {
+        let r = bare_report();
+        let page = |glb: &[u8]| {
+            report_html(&PageInputs {
+                report: &r,
+                plots: vec![],
+                program: None,
+                scene: Some((glb, [0.0; 3], [1.0; 3])),
+            })
+        };
+        let small = page(b"glTF");
+        assert!(small.contains("<model-viewer id=\"scene\""));
+        let large = page(&vec![0u8; MAX_EMBEDDED_SCENE_BYTES + 1]);
+        assert!(!large.contains("<model-viewer") && !large.contains("data:model/gltf-binary"));
+        assert!(
+            large.contains("scene.glb is 32.0 MB, more than the 32 MB a page embeds"),
+            "{}",
+            &large[large.find("<h2>3-D").unwrap_or(0)..][..400]
+        );
+        assert!(large.len() < 2 * 1024 * 1024, "{}", large.len());
+    }
 
     #[test]
     fn text_is_escaped() {
