@@ -11,7 +11,7 @@
 //! minor, the bore). Lengths in mm, angles in radians.
 
 use crate::math::Real;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The way the thread winds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -24,7 +24,7 @@ pub enum Hand {
 }
 
 /// A diameter's limits (mm).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Limits {
     /// The least.
     pub min: Real,
@@ -42,10 +42,15 @@ impl Limits {
     pub fn width(&self) -> Real {
         self.max - self.min
     }
+
+    /// The middle of the band: what a cut aims at.
+    pub fn middle(&self) -> Real {
+        0.5 * (self.min + self.max)
+    }
 }
 
 /// What the finished thread must hold, and whose limits they are.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ThreadLimits {
     /// The pitch diameter (for a worm: the diameter where its thickness is
     /// measured).
@@ -73,6 +78,18 @@ pub struct ThreadProfile {
     pub section: ThreadSection,
     /// The limits of the finished thread.
     pub limits: ThreadLimits,
+}
+
+impl ThreadProfile {
+    /// The section a cut aims at: the pitch diameter in the middle of its
+    /// limits (the flanks and the root moved with it), the crest (the
+    /// blank turned, the bore bored) in the middle of its.
+    pub fn aimed(&self) -> ThreadSection {
+        ThreadSection {
+            crest_diameter: self.limits.crest.middle(),
+            ..self.section.aimed(self.limits.pitch_diameter.middle())
+        }
+    }
 }
 
 /// A thread's axial section and basic sizes: see the module's docs. What

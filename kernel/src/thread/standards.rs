@@ -230,7 +230,7 @@ pub fn metric(
 
 /// ISO 261's coarse pitch of the diameters it names (0 for others): the
 /// designation leaves a coarse pitch out.
-fn coarse_pitch(d: Real) -> Real {
+pub(crate) fn coarse_pitch(d: Real) -> Real {
     const COARSE: [(Real, Real); 16] = [
         (3.0, 0.5),
         (4.0, 0.7),

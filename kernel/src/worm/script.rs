@@ -11,7 +11,7 @@ use crate::worm::{self, FlankOrder, PlanSettings, ThreadCutter, WormSizes};
 use rhai::plugin::*;
 use rhai::{Array, EvalAltResult, Map};
 
-fn cutter_of(tool: &Tool) -> Result<ThreadCutter, Box<EvalAltResult>> {
+pub(crate) fn cutter_of(tool: &Tool) -> Result<ThreadCutter, Box<EvalAltResult>> {
     match tool.shape {
         ToolShape::ThreadCutter(c) => Ok(c),
         _ => Err(format!("tool '{}' is not a thread cutter", tool.name).into()),
@@ -183,92 +183,102 @@ pub mod worm_api {
     /// (-1 left, 0 radial, 1 right), `planned_area`.
     #[rhai_fn(pure, return_raw)]
     pub fn plan(w: &mut WormSizes, tool: Tool, settings: Map) -> Result<Map, Box<EvalAltResult>> {
-        const KEYS: [&str; 7] = [
-            "roughing_passes",
-            "min_depth",
-            "finish_depth",
-            "finish_passes",
-            "order",
-            "axial_step",
-            "by_depth",
-        ];
-        if let Some(k) = settings.keys().find(|k| !KEYS.contains(&k.as_str())) {
+        plan_map(&w.section(), &tool, &settings)
+    }
+}
+
+/// The plan of passes over `section` for `tool` with a script's
+/// `settings` (the worm's `plan` and the thread's), as columns.
+pub(crate) fn plan_map(
+    section: &crate::thread::ThreadSection,
+    tool: &Tool,
+    settings: &Map,
+) -> Result<Map, Box<EvalAltResult>> {
+    const KEYS: [&str; 7] = [
+        "roughing_passes",
+        "min_depth",
+        "finish_depth",
+        "finish_passes",
+        "order",
+        "axial_step",
+        "by_depth",
+    ];
+    if let Some(k) = settings.keys().find(|k| !KEYS.contains(&k.as_str())) {
+        return Err(format!(
+            "plan: unknown setting '{k}' (settings: {})",
+            KEYS.join(", ")
+        )
+        .into());
+    }
+    let num = |k: &str| -> Result<Real, Box<EvalAltResult>> {
+        settings
+            .get(k)
+            .and_then(number)
+            .ok_or_else(|| format!("plan: '{k}' must be a number").into())
+    };
+    let count = |k: &str| -> Result<usize, Box<EvalAltResult>> {
+        let v = num(k)?;
+        if !(0.0..=worm::MAX_PASSES as Real).contains(&v) || v.fract() != 0.0 {
             return Err(format!(
-                "plan: unknown setting '{k}' (settings: {})",
-                KEYS.join(", ")
+                "plan: {k} = {v} must be a whole number from 0 to {}",
+                worm::MAX_PASSES
             )
             .into());
         }
-        let num = |k: &str| -> Result<Real, Box<EvalAltResult>> {
-            settings
-                .get(k)
-                .and_then(number)
-                .ok_or_else(|| format!("plan: '{k}' must be a number").into())
-        };
-        let count = |k: &str| -> Result<usize, Box<EvalAltResult>> {
-            let v = num(k)?;
-            if !(0.0..=worm::MAX_PASSES as Real).contains(&v) || v.fract() != 0.0 {
-                return Err(format!(
-                    "plan: {k} = {v} must be a whole number from 0 to {}",
-                    worm::MAX_PASSES
-                )
-                .into());
-            }
-            Ok(v as usize)
-        };
-        let order = settings
-            .get("order")
-            .and_then(|d| d.clone().into_string().ok())
-            .ok_or("plan: 'order' must be a string")?;
-        let by_depth = settings
-            .get("by_depth")
-            .and_then(|d| d.as_bool().ok())
-            .ok_or("plan: 'by_depth' must be true or false")?;
-        let n = count("roughing_passes")?;
-        let s = PlanSettings {
-            roughing_passes: (n > 0).then_some(n),
-            min_depth: num("min_depth")?,
-            finish_depth: num("finish_depth")?,
-            finish_passes: count("finish_passes")?,
-            order: FlankOrder::parse(&order).map_err(|e| format!("plan: {e}"))?,
-            axial_step: num("axial_step")?,
-            starts_by_depth: by_depth,
-        };
-        let passes = kernel(worm::plan(&w.section(), &cutter_of(&tool)?, &s))?;
-        let col = |f: &dyn Fn(&worm::PlannedPass) -> Real| {
-            Dynamic::from(Floats::new(passes.iter().map(f).collect()))
-        };
-        let mut m = Map::new();
-        m.insert(
-            "kind".into(),
-            Dynamic::from(
-                passes
-                    .iter()
-                    .map(|p| {
-                        Dynamic::from(match p.kind {
-                            worm::PassKind::Rough => "rough",
-                            worm::PassKind::Finish => "finish",
-                            worm::PassKind::Side => "side",
-                        })
+        Ok(v as usize)
+    };
+    let order = settings
+        .get("order")
+        .and_then(|d| d.clone().into_string().ok())
+        .ok_or("plan: 'order' must be a string")?;
+    let by_depth = settings
+        .get("by_depth")
+        .and_then(|d| d.as_bool().ok())
+        .ok_or("plan: 'by_depth' must be true or false")?;
+    let n = count("roughing_passes")?;
+    let s = PlanSettings {
+        roughing_passes: (n > 0).then_some(n),
+        min_depth: num("min_depth")?,
+        finish_depth: num("finish_depth")?,
+        finish_passes: count("finish_passes")?,
+        order: FlankOrder::parse(&order).map_err(|e| format!("plan: {e}"))?,
+        axial_step: num("axial_step")?,
+        starts_by_depth: by_depth,
+    };
+    let passes = kernel(worm::plan(section, &cutter_of(tool)?, &s))?;
+    let col = |f: &dyn Fn(&worm::PlannedPass) -> Real| {
+        Dynamic::from(Floats::new(passes.iter().map(f).collect()))
+    };
+    let mut m = Map::new();
+    m.insert(
+        "kind".into(),
+        Dynamic::from(
+            passes
+                .iter()
+                .map(|p| {
+                    Dynamic::from(match p.kind {
+                        worm::PassKind::Rough => "rough",
+                        worm::PassKind::Finish => "finish",
+                        worm::PassKind::Side => "side",
                     })
-                    .collect::<Array>(),
-            ),
-        );
-        m.insert("start".into(), col(&|p| Real::from(p.start)));
-        m.insert("depth".into(), col(&|p| p.depth));
-        m.insert("cumulative".into(), col(&|p| p.cumulative));
-        m.insert("offset".into(), col(&|p| p.offset));
-        m.insert(
-            "flank".into(),
-            col(&|p| match p.flank {
-                worm::Flank::Left => -1.0,
-                worm::Flank::Radial => 0.0,
-                worm::Flank::Right => 1.0,
-            }),
-        );
-        m.insert("planned_area".into(), col(&|p| p.planned_area));
-        Ok(m)
-    }
+                })
+                .collect::<Array>(),
+        ),
+    );
+    m.insert("start".into(), col(&|p| Real::from(p.start)));
+    m.insert("depth".into(), col(&|p| p.depth));
+    m.insert("cumulative".into(), col(&|p| p.cumulative));
+    m.insert("offset".into(), col(&|p| p.offset));
+    m.insert(
+        "flank".into(),
+        col(&|p| match p.flank {
+            worm::Flank::Left => -1.0,
+            worm::Flank::Radial => 0.0,
+            worm::Flank::Right => 1.0,
+        }),
+    );
+    m.insert("planned_area".into(), col(&|p| p.planned_area));
+    Ok(m)
 }
 
 /// The worm's part of the script API, as the reference lists it.

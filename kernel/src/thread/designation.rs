@@ -1,0 +1,290 @@
+//! A thread named as a drawing names it: `M20x2.5-6g`, `M30x2-6H`,
+//! `M20x5(P2.5)-6g-LH`, `Tr40x7`, `Tr40x14(P7)`, `1-5 ACME-2G`,
+//! `3/4-6 ACME-2G`, `2-8 BUTT 7/45`, read into a [`ThreadProfile`] by the
+//! standards' formulas ([`super::standards`]).
+//!
+//! The grammar, each part separated by `-` or a space:
+//! - ISO metric: `M<d>[x<lead>[(P<pitch>)]][-<class>]`; the pitch left out
+//!   is ISO 261's coarse one; the class (`6g`, `6H`, ...) says external
+//!   (lower case) or internal (upper case); none: 6g or 6H.
+//! - trapezoidal: `Tr<d>x<lead>[(P<pitch>)]`, its limits stated (ISO
+//!   2903's classes are not offered).
+//! - ACME: `<D>-<tpi> ACME-<n>G`, `D` in inches, decimal or a fraction.
+//! - buttress: `<D>-<tpi> BUTT [7/45]`, ASME B1.9's form, limits stated.
+//! - a trailing `LH` makes it left-handed (`RH`, the default, may be
+//!   written).
+//!
+//! What a designation leaves to the drawing (internal or external where
+//! its class does not say, the stated limits, the buttress's load flank)
+//! comes in [`Drawing`].
+//!
+//! Hand-written: a few fixed forms with no crate that reads them.
+
+use super::profile::{Hand, ThreadProfile};
+use super::standards::{self, LoadFlank, StatedLimits};
+use crate::input::InputError;
+use crate::math::Real;
+
+/// What a designation leaves to the drawing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Drawing {
+    /// Internal (a nut's) or external; `None`: as the designation says (a
+    /// metric class's letter), else external.
+    pub internal: Option<bool>,
+    /// The limits of the threads whose standard leaves them to the
+    /// drawing (trapezoidal, buttress).
+    pub stated: StatedLimits,
+    /// Which way a buttress's load flank faces.
+    pub load: LoadFlank,
+}
+
+/// The longest designation read.
+const MAX_LEN: usize = 64;
+
+/// The thread `text` names, with what `drawing` adds.
+///
+/// # Failures
+/// Text that is none of the forms above, naming what was expected; a size
+/// the standard refuses ([`super::standards`]); a lead that is not a whole
+/// number of pitches; an internal thread asked of an external class (or
+/// the reverse).
+pub fn designated(text: &str, drawing: &Drawing) -> Result<ThreadProfile, InputError> {
+    let bad = |why: &str| InputError::BadText {
+        what: "thread designation".into(),
+        value: format!("'{}':", crate::files::excerpt(text)),
+        reason: why.into(),
+    };
+    if text.len() > MAX_LEN || text.chars().any(|c| c.is_control()) {
+        return Err(bad(&format!(
+            "not a designation (at most {MAX_LEN} printable characters)"
+        )));
+    }
+    let mut words: Vec<&str> = text
+        .split(|c: char| c == ' ' || c == '-')
+        .filter(|w| !w.is_empty())
+        .collect();
+    let hand = match words.last() {
+        Some(&"LH") => {
+            words.pop();
+            Hand::Left
+        }
+        Some(&"RH") => {
+            words.pop();
+            Hand::Right
+        }
+        _ => Hand::Right,
+    };
+    let num = |s: &str, what: &str| -> Result<Real, InputError> {
+        let v = match s.split_once('/') {
+            Some((a, b)) => a
+                .parse::<Real>()
+                .ok()
+                .zip(b.parse::<Real>().ok())
+                .map(|(a, b)| a / b),
+            None => s.parse::<Real>().ok(),
+        };
+        v.filter(|v| v.is_finite() && *v > 0.0)
+            .ok_or_else(|| bad(&format!("{what} '{s}' is not a positive number")))
+    };
+    // `<lead>[(P<pitch>)]`: the pitch and the number of starts.
+    let lead_pitch = |s: &str| -> Result<(Real, u32), InputError> {
+        let (lead, pitch) = match s.split_once("(P") {
+            Some((l, p)) => {
+                let p = p
+                    .strip_suffix(')')
+                    .ok_or_else(|| bad("'(P' without its ')'"))?;
+                (num(l, "lead")?, num(p, "pitch")?)
+            }
+            None => {
+                let l = num(s, "pitch")?;
+                (l, l)
+            }
+        };
+        let starts = (lead / pitch).round();
+        if (lead / pitch - starts).abs() > 1e-9 || !(1.0..=12.0).contains(&starts) {
+            return Err(bad(&format!(
+                "the lead {lead} is not 1 to 12 times the pitch {pitch}"
+            )));
+        }
+        Ok((pitch, starts as u32))
+    };
+    let external_unless = |asked: bool| -> Result<bool, InputError> {
+        match drawing.internal {
+            Some(i) if i != asked => Err(bad(&format!(
+                "its class is an {} thread's, and the drawing says {}",
+                if asked { "internal" } else { "external" },
+                if i { "internal" } else { "external" }
+            ))),
+            _ => Ok(asked),
+        }
+    };
+    let internal = drawing.internal.unwrap_or(false);
+    match words.as_slice() {
+        [m, rest @ ..] if m.starts_with('M') && rest.len() <= 1 => {
+            let size = &m[1..];
+            let (d, pitch, starts) = match size.split_once('x') {
+                Some((d, lp)) => {
+                    let (p, z) = lead_pitch(lp)?;
+                    (num(d, "diameter")?, p, z)
+                }
+                None => {
+                    let d = num(size, "diameter")?;
+                    let p = standards::coarse_pitch(d);
+                    if p == 0.0 {
+                        return Err(bad(&format!(
+                            "M{size} has no coarse pitch in ISO 261's table: give it, as M{size}x1.5"
+                        )));
+                    }
+                    (d, p, 1)
+                }
+            };
+            let (class, internal) = match rest {
+                [c] => {
+                    let upper = c.chars().last().is_some_and(|l| l.is_ascii_uppercase());
+                    (*c, external_unless(upper)?)
+                }
+                _ => (if internal { "6H" } else { "6g" }, internal),
+            };
+            standards::metric(d, pitch, internal, class, starts, hand)
+        }
+        [t] if t.starts_with("Tr") => {
+            let (d, lp) = t[2..]
+                .split_once('x')
+                .ok_or_else(|| bad("a trapezoidal thread is Tr<d>x<pitch>, as Tr40x7"))?;
+            let (pitch, starts) = lead_pitch(lp)?;
+            standards::trapezoidal(num(d, "diameter")?, pitch, internal, starts, hand, drawing.stated)
+        }
+        [d, tpi, acme, class] if *acme == "ACME" => {
+            let grade = class
+                .strip_suffix('G')
+                .and_then(|g| g.parse::<u32>().ok())
+                .ok_or_else(|| bad(&format!("ACME class '{class}' is not <n>G, as 2G")))?;
+            standards::acme(num(d, "diameter")?, num(tpi, "threads per inch")?, internal, grade, 1, hand)
+        }
+        [d, tpi, butt, form @ ..] if *butt == "BUTT" && (form.is_empty() || form == ["7/45"]) => {
+            standards::buttress(
+                num(d, "diameter")?,
+                num(tpi, "threads per inch")?,
+                internal,
+                drawing.load,
+                1,
+                hand,
+                drawing.stated,
+            )
+        }
+        _ => Err(bad(
+            "not a form pilgrim reads: M20x2.5-6g, M30x2-6H, Tr40x7, Tr40x14(P7), 1-5 ACME-2G, 2-8 BUTT 7/45 (LH at the end for a left hand)",
+        )),
+    }
+    .map_err(|e| match e {
+        InputError::BadText { ref what, .. } if what == "thread designation" => e,
+        other => bad(&other.to_string()),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const DRAWING: Drawing = Drawing {
+        internal: None,
+        stated: StatedLimits {
+            pitch_allowance: 0.0,
+            pitch_tolerance: 0.1,
+            crest_tolerance: 0.2,
+            root_tolerance: 0.3,
+        },
+        load: LoadFlank::TowardsChuck,
+    };
+
+    fn read(t: &str) -> ThreadProfile {
+        designated(t, &DRAWING).unwrap_or_else(|e| panic!("{t}: {e}"))
+    }
+
+    /// Each form reads into the standard's profile, as its own function
+    /// makes it.
+    #[test]
+    fn designations_read_into_the_standards_profiles() {
+        let s = DRAWING.stated;
+        assert_eq!(
+            read("M20x2.5-6g"),
+            standards::metric(20.0, 2.5, false, "6g", 1, Hand::Right).unwrap()
+        );
+        assert_eq!(read("M20"), read("M20-6g"));
+        assert_eq!(
+            read("M30x2-6H"),
+            standards::metric(30.0, 2.0, true, "6H", 1, Hand::Right).unwrap()
+        );
+        let two = read("M20x5(P2.5)-6g-LH");
+        assert_eq!((two.section.starts, two.section.hand), (2, Hand::Left));
+        assert_eq!(two.section.lead(), 5.0);
+        assert_eq!(
+            read("Tr40x7"),
+            standards::trapezoidal(40.0, 7.0, false, 1, Hand::Right, s).unwrap()
+        );
+        assert_eq!(read("Tr40x14(P7)").section.starts, 2);
+        assert_eq!(
+            read("1-5 ACME-2G"),
+            standards::acme(1.0, 5.0, false, 2, 1, Hand::Right).unwrap()
+        );
+        assert_eq!(read("3/4-6 ACME-2G").section.major, 0.75 * 25.4);
+        let b = read("2-8 BUTT 7/45");
+        assert_eq!(
+            b,
+            standards::buttress(2.0, 8.0, false, LoadFlank::TowardsChuck, 1, Hand::Right, s)
+                .unwrap()
+        );
+        assert_eq!(read("2-8 BUTT"), b);
+        let nut = designated(
+            "Tr40x7",
+            &Drawing {
+                internal: Some(true),
+                ..DRAWING
+            },
+        )
+        .unwrap();
+        assert!(nut.section.internal);
+    }
+
+    /// What is not a designation, or not a size the standard has, is
+    /// refused, naming the text and what was expected.
+    #[test]
+    fn bad_designations_are_named() {
+        for (t, says) in [
+            ("M21-6g", "no coarse pitch"),
+            ("M20x2.5-9g", "tolerance class '9g'"),
+            ("M20x2.7-6g", "ISO 965-1's table"),
+            ("M20x5(P2)-6g", "not 1 to 12 times the pitch"),
+            ("M20x2.5(P2.5-6g", "without its ')'"),
+            ("Tr40", "Tr<d>x<pitch>"),
+            ("1-5 ACME-3G", "ACME class"),
+            ("1-5 ACME-2", "ACME class '2'"),
+            ("UNC 1/2-13", "not a form pilgrim reads"),
+            ("M20xA-6g", "pitch 'A' is not a positive number"),
+            ("", "not a form"),
+        ] {
+            let e = designated(t, &DRAWING).unwrap_err().to_string();
+            assert!(
+                e.contains(&format!("thread designation '{t}'")) && e.contains(says),
+                "{t}: {e}"
+            );
+        }
+        let e = designated(
+            "M30x2-6H",
+            &Drawing {
+                internal: Some(false),
+                ..DRAWING
+            },
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("an internal thread's, and the drawing says external"),
+            "{e}"
+        );
+        assert!(designated(&"M".repeat(100), &DRAWING)
+            .unwrap_err()
+            .to_string()
+            .contains("at most 64"));
+    }
+}
