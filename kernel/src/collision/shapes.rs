@@ -25,6 +25,10 @@ const MAX_SECTORS: usize = 96;
 /// Points on each arc of a guard's sector.
 const ARC_POINTS: usize = 3;
 
+/// The sides of the polygons whose hull holds a cone's frustum: 64 stand
+/// off its circles by at most 0.12 % of their radius.
+const CONE_SIDES: usize = 64;
+
 /// A shape and where it stands in its body's frame.
 #[derive(Clone)]
 pub struct Shaped {
@@ -67,6 +71,34 @@ pub fn solid(s: &Solid) -> Shaped {
             shape: SharedShape::cylinder(length / 2.0, radius),
             local: along_z(),
         },
+        Solid::Cone {
+            radius,
+            end_radius,
+            length,
+        } => {
+            // The hull of two polygons whose edges touch the circles: it
+            // holds the frustum.
+            let n = CONE_SIDES;
+            let out = 1.0 / (std::f64::consts::PI / n as Real).cos();
+            let points: Vec<Vector> = [(radius, -length / 2.0), (end_radius, length / 2.0)]
+                .into_iter()
+                .flat_map(|(r, z)| {
+                    (0..n).map(move |i| {
+                        let (s, c) = (std::f64::consts::TAU * i as Real / n as Real).sin_cos();
+                        Vector::new(out * r * c, out * r * s, z)
+                    })
+                })
+                .collect();
+            match SharedShape::convex_hull(&points) {
+                Some(hull) => here(hull),
+                // Points that span no volume cannot come of sizes above 0;
+                // the cylinder that holds the frustum, were they to.
+                None => Shaped {
+                    shape: SharedShape::cylinder(length / 2.0, radius.max(end_radius)),
+                    local: along_z(),
+                },
+            }
+        }
         Solid::Block { size } => here(SharedShape::cuboid(
             size[0] / 2.0,
             size[1] / 2.0,
@@ -278,5 +310,28 @@ mod tests {
         assert!(d < 1e-9, "{d}");
         // Its reach holds it.
         assert!(guard.reach() >= 220.0, "{}", guard.reach());
+        // A centre's cone, 4 mm at its point (z = -20) to 27 mm at z = 20:
+        // a ball of 1 mm on its axis's side 8 mm out clears it by the
+        // cone's slant distance near its point, and one touching its wide
+        // end's rim touches it (the hull holds the circles).
+        let cone = solid(&Solid::Cone {
+            radius: 4.0,
+            end_radius: 27.0,
+            length: 40.0,
+        });
+        let at = |x: Real, z: Real| {
+            let p = Mat4::new_translation(&crate::math::Vec3::new(x, 0.0, z));
+            parry3d_f64::query::distance(&pose(&cone.local), &*cone.shape, &pose(&p), &*ball)
+                .unwrap()
+                .distance
+        };
+        // The slant at z = -20 + 1: radius 4 + 23/40; the point (8, -19)
+        // stands off it by (8 - r) cos(atan(23/40)) less the ball.
+        let slope: Real = 23.0 / 40.0;
+        let want = (8.0 - (4.0 + slope)) * slope.atan().cos() - 1.0;
+        let got = at(8.0, -19.0);
+        assert!((got - want).abs() < 0.01 * 8.0, "{got} vs {want}");
+        assert!(at(28.0, 20.0) < 1e-9);
+        assert!(at(0.0, -22.0) > 0.99 && at(0.0, -22.0) < 1.0 + 1e-9);
     }
 }

@@ -431,6 +431,15 @@ pub enum Solid {
         /// Length (mm).
         length: Real,
     },
+    /// A cone's frustum along the frame's Z, centred on the origin.
+    Cone {
+        /// Radius at the -Z end (mm).
+        radius: Real,
+        /// Radius at the +Z end (mm).
+        end_radius: Real,
+        /// Length (mm).
+        length: Real,
+    },
     /// A box centred on the origin, edges along the frame's axes.
     Block {
         /// Its edges along X, Y and Z (mm).
@@ -472,6 +481,15 @@ impl Solid {
             },
             BodyShape::Cylinder { radius, length } => Solid::Cylinder {
                 radius: size(radius, "radius")?,
+                length: size(length, "length")?,
+            },
+            BodyShape::Cone {
+                radius,
+                end_radius,
+                length,
+            } => Solid::Cone {
+                radius: size(radius, "radius")?,
+                end_radius: size(end_radius, "end_radius")?,
                 length: size(length, "length")?,
             },
             BodyShape::Block { size: [x, y, z] } => Solid::Block {

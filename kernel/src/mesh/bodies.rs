@@ -29,6 +29,24 @@ pub fn body_mesh(solid: &Solid, tol: Real) -> Result<TriMesh, MeshError> {
         )),
         Solid::Cylinder { radius, length } => Ok(cylinder(radius, length, tol)?
             .transformed(&Mat4::new_translation(&Vec3::new(0.0, 0.0, -length / 2.0)))),
+        Solid::Cone {
+            radius,
+            end_radius,
+            length,
+        } => {
+            // Two polygons inscribed within the tolerance, the wider's
+            // count for both.
+            let n = arc_segments(radius.max(end_radius), std::f64::consts::TAU, tol, 8)?;
+            let ring = |r: Real, z: Real| {
+                (0..n)
+                    .map(|i| {
+                        let (s, c) = (std::f64::consts::TAU * i as Real / n as Real).sin_cos();
+                        [r * c, r * s, z]
+                    })
+                    .collect::<Vec<_>>()
+            };
+            sweep(&[ring(radius, -length / 2.0), ring(end_radius, length / 2.0)])
+        }
         Solid::Block { size: [x, y, z] } => {
             let ring = |h: Real| {
                 vec![
@@ -103,6 +121,14 @@ mod tests {
                 6.0e6,
             ),
             (
+                Solid::Cone {
+                    radius: 4.0,
+                    end_radius: 27.0,
+                    length: 40.0,
+                },
+                pi / 3.0 * 40.0 * (16.0 + 4.0 * 27.0 + 729.0),
+            ),
+            (
                 Solid::Guard {
                     inner: 260.0,
                     outer: 280.0,
@@ -118,6 +144,7 @@ mod tests {
             // Chords within tol lose at most 2 tol / r of a section's area.
             let r = match solid {
                 Solid::Roller { radius, .. } | Solid::Cylinder { radius, .. } => radius,
+                Solid::Cone { radius, .. } => radius,
                 Solid::Guard { inner, .. } => inner,
                 Solid::Block { .. } => f64::INFINITY,
             };
@@ -128,7 +155,7 @@ mod tests {
             let (lo, hi) = m.bounds();
             match solid {
                 Solid::Roller { length, .. } => assert!((hi[1] - lo[1] - length).abs() < 1e-9),
-                Solid::Cylinder { length, .. } => {
+                Solid::Cylinder { length, .. } | Solid::Cone { length, .. } => {
                     assert!(
                         (lo[2] + length / 2.0).abs() < 1e-9 && (hi[2] - length / 2.0).abs() < 1e-9
                     )

@@ -22,8 +22,9 @@
 // setup's `feed_group`; 1.4: a thread block's `start_deg`; 1.5: a body's
 // `approach_feed`, a block's `number`; 1.6: the body shapes `cylinder`,
 // `box` and `guard`; 1.7: a body's `mount`, a constant factor's `scale`,
-// an axis's `max_accel`; 1.8: an axis's `turns_part`).
-#define PILGRIM_ABI_MINOR 8
+// an axis's `max_accel`; 1.8: an axis's `turns_part`; 1.9: the body
+// shape `cone`).
+#define PILGRIM_ABI_MINOR 9
 
 // The call succeeded.
 #define PILGRIM_STATUS_OK 0

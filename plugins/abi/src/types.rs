@@ -340,6 +340,17 @@ pub enum BodyShape {
         /// Its edges (mm), or the constants that give them.
         size: [Quantity; 3],
     },
+    /// Since 1.9: the frustum of a cone along the body frame's Z, centred
+    /// on the origin: `radius` at its -Z end, `end_radius` at its +Z end
+    /// (a tailstock's centre, its point in the part's centre hole).
+    Cone {
+        /// Radius at the -Z end (mm), or the constant that gives it.
+        radius: Quantity,
+        /// Radius at the +Z end (mm), or the constant that gives it.
+        end_radius: Quantity,
+        /// Length (mm), or the constant that gives it.
+        length: Quantity,
+    },
     /// Since 1.6: a wheel's guard: a tube round the body frame's Z
     /// (`inner` and `outer` radius, `width` along Z, centred on the
     /// origin) over `cover_deg` of the turn, centred on the frame's +X;

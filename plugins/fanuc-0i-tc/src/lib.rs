@@ -113,7 +113,10 @@ pub fn describe() -> MachineInfo {
             // depth, and 5 mm more), the turret's disc behind it, a 200 mm chuck whose
             // jaws stand `chuck_gap` beyond the part's start (room for the
             // thread's run-out and the holder), the tailstock's centre and
-            // quill at the part's end.
+            // quill at the part's end: a slender (extended-point) centre, a
+            // cone from the 4 mm radius of the part's centre hole to 15 mm
+            // at the quill 40 mm behind it, so that a thread's approach
+            // beyond the part's face passes it.
             ("holder_gap".to_owned(), 16.0),
             ("holder_length".to_owned(), 80.0),
             ("holder_section".to_owned(), 25.0),
@@ -122,7 +125,8 @@ pub fn describe() -> MachineInfo {
             ("chuck_radius".to_owned(), 100.0),
             ("chuck_length".to_owned(), 100.0),
             ("chuck_gap".to_owned(), 30.0),
-            ("centre_radius".to_owned(), 10.0),
+            ("centre_radius".to_owned(), 4.0),
+            ("centre_end_radius".to_owned(), 15.0),
             ("centre_length".to_owned(), 40.0),
             ("quill_radius".to_owned(), 35.0),
             ("quill_length".to_owned(), 150.0),
@@ -187,11 +191,12 @@ fn bodies() -> Vec<BodySpec> {
         ),
         BodySpec::mounted(
             "tailstock_centre",
-            "the tailstock's centre in the part's end",
+            "the tailstock's centre, its point in the part's end",
             Mount::PartEnd,
             vec![half(FactorKind::Tz, "centre_length", 1.0)],
-            BodyShape::Cylinder {
+            BodyShape::Cone {
                 radius: c("centre_radius"),
+                end_radius: c("centre_end_radius"),
                 length: c("centre_length"),
             },
         ),
