@@ -429,8 +429,10 @@ pub fn leave_for_rs274(dir: &Path, tag: &str) {
 
 /// How a run of pilgrim ended and what it took: its exit code (`None` when
 /// a signal ended it), its error stream, its process id, its peak resident
-/// memory and its CPU time, as the system accounts them (`wait4`), not as
-/// a clock in the test sees them.
+/// memory (its own high-water mark, read from `/proc` while it runs:
+/// `wait4`'s `ru_maxrss` also counts the test process's, whose memory the
+/// child shares until it starts pilgrim) and its CPU time, as the system
+/// accounts them (`wait4`), not as a clock in the test sees them.
 #[allow(dead_code)]
 pub struct Measured {
     pub code: Option<i32>,
@@ -467,7 +469,16 @@ pub fn measured(
     });
     let pid = child.id();
     let start = std::time::Instant::now();
+    // `spawn` returns once the child has started pilgrim: its memory is
+    // pilgrim's alone from then on.
+    let hwm_kb = || -> Option<f64> {
+        let status = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
+        let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+        line.split_whitespace().nth(1)?.parse().ok()
+    };
+    let mut peak_kb: f64 = 0.0;
     loop {
+        peak_kb = peak_kb.max(hwm_kb().unwrap_or(0.0));
         let mut status = 0;
         // SAFETY: an all-zero rusage is valid; wait4 fills it.
         let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
@@ -480,7 +491,7 @@ pub fn measured(
                 code: libc::WIFEXITED(status).then(|| libc::WEXITSTATUS(status)),
                 err: reader.join().unwrap(),
                 pid,
-                peak_mb: usage.ru_maxrss as f64 / 1024.0,
+                peak_mb: peak_kb / 1024.0,
                 cpu_seconds: seconds(usage.ru_utime) + seconds(usage.ru_stime),
             });
         }
@@ -489,7 +500,7 @@ pub fn measured(
             child.wait().ok();
             return None;
         }
-        std::thread::sleep(std::time::Duration::from_millis(20));
+        std::thread::sleep(std::time::Duration::from_millis(5));
     }
 }
 
