@@ -22,6 +22,7 @@ mod mandrel_fidelity;
 mod plugins;
 mod ring;
 mod sdk;
+mod thread;
 mod times;
 mod trust;
 mod verify;

@@ -896,7 +896,7 @@ fn a_rapid_through_the_stock_is_refused() {
 /// the report's figures as numbers, units in the header), one of starts
 /// (each start's finished profile against its nominal) and one of the
 /// verification's figures.
-fn check_workbook(out: &std::path::Path) {
+pub(crate) fn check_workbook(out: &std::path::Path) {
     use calamine::{open_workbook, Data, Reader, Xlsx};
     let report = common::report_of(out);
     let v = &report["worm_verification"];

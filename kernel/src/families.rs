@@ -18,10 +18,11 @@ pub const KINDS: [&OutcomeKind; 3] = [
 /// The script API of the families that have their own, listed in the
 /// reference after the generic groups (numbers, profiles, paths,
 /// equidistants) and before the transforms, tools and toolpaths.
-pub(crate) const SCRIPT_API: [&ApiGroup; 3] = [
+pub(crate) const SCRIPT_API: [&ApiGroup; 4] = [
     &crate::revolution::SCRIPT_API,
     &crate::caliber::SCRIPT_API,
     &crate::worm::SCRIPT_API,
+    &crate::worm::THREAD_SCRIPT_API,
 ];
 
 /// The kind whose report key is `key`.

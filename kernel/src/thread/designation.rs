@@ -59,10 +59,7 @@ pub fn designated(text: &str, drawing: &Drawing) -> Result<ThreadProfile, InputE
             "not a designation (at most {MAX_LEN} printable characters)"
         )));
     }
-    let mut words: Vec<&str> = text
-        .split(|c: char| c == ' ' || c == '-')
-        .filter(|w| !w.is_empty())
-        .collect();
+    let mut words: Vec<&str> = text.split([' ', '-']).filter(|w| !w.is_empty()).collect();
     let hand = match words.last() {
         Some(&"LH") => {
             words.pop();

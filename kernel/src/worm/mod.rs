@@ -28,6 +28,7 @@ mod servo;
 mod simulate;
 mod sizes;
 mod solid;
+mod thread_script;
 mod workbook;
 
 pub use crate::tool::{ThreadCutter, ARC_TOLERANCE};
@@ -46,4 +47,5 @@ pub use simulate::{
 };
 pub use sizes::WormSizes;
 pub use solid::{worm_solid, WormSweep, MAX_AROUND};
+pub(crate) use thread_script::SCRIPT_API as THREAD_SCRIPT_API;
 pub use workbook::worm_pass_workbook;

@@ -85,7 +85,7 @@ impl Outcome for WormOutcome {
     ) -> Result<Vec<PartBody>, SceneError> {
         // The finished worm: the simulated section swept along the helix.
         let mesh_error = |source| SceneError::Mesh {
-            body: "worm".into(),
+            body: self.request.part.into(),
             source,
         };
         let (w, length) = (&self.check, self.request.length);
@@ -94,7 +94,7 @@ impl Outcome for WormOutcome {
         // the rest for the fit.
         let body = WormSweep::new(w, length, step_tolerance / 4.0).map_err(mesh_error)?;
         Ok(vec![PartBody {
-            name: "worm".into(),
+            name: self.request.part.into(),
             geometry: PartGeometry::Swept(Box::new(Swept {
                 mesh,
                 body: SweptBody::new(body),

@@ -76,6 +76,8 @@ pub struct WormRequest {
     /// start's pitch diameter within `pitch_diameter` (`None`: the
     /// tolerances alone).
     pub limits: Option<crate::thread::ThreadLimits>,
+    /// The finished part's name: its solid's files (`worm.stl`).
+    pub part: &'static str,
 }
 
 impl WormRequest {
@@ -94,6 +96,7 @@ impl WormRequest {
             space_centre,
             tolerances,
             limits: None,
+            part: "worm",
         }
     }
 }
@@ -1038,7 +1041,17 @@ fn measure(
             // The thread's middle (the last start's at the window's end:
             // 1 um inside it).
             tip_diameter: 2.0 * vertical_top(m, c + thread_middle(w)[1] - 1e-3).unwrap_or(0.0),
-            pitch_diameter: pitch_diameter(m, w, c, (r_lo, r_hi)),
+            // Searched over the straight flanks: from where the nose's
+            // arc meets them to the crest.
+            pitch_diameter: pitch_diameter(
+                m,
+                w,
+                c,
+                (
+                    r_f + cutter.nose_radius * (1.0 - w.flanks[0].min(w.flanks[1]).sin()) + 1e-6,
+                    r_a - 1e-6,
+                ),
+            ),
             over_wires: req
                 .limits
                 .as_ref()
@@ -1215,6 +1228,7 @@ mod tests {
                 lead: 0.01,
             },
             limits: Some(profile.limits.clone()),
+            part: "thread",
         };
         simulate(&program, &lathe, &Default::default(), &cutter, &req)
     }

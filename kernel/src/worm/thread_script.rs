@@ -1,0 +1,305 @@
+//! Threads of any profile for scripts: a thread named as a drawing names
+//! it ([`crate::thread::designated`]), its sizes as the cut aims at them,
+//! the plan of passes over its section, and its verification (the worm's
+//! simulation, held to the standard's limits). Angles in degrees; lengths
+//! mm.
+
+use super::script::{cutter_of, plan_map};
+use crate::binding::floats::{kernel, number};
+use crate::binding::{ApiGroup, VerifyForm};
+use crate::family::Verification;
+use crate::math::Real;
+use crate::thread::standards::{LoadFlank, StatedLimits};
+use crate::thread::{Drawing, Hand, ThreadProfile};
+use crate::tool::Tool;
+use crate::worm::{self, WormTolerances};
+use rhai::plugin::*;
+use rhai::{EvalAltResult, Map};
+
+/// The keys of a drawing's map, in the order the docs give them.
+const DRAWING_KEYS: [&str; 6] = [
+    "internal",
+    "pitch_allowance",
+    "pitch_tolerance",
+    "crest_tolerance",
+    "root_tolerance",
+    "load",
+];
+
+/// The drawing of a script's map: every key of [`DRAWING_KEYS`].
+fn drawing(m: &Map) -> Result<Drawing, Box<EvalAltResult>> {
+    if let Some(k) = m.keys().find(|k| !DRAWING_KEYS.contains(&k.as_str())) {
+        return Err(format!(
+            "thread_profile: unknown drawing key '{k}' (keys: {})",
+            DRAWING_KEYS.join(", ")
+        )
+        .into());
+    }
+    let text = |k: &str| -> Result<String, Box<EvalAltResult>> {
+        m.get(k)
+            .and_then(|v| v.clone().into_string().ok())
+            .ok_or_else(|| format!("thread_profile: drawing key '{k}' must be a string").into())
+    };
+    let num = |k: &str| -> Result<Real, Box<EvalAltResult>> {
+        let v = m
+            .get(k)
+            .and_then(number)
+            .ok_or_else(|| format!("thread_profile: drawing key '{k}' must be a number (mm)"))?;
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(
+                format!("thread_profile: drawing key '{k}' = {v} must be 0 or more (mm)").into(),
+            );
+        }
+        Ok(v)
+    };
+    let internal = match text("internal")?.as_str() {
+        "auto" => None,
+        "internal" => Some(true),
+        "external" => Some(false),
+        other => {
+            return Err(format!(
+                "thread_profile: internal = '{other}' is not auto, internal or external"
+            )
+            .into())
+        }
+    };
+    let load = match text("load")?.as_str() {
+        "chuck" => LoadFlank::TowardsChuck,
+        "tailstock" => LoadFlank::AwayFromChuck,
+        other => {
+            return Err(format!(
+                "thread_profile: load = '{other}' is not chuck or tailstock (the way a buttress's load flank faces)"
+            )
+            .into())
+        }
+    };
+    Ok(Drawing {
+        internal,
+        stated: StatedLimits {
+            pitch_allowance: num("pitch_allowance")?,
+            pitch_tolerance: num("pitch_tolerance")?,
+            crest_tolerance: num("crest_tolerance")?,
+            root_tolerance: num("root_tolerance")?,
+        },
+        load,
+    })
+}
+
+/// A thread's sizes, the plan over its section.
+#[export_module]
+pub mod thread_api {
+    use super::*;
+
+    /// The thread `designation` names (`M20x2.5-6g`, `M30x2-6H`, `Tr40x7`,
+    /// `Tr40x14(P7)`, `1-5 ACME-2G`, `2-8 BUTT 7/45`, `LH` at the end for a
+    /// left hand), with what its designation leaves to the drawing:
+    /// `#{ internal: "auto" | "internal" | "external", pitch_allowance,
+    /// pitch_tolerance, crest_tolerance, root_tolerance (mm: the limits
+    /// of threads whose standard leaves them to the drawing: trapezoidal,
+    /// buttress), load: "chuck" | "tailstock" (which way a buttress's load
+    /// flank faces) }`.
+    ///
+    /// ```rhai
+    /// let t = thread_profile("M20x2.5-6g", #{ internal: "auto", pitch_allowance: 0.0,
+    ///     pitch_tolerance: 0.2, crest_tolerance: 0.3, root_tolerance: 0.3, load: "chuck" });
+    /// t.pitch_diameter    // 18.249: the middle of 6g's band
+    /// ```
+    #[rhai_fn(return_raw)]
+    pub fn thread_profile(
+        designation: &str,
+        drawing: Map,
+    ) -> Result<ThreadProfile, Box<EvalAltResult>> {
+        kernel(crate::thread::designated(
+            designation,
+            &super::drawing(&drawing)?,
+        ))
+    }
+
+    /// The designation, as the standard writes it.
+    #[rhai_fn(get = "designation", pure)]
+    pub fn designation(t: &mut ThreadProfile) -> String {
+        t.designation.clone()
+    }
+    /// Where the form and the limits come from (`ISO 68-1, ISO 965-1`;
+    /// the limits' source: `ISO 965-1 6g`, `stated`).
+    #[rhai_fn(get = "standard", pure)]
+    pub fn standard(t: &mut ThreadProfile) -> String {
+        format!("{} ({})", t.standard, t.limits.source)
+    }
+    /// An internal thread (a nut's).
+    #[rhai_fn(get = "internal", pure)]
+    pub fn internal(t: &mut ThreadProfile) -> bool {
+        t.section.internal
+    }
+    /// Left-handed.
+    #[rhai_fn(get = "left_hand", pure)]
+    pub fn left_hand(t: &mut ThreadProfile) -> bool {
+        t.section.hand == Hand::Left
+    }
+    /// The pitch between neighbouring threads (mm).
+    #[rhai_fn(get = "pitch", pure)]
+    pub fn pitch(t: &mut ThreadProfile) -> Real {
+        t.section.pitch
+    }
+    /// The lead (mm).
+    #[rhai_fn(get = "lead", pure)]
+    pub fn lead(t: &mut ThreadProfile) -> Real {
+        t.section.lead()
+    }
+    /// The number of starts.
+    #[rhai_fn(get = "starts", pure)]
+    pub fn starts(t: &mut ThreadProfile) -> i64 {
+        i64::from(t.section.starts)
+    }
+    /// The pitch diameter the cut aims at: the middle of its limits (mm).
+    #[rhai_fn(get = "pitch_diameter", pure)]
+    pub fn pitch_diameter(t: &mut ThreadProfile) -> Real {
+        t.aimed().pitch_diameter
+    }
+    /// The root's diameter the cut aims at (mm): external, the minor;
+    /// internal, the major.
+    #[rhai_fn(get = "root_diameter", pure)]
+    pub fn root_diameter(t: &mut ThreadProfile) -> Real {
+        t.aimed().root_diameter
+    }
+    /// The crest's diameter: the blank's (external) or the bore's
+    /// (internal), the middle of its limits (mm).
+    #[rhai_fn(get = "crest_diameter", pure)]
+    pub fn crest_diameter(t: &mut ThreadProfile) -> Real {
+        t.aimed().crest_diameter
+    }
+    /// The depth the cut makes, crest to root (mm).
+    #[rhai_fn(get = "depth", pure)]
+    pub fn depth(t: &mut ThreadProfile) -> Real {
+        t.aimed().depth()
+    }
+    /// The space's width at the root (mm): the widest cutter tip.
+    #[rhai_fn(get = "root_space", pure)]
+    pub fn root_space(t: &mut ThreadProfile) -> Real {
+        t.aimed().root_space()
+    }
+    /// The root's rounding the standard gives (mm; 0: a flat root).
+    #[rhai_fn(get = "root_radius", pure)]
+    pub fn root_radius(t: &mut ThreadProfile) -> Real {
+        t.section.root_radius
+    }
+    /// The flank towards -Z's angle from the radial (deg).
+    #[rhai_fn(get = "left_flank_deg", pure)]
+    pub fn left_flank_deg(t: &mut ThreadProfile) -> Real {
+        t.section.flanks[0].to_degrees()
+    }
+    /// The flank towards +Z's (deg).
+    #[rhai_fn(get = "right_flank_deg", pure)]
+    pub fn right_flank_deg(t: &mut ThreadProfile) -> Real {
+        t.section.flanks[1].to_degrees()
+    }
+    /// The flanks the roughing passes follow: `alternating` for a
+    /// symmetric profile; for an asymmetric one (a buttress) its steeper
+    /// flank, `left` or `right`, so that the infeed runs along the load
+    /// flank and the open flank takes the chip.
+    #[rhai_fn(get = "infeed", pure)]
+    pub fn infeed(t: &mut ThreadProfile) -> String {
+        let [l, r] = t.section.flanks;
+        match l.total_cmp(&r) {
+            std::cmp::Ordering::Equal => "alternating",
+            std::cmp::Ordering::Less => "left",
+            std::cmp::Ordering::Greater => "right",
+        }
+        .into()
+    }
+    /// One space's area in the axial section, as the cut aims at it
+    /// (mm^2).
+    #[rhai_fn(get = "space_area", pure)]
+    pub fn space_area(t: &mut ThreadProfile) -> Real {
+        t.aimed().space_area()
+    }
+
+    /// The universal cutter's axial offset to each flank, `a_1z` (mm).
+    #[rhai_fn(pure, return_raw, name = "axial_offset")]
+    pub fn thread_axial_offset(
+        t: &mut ThreadProfile,
+        tool: Tool,
+    ) -> Result<Real, Box<EvalAltResult>> {
+        Ok(worm::axial_offset(&t.aimed(), &cutter_of(&tool)?))
+    }
+
+    /// The passes over the section the cut aims at, as the worm's `plan`
+    /// (the same settings and columns).
+    #[rhai_fn(pure, return_raw, name = "plan")]
+    pub fn thread_plan(
+        t: &mut ThreadProfile,
+        tool: Tool,
+        settings: Map,
+    ) -> Result<Map, Box<EvalAltResult>> {
+        plan_map(&t.aimed(), &tool, &settings)
+    }
+}
+
+/// The thread's part of the script API, as the reference lists it.
+pub(crate) const SCRIPT_API: ApiGroup = ApiGroup {
+    title: "Threads of any profile: designations, sizes, passes (`Thread`)",
+    types: |e| {
+        e.register_type_with_name::<ThreadProfile>("Thread");
+    },
+    register: |e, _| {
+        e.register_global_module(rhai::exported_module!(thread_api).into());
+    },
+    verify: Some(VerifyForm {
+        key: "thread_profile",
+        form: "#{ thread_profile, length, space_centre, tolerance: #{ form, position, flank_angle_deg, lead (optional) } }",
+        read: verification,
+    }),
+};
+
+/// The thread's request from the map of a script's `fn verify(p)`: the
+/// section the cut aims at, held to the standard's limits.
+fn verification(m: &Map) -> Result<Verification, Option<String>> {
+    let num = |k: &str| m.get(k).and_then(number).ok_or(None);
+    let profile = m
+        .get("thread_profile")
+        .and_then(|w| w.clone().try_cast::<ThreadProfile>())
+        .ok_or(None)?;
+    let t = m
+        .get("tolerance")
+        .and_then(|t| t.clone().try_cast::<Map>())
+        .ok_or(None)?;
+    let tnum = |k: &str| {
+        t.get(k).and_then(number).ok_or_else(|| {
+            Some(format!(
+                "fn verify(p): tolerance.{k} must be a number (tolerance: form, position, flank_angle_deg, lead)"
+            ))
+        })
+    };
+    let section = profile.aimed();
+    Ok(Verification::new(worm::WormRequest {
+        // The flanks are measured a twentieth of the depth inside the root
+        // and the crest.
+        flank_margin: 0.05 * section.depth(),
+        length: num("length")?,
+        space_centre: num("space_centre")?,
+        tolerances: WormTolerances {
+            form: tnum("form")?,
+            // The standard's limits hold the thickness (by the pitch
+            // diameter) and the diameters: these are the halves of their
+            // bands, for the record.
+            thickness: 0.25
+                * profile.limits.pitch_diameter.width()
+                * (section.flanks[0].tan() + section.flanks[1].tan()),
+            diameter: 0.5
+                * profile
+                    .limits
+                    .root
+                    .width()
+                    .max(profile.limits.crest.width()),
+            position: tnum("position")?,
+            flank_angle: tnum("flank_angle_deg")?.to_radians(),
+            lead: match t.get("lead") {
+                None => worm::LEAD_ERROR,
+                Some(_) => tnum("lead")?,
+            },
+        },
+        limits: Some(profile.limits.clone()),
+        part: "thread",
+        section,
+    }))
+}

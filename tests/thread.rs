@@ -1,0 +1,264 @@
+//! The thread family (`scripts/thread.rhai`): standard threads named as
+//! drawings name them, each default run verified by simulating its program
+//! pass by pass, its figures held against the standards' dimensions and
+//! against a gauge's arithmetic done here.
+
+use crate::common::{self, pilgrim, s, scratch};
+use std::path::PathBuf;
+
+const SCRIPT: &str = "scripts/thread.rhai";
+
+/// The thread run into a fresh directory `name` with `args`, succeeding:
+/// the run's directory.
+fn run(name: &str, args: &[&str]) -> PathBuf {
+    let out = scratch("thread", name).join("out");
+    let mut all = vec!["run", SCRIPT, "--out", s(&out), "--quiet"];
+    all.extend(args);
+    let (code, _, err) = pilgrim(&all);
+    assert_eq!(code, 0, "{name}: {err}");
+    out
+}
+
+/// What a standard prints for a thread (mm): its pitch diameter's, its
+/// crest's and its root's limits, and its flanks (deg).
+struct Printed {
+    pitch_diameter: [f64; 2],
+    crest: [f64; 2],
+    root: [f64; 2],
+    flanks: [f64; 2],
+}
+
+const INCH: f64 = 25.4;
+
+/// Each default run: the default M20x2.5-6g and the examples' Tr 40x7, 1"-5
+/// ACME 2G and 2"-8 7/45 buttress. Their limits are the standards' printed
+/// dimensions (ISO 965-2's M20 6g, ASME B1.5's 1-5 2G) or the drawing's
+/// stated ones; the run passes; each start's pitch diameter, as the gauge
+/// takes it on the simulated section, lies within its limits and within
+/// 5 um of the band's middle the cut aims at; the root and the crest are
+/// within theirs; the flanks stand at the standard's angles; and the
+/// measurement over wires is what a gauge's arithmetic gives for the pitch
+/// diameter measured, the wire the best size (P / 2 / cos a).
+#[test]
+fn each_default_thread_is_verified_against_its_standard() {
+    let cases: [(&str, Option<&str>, Printed); 4] = [
+        (
+            "m20",
+            None,
+            Printed {
+                pitch_diameter: [18.164, 18.334],
+                crest: [19.623, 19.958],
+                root: [16.721, 16.891],
+                flanks: [30.0, 30.0],
+            },
+        ),
+        (
+            "tr40x7",
+            Some("scripts/examples/thread-tr40x7.toml"),
+            Printed {
+                pitch_diameter: [36.2, 36.4],
+                crest: [39.6, 39.9],
+                root: [31.4, 31.9],
+                flanks: [15.0, 15.0],
+            },
+        ),
+        (
+            "acme",
+            Some("scripts/examples/thread-acme-1-5.toml"),
+            Printed {
+                pitch_diameter: [0.8726 * INCH, 0.8920 * INCH],
+                crest: [0.9900 * INCH, 1.0000 * INCH],
+                root: [0.7509 * INCH, 0.7800 * INCH],
+                flanks: [14.5, 14.5],
+            },
+        ),
+        (
+            "buttress",
+            Some("scripts/examples/thread-buttress-2-8.toml"),
+            // B1.9's form: E = D - 0.6 P, the external thread's depth
+            // 0.66271 P; the load flank (7 deg) on the space's +Z side.
+            Printed {
+                pitch_diameter: [
+                    2.0 * INCH - 0.6 * INCH / 8.0 - 0.2,
+                    2.0 * INCH - 0.6 * INCH / 8.0,
+                ],
+                crest: [2.0 * INCH - 0.3, 2.0 * INCH],
+                root: [
+                    2.0 * INCH - 2.0 * 0.66271 * INCH / 8.0 - 0.5,
+                    2.0 * INCH - 2.0 * 0.66271 * INCH / 8.0,
+                ],
+                flanks: [45.0, 7.0],
+            },
+        ),
+    ];
+    for (name, file, printed) in cases {
+        let args: Vec<&str> = file.map(|f| vec!["--params", f]).unwrap_or_default();
+        let out = run(name, &args);
+        let r = common::report_of(&out);
+        assert_eq!(r["verdict"]["status"], "passed", "{name}: {}", r["verdict"]);
+        let v = &r["worm_verification"];
+        let l = &v["limits"];
+        let band = |k: &str| [l[k]["min"].as_f64().unwrap(), l[k]["max"].as_f64().unwrap()];
+        // The standards print to 0.001 mm or 0.0001 in.
+        let printed_to = if name == "acme" {
+            0.00005 * INCH
+        } else {
+            0.0005
+        };
+        for (k, want) in [
+            ("pitch_diameter", printed.pitch_diameter),
+            ("crest", printed.crest),
+            ("root", printed.root),
+        ] {
+            let got = band(k);
+            assert!(
+                (got[0] - want[0]).abs() <= printed_to && (got[1] - want[1]).abs() <= printed_to,
+                "{name}: {k} {got:?}, printed {want:?}"
+            );
+        }
+        let pd = band("pitch_diameter");
+        for st in v["starts"].as_array().unwrap() {
+            let f = |k: &str| st[k].as_f64().unwrap();
+            let d2 = f("pitch_diameter");
+            assert!(pd[0] < d2 && d2 < pd[1], "{name}: {d2} outside {pd:?}");
+            let aim = 0.5 * (pd[0] + pd[1]);
+            assert!((d2 - aim).abs() < 0.005, "{name}: {d2} vs the aim {aim}");
+            for (k, lim) in [
+                ("root_diameter", band("root")),
+                ("tip_diameter", band("crest")),
+            ] {
+                assert!(
+                    lim[0] <= f(k) && f(k) <= lim[1],
+                    "{name}: {k} {} outside {lim:?}",
+                    f(k)
+                );
+            }
+            for (k, want) in [
+                ("left_angle_deg", printed.flanks[0]),
+                ("right_angle_deg", printed.flanks[1]),
+            ] {
+                assert!((f(k) - want).abs() < 0.05, "{name}: {k} {}", f(k));
+            }
+            if printed.flanks[0] == printed.flanks[1] {
+                // A gauge's arithmetic: M = d2 + w (1 + 1 / sin a) - (P / 2) / tan a.
+                let a = printed.flanks[0].to_radians();
+                let p = r["notes"]["pitch_mm"].as_f64().unwrap();
+                let w = p / 2.0 / a.cos();
+                assert!((v["wire"].as_f64().unwrap() - w).abs() < 1e-9, "{name}");
+                let m = d2 + w * (1.0 + 1.0 / a.sin()) - p / 2.0 / a.tan();
+                assert!(
+                    (f("over_wires") - m).abs() < 0.002,
+                    "{name}: M {} vs {m}",
+                    f("over_wires")
+                );
+                let ml = v["over_wires_limits"].as_array().unwrap();
+                assert!(
+                    ml[0].as_f64().unwrap() < f("over_wires")
+                        && f("over_wires") < ml[1].as_f64().unwrap()
+                );
+            } else {
+                assert!(
+                    st.get("over_wires").is_none(),
+                    "{name}: no best wire for unequal flanks"
+                );
+            }
+        }
+        crate::worm::check_workbook(&out);
+        // The STL, the scene and the page for CI's FreeCAD, glTF
+        // validator and headless Chromium.
+        common::leave_for_checkers(&out, &format!("thread-{name}"));
+        common::check_page(&out, "program.nc", 12.0);
+        common::leave_page_for_chromium(&out, &format!("thread-{name}"));
+        for f in [
+            "passes.csv",
+            "passes.svg",
+            "chip_area.svg",
+            "program.nc",
+            "thread.stl",
+            "report.html",
+        ] {
+            assert!(out.join(f).is_file(), "{name}: {f}");
+        }
+    }
+}
+
+/// A buttress cut with its roughing passes on the load flank: `auto` takes
+/// the steeper flank (the space's +Z side, 7 deg, when the load is taken
+/// towards the chuck), the open 45 deg flank taking the chip; with the
+/// load the other way, the other flank.
+#[test]
+fn a_buttress_is_roughed_along_its_load_flank() {
+    for (load, side) in [("chuck", "right"), ("tailstock", "left")] {
+        let out = run(
+            &format!("buttress-{load}"),
+            &[
+                "--params",
+                "scripts/examples/thread-buttress-2-8.toml",
+                "--set",
+                &format!("load={load}"),
+            ],
+        );
+        let r = common::report_of(&out);
+        let flanks = r["tables"]["passes"]["flank"].as_array().unwrap();
+        let kinds = r["tables"]["passes"]["kind"].as_array().unwrap();
+        let want = if side == "right" { 1.0 } else { -1.0 };
+        for (f, k) in flanks.iter().zip(kinds) {
+            if k.as_f64() == Some(0.0) {
+                assert_eq!(
+                    f.as_f64(),
+                    Some(want),
+                    "{load}: a roughing pass off the load flank"
+                );
+            }
+        }
+        let nominal = r["worm_verification"]["nominal_flanks_deg"]
+            .as_array()
+            .unwrap();
+        let seven = if side == "right" { 1 } else { 0 };
+        assert_eq!(nominal[seven].as_f64().unwrap().round(), 7.0, "{load}");
+    }
+}
+
+/// What the family cannot read or cannot yet cut is refused before any
+/// output, naming the value: a designation of no standard, a class the
+/// standard lacks, a drawing's unknown word; an internal or left-hand
+/// thread stops at its check with the FAILED report and no program.
+#[test]
+fn bad_threads_are_refused_with_clear_errors() {
+    let dir = scratch("thread", "bad");
+    for (set, says) in [
+        (
+            "designation=UNC 1/2-13",
+            "thread designation 'UNC 1/2-13': not a form pilgrim reads",
+        ),
+        ("designation=M20x2.5-9g", "tolerance class '9g'"),
+        ("designation=1-5 ACME-3G", "ACME class"),
+        (
+            "load=sideways",
+            "load = 'sideways' is not chuck or tailstock",
+        ),
+        (
+            "internal=maybe",
+            "internal = 'maybe' is not auto, internal or external",
+        ),
+    ] {
+        let out = dir.join(set.replace(|c: char| !c.is_ascii_alphanumeric(), "_"));
+        let (code, _, err) = pilgrim(&["run", SCRIPT, "--out", s(&out), "--quiet", "--set", set]);
+        assert_ne!(code, 0, "{set}");
+        assert!(err.contains(says), "{set}: {err}");
+        assert!(!out.exists(), "{set}: output written");
+    }
+    for (set, says) in [
+        ("designation=M30x2-6H", "the thread is external"),
+        ("designation=M20x2.5-6g-LH", "the thread is right-handed"),
+    ] {
+        let out = dir.join(set.replace(|c: char| !c.is_ascii_alphanumeric(), "_"));
+        let (code, _, err) = pilgrim(&["run", SCRIPT, "--out", s(&out), "--quiet", "--set", set]);
+        assert_ne!(code, 0, "{set}");
+        assert!(err.contains(says), "{set}: {err}");
+        assert!(
+            !out.join("program.nc").exists() && out.join("report.html").is_file(),
+            "{set}"
+        );
+    }
+}
