@@ -1,0 +1,68 @@
+//! Thread benchmarks. Run: `cargo bench --bench thread`.
+//!
+//! - `thread_job`: the default job (`scripts/thread.rhai`: an external
+//!   M20x2.5-6g, 30 mm, on the Fanuc 0i-TC) through the kernel's job call,
+//!   in process: the script loaded, the designation read, the plan,
+//!   inverse kinematics, the pass-by-pass simulation against ISO 965-1's
+//!   limits with the measurement over wires, the collision check, the
+//!   posts, the charts, `passes.xlsx`, the meshes, `report.html` and the
+//!   bytes of every file (not written to disk) (target <= 0.5 s); and the
+//!   same for the Tr 40x7 of `scripts/examples/thread-tr40x7.toml`.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use pilgrim_kernel::catalog::{Catalog, CompiledPlugin};
+use pilgrim_kernel::job::{self, JobOptions};
+use pilgrim_kernel::params::ParamSource;
+use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
+use std::hint::black_box;
+use std::path::Path;
+use std::time::Duration;
+
+fn thread_job(c: &mut Criterion) {
+    let catalog = Catalog::new(&[CompiledPlugin {
+        symbol: "pilgrim_plugin_fanuc_0i_tc",
+        entry: fanuc_0i_tc::pilgrim_plugin_fanuc_0i_tc,
+    }])
+    .unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let options = JobOptions {
+        program_name: "thread".into(),
+        ..JobOptions::default()
+    };
+    let mut g = c.benchmark_group("thread_job");
+    g.sample_size(20).measurement_time(Duration::from_secs(10));
+    let example =
+        std::fs::read_to_string(root.join("scripts/examples/thread-tr40x7.toml")).unwrap();
+    for (name, sets) in [
+        ("default_m20_end_to_end", vec![]),
+        (
+            "tr40x7_end_to_end",
+            vec![ParamSource::Toml {
+                label: "thread-tr40x7.toml".into(),
+                text: example,
+            }],
+        ),
+    ] {
+        let run = || {
+            let family = ScriptFamily::load(
+                &root.join("scripts/thread.rhai"),
+                &Limits::default(),
+                &Access::default(),
+            )
+            .unwrap();
+            let machine = catalog.open("fanuc-0i-tc").unwrap();
+            job::run(&family, &machine, &sets, &options, &mut |_| {}).unwrap()
+        };
+        let out = run();
+        assert!(
+            out.check::<pilgrim_kernel::worm::WormOutcome>().is_some() && out.files.len() >= 12,
+            "{name}: {} files",
+            out.files.len()
+        );
+        g.bench_function(name, |b| b.iter(|| black_box(run())));
+    }
+    g.finish();
+}
+
+criterion_group!(benches, thread_job);
+criterion_main!(benches);
