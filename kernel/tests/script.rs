@@ -417,7 +417,8 @@ fn a_verify_map_names_what_is_wrong_with_it() {
     assert!(
         e.contains("must return #{ profile, from, to, tolerance }")
             && e.contains(", #{ groove, psi,")
-            && e.contains(" or #{ worm, length,"),
+            && e.contains(", #{ worm, length,")
+            && e.contains(" or #{ thread_profile, length,"),
         "{e}"
     );
     let e = message(
