@@ -1320,5 +1320,11 @@ mod tests {
             s.pitch_diameter
         );
         assert_eq!(check.nominal_flanks_deg.map(Real::round), [45.0, 7.0]);
+        // The verdict's flank-angle figure takes each flank against its
+        // own angle (it once took both against the left's 45 degrees,
+        // and the 7 degree flank stood 38 degrees off).
+        let (figures, _) = check.findings();
+        let angle = figures.iter().find(|f| f.name == "flank angle").unwrap();
+        assert!(angle.value.abs() < 0.05, "{angle:?}");
     }
 }
