@@ -297,38 +297,78 @@ pub(crate) const SCRIPT_API: ApiGroup = ApiGroup {
     }),
 };
 
-/// The worm's request from the map of a script's `fn verify(p)`.
-fn verification(m: &Map) -> Result<Verification, Option<String>> {
-    let num = |k: &str| m.get(k).and_then(number).ok_or(None);
-    let sizes = m
-        .get("worm")
-        .and_then(|w| w.clone().try_cast::<WormSizes>())
-        .ok_or(None)?;
-    let t = m
-        .get("tolerance")
-        .and_then(|t| t.clone().try_cast::<Map>())
-        .ok_or(None)?;
-    let tnum = |k: &str| {
-        t.get(k).and_then(number).ok_or_else(|| {
+/// What the worm's and the thread's `fn verify(p)` maps share: the object
+/// under their key, `length`, `space_centre` and the `tolerance` map.
+pub(crate) struct VerifyMap<T> {
+    /// The object under the family's key (`worm`, `thread_profile`).
+    pub part: T,
+    /// The thread's length (mm).
+    pub length: Real,
+    /// Where start 0's space is centred (mm).
+    pub space_centre: Real,
+    tolerance: Map,
+    keys: &'static str,
+}
+
+impl<T: Clone + 'static> VerifyMap<T> {
+    /// The map `m` read: `Err(None)` where it is not of the form (no
+    /// object of type `T` under `key`, no numbers, no tolerance map);
+    /// `keys` lists the tolerance's keys in messages.
+    pub(crate) fn read(m: &Map, key: &str, keys: &'static str) -> Result<Self, Option<String>> {
+        let num = |k: &str| m.get(k).and_then(number).ok_or(None);
+        Ok(Self {
+            part: m
+                .get(key)
+                .and_then(|w| w.clone().try_cast::<T>())
+                .ok_or(None)?,
+            length: num("length")?,
+            space_centre: num("space_centre")?,
+            tolerance: m
+                .get("tolerance")
+                .and_then(|t| t.clone().try_cast::<Map>())
+                .ok_or(None)?,
+            keys,
+        })
+    }
+
+    /// The tolerance `k`, a number.
+    pub(crate) fn tolerance(&self, k: &str) -> Result<Real, Option<String>> {
+        self.tolerance.get(k).and_then(number).ok_or_else(|| {
             Some(format!(
-                "fn verify(p): tolerance.{k} must be a number (tolerance: form, thickness, diameter, position, flank_angle_deg)"
+                "fn verify(p): tolerance.{k} must be a number (tolerance: {})",
+                self.keys
             ))
         })
-    };
+    }
+
+    /// The lead's error allowed at the thread's ends: `tolerance.lead`,
+    /// [`worm::LEAD_ERROR`] where it is left out.
+    pub(crate) fn lead(&self) -> Result<Real, Option<String>> {
+        match self.tolerance.get("lead") {
+            None => Ok(worm::LEAD_ERROR),
+            Some(_) => self.tolerance("lead"),
+        }
+    }
+}
+
+/// The worm's request from the map of a script's `fn verify(p)`.
+fn verification(m: &Map) -> Result<Verification, Option<String>> {
+    let v = VerifyMap::<WormSizes>::read(
+        m,
+        "worm",
+        "form, thickness, diameter, position, flank_angle_deg",
+    )?;
     Ok(Verification::new(worm::WormRequest::worm(
-        &sizes,
-        num("length")?,
-        num("space_centre")?,
+        &v.part,
+        v.length,
+        v.space_centre,
         worm::WormTolerances {
-            form: tnum("form")?,
-            thickness: tnum("thickness")?,
-            diameter: tnum("diameter")?,
-            position: tnum("position")?,
-            flank_angle: tnum("flank_angle_deg")?.to_radians(),
-            lead: match t.get("lead") {
-                None => worm::LEAD_ERROR,
-                Some(_) => tnum("lead")?,
-            },
+            form: v.tolerance("form")?,
+            thickness: v.tolerance("thickness")?,
+            diameter: v.tolerance("diameter")?,
+            position: v.tolerance("position")?,
+            flank_angle: v.tolerance("flank_angle_deg")?.to_radians(),
+            lead: v.lead()?,
         },
     )))
 }

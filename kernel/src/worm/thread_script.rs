@@ -4,7 +4,7 @@
 //! simulation, held to the standard's limits). Angles in degrees; lengths
 //! mm.
 
-use super::script::{cutter_of, plan_map};
+use super::script::{cutter_of, plan_map, VerifyMap};
 use crate::binding::floats::{kernel, number};
 use crate::binding::{ApiGroup, VerifyForm};
 use crate::family::Verification;
@@ -254,31 +254,20 @@ pub(crate) const SCRIPT_API: ApiGroup = ApiGroup {
 /// The thread's request from the map of a script's `fn verify(p)`: the
 /// section the cut aims at, held to the standard's limits.
 fn verification(m: &Map) -> Result<Verification, Option<String>> {
-    let num = |k: &str| m.get(k).and_then(number).ok_or(None);
-    let profile = m
-        .get("thread_profile")
-        .and_then(|w| w.clone().try_cast::<ThreadProfile>())
-        .ok_or(None)?;
-    let t = m
-        .get("tolerance")
-        .and_then(|t| t.clone().try_cast::<Map>())
-        .ok_or(None)?;
-    let tnum = |k: &str| {
-        t.get(k).and_then(number).ok_or_else(|| {
-            Some(format!(
-                "fn verify(p): tolerance.{k} must be a number (tolerance: form, position, flank_angle_deg, lead)"
-            ))
-        })
-    };
-    let section = profile.aimed();
+    let v = VerifyMap::<ThreadProfile>::read(
+        m,
+        "thread_profile",
+        "form, position, flank_angle_deg, lead",
+    )?;
+    let (profile, section) = (&v.part, v.part.aimed());
     Ok(Verification::new(worm::WormRequest {
         // The flanks are measured a twentieth of the depth inside the root
         // and the crest.
         flank_margin: 0.05 * section.depth(),
-        length: num("length")?,
-        space_centre: num("space_centre")?,
+        length: v.length,
+        space_centre: v.space_centre,
         tolerances: WormTolerances {
-            form: tnum("form")?,
+            form: v.tolerance("form")?,
             // The standard's limits hold the thickness (by the pitch
             // diameter) and the diameters: these are the halves of their
             // bands, for the record.
@@ -291,12 +280,9 @@ fn verification(m: &Map) -> Result<Verification, Option<String>> {
                     .root
                     .width()
                     .max(profile.limits.crest.width()),
-            position: tnum("position")?,
-            flank_angle: tnum("flank_angle_deg")?.to_radians(),
-            lead: match t.get("lead") {
-                None => worm::LEAD_ERROR,
-                Some(_) => tnum("lead")?,
-            },
+            position: v.tolerance("position")?,
+            flank_angle: v.tolerance("flank_angle_deg")?.to_radians(),
+            lead: v.lead()?,
         },
         limits: Some(profile.limits.clone()),
         part: "thread",
