@@ -83,7 +83,14 @@ fn the_default_jobs_are_clear_and_report_each_pairs_clearance() {
         // Every pair checked is clear, and the ones named are among them.
         assert!(all.len() >= pairs.len(), "{job}: {all:?}");
         for c in all {
-            assert!(c["clearance_mm"].as_f64().unwrap() > 0.0, "{job}: {c}");
+            let (d, floor) = (
+                c["clearance_mm"].as_f64().unwrap(),
+                c["at_least_mm"].as_f64().unwrap(),
+            );
+            assert!(d > 0.0, "{job}: {c}");
+            // The least the sweep allows is below the smallest found and,
+            // the default jobs being clear, above nothing.
+            assert!(floor > 0.0 && floor <= d, "{job}: {c}");
         }
         for (a, b) in pairs {
             let d = clearance(&r, a, b);
@@ -100,6 +107,7 @@ fn the_default_jobs_are_clear_and_report_each_pairs_clearance() {
             || named(c, "rest", "rest_arm")));
         let page = std::fs::read_to_string(out.join("report.html")).unwrap();
         assert!(page.contains("<h2>Clearances</h2>"), "{job}");
+        assert!(page.contains("<th>at least (mm)</th>"), "{job}");
     }
 }
 

@@ -251,10 +251,11 @@ fn clearances(out: &mut String, r: &Report) {
         return;
     };
     out.push_str(&format!(
-        "<h2>Clearances</h2>\n<p>Click a row to see its block. Every pair of bodies the program moves relative to each other, checked along every move ({} places; measured again before two bodies can close {:.0} % of the last distance or {} mm; the part as its envelope of revolution at its largest). The smallest clearance of each pair, nearest first:</p>\n<table id=\"clearances\"><tr><th>bodies</th><th>clearance (mm)</th><th>at block</th></tr>\n",
+        "<h2>Clearances</h2>\n<p>Click a row to see its block. Every pair of bodies the program moves relative to each other, checked along every move ({} places; measured again before two bodies can close {:.0} % of the last distance or {} mm; the part as its envelope of revolution at its largest). The smallest clearance of each pair, nearest first, sought again every {} mm of the two bodies' motion over the moves either side of where it was found; <i>at least</i> is the least the distance can have been anywhere between two measurements:</p>\n<table id=\"clearances\"><tr><th>bodies</th><th>clearance (mm)</th><th>at least (mm)</th><th>at block</th></tr>\n",
         c.samples,
         100.0 * crate::collision::REMEASURE,
-        c.step_mm
+        c.step_mm,
+        crate::collision::FINE
     ));
     let mut pairs: Vec<_> = c.clearances.iter().collect();
     pairs.sort_by(|a, b| a.clearance_mm.total_cmp(&b.clearance_mm));
@@ -265,6 +266,7 @@ fn clearances(out: &mut String, r: &Report) {
             &[
                 format!("{} / {}", escape(&p.bodies[0]), escape(&p.bodies[1])),
                 crate::math::fixed(p.clearance_mm, 3),
+                crate::math::fixed(p.at_least_mm, 3),
                 escape(&p.block),
             ],
         );
