@@ -11,6 +11,12 @@
 //! axial profile: flank angles and form, thickness at the pitch line,
 //! root and tip diameters, each start's position.
 //!
+//! An internal thread is cut as its external twin in rho = -r
+//! ([`WormRequest::mirrored`]): its space opens towards the axis, so in
+//! rho it opens outwards as an external thread's, and the results are
+//! turned back (diameters positive, the measurement over wires one between
+//! balls).
+//!
 //! The section is periodic along the axis with the lead: one lead is
 //! simulated, from the middle of the thread before start 0's space, the
 //! cutter placed with its copies one lead either side. What the model
@@ -59,8 +65,7 @@ pub const LEAD_ERROR: Real = 0.01;
 /// What the family asks the simulation to check.
 #[derive(Debug, Clone, PartialEq)]
 pub struct WormRequest {
-    /// The thread's section (external: an internal thread is not
-    /// simulated yet).
+    /// The thread's section, external or internal.
     pub section: ThreadSection,
     /// How far inside the root and the crest the flanks are measured (mm,
     /// beside the cutter's nose radius at the root).
@@ -97,6 +102,37 @@ impl WormRequest {
             tolerances,
             limits: None,
             part: "worm",
+        }
+    }
+}
+
+impl WormRequest {
+    /// An internal thread's external twin in rho = -r: the section's
+    /// diameters and the limits negated. An internal thread's space opens
+    /// inwards from its root (the major) to its crest (the bore); in rho
+    /// it opens outwards from the root's rho to the crest's, as an
+    /// external thread's does, its flanks along the axis unchanged. So
+    /// the simulation, written for external threads, cuts it as it is:
+    /// the cutter's tip at rho = -x reaching towards +rho (towards the
+    /// axis, where its body stands inside the bore).
+    fn mirrored(&self) -> Self {
+        let t = &self.section;
+        Self {
+            section: ThreadSection {
+                internal: false,
+                major: -t.major,
+                pitch_diameter: -t.pitch_diameter,
+                root_diameter: -t.root_diameter,
+                crest_diameter: -t.crest_diameter,
+                ..t.clone()
+            },
+            limits: self.limits.as_ref().map(|l| crate::thread::ThreadLimits {
+                pitch_diameter: mirrored_limits(&l.pitch_diameter),
+                crest: mirrored_limits(&l.crest),
+                root: mirrored_limits(&l.root),
+                source: l.source.clone(),
+            }),
+            ..self.clone()
         }
     }
 }
@@ -232,6 +268,10 @@ pub struct WormCheck {
     /// with that wire: [least, most] (mm).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub over_wires_limits: Option<[Real; 2]>,
+    /// An internal thread: its section's surface is the lowest material
+    /// (the nut's inside), the measurement over wires one between balls.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub internal: bool,
 }
 
 impl WormCheck {
@@ -381,12 +421,49 @@ impl WormCheck {
         (figures, self.failures.clone())
     }
 
-    /// The finished worm's radius at `z` in the section at part angle 0
-    /// (the section repeats with the lead): the highest material there.
+    /// The finished thread's radius at `z` in the section at part angle 0
+    /// (the section repeats with the lead): the highest material there,
+    /// an internal thread's lowest.
     pub fn radius_at(&self, z: Real) -> Real {
         let (w0, lead) = self.window;
         let z = w0 + (z - w0).rem_euclid(lead);
-        vertical_top(&self.section, z).unwrap_or(0.0)
+        let r = if self.internal {
+            vertical_top(&flipped(&self.section), z).map(|r| -r)
+        } else {
+            vertical_top(&self.section, z)
+        };
+        r.unwrap_or(0.0)
+    }
+
+    /// The check of an internal thread's external twin (simulated in rho =
+    /// -r, [`WormRequest::mirrored`]) turned back: radii and diameters
+    /// positive, the limits its own.
+    fn mirrored(mut self) -> Self {
+        for s in &mut self.starts {
+            s.root_diameter = -s.root_diameter;
+            s.tip_diameter = -s.tip_diameter;
+            s.pitch_diameter = -s.pitch_diameter;
+            s.over_wires = s.over_wires.map(|m| -m);
+        }
+        self.nominal.1 = -self.nominal.1;
+        self.nominal.2 = -self.nominal.2;
+        self.limits = self.limits.map(|l| crate::thread::ThreadLimits {
+            pitch_diameter: mirrored_limits(&l.pitch_diameter),
+            crest: mirrored_limits(&l.crest),
+            root: mirrored_limits(&l.root),
+            source: l.source,
+        });
+        self.over_wires_limits = self.over_wires_limits.map(|[a, b]| [-b, -a]);
+        for chip in &mut self.chips {
+            for ring in chip {
+                for p in ring {
+                    p[1] = -p[1];
+                }
+            }
+        }
+        self.section = flipped(&self.section);
+        self.internal = true;
+        self
     }
 
     /// The finished section's outline over one lead from `window.0`, as
@@ -406,6 +483,12 @@ impl WormCheck {
         zs.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
         zs.iter().map(|&z| [z, self.radius_at(z)]).collect()
     }
+}
+
+/// `m` mirrored across the axis (r to -r).
+fn flipped(m: &MultiPolygon<Real>) -> MultiPolygon<Real> {
+    use geo::MapCoords;
+    m.map_coords(|c| Coord { x: c.x, y: -c.y })
 }
 
 /// The section of a check read back from a report, which does not hold it.
@@ -526,22 +609,27 @@ pub fn simulate(
     cutter: &ThreadCutter,
     req: &WormRequest,
 ) -> Result<WormCheck, VerifyError> {
+    // An internal thread is simulated as its external twin in rho = -r
+    // (see `mirrored`), and its results turned back.
+    let inside = req.section.internal;
+    let twin;
+    let req = if inside {
+        twin = req.mirrored();
+        &twin
+    } else {
+        req
+    };
+    let rho = if inside { -1.0 } else { 1.0 };
     let w = &req.section;
     let tol = &req.tolerances;
     let fail = |m: String| VerifyError::Failed(m);
-    if w.internal {
-        return Err(fail(
-            "an internal thread's cut is not simulated yet: only external threads are verified"
-                .into(),
-        ));
-    }
     let (written, _) = as_written(program);
     let poses = replay(&written, machine, tool)?;
-    let at = |i: usize| (poses[6 * i], poses[6 * i + 2]);
+    let at = |i: usize| (rho * poses[6 * i], poses[6 * i + 2]);
     let lead = w.lead();
     let (px, z1) = (w.pitch, w.starts);
     let (r_a, r_f) = (w.crest_diameter / 2.0, w.root_diameter / 2.0);
-    let r_core = r_f - (2.0f64).min(r_f / 2.0);
+    let r_core = r_f - (2.0f64).min(r_f.abs() / 2.0);
     let c0 = req.space_centre;
     // The window starts in the middle of the crest before start 0's
     // space.
@@ -594,7 +682,7 @@ pub fn simulate(
                 if hi > -req.length - half && lo < half {
                     found(i, format!(
                         "{}: a move that is not a thread block crosses the blank (tip at diameter {:.3}, z from {:.3} to {:.3}; the worm runs from z = {:.3} to 0 at diameter {:.3})",
-                        name(), 2.0 * low, z0, z1e, -req.length, 2.0 * r_a
+                        name(), diameter(low), z0, z1e, -req.length, diameter(r_a)
                     ));
                 }
             }
@@ -606,8 +694,8 @@ pub fn simulate(
                 format!(
                     "{}: a thread block that changes X (from {:.4} to {:.4}) cuts a taper, not a worm",
                     name(),
-                    2.0 * r0,
-                    2.0 * r1
+                    diameter(r0),
+                    diameter(r1)
                 ),
             );
             continue;
@@ -701,11 +789,11 @@ pub fn simulate(
                 }
             }
         }
-        let x = x_axis.map(|k| b.values[k]).unwrap_or(2.0 * r1);
+        let x = x_axis.map(|k| b.values[k]).unwrap_or(diameter(r1));
         if gouge > tol.form {
             found(i, format!(
                 "{}: the cutter cuts {:.4} mm beyond the nominal thread space (at z = {:.3} in the section, diameter {:.3}; X{x:.3}, offset {offset:.4} mm from start {}'s space; tolerance {} mm)",
-                name(), gouge, worst[0], 2.0 * worst[1], start + 1, tol.form
+                name(), gouge, worst[0], diameter(worst[1]), start + 1, tol.form
             ));
         }
         // Where the cutting edges at the blank's radius meet the thread's
@@ -774,7 +862,7 @@ pub fn simulate(
     }
     let (starts, unmeasured) = measure(&material, req, cutter);
     failures.extend(unmeasured);
-    Ok(WormCheck {
+    let check = WormCheck {
         failures,
         nominal: (
             w.pitch - w.space_at_pitch,
@@ -804,7 +892,23 @@ pub fn simulate(
         chips,
         section: material,
         window: (w0, lead),
-    })
+        internal: false,
+    };
+    Ok(if inside { check.mirrored() } else { check })
+}
+
+/// A diameter of the section from a radius of the simulation's, which is
+/// negative for an internal thread's twin.
+fn diameter(r: Real) -> Real {
+    2.0 * r.abs()
+}
+
+/// A diameter's limits in rho = -r: negated, least first.
+fn mirrored_limits(l: &crate::thread::Limits) -> crate::thread::Limits {
+    crate::thread::Limits {
+        min: -l.max,
+        max: -l.min,
+    }
 }
 
 /// The worm's material for the process's rules ([`crate::process`]): the
@@ -814,6 +918,9 @@ pub fn simulate(
 /// block's chip, the last at each start finishing it.
 #[derive(Debug, Clone)]
 pub struct WormStock {
+    /// +1, or -1 for an internal thread: radii are taken as rho = -r, so
+    /// that the material lies below the crest as an external thread's.
+    rho: Real,
     tip_radius: Real,
     length: Real,
     /// The cutter's outline about its tip's centre, sampled every 0.1 mm.
@@ -852,8 +959,10 @@ impl WormStock {
                 finishes: last_of_start(k),
             })
             .collect();
+        let rho = req.section.opening();
         Self {
-            tip_radius: req.section.crest_diameter / 2.0,
+            rho,
+            tip_radius: rho * req.section.crest_diameter / 2.0,
             length: req.length,
             outline,
             passes,
@@ -863,7 +972,7 @@ impl WormStock {
 
 impl crate::process::Stock for WormStock {
     fn tool_depth(&self, _: usize, pose: &[Real]) -> Real {
-        let (z, r) = (pose[2], pose[0].hypot(pose[1]));
+        let (z, r) = (pose[2], self.rho * pose[0].hypot(pose[1]));
         // Into the blank, the outline's points over it; off it, the
         // nearest's distance.
         self.outline
@@ -974,7 +1083,7 @@ fn measure(
                 fail(format!(
                     "start {}: no space cut at diameter {:.3} (the thread's space is not there)",
                     k + 1,
-                    2.0 * r
+                    diameter(r)
                 ))
             })
         };
@@ -1067,7 +1176,7 @@ fn measure(
                 failures.push(fail(format!(
                     "start {s}, {flank} flank: {} {:.4} mm from the nominal flank at diameter {:.3} (tolerance {} mm)",
                     if form > 0.0 { "material left" } else { "cut too deep" },
-                    form.abs(), 2.0 * r, tol.form
+                    form.abs(), diameter(r), tol.form
                 )));
             }
         }
@@ -1095,7 +1204,9 @@ fn measure(
         ] {
             if req.limits.is_none() && (d - nominal).abs() > tol.diameter {
                 failures.push(fail(format!(
-                    "start {s}: {what} {d:.4} mm, nominal {nominal:.4} mm (tolerance {} mm)",
+                    "start {s}: {what} {:.4} mm, nominal {:.4} mm (tolerance {} mm)",
+                    d.abs(),
+                    nominal.abs(),
                     tol.diameter
                 )));
             }
@@ -1107,9 +1218,11 @@ fn measure(
                 ("crest diameter", p.tip_diameter, &l.crest),
             ] {
                 if !d.holds(v, 0.0) {
+                    let (lo, hi) = (d.min.abs().min(d.max.abs()), d.min.abs().max(d.max.abs()));
                     failures.push(fail(format!(
-                        "start {s}: {what} {v:.4} mm, outside {:.4} to {:.4} mm ({})",
-                        d.min, d.max, l.source
+                        "start {s}: {what} {:.4} mm, outside {lo:.4} to {hi:.4} mm ({})",
+                        v.abs(),
+                        l.source
                     )));
                 }
             }
@@ -1141,18 +1254,23 @@ mod tests {
         cut(&profile, aim, FlankOrder::Alternating)
     }
 
-    /// `profile` cut `aim` mm below its basic pitch diameter by a cutter of
-    /// its own flanks and root space, the roughing passes on `order`'s
-    /// flanks.
+    /// `profile` cut `aim` mm into the material from its basic pitch
+    /// diameter (an external thread's smaller, an internal's larger) by a
+    /// cutter of its own flanks and root space, the roughing passes on
+    /// `order`'s flanks: the tip towards the axis from above an external
+    /// thread, away from it from inside an internal thread's bore.
     fn cut(
         profile: &ThreadProfile,
         aim: Real,
         order: FlankOrder,
     ) -> Result<WormCheck, VerifyError> {
         // The blank turned to the middle of the crest's band.
+        let s = profile.section.opening();
         let t = &ThreadSection {
             crest_diameter: profile.limits.crest.middle(),
-            ..profile.section.aimed(profile.section.pitch_diameter - aim)
+            ..profile
+                .section
+                .aimed(profile.section.pitch_diameter - s * aim)
         };
         let cutter =
             ThreadCutter::new(t.root_space(), 0.15, t.flanks[0], t.flanks[1], 3.0).unwrap();
@@ -1178,9 +1296,9 @@ mod tests {
             keep: vec![],
             number: None,
         };
-        let clear = r_crest + 1.0;
+        let clear = r_crest + s;
         for p in &passes {
-            let r = r_crest - p.cumulative;
+            let r = r_crest - s * p.cumulative;
             let zs = c0 + p.offset;
             let ze = -length - 5.0;
             blocks.push(block(Motion::Rapid, clear, zs, 0.0));
@@ -1273,6 +1391,54 @@ mod tests {
         assert!(
             lo < m && m < hi && (hi - lo - 0.17).abs() < 1e-9,
             "{lo} {m} {hi}"
+        );
+    }
+
+    /// An internal M30x2 6H cut from inside its bore: its pitch diameter
+    /// measured from the cut as a gauge takes it (the simulation in rho =
+    /// -r, turned back), held to 6H's 28.701 to 28.925 mm; cut 0.05 mm
+    /// short of the basic it is refused naming the limit; the major (the
+    /// root) beyond its least, the minor (the bore) within its band; the
+    /// measurement between balls inside what 6H allows.
+    #[test]
+    fn an_internal_thread_is_cut_and_held_from_inside_its_bore() {
+        let nut = standards::metric(30.0, 2.0, true, "6H", 1, Hand::Right).unwrap();
+        let check = cut(&nut, 0.1, FlankOrder::Alternating).unwrap();
+        assert!(check.internal, "{:?}", check.failures);
+        assert!(!check.starts.is_empty(), "{:?}", check.failures);
+        let s = &check.starts[0];
+        assert!((s.pitch_diameter - 28.801).abs() < 2e-3, "{s:?}");
+        for a in [s.left_angle_deg, s.right_angle_deg] {
+            assert!((a - 30.0).abs() < 0.05, "{a}");
+        }
+        let l = check.limits.clone().unwrap();
+        assert!((l.pitch_diameter.min - 28.701).abs() < 1e-3, "{l:?}");
+        assert!((l.pitch_diameter.max - 28.925).abs() < 1e-3, "{l:?}");
+        assert!(s.root_diameter >= l.root.min, "{s:?} {l:?}");
+        assert!(l.crest.holds(s.tip_diameter, 1e-9), "{s:?} {l:?}");
+        // Between balls: the pitch diameter less the wires' reach.
+        let wire = check.wire.unwrap();
+        let m = s.over_wires.unwrap();
+        let want = nut.section.over_wires(wire, s.pitch_diameter).unwrap();
+        assert!(
+            (m - want).abs() < 1e-3 && m < s.pitch_diameter,
+            "M {m} vs {want}"
+        );
+        let [lo, hi] = check.over_wires_limits.unwrap();
+        assert!(lo < m && m < hi, "{lo} {m} {hi}");
+        // The section's surface is the nut's inside.
+        assert!(
+            (check.radius_at(check.window.0 + 0.25) - s.tip_diameter / 2.0).abs() < 0.05,
+            "{}",
+            check.radius_at(check.window.0 + 0.25)
+        );
+        let _ = check.clone().verified().unwrap();
+        let short = cut(&nut, -0.05, FlankOrder::Alternating).unwrap();
+        let e = short.verified().unwrap_err().to_string();
+        assert!(
+            e.contains("start 1: pitch diameter 28.65")
+                && e.contains("outside 28.7010 to 28.9250 mm (ISO 965-1 6H)"),
+            "{e}"
         );
     }
 
