@@ -3,7 +3,7 @@
 //! pass by pass, its figures held against the standards' dimensions and
 //! against a gauge's arithmetic done here.
 
-use crate::common::{self, pilgrim, s, scratch};
+use crate::common::{self, pilgrim, s, scratch, word};
 use std::path::PathBuf;
 
 const SCRIPT: &str = "scripts/thread.rhai";
@@ -261,4 +261,40 @@ fn bad_threads_are_refused_with_clear_errors() {
             "{set}"
         );
     }
+}
+
+/// The default M20 posted for LinuxCNC: every thread block a G33 with the
+/// pitch as its K, at the axis program's Z; left for `.ci/run`, where
+/// LinuxCNC's `rs274` reads it and its canonical moves are compared with
+/// the axis program (`.ci/rs274_check.py`).
+#[test]
+fn the_linuxcnc_program_is_left_for_its_interpreter() {
+    let out = run("linuxcnc", &["--post", "linuxcnc"]);
+    let ngc = std::fs::read_to_string(out.join("program.ngc")).unwrap();
+    assert!(ngc.starts_with("%\n") && ngc.contains(" G7\n"), "{ngc}");
+    let program: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("program.json")).unwrap()).unwrap();
+    let threads: Vec<&serde_json::Value> = program["blocks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|b| b["motion"]["type"] == "thread")
+        .collect();
+    let g33: Vec<&str> = ngc.lines().filter(|l| l.contains(" G33 ")).collect();
+    assert!(
+        !threads.is_empty() && g33.len() == threads.len(),
+        "{} vs {}",
+        g33.len(),
+        threads.len()
+    );
+    for (line, b) in g33.iter().zip(&threads) {
+        assert_eq!(word(line, 'K'), Some(2.5), "{line}");
+        let z = b["values"][1].as_f64().unwrap();
+        assert_eq!(
+            word(line, 'Z'),
+            Some((z * 1000.0).round() / 1000.0),
+            "{line}"
+        );
+    }
+    common::leave_for_rs274(&out, "thread");
 }

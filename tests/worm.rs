@@ -6,7 +6,7 @@
 
 use crate::common;
 
-use common::{pilgrim, s, scratch};
+use common::{pilgrim, s, scratch, word};
 use pilgrim_kernel::plugin::PluginMachine;
 use pilgrim_kernel::program::{AxisProgram, Block, ProgramAxis};
 use pilgrim_kernel::step::Sections;
@@ -41,13 +41,6 @@ fn run_worm(name: &str, args: &[&str]) -> (PathBuf, PathBuf) {
 
 fn report(dir: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap()
-}
-
-/// The value of address `a` in a block's words (`X12.5`).
-fn word(code: &str, a: char) -> Option<f64> {
-    code.split_whitespace()
-        .find(|w| w.starts_with(a) && w[1..].parse::<f64>().is_ok())
-        .map(|w| w[1..].parse().unwrap())
 }
 
 /// A Fanuc program (`program.nc`) read as the control reads it, from the

@@ -610,3 +610,10 @@ impl Playback {
 }
 
 use std::f64::consts::{PI, TAU};
+
+/// The value of address `a` in a block's words (`X12.5`).
+pub fn word(code: &str, a: char) -> Option<f64> {
+    code.split_whitespace()
+        .find(|w| w.starts_with(a) && w[1..].parse::<f64>().is_ok())
+        .map(|w| w[1..].parse().unwrap())
+}
