@@ -9,7 +9,8 @@
 //!   (lower case) or internal (upper case); none: 6g or 6H.
 //! - trapezoidal: `Tr<d>x<lead>[(P<pitch>)]`, its limits stated (ISO
 //!   2903's classes are not offered).
-//! - ACME: `<D>-<tpi> ACME-<n>G`, `D` in inches, decimal or a fraction.
+//! - ACME: `<D>-<tpi> ACME-<n>G`, `D` in inches, decimal or a fraction;
+//!   more starts as ASME writes them, `<D>-<pitch>P-<lead>L ACME-<n>G`.
 //! - buttress: `<D>-<tpi> BUTT [7/45]`, ASME B1.9's form, limits stated.
 //! - a trailing `LH` makes it left-handed (`RH`, the default, may be
 //!   written).
@@ -151,12 +152,27 @@ pub fn designated(text: &str, drawing: &Drawing) -> Result<ThreadProfile, InputE
             let (pitch, starts) = lead_pitch(lp)?;
             standards::trapezoidal(num(d, "diameter")?, pitch, internal, starts, hand, drawing.stated)
         }
-        [d, tpi, acme, class] if *acme == "ACME" => {
+        [d, size @ .., acme, class] if *acme == "ACME" && (1..=2).contains(&size.len()) => {
             let grade = class
                 .strip_suffix('G')
                 .and_then(|g| g.parse::<u32>().ok())
                 .ok_or_else(|| bad(&format!("ACME class '{class}' is not <n>G, as 2G")))?;
-            standards::acme(num(d, "diameter")?, num(tpi, "threads per inch")?, internal, grade, 1, hand)
+            // `<tpi>`, or ASME's multiple-start `<pitch>P-<lead>L` (inches).
+            let (tpi, starts) = match size {
+                [tpi] => (num(tpi, "threads per inch")?, 1),
+                [p, l] => {
+                    let inches = |w: &str, end: char, what: &str| {
+                        w.strip_suffix(end)
+                            .ok_or_else(|| bad(&format!("'{w}' is not the {what} as <inches>{end}")))
+                            .and_then(|v| num(v, what))
+                    };
+                    let (pitch, lead) = (inches(p, 'P', "pitch")?, inches(l, 'L', "lead")?);
+                    let (_, starts) = lead_pitch(&format!("{lead}(P{pitch})"))?;
+                    (1.0 / pitch, starts)
+                }
+                _ => return Err(bad("an ACME size is <tpi> or <pitch>P-<lead>L")),
+            };
+            standards::acme(num(d, "diameter")?, tpi, internal, grade, starts, hand)
         }
         [d, tpi, butt, form @ ..] if *butt == "BUTT" && (form.is_empty() || form == ["7/45"]) => {
             standards::buttress(
@@ -170,7 +186,7 @@ pub fn designated(text: &str, drawing: &Drawing) -> Result<ThreadProfile, InputE
             )
         }
         _ => Err(bad(
-            "not a form pilgrim reads: M20x2.5-6g, M30x2-6H, Tr40x7, Tr40x14(P7), 1-5 ACME-2G, 2-8 BUTT 7/45 (LH at the end for a left hand)",
+            "not a form pilgrim reads: M20x2.5-6g, M30x2-6H, Tr40x7, Tr40x14(P7), 1-5 ACME-2G, 1-0.2P-0.4L ACME-2G, 2-8 BUTT 7/45 (LH at the end for a left hand)",
         )),
     }
     .map_err(|e| match e {
@@ -215,6 +231,14 @@ mod tests {
         let two = read("M20x5(P2.5)-6g-LH");
         assert_eq!((two.section.starts, two.section.hand), (2, Hand::Left));
         assert_eq!(two.section.lead(), 5.0);
+        // Reported as it was read: the lead with its pitch, the hand.
+        assert_eq!(two.designation, "M20x5(P2.5)-6g-LH");
+        assert_eq!(read("Tr40x14(P7)").designation, "Tr40x14(P7)");
+        assert_eq!(read("Tr40x7 LH").designation, "Tr40x7-LH");
+        assert_eq!(read("1-5 ACME-2G-LH").designation, "1-5 ACME-2G-LH");
+        let two_start = standards::acme(1.0, 5.0, false, 2, 2, Hand::Right).unwrap();
+        assert_eq!(two_start.designation, "1-0.2P-0.4L ACME-2G");
+        assert_eq!(read("1-0.2P-0.4L ACME-2G"), two_start);
         assert_eq!(
             read("Tr40x7"),
             standards::trapezoidal(40.0, 7.0, false, 1, Hand::Right, s).unwrap()

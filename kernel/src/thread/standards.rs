@@ -203,13 +203,13 @@ pub fn metric(
             source: format!("ISO 965-1 {class}"),
         }
     };
-    let fine = if (pitch - coarse_pitch(d)).abs() < 1e-9 {
+    let fine = if starts == 1 && (pitch - coarse_pitch(d)).abs() < 1e-9 {
         format!("M{}", number(d))
     } else {
-        format!("M{}x{}", number(d), number(pitch))
+        format!("M{}x{}", number(d), lead_and_pitch(pitch, starts))
     };
     Ok(ThreadProfile {
-        designation: format!("{fine}-{class}"),
+        designation: format!("{fine}-{class}{}", hand_suffix(hand)),
         standard: "ISO 68-1, ISO 965-1".into(),
         section: ThreadSection {
             internal,
@@ -256,6 +256,38 @@ pub(crate) fn coarse_pitch(d: Real) -> Real {
 }
 
 /// A size as a designation writes it: no trailing zeros.
+/// A designation's size after the `x`: the pitch, or for more starts the
+/// lead with the pitch, as ISO writes it (`14(P7)`).
+fn lead_and_pitch(pitch: Real, starts: u32) -> String {
+    if starts == 1 {
+        number(pitch)
+    } else {
+        format!("{}(P{})", number(Real::from(starts) * pitch), number(pitch))
+    }
+}
+
+/// `-LH` for a left hand (ISO's and ASME's suffix), nothing for a right.
+fn hand_suffix(hand: Hand) -> &'static str {
+    match hand {
+        Hand::Left => "-LH",
+        Hand::Right => "",
+    }
+}
+
+/// An inch thread's size after its diameter: threads per inch, or for
+/// more starts ASME's pitch and lead in inches (`0.2P-0.4L`).
+fn inch_lead(tpi: Real, starts: u32) -> String {
+    if starts == 1 {
+        number(tpi)
+    } else {
+        format!(
+            "{}P-{}L",
+            number(1.0 / tpi),
+            number(Real::from(starts) / tpi)
+        )
+    }
+}
+
 pub(crate) fn number(v: Real) -> String {
     let s = format!("{v:.4}");
     s.trim_end_matches('0').trim_end_matches('.').to_owned()
@@ -346,7 +378,12 @@ pub fn trapezoidal(
         (d - 2.0 * h3, d)
     };
     Ok(ThreadProfile {
-        designation: format!("Tr{}x{}", number(d), number(pitch)),
+        designation: format!(
+            "Tr{}x{}{}",
+            number(d),
+            lead_and_pitch(pitch, starts),
+            hand_suffix(hand)
+        ),
         standard: "ISO 2904".into(),
         section: ThreadSection {
             internal,
@@ -427,7 +464,12 @@ pub fn acme(
         max: b * INCH,
     };
     Ok(ThreadProfile {
-        designation: format!("{}-{} ACME-{grade}G", number(d_in), number(tpi)),
+        designation: format!(
+            "{}-{} ACME-{grade}G{}",
+            number(d_in),
+            inch_lead(tpi, starts),
+            hand_suffix(hand)
+        ),
         standard: "ASME B1.5".into(),
         section: ThreadSection {
             internal,
@@ -499,7 +541,12 @@ pub fn buttress(
         LoadFlank::AwayFromChuck => [seven, fortyfive],
     };
     Ok(ThreadProfile {
-        designation: format!("{}-{} BUTT 7/45", number(d_in), number(tpi)),
+        designation: format!(
+            "{}-{} BUTT 7/45{}",
+            number(d_in),
+            inch_lead(tpi, starts),
+            hand_suffix(hand)
+        ),
         standard: "ASME B1.9".into(),
         section: ThreadSection {
             internal,
