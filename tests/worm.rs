@@ -223,7 +223,7 @@ fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
     // The finished worm's solid: closed, and its volume the section's swept
     // along the helix, pi b1 / L * integral of r(u)^2 over a lead (for any
     // length: every section across the axis meets a whole lead of it).
-    let solid = pilgrim_kernel::worm::worm_solid(&check, 60.0, 0.01).unwrap();
+    let solid = pilgrim_kernel::worm::worm_solid(&check, 60.0, 0.01, None).unwrap();
     solid.check_closed().unwrap();
     // Every vertex between the root's and the tip's circles (the axis's
     // points of the flat ends aside).

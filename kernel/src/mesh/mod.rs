@@ -24,7 +24,7 @@ pub use gltf_writer::{write_glb, write_gltf};
 pub use revolve::{body_of_revolution, cylinder, revolve, wheel};
 pub use scene::{frame_from_pose, Motion, Node, Scene, Spin, MAX_SPIN_STEP};
 pub use stl_writer::{read_stl, read_stl_bytes, write_stl, StlFormat};
-pub use sweep::sweep;
+pub use sweep::{sweep, sweep_hollow};
 
 use crate::math::{Mat4, Real};
 use std::collections::HashMap;

@@ -26,6 +26,44 @@ use crate::math::Real;
 /// assert!((m.volume() - 10.0).abs() < 1e-12);
 /// ```
 pub fn sweep(rings: &[Vec<[Real; 3]>]) -> Result<TriMesh, MeshError> {
+    swept(rings, None)
+}
+
+/// The solid between two sequences of closed sections, `outer` and the
+/// hole `inner` inside it (a nut: its outside, its thread), as [`sweep`]
+/// makes one: each sequence's sides, and flat caps with the hole in them
+/// (ear clipping with a hole). The two sequences have as many rings, ring
+/// `j` of each in one plane, the hole's rings wound as the outside's.
+///
+/// # Failures
+/// As [`sweep`]'s, for either sequence; sequences of different lengths.
+///
+/// ```
+/// use pilgrim_kernel::mesh::sweep_hollow;
+/// // A square tube: 2 mm square outside, a 1 mm square hole, 10 mm long.
+/// let ring = |z: f64, a: f64, b: f64| vec![[a, a, z], [b, a, z], [b, b, z], [a, b, z]];
+/// let outer = [ring(0.0, 0.0, 2.0), ring(10.0, 0.0, 2.0)];
+/// let inner = [ring(0.0, 0.5, 1.5), ring(10.0, 0.5, 1.5)];
+/// let m = sweep_hollow(&outer, &inner).unwrap();
+/// m.check_closed().unwrap();
+/// assert!((m.volume() - 30.0).abs() < 1e-9);
+/// ```
+pub fn sweep_hollow(
+    outer: &[Vec<[Real; 3]>],
+    inner: &[Vec<[Real; 3]>],
+) -> Result<TriMesh, MeshError> {
+    if inner.len() != outer.len() {
+        return Err(MeshError::Degenerate(format!(
+            "the hole has {} sections, the outside {}",
+            inner.len(),
+            outer.len()
+        )));
+    }
+    swept(outer, Some(inner))
+}
+
+/// The rings checked: at least 2, of the same size (at least 3), finite.
+fn check_rings(rings: &[Vec<[Real; 3]>]) -> Result<usize, MeshError> {
     if rings.len() < 2 {
         return Err(MeshError::Degenerate(format!(
             "a sweep needs at least 2 sections, got {}",
@@ -51,17 +89,35 @@ pub fn sweep(rings: &[Vec<[Real; 3]>]) -> Result<TriMesh, MeshError> {
             }
         }
     }
+    Ok(m)
+}
+
+/// [`sweep`], with a hole through it where `holes` are given.
+fn swept(rings: &[Vec<[Real; 3]>], holes: Option<&[Vec<[Real; 3]>]>) -> Result<TriMesh, MeshError> {
+    let m = check_rings(rings)?;
+    let h = holes.map(check_rings).transpose()?.unwrap_or(0);
     let mut mesh = TriMesh::default();
-    for r in rings {
-        mesh.positions.extend_from_slice(r);
-    }
-    let m32 = m as u32;
-    for j in 0..rings.len() as u32 - 1 {
-        let (a, b) = (j * m32, (j + 1) * m32);
-        for k in 0..m32 {
-            let k1 = (k + 1) % m32;
-            mesh.triangles.push([a + k, b + k, b + k1]);
-            mesh.triangles.push([a + k, b + k1, a + k1]);
+    // The sides: the outside's, then the hole's wound the other way (its
+    // faces look into the hole).
+    for (sequence, reversed) in [(rings, false), (holes.unwrap_or(&[]), true)] {
+        let base = mesh.positions.len() as u32;
+        for r in sequence {
+            mesh.positions.extend_from_slice(r);
+        }
+        let m32 = sequence.first().map_or(0, Vec::len) as u32;
+        for j in 0..(sequence.len() as u32).saturating_sub(1) {
+            let (a, b) = (base + j * m32, base + (j + 1) * m32);
+            for k in 0..m32 {
+                let k1 = (k + 1) % m32;
+                let (t1, t2) = ([a + k, b + k, b + k1], [a + k, b + k1, a + k1]);
+                if reversed {
+                    mesh.triangles.push([t1[0], t1[2], t1[1]]);
+                    mesh.triangles.push([t2[0], t2[2], t2[1]]);
+                } else {
+                    mesh.triangles.push(t1);
+                    mesh.triangles.push(t2);
+                }
+            }
         }
     }
     let side_count = mesh.triangles.len();
@@ -69,7 +125,12 @@ pub fn sweep(rings: &[Vec<[Real; 3]>]) -> Result<TriMesh, MeshError> {
     // triangulated in its plane, the triangles wound as the ring (the
     // first cap) or against it (the last), as the sides are.
     for (j, first) in [(0, true), (rings.len() - 1, false)] {
-        let r = &rings[j];
+        // The section, its hole's points after its own.
+        let r: Vec<[Real; 3]> = rings[j]
+            .iter()
+            .chain(holes.map_or(&[][..], |hs| &hs[j][..]))
+            .copied()
+            .collect();
         // The ring's plane: Newell's normal, and two axes in it.
         let mut n = [0.0; 3];
         for k in 0..m {
@@ -99,21 +160,35 @@ pub fn sweep(rings: &[Vec<[Real; 3]>]) -> Result<TriMesh, MeshError> {
                 [dot(d, u), dot(d, v)]
             })
             .collect();
-        let tris = earcutr::earcut(&flat, &[], 2).map_err(|e| {
+        let hole_starts: &[usize] = if h > 0 { &[m] } else { &[] };
+        let tris = earcutr::earcut(&flat, hole_starts, 2).map_err(|e| {
             MeshError::Degenerate(format!("section {j} cannot be triangulated: {e:?}"))
         })?;
-        // A simple polygon's triangles cover exactly its area.
+        // A simple polygon's triangles cover exactly its area (less its
+        // hole's).
+        let hole_area2 = if h > 0 {
+            let mut a = 0.0;
+            for k in 0..h {
+                let (p, q) = (r[m + k], r[m + (k + 1) % h]);
+                a += dot(cross(p, q), n);
+            }
+            a.abs()
+        } else {
+            0.0
+        };
         let covered: Real = tris
             .chunks_exact(3)
             .map(|t| dot(cross(sub(r[t[1]], r[t[0]]), sub(r[t[2]], r[t[0]])), n).abs())
             .sum();
-        if tris.len() != 3 * (m - 2) || (covered - area2).abs() > 1e-9 * area2 {
+        let want = area2 - hole_area2;
+        let count = if h > 0 { m + h } else { m - 2 };
+        if tris.len() != 3 * count || (covered - want).abs() > 1e-9 * area2 {
             return Err(MeshError::Degenerate(format!(
                 "section {j} is not a simple polygon: its cap cannot be made"
             )));
         }
         let base = mesh.positions.len() as u32;
-        mesh.positions.extend_from_slice(r);
+        mesh.positions.extend_from_slice(&r);
         for t in tris.chunks_exact(3) {
             let (a, b, c) = (t[0], t[1], t[2]);
             let along = dot(cross(sub(r[b], r[a]), sub(r[c], r[a])), n) > 0.0;

@@ -83,6 +83,9 @@ pub struct WormRequest {
     pub limits: Option<crate::thread::ThreadLimits>,
     /// The finished part's name: its solid's files (`worm.stl`).
     pub part: &'static str,
+    /// An internal thread's part, a nut: its outside diameter (mm). `None`
+    /// for an external thread, whose part is solid to its axis.
+    pub outside_diameter: Option<Real>,
 }
 
 impl WormRequest {
@@ -102,6 +105,7 @@ impl WormRequest {
             tolerances,
             limits: None,
             part: "worm",
+            outside_diameter: None,
         }
     }
 }
@@ -922,6 +926,9 @@ pub struct WormStock {
     /// that the material lies below the crest as an external thread's.
     rho: Real,
     tip_radius: Real,
+    /// The material's far side in rho: a nut's outside (none: the axis,
+    /// which no tool reaches).
+    far: Real,
     length: Real,
     /// The cutter's outline about its tip's centre, sampled every 0.1 mm.
     outline: Vec<[Real; 2]>,
@@ -963,6 +970,10 @@ impl WormStock {
         Self {
             rho,
             tip_radius: rho * req.section.crest_diameter / 2.0,
+            far: req
+                .outside_diameter
+                .filter(|_| req.section.internal)
+                .map_or(Real::NEG_INFINITY, |d| -d / 2.0),
             length: req.length,
             outline,
             passes,
@@ -980,7 +991,8 @@ impl crate::process::Stock for WormStock {
             .map(|p| {
                 let (pz, pr) = (z + p[0], r + p[1]);
                 let dz = (pz - 0.0).max(-self.length - pz).max(0.0);
-                let dr = pr - self.tip_radius;
+                // Beyond the crest, or beyond a nut's outside.
+                let dr = (pr - self.tip_radius).max(self.far - pr);
                 if dz == 0.0 {
                     -dr
                 } else {
@@ -1347,6 +1359,7 @@ mod tests {
             },
             limits: Some(profile.limits.clone()),
             part: "thread",
+            outside_diameter: None,
         };
         simulate(&program, &lathe, &Default::default(), &cutter, &req)
     }
@@ -1433,6 +1446,24 @@ mod tests {
             check.radius_at(check.window.0 + 0.25)
         );
         let _ = check.clone().verified().unwrap();
+        // Its part: a nut of 45 mm round the thread, closed, its volume
+        // between the cylinders' at its root and at its crest.
+        let solid = crate::worm::worm_solid(&check, 30.0, 0.01, Some(45.0)).unwrap();
+        solid.check_closed().unwrap();
+        let tube = |r: Real| std::f64::consts::PI * (22.5f64.powi(2) - r * r) * 30.0;
+        let v = solid.volume();
+        assert!(
+            tube(s.root_diameter / 2.0) < v && v < tube(s.tip_diameter / 2.0),
+            "{} < {v} < {}",
+            tube(s.root_diameter / 2.0),
+            tube(s.tip_diameter / 2.0)
+        );
+        let (lo, hi) = solid.bounds();
+        assert!(
+            (hi[0] - 22.5).abs() < 1e-9 && (lo[2] + 30.0).abs() < 1e-9,
+            "{lo:?} {hi:?}"
+        );
+        assert!(crate::worm::worm_solid(&check, 30.0, 0.01, Some(28.0)).is_err());
         let short = cut(&nut, -0.05, FlankOrder::Alternating).unwrap();
         let e = short.verified().unwrap_err().to_string();
         assert!(

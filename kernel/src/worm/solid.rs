@@ -10,6 +10,9 @@
 //! helices (within a small fraction of the spacing) and the profile is
 //! sampled every `lead / n` along them; `n` is set by the chordal
 //! tolerance at the tip.
+//!
+//! An internal thread's part is a nut: the same helical surface as the
+//! hole through a cylinder of its outside diameter.
 
 use super::WormCheck;
 use crate::math::Real;
@@ -20,18 +23,38 @@ use std::f64::consts::TAU;
 pub const MAX_AROUND: usize = 2048;
 
 /// The worm of `check`'s finished section, `length` long, its round
-/// sampling within `tol` of the tip circle (at least 24 points).
+/// sampling within `tol` of the tip circle (at least 24 points); for an
+/// internal thread, the nut round it, `outside` its outside diameter.
 ///
 /// # Failures
-/// A length or tolerance not positive; a mesh that cannot be closed.
-pub fn worm_solid(check: &WormCheck, length: Real, tol: Real) -> Result<TriMesh, MeshError> {
+/// A length or tolerance not positive; an internal thread without an
+/// outside diameter beyond its thread; a mesh that cannot be closed.
+pub fn worm_solid(
+    check: &WormCheck,
+    length: Real,
+    tol: Real,
+    outside: Option<Real>,
+) -> Result<TriMesh, MeshError> {
     crate::math::positive("worm length", length)
         .map_err(|e| MeshError::Degenerate(e.to_string()))?;
     crate::math::positive("mesh tolerance", tol)
         .map_err(|e| MeshError::Degenerate(e.to_string()))?;
     let (w0, lead) = check.window;
     let outline = check.outline();
-    let r_tip = outline.iter().map(|p| p[1]).fold(0.0, Real::max);
+    let r_thread = outline.iter().map(|p| p[1]).fold(0.0, Real::max);
+    let nut = match (check.internal, outside) {
+        (false, _) => None,
+        (true, Some(d)) if d / 2.0 > r_thread => Some(d / 2.0),
+        (true, d) => {
+            return Err(MeshError::Degenerate(format!(
+                "the nut's outside diameter {} is not beyond its thread's {:.3} mm",
+                d.map_or("(none given)".to_owned(), |d| format!("{d} mm")),
+                2.0 * r_thread
+            )))
+        }
+    };
+    // The chordal tolerance holds on the largest circle.
+    let r_tip = nut.unwrap_or(r_thread);
     // The outline between its corners, repeated with the lead.
     let radius = |z: Real| -> Real {
         let u = w0 + (z - w0).rem_euclid(lead);
@@ -72,7 +95,23 @@ pub fn worm_solid(check: &WormCheck, length: Real, tol: Real) -> Result<TriMesh,
                 .collect()
         })
         .collect();
-    sweep(&rings)
+    match nut {
+        None => sweep(&rings),
+        Some(r) => {
+            let outside: Vec<Vec<[Real; 3]>> = zs
+                .iter()
+                .map(|&z| {
+                    (0..n)
+                        .map(|k| {
+                            let phi = TAU * k as Real / n as Real;
+                            [r * phi.cos(), r * phi.sin(), z]
+                        })
+                        .collect()
+                })
+                .collect();
+            crate::mesh::sweep_hollow(&outside, &rings)
+        }
+    }
 }
 
 /// The finished worm exactly, for STEP: the section `outline` (`(z, r)`

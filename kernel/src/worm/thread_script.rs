@@ -286,6 +286,8 @@ fn verification(m: &Map) -> Result<Verification, Option<String>> {
         },
         limits: Some(profile.limits.clone()),
         part: "thread",
+        // A nut's outside, where the script gives it.
+        outside_diameter: m.get("outside_diameter").and_then(number),
         section,
     }))
 }
