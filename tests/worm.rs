@@ -253,7 +253,7 @@ fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
         worst_mesh < 1e-3,
         "worm.stl strays {worst_mesh} mm from the helix"
     );
-    let sweep = pilgrim_kernel::worm::WormSweep::new(&check, 60.0, 2.5e-4).unwrap();
+    let sweep = pilgrim_kernel::worm::WormSweep::new(&check, 60.0, 2.5e-4, None).unwrap();
     let mut worst_sweep: f64 = 0.0;
     for k in 0..sweep.pieces() {
         for (u, v) in [(0.0, 0.0), (0.37, 0.5), (0.81, 0.93)] {

@@ -56,6 +56,14 @@ pub trait Sections {
     fn ends_along_z(&self) -> bool {
         false
     }
+    /// A hollow body's outside: the solid is then the space between a
+    /// cylinder of this radius about Z, from the first section's plane to
+    /// the last's (each square to Z), and the sections, which bound its
+    /// hole (a nut round its thread). `None` (the default): the sections
+    /// bound the solid.
+    fn outside(&self) -> Option<Real> {
+        None
+    }
 }
 
 /// What fitting a swept solid found.
@@ -566,25 +574,94 @@ pub fn swept_step(
     }
     let start: Wire = first.iter().rev().map(Edge::inverse).collect();
     let end: Wire = last.iter().cloned().collect();
-    for (which, wire) in [("first", start), ("last", end)] {
-        faces.push(
-            truck_modeling::builder::try_attach_plane(&[wire])
-                .map_err(|e| bad(format!("the {which} section is not a plane face: {e}")))?,
-        );
-    }
-    if signed < 0.0 {
-        faces = faces.iter().map(Face::inverse).collect();
-    }
-    let solid = truck_modeling::Solid::try_new(vec![Shell::from(faces)])
-        .map_err(|e| bad(format!("the faces do not close a solid: {e}")))?;
+    let (solid, volume) =
+        match body.outside() {
+            None => {
+                for (which, wire) in [("first", start), ("last", end)] {
+                    faces.push(truck_modeling::builder::try_attach_plane(&[wire]).map_err(
+                        |e| bad(format!("the {which} section is not a plane face: {e}")),
+                    )?);
+                }
+                if signed < 0.0 {
+                    faces = faces.iter().map(Face::inverse).collect();
+                }
+                let solid = truck_modeling::Solid::try_new(vec![Shell::from(faces)])
+                    .map_err(|e| bad(format!("the faces do not close a solid: {e}")))?;
+                (solid, signed.abs())
+            }
+            Some(radius) => {
+                // The sections' faces look into the hole; the caps are rings
+                // between the cylinder's circles and the sections' ends.
+                let (z0, z1) = (ps[0].ctrl[0][0][2], ps[0].ctrl[0][along - 1][2]);
+                let (mut start, mut end) = (start, end);
+                if signed >= 0.0 {
+                    faces = faces.iter().map(Face::inverse).collect();
+                    start = start.inverse();
+                    end = end.inverse();
+                }
+                let solid = hollow(faces, [start, end], radius, [z0, z1])
+                    .map_err(|e| bad(format!("the nut's faces do not close a solid: {e}")))?;
+                let outside = std::f64::consts::PI * radius * radius * (z1 - z0).abs();
+                (solid, outside - signed.abs())
+            }
+        };
     let text = write(name, what, &solid, &crate::math::Mat4::identity())?;
     Ok(SweptFit {
         text,
-        volume: signed.abs(),
+        volume,
         deviation,
         faces: n,
         along,
     })
+}
+
+/// The solid between a cylinder of `radius` about Z from `z[0]` to `z[1]`
+/// and the hole the `inner` faces bound, whose end wires are `ends` (each
+/// running as the ring's cap uses it): the cylinder, and the caps as
+/// planes with the hole in them. The cylinder is swept from a line, which
+/// way its faces look found by which closes the shell.
+fn hollow(
+    inner: Vec<Face>,
+    ends: [Wire; 2],
+    radius: Real,
+    z: [Real; 2],
+) -> Result<truck_modeling::Solid, String> {
+    use truck_modeling::{builder, Point3, Rad, Vector3};
+    let a = builder::vertex(Point3::new(radius, 0.0, z[0]));
+    let b = builder::vertex(Point3::new(radius, 0.0, z[1]));
+    let cylinder = builder::rsweep(
+        &builder::line(&a, &b),
+        Point3::new(0.0, 0.0, 0.0),
+        Vector3::unit_z(),
+        Rad(std::f64::consts::TAU),
+    );
+    let mut last = String::new();
+    for outward in [
+        cylinder.clone(),
+        cylinder.iter().map(Face::inverse).collect(),
+    ] {
+        let mut circles = outward.extract_boundaries();
+        let key = |w: &Wire| w.front_vertex().map_or(0.0, |v| (v.point().z - z[0]).abs());
+        circles.sort_by(|p, q| key(p).total_cmp(&key(q)));
+        let mut faces: Vec<Face> = inner.clone();
+        faces.extend(outward.iter().cloned());
+        let caps: Result<Vec<Face>, String> = circles
+            .iter()
+            .zip(&ends)
+            .map(|(circle, hole)| {
+                builder::try_attach_plane(&[circle.inverse(), hole.clone()])
+                    .map_err(|e| e.to_string())
+            })
+            .collect();
+        match caps.and_then(|caps| {
+            faces.extend(caps);
+            truck_modeling::Solid::try_new(vec![Shell::from(faces)]).map_err(|e| e.to_string())
+        }) {
+            Ok(solid) => return Ok(solid),
+            Err(e) => last = e,
+        }
+    }
+    Err(last)
 }
 
 #[cfg(test)]
@@ -593,6 +670,41 @@ mod tests {
     use crate::assert_near;
     use std::f64::consts::{PI, TAU};
     use truck_modeling::ParametricSurface;
+
+    /// A twisted bore of radius 5 from z = -10 to 0 (its four quarters
+    /// turning a quarter turn along it) through a cylinder of radius 10.
+    struct Bore;
+    impl Sections for Bore {
+        fn pieces(&self) -> usize {
+            4
+        }
+        fn straight(&self, _: usize) -> bool {
+            false
+        }
+        fn point(&self, k: usize, u: Real, v: Real) -> [Real; 3] {
+            let t = (k as Real + u) * TAU / 4.0 + v * TAU / 4.0;
+            [5.0 * t.cos(), 5.0 * t.sin(), -10.0 + 10.0 * v]
+        }
+        fn along(&self) -> usize {
+            8
+        }
+        fn outside(&self) -> Option<Real> {
+            Some(10.0)
+        }
+    }
+
+    /// A hollow body: the faces close one solid (the cylinder's, the
+    /// bore's and two rings), its volume the tube's.
+    #[test]
+    fn a_hollow_body_is_a_tube_round_its_sections() {
+        let fit = swept_step("bore", "a tube", &Bore, 1e-3).unwrap();
+        assert_near!(fit.volume, PI * (100.0 - 25.0) * 10.0, 0.5);
+        assert!(
+            fit.text.contains("MANIFOLD_SOLID_BREP"),
+            "{}",
+            &fit.text[..400]
+        );
+    }
 
     /// An annular sector: hub 50, rim 100, 20 wide, over 0.3 to 2.5 rad;
     /// the rim's outer piece bulges as a cosine across (not straight).

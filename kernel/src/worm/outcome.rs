@@ -91,17 +91,15 @@ impl Outcome for WormOutcome {
         let (w, length) = (&self.check, self.request.length);
         let mesh = worm_solid(w, length, mesh_tolerance, self.request.outside_diameter)
             .map_err(mesh_error)?;
-        if w.internal {
-            // The helical sweep below is the thread's own surface closed to
-            // the axis: a bolt, not the nut. Refused rather than written.
-            return Err(SceneError::Place(format!(
-                "the {}'s STEP solid: a nut's (an internal thread's) is not built yet; its mesh is",
-                self.request.part
-            )));
-        }
         // A quarter of the STEP tolerance for merging the outline's points,
         // the rest for the fit.
-        let body = WormSweep::new(w, length, step_tolerance / 4.0).map_err(mesh_error)?;
+        let body = WormSweep::new(
+            w,
+            length,
+            step_tolerance / 4.0,
+            self.request.outside_diameter,
+        )
+        .map_err(mesh_error)?;
         Ok(vec![PartBody {
             name: self.request.part.into(),
             geometry: PartGeometry::Swept(Box::new(Swept {

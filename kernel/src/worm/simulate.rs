@@ -1464,6 +1464,15 @@ mod tests {
             "{lo:?} {hi:?}"
         );
         assert!(crate::worm::worm_solid(&check, 30.0, 0.01, Some(28.0)).is_err());
+        // Its STEP: the nut's faces close a solid of the mesh's volume
+        // (the mesh's chords inside the helical surface by at most 0.01).
+        let sweep = crate::worm::WormSweep::new(&check, 30.0, 2.5e-4, Some(45.0)).unwrap();
+        let fit = crate::step::swept_step("nut", "a nut", &sweep, 1e-3).unwrap();
+        assert!(
+            (fit.volume - v).abs() < 0.01 * 30.0 * 100.0,
+            "{} vs {v}",
+            fit.volume
+        );
         let short = cut(&nut, -0.05, FlankOrder::Alternating).unwrap();
         let e = short.verified().unwrap_err().to_string();
         assert!(

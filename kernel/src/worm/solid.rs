@@ -42,17 +42,7 @@ pub fn worm_solid(
     let (w0, lead) = check.window;
     let outline = check.outline();
     let r_thread = outline.iter().map(|p| p[1]).fold(0.0, Real::max);
-    let nut = match (check.internal, outside) {
-        (false, _) => None,
-        (true, Some(d)) if d / 2.0 > r_thread => Some(d / 2.0),
-        (true, d) => {
-            return Err(MeshError::Degenerate(format!(
-                "the nut's outside diameter {} is not beyond its thread's {:.3} mm",
-                d.map_or("(none given)".to_owned(), |d| format!("{d} mm")),
-                2.0 * r_thread
-            )))
-        }
-    };
+    let nut = nut_radius(check, outside, r_thread)?;
     // The chordal tolerance holds on the largest circle.
     let r_tip = nut.unwrap_or(r_thread);
     // The outline between its corners, repeated with the lead.
@@ -114,6 +104,25 @@ pub fn worm_solid(
     }
 }
 
+/// An internal thread's nut's outside radius, from its diameter `outside`,
+/// beyond the thread's largest radius `r_thread`; `None` for an external
+/// thread.
+fn nut_radius(
+    check: &WormCheck,
+    outside: Option<Real>,
+    r_thread: Real,
+) -> Result<Option<Real>, MeshError> {
+    match (check.internal, outside) {
+        (false, _) => Ok(None),
+        (true, Some(d)) if d / 2.0 > r_thread => Ok(Some(d / 2.0)),
+        (true, d) => Err(MeshError::Degenerate(format!(
+            "the nut's outside diameter {} is not beyond its thread's {:.3} mm",
+            d.map_or("(none given)".to_owned(), |d| format!("{d} mm")),
+            2.0 * r_thread
+        ))),
+    }
+}
+
 /// The finished worm exactly, for STEP: the section `outline` (`(z, r)`
 /// over one lead from `window`'s start, straight between its points,
 /// repeated with the lead) swept helically as [`worm_solid`] meshes it,
@@ -131,17 +140,26 @@ pub struct WormSweep {
     /// The largest radial distance of a dropped point from the outline
     /// kept (mm).
     simplified: Real,
+    /// A nut's outside radius (an internal thread's part).
+    outside: Option<Real>,
 }
 
 impl WormSweep {
-    /// The worm of `check`'s finished section, `length` long; points of the
-    /// outline within `merge` (mm, radially) of the line between their
-    /// neighbours kept are dropped (the simulation's outline has pairs a
-    /// micrometre apart and long straight runs).
+    /// The worm of `check`'s finished section, `length` long (for an
+    /// internal thread the nut round it, `outside` its outside diameter);
+    /// points of the outline within `merge` (mm, radially) of the line
+    /// between their neighbours kept are dropped (the simulation's outline
+    /// has pairs a micrometre apart and long straight runs).
     ///
     /// # Failures
-    /// A length or merge distance not positive or an empty section.
-    pub fn new(check: &WormCheck, length: Real, merge: Real) -> Result<Self, MeshError> {
+    /// A length or merge distance not positive, an empty section; an
+    /// internal thread without an outside diameter beyond its thread.
+    pub fn new(
+        check: &WormCheck,
+        length: Real,
+        merge: Real,
+        outside: Option<Real>,
+    ) -> Result<Self, MeshError> {
         let degenerate = |e: crate::input::InputError| MeshError::Degenerate(e.to_string());
         crate::math::positive("worm length", length).map_err(degenerate)?;
         crate::math::positive("outline merge distance", merge).map_err(degenerate)?;
@@ -150,6 +168,8 @@ impl WormSweep {
         if all.len() < 2 || !all.iter().any(|p| p[1] > 0.0) {
             return Err(MeshError::Degenerate("the worm's section is empty".into()));
         }
+        let r_thread = all.iter().map(|p| p[1]).fold(0.0, Real::max);
+        let outside = nut_radius(check, outside, r_thread)?;
         all.push([all[0][0] + lead, all[0][1]]);
         // Greedy: from each point kept, reach as far as every point passed
         // stays within `merge` of the chord, radially. Written here, not
@@ -189,6 +209,7 @@ impl WormSweep {
             lead,
             length,
             simplified,
+            outside,
         })
     }
 
@@ -219,6 +240,10 @@ impl crate::step::Sections for WormSweep {
     fn along(&self) -> usize {
         // Eight points a turn to start.
         (8.0 * self.length / self.lead).ceil() as usize + 1
+    }
+
+    fn outside(&self) -> Option<Real> {
+        self.outside
     }
 }
 
