@@ -30,8 +30,9 @@ struct Printed {
 
 const INCH: f64 = 25.4;
 
-/// Each default run: the default M20x2.5-6g and the examples' Tr 40x7, 1"-5
-/// ACME 2G and 2"-8 7/45 buttress. Their limits are the standards' printed
+/// Each default run: the default M20x2.5-6g and the examples' M30x2-6H
+/// nut (cut from inside its bore), Tr 40x7, 1"-5 ACME 2G and 2"-8 7/45
+/// buttress. Their limits are the standards' printed
 /// dimensions (ISO 965-2's M20 6g, ASME B1.5's 1-5 2G) or the drawing's
 /// stated ones; the run passes; each start's pitch diameter, as the gauge
 /// takes it on the simulated section, lies within its limits and within
@@ -41,7 +42,7 @@ const INCH: f64 = 25.4;
 /// diameter measured, the wire the best size (P / 2 / cos a).
 #[test]
 fn each_default_thread_is_verified_against_its_standard() {
-    let cases: [(&str, Option<&str>, Printed); 4] = [
+    let cases: [(&str, Option<&str>, Printed); 5] = [
         (
             "m20",
             None,
@@ -49,6 +50,18 @@ fn each_default_thread_is_verified_against_its_standard() {
                 pitch_diameter: [18.164, 18.334],
                 crest: [19.623, 19.958],
                 root: [16.721, 16.891],
+                flanks: [30.0, 30.0],
+            },
+        ),
+        (
+            // ISO 965-2 prints the nut's least major diameter only: the
+            // most is left unchecked here (NaN).
+            "m30-nut",
+            Some("scripts/examples/thread-m30x2-6h.toml"),
+            Printed {
+                pitch_diameter: [28.701, 28.925],
+                crest: [27.835, 28.210],
+                root: [30.0, f64::NAN],
                 flanks: [30.0, 30.0],
             },
         ),
@@ -112,7 +125,8 @@ fn each_default_thread_is_verified_against_its_standard() {
         ] {
             let got = band(k);
             assert!(
-                (got[0] - want[0]).abs() <= printed_to && (got[1] - want[1]).abs() <= printed_to,
+                (got[0] - want[0]).abs() <= printed_to
+                    && (want[1].is_nan() || (got[1] - want[1]).abs() <= printed_to),
                 "{name}: {k} {got:?}, printed {want:?}"
             );
         }
@@ -140,12 +154,15 @@ fn each_default_thread_is_verified_against_its_standard() {
                 assert!((f(k) - want).abs() < 0.05, "{name}: {k} {}", f(k));
             }
             if printed.flanks[0] == printed.flanks[1] {
-                // A gauge's arithmetic: M = d2 + w (1 + 1 / sin a) - (P / 2) / tan a.
+                // A gauge's arithmetic: over wires M = d2 + w (1 + 1 / sin a)
+                // - (P / 2) / tan a; a nut's between balls the same terms
+                // taken from d2.
                 let a = printed.flanks[0].to_radians();
                 let p = r["notes"]["pitch_mm"].as_f64().unwrap();
                 let w = p / 2.0 / a.cos();
                 assert!((v["wire"].as_f64().unwrap() - w).abs() < 1e-9, "{name}");
-                let m = d2 + w * (1.0 + 1.0 / a.sin()) - p / 2.0 / a.tan();
+                let sign = if v["internal"] == true { -1.0 } else { 1.0 };
+                let m = d2 + sign * (w * (1.0 + 1.0 / a.sin()) - p / 2.0 / a.tan());
                 assert!(
                     (f("over_wires") - m).abs() < 0.002,
                     "{name}: M {} vs {m}",
@@ -162,6 +179,23 @@ fn each_default_thread_is_verified_against_its_standard() {
                     "{name}: no best wire for unequal flanks"
                 );
             }
+        }
+        if name == "m30-nut" {
+            // On the boring bar, the tailstock away: the bar clear of the
+            // nut along the whole program, no holder or tailstock.
+            let pairs = r["collisions"]["clearances"].as_array().unwrap();
+            let pair = |a: &str, b: &str| {
+                pairs
+                    .iter()
+                    .find(|c| c["bodies"][0] == a && c["bodies"][1] == b)
+            };
+            let bar = pair("boring_bar", "thread").expect("the bar and the nut are checked");
+            assert!(bar["clearance_mm"].as_f64().unwrap() > 0.5, "{bar}");
+            assert!(pairs
+                .iter()
+                .all(|c| !c["bodies"].to_string().contains("holder")
+                    && !c["bodies"].to_string().contains("tailstock")));
+            assert!(out.join("thread.step").is_file() && out.join("boring_bar.stl").is_file());
         }
         crate::worm::check_workbook(&out);
         // The STL, the scene and the page for CI's FreeCAD, glTF
@@ -248,12 +282,23 @@ fn bad_threads_are_refused_with_clear_errors() {
         assert!(err.contains(says), "{set}: {err}");
         assert!(!out.exists(), "{set}: output written");
     }
-    for (set, says) in [
-        ("designation=M30x2-6H", "the thread is external"),
-        ("designation=M20x2.5-6g-LH", "the thread is right-handed"),
+    for (sets, says) in [
+        (
+            &["designation=M30x2-6H", "outside_diameter=29"][..],
+            "the nut's outside is beyond its thread",
+        ),
+        (
+            &["designation=M20x2.5-6g-LH"][..],
+            "the thread is right-handed",
+        ),
     ] {
+        let set = sets.join(" ");
         let out = dir.join(set.replace(|c: char| !c.is_ascii_alphanumeric(), "_"));
-        let (code, _, err) = pilgrim(&["run", SCRIPT, "--out", s(&out), "--quiet", "--set", set]);
+        let mut args = vec!["run", SCRIPT, "--out", s(&out), "--quiet"];
+        for one in sets {
+            args.extend(["--set", one]);
+        }
+        let (code, _, err) = pilgrim(&args);
         assert_ne!(code, 0, "{set}");
         assert!(err.contains(says), "{set}: {err}");
         assert!(

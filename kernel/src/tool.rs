@@ -195,6 +195,12 @@ impl Tool {
         }
     }
 
+    /// Whether the tool cuts inside a bore (a thread cutter on a boring
+    /// bar): the machine's bodies for such tools hold it.
+    pub fn cuts_inside(&self) -> bool {
+        matches!(self.shape, ToolShape::ThreadCutter(c) if c.inside)
+    }
+
     /// A thread cutter tracked at its tip's centre (the tool frame's
     /// origin), its section in the tool frame's XZ plane (X radial, Z
     /// along the part's axis).

@@ -20,6 +20,7 @@
 //! **The part** is taken at its largest: the part body of the greatest
 //! volume (the blank where the family gives one), as its envelope of
 //! revolution about its axis (a stack of cylinders as wide as the mesh,
+//! rings where the axis lies outside it, as in a nut's bore:
 //! [`shapes::envelope`]). A clearance to it is smaller than to the part at
 //! that moment by at most the stock, the groove or thread not yet cut, and
 //! twice the mesh tolerance.
@@ -574,8 +575,14 @@ mod tests {
     fn the_smallest_clearance_is_found_between_the_sweeps_samples() {
         let machine = ChainMachine::new(Machine::from_info(fanuc_0i_tc::describe()).unwrap());
         let axes = ["X".to_owned(), "Z".to_owned()];
-        let placement =
-            Placement::new(machine.info(), &axes, Vec3::zeros(), Some((-100.0, 0.0))).unwrap();
+        let placement = Placement::new(
+            machine.info(),
+            &axes,
+            Vec3::zeros(),
+            Some((-100.0, 0.0)),
+            false,
+        )
+        .unwrap();
         // The tool's tip from radius 100 at z = -300 to radius 130 at z = 0:
         // the holder's edge passes the chuck's rim (radius 100, from z =
         // -230 to -130) on a slant.

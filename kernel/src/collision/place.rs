@@ -56,7 +56,9 @@ impl Placement {
     /// The bodies of the machine `info` with a solid, for a program over
     /// `program_axes`: the tool's spindle centre at `tool_centre` in the
     /// tool frame, the part's solids from `part_z.0` to `part_z.1` along
-    /// its axis (none: bodies at its ends are left out).
+    /// its axis (none: bodies at its ends are left out); the bodies there
+    /// for a tool that cuts inside a bore where `inside`, from outside
+    /// otherwise (a body's `reach`).
     ///
     /// # Failures
     /// A description that does not compile (it did when loaded).
@@ -65,6 +67,7 @@ impl Placement {
         program_axes: &[String],
         tool_centre: Vec3,
         part_z: Option<(Real, Real)>,
+        inside: bool,
     ) -> Result<Self, CollisionError> {
         let machine = |e: crate::machine::MachineError| CollisionError::Machine(e.to_string());
         let tool_chain = if info.chain.is_empty() {
@@ -89,6 +92,9 @@ impl Placement {
             let Some(shape) = &spec.shape else {
                 continue;
             };
+            if !spec.reach.holds(inside) {
+                continue;
+            }
             let solid = Solid::of(shape, &info.constants).map_err(CollisionError::Machine)?;
             let own = || {
                 body.chain()

@@ -10,7 +10,7 @@
 
 use crate::machine::Solid;
 use crate::math::{Mat4, Real, Vec3};
-use crate::mesh::TriMesh;
+use crate::mesh::{cross, dot, sub, TriMesh};
 use parry3d_f64::math::{Pose, Rot3, Vector};
 use parry3d_f64::shape::SharedShape;
 
@@ -110,31 +110,46 @@ pub fn solid(s: &Solid) -> Shaped {
             width,
             cover,
         } => {
-            // Each sector is the hull of its inner arc's ends (a chord
-            // inside the arc by at most GUARD_FILL) and of its outer arc's
-            // points pushed out so that the hull's edges touch the arc:
-            // the sectors hold the guard.
-            let per = 2.0 * (1.0 - GUARD_FILL / inner).clamp(-1.0, 1.0).acos();
-            let sectors = ((cover / per).ceil() as usize).clamp(1, MAX_SECTORS);
-            let spacing = cover / (sectors * (ARC_POINTS - 1)) as Real;
-            let out = outer / (spacing / 2.0).cos();
-            let pieces = (0..sectors)
-                .filter_map(|i| {
-                    let at = |k: usize| -cover / 2.0 + spacing * (i * (ARC_POINTS - 1) + k) as Real;
-                    let points: Vec<Vector> = (0..ARC_POINTS)
-                        .flat_map(|k| {
-                            let (s, c) = at(k).sin_cos();
-                            [inner, out].into_iter().flat_map(move |r| {
-                                [-width / 2.0, width / 2.0].map(|z| Vector::new(r * c, r * s, z))
-                            })
-                        })
-                        .collect();
-                    SharedShape::convex_hull(&points).map(|h| (Pose::identity(), h))
-                })
+            let pieces = ring_sectors(inner, outer, width, cover, GUARD_FILL)
+                .into_iter()
+                .map(|h| (Pose::identity(), h))
                 .collect();
             here(SharedShape::compound(pieces))
         }
     }
+}
+
+/// The convex sectors that hold a ring about Z from radius `inner` to
+/// `outer`, `width` along Z about 0, over the angle `cover` about +X:
+/// each sector the hull of its inner arc's ends (a chord inside the arc by
+/// at most `fill`, the sectors as many as that takes, at most
+/// [`MAX_SECTORS`]) and of its outer arc's points pushed out so that the
+/// hull's edges touch the arc.
+fn ring_sectors(
+    inner: Real,
+    outer: Real,
+    width: Real,
+    cover: Real,
+    fill: Real,
+) -> Vec<SharedShape> {
+    let per = 2.0 * (1.0 - fill / inner).clamp(-1.0, 1.0).acos();
+    let sectors = ((cover / per).ceil() as usize).clamp(1, MAX_SECTORS);
+    let spacing = cover / (sectors * (ARC_POINTS - 1)) as Real;
+    let out = outer / (spacing / 2.0).cos();
+    (0..sectors)
+        .filter_map(|i| {
+            let at = |k: usize| -cover / 2.0 + spacing * (i * (ARC_POINTS - 1) + k) as Real;
+            let points: Vec<Vector> = (0..ARC_POINTS)
+                .flat_map(|k| {
+                    let (s, c) = at(k).sin_cos();
+                    [inner, out].into_iter().flat_map(move |r| {
+                        [-width / 2.0, width / 2.0].map(|z| Vector::new(r * c, r * s, z))
+                    })
+                })
+                .collect();
+            SharedShape::convex_hull(&points)
+        })
+        .collect()
 }
 
 /// The tool's solid in the tool frame: a wheel exactly, as a round
@@ -182,9 +197,13 @@ const MAX_SLABS: usize = 64;
 /// over its length (and the ring of vertices on either side, which bound
 /// the surface between them), plus `tol` for the chords between vertices.
 /// A slab runs on while the envelope's radius varies by at most `tol`
-/// (coarser if that would take more than [`MAX_SLABS`]). Conservative for
-/// any part; exact to `2 tol` for a body of revolution (a mandrel, a roll's
-/// blank, a thread's outer cylinder). `None` for an empty mesh.
+/// (coarser if that would take more than [`MAX_SLABS`]). Where the axis is
+/// outside the part in a slab (a nut, a bored part: [`axis_inside`]), the
+/// slab is a ring whose hole is as wide as the mesh's nearest vertex to
+/// the axis there, less `tol` for the chords and `tol` for the ring's own
+/// (convex sectors, [`ring_sectors`]). Conservative for any part; exact to
+/// `2 tol` for a body of revolution (a mandrel, a roll's blank, a thread's
+/// outer cylinder, a nut's bore). `None` for an empty mesh.
 pub fn envelope(mesh: &TriMesh, tol: Real) -> Option<Shaped> {
     let mut rings: Vec<(Real, Real)> = mesh
         .positions
@@ -228,18 +247,84 @@ pub fn envelope(mesh: &TriMesh, tol: Real) -> Option<Shaped> {
         band *= 2.0;
         stack = slabs(band);
     }
-    let pieces = stack
-        .into_iter()
-        .map(|(z0, z1, r)| {
-            let half = ((z1 - z0) / 2.0).max(1e-6);
-            let place = Mat4::new_translation(&Vec3::new(0.0, 0.0, (z0 + z1) / 2.0)) * along_z();
-            (pose(&place), SharedShape::cylinder(half, r + tol))
-        })
-        .collect();
+    let inside = axis_inside(
+        mesh,
+        &stack.iter().map(|s| (s.0 + s.1) / 2.0).collect::<Vec<_>>(),
+    );
+    let mut pieces = Vec::new();
+    for ((z0, z1, r), solid) in stack.into_iter().zip(inside) {
+        let half = ((z1 - z0) / 2.0).max(1e-6);
+        let centre = Mat4::new_translation(&Vec3::new(0.0, 0.0, (z0 + z1) / 2.0));
+        let hole = (!solid)
+            .then(|| {
+                mesh.positions
+                    .iter()
+                    .filter(|p| p[2] >= z0 - 1e-9 && p[2] <= z1 + 1e-9)
+                    .map(|p| p[0].hypot(p[1]))
+                    .fold(Real::INFINITY, Real::min)
+                    - tol
+            })
+            .filter(|h| h.is_finite() && *h > tol);
+        match hole {
+            Some(h) => pieces.extend(
+                ring_sectors(h, r + tol, 2.0 * half, std::f64::consts::TAU, tol)
+                    .into_iter()
+                    .map(|s| (pose(&centre), s)),
+            ),
+            None => pieces.push((
+                pose(&(centre * along_z())),
+                SharedShape::cylinder(half, r + tol),
+            )),
+        }
+    }
     Some(Shaped {
         shape: SharedShape::compound(pieces),
         local: Mat4::identity(),
     })
+}
+
+/// For each of `zs`, whether the part frame's axis there lies inside the
+/// closed mesh: the parity of a ray's crossings from the axis outwards.
+/// Written here (Moller-Trumbore on the triangles near the ray): parry's
+/// ray cast gives the first hit only, and its inside test needs a mesh
+/// with merged vertices and pseudo-normals. The ray leaves at an odd angle
+/// and a hair off `z` so that it meets no edge or vertex of a mesh built
+/// on round angles.
+fn axis_inside(mesh: &TriMesh, zs: &[Real]) -> Vec<bool> {
+    let (s, c) = 0.123_456_789_f64.sin_cos();
+    let mut crossings = vec![0usize; zs.len()];
+    for t in &mesh.triangles {
+        let [a, b, d] = t.map(|i| mesh.positions[i as usize]);
+        let (lo, hi) = (a[2].min(b[2]).min(d[2]), a[2].max(b[2]).max(d[2]));
+        for (k, &z) in zs.iter().enumerate() {
+            let o = [0.0, 0.0, z + 1.234_567e-7];
+            if o[2] < lo || o[2] > hi {
+                continue;
+            }
+            // Moller-Trumbore, the ray o + t (c, s, 0), t > 0.
+            let (e1, e2) = (sub(b, a), sub(d, a));
+            let dir = [c, s, 0.0];
+            let p = cross(dir, e2);
+            let det = dot(e1, p);
+            if det.abs() < 1e-15 {
+                continue;
+            }
+            let tv = sub(o, a);
+            let u = dot(tv, p) / det;
+            if !(0.0..=1.0).contains(&u) {
+                continue;
+            }
+            let q = cross(tv, e1);
+            let v = dot(dir, q) / det;
+            if v < 0.0 || u + v > 1.0 {
+                continue;
+            }
+            if dot(e2, q) / det > 0.0 {
+                crossings[k] += 1;
+            }
+        }
+    }
+    crossings.into_iter().map(|n| n % 2 == 1).collect()
 }
 
 /// A rigid motion (rotation and translation only) as parry's pose.
@@ -257,6 +342,54 @@ pub fn pose(m: &Mat4) -> Pose {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A tube's envelope is a ring: a bar of radius 8 on the axis of a
+    /// 14 mm bore stands 6 mm clear of it (within the mesh's tolerance),
+    /// a bar outside stands off its outside; a solid rod's envelope holds
+    /// its axis.
+    #[test]
+    fn a_hollow_parts_envelope_keeps_its_bore() {
+        let circle = |r: Real, z: Real| -> Vec<[Real; 3]> {
+            (0..96)
+                .map(|k| {
+                    let a = std::f64::consts::TAU * k as Real / 96.0;
+                    [r * a.cos(), r * a.sin(), z]
+                })
+                .collect()
+        };
+        let tube = crate::mesh::sweep_hollow(
+            &[circle(22.5, -30.0), circle(22.5, 0.0)],
+            &[circle(14.0, -30.0), circle(14.0, 0.0)],
+        )
+        .unwrap();
+        let tol = 14.0 * (1.0 - (std::f64::consts::PI / 96.0).cos());
+        let env = envelope(&tube, tol).unwrap();
+        let bar = SharedShape::cylinder(40.0, 8.0);
+        let at = |x: Real| {
+            let m = Mat4::new_translation(&crate::math::Vec3::new(x, 0.0, -15.0)) * along_z();
+            parry3d_f64::query::distance(&pose(&env.local), &*env.shape, &pose(&m), &*bar)
+                .unwrap()
+                .distance
+        };
+        let d = at(0.0);
+        assert!(d < 6.0 && d > 6.0 - 3.0 * tol, "{d} (tol {tol})");
+        let d = at(40.0);
+        assert!(
+            d <= 40.0 - 8.0 - 22.5 && d > 40.0 - 8.0 - 22.5 - 2.0 * tol,
+            "{d}"
+        );
+        let rod = crate::mesh::sweep(&[circle(22.5, -30.0), circle(22.5, 0.0)]).unwrap();
+        let env = envelope(&rod, tol).unwrap();
+        let d = parry3d_f64::query::distance(
+            &pose(&env.local),
+            &*env.shape,
+            &pose(&(Mat4::new_translation(&crate::math::Vec3::new(0.0, 0.0, -15.0)) * along_z())),
+            &*bar,
+        )
+        .unwrap()
+        .distance;
+        assert_eq!(d, 0.0);
+    }
 
     /// Two unit-free checks of the conversions: a box 100 mm long along X
     /// turned a quarter about Z stands 50 mm along Y; a guard's compound

@@ -136,8 +136,14 @@ pub fn placement(
 ) -> Result<crate::collision::Placement, SceneError> {
     let axes: Vec<String> = program.axes.iter().map(|a| a.name.clone()).collect();
     let part_z = crate::collision::part_at_largest(parts).map(|(_, m)| crate::collision::part_z(m));
-    crate::collision::Placement::new(machine.info(), &axes, tool.spindle_centre(), part_z)
-        .map_err(placing)
+    crate::collision::Placement::new(
+        machine.info(),
+        &axes,
+        tool.spindle_centre(),
+        part_z,
+        tool.cuts_inside(),
+    )
+    .map_err(placing)
 }
 
 fn placing(e: crate::collision::CollisionError) -> SceneError {

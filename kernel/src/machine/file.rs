@@ -90,6 +90,7 @@ struct BodyFile {
     shape: Option<Spanned<BodyShape>>,
     approach_feed: Option<Spanned<crate::machine::Quantity>>,
     mount: Option<Spanned<crate::machine::Mount>>,
+    reach: Option<Spanned<pilgrim_plugin_abi::types::Reach>>,
 }
 
 /// Turns byte spans into `file:line:column` errors.
@@ -232,6 +233,11 @@ impl Machine {
                     .as_ref()
                     .map(|m| *m.get_ref())
                     .unwrap_or_default(),
+                reach: body
+                    .reach
+                    .as_ref()
+                    .map(|r| *r.get_ref())
+                    .unwrap_or_default(),
             });
         }
         let tool = match &file.tool {
@@ -333,6 +339,7 @@ fn span_of(file: &MachineFile, e: &Invalid) -> Range<usize> {
                 "shape" => body.shape.as_ref().map(Spanned::span),
                 "approach_feed" => body.approach_feed.as_ref().map(Spanned::span),
                 "mount" => body.mount.as_ref().map(Spanned::span),
+                "reach" => body.reach.as_ref().map(Spanned::span),
                 _ => None,
             };
             at.unwrap_or_else(|| body.chain.span())

@@ -209,6 +209,9 @@ fn body(b: &BodySpec) -> Value {
     if !b.mount.is_part() {
         t.insert("mount".into(), b.mount.word().into());
     }
+    if !b.reach.is_any() {
+        t.insert("reach".into(), b.reach.word().into());
+    }
     t.insert("chain".into(), chain(&b.chain));
     t.into()
 }
@@ -218,6 +221,7 @@ mod tests {
     use super::*;
     use crate::machine::Machine;
     use crate::machine::Mount;
+    use pilgrim_plugin_abi::types::Reach;
 
     /// The mill with a body of each shape (sizes as numbers and as a
     /// constant).
@@ -262,10 +266,15 @@ mod tests {
                 shape: Some(shape),
                 approach_feed: None,
                 mount: Mount::Part,
+                reach: Default::default(),
             });
         }
-        // A body on the tool, and one where the part begins.
-        for (name, mount) in [("collar", Mount::Tool), ("chuck", Mount::PartStart)] {
+        // A body on the tool for tools that cut inside a bore, and one
+        // where the part begins.
+        for (name, mount, reach) in [
+            ("collar", Mount::Tool, Reach::Inside),
+            ("chuck", Mount::PartStart, Reach::Any),
+        ] {
             info.bodies.push(BodySpec {
                 name: name.into(),
                 description: String::new(),
@@ -277,6 +286,7 @@ mod tests {
                 }),
                 approach_feed: None,
                 mount,
+                reach,
             });
         }
         info

@@ -95,11 +95,11 @@ pub struct TriMesh {
     pub triangles: Vec<[u32; 3]>,
 }
 
-fn sub(a: [Real; 3], b: [Real; 3]) -> [Real; 3] {
+pub(crate) fn sub(a: [Real; 3], b: [Real; 3]) -> [Real; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
-fn cross(a: [Real; 3], b: [Real; 3]) -> [Real; 3] {
+pub(crate) fn cross(a: [Real; 3], b: [Real; 3]) -> [Real; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -107,7 +107,7 @@ fn cross(a: [Real; 3], b: [Real; 3]) -> [Real; 3] {
     ]
 }
 
-fn dot(a: [Real; 3], b: [Real; 3]) -> Real {
+pub(crate) fn dot(a: [Real; 3], b: [Real; 3]) -> Real {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 

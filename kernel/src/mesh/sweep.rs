@@ -32,11 +32,13 @@ pub fn sweep(rings: &[Vec<[Real; 3]>]) -> Result<TriMesh, MeshError> {
 /// The solid between two sequences of closed sections, `outer` and the
 /// hole `inner` inside it (a nut: its outside, its thread), as [`sweep`]
 /// makes one: each sequence's sides, and flat caps with the hole in them
-/// (ear clipping with a hole). The two sequences have as many rings, ring
-/// `j` of each in one plane, the hole's rings wound as the outside's.
+/// (ear clipping with a hole). Each sequence has its own number of rings
+/// and of points a ring (a straight outside needs two rings); their first
+/// rings lie in one plane, their last in another, the hole's wound as the
+/// outside's.
 ///
 /// # Failures
-/// As [`sweep`]'s, for either sequence; sequences of different lengths.
+/// As [`sweep`]'s, for either sequence.
 ///
 /// ```
 /// use pilgrim_kernel::mesh::sweep_hollow;
@@ -52,13 +54,6 @@ pub fn sweep_hollow(
     outer: &[Vec<[Real; 3]>],
     inner: &[Vec<[Real; 3]>],
 ) -> Result<TriMesh, MeshError> {
-    if inner.len() != outer.len() {
-        return Err(MeshError::Degenerate(format!(
-            "the hole has {} sections, the outside {}",
-            inner.len(),
-            outer.len()
-        )));
-    }
     swept(outer, Some(inner))
 }
 
@@ -125,12 +120,16 @@ fn swept(rings: &[Vec<[Real; 3]>], holes: Option<&[Vec<[Real; 3]>]>) -> Result<T
     // triangulated in its plane, the triangles wound as the ring (the
     // first cap) or against it (the last), as the sides are.
     for (j, first) in [(0, true), (rings.len() - 1, false)] {
-        // The section, its hole's points after its own.
-        let r: Vec<[Real; 3]> = rings[j]
-            .iter()
-            .chain(holes.map_or(&[][..], |hs| &hs[j][..]))
-            .copied()
-            .collect();
+        // The section, its hole's points after its own (the hole's first
+        // or last ring).
+        let hole = holes.map_or(&[][..], |hs| {
+            if first {
+                &hs[0][..]
+            } else {
+                &hs[hs.len() - 1][..]
+            }
+        });
+        let r: Vec<[Real; 3]> = rings[j].iter().chain(hole).copied().collect();
         // The ring's plane: Newell's normal, and two axes in it.
         let mut n = [0.0; 3];
         for k in 0..m {

@@ -26,6 +26,11 @@ pub struct ThreadCutter {
     pub right_angle: Real,
     /// Height of the cutting profile above the tip (mm).
     pub height: Real,
+    /// It cuts inside a bore, on a boring bar: its tip looks away from the
+    /// axis (`r` above then means towards the axis), and the machine's
+    /// bodies for tools inside a bore hold it.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub inside: bool,
 }
 
 impl ThreadCutter {
@@ -70,6 +75,7 @@ impl ThreadCutter {
             left_angle,
             right_angle,
             height,
+            inside: false,
         };
         let need = c.inset(left_angle) + c.inset(right_angle);
         if need > tip_width {

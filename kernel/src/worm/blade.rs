@@ -37,6 +37,9 @@ pub struct ThreadBlade {
     tip_radius: Real,
     lead: Real,
     pose: Mat4,
+    /// +1 for a blade cutting from outside (its body away from the axis),
+    /// -1 inside a bore (its body towards the axis).
+    side: Real,
 }
 
 impl ThreadBlade {
@@ -51,6 +54,7 @@ impl ThreadBlade {
             tip_radius,
             lead,
             pose,
+            side: if cutter.inside { -1.0 } else { 1.0 },
         }
     }
 
@@ -64,14 +68,15 @@ impl ThreadBlade {
     }
 
     /// Piece `k`'s point at `u` in the section `y` off the cutting plane, in
-    /// the tool frame (x radial from the tip, y across, z along the axis).
+    /// the tool frame (x radial from the tip, y across, z along the axis;
+    /// the body away from the axis, or towards it inside a bore).
     fn local(&self, k: usize, u: Real, y: Real) -> [Real; 3] {
         let [z, h] = self.outline.point_on(k, u);
         let s = self.scale(y);
         let h = self.top + s * (h - self.top);
-        let rho = self.tip_radius + h;
+        let rho = self.tip_radius + self.side * h;
         let shift = self.lead * y.atan2(rho) / std::f64::consts::TAU;
-        [h, y, s * z + shift]
+        [self.side * h, y, s * z + shift]
     }
 
     /// The blade's volume (mm^3): each section's area (the helix's shift

@@ -125,6 +125,23 @@ pub mod worm_api {
         Ok(Tool::thread_cutter(name, number, c))
     }
 
+    /// The thread cutter `tool` on a boring bar, cutting inside a bore:
+    /// its tip looks away from the axis, and the machine's bodies for
+    /// tools inside a bore (a boring bar, with the tailstock away) hold
+    /// it.
+    /// ```rhai
+    /// let tool = thread_cutter("boring bar", 2, 0.25, 0.1, 30.0, 30.0, 3.0).inside_bore();
+    /// ```
+    #[rhai_fn(return_raw)]
+    pub fn inside_bore(tool: Tool) -> Result<Tool, Box<EvalAltResult>> {
+        let mut c = cutter_of(&tool)?;
+        c.inside = true;
+        Ok(Tool {
+            shape: ToolShape::ThreadCutter(c),
+            ..tool
+        })
+    }
+
     /// The cutter's width at `r` above its tip (mm).
     #[rhai_fn(return_raw)]
     pub fn cutter_width(tool: Tool, r: Real) -> Result<Real, Box<EvalAltResult>> {

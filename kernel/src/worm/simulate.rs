@@ -681,7 +681,9 @@ pub fn simulate(
                 && z0 == z1e
                 && r1 >= r0;
             if low < r_a - 1e-9 && !out_of_groove {
-                let half = cutter.width_at(r_a - low) / 2.0;
+                // The cutter's profile reaches its height above the tip; what
+                // holds it is the collision check's.
+                let half = cutter.width_at((r_a - low).min(cutter.height)) / 2.0;
                 let (lo, hi) = (z0.min(z1e), z0.max(z1e));
                 if hi > -req.length - half && lo < half {
                     found(i, format!(

@@ -43,8 +43,7 @@ pub fn worm_solid(
     let outline = check.outline();
     let r_thread = outline.iter().map(|p| p[1]).fold(0.0, Real::max);
     let nut = nut_radius(check, outside, r_thread)?;
-    // The chordal tolerance holds on the largest circle.
-    let r_tip = nut.unwrap_or(r_thread);
+    let r_tip = r_thread;
     // The outline between its corners, repeated with the lead.
     let radius = |z: Real| -> Real {
         let u = w0 + (z - w0).rem_euclid(lead);
@@ -88,7 +87,11 @@ pub fn worm_solid(
     match nut {
         None => sweep(&rings),
         Some(r) => {
-            let outside: Vec<Vec<[Real; 3]>> = zs
+            // The outside is straight along the axis: its two end rings,
+            // as many points round as the tolerance asks there.
+            let step = 2.0 * (1.0 - (tol / r).min(1.0)).acos();
+            let n = ((TAU / step).ceil() as usize).clamp(24, MAX_AROUND);
+            let outside: Vec<Vec<[Real; 3]>> = [-length, 0.0]
                 .iter()
                 .map(|&z| {
                     (0..n)

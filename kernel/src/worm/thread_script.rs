@@ -246,7 +246,7 @@ pub(crate) const SCRIPT_API: ApiGroup = ApiGroup {
     },
     verify: Some(VerifyForm {
         key: "thread_profile",
-        form: "#{ thread_profile, length, space_centre, tolerance: #{ form, position, flank_angle_deg, lead (optional) } }",
+        form: "#{ thread_profile, length, space_centre, outside_diameter (a nut's, optional), tolerance: #{ form, position, flank_angle_deg, lead (optional) } }",
         read: verification,
     }),
 };

@@ -406,6 +406,47 @@ impl Mount {
     }
 }
 
+/// Since 1.10: which tools a body is there for. A lathe holds a tool that
+/// cuts from outside the part in a holder, with the tailstock up; one
+/// that cuts inside a bore on a boring bar, the tailstock away.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Reach {
+    /// Every tool.
+    #[default]
+    Any,
+    /// Tools that cut from outside the part.
+    Outside,
+    /// Tools that cut inside a bore.
+    Inside,
+}
+
+impl Reach {
+    /// Whether this is the default, [`Reach::Any`].
+    pub fn is_any(&self) -> bool {
+        *self == Self::Any
+    }
+
+    /// `any`, `outside` or `inside`.
+    pub fn word(self) -> &'static str {
+        match self {
+            Self::Any => "any",
+            Self::Outside => "outside",
+            Self::Inside => "inside",
+        }
+    }
+
+    /// Whether the body is there for a tool that cuts inside a bore
+    /// (`inside`) or from outside.
+    pub fn holds(self, inside: bool) -> bool {
+        match self {
+            Self::Any => true,
+            Self::Outside => !inside,
+            Self::Inside => inside,
+        }
+    }
+}
+
 /// A body of the machine other than the tool: moving (a steady rest), on
 /// the tool (a guard), or standing where the part is held (a chuck).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -434,6 +475,9 @@ pub struct BodySpec {
     /// constant that gives it; `None` for a body that never touches it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub approach_feed: Option<Quantity>,
+    /// Since 1.10: which tools it is there for.
+    #[serde(default, skip_serializing_if = "Reach::is_any")]
+    pub reach: Reach,
 }
 
 impl BodySpec {
@@ -454,7 +498,13 @@ impl BodySpec {
             shape: Some(shape),
             approach_feed: None,
             mount,
+            reach: Reach::Any,
         }
+    }
+
+    /// The same body, there only for the tools `reach` says.
+    pub fn for_tools(self, reach: Reach) -> Self {
+        Self { reach, ..self }
     }
 }
 

@@ -21,7 +21,7 @@
 
 use pilgrim_plugin_abi::types::{
     Axis, AxisKind, BodyShape, BodySpec, FactorKind, FactorSpec, MachineInfo, Mount, Plane,
-    ProgramSetup, Quantity, Radial, ToolSpec,
+    ProgramSetup, Quantity, Radial, Reach, ToolSpec,
 };
 use pilgrim_plugin_abi::{check_axial_section, export_plugin, Plugin, PluginError};
 
@@ -130,6 +130,14 @@ pub fn describe() -> MachineInfo {
             ("centre_length".to_owned(), 40.0),
             ("quill_radius".to_owned(), 35.0),
             ("quill_length".to_owned(), 150.0),
+            // A tool that cuts inside a bore rides a 16 mm boring bar, its
+            // axis `bar_tip` behind the tip (the insert reaches 2 mm
+            // beyond the bar: an M30's 1.2 mm depth and room), 70 mm out
+            // of the turret (4.4 diameters: a steel bar's reach); the
+            // tailstock is away, the bar coming from that side.
+            ("bar_radius".to_owned(), 8.0),
+            ("bar_tip".to_owned(), 10.0),
+            ("bar_length".to_owned(), 70.0),
         ]
         .into_iter()
         .collect(),
@@ -143,8 +151,10 @@ pub fn describe() -> MachineInfo {
     }
 }
 
-/// The lathe's bodies: the holder and the turret (on the tool, from its
-/// tip outward), the chuck at the part's start, the tailstock at its end.
+/// The lathe's bodies: for a tool that cuts from outside, the holder and
+/// the turret (on the tool, from its tip outward) and the tailstock at the
+/// part's end; for one inside a bore, the boring bar (from its tip back
+/// along +Z) and the turret at its end; the chuck at the part's start.
 fn bodies() -> Vec<BodySpec> {
     let c = |name: &str| Quantity::Constant(name.into());
     let k = |f: FactorKind, name: &str| FactorSpec::constant(f, name);
@@ -161,7 +171,8 @@ fn bodies() -> Vec<BodySpec> {
             BodyShape::Block {
                 size: [c("holder_length"), c("holder_section"), c("holder_section")],
             },
-        ),
+        )
+        .for_tools(Reach::Outside),
         BodySpec::mounted(
             "turret",
             "the turret's disc carrying the holder",
@@ -175,7 +186,38 @@ fn bodies() -> Vec<BodySpec> {
                 radius: c("turret_radius"),
                 length: c("turret_width"),
             },
-        ),
+        )
+        .for_tools(Reach::Outside),
+        BodySpec::mounted(
+            "boring_bar",
+            "the boring bar, its axis bar_tip behind the tip, from the tip's plane back along +Z",
+            Mount::Tool,
+            vec![
+                FactorSpec::scaled(FactorKind::Tx, "bar_tip", -1.0),
+                half(FactorKind::Tz, "bar_length", 1.0),
+            ],
+            BodyShape::Cylinder {
+                radius: c("bar_radius"),
+                length: c("bar_length"),
+            },
+        )
+        .for_tools(Reach::Inside),
+        BodySpec::mounted(
+            "bar_turret",
+            "the turret's disc holding the boring bar at its rim",
+            Mount::Tool,
+            vec![
+                FactorSpec::scaled(FactorKind::Tx, "bar_tip", -1.0),
+                k(FactorKind::Tx, "turret_radius"),
+                k(FactorKind::Tz, "bar_length"),
+                half(FactorKind::Tz, "turret_width", 1.0),
+            ],
+            BodyShape::Cylinder {
+                radius: c("turret_radius"),
+                length: c("turret_width"),
+            },
+        )
+        .for_tools(Reach::Inside),
         BodySpec::mounted(
             "chuck",
             "the chuck, its jaws chuck_gap beyond the part's start",
@@ -199,7 +241,8 @@ fn bodies() -> Vec<BodySpec> {
                 end_radius: c("centre_end_radius"),
                 length: c("centre_length"),
             },
-        ),
+        )
+        .for_tools(Reach::Outside),
         BodySpec::mounted(
             "tailstock_quill",
             "the tailstock's quill behind its centre",
@@ -212,7 +255,8 @@ fn bodies() -> Vec<BodySpec> {
                 radius: c("quill_radius"),
                 length: c("quill_length"),
             },
-        ),
+        )
+        .for_tools(Reach::Outside),
     ]
 }
 

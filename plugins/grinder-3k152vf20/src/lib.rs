@@ -212,6 +212,7 @@ fn bodies() -> Vec<BodySpec> {
             // this speed, never at rapid.
             approach_feed: Some(Quantity::Constant("rest_approach_feed".into())),
             mount: Mount::Part,
+            reach: Default::default(),
         },
         // The arm carrying the roller: from the roller's back, away from
         // the part (the rest's frame has +X away from the axis).
@@ -237,6 +238,7 @@ fn bodies() -> Vec<BodySpec> {
             }),
             approach_feed: None,
             mount: Mount::Part,
+            reach: Default::default(),
         },
         BodySpec::mounted(
             "guard",
