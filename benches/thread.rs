@@ -7,7 +7,9 @@
 //!   limits with the measurement over wires, the collision check, the
 //!   posts, the charts, `passes.xlsx`, the meshes, `report.html` and the
 //!   bytes of every file (not written to disk) (target <= 0.5 s); and the
-//!   same for the Tr 40x7 of `scripts/examples/thread-tr40x7.toml`.
+//!   same for the Tr 40x7 of `scripts/examples/thread-tr40x7.toml` and
+//!   the M30x2-6H nut of `scripts/examples/thread-m30x2-6h.toml` (cut
+//!   inside its bore on the boring bar).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pilgrim_kernel::catalog::{Catalog, CompiledPlugin};
@@ -31,17 +33,16 @@ fn thread_job(c: &mut Criterion) {
     };
     let mut g = c.benchmark_group("thread_job");
     g.sample_size(20).measurement_time(Duration::from_secs(10));
-    let example =
-        std::fs::read_to_string(root.join("scripts/examples/thread-tr40x7.toml")).unwrap();
+    let example = |file: &str| {
+        vec![ParamSource::Toml {
+            label: file.into(),
+            text: std::fs::read_to_string(root.join("scripts/examples").join(file)).unwrap(),
+        }]
+    };
     for (name, sets) in [
         ("default_m20_end_to_end", vec![]),
-        (
-            "tr40x7_end_to_end",
-            vec![ParamSource::Toml {
-                label: "thread-tr40x7.toml".into(),
-                text: example,
-            }],
-        ),
+        ("tr40x7_end_to_end", example("thread-tr40x7.toml")),
+        ("m30_nut_end_to_end", example("thread-m30x2-6h.toml")),
     ] {
         let run = || {
             let family = ScriptFamily::load(
