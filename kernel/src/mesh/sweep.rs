@@ -116,6 +116,16 @@ fn swept(rings: &[Vec<[Real; 3]>], holes: Option<&[Vec<[Real; 3]>]>) -> Result<T
         }
     }
     let side_count = mesh.triangles.len();
+    let outside_sides = 2 * m * (rings.len() - 1);
+    // Which sections a side face `i` lies between, named.
+    let between = |i: usize| -> String {
+        let (whose, ring) = if i < outside_sides {
+            ("", i / (2 * m))
+        } else {
+            ("the hole's ", (i - outside_sides) / (2 * h))
+        };
+        format!("{whose}sections {ring} and {}", ring + 1)
+    };
     // Caps, on vertices of their own (flat shading): each section
     // triangulated in its plane, the triangles wound as the ring (the
     // first cap) or against it (the last), as the sides are.
@@ -212,11 +222,11 @@ fn swept(rings: &[Vec<[Real; 3]>], holes: Option<&[Vec<[Real; 3]>]>) -> Result<T
         );
         let n = cross(sub(b, a), sub(c, a));
         if dot(n, n) == 0.0 {
-            let ring = if i < side_count { i / (2 * m) } else { 0 };
-            return Err(MeshError::Degenerate(format!(
-                "a face between sections {ring} and {} has no area",
-                ring + 1
-            )));
+            return Err(MeshError::Degenerate(if i < side_count {
+                format!("a face between {} has no area", between(i))
+            } else {
+                "a face of an end section's cap has no area".to_owned()
+            }));
         }
         for v in t {
             let s = &mut acc[*v as usize];
@@ -227,4 +237,31 @@ fn swept(rings: &[Vec<[Real; 3]>], holes: Option<&[Vec<[Real; 3]>]>) -> Result<T
     }
     mesh.normals = acc.into_iter().map(normalize).collect();
     Ok(mesh)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square(z: Real, a: Real, b: Real) -> Vec<[Real; 3]> {
+        vec![[a, a, z], [b, a, z], [b, b, z], [a, b, z]]
+    }
+
+    /// A degenerate face of a hole's side is named as the hole's: two of
+    /// its sections in one place leave its faces between them no area.
+    #[test]
+    fn a_flat_hole_is_named_by_its_own_sections() {
+        let outer = [square(0.0, 0.0, 2.0), square(10.0, 0.0, 2.0)];
+        let inner = [
+            square(0.0, 0.5, 1.5),
+            square(5.0, 0.5, 1.5),
+            square(5.0, 0.5, 1.5),
+            square(10.0, 0.5, 1.5),
+        ];
+        let e = sweep_hollow(&outer, &inner).unwrap_err().to_string();
+        assert!(
+            e.contains("a face between the hole's sections 1 and 2 has no area"),
+            "{e}"
+        );
+    }
 }
