@@ -130,12 +130,7 @@ impl WormRequest {
                 crest_diameter: -t.crest_diameter,
                 ..t.clone()
             },
-            limits: self.limits.as_ref().map(|l| crate::thread::ThreadLimits {
-                pitch_diameter: mirrored_limits(&l.pitch_diameter),
-                crest: mirrored_limits(&l.crest),
-                root: mirrored_limits(&l.root),
-                source: l.source.clone(),
-            }),
+            limits: self.limits.as_ref().map(mirrored_limits),
             ..self.clone()
         }
     }
@@ -451,12 +446,7 @@ impl WormCheck {
         }
         self.nominal.1 = -self.nominal.1;
         self.nominal.2 = -self.nominal.2;
-        self.limits = self.limits.map(|l| crate::thread::ThreadLimits {
-            pitch_diameter: mirrored_limits(&l.pitch_diameter),
-            crest: mirrored_limits(&l.crest),
-            root: mirrored_limits(&l.root),
-            source: l.source,
-        });
+        self.limits = self.limits.as_ref().map(mirrored_limits);
         self.over_wires_limits = self.over_wires_limits.map(|[a, b]| [-b, -a]);
         for chip in &mut self.chips {
             for ring in chip {
@@ -909,11 +899,18 @@ fn diameter(r: Real) -> Real {
     2.0 * r.abs()
 }
 
-/// A diameter's limits in rho = -r: negated, least first.
-fn mirrored_limits(l: &crate::thread::Limits) -> crate::thread::Limits {
-    crate::thread::Limits {
-        min: -l.max,
-        max: -l.min,
+/// A thread's limits in rho = -r, or back (its own inverse): each band
+/// negated, least first.
+fn mirrored_limits(l: &crate::thread::ThreadLimits) -> crate::thread::ThreadLimits {
+    let band = |b: &crate::thread::Limits| crate::thread::Limits {
+        min: -b.max,
+        max: -b.min,
+    };
+    crate::thread::ThreadLimits {
+        pitch_diameter: band(&l.pitch_diameter),
+        crest: band(&l.crest),
+        root: band(&l.root),
+        source: l.source.clone(),
     }
 }
 
