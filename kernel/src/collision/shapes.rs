@@ -292,15 +292,21 @@ pub fn envelope(mesh: &TriMesh, tol: Real) -> Option<Shaped> {
 /// on round angles.
 fn axis_inside(mesh: &TriMesh, zs: &[Real]) -> Vec<bool> {
     let (s, c) = 0.123_456_789_f64.sin_cos();
+    // The rays' heights, ascending: each triangle meets those within its
+    // own span of z only.
+    let mut order: Vec<usize> = (0..zs.len()).collect();
+    order.sort_by(|&i, &j| zs[i].total_cmp(&zs[j]));
+    let heights: Vec<Real> = order.iter().map(|&k| zs[k] + 1.234_567e-7).collect();
     let mut crossings = vec![0usize; zs.len()];
     for t in &mesh.triangles {
         let [a, b, d] = t.map(|i| mesh.positions[i as usize]);
         let (lo, hi) = (a[2].min(b[2]).min(d[2]), a[2].max(b[2]).max(d[2]));
-        for (k, &z) in zs.iter().enumerate() {
-            let o = [0.0, 0.0, z + 1.234_567e-7];
-            if o[2] < lo || o[2] > hi {
-                continue;
+        let first = heights.partition_point(|&z| z < lo);
+        for (n, &z) in heights[first..].iter().enumerate() {
+            if z > hi {
+                break;
             }
+            let (k, o) = (order[first + n], [0.0, 0.0, z]);
             // Moller-Trumbore, the ray o + t (c, s, 0), t > 0.
             let (e1, e2) = (sub(b, a), sub(d, a));
             let dir = [c, s, 0.0];
