@@ -343,3 +343,23 @@ fn the_linuxcnc_program_is_left_for_its_interpreter() {
     }
     common::leave_for_rs274(&out, "thread");
 }
+
+/// A script whose verify map gives the nut's outside as text is refused,
+/// naming the key and the value, and writes nothing.
+#[test]
+fn a_verify_map_with_a_bad_outside_is_refused() {
+    let dir = scratch("thread", "bad-outside");
+    let text = std::fs::read_to_string(SCRIPT).unwrap();
+    let from = "outside_diameter: outside_diameter(p, t),";
+    assert!(text.contains(from));
+    let script = dir.join("thread.rhai");
+    std::fs::write(&script, text.replace(from, "outside_diameter: \"wide\",")).unwrap();
+    let out = dir.join("out");
+    let (code, _, err) = pilgrim(&["run", s(&script), "--out", s(&out), "--quiet"]);
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("outside_diameter must be a number above 0") && err.contains("wide"),
+        "{err}"
+    );
+    assert!(!out.join("program.nc").exists(), "{err}");
+}

@@ -287,7 +287,14 @@ fn verification(m: &Map) -> Result<Verification, Option<String>> {
         limits: Some(profile.limits.clone()),
         part: "thread",
         // A nut's outside, where the script gives it.
-        outside_diameter: m.get("outside_diameter").and_then(number),
+        outside_diameter: match m.get("outside_diameter") {
+            None => None,
+            Some(d) => Some(number(d).filter(|d| *d > 0.0).ok_or_else(|| {
+                Some(format!(
+                    "fn verify(p): outside_diameter must be a number above 0 (the nut's, mm), not {d}"
+                ))
+            })?),
+        },
         section,
     }))
 }
