@@ -20,7 +20,8 @@
 //! **The part** is taken at its largest: the part body of the greatest
 //! volume (the blank where the family gives one), as its envelope of
 //! revolution about its axis (a stack of cylinders as wide as the mesh,
-//! rings where the axis lies outside it, as in a nut's bore:
+//! rings where the axis lies outside it, as in a nut's bore, when the
+//! tool cuts inside a bore:
 //! [`shapes::envelope`]). A clearance to it is smaller than to the part at
 //! that moment by at most the stock, the groove or thread not yet cut, and
 //! twice the mesh tolerance.
@@ -326,7 +327,9 @@ pub fn check(
         ));
     }
     if let Some((name, mesh)) = solids.part {
-        if let Some(shaped) = shapes::envelope(mesh, solids.tolerance) {
+        // The bore counts where the tool cuts inside it.
+        let bore = solids.tool.is_some_and(|(_, t, _)| t.cuts_inside());
+        if let Some(shaped) = shapes::envelope(mesh, solids.tolerance, bore) {
             entities.push(entity(name, shaped, Which::Part, Vec::new(), false, true));
         }
     }

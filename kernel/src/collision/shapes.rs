@@ -197,14 +197,18 @@ const MAX_SLABS: usize = 64;
 /// over its length (and the ring of vertices on either side, which bound
 /// the surface between them), plus `tol` for the chords between vertices.
 /// A slab runs on while the envelope's radius varies by at most `tol`
-/// (coarser if that would take more than [`MAX_SLABS`]). Where the axis is
-/// outside the part in a slab (a nut, a bored part: [`axis_inside`]), the
-/// slab is a ring whose hole is as wide as the mesh's nearest vertex to
+/// (coarser if that would take more than [`MAX_SLABS`]). With `bore`
+/// (the run's tool cuts inside a bore), where the axis is outside the
+/// part in a slab (a nut, a bored part: [`axis_inside`]), the slab is a
+/// ring whose hole is as wide as the mesh's nearest vertex to
 /// the axis there, less `tol` for the chords and `tol` for the ring's own
 /// (convex sectors, [`ring_sectors`]). Conservative for any part; exact to
 /// `2 tol` for a body of revolution (a mandrel, a roll's blank, a thread's
-/// outer cylinder, a nut's bore). `None` for an empty mesh.
-pub fn envelope(mesh: &TriMesh, tol: Real) -> Option<Shaped> {
+/// outer cylinder, a nut's bore). Without `bore` the part is taken whole:
+/// nothing of the machine enters its bore but what rides with it (a
+/// roll's arbor), and a ring's sectors cost every query more than a
+/// cylinder. `None` for an empty mesh.
+pub fn envelope(mesh: &TriMesh, tol: Real, bore: bool) -> Option<Shaped> {
     let mut rings: Vec<(Real, Real)> = mesh
         .positions
         .iter()
@@ -247,10 +251,14 @@ pub fn envelope(mesh: &TriMesh, tol: Real) -> Option<Shaped> {
         band *= 2.0;
         stack = slabs(band);
     }
-    let inside = axis_inside(
-        mesh,
-        &stack.iter().map(|s| (s.0 + s.1) / 2.0).collect::<Vec<_>>(),
-    );
+    let inside = if bore {
+        axis_inside(
+            mesh,
+            &stack.iter().map(|s| (s.0 + s.1) / 2.0).collect::<Vec<_>>(),
+        )
+    } else {
+        vec![true; stack.len()]
+    };
     let mut pieces = Vec::new();
     for ((z0, z1, r), solid) in stack.into_iter().zip(inside) {
         let half = ((z1 - z0) / 2.0).max(1e-6);
@@ -349,10 +357,10 @@ pub fn pose(m: &Mat4) -> Pose {
 mod tests {
     use super::*;
 
-    /// A tube's envelope is a ring: a bar of radius 8 on the axis of a
-    /// 14 mm bore stands 6 mm clear of it (within the mesh's tolerance),
-    /// a bar outside stands off its outside; a solid rod's envelope holds
-    /// its axis.
+    /// A tube's envelope, for a tool inside its bore, is a ring: a bar of
+    /// radius 8 on the axis of a 14 mm bore stands 6 mm clear of it (within
+    /// the mesh's tolerance), a bar outside stands off its outside; for
+    /// other tools it is whole; a solid rod's envelope holds its axis.
     #[test]
     fn a_hollow_parts_envelope_keeps_its_bore() {
         let circle = |r: Real, z: Real| -> Vec<[Real; 3]> {
@@ -369,7 +377,7 @@ mod tests {
         )
         .unwrap();
         let tol = 14.0 * (1.0 - (std::f64::consts::PI / 96.0).cos());
-        let env = envelope(&tube, tol).unwrap();
+        let env = envelope(&tube, tol, true).unwrap();
         let bar = SharedShape::cylinder(40.0, 8.0);
         let at = |x: Real| {
             let m = Mat4::new_translation(&crate::math::Vec3::new(x, 0.0, -15.0)) * along_z();
@@ -384,8 +392,15 @@ mod tests {
             d <= 40.0 - 8.0 - 22.5 && d > 40.0 - 8.0 - 22.5 - 2.0 * tol,
             "{d}"
         );
+        // Taken whole where no tool cuts inside a bore.
+        let whole = envelope(&tube, tol, false).unwrap();
+        let m = Mat4::new_translation(&crate::math::Vec3::new(0.0, 0.0, -15.0)) * along_z();
+        let d = parry3d_f64::query::distance(&pose(&whole.local), &*whole.shape, &pose(&m), &*bar)
+            .unwrap()
+            .distance;
+        assert_eq!(d, 0.0);
         let rod = crate::mesh::sweep(&[circle(22.5, -30.0), circle(22.5, 0.0)]).unwrap();
-        let env = envelope(&rod, tol).unwrap();
+        let env = envelope(&rod, tol, true).unwrap();
         let d = parry3d_f64::query::distance(
             &pose(&env.local),
             &*env.shape,
