@@ -255,8 +255,8 @@ fn a_buttress_is_roughed_along_its_load_flank() {
 
 /// What the family cannot read or cannot yet cut is refused before any
 /// output, naming the value: a designation of no standard, a class the
-/// standard lacks, a drawing's unknown word; an internal or left-hand
-/// thread stops at its check with the FAILED report and no program.
+/// standard lacks, a drawing's unknown word; a nut whose outside is inside
+/// its thread stops at its check with the FAILED report and no program.
 #[test]
 fn bad_threads_are_refused_with_clear_errors() {
     let dir = scratch("thread", "bad");
@@ -282,16 +282,10 @@ fn bad_threads_are_refused_with_clear_errors() {
         assert!(err.contains(says), "{set}: {err}");
         assert!(!out.exists(), "{set}: output written");
     }
-    for (sets, says) in [
-        (
-            &["designation=M30x2-6H", "outside_diameter=29"][..],
-            "the nut's outside is beyond its thread",
-        ),
-        (
-            &["designation=M20x2.5-6g-LH"][..],
-            "the thread is right-handed",
-        ),
-    ] {
+    for (sets, says) in [(
+        &["designation=M30x2-6H", "outside_diameter=29"][..],
+        "the nut's outside is beyond its thread",
+    )] {
         let set = sets.join(" ");
         let out = dir.join(set.replace(|c: char| !c.is_ascii_alphanumeric(), "_"));
         let mut args = vec!["run", SCRIPT, "--out", s(&out), "--quiet"];
@@ -342,6 +336,56 @@ fn the_linuxcnc_program_is_left_for_its_interpreter() {
         );
     }
     common::leave_for_rs274(&out, "thread");
+}
+
+/// A left hand, M20x2.5-6g-LH, posted for LinuxCNC: the spindle in M3,
+/// every thread block runs towards +Z (the tailstock), from beyond the
+/// thread's far end by at least S1 to past the face by at least S2, each
+/// as the cutter's edges reach; the simulation finds it left-handed and
+/// its pitch diameter within 6g (ISO 965-2: 18.164 to 18.334); its solid
+/// winds left. Left for rs274 too.
+#[test]
+fn a_left_hand_is_cut_towards_the_tailstock() {
+    let out = run(
+        "lh",
+        &["--set", "designation=M20x2.5-6g-LH", "--post", "linuxcnc"],
+    );
+    let r = common::report_of(&out);
+    assert_eq!(r["verdict"]["status"], "passed", "{}", r["verdict"]);
+    let v = &r["worm_verification"];
+    assert_eq!(v["hand"], "left");
+    let d2 = v["starts"][0]["pitch_diameter"].as_f64().unwrap();
+    assert!((18.164..=18.334).contains(&d2), "{d2}");
+    let notes = &r["notes"];
+    let (s1, s2) = (
+        notes["s1_mm"].as_f64().unwrap(),
+        notes["s2_mm"].as_f64().unwrap(),
+    );
+    for p in v["passes"].as_array().unwrap() {
+        let (approach, runout) = (
+            p["approach_mm"].as_f64().unwrap(),
+            p["runout_mm"].as_f64().unwrap(),
+        );
+        assert!(approach >= s1 - 1e-6 && runout >= s2 - 1e-6, "{p}");
+    }
+    let ngc = std::fs::read_to_string(out.join("program.ngc")).unwrap();
+    assert!(ngc.contains(" M3") && !ngc.contains("M4"), "{ngc}");
+    let program: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("program.json")).unwrap()).unwrap();
+    let blocks = program["blocks"].as_array().unwrap();
+    let mut threads = 0;
+    for (i, b) in blocks.iter().enumerate() {
+        if b["motion"]["type"] == "thread" {
+            let (from, to) = (
+                blocks[i - 1]["values"][1].as_f64().unwrap(),
+                b["values"][1].as_f64().unwrap(),
+            );
+            assert!(from < -30.0 && to > 0.0, "block {}: {from} to {to}", i + 1);
+            threads += 1;
+        }
+    }
+    assert!(threads > 5, "{threads}");
+    common::leave_for_rs274(&out, "thread-lh");
 }
 
 /// A script whose verify map gives the nut's outside as text is refused,

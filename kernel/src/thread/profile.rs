@@ -14,13 +14,28 @@ use crate::math::Real;
 use serde::{Deserialize, Serialize};
 
 /// The way the thread winds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Hand {
     /// Right-handed: advancing along +Z as it turns about +Z.
+    #[default]
     Right,
     /// Left-handed.
     Left,
+}
+
+impl Hand {
+    /// +1 for a right hand, -1 for a left: the sign of the axial advance
+    /// per turn about +Z. In the axial section at the part's angle 0,
+    /// start `k` of a multi-start thread lies `sign k` pitches along +Z
+    /// from start 0 (a right hand's starts follow one another towards
+    /// +Z as the start angle grows, a left hand's towards -Z).
+    pub fn sign(self) -> Real {
+        match self {
+            Hand::Right => 1.0,
+            Hand::Left => -1.0,
+        }
+    }
 }
 
 /// A diameter's limits (mm).

@@ -31,7 +31,7 @@ use crate::machine::MachineKinematics;
 use crate::math::Real;
 use crate::program::{block_name, AxisProgram};
 use crate::replay::{as_written, replay, VerifyError};
-use crate::thread::ThreadSection;
+use crate::thread::{Hand, ThreadSection};
 use crate::toolpath::Motion;
 use crate::transform::ToolFrame;
 use crate::verdict::{Figure, Finding};
@@ -271,6 +271,9 @@ pub struct WormCheck {
     /// (the nut's inside), the measurement over wires one between balls.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub internal: bool,
+    /// The way the thread winds: its solid's helix.
+    #[serde(default)]
+    pub hand: Hand,
 }
 
 impl WormCheck {
@@ -715,10 +718,26 @@ pub fn simulate(
             );
             continue;
         }
+        // The spindle turns as M3 (the lint refuses any other word): a
+        // block towards -Z cuts a right-hand helix, towards +Z a left.
         let dir = (z1e - z0).signum();
+        let cuts = if dir < 0.0 { Hand::Right } else { Hand::Left };
+        if cuts != w.hand {
+            found(i, format!(
+                "{}: a thread block towards {} with the spindle in M3 cuts a {}-hand helix, and the thread is {}-handed (cut it towards {})",
+                name(),
+                if dir < 0.0 { "-Z (the chuck)" } else { "+Z (the tailstock)" },
+                hand_name(cuts),
+                hand_name(w.hand),
+                if dir < 0.0 { "+Z" } else { "-Z" },
+            ));
+            // Simulated still: the axial section at angle 0 is cut the
+            // same, and a failed run shows every pass.
+        }
         let z_sec = z0 - dir * l * start_deg / 360.0;
         let k_raw = ((z_sec - c0) / px).round();
-        let start = (k_raw as i64).rem_euclid(i64::from(z1)) as u32;
+        // Start k lies `sign k` pitches from start 0 (see `Hand::sign`).
+        let start = ((w.hand.sign() * k_raw) as i64).rem_euclid(i64::from(z1)) as u32;
         let offset = z_sec - (c0 + k_raw * px);
         let zw = w0 + (z_sec - w0).rem_euclid(lead);
         let section = cutter.section(r_a + 1.0 - r1);
@@ -889,8 +908,17 @@ pub fn simulate(
         section: material,
         window: (w0, lead),
         internal: false,
+        hand: w.hand,
     };
     Ok(if inside { check.mirrored() } else { check })
+}
+
+/// A hand as a message names it.
+fn hand_name(h: Hand) -> &'static str {
+    match h {
+        Hand::Right => "right",
+        Hand::Left => "left",
+    }
 }
 
 /// A diameter of the section from a radius of the simulation's, which is
@@ -1088,7 +1116,10 @@ fn measure(
     let samples = 21;
     let mut out = Vec::new();
     'starts: for k in 0..w.starts {
-        let c = c0 + Real::from(k) * px;
+        // Start k lies `sign k` pitches from start 0 (`Hand::sign`), the
+        // same modulo the lead as the window's place for it.
+        let place = (w.hand.sign() as i64 * i64::from(k)).rem_euclid(i64::from(w.starts));
+        let c = c0 + place as Real * px;
         let space = |r: Real| {
             space_edges(m, r, c).ok_or_else(|| {
                 fail(format!(
@@ -1275,6 +1306,18 @@ mod tests {
         aim: Real,
         order: FlankOrder,
     ) -> Result<WormCheck, VerifyError> {
+        cut_towards(profile, aim, order, -1.0)
+    }
+
+    /// [`cut`], the thread blocks towards -Z (`towards` -1, from 5 mm
+    /// beyond the face) or +Z (+1, from 5 mm beyond the thread's far
+    /// end), each start at its start angle.
+    fn cut_towards(
+        profile: &ThreadProfile,
+        aim: Real,
+        order: FlankOrder,
+        towards: Real,
+    ) -> Result<WormCheck, VerifyError> {
         // The blank turned to the middle of the crest's band.
         let s = profile.section.opening();
         let t = &ThreadSection {
@@ -1295,7 +1338,8 @@ mod tests {
             starts_by_depth: true,
         };
         let passes = plan(t, &cutter, &settings).unwrap();
-        let (length, c0, rpm) = (30.0, 5.0, 300.0);
+        let (length, rpm) = (30.0, 300.0);
+        let c0 = if towards < 0.0 { 5.0 } else { -length - 5.0 };
         let r_crest = t.crest_diameter / 2.0;
         let mut blocks = Vec::new();
         let block = |motion, x: Real, z: Real, feed: Real| Block {
@@ -1311,13 +1355,13 @@ mod tests {
         for p in &passes {
             let r = r_crest - s * p.cumulative;
             let zs = c0 + p.offset;
-            let ze = -length - 5.0;
+            let ze = if towards < 0.0 { -length - 5.0 } else { 5.0 };
             blocks.push(block(Motion::Rapid, clear, zs, 0.0));
             blocks.push(block(Motion::Rapid, r, zs, 0.0));
             blocks.push(block(
                 Motion::Thread {
                     lead: t.lead(),
-                    start_deg: 0.0,
+                    start_deg: 360.0 * Real::from(p.start) / Real::from(t.starts),
                 },
                 r,
                 ze,
@@ -1478,6 +1522,61 @@ mod tests {
             e.contains("start 1: pitch diameter 28.65")
                 && e.contains("outside 28.7010 to 28.9250 mm (ISO 965-1 6H)"),
             "{e}"
+        );
+    }
+
+    /// A left hand, two starts (M20x5(P2.5)-6g-LH): cut towards +Z with
+    /// the spindle in M3, each start at its angle, both starts' pitch
+    /// diameters hold 6g, and each start is found where its angle puts it
+    /// (start 2 a pitch towards -Z of start 1 in the section at angle 0).
+    /// Cut towards -Z, each block is refused naming the hand it cuts. Its
+    /// solid winds left: the section at +90 degrees is the one at 0
+    /// shifted a quarter lead towards -Z.
+    #[test]
+    fn a_left_hand_is_cut_towards_the_tailstock() {
+        let lh = standards::metric(20.0, 2.5, false, "6g", 2, Hand::Left).unwrap();
+        let check = cut_towards(&lh, 0.1, FlankOrder::Alternating, 1.0).unwrap();
+        assert_eq!(check.hand, Hand::Left);
+        let check = check.verified().unwrap();
+        assert_eq!(check.starts.len(), 2);
+        for s in &check.starts {
+            assert!((s.pitch_diameter - 18.276).abs() < 2e-3, "{s:?}");
+            assert!(s.position_error.abs() < 1e-3, "{s:?}");
+        }
+        // Every pass cut the start its angle names, at its own space.
+        for p in &check.passes {
+            assert!(p.offset.abs() < 1.0, "{p:?}");
+        }
+        assert!(check.passes.iter().any(|p| p.start == 1));
+        let wrong = cut_towards(&lh, 0.1, FlankOrder::Alternating, -1.0).unwrap();
+        let e = wrong.verified().unwrap_err().to_string();
+        assert!(
+            e.contains("towards -Z (the chuck) with the spindle in M3 cuts a right-hand helix, and the thread is left-handed"),
+            "{e}"
+        );
+        // The solid: a vertex at angle phi lies on the section at 0
+        // shifted by -lead phi / 2 pi (a right hand's, +).
+        let solid = crate::worm::worm_solid(&check, 30.0, 0.01, None).unwrap();
+        solid.check_closed().unwrap();
+        let (w0, lead) = check.window;
+        let mut worst: Real = 0.0;
+        for p in &solid.positions {
+            let (r, phi) = (p[0].hypot(p[1]), p[1].atan2(p[0]));
+            if r > 1.0 && p[2] < -1.0 && p[2] > -29.0 {
+                let z = p[2] + lead * phi / std::f64::consts::TAU;
+                worst = worst.max((check.radius_at(w0 + (z - w0).rem_euclid(lead)) - r).abs());
+            }
+        }
+        assert!(worst < 0.02, "{worst}");
+        let sweep = crate::worm::WormSweep::new(&check, 30.0, 2.5e-4, None).unwrap();
+        use crate::step::Sections;
+        let q = sweep.point(0, 0.5, 0.5);
+        let phi = q[1].atan2(q[0]);
+        let z = q[2] + lead * phi / std::f64::consts::TAU;
+        let r = q[0].hypot(q[1]);
+        assert!(
+            (check.radius_at(w0 + (z - w0).rem_euclid(lead)) - r).abs() < 0.02,
+            "{r}"
         );
     }
 

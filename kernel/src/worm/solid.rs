@@ -1,7 +1,9 @@
 //! The finished worm as a closed solid: the simulated section swept
 //! helically, right-handed about +Z (the section at the part's angle
 //! `phi` is the one at 0 shifted `+lead phi / 2 pi` along the axis), from
-//! z = -length to 0, with flat ends.
+//! z = -length to 0, with flat ends. A left hand is the right hand's
+//! mirror in the plane y = 0, which holds the section at angle 0: the
+//! section at `phi` is the one at 0 shifted `-lead phi / 2 pi`.
 //!
 //! The rings are sections across the axis; a ring's points are `n` angles
 //! round the axis, the rings evenly spaced from -length to 0 as near
@@ -40,6 +42,7 @@ pub fn worm_solid(
     crate::math::positive("mesh tolerance", tol)
         .map_err(|e| MeshError::Degenerate(e.to_string()))?;
     let (w0, lead) = check.window;
+    let hand = check.hand.sign();
     let outline = check.outline();
     let r_thread = outline.iter().map(|p| p[1]).fold(0.0, Real::max);
     let nut = nut_radius(check, outside, r_thread)?;
@@ -79,7 +82,7 @@ pub fn worm_solid(
                 .map(|k| {
                     let phi = TAU * k as Real / n as Real;
                     let r = radius(z - lead * phi / TAU);
-                    [r * phi.cos(), r * phi.sin(), z]
+                    [r * phi.cos(), hand * r * phi.sin(), z]
                 })
                 .collect()
         })
@@ -97,7 +100,8 @@ pub fn worm_solid(
                     (0..n)
                         .map(|k| {
                             let phi = TAU * k as Real / n as Real;
-                            [r * phi.cos(), r * phi.sin(), z]
+                            // Wound as the hole's rings.
+                            [r * phi.cos(), hand * r * phi.sin(), z]
                         })
                         .collect()
                 })
@@ -140,6 +144,8 @@ pub struct WormSweep {
     points: Vec<[Real; 2]>,
     lead: Real,
     length: Real,
+    /// +1 for a right hand, -1 for a left (the right's mirror in y = 0).
+    hand: Real,
     /// The largest radial distance of a dropped point from the outline
     /// kept (mm).
     simplified: Real,
@@ -211,6 +217,7 @@ impl WormSweep {
             points,
             lead,
             length,
+            hand: check.hand.sign(),
             simplified,
             outside,
         })
@@ -237,7 +244,7 @@ impl crate::step::Sections for WormSweep {
         let (s, r) = (a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1]));
         let z = -self.length + v * self.length;
         let phi = TAU * (z - s) / self.lead;
-        [r * phi.cos(), r * phi.sin(), z]
+        [r * phi.cos(), self.hand * r * phi.sin(), z]
     }
 
     fn along(&self) -> usize {
