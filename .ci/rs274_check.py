@@ -6,7 +6,9 @@ program; it must say nothing but "executing", its canonical output must
 end the program, and every spindle-synchronised move
 (START_SPEED_FEED_SYNC then STRAIGHT_FEED) must have the lead and the
 place (X as a radius: the program is on diameter, G7) of the axis
-program's thread blocks, in order, within the program's 0.001 mm.
+program's thread blocks, in order, within the program's 0.001 mm; and
+every move, rapid or cut, must be the axis program's block in order (a
+threading cycle's moves, G76, as LinuxCNC makes them).
 """
 import json
 import pathlib
@@ -60,6 +62,22 @@ def check(d):
         synced += 1
     if synced != len(threads):
         return f"{synced} synchronised moves for {len(threads)} thread blocks"
+    # Every move, rapid or cut, in order: a threading cycle's (G76) as the
+    # axis program's blocks hold the moves it makes. An axis a block keeps
+    # (not yet written) stands where it is.
+    moves = [l for l in canon if "STRAIGHT_TRAVERSE(" in l or "STRAIGHT_FEED(" in l]
+    blocks = program["blocks"]
+    if len(moves) != len(blocks):
+        return f"{len(moves)} moves read, the axis program has {len(blocks)} blocks"
+    for n, (line, b) in enumerate(zip(moves, blocks)):
+        rapid = "STRAIGHT_TRAVERSE(" in line
+        if rapid != (b["motion"]["type"] == "rapid"):
+            return f"move {n + 1} is {'a rapid' if rapid else 'a feed'}, the axis program's block {n + 1} a {b['motion']['type']}"
+        x, _, z = args(line)[:3]
+        keep = b.get("keep", [])
+        for name, got, want in (("X", x, b["values"][0] / 2.0), ("Z", z, b["values"][1])):
+            if name not in keep and abs(got - want) > 1e-3:
+                return f"move {n + 1}: {name} {got}, the axis program's block {n + 1} says {want}"
     return None
 
 

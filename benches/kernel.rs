@@ -179,6 +179,7 @@ fn circle_program(n: usize) -> pilgrim_kernel::program::AxisProgram {
         axes: vec![axis("X"), axis("Y"), axis("Z")],
         blocks,
         setup: ProgramSetup::default(),
+        cycles: Vec::new(),
     }
 }
 

@@ -388,6 +388,79 @@ fn a_left_hand_is_cut_towards_the_tailstock() {
     common::leave_for_rs274(&out, "thread-lh");
 }
 
+/// LinuxCNC's G76 (`cycle = g76`) on the lathe with a LinuxCNC control,
+/// Tr40x14(P7): the program the control reads holds one G76 per start and
+/// no G33; the run verifies the moves the cycle makes (the lint's
+/// expansion, which rs274 holds to LinuxCNC's own in CI), each start's
+/// pitch diameter within its stated limits; the same passes posted for
+/// Fanuc are G32 blocks, one per cycle pass. The file verified as it
+/// stands passes; with a tapered end (E) it is refused, naming the word.
+#[test]
+fn a_g76_cycle_is_verified_as_the_control_makes_it() {
+    let dir = scratch("thread", "g76-machine");
+    let (code, toml, err) = pilgrim(&["machines", "--toml", "fanuc-0i-tc"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(toml.contains("control = \"fanuc\""), "{toml}");
+    let machine = dir.join("lathe.toml");
+    std::fs::write(
+        &machine,
+        toml.replace("control = \"fanuc\"", "control = \"linuxcnc\""),
+    )
+    .unwrap();
+    let sets = ["--set", "cycle=g76", "--set", "designation=Tr40x14(P7)"];
+    let mut args = vec!["--machine", s(&machine), "--post", "fanuc"];
+    args.extend(sets);
+    let out = run("g76", &args);
+    let r = common::report_of(&out);
+    assert_eq!(r["verdict"]["status"], "passed", "{}", r["verdict"]);
+    let ngc = std::fs::read_to_string(out.join("program.ngc")).unwrap();
+    let cycles: Vec<&str> = ngc.lines().filter(|l| l.contains(" G76 P")).collect();
+    assert!(cycles.len() == 2 && !ngc.contains("G33"), "{ngc}");
+    for c in &cycles {
+        assert_eq!(word(c, 'P'), Some(14.0), "{c}");
+        assert_eq!(word(c, 'Q'), Some(14.5), "{c}");
+    }
+    let v = &r["worm_verification"];
+    let l = &v["limits"]["pitch_diameter"];
+    let (lo, hi) = (l["min"].as_f64().unwrap(), l["max"].as_f64().unwrap());
+    let starts = v["starts"].as_array().unwrap();
+    assert_eq!(starts.len(), 2);
+    for st in starts {
+        let d2 = st["pitch_diameter"].as_f64().unwrap();
+        assert!(lo <= d2 && d2 <= hi, "{lo} {d2} {hi}");
+    }
+    let passes = v["passes"].as_array().unwrap().len();
+    let nc = std::fs::read_to_string(out.join("program.nc")).unwrap();
+    assert_eq!(nc.matches("G32 ").count(), passes, "{nc}");
+    common::leave_for_rs274(&out, "thread-g76");
+    let verify = |file: &std::path::Path, name: &str| {
+        let report = dir.join(name);
+        let mut args = vec![
+            "verify",
+            s(file),
+            "--machine",
+            s(&machine),
+            "--family",
+            SCRIPT,
+            "--out",
+            s(&report),
+            "--quiet",
+        ];
+        args.extend(sets);
+        pilgrim(&args)
+    };
+    let (code, _, err) = verify(&out.join("program.ngc"), "as-it-stands");
+    assert_eq!(code, 0, "{err}");
+    let tapered = dir.join("tapered.ngc");
+    std::fs::write(&tapered, ngc.replacen(" H2\n", " H2 E1.0\n", 1)).unwrap();
+    let (code, _, err) = verify(&tapered, "tapered");
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("G76 E1") && err.contains("tapered ends"),
+        "{err}"
+    );
+}
+
 /// A script whose verify map gives the nut's outside as text is refused,
 /// naming the key and the value, and writes nothing.
 #[test]

@@ -113,6 +113,7 @@ fn read_nc(nc: &str, rpm: f64) -> AxisProgram {
         axes: vec![axis("X"), axis("Z")],
         blocks,
         setup: Default::default(),
+        cycles: Vec::new(),
     }
 }
 

@@ -97,6 +97,24 @@ pub struct Toolpath {
     /// What the family warns of (the run goes on).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
+    /// Runs of passes a control's threading cycle makes: a program writes
+    /// each as its cycle where its dialect has it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cycles: Vec<PassCycle>,
+}
+
+/// Passes `first_pass..first_pass + passes` of a toolpath: the moves a
+/// threading cycle makes from where the pass before them ends (the
+/// program holds each move as a block, and [`crate::program::cycle`]
+/// checks that they are the cycle's).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PassCycle {
+    /// The first pass the cycle makes (from 0).
+    pub first_pass: usize,
+    /// How many passes.
+    pub passes: usize,
+    /// The cycle's words.
+    pub cycle: crate::program::cycle::ThreadCycle,
 }
 
 /// A chart a run draws (`<file>.svg`) from one of the toolpath's tables:
@@ -186,6 +204,7 @@ impl Toolpath {
             tables: BTreeMap::new(),
             plots: Vec::new(),
             warnings: Vec::new(),
+            cycles: Vec::new(),
         }
     }
 

@@ -357,6 +357,7 @@ fn at_place(program: &AxisProgram, place: PosePlace) -> Result<AxisProgram, Scen
         axes: program.axes.clone(),
         blocks: vec![block],
         setup: program.setup.clone(),
+        cycles: Vec::new(),
     })
 }
 

@@ -201,6 +201,7 @@ fn assemble(read: ReadText, frame: &AxisProgram) -> TextProgram {
         axes: written.iter().map(|&i| frame.axes[i].clone()).collect(),
         blocks,
         setup: frame.setup.clone(),
+        cycles: Vec::new(),
     };
     TextProgram { program, lines }
 }
@@ -599,7 +600,7 @@ fn lint_gcode(
                         return Err(fault(place(k), not_read(reading, d, 'G', &g.number)));
                     }
                     match n {
-                        0 | 1 | 32 | 33 => motion_here = Some(n),
+                        0 | 1 | 32 | 33 | 76 => motion_here = Some(n),
                         97 => st.constant_speed = true,
                         // LinuxCNC's diameter (G7) and radius (G8) modes.
                         7 | 8 => radial_here.push(n == 7),
@@ -704,6 +705,133 @@ fn lint_gcode(
                 ));
             }
             st.feed_group = true;
+        }
+        // A threading cycle (LinuxCNC's G76): the moves it makes, each
+        // held and read as a block of its own.
+        if motion_here == Some(76) {
+            let (cycle, end_x) = cycle_words(&read, d).map_err(|m| fault(place(k), m))?;
+            let needs = [
+                (
+                    !st.spindle_on,
+                    "a threading cycle with the spindle stopped (no M3)".to_owned(),
+                ),
+                (
+                    !st.speed.is_some_and(|v| v >= 1.0),
+                    "a threading cycle with no spindle speed S written".to_owned(),
+                ),
+                (
+                    d.reading.thread_needs_constant_speed && !st.constant_speed,
+                    "a threading cycle before constant spindle speed (G97)".to_owned(),
+                ),
+                (
+                    program.setup.coolant && !st.coolant,
+                    format!(
+                        "a threading cycle with the coolant off ({} not written)",
+                        d.coolant.0
+                    ),
+                ),
+                (
+                    d.radial_words.is_some()
+                        && program.setup.radial.is_some()
+                        && st.radial.is_none(),
+                    "a threading cycle before the radial axis's programming is set".to_owned(),
+                ),
+            ];
+            if let Some((_, m)) = needs.into_iter().find(|(bad, _)| *bad) {
+                return Err(fault(place(k), m));
+            }
+            let (Some(xi), Some(zi)) = (
+                names.iter().position(|n| *n == 'X'),
+                names.iter().position(|n| *n == 'Z'),
+            ) else {
+                return Err(fault(
+                    place(k),
+                    format!(
+                        "a threading cycle on {}, which programs no X and Z",
+                        program.machine
+                    ),
+                ));
+            };
+            let (Some(x0), Some(z0)) = (st.values[xi], st.values[zi]) else {
+                return Err(fault(
+                    place(k),
+                    "a threading cycle before X and Z are written (the drive line it starts from)"
+                        .into(),
+                ));
+            };
+            let moves = super::cycle::expand(&cycle, [x0, z0], st.radial == Some(true), end_x)
+                .map_err(|m| fault(place(k), m))?;
+            let comment = comments[comment_from.min(line)..line]
+                .iter()
+                .rev()
+                .find_map(Clone::clone);
+            comment_from = line + 1;
+            for (n, mv) in moves.iter().enumerate() {
+                let b = if reading { None } else { program.blocks.get(k) };
+                if !reading && b.is_none() {
+                    return Err(fault(
+                        at_line(line),
+                        format!(
+                            "the threading cycle's move {} is beyond the axis program's {} blocks",
+                            n + 1,
+                            program.blocks.len()
+                        ),
+                    ));
+                }
+                let mut values = st.values.clone();
+                values[xi] = Some(mv.x);
+                values[zi] = Some(mv.z);
+                if let Some(b) = b {
+                    let off = (0..names.len())
+                        .find(|&i| values[i].is_some_and(|v| !((v - b.values[i]).abs() <= half)));
+                    if b.motion != mv.motion || off.is_some() {
+                        return Err(fault(
+                            place(k),
+                            format!(
+                                "the threading cycle's move {} is {:?} to X{} Z{}, the axis program's {:?} to X{} Z{}",
+                                n + 1,
+                                mv.motion,
+                                crate::math::fixed(mv.x, decimals + 2),
+                                crate::math::fixed(mv.z, decimals + 2),
+                                b.motion,
+                                crate::math::fixed(b.values[xi], decimals + 2),
+                                crate::math::fixed(b.values[zi], decimals + 2)
+                            ),
+                        ));
+                    }
+                }
+                for (i, v) in [(xi, mv.x), (zi, mv.z)] {
+                    if let Some(a) = axes.iter().find(|a| a.name == program.axes[i].name) {
+                        let (lo, hi) = (a.to_user(a.min), a.to_user(a.max));
+                        if v < lo - half || v > hi + half {
+                            return Err(fault(
+                                place(k),
+                                format!(
+                                    "the threading cycle's move {} takes {} to {v}, outside the axis's travel [{lo}, {hi}]",
+                                    n + 1,
+                                    program.axes[i].name
+                                ),
+                            ));
+                        }
+                    }
+                }
+                st.values = values;
+                out.blocks.push(ReadBlock {
+                    motion: mv.motion,
+                    values: st.values.clone(),
+                    feed: match mv.motion {
+                        Motion::Thread { lead, .. } => lead * st.speed.unwrap_or_default(),
+                        _ => 0.0,
+                    },
+                    spindle: if n == 0 { speed_next.take() } else { None },
+                    comment: if n == 0 { comment.clone() } else { None },
+                    number: block.line_number,
+                    line,
+                });
+                k += 1;
+            }
+            st.motion = Some(76);
+            continue;
         }
         let mut lead_here = None;
         let mut s_here = None;
@@ -824,6 +952,12 @@ fn lint_gcode(
                 "a move before any motion word (G0, G1)".into(),
             ));
         };
+        if m == 76 {
+            return Err(fault(
+                place(k),
+                "a move under a threading cycle's modal G76 without its words: write G0 or G1 first".into(),
+            ));
+        }
         let is_thread = m == 32 || m == 33;
         if let Some(b) = b {
             let want = match b.motion {
@@ -1021,6 +1155,66 @@ fn lint_gcode(
         lines: lines.len(),
     };
     Ok(out)
+}
+
+/// A threading cycle's words as read (`read`, its block's letters and
+/// values): the cycle and the block's X, where it writes one (where the
+/// cycle leaves the tool). LinuxCNC's defaults: `R` 1, `Q` not given
+/// (-1, no compound), `H` 0.
+///
+/// # Failures
+/// A word missing or given twice, `H` not a whole number, the tapered
+/// ends (`E`, `L`), which are not simulated, or a word the cycle has not.
+fn cycle_words(
+    read: &[(char, Real)],
+    d: &Dialect,
+) -> Result<(super::cycle::ThreadCycle, Option<Real>), String> {
+    let mut seen: Vec<char> = Vec::new();
+    let mut get = |c: char| -> Result<Option<Real>, String> {
+        let mut found = read.iter().filter(|(l, _)| *l == c).map(|(_, v)| *v);
+        let v = found.next();
+        if found.next().is_some() {
+            return Err(format!("G76 gives {c} twice"));
+        }
+        seen.push(c);
+        Ok(v)
+    };
+    let need = |c: char, v: Option<Real>| v.ok_or_else(|| format!("G76 without its {c} word"));
+    let pitch = need('P', get('P')?)?;
+    let z = need('Z', get('Z')?)?;
+    let i = need('I', get('I')?)?;
+    let j = need('J', get('J')?)?;
+    let k = need('K', get('K')?)?;
+    let r = get('R')?.unwrap_or(1.0);
+    let q = get('Q')?.unwrap_or(-1.0);
+    let h = get('H')?.unwrap_or(0.0);
+    let end_x = get('X')?;
+    if !(h >= 0.0 && h.fract() == 0.0 && h <= 1000.0) {
+        return Err(format!(
+            "G76 H{h}: the spring passes must be a whole number from 0 to 1000"
+        ));
+    }
+    if let Some((c, v)) = read.iter().find(|(l, _)| !seen.contains(l)) {
+        return Err(match c {
+            'E' | 'L' => format!(
+                "G76 {c}{v}: the cycle's tapered ends, which the verification does not simulate; verify a program without them"
+            ),
+            _ => format!("G76 {c}{v}: not a word of {}'s threading cycle", d.name),
+        });
+    }
+    Ok((
+        super::cycle::ThreadCycle {
+            pitch,
+            z,
+            i,
+            j,
+            r,
+            k,
+            q,
+            h: h as u32,
+        },
+        end_x,
+    ))
 }
 
 /// Why the reader refuses the word `letter number` in `d`: in a program
@@ -1652,5 +1846,95 @@ mod tests {
             "GOTO/50.000,-60.000",
             &["block 6", "a feed move"],
         );
+    }
+    /// A threading cycle: LinuxCNC writes the run of blocks it makes as
+    /// one G76 block, which the lint expands and holds move by move to
+    /// the axis program, and a reader takes as those moves; Fanuc writes
+    /// the same moves as blocks. A word changed in the text, a tapered
+    /// end, a word given twice, a bare move under G76's modal motion are
+    /// refused, named.
+    #[test]
+    fn a_threading_cycle_is_written_read_and_held() {
+        use crate::program::cycle::{expand, CycleSpan, ThreadCycle};
+        let c = ThreadCycle {
+            pitch: 2.5,
+            z: -35.0,
+            i: -4.0,
+            j: 0.6,
+            r: 2.0,
+            k: 3.0,
+            q: 29.5,
+            h: 1,
+        };
+        let mut p = program();
+        let block =
+            |motion: Motion, x: Real, z: Real, comment: Option<&str>| crate::program::Block {
+                motion,
+                values: vec![x, z],
+                feed: if motion == Motion::Rapid {
+                    0.0
+                } else {
+                    2.5 * 399.4
+                },
+                spindle: None,
+                comment: comment.map(str::to_owned),
+                keep: Vec::new(),
+                number: None,
+            };
+        let moves = expand(&c, [24.0, 5.0], false, None).unwrap();
+        p.blocks = std::iter::once(block(Motion::Rapid, 24.0, 5.0, Some("drive line")))
+            .chain(moves.iter().map(|m| block(m.motion, m.x, m.z, None)))
+            .chain([block(Motion::Rapid, 50.0, -35.0, Some("away"))])
+            .collect();
+        p.cycles = vec![CycleSpan {
+            first: 1,
+            count: moves.len(),
+            cycle: c.clone(),
+        }];
+        let text = post(&p, &LINUXCNC).unwrap();
+        assert!(
+            text.contains(
+                "N20 G76 P2.5000 Z-35.000 I-4.0000 J0.6000 R2.0000 K3.0000 Q29.5000 H1\n"
+            ) && !text.contains("G33"),
+            "{text}"
+        );
+        let n_after = 10 + 10 * (1 + moves.len());
+        assert!(text.contains(&format!("N{n_after} G0 X50.000\n")), "{text}");
+        let linted = lint(&text, &p, &LINUXCNC, &axes()).unwrap();
+        assert_eq!(linted.moves, p.blocks.len());
+        let mut frame = p.clone();
+        frame.blocks.clear();
+        frame.cycles.clear();
+        let got = read(&text, &frame, &LINUXCNC, &axes()).unwrap().program;
+        assert_eq!(got.blocks.len(), p.blocks.len());
+        for (g, want) in got.blocks.iter().zip(&p.blocks) {
+            assert_eq!(g.motion, want.motion);
+            for (a, b) in g.values.iter().zip(&want.values) {
+                assert!((a - b).abs() < 1e-9, "{a} {b}");
+            }
+        }
+        // Fanuc has no such cycle: the moves as blocks, linted as ever.
+        let f = post(&p, &FANUC).unwrap();
+        assert!(!f.contains("G76") && f.matches("G32").count() == 26, "{f}");
+        lint(&f, &p, &FANUC, &axes()).unwrap();
+        for (from, to, says) in [
+            ("J0.6000", "J0.6100", "the threading cycle's move"),
+            (" H1\n", " H1 E1.0\n", "tapered ends"),
+            (" H1\n", " H1 J0.7\n", "G76 gives J twice"),
+            (" I-4.0000", "", "G76 without its I word"),
+            (
+                "G0 X50.000",
+                "X50.000",
+                "under a threading cycle's modal G76",
+            ),
+        ] {
+            let bad = text.replacen(from, to, 1);
+            let e = lint(&bad, &p, &LINUXCNC, &axes()).unwrap_err().to_string();
+            assert!(e.contains(says), "{to}: {e}");
+            let e = read(&bad, &frame, &LINUXCNC, &axes());
+            if from != "J0.6000" {
+                assert!(e.is_err_and(|e| e.to_string().contains(says)), "{to}");
+            }
+        }
     }
 }

@@ -8,6 +8,7 @@
 //! and axis), and written as text by a [`PostProcessor`]: the shared writer
 //! in a control's dialect ([`post()`]), or a plugin's own.
 
+pub mod cycle;
 pub mod lint;
 pub mod post;
 
@@ -36,6 +37,15 @@ pub enum ProgramError {
         /// The block, as the program names it.
         block: String,
         /// What failed.
+        message: String,
+    },
+    /// A toolpath's threading cycle whose passes are not the moves the
+    /// cycle makes, or that the program cannot hold.
+    #[error("{block}: {message}")]
+    Cycle {
+        /// The block, as the program names it.
+        block: String,
+        /// What is wrong.
         message: String,
     },
     /// The machine's kinematics failed as a whole.
@@ -583,6 +593,14 @@ pub fn build(
     let names: Vec<&str> = columns.iter().map(|(a, _)| a.name.as_str()).collect();
     let blocks = with_start_and_end(blocks, &names, &info.setup);
     let name_of = |i: usize| name_in(&info.control, &blocks, i);
+    let cycles = cycle_spans(
+        toolpath,
+        &blocks,
+        start_blocks(&info.setup),
+        &names,
+        info,
+        &name_of,
+    )?;
     check_spindle(info, &blocks, toolpath.spindle_rpm, &name_of)?;
     let min = info.min_feed.unwrap_or(MIN_FEED).max(MIN_FEED);
     if let Some((i, b)) = blocks
@@ -670,7 +688,120 @@ pub fn build(
             .collect(),
         blocks,
         setup: info.setup.clone(),
+        cycles,
     })
+}
+
+/// The toolpath's threading cycles as runs of the program's `blocks`
+/// (the toolpath's own start `offset` blocks after the program's start),
+/// each checked to be the moves its cycle makes from the block before
+/// it: X and Z as the cycle puts them (X on diameter where the machine's
+/// setup programs it so), every other axis standing, within 1 um.
+fn cycle_spans(
+    toolpath: &Toolpath,
+    blocks: &[Block],
+    offset: usize,
+    names: &[&str],
+    info: &MachineInfo,
+    name_of: &dyn Fn(usize) -> String,
+) -> Result<Vec<cycle::CycleSpan>, ProgramError> {
+    let ranges: Vec<std::ops::Range<usize>> = toolpath.pass_ranges().map(|(_, r)| r).collect();
+    let diameter = info.setup.radial == Some(pilgrim_plugin_abi::types::Radial::Diameter);
+    let (Some(x), Some(z)) = (
+        names.iter().position(|n| *n == "X"),
+        names.iter().position(|n| *n == "Z"),
+    ) else {
+        return match toolpath.cycles.first() {
+            None => Ok(Vec::new()),
+            Some(_) => Err(ProgramError::Machine {
+                machine: info.name.clone(),
+                message:
+                    "a threading cycle needs the axes X and Z, which the machine does not program"
+                        .into(),
+            }),
+        };
+    };
+    let mut spans: Vec<cycle::CycleSpan> = Vec::new();
+    for c in &toolpath.cycles {
+        let (first, last) = (c.first_pass, c.first_pass + c.passes);
+        let bad = |block: usize, message: String| ProgramError::Cycle {
+            block: name_of(block),
+            message,
+        };
+        if c.passes == 0 || last > ranges.len() {
+            return Err(bad(
+                offset,
+                format!(
+                    "a threading cycle over passes {} to {last}, of the toolpath's {}",
+                    first + 1,
+                    ranges.len()
+                ),
+            ));
+        }
+        let span = offset + ranges[first].start..offset + ranges[last - 1].end;
+        if span.start == 0
+            || spans
+                .last()
+                .is_some_and(|s| s.first + s.count > span.start - 1)
+        {
+            return Err(bad(
+                span.start,
+                "a threading cycle with no move of its own before it (the drive line it starts from)".into(),
+            ));
+        }
+        if cycle::as_written(&c.cycle) != c.cycle {
+            return Err(bad(
+                span.start,
+                format!(
+                    "the threading cycle's words are not as a program writes them ({}): round them with the cycle's own rounding",
+                    cycle::words(&c.cycle)
+                ),
+            ));
+        }
+        let before = &blocks[span.start - 1];
+        let moves = cycle::expand(
+            &c.cycle,
+            [before.values[x], before.values[z]],
+            diameter,
+            None,
+        )
+        .map_err(|m| bad(span.start, m))?;
+        if moves.len() != span.len() {
+            return Err(bad(
+                span.start,
+                format!(
+                    "the threading cycle makes {} moves, its passes hold {}",
+                    moves.len(),
+                    span.len()
+                ),
+            ));
+        }
+        for (i, m) in span.clone().zip(&moves) {
+            let b = &blocks[i];
+            let stands = (0..names.len())
+                .filter(|&k| k != x && k != z)
+                .all(|k| (b.values[k] - before.values[k]).abs() <= 1e-6);
+            if b.motion != m.motion
+                || (b.values[x] - m.x).abs() > 1e-6
+                || (b.values[z] - m.z).abs() > 1e-6
+                || !stands
+            {
+                return Err(bad(
+                    i,
+                    format!(
+                        "{:?} to X{} Z{}, where the threading cycle makes {:?} to X{} Z{}",
+                        b.motion, b.values[x], b.values[z], m.motion, m.x, m.z
+                    ),
+                ));
+            }
+        }
+        spans.push(cycle::CycleSpan {
+            first: span.start,
+            count: span.len(),
+            cycle: c.cycle.clone(),
+        });
+    }
+    Ok(spans)
 }
 
 /// `blocks` (the toolpath's) with the setup's start before them and its end
@@ -873,6 +1004,7 @@ pub fn frame(info: &MachineInfo) -> AxisProgram {
             .collect(),
         blocks: Vec::new(),
         setup: info.setup.clone(),
+        cycles: Vec::new(),
     }
 }
 
@@ -920,6 +1052,7 @@ pub(crate) fn test_program() -> AxisProgram {
             block(Motion::Rapid, [50.0, -60.0], 0.0, None),
         ],
         setup: ProgramSetup::default(),
+        cycles: Vec::new(),
     }
 }
 

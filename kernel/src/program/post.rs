@@ -13,7 +13,7 @@
 //! |---|---|---|---|---|
 //! | `sinumerik` (840D) | `.mpf`, `%_N_<NAME>_MPF` | `N1`.. before the moves, move `i` (from 0) is `N(10 + 10 i)` | `; text` | `G0 G1 G33 K<lead> SF=<start>` |
 //! | `fanuc` (0i) | `.nc`, `%` `O<number>` ... `%` (number 0: a block to paste after the tool call) | none (5-digit N would overflow) | `(TEXT)` | `G00 G01 G32 F<lead> Q<start, 0.001 deg>` |
-//! | `linuxcnc` | `.ngc`, `%` ... `%` | as Sinumerik | `(text)` | `G0 G1 G33 K<lead>` |
+//! | `linuxcnc` | `.ngc`, `%` ... `%` | as Sinumerik | `(text)` | `G0 G1 G33 K<lead>`, `G76 P Z I J R K Q H` for a threading cycle's blocks |
 //! | `cld` (APT) | `.cld` | none | `PPRINT/text` | `RAPID`, `FEDRAT/`, `GOTO/` |
 //!
 //! The machine's [`ProgramSetup`] becomes words of the dialect: the work
@@ -119,6 +119,10 @@ pub struct Dialect {
     /// control has no word for it (then a program with one is refused,
     /// and a multi-start thread shifts its starts along Z instead).
     pub thread_start: Option<ThreadStart>,
+    /// The word of the threading cycle the dialect writes for a run of
+    /// blocks a cycle makes ([`super::cycle`]: LinuxCNC's `G76`), or
+    /// `None`: the blocks are written one by one.
+    pub thread_cycle: Option<&'static str>,
     /// What the lint reads in a program of this dialect beyond the words
     /// above: the codes it writes, how the program names itself, the
     /// tool word's form.
@@ -206,6 +210,7 @@ pub const SINUMERIK: Dialect = Dialect {
         decimals: 3,
         modal: true,
     }),
+    thread_cycle: None,
     reading: Reading {
         g_codes: &[0, 1, 17, 18, 19, 33, 54, 55, 56, 57, 58, 59, 71, 90, 94],
         m_codes: &[3, 5, 8, 9, 30],
@@ -262,6 +267,7 @@ pub const FANUC: Dialect = Dialect {
         decimals: 0,
         modal: false,
     }),
+    thread_cycle: None,
     reading: Reading {
         g_codes: &[0, 1, 18, 17, 19, 21, 32, 40, 54, 55, 56, 57, 58, 59, 97, 98],
         m_codes: &[3, 5, 8, 9, 30],
@@ -305,9 +311,10 @@ pub const LINUXCNC: Dialect = Dialect {
     feed_group: None,
     lead_every_block: true,
     thread_start: None,
+    thread_cycle: Some("G76"),
     reading: Reading {
         g_codes: &[
-            0, 1, 7, 8, 17, 18, 19, 21, 33, 40, 54, 55, 56, 57, 58, 59, 90, 94, 97,
+            0, 1, 7, 8, 17, 18, 19, 21, 33, 40, 54, 55, 56, 57, 58, 59, 76, 90, 94, 97,
         ],
         m_codes: &[2, 3, 5, 8, 9],
         end_code: 2,
@@ -352,6 +359,7 @@ pub const CLD: Dialect = Dialect {
     lead_every_block: false,
     thread_start: None,
     // Records, not G-code: the lint reads them by their own rules.
+    thread_cycle: None,
     reading: Reading {
         g_codes: &[],
         m_codes: &[],
@@ -431,6 +439,13 @@ impl Writer<'_> {
                 self.next = Some((n + step, step));
             }
             None => self.line(text),
+        }
+    }
+
+    /// Passes over `n` numbers (the moves a cycle's one block makes).
+    fn skip(&mut self, n: usize) {
+        if let Some((next, step)) = self.next {
+            self.next = Some((next + step * n as u64, step));
         }
     }
 
@@ -639,8 +654,47 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
     let mut last_spindle = program.spindle_rpm.round() as i64;
     let mut last_start: Option<String> = None;
     let mut ticker = crate::budget::Ticker::new("the post", 1024);
+    // Blocks a threading cycle the dialect writes makes, up to here.
+    let mut made_by_cycle = 0;
     for (k, b) in program.blocks.iter().enumerate() {
         ticker.tick()?;
+        if k < made_by_cycle {
+            continue;
+        }
+        let span = d
+            .thread_cycle
+            .and_then(|word| Some((word, program.cycles.iter().find(|s| s.first == k)?)));
+        if let (Some((word, span)), Style::GCode) = (span, d.style) {
+            let blocks = program.blocks.get(k..k + span.count).unwrap_or_default();
+            if blocks.len() != span.count || blocks.iter().any(|b| b.spindle.is_some()) {
+                return Err(PostError::BadBlock {
+                    block: super::name_in(d.name, &program.blocks, k),
+                    message: format!(
+                        "a threading cycle over {} blocks, {}",
+                        span.count,
+                        if blocks.len() != span.count {
+                            "beyond the program's end"
+                        } else {
+                            "the spindle's speed changing in it"
+                        }
+                    ),
+                });
+            }
+            if let Some(c) = &b.comment {
+                w.comment(c);
+            }
+            w.block(&format!("{word} {}", super::cycle::words(&span.cycle)));
+            // The cycle's own moves keep their numbers (move i is
+            // N(first + i step)), and it leaves the tool at its last.
+            w.skip(span.count - 1);
+            let decimals = program.decimals.unwrap_or(d.decimals);
+            for (slot, v) in last_words.iter_mut().zip(&blocks[span.count - 1].values) {
+                *slot = Some(fixed(*v, decimals));
+            }
+            last_motion = Some(word);
+            made_by_cycle = k + span.count;
+            continue;
+        }
         if let Some(c) = &b.comment {
             w.comment(c);
         }

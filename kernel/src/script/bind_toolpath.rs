@@ -353,4 +353,104 @@ pub mod toolpath_api {
         });
         Ok(())
     }
+
+    /// Appends the passes a control's threading cycle makes from the
+    /// toolpath's last point (its drive line), in the axial plane (y 0, X
+    /// the program's on diameter where `diameter`, the tracked point's x
+    /// then half of it): LinuxCNC's G76, its words in `words` (`p` the
+    /// lead, `z`, `i`, `j`, `r`, `k`, `q`, `h` as the cycle's; see the
+    /// kernel's `program::cycle`), each rounded as a program writes it.
+    /// A program for a control that has the cycle writes it as one block;
+    /// any other, as its moves. Each cycle pass is named `name n`, the
+    /// cycle's last move `name end`. Returns each pass's depth below the
+    /// crest (radial, mm) and its start's shift along Z (mm), as maps
+    /// `#{ depth, shift }`.
+    #[rhai_fn(return_raw)]
+    pub fn add_thread_cycle(
+        tp: &mut ToolpathHandle,
+        name: &str,
+        words: Map,
+        diameter: bool,
+    ) -> Result<Array, Box<EvalAltResult>> {
+        const KEYS: [&str; 8] = ["p", "z", "i", "j", "r", "k", "q", "h"];
+        kernel(crate::names::check_name("pass name", name))?;
+        if let Some(k) = words.keys().find(|k| !KEYS.contains(&k.as_str())) {
+            return err(format!(
+                "add_thread_cycle: unknown key '{k}' (keys: {})",
+                KEYS.join(", ")
+            ));
+        }
+        let word = |k: &str| -> Result<Real, Box<EvalAltResult>> {
+            words
+                .get(k)
+                .and_then(number)
+                .ok_or_else(|| format!("add_thread_cycle: '{k}' must be a number").into())
+        };
+        let h = word("h")?;
+        if !(h >= 0.0 && h.fract() == 0.0 && h <= 1000.0) {
+            return err(format!(
+                "add_thread_cycle: h = {h}: the spring passes must be a whole number from 0 to 1000"
+            ));
+        }
+        let cycle = crate::program::cycle::as_written(&crate::program::cycle::ThreadCycle {
+            pitch: word("p")?,
+            z: word("z")?,
+            i: word("i")?,
+            j: word("j")?,
+            r: word("r")?,
+            k: word("k")?,
+            q: word("q")?,
+            h: h as u32,
+        });
+        let mut t = tp.borrow_mut();
+        if !t.aux_names.is_empty() {
+            return err("add_thread_cycle: a toolpath with auxiliary values cannot hold a cycle (its moves carry none)");
+        }
+        let Some(last) = t.passes.last().and_then(|p| p.points.last()).cloned() else {
+            return err("add_thread_cycle: the toolpath has no point yet: the cycle starts where its last pass ends (the drive line)");
+        };
+        let scale = if diameter { 2.0 } else { 1.0 };
+        let start = [last.point[0] * scale, last.point[2]];
+        let moves = crate::program::cycle::expand(&cycle, start, diameter, None)
+            .map_err(|m| format!("add_thread_cycle: {m}"))?;
+        let crest = start[0] + cycle.i;
+        let point = |m: &crate::program::cycle::CycleMove| ClPoint {
+            point: [m.x / scale, 0.0, m.z],
+            axis: [0.0, 0.0, 1.0],
+            motion: m.motion,
+            feed: match m.motion {
+                Motion::Thread { lead, .. } => lead * t.spindle_rpm,
+                _ => 0.0,
+            },
+            aux: Vec::new(),
+        };
+        let first_pass = t.passes.len();
+        let mut depths = Array::new();
+        let mut passes = Vec::new();
+        for (n, four) in moves.chunks(4).enumerate() {
+            if four.len() < 4 {
+                passes.push(Pass {
+                    name: format!("{name} end"),
+                    points: four.iter().map(point).collect(),
+                });
+                continue;
+            }
+            let depth = (four[2].x - crest).abs() / scale;
+            let mut d = Map::new();
+            d.insert("depth".into(), depth.into());
+            d.insert("shift".into(), (four[0].z - start[1]).into());
+            depths.push(d.into());
+            passes.push(Pass {
+                name: format!("{name} {}", n + 1),
+                points: four.iter().map(point).collect(),
+            });
+        }
+        t.cycles.push(crate::toolpath::PassCycle {
+            first_pass,
+            passes: passes.len(),
+            cycle,
+        });
+        t.passes.extend(passes);
+        Ok(depths)
+    }
 }

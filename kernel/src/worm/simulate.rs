@@ -1385,6 +1385,7 @@ mod tests {
             axes: vec![axis("X"), axis("Z")],
             blocks,
             setup: Default::default(),
+            cycles: Vec::new(),
         };
         let lathe = ChainMachine::new(Machine::from_info(fanuc_0i_tc::describe()).unwrap());
         let req = WormRequest {

@@ -23,8 +23,9 @@
 // `approach_feed`, a block's `number`; 1.6: the body shapes `cylinder`,
 // `box` and `guard`; 1.7: a body's `mount`, a constant factor's `scale`,
 // an axis's `max_accel`; 1.8: an axis's `turns_part`; 1.9: the body
-// shape `cone`; 1.10: a body's `reach`).
-#define PILGRIM_ABI_MINOR 10
+// shape `cone`; 1.10: a body's `reach`; 1.11: a program's threading
+// `cycles`).
+#define PILGRIM_ABI_MINOR 11
 
 // The call succeeded.
 #define PILGRIM_STATUS_OK 0

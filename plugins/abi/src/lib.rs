@@ -98,8 +98,9 @@ pub const ABI_MAJOR: u32 = 1;
 /// `approach_feed`, a block's `number`; 1.6: the body shapes `cylinder`,
 /// `box` and `guard`; 1.7: a body's `mount`, a constant factor's `scale`,
 /// an axis's `max_accel`; 1.8: an axis's `turns_part`; 1.9: the body
-/// shape `cone`; 1.10: a body's `reach`).
-pub const ABI_MINOR: u32 = 10;
+/// shape `cone`; 1.10: a body's `reach`; 1.11: a program's threading
+/// `cycles`).
+pub const ABI_MINOR: u32 = 11;
 
 /// The call succeeded.
 pub const STATUS_OK: i32 = 0;

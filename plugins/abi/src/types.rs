@@ -749,6 +749,53 @@ pub struct AxisProgram {
     /// are blocks already.
     #[serde(default)]
     pub setup: ProgramSetup,
+    /// Since 1.11: runs of blocks a control's threading cycle makes, each
+    /// written as its cycle where the dialect has it (LinuxCNC's G76),
+    /// as its blocks elsewhere. The blocks are the cycle's passes as the
+    /// control makes them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cycles: Vec<CycleSpan>,
+}
+
+/// Since 1.11: the blocks `first..first + count` of a program, which one
+/// threading cycle makes from where the block before them leaves the
+/// tool.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CycleSpan {
+    /// The first block the cycle makes (from 0).
+    pub first: usize,
+    /// How many blocks it makes.
+    pub count: usize,
+    /// The cycle.
+    pub cycle: ThreadCycle,
+}
+
+/// Since 1.11: a multi-pass threading cycle by its words, in program
+/// units (X's words on diameter where the program is): LinuxCNC's G76
+/// (`G76 P Z I J R K Q H`), the passes
+/// `depth = |I| + J n^(1/R)` from the drive line (where the tool stands
+/// before it) while below `|I| + K`, then `H + 1` at the full depth, each
+/// pass's start moved along Z by its depth below the crest times
+/// `tan Q`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ThreadCycle {
+    /// `P`: the lead (mm per turn).
+    pub pitch: f64,
+    /// `Z`: where the passes end along Z, the cycle's last place.
+    pub z: f64,
+    /// `I`: the crest's offset from the drive line, negative outside a
+    /// part, positive inside a bore.
+    pub i: f64,
+    /// `J`: the first pass's depth below the crest.
+    pub j: f64,
+    /// `R`: the depth's degression (1: constant depth, 2: constant area).
+    pub r: f64,
+    /// `K`: the thread's full depth below the crest.
+    pub k: f64,
+    /// `Q`: the compound angle (deg).
+    pub q: f64,
+    /// `H`: spring passes at the full depth after the first.
+    pub h: u32,
 }
 
 impl AxisProgram {
