@@ -105,7 +105,7 @@ pub struct Toolpath {
 
 /// Passes `first_pass..first_pass + passes` of a toolpath: the moves a
 /// threading cycle makes from where the pass before them ends (the
-/// program holds each move as a block, and [`crate::program::cycle`]
+/// program holds each move as a block, and the program module
 /// checks that they are the cycle's).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PassCycle {
@@ -114,7 +114,7 @@ pub struct PassCycle {
     /// How many passes.
     pub passes: usize,
     /// The cycle's words.
-    pub cycle: crate::program::cycle::ThreadCycle,
+    pub cycle: pilgrim_plugin_abi::types::ThreadCycle,
 }
 
 /// A chart a run draws (`<file>.svg`) from one of the toolpath's tables:
