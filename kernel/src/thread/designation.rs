@@ -12,6 +12,9 @@
 //! - ACME: `<D>-<tpi> ACME-<n>G`, `D` in inches, decimal or a fraction;
 //!   more starts as ASME writes them, `<D>-<pitch>P-<lead>L ACME-<n>G`.
 //! - buttress: `<D>-<tpi> BUTT [7/45]`, ASME B1.9's form, limits stated.
+//! - straight pipe (ISO 228-1): `G<size>` internal, `G<size>A` or
+//!   `G<size>B` external, the size as the standard writes it (`1/2`,
+//!   `1 1/2`).
 //! - a trailing `LH` makes it left-handed (`RH`, the default, may be
 //!   written).
 //!
@@ -185,8 +188,22 @@ pub fn designated(text: &str, drawing: &Drawing) -> Result<ThreadProfile, InputE
                 drawing.stated,
             )
         }
+        [g, ..] if g.starts_with('G') => {
+            // ISO 228-1: `G<size>` internal, `G<size>A` or `B` external.
+            let all = words.join(" ");
+            let body = all[1..].trim();
+            let (size, class) = match body.chars().last() {
+                Some(c @ ('A' | 'B')) => (body[..body.len() - 1].trim(), Some(c)),
+                _ => (body, None),
+            };
+            let internal = match class {
+                Some(_) => external_unless(false)?,
+                None => drawing.internal.unwrap_or(true),
+            };
+            standards::pipe(size, internal, class, 1, hand)
+        }
         _ => Err(bad(
-            "not a form pilgrim reads: M20x2.5-6g, M30x2-6H, Tr40x7, Tr40x14(P7), 1-5 ACME-2G, 1-0.2P-0.4L ACME-2G, 2-8 BUTT 7/45 (LH at the end for a left hand)",
+            "not a form pilgrim reads: M20x2.5-6g, M30x2-6H, Tr40x7, Tr40x14(P7), 1-5 ACME-2G, 1-0.2P-0.4L ACME-2G, 2-8 BUTT 7/45, G1/2A, G1 1/2 (LH at the end for a left hand)",
         )),
     }
     .map_err(|e| match e {
@@ -265,6 +282,20 @@ mod tests {
         )
         .unwrap();
         assert!(nut.section.internal);
+        // ISO 228-1: a class says external; none, internal.
+        for (text, size, internal, class) in [
+            ("G1/2A", "1/2", false, Some('A')),
+            ("G 1/2 B", "1/2", false, Some('B')),
+            ("G1 1/2A", "1 1/2", false, Some('A')),
+            ("G1-1/2", "1 1/2", true, None),
+        ] {
+            assert_eq!(
+                read(text),
+                standards::pipe(size, internal, class, 1, Hand::Right).unwrap(),
+                "{text}"
+            );
+        }
+        assert_eq!(read("G3/4-LH").section.hand, Hand::Left);
     }
 
     /// What is not a designation, or not a size the standard has, is
@@ -283,6 +314,7 @@ mod tests {
             ("UNC 1/2-13", "not a form pilgrim reads"),
             ("M20xA-6g", "pitch 'A' is not a positive number"),
             ("", "not a form"),
+            ("G9/16A", "not a size of ISO 228-1"),
         ] {
             let e = designated(t, &DRAWING).unwrap_err().to_string();
             assert!(

@@ -27,6 +27,16 @@
 //!   other at 45, `h = 0.6 P` of engagement, the external thread's depth
 //!   `0.66271 P`, root radius `0.07141 P`. Limits stated.
 //!
+//! - **Pipe threads, straight** (ISO 228-1, `G`): the Whitworth form of
+//!   ISO 7-1, 55 degrees, `H = 0.960491 P`, depth `h = 0.640327 P`, crest
+//!   and root rounded `r = 0.137329 P`; `d2 = d - h`, `d1 = d - 2 h`; the
+//!   sizes and threads per inch of its table 1, and its tolerances by
+//!   threads per inch: the internal pitch diameter `+TD2` above the basic,
+//!   the external one `TD2` (class A) or `2 TD2` (class B) below it, the
+//!   external major `2 TD2` below, the internal minor its own band above
+//!   (the crest's rounding is not modelled: the blank is turned to the
+//!   major, the bore to the minor).
+//!
 //! Hand-written: these are tables and one-line formulas of the standards,
 //! with no crate that holds them.
 
@@ -565,9 +575,198 @@ pub fn buttress(
     })
 }
 
+/// ISO 228-1's sizes: the size as the designation writes it, threads per
+/// inch, the major diameter (mm).
+const PIPE_SIZES: [(&str, Real, Real); 24] = [
+    ("1/16", 28.0, 7.723),
+    ("1/8", 28.0, 9.728),
+    ("1/4", 19.0, 13.157),
+    ("3/8", 19.0, 16.662),
+    ("1/2", 14.0, 20.955),
+    ("5/8", 14.0, 22.911),
+    ("3/4", 14.0, 26.441),
+    ("7/8", 14.0, 30.201),
+    ("1", 11.0, 33.249),
+    ("1 1/8", 11.0, 37.897),
+    ("1 1/4", 11.0, 41.910),
+    ("1 1/2", 11.0, 47.803),
+    ("1 3/4", 11.0, 53.746),
+    ("2", 11.0, 59.614),
+    ("2 1/4", 11.0, 65.710),
+    ("2 1/2", 11.0, 75.184),
+    ("2 3/4", 11.0, 81.534),
+    ("3", 11.0, 87.884),
+    ("3 1/2", 11.0, 100.330),
+    ("4", 11.0, 113.030),
+    ("4 1/2", 11.0, 125.730),
+    ("5", 11.0, 138.430),
+    ("5 1/2", 11.0, 151.130),
+    ("6", 11.0, 163.830),
+];
+
+/// A straight pipe thread `G<size>` (ISO 228-1), external of class `A`
+/// or `B`, or internal (`class` `None`); the sizes as the designation
+/// writes them (`1/2`, `1 1/2`).
+///
+/// # Failures
+/// A size ISO 228-1 does not name; a class other than A or B on an
+/// external thread, or one on an internal thread.
+pub fn pipe(
+    size: &str,
+    internal: bool,
+    class: Option<char>,
+    starts: u32,
+    hand: Hand,
+) -> Result<ThreadProfile, InputError> {
+    let Some(&(name, tpi, d)) = PIPE_SIZES.iter().find(|(n, _, _)| *n == size) else {
+        return Err(InputError::BadText {
+            what: "pipe thread size".into(),
+            value: format!("'{}'", crate::files::excerpt(size)),
+            reason: format!(
+                "not a size of ISO 228-1 ({})",
+                PIPE_SIZES.map(|s| s.0).join(", ")
+            ),
+        });
+    };
+    let class = match (internal, class) {
+        (false, Some(c @ ('A' | 'B'))) => Some(c),
+        (true, None) => None,
+        (false, c) => {
+            return Err(InputError::out_of_range(
+                format!(
+                    "ISO 228-1 class '{}'",
+                    c.map_or(String::new(), String::from)
+                ),
+                0.0,
+                "A or B on an external thread",
+            ))
+        }
+        (true, Some(c)) => {
+            return Err(InputError::out_of_range(
+                format!("ISO 228-1 class '{c}'"),
+                0.0,
+                "none on an internal thread (its pitch diameter has one tolerance)",
+            ))
+        }
+    };
+    let p = INCH / tpi;
+    let (h, r) = (0.640327 * p, 0.137329 * p);
+    let (d2, d1) = (d - h, d - 2.0 * h);
+    // ISO 228-1's tolerances (mm) by threads per inch: TD2, and the
+    // internal minor's.
+    let (td2, td1) = match tpi as u32 {
+        28 => (0.107, 0.282),
+        19 => (0.125, 0.445),
+        14 => (0.142, 0.541),
+        _ if d <= 60.0 => (0.180, 0.640),
+        _ => (0.217, 0.640),
+    };
+    let big_h = 0.960491 * p;
+    let limits = if internal {
+        ThreadLimits {
+            pitch_diameter: Limits {
+                min: d2,
+                max: d2 + td2,
+            },
+            crest: Limits {
+                min: d1,
+                max: d1 + td1,
+            },
+            // The nut's root: at least the major; its rounding free to
+            // the fundamental triangle's truncation.
+            root: Limits {
+                min: d,
+                max: d + big_h / 6.0,
+            },
+            source: "ISO 228-1".into(),
+        }
+    } else {
+        let band = if class == Some('A') { td2 } else { 2.0 * td2 };
+        ThreadLimits {
+            pitch_diameter: Limits {
+                min: d2 - band,
+                max: d2,
+            },
+            crest: Limits {
+                min: d - 2.0 * td2,
+                max: d,
+            },
+            // The root (the rounded minor) at most the basic minor, at
+            // least a pitch diameter's band below it.
+            root: Limits {
+                min: d1 - band,
+                max: d1,
+            },
+            source: format!("ISO 228-1 class {}", class.unwrap_or('A')),
+        }
+    };
+    let starts_text = if starts == 1 {
+        String::new()
+    } else {
+        format!(" ({starts} starts)")
+    };
+    Ok(ThreadProfile {
+        designation: format!(
+            "G{name}{}{starts_text}{}",
+            class.map_or(String::new(), String::from),
+            hand_suffix(hand)
+        ),
+        standard: "ISO 228-1".into(),
+        section: ThreadSection {
+            internal,
+            pitch: p,
+            starts,
+            hand,
+            major: d,
+            pitch_diameter: d2,
+            root_diameter: if internal { d } else { d1 },
+            crest_diameter: if internal { d1 } else { d },
+            flanks: [27.5_f64.to_radians(); 2],
+            space_at_pitch: p / 2.0,
+            root_radius: r,
+        },
+        limits,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// ISO 228-1's printed G 1/2 (14 threads per inch, mm to 3 decimals):
+    /// d 20.955, d2 19.793, d1 18.631; external class A's pitch diameter
+    /// 19.651 to 19.793, class B's from 19.509, the major 20.671 to
+    /// 20.955; internal, the pitch diameter 19.793 to 19.935, the minor
+    /// 18.631 to 19.172. G 1 (11 tpi): d2 31.770, class A from 31.590. The
+    /// profile at 27.5 degrees, its spaces half the pitch at d2. The
+    /// standard subtracts its depth rounded (1.162) twice for d1, 0.5 um
+    /// from the exact depth's: d1 within 1 um.
+    #[test]
+    fn pipe_sizes_are_the_standards_printed_ones() {
+        let a = pipe("1/2", false, Some('A'), 1, Hand::Right).unwrap();
+        assert_eq!(a.designation, "G1/2A");
+        near(a.section.pitch, 1.814, 3);
+        near(a.section.pitch_diameter, 19.793, 3);
+        assert!((a.section.root_diameter - 18.631).abs() < 1e-3);
+        near(a.limits.pitch_diameter.min, 19.651, 3);
+        near(a.limits.crest.min, 20.671, 3);
+        near(a.limits.crest.max, 20.955, 3);
+        let b = pipe("1/2", false, Some('B'), 1, Hand::Right).unwrap();
+        near(b.limits.pitch_diameter.min, 19.509, 3);
+        let nut = pipe("1/2", true, None, 1, Hand::Left).unwrap();
+        assert_eq!(nut.designation, "G1/2-LH");
+        near(nut.limits.pitch_diameter.max, 19.935, 3);
+        assert!((nut.limits.crest.min - 18.631).abs() < 1e-3);
+        assert!((nut.limits.crest.max - 19.172).abs() < 1e-3);
+        let one = pipe("1", false, Some('A'), 1, Hand::Right).unwrap();
+        near(one.section.pitch_diameter, 31.770, 3);
+        near(one.limits.pitch_diameter.min, 31.590, 3);
+        assert!((a.section.flanks[0].to_degrees() - 27.5).abs() < 1e-12);
+        near(a.section.space_at(19.793 / 2.0), 1.814 / 2.0, 3);
+        assert!(pipe("9/16", false, Some('A'), 1, Hand::Right).is_err());
+        assert!(pipe("1/2", false, None, 1, Hand::Right).is_err());
+        assert!(pipe("1/2", true, Some('A'), 1, Hand::Right).is_err());
+    }
 
     /// Within half a unit of the last decimal the standard prints.
     fn near(got: Real, want: Real, decimals: i32) {
