@@ -122,7 +122,7 @@ fn each_default_thread_is_verified_against_its_standard() {
         let out = run(name, &args);
         let r = common::report_of(&out);
         assert_eq!(r["verdict"]["status"], "passed", "{name}: {}", r["verdict"]);
-        let v = &r["worm_verification"];
+        let v = &r["thread_verification"];
         let l = &v["limits"];
         let band = |k: &str| [l[k]["min"].as_f64().unwrap(), l[k]["max"].as_f64().unwrap()];
         // The standards print to 0.001 mm or 0.0001 in.
@@ -263,7 +263,7 @@ fn a_buttress_is_roughed_along_its_load_flank() {
                 );
             }
         }
-        let nominal = r["worm_verification"]["nominal_flanks_deg"]
+        let nominal = r["thread_verification"]["nominal_flanks_deg"]
             .as_array()
             .unwrap();
         let seven = if side == "right" { 1 } else { 0 };
@@ -370,7 +370,7 @@ fn a_left_hand_is_cut_towards_the_tailstock() {
     );
     let r = common::report_of(&out);
     assert_eq!(r["verdict"]["status"], "passed", "{}", r["verdict"]);
-    let v = &r["worm_verification"];
+    let v = &r["thread_verification"];
     assert_eq!(v["hand"], "left");
     let d2 = v["starts"][0]["pitch_diameter"].as_f64().unwrap();
     assert!((18.164..=18.334).contains(&d2), "{d2}");
@@ -438,7 +438,7 @@ fn a_g76_cycle_is_verified_as_the_control_makes_it() {
         assert_eq!(word(c, 'P'), Some(14.0), "{c}");
         assert_eq!(word(c, 'Q'), Some(14.5), "{c}");
     }
-    let v = &r["worm_verification"];
+    let v = &r["thread_verification"];
     let l = &v["limits"]["pitch_diameter"];
     let (lo, hi) = (l["min"].as_f64().unwrap(), l["max"].as_f64().unwrap());
     let starts = v["starts"].as_array().unwrap();

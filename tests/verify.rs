@@ -47,7 +47,7 @@ fn the_default_runs_verify_with_their_own_figures() {
         assert_eq!(code, 0, "{job}: {err}");
         assert!(said.contains("verified"), "{job}: {said}");
         let (run, verified) = (report(&out), report(&out.with_extension("verify")));
-        for key in ["verification", "groove_verification", "worm_verification"] {
+        for key in ["verification", "groove_verification", "thread_verification"] {
             assert_eq!(
                 lower(&run[key]),
                 lower(&verified[key]),

@@ -285,7 +285,7 @@ fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
     );
     // The run's own simulation says the same.
     let r = report(&out);
-    let w = &r["worm_verification"];
+    let w = &r["thread_verification"];
     assert_eq!(w["passes"].as_array().unwrap().len(), check.passes.len());
     assert!((w["removed_area"].as_f64().unwrap() - check.removed_area).abs() < 1e-6);
     // S1 and S2 are the minimums of Fanuc's exact form at 100 rpm.
@@ -756,7 +756,7 @@ fn threads_run_at_full_lead_from_edge_to_edge() {
         let v = lead * rpm / 60.0;
         let s1 = t * v * (-1.0 - 0.01f64.ln() + 0.01);
         let s2 = t * v;
-        let sim = r["worm_verification"]["passes"].as_array().unwrap();
+        let sim = r["thread_verification"]["passes"].as_array().unwrap();
         let mut k = 0;
         for (i, b) in program.blocks.iter().enumerate() {
             if !matches!(b.motion, Motion::Thread { .. }) {
@@ -803,7 +803,7 @@ fn the_replay_reads_the_lead_as_written() {
     let lead = 10.0 * std::f64::consts::PI;
     let want = (f - lead).abs() * 60.0 / lead;
     let r = report(&out);
-    let got = r["worm_verification"]["lead_error"].as_f64().unwrap();
+    let got = r["thread_verification"]["lead_error"].as_f64().unwrap();
     assert!(want > 1e-5 && (got - want).abs() < 1e-9, "{got} vs {want}");
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -819,9 +819,9 @@ fn export_keeps_the_verification() {
     assert_eq!(code, 0, "{err}");
     let after = report(&out);
     assert_eq!(after["pose_block"], 20);
-    assert_eq!(after["worm_verification"], before["worm_verification"]);
+    assert_eq!(after["thread_verification"], before["thread_verification"]);
     assert!(
-        after["worm_verification"]["passes"]
+        after["thread_verification"]["passes"]
             .as_array()
             .unwrap()
             .len()
@@ -893,7 +893,7 @@ fn a_rapid_through_the_stock_is_refused() {
 pub(crate) fn check_workbook(out: &std::path::Path) {
     use calamine::{open_workbook, Data, Reader, Xlsx};
     let report = common::report_of(out);
-    let v = &report["worm_verification"];
+    let v = &report["thread_verification"];
     let mut book: Xlsx<_> = open_workbook(out.join("passes.xlsx")).unwrap();
     assert_eq!(book.sheet_names(), ["passes", "starts", "figures"]);
     let number = |d: &Data| match d {

@@ -86,7 +86,7 @@ pub struct Report {
     #[serde(default)]
     pub axis_ranges: BTreeMap<String, [f64; 2]>,
     /// What the family's verification found, under its kind's key
-    /// (`verification`, `groove_verification`, `worm_verification`: each
+    /// (`verification`, `groove_verification`, `thread_verification`: each
     /// family's own entry, [`crate::family::Outcome::to_json`]), at the top
     /// level of `report.json`.
     #[serde(flatten)]

@@ -1,6 +1,6 @@
 //! A worm's verification as the run uses it: the request ([`WormRequest`])
 //! simulates a program's cut pass by pass with [`simulate`]; the outcome
-//! gives the verdict's figures, the report's `worm_verification`, the
+//! gives the verdict's figures, the report's `thread_verification`, the
 //! finished worm's solid, the simulated areas in the family's `passes`
 //! table, `passes.csv`, `passes.xlsx`, `passes.svg` and the page's section.
 
@@ -158,10 +158,10 @@ impl Outcome for WormOutcome {
     }
 }
 
-/// The worm's simulation in `report.json` (`worm_verification`) and on
-/// the page.
+/// The thread's simulation (a worm's, any standard thread's) in
+/// `report.json` (`thread_verification`) and on the page.
 pub const KIND: OutcomeKind = OutcomeKind {
-    key: "worm_verification",
+    key: "thread_verification",
     section,
 };
 

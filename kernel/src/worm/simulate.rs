@@ -213,7 +213,7 @@ pub struct StartProfile {
     pub over_wires: Option<Real>,
 }
 
-/// The simulation's result (`report.json`'s `worm_verification`; the
+/// The simulation's result (`report.json`'s `thread_verification`; the
 /// section and chips, for drawing, are not in it).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WormCheck {
