@@ -266,6 +266,30 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
     };
     first = sources(first, args.params.as_deref(), &args.sets)?;
     let machine = catalog.open(&spec).map_err(|e| e.to_string())?;
+    // A program file is read in its machine's control's dialect: one whose
+    // extension is another dialect's was written for another control.
+    let control = &machine.kinematics.info().control;
+    let ext = file.extension().and_then(|e| e.to_str()).unwrap_or("");
+    let dialects = pilgrim_kernel::program::post::DIALECTS;
+    if let (Some(theirs), Some(ours)) = (
+        dialects
+            .iter()
+            .find(|d| d.extension.eq_ignore_ascii_case(ext)),
+        pilgrim_kernel::program::post::dialect(control),
+    ) {
+        if theirs.name != ours.name {
+            return Err(format!(
+                "{}: a .{ext} file is a {} program, and machine {}'s control reads {} (.{}): verify it on a machine whose control is {} (a machine file's control = \"{}\")",
+                file.display(),
+                theirs.name,
+                machine.kinematics.info().name,
+                ours.name,
+                ours.extension,
+                theirs.name,
+                theirs.name
+            ));
+        }
+    }
     let options = JobOptions {
         program_name: "verify".into(),
         program_file: Some(pilgrim_kernel::files::shown_path(&file)),

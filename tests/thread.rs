@@ -412,7 +412,9 @@ fn a_left_hand_is_cut_towards_the_tailstock() {
 /// expansion, which rs274 holds to LinuxCNC's own in CI), each start's
 /// pitch diameter within its stated limits; the same passes posted for
 /// Fanuc are G32 blocks, one per cycle pass. The file verified as it
-/// stands passes; with a tapered end (E) it is refused, naming the word.
+/// stands passes; with a tapered end (E) it is refused, naming the word;
+/// on a machine whose control is Fanuc it is refused as another
+/// control's program.
 #[test]
 fn a_g76_cycle_is_verified_as_the_control_makes_it() {
     let dir = scratch("thread", "g76-machine");
@@ -451,6 +453,9 @@ fn a_g76_cycle_is_verified_as_the_control_makes_it() {
     let nc = std::fs::read_to_string(out.join("program.nc")).unwrap();
     assert_eq!(nc.matches("G32 ").count(), passes, "{nc}");
     common::leave_for_rs274(&out, "thread-g76");
+    // The page's listing: a cycle's moves all stand on its G76 line.
+    common::check_page(&out, "program.ngc", 12.0);
+    common::leave_page_for_chromium(&out, "thread-g76");
     let verify = |file: &std::path::Path, name: &str| {
         let report = dir.join(name);
         let mut args = vec![
@@ -469,6 +474,25 @@ fn a_g76_cycle_is_verified_as_the_control_makes_it() {
     };
     let (code, _, err) = verify(&out.join("program.ngc"), "as-it-stands");
     assert_eq!(code, 0, "{err}");
+    // On the built-in lathe, whose control is Fanuc, a .ngc file is
+    // refused, naming both dialects.
+    let wrong = dir.join("wrong");
+    let (code, _, err) = pilgrim(&[
+        "verify",
+        s(&out.join("program.ngc")),
+        "--family",
+        SCRIPT,
+        "--out",
+        s(&wrong),
+        "--quiet",
+    ]);
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("a .ngc file is a linuxcnc program")
+            && err.contains("control reads fanuc (.nc)")
+            && !wrong.exists(),
+        "{err}"
+    );
     let tapered = dir.join("tapered.ngc");
     std::fs::write(&tapered, ngc.replacen(" H2\n", " H2 E1.0\n", 1)).unwrap();
     let (code, _, err) = verify(&tapered, "tapered");
