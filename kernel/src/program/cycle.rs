@@ -189,22 +189,26 @@ pub fn expand(
     Ok(moves)
 }
 
+/// An external M20's cycle on diameter (the tests' example): P2.5,
+/// from the drive line 4 mm over the crest, J0.6, R2, K3, Q29.5, H1, to
+/// Z-35.
+#[cfg(test)]
+pub(crate) fn m20() -> ThreadCycle {
+    ThreadCycle {
+        pitch: 2.5,
+        z: -35.0,
+        i: -4.0,
+        j: 0.6,
+        r: 2.0,
+        k: 3.0,
+        q: 29.5,
+        h: 1,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn m20() -> ThreadCycle {
-        ThreadCycle {
-            pitch: 2.5,
-            z: -35.0,
-            i: -4.0,
-            j: 0.6,
-            r: 2.0,
-            k: 3.0,
-            q: 29.5,
-            h: 1,
-        }
-    }
 
     /// An external M20 on diameter from X24 Z5: the passes' depths are
     /// J sqrt(n) (radially half of it) below the crest at X20, until the

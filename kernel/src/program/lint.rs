@@ -761,11 +761,7 @@ fn lint_gcode(
             };
             let moves = super::cycle::expand(&cycle, [x0, z0], st.radial == Some(true), end_x)
                 .map_err(|m| fault(place(k), m))?;
-            let comment = comments[comment_from.min(line)..line]
-                .iter()
-                .rev()
-                .find_map(Clone::clone);
-            comment_from = line + 1;
+            let comment = comment_before(&comments, &mut comment_from, line);
             for (n, mv) in moves.iter().enumerate() {
                 let b = if reading { None } else { program.blocks.get(k) };
                 if !reading && b.is_none() {
@@ -1101,11 +1097,7 @@ fn lint_gcode(
         }
         // The move as read (a lint reads it too: what a run verifies).
         {
-            let comment = comments[comment_from.min(line)..line]
-                .iter()
-                .rev()
-                .find_map(Clone::clone);
-            comment_from = line + 1;
+            let comment = comment_before(&comments, &mut comment_from, line);
             out.blocks.push(ReadBlock {
                 motion,
                 values: st.values.clone(),
@@ -1155,6 +1147,17 @@ fn lint_gcode(
         lines: lines.len(),
     };
     Ok(out)
+}
+
+/// The last comment line among `comments[from..line]` (the pass a move at
+/// `line` begins), the search starting after `line` for the next move.
+fn comment_before(comments: &[Option<String>], from: &mut usize, line: usize) -> Option<String> {
+    let found = comments[(*from).min(line)..line]
+        .iter()
+        .rev()
+        .find_map(Clone::clone);
+    *from = line + 1;
+    found
 }
 
 /// A threading cycle's words as read (`read`, its block's letters and
@@ -1855,17 +1858,8 @@ mod tests {
     /// refused, named.
     #[test]
     fn a_threading_cycle_is_written_read_and_held() {
-        use crate::program::cycle::{expand, CycleSpan, ThreadCycle};
-        let c = ThreadCycle {
-            pitch: 2.5,
-            z: -35.0,
-            i: -4.0,
-            j: 0.6,
-            r: 2.0,
-            k: 3.0,
-            q: 29.5,
-            h: 1,
-        };
+        use crate::program::cycle::{expand, m20, CycleSpan};
+        let c = m20();
         let mut p = program();
         let block =
             |motion: Motion, x: Real, z: Real, comment: Option<&str>| crate::program::Block {
