@@ -1103,6 +1103,73 @@ mod tests {
         assert!((turn.feed - 1500.0 / chord).abs() < 1e-6, "{}", turn.feed);
     }
 
+    /// A toolpath's threading cycle becomes a run of the program's
+    /// blocks, each the move the cycle makes (X on the lathe's diameter);
+    /// passes that are not the cycle's moves, or words not as a program
+    /// writes them, are refused, naming the block.
+    #[test]
+    fn a_cycles_passes_must_be_its_moves() {
+        use crate::machine::{ChainMachine, Machine};
+        use crate::toolpath::{ClPoint, Pass, PassCycle};
+        let lathe = ChainMachine::new(Machine::from_info(fanuc_0i_tc::describe()).unwrap());
+        let cutter = crate::tool::ThreadCutter::new(0.3, 0.1, 0.5236, 0.5236, 3.0).unwrap();
+        let c = cycle::m20();
+        let point = |motion: Motion, x: Real, z: Real| ClPoint {
+            point: [x / 2.0, 0.0, z],
+            axis: [0.0, 0.0, 1.0],
+            motion,
+            feed: if motion == Motion::Rapid {
+                0.0
+            } else {
+                2.5 * 300.0
+            },
+            aux: vec![],
+        };
+        let moves = cycle::expand(&c, [24.0, 5.0], true, None).unwrap();
+        let toolpath = |c: &cycle::ThreadCycle, nudge: Real| {
+            let mut tp = Toolpath::new(
+                "t",
+                crate::tool::Tool::thread_cutter("c", 1, cutter),
+                300.0,
+                vec![],
+            );
+            tp.passes.push(Pass {
+                name: "drive line".into(),
+                points: vec![point(Motion::Rapid, 24.0, 5.0)],
+            });
+            for (n, four) in moves.chunks(4).enumerate() {
+                tp.passes.push(Pass {
+                    name: format!("cycle {n}"),
+                    points: four
+                        .iter()
+                        .map(|m| point(m.motion, m.x, m.z + if n == 3 { nudge } else { 0.0 }))
+                        .collect(),
+                });
+            }
+            tp.cycles.push(PassCycle {
+                first_pass: 1,
+                passes: tp.passes.len() - 1,
+                cycle: c.clone(),
+            });
+            tp
+        };
+        let p = build(&toolpath(&c, 0.0), &lathe, "t").unwrap();
+        let span = &p.cycles[0];
+        assert_eq!(span.count, moves.len());
+        let x = p.axes.iter().position(|a| a.name == "X").unwrap();
+        let first = &p.blocks[span.first];
+        assert!((first.values[x] - moves[0].x).abs() < 1e-9, "{first:?}");
+        let e = build(&toolpath(&c, 0.01), &lathe, "t")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("where the threading cycle makes"), "{e}");
+        let loose = cycle::ThreadCycle { q: 29.51234, ..c };
+        let e = build(&toolpath(&loose, 0.0), &lathe, "t")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("not as a program writes them"), "{e}");
+    }
+
     /// The fast rounding is the text's, near-ties and negative zeros
     /// included.
     #[test]
