@@ -453,6 +453,21 @@ fn a_g76_cycle_is_verified_as_the_control_makes_it() {
     let nc = std::fs::read_to_string(out.join("program.nc")).unwrap();
     assert_eq!(nc.matches("G32 ").count(), passes, "{nc}");
     common::leave_for_rs274(&out, "thread-g76");
+    // Radial infeed asked: Q 0, every pass straight in.
+    let radial = run(
+        "g76-radial",
+        &[
+            "--set",
+            "cycle=g76",
+            "--set",
+            "flank_order=radial",
+            "--post",
+            "linuxcnc",
+        ],
+    );
+    let text = std::fs::read_to_string(radial.join("program.ngc")).unwrap();
+    let line = text.lines().find(|l| l.contains(" G76 P")).unwrap();
+    assert_eq!(word(line, 'Q'), Some(0.0), "{line}");
     // The page's listing: a cycle's moves all stand on its G76 line.
     common::check_page(&out, "program.ngc", 12.0);
     common::leave_page_for_chromium(&out, "thread-g76");
