@@ -1112,7 +1112,9 @@ mod tests {
         use crate::machine::{ChainMachine, Machine};
         use crate::toolpath::{ClPoint, Pass, PassCycle};
         let lathe = ChainMachine::new(Machine::from_info(fanuc_0i_tc::describe()).unwrap());
-        let cutter = crate::tool::ThreadCutter::new(0.3, 0.1, 0.5236, 0.5236, 3.0).unwrap();
+        let cutter =
+            crate::tool::ThreadCutter::new(0.3, 0.1, 30f64.to_radians(), 30f64.to_radians(), 3.0)
+                .unwrap();
         let c = cycle::m20();
         let point = |motion: Motion, x: Real, z: Real| ClPoint {
             point: [x / 2.0, 0.0, z],
