@@ -484,10 +484,11 @@ pub fn check_groove(
     let r_d = req.groove.roll_radius();
     let mut points = Vec::with_capacity(n_theta * nc);
     for &t in &thetas {
+        let section = req.groove.section(t)?;
         for &(psi, _) in &psi_grid {
-            points.push(req.groove.point(t, psi)?);
+            points.push(req.groove.point_of(&section, t, psi));
         }
-        let half = req.groove.section(t)?.edge_x();
+        let half = section.edge_x();
         for &(side, d, _) in &rim {
             points.push(Vec3::new(r_d * t.cos(), r_d * t.sin(), side * (half + d)));
         }

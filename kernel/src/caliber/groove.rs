@@ -638,7 +638,14 @@ impl Groove {
     /// # Failures
     /// `theta` outside the tables.
     pub fn point(&self, theta: Real, psi: Real) -> Result<Vec3, GrooveError> {
-        Ok(self.placed(theta, self.section(theta)?.point(psi)))
+        Ok(self.point_of(&self.section(theta)?, theta, psi))
+    }
+
+    /// The groove's point at `psi` of `section`, the section at `theta`
+    /// ([`Self::section`]), in the roll's frame: [`Self::point`] for many
+    /// points of one section, which is built once.
+    pub fn point_of(&self, section: &GrooveSection, theta: Real, psi: Real) -> Vec3 {
+        self.placed(theta, section.point(psi))
     }
 
     /// A point `(x_A, z_A)` of the section at `theta` in the roll's frame.

@@ -63,10 +63,11 @@ pub fn contact_patch(
     let turn = mid + crate::math::wrap_angle(wheel.centre.y.atan2(wheel.centre.x) - mid);
     let mut best = (Real::INFINITY, turn.clamp(lo, hi), 0.0);
     for i in 0..=60 {
+        let t = (turn + (i as Real - 30.0) * 0.2f64.to_radians()).clamp(lo, hi);
+        let section = g.section(t)?;
         for j in 0..=180 {
-            let t = (turn + (i as Real - 30.0) * 0.2f64.to_radians()).clamp(lo, hi);
             let psi = (j as Real - 90.0).to_radians();
-            let d = wheel_distance(&wheel, &g.point(t, psi)?);
+            let d = wheel_distance(&wheel, &g.point_of(&section, t, psi));
             if d < best.0 {
                 best = (d, t, psi);
             }
@@ -88,8 +89,9 @@ pub fn contact_patch(
         let mut least = Real::INFINITY;
         let (mut i0, mut i1, mut j0, mut j1) = (N, 0, N, 0);
         for (i, &t) in ts.iter().enumerate() {
+            let section = g.section(t)?;
             for (j, &p) in ps.iter().enumerate() {
-                let d = wheel_distance(&wheel, &g.point(t, p)?);
+                let d = wheel_distance(&wheel, &g.point_of(&section, t, p));
                 least = least.min(d);
                 if d <= req.patch_gap {
                     inside[i * (N + 1) + j] = true;

@@ -4,6 +4,7 @@
 use super::check::{placed, wheel_distance, GrooveRequest};
 use super::groove::Groove;
 use super::pose::TorusWheel;
+use super::section::GrooveSection;
 use crate::math::{Real, Vec3};
 use crate::program::ProgramPass;
 use crate::tool::Wheel;
@@ -57,10 +58,21 @@ impl GrooveStock {
     fn nearest(&self, w: &TorusWheel, from: Option<(Real, Real)>) -> (Real, (Real, Real)) {
         use std::f64::consts::FRAC_PI_2;
         let (lo, hi) = self.groove.theta_range();
+        // The last section built, for the next point at its theta (the
+        // search steps psi at one theta, and the grid runs psi inside).
+        let last: std::cell::RefCell<Option<(Real, GrooveSection)>> = Default::default();
         let f = |t: Real, p: Real| {
-            self.groove
-                .point(t.clamp(lo, hi), p.clamp(-FRAC_PI_2, FRAC_PI_2))
-                .map_or(Real::INFINITY, |q| wheel_distance(w, &q))
+            let t = t.clamp(lo, hi);
+            let mut last = last.borrow_mut();
+            if last.as_ref().is_none_or(|(at, _)| *at != t) {
+                *last = self.groove.section(t).ok().map(|s| (t, s));
+            }
+            last.as_ref().map_or(Real::INFINITY, |(_, s)| {
+                wheel_distance(
+                    w,
+                    &self.groove.point_of(s, t, p.clamp(-FRAC_PI_2, FRAC_PI_2)),
+                )
+            })
         };
         let mut best = match from {
             Some(tp) => (f(tp.0, tp.1), tp),
