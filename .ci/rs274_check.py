@@ -94,7 +94,7 @@ def main():
             failed += 1
             print(f"FAIL  rs274 {d.name}: {problem}")
         else:
-            print(f"ok    rs274 {d.name}: every synchronised move as the axis program says")
+            print(f"ok    rs274 {d.name}: every move, rapid or cut, and every synchronised one as the axis program says")
     return 1 if failed else 0
 
 

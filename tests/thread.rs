@@ -360,8 +360,8 @@ fn the_linuxcnc_program_is_left_for_its_interpreter() {
 /// every thread block runs towards +Z (the tailstock), from beyond the
 /// thread's far end by at least S1 to past the face by at least S2, each
 /// as the cutter's edges reach; the simulation finds it left-handed and
-/// its pitch diameter within 6g (ISO 965-2: 18.164 to 18.334); its solid
-/// winds left. Left for rs274 too.
+/// its pitch diameter within 6g (ISO 965-2: 18.164 to 18.334). Left for
+/// rs274, and its solids for FreeCAD and the glTF validator.
 #[test]
 fn a_left_hand_is_cut_towards_the_tailstock() {
     let out = run(
@@ -404,6 +404,13 @@ fn a_left_hand_is_cut_towards_the_tailstock() {
     }
     assert!(threads > 5, "{threads}");
     common::leave_for_rs274(&out, "thread-lh");
+    // Its solids (the mesh and the STEP mirrored from a right hand's) for
+    // CI's FreeCAD and glTF checks.
+    common::leave_for_checkers(&out, "thread-lh");
+    let mesh = pilgrim_kernel::mesh::read_stl(&out.join("thread.stl")).unwrap();
+    let v = mesh.volume();
+    assert!(v > 0.0, "{v}");
+    common::leave_step_for_freecad(&out, "thread-lh", "thread", v, 0.01 * v);
 }
 
 /// LinuxCNC's G76 (`cycle = g76`) on the lathe with a LinuxCNC control,
