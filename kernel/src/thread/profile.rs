@@ -36,6 +36,21 @@ impl Hand {
             Hand::Left => -1.0,
         }
     }
+
+    /// The place, counted in pitches along +Z from start 0 modulo the
+    /// starts, of start `k` in the section at angle 0; and, the map being
+    /// its own inverse, the start at place `k` (see [`Hand::sign`]).
+    pub fn start_place(self, k: i64, starts: u32) -> u32 {
+        (self.sign() as i64 * k).rem_euclid(i64::from(starts)) as u32
+    }
+
+    /// `right` or `left`, as a message names the hand.
+    pub fn name(self) -> &'static str {
+        match self {
+            Hand::Right => "right",
+            Hand::Left => "left",
+        }
+    }
 }
 
 /// A diameter's limits (mm).

@@ -609,6 +609,7 @@ pub fn simulate(
     // An internal thread is simulated as its external twin in rho = -r
     // (see `mirrored`), and its results turned back.
     let inside = req.section.internal;
+    let rho = req.section.opening();
     let twin;
     let req = if inside {
         twin = req.mirrored();
@@ -616,7 +617,6 @@ pub fn simulate(
     } else {
         req
     };
-    let rho = if inside { -1.0 } else { 1.0 };
     let w = &req.section;
     let tol = &req.tolerances;
     let fail = |m: String| VerifyError::Failed(m);
@@ -727,8 +727,8 @@ pub fn simulate(
                 "{}: a thread block towards {} with the spindle in M3 cuts a {}-hand helix, and the thread is {}-handed (cut it towards {})",
                 name(),
                 if dir < 0.0 { "-Z (the chuck)" } else { "+Z (the tailstock)" },
-                hand_name(cuts),
-                hand_name(w.hand),
+                cuts.name(),
+                w.hand.name(),
                 if dir < 0.0 { "+Z" } else { "-Z" },
             ));
             // Simulated still: the axial section at angle 0 is cut the
@@ -736,8 +736,7 @@ pub fn simulate(
         }
         let z_sec = z0 - dir * l * start_deg / 360.0;
         let k_raw = ((z_sec - c0) / px).round();
-        // Start k lies `sign k` pitches from start 0 (see `Hand::sign`).
-        let start = ((w.hand.sign() * k_raw) as i64).rem_euclid(i64::from(z1)) as u32;
+        let start = w.hand.start_place(k_raw as i64, z1);
         let offset = z_sec - (c0 + k_raw * px);
         let zw = w0 + (z_sec - w0).rem_euclid(lead);
         let section = cutter.section(r_a + 1.0 - r1);
@@ -911,14 +910,6 @@ pub fn simulate(
         hand: w.hand,
     };
     Ok(if inside { check.mirrored() } else { check })
-}
-
-/// A hand as a message names it.
-fn hand_name(h: Hand) -> &'static str {
-    match h {
-        Hand::Right => "right",
-        Hand::Left => "left",
-    }
 }
 
 /// A diameter of the section from a radius of the simulation's, which is
@@ -1116,10 +1107,8 @@ fn measure(
     let samples = 21;
     let mut out = Vec::new();
     'starts: for k in 0..w.starts {
-        // Start k lies `sign k` pitches from start 0 (`Hand::sign`), the
-        // same modulo the lead as the window's place for it.
-        let place = (w.hand.sign() as i64 * i64::from(k)).rem_euclid(i64::from(w.starts));
-        let c = c0 + place as Real * px;
+        // The start's place in the window (modulo the lead).
+        let c = c0 + Real::from(w.hand.start_place(i64::from(k), w.starts)) * px;
         let space = |r: Real| {
             space_edges(m, r, c).ok_or_else(|| {
                 fail(format!(
