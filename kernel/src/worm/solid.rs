@@ -46,7 +46,6 @@ pub fn worm_solid(
     let outline = check.outline();
     let r_thread = outline.iter().map(|p| p[1]).fold(0.0, Real::max);
     let nut = nut_radius(check, outside, r_thread)?;
-    let r_tip = r_thread;
     // The outline between its corners, repeated with the lead.
     let radius = |z: Real| -> Real {
         let u = w0 + (z - w0).rem_euclid(lead);
@@ -61,11 +60,10 @@ pub fn worm_solid(
         };
         a[1] + t * (b[1] - a[1])
     };
-    if outline.len() < 2 || !(r_tip > 0.0) {
+    if outline.len() < 2 || !(r_thread > 0.0) {
         return Err(MeshError::Degenerate("the worm's section is empty".into()));
     }
-    let step = 2.0 * (1.0 - (tol / r_tip).min(1.0)).acos();
-    let n = ((TAU / step).ceil() as usize).clamp(24, MAX_AROUND);
+    let n = points_round(r_thread, tol);
     // Rings evenly from -length to 0, as near lead / n apart as a whole
     // number of them allows: each quad's diagonal then strays from its
     // helix by at most a (2 rings)-th of a ring's spacing.
@@ -92,8 +90,7 @@ pub fn worm_solid(
         Some(r) => {
             // The outside is straight along the axis: its two end rings,
             // as many points round as the tolerance asks there.
-            let step = 2.0 * (1.0 - (tol / r).min(1.0)).acos();
-            let n = ((TAU / step).ceil() as usize).clamp(24, MAX_AROUND);
+            let n = points_round(r, tol);
             let outside: Vec<Vec<[Real; 3]>> = [-length, 0.0]
                 .iter()
                 .map(|&z| {
@@ -109,6 +106,13 @@ pub fn worm_solid(
             crate::mesh::sweep_hollow(&outside, &rings)
         }
     }
+}
+
+/// How many points round a circle of radius `r` keep its chords within
+/// `tol` of it: at least 24, at most [`MAX_AROUND`].
+fn points_round(r: Real, tol: Real) -> usize {
+    let step = 2.0 * (1.0 - (tol / r).min(1.0)).acos();
+    ((TAU / step).ceil() as usize).clamp(24, MAX_AROUND)
 }
 
 /// An internal thread's nut's outside radius, from its diameter `outside`,
