@@ -348,37 +348,37 @@ pub fn check(
     let names = placement.axes();
     let w = names.len();
     let rows = axis_rows(program, info, names, 0..n).map_err(CollisionError::Program)?;
+    // Entity `e`'s frame at the axis values `q`, the tool's frame `tool`.
+    let frame_of = |e: &Entity, q: &[Real], tool: &Mat4| -> Result<Mat4, CollisionError> {
+        let f = match e.which {
+            Which::Tool => *tool,
+            Which::Body(i) => placement.body_frame(i, q, tool)?,
+            Which::Part => Mat4::identity(),
+        };
+        Ok(f * e.shaped.local)
+    };
     let frames = |q: &[Real]| -> Result<Vec<Mat4>, CollisionError> {
         let tool = placement.tool_frame(q)?;
-        entities
-            .iter()
-            .map(|e| {
-                let f = match e.which {
-                    Which::Tool => tool,
-                    Which::Body(i) => placement.body_frame(i, q, &tool)?,
-                    Which::Part => Mat4::identity(),
-                };
-                Ok(f * e.shaped.local)
-            })
-            .collect()
+        entities.iter().map(|e| frame_of(e, q, &tool)).collect()
     };
     let lerp = |a: &[Real], b: &[Real], t: Real| -> Vec<Real> {
         a.iter().zip(b).map(|(x, y)| x + (y - x) * t).collect()
     };
     let mut state: Vec<PairState> = pairs.iter().map(|_| PairState::new()).collect();
     let queries = std::cell::Cell::new(0usize);
-    let distance = |(i, j): (usize, usize), f: &[Mat4]| -> Real {
+    // The pair (i, j)'s distance, its bodies at the frames `fi`, `fj`.
+    let distance = |(i, j): (usize, usize), fi: &Mat4, fj: &Mat4| -> Real {
         queries.set(queries.get() + 1);
         parry3d_f64::query::distance(
-            &shapes::pose(&f[i]),
+            &shapes::pose(fi),
             &*entities[i].shaped.shape,
-            &shapes::pose(&f[j]),
+            &shapes::pose(fj),
             &*entities[j].shaped.shape,
         )
         .map_or(0.0, |d| d.distance)
     };
-    let measure = |pair: (usize, usize), f: &[Mat4], block: usize, s: &mut PairState| {
-        s.record(distance(pair, f), block);
+    let measure = |(i, j): (usize, usize), f: &[Mat4], block: usize, s: &mut PairState| {
+        s.record(distance((i, j), &f[i], &f[j]), block);
     };
     let mut before = frames(&rows[0..w])?;
     for (&pair, s) in pairs.iter().zip(state.iter_mut()) {
@@ -486,8 +486,15 @@ pub fn check(
                 let mut best = (Real::INFINITY, 0);
                 for m in 0..=places {
                     samples += 1;
+                    // The pair's two frames only.
                     let t = lo + (hi - lo) * m as Real / places as Real;
-                    let d = distance((i, j), &frames(&lerp(a, b, t))?);
+                    let q = lerp(a, b, t);
+                    let tool = placement.tool_frame(&q)?;
+                    let (fi, fj) = (
+                        frame_of(&entities[i], &q, &tool)?,
+                        frame_of(&entities[j], &q, &tool)?,
+                    );
+                    let d = distance((i, j), &fi, &fj);
                     if d < best.0 {
                         best = (d, m);
                     }
