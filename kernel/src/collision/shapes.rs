@@ -10,7 +10,7 @@
 
 use crate::machine::Solid;
 use crate::math::{Mat4, Real, Vec3};
-use crate::mesh::{cross, dot, sub, TriMesh};
+use crate::mesh::TriMesh;
 use parry3d_f64::math::{Pose, Rot3, Vector};
 use parry3d_f64::shape::SharedShape;
 
@@ -292,13 +292,15 @@ pub fn envelope(mesh: &TriMesh, tol: Real, bore: bool) -> Option<Shaped> {
 }
 
 /// For each of `zs`, whether the part frame's axis there lies inside the
-/// closed mesh: the parity of a ray's crossings from the axis outwards.
-/// Written here (Moller-Trumbore on the triangles near the ray): parry's
-/// ray cast gives the first hit only, and its inside test needs a mesh
-/// with merged vertices and pseudo-normals. The ray leaves at an odd angle
-/// and a hair off `z` so that it meets no edge or vertex of a mesh built
-/// on round angles.
+/// closed mesh: the parity of a ray's crossings from the axis outwards,
+/// each triangle near the ray cast against it (parry's `Triangle`; its
+/// mesh ray cast gives the first hit only, and its inside test needs a
+/// mesh with merged vertices and pseudo-normals). The ray leaves at an
+/// odd angle and a hair off `z` so that it meets no edge or vertex of a
+/// mesh built on round angles.
 fn axis_inside(mesh: &TriMesh, zs: &[Real]) -> Vec<bool> {
+    use parry3d_f64::query::{Ray, RayCast};
+    use parry3d_f64::shape::Triangle;
     let (s, c) = 0.123_456_789_f64.sin_cos();
     // The rays' heights, ascending: each triangle meets those within its
     // own span of z only.
@@ -310,31 +312,15 @@ fn axis_inside(mesh: &TriMesh, zs: &[Real]) -> Vec<bool> {
         let [a, b, d] = t.map(|i| mesh.positions[i as usize]);
         let (lo, hi) = (a[2].min(b[2]).min(d[2]), a[2].max(b[2]).max(d[2]));
         let first = heights.partition_point(|&z| z < lo);
+        let v = |p: [Real; 3]| Vector::new(p[0], p[1], p[2]);
+        let triangle = Triangle::new(v(a), v(b), v(d));
         for (n, &z) in heights[first..].iter().enumerate() {
             if z > hi {
                 break;
             }
-            let (k, o) = (order[first + n], [0.0, 0.0, z]);
-            // Moller-Trumbore, the ray o + t (c, s, 0), t > 0.
-            let (e1, e2) = (sub(b, a), sub(d, a));
-            let dir = [c, s, 0.0];
-            let p = cross(dir, e2);
-            let det = dot(e1, p);
-            if det.abs() < 1e-15 {
-                continue;
-            }
-            let tv = sub(o, a);
-            let u = dot(tv, p) / det;
-            if !(0.0..=1.0).contains(&u) {
-                continue;
-            }
-            let q = cross(tv, e1);
-            let v = dot(dir, q) / det;
-            if v < 0.0 || u + v > 1.0 {
-                continue;
-            }
-            if dot(e2, q) / det > 0.0 {
-                crossings[k] += 1;
+            let ray = Ray::new(Vector::new(0.0, 0.0, z), Vector::new(c, s, 0.0));
+            if triangle.intersects_local_ray(&ray, Real::MAX) {
+                crossings[order[first + n]] += 1;
             }
         }
     }
