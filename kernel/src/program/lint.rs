@@ -20,7 +20,7 @@
 //! ISO words only.
 
 use super::post::{Dialect, Style};
-use super::{name_in, AxisProgram};
+use super::{name_in, AxisProgram, ProgramSetup};
 use crate::machine::{Axis, AxisKind};
 use crate::math::Real;
 use crate::toolpath::Motion;
@@ -710,34 +710,13 @@ fn lint_gcode(
         // held and read as a block of its own.
         if motion_here == Some(76) {
             let (cycle, end_x) = cycle_words(&read, d).map_err(|m| fault(place(k), m))?;
-            let needs = [
-                (
-                    !st.spindle_on,
-                    "a threading cycle with the spindle stopped (no M3)".to_owned(),
-                ),
-                (
-                    !st.speed.is_some_and(|v| v >= 1.0),
-                    "a threading cycle with no spindle speed S written".to_owned(),
-                ),
-                (
-                    d.reading.thread_needs_constant_speed && !st.constant_speed,
-                    "a threading cycle before constant spindle speed (G97)".to_owned(),
-                ),
-                (
-                    program.setup.coolant && !st.coolant,
-                    format!(
-                        "a threading cycle with the coolant off ({} not written)",
-                        d.coolant.0
-                    ),
-                ),
-                (
-                    d.radial_words.is_some()
-                        && program.setup.radial.is_some()
-                        && st.radial.is_none(),
-                    "a threading cycle before the radial axis's programming is set".to_owned(),
-                ),
-            ];
-            if let Some((_, m)) = needs.into_iter().find(|(bad, _)| *bad) {
+            let what = "a threading cycle";
+            let needs_g97 = (d.reading.thread_needs_constant_speed && !st.constant_speed)
+                .then(|| format!("{what} before constant spindle speed (G97)"));
+            if let Some(m) = cutting_fault(&st, d, &program.setup, what)
+                .or(needs_g97)
+                .or_else(|| setup_fault(&st, d, &program.setup, what))
+            {
                 return Err(fault(place(k), m));
             }
             let (Some(xi), Some(zi)) = (
@@ -971,26 +950,11 @@ fn lint_gcode(
         if m == 1 && !st.feed {
             return Err(fault(place(k), "G1 before any feed F".into()));
         }
-        if m != 0 && !st.spindle_on {
-            return Err(fault(
-                place(k),
-                "a cutting move with the spindle stopped (no M3)".into(),
-            ));
-        }
-        if m != 0 && !st.speed.is_some_and(|v| v >= 1.0) {
-            return Err(fault(
-                place(k),
-                "a cutting move with no spindle speed S written".into(),
-            ));
-        }
-        if m != 0 && program.setup.coolant && !st.coolant {
-            return Err(fault(
-                place(k),
-                format!(
-                    "a cutting move with the coolant off ({} not written), which the machine's setup turns on",
-                    d.coolant.0
-                ),
-            ));
+        if let Some(m) = (m != 0)
+            .then(|| cutting_fault(&st, d, &program.setup, "a cutting move"))
+            .flatten()
+        {
+            return Err(fault(place(k), m));
         }
         if sf_here.is_some() && !is_thread {
             return Err(fault(
@@ -998,20 +962,8 @@ fn lint_gcode(
                 "SF= outside a thread block, where the writer never puts it".into(),
             ));
         }
-        // Radius or diameter and the feed group, where the dialect has
-        // words for them, as the setup says before the first move.
-        let radial_word = d.radial_words.is_some() && d.style == Style::GCode;
-        if radial_word && program.setup.radial.is_some() && st.radial.is_none() {
-            return Err(fault(
-                place(k),
-                "a move before the radial axis's programming (radius or diameter) is set, which the machine's setup states".into(),
-            ));
-        }
-        if d.feed_group.is_some() && !program.setup.feed_group.is_empty() && !st.feed_group {
-            return Err(fault(
-                place(k),
-                "a move before the feed group the machine's setup states".into(),
-            ));
+        if let Some(m) = setup_fault(&st, d, &program.setup, "a move") {
+            return Err(fault(place(k), m));
         }
         let read_lead = st.lead.unwrap_or(Real::NAN);
         let motion = match m {
@@ -1147,6 +1099,42 @@ fn lint_gcode(
         lines: lines.len(),
     };
     Ok(out)
+}
+
+/// What the modal state `st` lacks for `what` (a cutting move, a cycle)
+/// to cut: the spindle on, a speed written, the coolant on where the
+/// machine's `setup` turns it on.
+fn cutting_fault(st: &State, d: &Dialect, setup: &ProgramSetup, what: &str) -> Option<String> {
+    if !st.spindle_on {
+        Some(format!("{what} with the spindle stopped (no M3)"))
+    } else if !st.speed.is_some_and(|v| v >= 1.0) {
+        Some(format!("{what} with no spindle speed S written"))
+    } else if setup.coolant && !st.coolant {
+        Some(format!(
+            "{what} with the coolant off ({} not written), which the machine's setup turns on",
+            d.coolant.0
+        ))
+    } else {
+        None
+    }
+}
+
+/// What the modal state `st` lacks for `what` (any move) of the machine's
+/// `setup`, where the dialect has words for it: radius or diameter
+/// programming, the feed's group, each set before the first move.
+fn setup_fault(st: &State, d: &Dialect, setup: &ProgramSetup, what: &str) -> Option<String> {
+    let radial_word = d.radial_words.is_some() && d.style == Style::GCode;
+    if radial_word && setup.radial.is_some() && st.radial.is_none() {
+        Some(format!(
+            "{what} before the radial axis's programming (radius or diameter) is set, which the machine's setup states"
+        ))
+    } else if d.feed_group.is_some() && !setup.feed_group.is_empty() && !st.feed_group {
+        Some(format!(
+            "{what} before the feed group the machine's setup states"
+        ))
+    } else {
+        None
+    }
 }
 
 /// The last comment line among `comments[from..line]` (the pass a move at
@@ -1854,8 +1842,8 @@ mod tests {
     /// one G76 block, which the lint expands and holds move by move to
     /// the axis program, and a reader takes as those moves; Fanuc writes
     /// the same moves as blocks. A word changed in the text, a tapered
-    /// end, a word given twice, a bare move under G76's modal motion are
-    /// refused, named.
+    /// end, a word given twice, a bare move under G76's modal motion, a
+    /// cycle with the spindle stopped are refused, named.
     #[test]
     fn a_threading_cycle_is_written_read_and_held() {
         use crate::program::cycle::{expand, m20, CycleSpan};
@@ -1920,6 +1908,11 @@ mod tests {
                 "G0 X50.000",
                 "X50.000",
                 "under a threading cycle's modal G76",
+            ),
+            (
+                "S399 M3",
+                "S399 M5",
+                "a threading cycle with the spindle stopped (no M3)",
             ),
         ] {
             let bad = text.replacen(from, to, 1);
