@@ -523,6 +523,20 @@ fn a_g76_cycle_is_verified_as_the_control_makes_it() {
         err.contains("G76 E1") && err.contains("tapered ends"),
         "{err}"
     );
+    // The failure is a report to look at, naming the block and why, and
+    // no program.
+    let failed = dir.join("tapered");
+    let report = std::fs::read_to_string(failed.join("report.json")).unwrap();
+    assert!(
+        report.contains("N40") && report.contains("tapered ends"),
+        "{report}"
+    );
+    assert!(failed.join("report.html").is_file());
+    assert!(std::fs::read_dir(&failed).unwrap().all(|f| !f
+        .unwrap()
+        .file_name()
+        .to_string_lossy()
+        .starts_with("program.n")));
 }
 
 /// A script whose verify map gives the nut's outside as text is refused,
