@@ -360,8 +360,11 @@ pub mod toolpath_api {
     /// then half of it): LinuxCNC's G76, its words in `words` (`p` the
     /// lead, `z`, `i`, `j`, `r`, `k`, `q`, `h` as the cycle's; see the
     /// kernel's `program::cycle`), each rounded as a program writes it.
-    /// A program for a control that has the cycle writes it as one block;
-    /// any other, as its moves. Each cycle pass is named `name n`, the
+    /// `diameter` must say how the machine programs X: building the
+    /// program checks every move against the cycle as the machine's setup
+    /// programs it, and refuses a mismatch, naming the block. A program
+    /// for a control that has the cycle writes it as one block; any
+    /// other, as its moves. Each cycle pass is named `name n`, the
     /// cycle's last move `name end`. Returns each pass's depth below the
     /// crest (radial, mm) and its start's shift along Z (mm), as maps
     /// `#{ depth, shift }`.
