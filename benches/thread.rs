@@ -9,7 +9,10 @@
 //!   bytes of every file (not written to disk) (target <= 0.5 s); and the
 //!   same for the Tr 40x7 of `scripts/examples/thread-tr40x7.toml` and
 //!   the M30x2-6H nut of `scripts/examples/thread-m30x2-6h.toml` (cut
-//!   inside its bore on the boring bar).
+//!   inside its bore on the boring bar); the default M20 planned as
+//!   LinuxCNC's G76 makes it (`cycle = "g76"`), posted for LinuxCNC too
+//!   (the cycle written, its lint expanding it); and the pipe thread G 1/2
+//!   A of `scripts/examples/thread-g1-2a.toml`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pilgrim_kernel::catalog::{Catalog, CompiledPlugin};
@@ -39,10 +42,24 @@ fn thread_job(c: &mut Criterion) {
             text: std::fs::read_to_string(root.join("scripts/examples").join(file)).unwrap(),
         }]
     };
-    for (name, sets) in [
-        ("default_m20_end_to_end", vec![]),
-        ("tr40x7_end_to_end", example("thread-tr40x7.toml")),
-        ("m30_nut_end_to_end", example("thread-m30x2-6h.toml")),
+    let g76 = vec![ParamSource::Toml {
+        label: "cycle".into(),
+        text: "cycle = \"g76\"\n".into(),
+    }];
+    let linuxcnc = JobOptions {
+        also_post: vec!["linuxcnc".into()],
+        ..options.clone()
+    };
+    for (name, sets, options) in [
+        ("default_m20_end_to_end", vec![], &options),
+        ("tr40x7_end_to_end", example("thread-tr40x7.toml"), &options),
+        (
+            "m30_nut_end_to_end",
+            example("thread-m30x2-6h.toml"),
+            &options,
+        ),
+        ("m20_g76_linuxcnc_end_to_end", g76, &linuxcnc),
+        ("g1_2a_end_to_end", example("thread-g1-2a.toml"), &options),
     ] {
         let run = || {
             let family = ScriptFamily::load(
@@ -52,7 +69,7 @@ fn thread_job(c: &mut Criterion) {
             )
             .unwrap();
             let machine = catalog.open("fanuc-0i-tc").unwrap();
-            job::run(&family, &machine, &sets, &options, &mut |_| {}).unwrap()
+            job::run(&family, &machine, &sets, options, &mut |_| {}).unwrap()
         };
         let out = run();
         assert!(
