@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 mod thread_cutter;
 
-pub use thread_cutter::{ThreadCutter, ARC_TOLERANCE};
+pub use thread_cutter::{GroundFlanks, ThreadCutter, ARC_TOLERANCE, FORM_STEP};
 
 /// A grinding wheel: a disk of `diameter` and `width` whose periphery is
 /// rounded with `rounding_radius` (a torus, MATH §2.2). Every other radius

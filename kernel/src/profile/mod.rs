@@ -15,6 +15,7 @@
 
 mod builder;
 mod ellipse;
+mod helicoid;
 mod law;
 mod simplify;
 mod smooth;
@@ -23,6 +24,7 @@ mod workbook;
 
 pub use builder::{Bulge, ProfileBuilder};
 pub use ellipse::EllipseSection;
+pub use helicoid::FlankForm;
 pub use law::{uniform_grid, MandrelLaw};
 pub use simplify::{simplify_polyline, Polyline};
 pub use smooth::Smoothing;

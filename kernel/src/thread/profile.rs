@@ -3,14 +3,18 @@
 //! verification, whatever standard it comes from.
 //!
 //! The section is a rack along the part's axis: each space (the groove a
-//! cutter makes) has two straight flanks, each at its own angle from the
-//! radial direction (a buttress's differ), a width at the pitch diameter,
-//! and a root. An external thread's space opens outwards, from its root
+//! cutter makes) has two flanks, each at its own angle from the radial
+//! direction (a buttress's differ), a width at the pitch diameter, and a
+//! root. The flanks are straight (every standard thread, ZA worms), or
+//! the curves of a worm's flanks that are straight in another plane (ZN,
+//! ZI: [`FlankForm`]), symmetric, their angles those at the pitch
+//! diameter. An external thread's space opens outwards, from its root
 //! (the minor diameter) to its crest (the major, the blank's); an internal
 //! thread's opens inwards, from its root (the major) to its crest (the
 //! minor, the bore). Lengths in mm, angles in radians.
 
 use crate::math::Real;
+use crate::profile::FlankForm;
 use serde::{Deserialize, Serialize};
 
 /// The way the thread winds.
@@ -153,6 +157,10 @@ pub struct ThreadSection {
     pub space_at_pitch: Real,
     /// The root's rounding (0: a flat root with sharp corners).
     pub root_radius: Real,
+    /// How the flanks are generated: straight in this section, or a
+    /// worm's curves (ZN, ZI; external, symmetric).
+    #[serde(skip_serializing_if = "FlankForm::is_axial")]
+    pub form: FlankForm,
 }
 
 impl ThreadSection {
@@ -192,8 +200,24 @@ impl ThreadSection {
     /// The space's width along the axis at radius `r` (its flanks
     /// extended beyond the root and crest).
     pub fn space_at(&self, r: Real) -> Real {
-        let spread = self.flanks[0].tan() + self.flanks[1].tan();
-        self.space_at_pitch + self.opening() * (r - self.pitch_diameter / 2.0) * spread
+        match self.form.half_space(r) {
+            Some(half) => 2.0 * half,
+            None => {
+                let spread = self.flanks[0].tan() + self.flanks[1].tan();
+                self.space_at_pitch + self.opening() * (r - self.pitch_diameter / 2.0) * spread
+            }
+        }
+    }
+
+    /// How far the space reaches at radius `r` from its centre, the middle
+    /// of its root (where a radial pass puts the cutter's tip): towards -Z,
+    /// then +Z, each flank at its own angle (or on its curve).
+    pub fn reach(&self, r: Real) -> [Real; 2] {
+        if let Some(half) = self.form.half_space(r) {
+            return [half; 2];
+        }
+        let up = self.opening() * (r - self.root_diameter / 2.0);
+        [0, 1].map(|k| self.root_space() / 2.0 + up * self.flanks[k].tan())
     }
 
     /// The space's width at its root (before the root's rounding): the
@@ -202,23 +226,42 @@ impl ThreadSection {
         self.space_at(self.root_diameter / 2.0)
     }
 
-    /// The space's area in the axial section, root to crest (a trapezoid).
+    /// The space's area in the axial section, root to crest: a trapezoid,
+    /// or between curved flanks by Simpson's rule over 256 intervals (the
+    /// curves' fourth derivatives are small: well below 1e-9 mm^2).
     pub fn space_area(&self) -> Real {
-        0.5 * (self.root_space() + self.space_at(self.crest_diameter / 2.0)) * self.depth()
+        let (root, crest) = (self.root_diameter / 2.0, self.crest_diameter / 2.0);
+        if self.form.is_axial() {
+            return 0.5 * (self.root_space() + self.space_at(crest)) * self.depth();
+        }
+        let n = 256;
+        let h = (crest - root) / n as Real;
+        let sum: Real = (0..=n)
+            .map(|i| {
+                let w = if i == 0 || i == n {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                w * self.space_at(root + h * i as Real)
+            })
+            .sum();
+        (sum * h / 3.0).abs()
     }
 
     /// The space's outline in the axial section, its root centred on
     /// `centre` (z): four corners `[z, r]`, root first, the -Z flank's
-    /// root corner first.
+    /// root corner first (curved flanks by their chords).
     pub fn space_outline(&self, centre: Real) -> [[Real; 2]; 4] {
         let (root, crest) = (self.root_diameter / 2.0, self.crest_diameter / 2.0);
-        let half = self.root_space() / 2.0;
-        let depth = crest - root;
+        let (low, high) = (self.reach(root), self.reach(crest));
         [
-            [centre - half, root],
-            [centre + half, root],
-            [centre + half + depth.abs() * self.flanks[1].tan(), crest],
-            [centre - half - depth.abs() * self.flanks[0].tan(), crest],
+            [centre - low[0], root],
+            [centre + low[1], root],
+            [centre + high[1], crest],
+            [centre - high[0], crest],
         ]
     }
 
@@ -226,10 +269,10 @@ impl ThreadSection {
     /// of diameter `wire` laid in opposite spaces, the pitch diameter at
     /// `pitch_diameter`: each wire touches both flanks of its space, its
     /// centre `wire / 2 / sin(b)` from the flanks' meeting point (`b` the
-    /// half-angle). Symmetric profiles only (`None` otherwise); the lead
-    /// angle's small correction left out.
+    /// half-angle). Symmetric straight-flanked profiles only (`None`
+    /// otherwise); the lead angle's small correction left out.
     pub fn over_wires(&self, wire: Real, pitch_diameter: Real) -> Option<Real> {
-        if (self.flanks[0] - self.flanks[1]).abs() > 1e-12 {
+        if (self.flanks[0] - self.flanks[1]).abs() > 1e-12 || !self.form.is_axial() {
             return None;
         }
         let b = self.flanks[0];
@@ -237,10 +280,10 @@ impl ThreadSection {
         Some(pitch_diameter + s * (wire * (1.0 + 1.0 / b.sin()) - self.space_at_pitch / b.tan()))
     }
 
-    /// The best wire of a symmetric profile: the one that touches its
-    /// flanks at the pitch diameter.
+    /// The best wire of a symmetric straight-flanked profile: the one that
+    /// touches its flanks at the pitch diameter.
     pub fn best_wire(&self) -> Option<Real> {
-        ((self.flanks[0] - self.flanks[1]).abs() <= 1e-12)
+        ((self.flanks[0] - self.flanks[1]).abs() <= 1e-12 && self.form.is_axial())
             .then(|| self.space_at_pitch / self.flanks[0].cos())
     }
 }

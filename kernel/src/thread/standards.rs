@@ -43,6 +43,7 @@
 use super::profile::{Hand, Limits, ThreadLimits, ThreadProfile, ThreadSection};
 use crate::input::InputError;
 use crate::math::{positive, Real};
+use crate::profile::FlankForm;
 
 /// The mm of an inch.
 pub const INCH: Real = 25.4;
@@ -233,6 +234,7 @@ pub fn metric(
             flanks: [30.0_f64.to_radians(); 2],
             space_at_pitch: pitch / 2.0,
             root_radius: if internal { 0.0 } else { h / 6.0 },
+            form: FlankForm::Axial,
         },
         limits,
     })
@@ -407,6 +409,7 @@ pub fn trapezoidal(
             flanks: [15.0_f64.to_radians(); 2],
             space_at_pitch: pitch / 2.0,
             root_radius: 0.0,
+            form: FlankForm::Axial,
         },
         limits: stated.limits(internal, d2, crest, root),
     })
@@ -493,6 +496,7 @@ pub fn acme(
             flanks: [14.5_f64.to_radians(); 2],
             space_at_pitch: p * INCH / 2.0,
             root_radius: 0.0,
+            form: FlankForm::Axial,
         },
         limits: ThreadLimits {
             pitch_diameter: mm(pitch_l),
@@ -570,6 +574,7 @@ pub fn buttress(
             flanks,
             space_at_pitch: p / 2.0,
             root_radius: 0.07141 * p,
+            form: FlankForm::Axial,
         },
         limits: stated.limits(internal, e, crest, root),
     })
@@ -724,6 +729,7 @@ pub fn pipe(
             flanks: [27.5_f64.to_radians(); 2],
             space_at_pitch: p / 2.0,
             root_radius: r,
+            form: FlankForm::Axial,
         },
         limits,
     })

@@ -3,14 +3,22 @@
 //! rounded by the nose radius, its flanks at their own angles from the
 //! radial direction. A full-profile cutter has the worm's half-angle on
 //! both flanks and the root's space as its tip; a narrower "universal"
-//! one reaches the flanks by the axial offset `a_1z` (MATH §4.4).
+//! one reaches the flanks by the axial offset `a_1z` (MATH §4.4). A form
+//! cutter ground to a ZN or ZI worm's curved flanks ([`GroundFlanks`]) is
+//! the full-profile trapezoid whose flanks bend out on the curve of the
+//! space it was ground for.
 
 use crate::input::InputError;
 use crate::math::{positive, Real};
+use crate::profile::FlankForm;
 use serde::{Deserialize, Serialize};
 
 /// How far a nose arc's chords may stray from it (mm) in the section.
 pub const ARC_TOLERANCE: Real = 2e-4;
+
+/// The longest step along the height of a form cutter's curved flank in
+/// its section (mm): a ZI flank's curve strays 0.01 um from its chords.
+pub const FORM_STEP: Real = 0.1;
 
 /// A thread cutter's section. Its tracked point is the middle of its tip,
 /// its `z` along the worm's axis and `r` radial, away from the axis.
@@ -31,6 +39,21 @@ pub struct ThreadCutter {
     /// bodies for tools inside a bore hold it.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub inside: bool,
+    /// A form cutter's curved flanks (`None`: straight).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ground: Option<GroundFlanks>,
+}
+
+/// The flanks a form cutter is ground to: a worm's space of `form` with
+/// the cutter's tip at its root, `root` from the axis. Its flanks there
+/// follow the space's; above the tip they stand [`ThreadCutter::bulge`]
+/// outside the straight lines at the root's angles.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GroundFlanks {
+    /// The worm's flank form (curved: ZN or ZI).
+    pub form: FlankForm,
+    /// The radius of the root it is ground for (mm).
+    pub root: Real,
 }
 
 impl ThreadCutter {
@@ -76,6 +99,7 @@ impl ThreadCutter {
             right_angle,
             height,
             inside: false,
+            ground: None,
         };
         let need = c.inset(left_angle) + c.inset(right_angle);
         if need > tip_width {
@@ -90,14 +114,54 @@ impl ThreadCutter {
         Ok(c)
     }
 
+    /// The full-profile form cutter for a worm's space of curved `form`
+    /// (ZN, ZI) whose root is `root` from the axis: its tip the space's
+    /// width there, its flanks the space's, curved, at `nose_radius` and
+    /// `height` above the tip.
+    ///
+    /// # Failures
+    /// A straight form (cut with [`Self::new`]'s cutter); those of
+    /// [`Self::new`].
+    pub fn ground_to(
+        form: FlankForm,
+        root: Real,
+        nose_radius: Real,
+        height: Real,
+    ) -> Result<Self, InputError> {
+        let (Some(half), Some(angle)) = (form.half_space(root), form.axial_angle(root)) else {
+            return Err(InputError::out_of_range(
+                "form cutter's flanks",
+                0.0,
+                "curved (ZN or ZI): a straight flank takes the straight cutter",
+            ));
+        };
+        let mut c = Self::new(2.0 * half, nose_radius, angle, angle, height)?;
+        c.ground = Some(GroundFlanks { form, root });
+        Ok(c)
+    }
+
+    /// How far each flank stands outside its straight line (at the tip's
+    /// angle) at `h` above the tip: 0 for straight flanks; a form cutter's
+    /// curve less its tangent at the tip.
+    pub fn bulge(&self, h: Real) -> Real {
+        let Some(g) = self.ground else {
+            return 0.0;
+        };
+        match (g.form.half_space(g.root + h), g.form.half_space(g.root)) {
+            (Some(a), Some(b)) => a - b - h * self.left_angle.tan(),
+            _ => 0.0,
+        }
+    }
+
     /// How far a corner's arc starts inside the tip's end: `r (1 - sin a) / cos a`.
     pub(crate) fn inset(&self, angle: Real) -> Real {
         self.nose_radius * (1.0 - angle.sin()) / angle.cos()
     }
 
-    /// The width between the flanks' lines at `r` above the tip.
+    /// The width between the flanks' lines (or curves) at `r` above the
+    /// tip.
     pub fn width_at(&self, r: Real) -> Real {
-        self.tip_width + r * (self.left_angle.tan() + self.right_angle.tan())
+        self.tip_width + r * (self.left_angle.tan() + self.right_angle.tan()) + 2.0 * self.bulge(r)
     }
 
     /// How far the section reaches from the tip's centre at `h` above the
@@ -110,10 +174,10 @@ impl ThreadCutter {
             if !(h > 0.0) {
                 0.0
             } else if h >= r * (1.0 - a.sin()) {
-                self.tip_width / 2.0 + h * a.tan()
+                self.tip_width / 2.0 + h * a.tan() + self.bulge(h)
             } else {
                 let centre = self.tip_width / 2.0 - self.inset(a);
-                centre + (r * r - (r - h) * (r - h)).max(0.0).sqrt()
+                centre + (r * r - (r - h) * (r - h)).max(0.0).sqrt() + self.bulge(h)
             }
         };
         [side(self.left_angle), side(self.right_angle)]
@@ -161,6 +225,31 @@ impl ThreadCutter {
         pts.push([-w - top * self.left_angle.tan(), top]);
         // Built clockwise (down the right flank): turned round.
         pts.reverse();
+        if self.ground.is_some() {
+            pts = self.bent(&pts);
+        }
+        pts
+    }
+
+    /// A form cutter's section from its straight one: the flanks in steps
+    /// of at most [`FORM_STEP`] along the height, every point moved out by
+    /// the bulge at its height (the tip's points, at height 0, stay).
+    fn bent(&self, straight: &[[Real; 2]]) -> Vec<[Real; 2]> {
+        let mut pts = Vec::with_capacity(straight.len() + 128);
+        for (i, &p) in straight.iter().enumerate() {
+            if let Some(&q) = straight.get(i + 1) {
+                let n = ((q[1] - p[1]).abs() / FORM_STEP).ceil().max(1.0) as usize;
+                pts.extend((0..n).map(|k| {
+                    let t = k as Real / n as Real;
+                    [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]
+                }));
+            } else {
+                pts.push(p);
+            }
+        }
+        for p in &mut pts {
+            p[0] += p[0].signum() * self.bulge(p[1]);
+        }
         pts
     }
 }

@@ -163,10 +163,30 @@ pub fn cutter_outline(cutter: &ThreadCutter, top: Real) -> Section {
     use crate::step::Piece;
     let (w, r) = (cutter.tip_width / 2.0, cutter.nose_radius);
     let (tl, tr) = (cutter.left_angle.tan(), cutter.right_angle.tan());
+    // A form cutter's flank bends out by its bulge: lines in steps of
+    // FORM_STEP along the height (a straight cutter's flank is one line).
+    let bent = |p: [Real; 2]| [p[0] + p[0].signum() * cutter.bulge(p[1]), p[1]];
+    let flank = |from: [Real; 2], to: [Real; 2], pieces: &mut Vec<Piece>| {
+        let n = if cutter.ground.is_some() {
+            ((to[1] - from[1]).abs() / crate::tool::FORM_STEP)
+                .ceil()
+                .max(1.0) as usize
+        } else {
+            1
+        };
+        for k in 1..n {
+            let t = k as Real / n as Real;
+            pieces.push(Piece::Line(bent([
+                from[0] + t * (to[0] - from[0]),
+                from[1] + t * (to[1] - from[1]),
+            ])));
+        }
+        pieces.push(Piece::Line(bent(to)));
+    };
     let start = [-w - top * tl, top];
     let mut pieces = Vec::new();
     if r > 0.0 {
-        let at = |c: [Real; 2], a: Real| [c[0] + r * a.cos(), c[1] + r * a.sin()];
+        let at = |c: [Real; 2], a: Real| bent([c[0] + r * a.cos(), c[1] + r * a.sin()]);
         let half_pi = std::f64::consts::FRAC_PI_2;
         let cl = [-(w - cutter.inset(cutter.left_angle)), r];
         let cr = [w - cutter.inset(cutter.right_angle), r];
@@ -174,7 +194,8 @@ pub fn cutter_outline(cutter: &ThreadCutter, top: Real) -> Section {
             -std::f64::consts::PI + cutter.left_angle,
             -cutter.right_angle,
         );
-        pieces.push(Piece::Line(at(cl, l0)));
+        let straight = |c: [Real; 2], a: Real| [c[0] + r * a.cos(), c[1] + r * a.sin()];
+        flank(start, straight(cl, l0), &mut pieces);
         pieces.push(Piece::Arc {
             through: at(cl, 0.5 * (l0 - half_pi)),
             to: at(cl, -half_pi),
@@ -184,11 +205,13 @@ pub fn cutter_outline(cutter: &ThreadCutter, top: Real) -> Section {
             through: at(cr, 0.5 * (r1 - half_pi)),
             to: at(cr, r1),
         });
+        flank(straight(cr, r1), [w + top * tr, top], &mut pieces);
     } else {
-        pieces.push(Piece::Line([-w, 0.0]));
+        flank(start, [-w, 0.0], &mut pieces);
         pieces.push(Piece::Line([w, 0.0]));
+        flank([w, 0.0], [w + top * tr, top], &mut pieces);
     }
-    pieces.push(Piece::Line([w + top * tr, top]));
+    let start = bent(start);
     pieces.push(Piece::Line(start));
     Section { start, pieces }
 }

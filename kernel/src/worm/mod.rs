@@ -45,7 +45,7 @@ pub use simulate::{
     simulate, SimulatedPass, StartProfile, WormCheck, WormRequest, WormStock, WormTolerances,
     LEAD_ERROR,
 };
-pub use sizes::WormSizes;
+pub use sizes::{WormProfile, WormSizes};
 pub use solid::{worm_solid, WormSweep, MAX_AROUND};
 pub(crate) use thread_script::SCRIPT_API as THREAD_SCRIPT_API;
 pub use workbook::worm_pass_workbook;

@@ -219,7 +219,8 @@ pub struct PlanSettings {
 /// The whole plan: every pass in the order cut, all starts.
 ///
 /// # Failures
-/// The finishing stock at or beyond the thread's height; a roughing law
+/// A form cutter ([`ThreadCutter::ground_to`]) on any flank order but
+/// radial; the finishing stock at or beyond the thread's height; a roughing law
 /// that cannot be laid out ([`roughing_depths`]); a non-positive axial
 /// step; more passes than [`MAX_PASSES`].
 pub fn plan(
@@ -236,6 +237,13 @@ pub fn plan(
             stock,
             format!("from 0 to below the thread's height h1 = {h:.4} mm"),
         ));
+    }
+    if c.ground.is_some() && s.order != FlankOrder::Radial {
+        return Err(InputError::BadText {
+            what: "flank order".into(),
+            value: format!("\"{:?}\"", s.order).to_lowercase(),
+            reason: "is refused for a form cutter ground to curved flanks (ZN, ZI): it plunges straight in, flank order radial (moved along a flank, its curve would cross the flank's)".into(),
+        });
     }
     let rough = roughing_depths(h - stock, s.roughing_passes, s.min_depth)?;
     // On a flank the cutter's edge stands on that flank's final line.
@@ -443,5 +451,37 @@ mod tests {
         assert_eq!(p[0].flank, Flank::Left);
         assert!((p[0].offset + (w.height() - p[0].cumulative) * a.tan()).abs() < 1e-12);
         assert_eq!(p[2].flank, Flank::Right);
+    }
+
+    /// A form cutter ground to curved flanks plunges radially: any flank
+    /// order but radial is refused, naming it.
+    #[test]
+    fn a_form_cutter_plunges_straight_in() {
+        use crate::worm::{WormProfile, WormSizes};
+        let a = 20f64.to_radians();
+        let w = WormSizes::with_profile(5.0, 2, 50.0, 0.2, a, None, WormProfile::ZI).unwrap();
+        let t = w.section();
+        let c = ThreadCutter::ground_to(t.form, w.root_radius(), 0.3, 13.0).unwrap();
+        let mut s = PlanSettings {
+            roughing_passes: None,
+            min_depth: 0.15,
+            finish_depth: 0.05,
+            finish_passes: 2,
+            order: FlankOrder::Alternating,
+            axial_step: 0.5,
+            starts_by_depth: true,
+        };
+        let e = plan(&t, &c, &s).unwrap_err().to_string();
+        assert!(
+            e.contains("flank order \"alternating\" is refused for a form cutter"),
+            "{e}"
+        );
+        s.order = FlankOrder::Radial;
+        let passes = plan(&t, &c, &s).unwrap();
+        // Its width at the pitch line is the space's: no side steps.
+        assert!(passes
+            .iter()
+            .all(|p| p.offset == 0.0 && p.kind != PassKind::Side));
+        assert!(axial_offset(&t, &c).abs() < 1e-12);
     }
 }

@@ -252,7 +252,8 @@ pub struct WormCheck {
     #[serde(default)]
     pub nominal_alpha_deg: Real,
     /// The nominal flank angles (deg): the space's flank towards -Z (the
-    /// left), then +Z.
+    /// left), then +Z; curved flanks' (ZN, ZI) least-squares lines over
+    /// the radii the flanks are measured at.
     #[serde(default)]
     pub nominal_flanks_deg: [Real; 2],
     /// The standard's limits the thread was held to (none: the
@@ -552,41 +553,44 @@ fn segment_distance(p: [Real; 2], a: [Real; 2], b: [Real; 2]) -> Real {
     ((p[0] - a[0] - t * dx).powi(2) + (p[1] - a[1] - t * dy).powi(2)).sqrt()
 }
 
-/// How far the nominal space reaches at radius `r` from its centre, the
-/// middle of its root (where a radial pass puts the cutter's tip): towards
-/// -Z, then +Z, each flank at its own angle.
-fn space_reach(t: &ThreadSection, r: Real) -> [Real; 2] {
-    let up = t.opening() * (r - t.root_diameter / 2.0);
-    [0, 1].map(|k| t.root_space() / 2.0 + up * t.flanks[k].tan())
-}
-
 /// How far the middles of the threads' crests either side of a space
 /// stand from its centre (the root's middle): before it (towards -Z), then
 /// after it. Below the crest the thread is wider, so a line there stays in
 /// the thread (a buttress's too).
 fn thread_middle(t: &ThreadSection) -> [Real; 2] {
-    let reach = space_reach(t, t.crest_diameter / 2.0);
+    let reach = t.reach(t.crest_diameter / 2.0);
     let half = (t.pitch - reach[0] - reach[1]) / 2.0;
     [reach[0] + half, reach[1] + half]
 }
 
-/// The nominal spaces of one lead's window (and one either side), each a
-/// trapezoid from the root to above the crest.
-fn nominal_spaces(t: &ThreadSection, c0: Real) -> Vec<[[Real; 2]; 4]> {
+/// The nominal spaces of one lead's window (and one either side), each an
+/// outline from the root to above the crest: a trapezoid, or curved
+/// flanks in chords of [`NOMINAL_CHORDS`] along the depth.
+fn nominal_spaces(t: &ThreadSection, c0: Real) -> Vec<Vec<[Real; 2]>> {
     let (root, top) = (t.root_diameter / 2.0, t.crest_diameter / 2.0 + 2.0);
-    let (bottom, upper) = (space_reach(t, root), space_reach(t, top));
+    let n = if t.form.is_axial() { 1 } else { NOMINAL_CHORDS };
+    let radii: Vec<Real> = (0..=n)
+        .map(|i| root + (top - root) * i as Real / n as Real)
+        .collect();
+    let reach: Vec<[Real; 2]> = radii.iter().map(|&r| t.reach(r)).collect();
     (-1..=i64::from(t.starts))
         .map(|k| {
             let c = c0 + k as Real * t.pitch;
-            [
-                [c - bottom[0], root],
-                [c + bottom[1], root],
-                [c + upper[1], top],
-                [c - upper[0], top],
-            ]
+            // From the -Z flank's root corner along the root, up the +Z
+            // flank, back down the -Z flank.
+            let up = radii.iter().zip(&reach).map(|(&r, e)| [c + e[1], r]);
+            let down = radii.iter().zip(&reach).rev().map(|(&r, e)| [c - e[0], r]);
+            let mut outline: Vec<[Real; 2]> = up.chain(down).collect();
+            outline.rotate_right(1);
+            outline
         })
         .collect()
 }
+
+/// The chords of a curved nominal flank: 64 over a worm's depth of 11 mm
+/// and 2 above it leave 0.2 mm each, within 0.02 um of a ZI flank's curve
+/// (its axial angle turns 3 degrees over the depth).
+const NOMINAL_CHORDS: usize = 64;
 
 /// Replays `program` (as written) on `machine` and simulates the cut of
 /// `cutter` (tracked at `tool`) in the worm's axial section; see the
@@ -792,8 +796,8 @@ pub fn simulate(
                 let d = spaces
                     .iter()
                     .map(|s| {
-                        (0..4)
-                            .map(|j| segment_distance(q, s[j], s[(j + 1) % 4]))
+                        (0..s.len())
+                            .map(|j| segment_distance(q, s[j], s[(j + 1) % s.len()]))
                             .fold(Real::INFINITY, Real::min)
                     })
                     .fold(Real::INFINITY, Real::min);
@@ -875,6 +879,7 @@ pub fn simulate(
         return Err(VerifyError::NoCuttingPass);
     }
     let (starts, unmeasured) = measure(&material, req, cutter);
+    let nominal_flanks = nominal_flanks_deg(w, &flank_radii(req, cutter));
     failures.extend(unmeasured);
     let check = WormCheck {
         failures,
@@ -883,8 +888,8 @@ pub fn simulate(
             w.root_diameter,
             w.crest_diameter,
         ),
-        nominal_alpha_deg: w.flanks[0].to_degrees(),
-        nominal_flanks_deg: w.flanks.map(Real::to_degrees),
+        nominal_alpha_deg: nominal_flanks[0],
+        nominal_flanks_deg: nominal_flanks,
         limits: req.limits.clone(),
         wire: req.limits.as_ref().and(w.best_wire()),
         over_wires_limits: req.limits.as_ref().and_then(|l| {
@@ -1084,6 +1089,34 @@ fn line(samples: &[(Real, Real)]) -> [Real; 2] {
     [mz - b * mr, b]
 }
 
+/// The radii the flanks are measured at: 21, clear of the root's fillet
+/// and the tip's edge.
+fn flank_radii(req: &WormRequest, cutter: &ThreadCutter) -> Vec<Real> {
+    let w = &req.section;
+    let r_lo = w.root_diameter / 2.0 + 2.0 * cutter.nose_radius + req.flank_margin;
+    let r_hi = w.crest_diameter / 2.0 - req.flank_margin;
+    (0..21)
+        .map(|j| r_lo + (r_hi - r_lo) * j as Real / 20.0)
+        .collect()
+}
+
+/// The nominal flanks' angles the measured ones are held to (deg, the
+/// flank towards -Z first): straight flanks' own; curved flanks' (ZN, ZI)
+/// least-squares lines over the `radii` they are measured at, as the
+/// measured angles are taken.
+fn nominal_flanks_deg(w: &ThreadSection, radii: &[Real]) -> [Real; 2] {
+    if w.form.is_axial() {
+        return w.flanks.map(Real::to_degrees);
+    }
+    let side = |k: usize, sign: Real| -> Vec<(Real, Real)> {
+        radii.iter().map(|&r| (r, sign * w.reach(r)[k])).collect()
+    };
+    [
+        (-slope(&side(0, -1.0))).atan().to_degrees(),
+        slope(&side(1, 1.0)).atan().to_degrees(),
+    ]
+}
+
 /// The finished profile at every start, and what of it fails against the
 /// nominal (a start whose space is not there is not measured further).
 fn measure(
@@ -1100,11 +1133,9 @@ fn measure(
         w.root_diameter / 2.0,
         w.pitch_diameter / 2.0,
     );
-    // The flanks are measured clear of the root's fillet and the tip's edge.
-    let r_lo = r_f + 2.0 * cutter.nose_radius + req.flank_margin;
-    let r_hi = r_a - req.flank_margin;
+    let radii = flank_radii(req, cutter);
+    let nominal_angles = nominal_flanks_deg(w, &radii);
     let c0 = req.space_centre;
-    let samples = 21;
     let mut out = Vec::new();
     'starts: for k in 0..w.starts {
         // The start's place in the window (modulo the lead).
@@ -1121,8 +1152,7 @@ fn measure(
         let (mut left, mut right) = (Vec::new(), Vec::new());
         let (mut left_form, mut right_form): (Real, Real) = (0.0, 0.0);
         let mut worst_at = [0.0; 2];
-        for j in 0..samples {
-            let r = r_lo + (r_hi - r_lo) * j as Real / (samples - 1) as Real;
+        for &r in &radii {
             let (zl, zr) = match space(r) {
                 Ok(s) => s,
                 Err(e) => {
@@ -1132,7 +1162,7 @@ fn measure(
             };
             left.push((r, zl));
             right.push((r, zr));
-            let reach = space_reach(w, r);
+            let reach = w.reach(r);
             let dl = (zl - (c - reach[0])) * w.flanks[0].cos();
             let dr = ((c + reach[1]) - zr) * w.flanks[1].cos();
             if dl.abs() > left_form.abs() {
@@ -1169,7 +1199,7 @@ fn measure(
             // The pitch line's middle stands off the root's by half the
             // flanks' difference over the depth between them.
             position_error: 0.5 * (zl + zr) - c - {
-                let reach = space_reach(w, r1);
+                let reach = w.reach(r1);
                 0.5 * (reach[1] - reach[0])
             },
             thickness: next - zr,
@@ -1212,8 +1242,8 @@ fn measure(
             }
         }
         for (flank, a, alpha) in [
-            ("left", p.left_angle_deg, w.flanks[0].to_degrees()),
-            ("right", p.right_angle_deg, w.flanks[1].to_degrees()),
+            ("left", p.left_angle_deg, nominal_angles[0]),
+            ("right", p.right_angle_deg, nominal_angles[1]),
         ] {
             if (a - alpha).abs() > tol.flank_angle.to_degrees() {
                 failures.push(fail(format!(
@@ -1307,6 +1337,19 @@ mod tests {
         order: FlankOrder,
         towards: Real,
     ) -> Result<WormCheck, VerifyError> {
+        cut_by(profile, aim, order, towards, |t| {
+            ThreadCutter::new(t.root_space(), 0.15, t.flanks[0], t.flanks[1], 3.0).unwrap()
+        })
+    }
+
+    /// [`cut_towards`] by the cutter `make` makes for the aimed section.
+    fn cut_by(
+        profile: &ThreadProfile,
+        aim: Real,
+        order: FlankOrder,
+        towards: Real,
+        make: fn(&ThreadSection) -> ThreadCutter,
+    ) -> Result<WormCheck, VerifyError> {
         // The blank turned to the middle of the crest's band.
         let s = profile.section.opening();
         let t = &ThreadSection {
@@ -1315,8 +1358,7 @@ mod tests {
                 .section
                 .aimed(profile.section.pitch_diameter - s * aim)
         };
-        let cutter =
-            ThreadCutter::new(t.root_space(), 0.15, t.flanks[0], t.flanks[1], 3.0).unwrap();
+        let cutter = make(t);
         let settings = PlanSettings {
             roughing_passes: None,
             min_depth: 0.05,
@@ -1327,8 +1369,18 @@ mod tests {
             starts_by_depth: true,
         };
         let passes = plan(t, &cutter, &settings).unwrap();
-        let (length, rpm) = (30.0, 300.0);
-        let c0 = if towards < 0.0 { 5.0 } else { -length - 5.0 };
+        // A worm's long lead slower, and its deep space's edges further
+        // out, S1 within the run-in before the face.
+        let (length, rpm, run_in) = if t.lead() > 10.0 {
+            (30.0, 60.0, 5.0 + t.depth())
+        } else {
+            (30.0, 300.0, 5.0)
+        };
+        let c0 = if towards < 0.0 {
+            run_in
+        } else {
+            -length - run_in
+        };
         let r_crest = t.crest_diameter / 2.0;
         let mut blocks = Vec::new();
         let block = |motion, x: Real, z: Real, feed: Real| Block {
@@ -1344,7 +1396,11 @@ mod tests {
         for p in &passes {
             let r = r_crest - s * p.cumulative;
             let zs = c0 + p.offset;
-            let ze = if towards < 0.0 { -length - 5.0 } else { 5.0 };
+            let ze = if towards < 0.0 {
+                -length - run_in
+            } else {
+                run_in
+            };
             blocks.push(block(Motion::Rapid, clear, zs, 0.0));
             blocks.push(block(Motion::Rapid, r, zs, 0.0));
             blocks.push(block(
@@ -1620,5 +1676,70 @@ mod tests {
         let (figures, _) = check.findings();
         let angle = figures.iter().find(|f| f.name == "flank angle").unwrap();
         assert!(angle.value.abs() < 0.05, "{angle:?}");
+    }
+
+    /// A ZI worm's flanks are curves in the axial section (its axial angle
+    /// turns from 18.2 to 21.2 degrees over the depth): a straight cutter
+    /// on their tangent at the pitch line leaves them tens of micrometres
+    /// off, refused naming the flank's form; the form cutter ground to them
+    /// cuts them within a micrometre, its angles those of the curve's
+    /// line. A ZN worm's form cutter (its flanks nearly straight) leaves
+    /// the ZI worm's curve as the straight one does.
+    #[test]
+    fn a_zi_worm_is_held_to_its_curved_flanks() {
+        use crate::worm::{WormProfile, WormSizes};
+        let worm = |profile| {
+            WormSizes::with_profile(5.0, 2, 50.0, 0.2, 20f64.to_radians(), None, profile)
+                .unwrap()
+                .profile(0.05, 0.02)
+        };
+        let zi = worm(WormProfile::ZI);
+        let form = |t: &ThreadSection| {
+            ThreadCutter::ground_to(t.form, t.root_diameter / 2.0, 0.15, 13.0).unwrap()
+        };
+        let check = cut_by(&zi, 0.0, FlankOrder::Radial, -1.0, form).unwrap();
+        let worst = check
+            .starts
+            .iter()
+            .map(|s| s.left_form.abs().max(s.right_form.abs()))
+            .fold(0.0, Real::max);
+        assert!(worst < 1e-3, "{worst}");
+        let nominal = check.nominal_flanks_deg;
+        for s in &check.starts {
+            assert!((s.left_angle_deg - nominal[0]).abs() < 5e-3, "{s:?}");
+            assert!((s.right_angle_deg - nominal[1]).abs() < 5e-3, "{s:?}");
+        }
+        check.clone().verified().unwrap();
+        // The curve's line over the measured band is steeper than its
+        // tangent at the root, less steep than its tangent at the tip.
+        let at = |r: Real| zi.section.form.axial_angle(r).unwrap().to_degrees();
+        assert!(
+            at(19.0) < nominal[1] && nominal[1] < at(30.0),
+            "{nominal:?}"
+        );
+        // A straight cutter on the curve's tangent at the pitch line (the
+        // space's width there, no side steps) leaves the curve either side.
+        let straight = |t: &ThreadSection| {
+            let a = t.flanks[0];
+            let tip = t.space_at_pitch - (t.pitch_diameter - t.root_diameter) * a.tan();
+            ThreadCutter::new(tip, 0.15, a, a, 13.0).unwrap()
+        };
+        let e = cut_by(&zi, 0.0, FlankOrder::Radial, -1.0, straight)
+            .unwrap()
+            .verified()
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("flank: material left"), "{e}");
+        // The ZN worm's cutter in the ZI worm's space cuts beyond it.
+        let e = cut_by(&zi, 0.0, FlankOrder::Radial, -1.0, |_| {
+            let a = 20f64.to_radians();
+            let zn = WormSizes::with_profile(5.0, 2, 50.0, 0.2, a, None, WormProfile::ZN).unwrap();
+            ThreadCutter::ground_to(zn.section().form, 19.0, 0.15, 13.0).unwrap()
+        })
+        .unwrap()
+        .verified()
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("start 1, left flank: material left"), "{e}");
     }
 }

@@ -3,13 +3,14 @@
 
 use crate::input::InputError;
 use crate::math::{positive, Real};
+use crate::profile::FlankForm;
 use crate::thread::{Hand, Limits, ThreadLimits, ThreadProfile, ThreadSection};
 use serde::Serialize;
 use std::f64::consts::PI;
 
-/// A cylindrical worm with a ZA profile (straight flanks in the axial
-/// section) and the sizes derived from its module, starts and pitch
-/// diameter. All lengths in mm, angles in radians.
+/// A cylindrical worm, its flanks ZA (straight in the axial section), ZN
+/// or ZI (DIN 3975: [`FlankForm`]), and the sizes derived from its module,
+/// starts and pitch diameter. All lengths in mm, angles in radians.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct WormSizes {
     /// Module m.
@@ -20,18 +21,53 @@ pub struct WormSizes {
     pub pitch_diameter: Real,
     /// Radial clearance factor c*.
     pub clearance: Real,
-    /// Profile half-angle alpha in the axial section.
+    /// The profile's angle as its kind gives it: a ZA worm's half-angle in
+    /// the axial section, a ZN or ZI worm's normal pressure angle (the
+    /// axial one at the pitch diameter is [`Self::axial_alpha`]).
     pub alpha: Real,
+    /// The flanks' kind.
+    pub profile: WormProfile,
     /// Axial thickness of the thread at the pitch line, S_a1 (in the axial
     /// section the thread is a rack: its chord at the pitch line is its
     /// axial thickness). `p_x / 2` unless thinned for backlash.
     pub thickness: Real,
 }
 
+/// A worm's flank kind (DIN 3975).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub enum WormProfile {
+    /// Straight flanks in the axial section.
+    #[default]
+    ZA,
+    /// Straight flanks in the space's normal section.
+    ZN,
+    /// Involute helicoids.
+    ZI,
+}
+
+impl WormProfile {
+    /// The kind named `ZA`, `ZN` or `ZI` (any case).
+    ///
+    /// # Failures
+    /// Any other name.
+    pub fn parse(name: &str) -> Result<Self, InputError> {
+        match name.to_ascii_uppercase().as_str() {
+            "ZA" => Ok(Self::ZA),
+            "ZN" => Ok(Self::ZN),
+            "ZI" => Ok(Self::ZI),
+            _ => Err(InputError::BadText {
+                what: "worm profile".into(),
+                value: crate::names::quoted(name),
+                reason: "is not ZA, ZN or ZI".into(),
+            }),
+        }
+    }
+}
+
 impl WormSizes {
     /// The worm of module `m`, `z1` starts, pitch diameter `d1`, clearance
     /// factor `c`, half-angle `alpha` and pitch-line thickness `s_a1`
-    /// (`None`: half the axial pitch).
+    /// (`None`: half the axial pitch), its flanks ZA.
     ///
     /// # Failures
     /// A value that is not positive and finite (`c` may be 0); `z1` of 0;
@@ -44,6 +80,24 @@ impl WormSizes {
         c: Real,
         alpha: Real,
         s_a1: Option<Real>,
+    ) -> Result<Self, InputError> {
+        Self::with_profile(m, z1, d1, c, alpha, s_a1, WormProfile::ZA)
+    }
+
+    /// The worm of [`Self::new`] with flanks of kind `profile`, `alpha` as
+    /// that kind gives it (the normal pressure angle of ZN and ZI).
+    ///
+    /// # Failures
+    /// Those of [`Self::new`]; a ZI worm whose root lies inside its base
+    /// cylinder (its flanks would not reach the root).
+    pub fn with_profile(
+        m: Real,
+        z1: i64,
+        d1: Real,
+        c: Real,
+        alpha: Real,
+        s_a1: Option<Real>,
+        profile: WormProfile,
     ) -> Result<Self, InputError> {
         positive("module m", m)?;
         if z1 <= 0 || z1 > 100 {
@@ -76,6 +130,7 @@ impl WormSizes {
             pitch_diameter: d1,
             clearance: c,
             alpha,
+            profile,
             thickness: PI * m / 2.0,
         };
         if let Some(s) = s_a1 {
@@ -92,13 +147,25 @@ impl WormSizes {
                 ),
             ));
         }
+        if let Some(base) = w.section().form.base_radius() {
+            if base >= w.root_radius() {
+                return Err(InputError::out_of_range(
+                    "root diameter d_f1 of the ZI worm",
+                    w.root_diameter(),
+                    format!(
+                        "above its base cylinder's diameter {:.4} (a larger pitch diameter, module or normal angle)",
+                        2.0 * base
+                    ),
+                ));
+            }
+        }
         if !(w.root_space() > 0.0) {
             return Err(InputError::out_of_range(
                 "thread thickness S_a1",
                 w.thickness,
                 format!(
                     "below {:.4} mm, so that a space remains at the root",
-                    w.axial_pitch() - 2.0 * (w.pitch_radius() - w.root_radius()) * alpha.tan()
+                    w.thickness + w.root_space()
                 ),
             ));
         }
@@ -151,10 +218,11 @@ impl WormSizes {
     }
 
     /// Width of the space between threads along the axis at radius `r`:
-    /// `p_x - S_a1` at the pitch line, narrower by `2 tan(alpha)` per mm
-    /// towards the root.
+    /// `p_x - S_a1` at the pitch line; a ZA worm's narrower by `2
+    /// tan(alpha)` per mm towards the root, a ZN or ZI worm's on its
+    /// flanks' curves ([`ThreadSection::space_at`]).
     pub fn space_at(&self, r: Real) -> Real {
-        self.axial_pitch() - self.thickness - 2.0 * (self.pitch_radius() - r) * self.alpha.tan()
+        self.section().space_at(r)
     }
 
     /// Width of the space at the root: the widest tip a cutter may have.
@@ -163,15 +231,36 @@ impl WormSizes {
     }
 
     /// Area of one thread space in the axial section, between root and
-    /// tip (a trapezoid).
+    /// tip.
     pub fn space_area(&self) -> Real {
-        0.5 * (self.root_space() + self.space_at(self.tip_radius())) * self.height()
+        self.section().space_area()
     }
 
-    /// The worm's ZA section (straight flanks in the axial section) as a
-    /// thread's: the axial pitch `pi m`, the flanks at the profile angle,
-    /// the space at the pitch diameter the pitch less the thread's
-    /// thickness there.
+    /// The flanks' half-angle in the axial section at the pitch diameter:
+    /// a ZA worm's `alpha`; a ZN or ZI worm's from its normal angle and
+    /// its flanks' curve.
+    pub fn axial_alpha(&self) -> Real {
+        self.form()
+            .axial_angle(self.pitch_radius())
+            .unwrap_or(self.alpha)
+    }
+
+    /// The flanks' form ([`FlankForm`]): the space's half at the pitch
+    /// line, the helical parameter from the lead.
+    fn form(&self) -> FlankForm {
+        let half = (self.axial_pitch() - self.thickness) / 2.0;
+        let p = self.lead() / std::f64::consts::TAU;
+        match self.profile {
+            WormProfile::ZA => FlankForm::Axial,
+            WormProfile::ZN => FlankForm::zn(self.alpha, half, self.pitch_radius(), p),
+            WormProfile::ZI => FlankForm::zi(self.alpha, half, self.pitch_radius(), p),
+        }
+    }
+
+    /// The worm's section as a thread's: the axial pitch `pi m`, the
+    /// flanks at the axial angle (a ZN or ZI worm's on their curves), the
+    /// space at the pitch diameter the pitch less the thread's thickness
+    /// there.
     pub fn section(&self) -> ThreadSection {
         ThreadSection {
             internal: false,
@@ -182,9 +271,10 @@ impl WormSizes {
             pitch_diameter: self.pitch_diameter,
             root_diameter: self.root_diameter(),
             crest_diameter: self.tip_diameter(),
-            flanks: [self.alpha; 2],
+            flanks: [self.axial_alpha(); 2],
             space_at_pitch: self.axial_pitch() - self.thickness,
             root_radius: 0.0,
+            form: self.form(),
         }
     }
 
@@ -200,15 +290,22 @@ impl WormSizes {
         let number = crate::thread::standards::number;
         ThreadProfile {
             designation: format!(
-                "ZA m{} z{} d{}",
+                "{} m{} z{} d{}",
+                self.form().name(),
                 number(self.module),
                 self.starts,
                 number(self.pitch_diameter)
             ),
-            standard: "MATH §4.1 (ZA worm)".into(),
+            standard: match self.profile {
+                WormProfile::ZA => "MATH §4.1 (ZA worm)".into(),
+                _ => format!("MATH §4.1, DIN 3975 ({} worm)", self.form().name()),
+            },
             section: self.section(),
             limits: ThreadLimits {
-                pitch_diameter: band(self.pitch_diameter, thickness / (2.0 * self.alpha.tan())),
+                pitch_diameter: band(
+                    self.pitch_diameter,
+                    thickness / (2.0 * self.axial_alpha().tan()),
+                ),
                 crest: band(self.tip_diameter(), diameter),
                 root: band(self.root_diameter(), diameter),
                 source: "stated".into(),
@@ -275,5 +372,34 @@ mod tests {
         near(t.section.space_area(), w.space_area());
         near(t.section.lead(), w.lead());
         near(t.section.depth(), w.height());
+    }
+
+    /// A ZN or ZI worm: its section's space the pitch less the thickness
+    /// at the pitch line, as a ZA worm's; its axial angle there from the
+    /// normal angle (ZI: DIN 3975's `tan alpha_x = tan alpha_n / cos
+    /// gamma`); named by its kind. A ZI worm whose root lies inside its
+    /// base cylinder, and an unknown kind, are refused by name.
+    #[test]
+    fn zn_and_zi_worms_are_sized_from_their_normal_angle() {
+        let a = 20f64.to_radians();
+        for profile in [WormProfile::ZN, WormProfile::ZI] {
+            let w = WormSizes::with_profile(5.0, 2, 50.0, 0.2, a, None, profile).unwrap();
+            let t = w.section();
+            assert!((t.space_at(25.0) - (w.axial_pitch() - w.thickness)).abs() < 1e-12);
+            assert!(w.profile(0.05, 0.02).designation.starts_with(t.form.name()));
+            assert!((w.height() - 11.0).abs() < 1e-12);
+        }
+        let zi = WormSizes::with_profile(5.0, 2, 50.0, 0.2, a, None, WormProfile::ZI).unwrap();
+        let want = (a.tan() / zi.lead_angle().cos()).atan();
+        assert!((zi.axial_alpha() - want).abs() < 1e-12);
+        // m 5, one start, d1 20: r_b = 5.55 mm, the root 4.
+        let e = WormSizes::with_profile(5.0, 1, 20.0, 0.2, a, None, WormProfile::ZI)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("root diameter d_f1 of the ZI worm = 8"), "{e}");
+        assert!(e.contains("base cylinder"), "{e}");
+        let e = WormProfile::parse("ZK").unwrap_err().to_string();
+        assert!(e.contains("\"ZK\" is not ZA, ZN or ZI"), "{e}");
+        assert_eq!(WormProfile::parse("zi").unwrap(), WormProfile::ZI);
     }
 }
