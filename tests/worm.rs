@@ -940,3 +940,124 @@ pub(crate) fn check_workbook(out: &std::path::Path) {
     assert_eq!(number(&removed[1]), v["removed_area"].as_f64().unwrap());
     assert_eq!(removed[2].to_string(), "mm²");
 }
+
+/// The vertices of a run's `worm.stl` (f32 binary STL), each once per
+/// facet.
+fn stl_vertices(path: &Path) -> Vec<[f64; 3]> {
+    let stl = std::fs::read(path).unwrap();
+    let facets = u32::from_le_bytes(stl[80..84].try_into().unwrap()) as usize;
+    (0..facets)
+        .flat_map(|f| {
+            let stl = &stl;
+            (0..3).map(move |k| {
+                let o = 84 + 50 * f + 12 + 12 * k;
+                [0, 1, 2].map(|j| {
+                    f32::from_le_bytes(stl[o + 4 * j..o + 4 * j + 4].try_into().unwrap()) as f64
+                })
+            })
+        })
+        .collect()
+}
+
+/// Each flank vertex of a run's worm (between 0.5 mm above the root's 19
+/// mm radius and below the tip's 30) carried along the right-handed helix
+/// to the axial section at angle 0: its radius and its distance along
+/// the axis from the middle of its space (the spaces `p_x` apart from
+/// the run's space centre).
+fn flank_points(out: &Path) -> Vec<(f64, f64)> {
+    let r = common::report_of(out);
+    let note = |k: &str| r["notes"][k].as_f64().unwrap();
+    let (lead, px, c0) = (
+        note("lead_mm"),
+        note("axial_pitch_mm"),
+        note("space_centre_mm"),
+    );
+    stl_vertices(&out.join("worm.stl"))
+        .into_iter()
+        .filter_map(|p| {
+            let (rho, phi) = (p[0].hypot(p[1]), p[1].atan2(p[0]));
+            (19.5..29.5).contains(&rho).then(|| {
+                let u = p[2] - lead * phi / std::f64::consts::TAU;
+                let d = (u - c0).rem_euclid(px);
+                (rho, if d > px / 2.0 { d - px } else { d })
+            })
+        })
+        .collect()
+}
+
+/// ZN and ZI worms (m 5, two starts, d1 50, alpha_n 20 deg) run from the
+/// command line: each verified, and its finished solid's flanks what the
+/// kind says, computed here from DIN 3975's definitions and not from the
+/// kernel's curves. ZI: every flank vertex's distance from its space's
+/// middle is the involute helicoid's, `s/2 + p (inv r - inv r1)` with
+/// `inv r = sqrt(r^2/r_b^2 - 1) - acos(r_b / r)` and `cos gamma_b = cos
+/// alpha_n cos gamma`, within 2 um; a straight flank on its tangent at
+/// the pitch line would be 20 um off. ZN: each vertex carried along its
+/// helix into the plane through its space's middle tilted by the lead
+/// angle lies on a straight line at 20 deg there, within 2 um.
+#[test]
+fn zn_and_zi_worms_are_cut_on_their_flanks_curves() {
+    use std::f64::consts::{PI, TAU};
+    let (px, p, r1) = (PI * 5.0, 2.0 * PI * 5.0 / TAU, 25.0);
+    let (an, gamma) = (20f64.to_radians(), (p / r1).atan());
+    let half = px / 4.0;
+    // ZI.
+    let (_, out) = run_worm("zi", &["--set", "profile=ZI"]);
+    let r = common::report_of(&out);
+    assert_eq!(r["verdict"]["status"], "passed", "{}", r["verdict"]);
+    let rb = p / (an.cos() * gamma.cos()).acos().tan();
+    let inv = |r: f64| ((r / rb).powi(2) - 1.0).sqrt() - (rb / r).acos();
+    let points = flank_points(&out);
+    assert!(points.len() > 1000, "{}", points.len());
+    let tangent = p * (r1 * r1 - rb * rb).sqrt() / (r1 * rb);
+    let (mut worst, mut straight) = (0.0f64, 0.0f64);
+    for &(rho, d) in &points {
+        worst = worst.max((d.abs() - (half + p * (inv(rho) - inv(r1)))).abs());
+        straight = straight.max((d.abs() - (half + (rho - r1) * tangent)).abs());
+    }
+    assert!(
+        worst < 2e-3,
+        "ZI flanks {worst} mm off the involute helicoid"
+    );
+    assert!(straight > 0.02, "{straight}");
+    let v = &r["thread_verification"];
+    for s in v["starts"].as_array().unwrap() {
+        assert!(
+            (s["thickness"].as_f64().unwrap() - px / 2.0).abs() < 1e-3,
+            "{s}"
+        );
+    }
+    // ZN.
+    let (_, out) = run_worm("zn", &["--set", "profile=ZN"]);
+    let r = common::report_of(&out);
+    assert_eq!(r["verdict"]["status"], "passed", "{}", r["verdict"]);
+    let (st, ct) = (gamma.sin(), gamma.cos());
+    // The plane holds the radial x and (0, -sin g, cos g): a point at
+    // (r, 0, d) reaches it at the helix angle f where r sin f cos g + (d +
+    // p f) sin g = 0; there its distance along the plane from the space's
+    // middle is s and its radial coordinate x.
+    let widths: Vec<f64> = flank_points(&out)
+        .into_iter()
+        .map(|(rho, d)| {
+            let g = |f: f64| rho * f.sin() * ct + (d + p * f) * st;
+            let mut f = 0.0f64;
+            for _ in 0..60 {
+                f -= g(f) / (rho * f.cos() * ct + p * st);
+            }
+            let (x, s) = (rho * f.cos(), -rho * f.sin() * st + (d + p * f) * ct);
+            // On a straight flank at alpha_n: |s| - (x - r1) tan alpha_n
+            // is the half-width at x = r1, the same for every point.
+            s.abs() - (x - r1) * an.tan()
+        })
+        .collect();
+    assert!(widths.len() > 1000, "{}", widths.len());
+    let (lo, hi) = widths
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), &w| (a.min(w), b.max(w)));
+    assert!(
+        hi - lo < 2e-3,
+        "ZN flanks spread {} mm in the normal plane",
+        hi - lo
+    );
+    assert!((lo - half * gamma.cos()).abs() < 0.01, "{lo}");
+}

@@ -24,8 +24,9 @@ pub mod worm_api {
     use super::*;
 
     /// A cylindrical ZA worm: module `m`, `z1` starts, pitch diameter
-    /// `d1`, clearance factor `c` (c*), profile half-angle `alpha_deg`,
-    /// thread thickness at the pitch line `s_a1` (0: half the axial pitch).
+    /// `d1`, clearance factor `c` (c*), profile half-angle `alpha_deg` in
+    /// the axial section, thread thickness at the pitch line `s_a1` (0:
+    /// half the axial pitch).
     #[rhai_fn(return_raw)]
     pub fn worm(
         m: Real,
@@ -43,6 +44,71 @@ pub mod worm_api {
             alpha_deg.to_radians(),
             (s_a1 != 0.0).then_some(s_a1),
         ))
+    }
+
+    /// A cylindrical worm of flank kind `profile` (DIN 3975): `ZA`
+    /// (straight in the axial section; `alpha_deg` the half-angle there),
+    /// `ZN` (straight in the space's normal section) or `ZI` (involute
+    /// helicoids), their `alpha_deg` the normal pressure angle; the rest
+    /// as the six-argument `worm`.
+    ///
+    /// ```rhai
+    /// let w = worm(5.0, 2, 50.0, 0.2, 20.0, 0.0, "ZI");
+    /// ```
+    #[rhai_fn(name = "worm", return_raw)]
+    pub fn worm_of(
+        m: Real,
+        z1: i64,
+        d1: Real,
+        c: Real,
+        alpha_deg: Real,
+        s_a1: Real,
+        profile: &str,
+    ) -> Result<WormSizes, Box<EvalAltResult>> {
+        kernel(WormSizes::with_profile(
+            m,
+            z1,
+            d1,
+            c,
+            alpha_deg.to_radians(),
+            (s_a1 != 0.0).then_some(s_a1),
+            kernel(worm::WormProfile::parse(profile))?,
+        ))
+    }
+
+    /// The flanks' kind: `ZA`, `ZN` or `ZI`.
+    #[rhai_fn(get = "profile", pure)]
+    pub fn profile(w: &mut WormSizes) -> String {
+        format!("{:?}", w.profile)
+    }
+
+    /// The flanks' half-angle in the axial section at the pitch diameter
+    /// (deg): a ZA worm's `alpha_deg`; a ZN or ZI worm's from its normal
+    /// angle.
+    #[rhai_fn(get = "axial_alpha_deg", pure)]
+    pub fn axial_alpha_deg(w: &mut WormSizes) -> Real {
+        w.axial_alpha().to_degrees()
+    }
+
+    /// The full-profile form cutter (tool `number`) ground to the worm's
+    /// curved flanks (ZN, ZI): its tip the space at the root, its flanks
+    /// the space's curves, `nose_radius` at its corners, reaching 2 mm
+    /// above the worm's tip. It plunges straight in (flank order radial).
+    #[rhai_fn(pure, return_raw)]
+    pub fn form_cutter(
+        w: &mut WormSizes,
+        name: &str,
+        number: i64,
+        nose_radius: Real,
+    ) -> Result<Tool, Box<EvalAltResult>> {
+        let number = crate::binding::tool_number(name, number)?;
+        let c = kernel(ThreadCutter::ground_to(
+            w.section().form,
+            w.root_radius(),
+            nose_radius,
+            w.height() + 2.0,
+        ))?;
+        Ok(Tool::thread_cutter(name, number, c))
     }
 
     /// Axial pitch `p_x = pi m` (mm).
