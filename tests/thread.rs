@@ -558,3 +558,82 @@ fn a_verify_map_with_a_bad_outside_is_refused() {
     );
     assert!(!out.join("program.nc").exists(), "{err}");
 }
+
+/// A worm named as the thread family reads worms (`ZI m5 z2 d50`, its
+/// example file) is cut by the form cutter and verified against its
+/// stated limits: each start's pitch diameter within 5 um of the band's
+/// middle (49.9, the cut 0.05 mm deeper on radius than the basic), its
+/// flanks within 1 um of their curve. The run's `thread.stl` puts every
+/// flank vertex on the involute helicoid computed here from DIN 3975's
+/// definition (`cos gamma_b = cos alpha_n cos gamma`), moved 0.05 mm
+/// towards the axis, within 2 um. With `cycle = g76` on LinuxCNC it is
+/// written as one G76 per start (radial: Q0) and left for rs274; as a nut
+/// it is refused by name (a worm is external).
+#[test]
+fn a_worm_named_by_its_designation_is_cut_on_its_curved_flanks() {
+    use std::f64::consts::{PI, TAU};
+    let out = run(
+        "worm-zi",
+        &["--params", "scripts/examples/thread-worm-zi.toml"],
+    );
+    let r = common::report_of(&out);
+    assert_eq!(r["verdict"]["status"], "passed", "{}", r["verdict"]);
+    let v = &r["thread_verification"];
+    for st in v["starts"].as_array().unwrap() {
+        let f = |k: &str| st[k].as_f64().unwrap();
+        assert!((f("pitch_diameter") - 49.9).abs() < 0.005, "{st}");
+        assert!(
+            f("left_form").abs() < 1e-3 && f("right_form").abs() < 1e-3,
+            "{st}"
+        );
+        assert!(st.get("over_wires").is_none(), "{st}");
+    }
+    let (px, p, r1, an) = (PI * 5.0, 2.0 * PI * 5.0 / TAU, 25.0, 20f64.to_radians());
+    let rb = p / (an.cos() * (p / r1).atan().cos()).acos().tan();
+    let inv = |r: f64| ((r / rb).powi(2) - 1.0).sqrt() - (rb / r).acos();
+    let points = crate::worm::flank_points(&out, "thread.stl", (19.5, 29.4));
+    assert!(points.len() > 1000, "{}", points.len());
+    let worst = points
+        .iter()
+        .map(|&(rho, d)| (d.abs() - (px / 4.0 + p * (inv(rho + 0.05) - inv(r1)))).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        worst < 2e-3,
+        "ZI flanks {worst} mm off the involute helicoid"
+    );
+    // G76 on LinuxCNC: straight in, one cycle per start.
+    let g76 = run(
+        "worm-zi-g76",
+        &[
+            "--params",
+            "scripts/examples/thread-worm-zi.toml",
+            "--set",
+            "cycle=g76",
+            "--post",
+            "linuxcnc",
+        ],
+    );
+    let ngc = std::fs::read_to_string(g76.join("program.ngc")).unwrap();
+    let cycles: Vec<&str> = ngc
+        .lines()
+        .filter(|l| l.starts_with('N') && l.contains(" G76 "))
+        .collect();
+    assert_eq!(cycles.len(), 2, "{ngc}");
+    assert!(cycles.iter().all(|l| l.contains("Q0.0000")), "{cycles:?}");
+    common::leave_for_rs274(&g76, "thread-worm-zi");
+    let (code, _, err) = pilgrim(&[
+        "run",
+        SCRIPT,
+        "--out",
+        s(&scratch("thread", "worm-nut").join("out")),
+        "--set",
+        "designation=ZI m5 z2 d50",
+        "--set",
+        "internal=internal",
+    ]);
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("an external thread's, and the drawing says internal"),
+        "{err}"
+    );
+}

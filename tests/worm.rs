@@ -943,7 +943,7 @@ pub(crate) fn check_workbook(out: &std::path::Path) {
 
 /// The vertices of a run's `worm.stl` (f32 binary STL), each once per
 /// facet.
-fn stl_vertices(path: &Path) -> Vec<[f64; 3]> {
+pub(crate) fn stl_vertices(path: &Path) -> Vec<[f64; 3]> {
     let stl = std::fs::read(path).unwrap();
     let facets = u32::from_le_bytes(stl[80..84].try_into().unwrap()) as usize;
     (0..facets)
@@ -959,24 +959,21 @@ fn stl_vertices(path: &Path) -> Vec<[f64; 3]> {
         .collect()
 }
 
-/// Each flank vertex of a run's worm (between 0.5 mm above the root's 19
-/// mm radius and below the tip's 30) carried along the right-handed helix
-/// to the axial section at angle 0: its radius and its distance along
-/// the axis from the middle of its space (the spaces `p_x` apart from
-/// the run's space centre).
-fn flank_points(out: &Path) -> Vec<(f64, f64)> {
+/// Each flank vertex of a run's solid `part` (`worm.stl`) with its radius
+/// within `band`, carried along the right-handed helix to the axial
+/// section at angle 0: its radius and its distance along the axis from
+/// the middle of its space (the spaces a pitch apart from the run's space
+/// centre).
+pub(crate) fn flank_points(out: &Path, part: &str, band: (f64, f64)) -> Vec<(f64, f64)> {
     let r = common::report_of(out);
-    let note = |k: &str| r["notes"][k].as_f64().unwrap();
-    let (lead, px, c0) = (
-        note("lead_mm"),
-        note("axial_pitch_mm"),
-        note("space_centre_mm"),
-    );
-    stl_vertices(&out.join("worm.stl"))
+    let note = |k: &str| r["notes"][k].as_f64();
+    let (lead, c0) = (note("lead_mm").unwrap(), note("space_centre_mm").unwrap());
+    let px = note("axial_pitch_mm").or(note("pitch_mm")).unwrap();
+    stl_vertices(&out.join(part))
         .into_iter()
         .filter_map(|p| {
             let (rho, phi) = (p[0].hypot(p[1]), p[1].atan2(p[0]));
-            (19.5..29.5).contains(&rho).then(|| {
+            (band.0..band.1).contains(&rho).then(|| {
                 let u = p[2] - lead * phi / std::f64::consts::TAU;
                 let d = (u - c0).rem_euclid(px);
                 (rho, if d > px / 2.0 { d - px } else { d })
@@ -1007,7 +1004,7 @@ fn zn_and_zi_worms_are_cut_on_their_flanks_curves() {
     assert_eq!(r["verdict"]["status"], "passed", "{}", r["verdict"]);
     let rb = p / (an.cos() * gamma.cos()).acos().tan();
     let inv = |r: f64| ((r / rb).powi(2) - 1.0).sqrt() - (rb / r).acos();
-    let points = flank_points(&out);
+    let points = flank_points(&out, "worm.stl", (19.5, 29.5));
     assert!(points.len() > 1000, "{}", points.len());
     let tangent = p * (r1 * r1 - rb * rb).sqrt() / (r1 * rb);
     let (mut worst, mut straight) = (0.0f64, 0.0f64);
@@ -1036,7 +1033,7 @@ fn zn_and_zi_worms_are_cut_on_their_flanks_curves() {
     // (r, 0, d) reaches it at the helix angle f where r sin f cos g + (d +
     // p f) sin g = 0; there its distance along the plane from the space's
     // middle is s and its radial coordinate x.
-    let widths: Vec<f64> = flank_points(&out)
+    let widths: Vec<f64> = flank_points(&out, "worm.stl", (19.5, 29.5))
         .into_iter()
         .map(|(rho, d)| {
             let g = |f: f64| rho * f.sin() * ct + (d + p * f) * st;

@@ -195,6 +195,17 @@ impl FlankForm {
         }
     }
 
+    /// The reference radius the form is defined at (`None` for
+    /// [`FlankForm::Axial`]).
+    pub fn reference(&self) -> Option<Real> {
+        match *self {
+            FlankForm::Axial => None,
+            FlankForm::Normal { reference, .. } | FlankForm::Involute { reference, .. } => {
+                Some(reference)
+            }
+        }
+    }
+
     /// Whether the flanks are straight in the axial section.
     pub fn is_axial(&self) -> bool {
         *self == FlankForm::Axial

@@ -15,6 +15,12 @@
 //! - straight pipe (ISO 228-1): `G<size>` internal, `G<size>A` or
 //!   `G<size>B` external, the size as the standard writes it (`1/2`,
 //!   `1 1/2`).
+//! - a cylindrical worm (DIN 3975): `Z<A|N|I> m<module> z<starts>
+//!   d<pitch diameter> [a<angle>]`, as `ZI m5 z2 d50`: the worm job's
+//!   sizes (c* 0.2, the thickness half the axial pitch), the angle (20
+//!   degrees unless given) a ZA worm's in the axial section, a ZN or ZI
+//!   worm's normal one; external, its limits stated. pilgrim's own
+//!   shorthand: DIN 3975 names the quantities, not a one-line form.
 //! - a trailing `LH` makes it left-handed (`RH`, the default, may be
 //!   written).
 //!
@@ -188,6 +194,34 @@ pub fn designated(text: &str, drawing: &Drawing) -> Result<ThreadProfile, InputE
                 drawing.stated,
             )
         }
+        [kind, sizes @ ..] if kind.len() == 2 && kind.starts_with('Z') => {
+            let profile = super::WormProfile::parse(kind).map_err(|e| bad(&e.to_string()))?;
+            let form = "a worm is Z<A|N|I> m<module> z<starts> d<pitch diameter> [a<angle>], as ZI m5 z2 d50";
+            let (mut m, mut z, mut d, mut a) = (None, None, None, 20.0);
+            for w in sizes {
+                let Some((k, v)) = w.char_indices().nth(1).map(|(i, _)| w.split_at(i)) else {
+                    return Err(bad(form));
+                };
+                match k {
+                    "m" => m = Some(num(v, "module")?),
+                    "z" => z = Some(num(v, "number of starts")?),
+                    "d" => d = Some(num(v, "pitch diameter")?),
+                    "a" => a = num(v, "profile angle")?,
+                    _ => return Err(bad(form)),
+                }
+            }
+            let (Some(m), Some(z), Some(d)) = (m, z, d) else {
+                return Err(bad(form));
+            };
+            if z.fract() != 0.0 || z > 12.0 {
+                return Err(bad(&format!("the number of starts z{z} is not a whole number from 1 to 12")));
+            }
+            external_unless(false)?;
+            let sizes =
+                super::WormSizes::with_profile(m, z as i64, d, 0.2, a.to_radians(), None, profile)
+                    .map_err(|e| bad(&e.to_string()))?;
+            Ok(sizes.drawn(hand, &drawing.stated))
+        }
         [g, ..] if g.starts_with('G') => {
             // ISO 228-1: `G<size>` internal, `G<size>A` or `B` external.
             let all = words.join(" ");
@@ -203,7 +237,7 @@ pub fn designated(text: &str, drawing: &Drawing) -> Result<ThreadProfile, InputE
             standards::pipe(size, internal, class, 1, hand)
         }
         _ => Err(bad(
-            "not a form pilgrim reads: M20x2.5-6g, M30x2-6H, Tr40x7, Tr40x14(P7), 1-5 ACME-2G, 1-0.2P-0.4L ACME-2G, 2-8 BUTT 7/45, G1/2A, G1 1/2 (LH at the end for a left hand)",
+            "not a form pilgrim reads: M20x2.5-6g, M30x2-6H, Tr40x7, Tr40x14(P7), 1-5 ACME-2G, 1-0.2P-0.4L ACME-2G, 2-8 BUTT 7/45, G1/2A, G1 1/2, ZI m5 z2 d50 (LH at the end for a left hand)",
         )),
     }
     .map_err(|e| match e {
@@ -215,6 +249,7 @@ pub fn designated(text: &str, drawing: &Drawing) -> Result<ThreadProfile, InputE
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::thread::ThreadSection;
 
     const DRAWING: Drawing = Drawing {
         internal: None,
@@ -236,6 +271,30 @@ mod tests {
     #[test]
     fn designations_read_into_the_standards_profiles() {
         let s = DRAWING.stated;
+        // A worm: the worm job's sizes, its kind's curves, the drawing's
+        // stated limits about its basic diameters (external), its hand.
+        let a = 20f64.to_radians();
+        for (kind, profile) in [
+            ("ZA", super::super::WormProfile::ZA),
+            ("ZN", super::super::WormProfile::ZN),
+            ("ZI", super::super::WormProfile::ZI),
+        ] {
+            let w =
+                super::super::WormSizes::with_profile(5.0, 2, 50.0, 0.2, a, None, profile).unwrap();
+            let t = read(&format!("{kind} m5 z2 d50-LH"));
+            assert_eq!(t.designation, format!("{kind} m5 z2 d50-LH"));
+            assert_eq!(
+                t.section,
+                ThreadSection {
+                    hand: Hand::Left,
+                    ..w.section()
+                }
+            );
+            assert_eq!(t.limits.pitch_diameter.max, 50.0);
+            assert!((t.limits.pitch_diameter.min - (50.0 - s.pitch_tolerance)).abs() < 1e-12);
+            assert_eq!(t.limits.crest.max, 60.0);
+        }
+        assert_eq!(read("ZN m4 z1 d40 a15").designation, "ZN m4 z1 d40 a15");
         assert_eq!(
             read("M20x2.5-6g"),
             standards::metric(20.0, 2.5, false, "6g", 1, Hand::Right).unwrap()
@@ -315,6 +374,12 @@ mod tests {
             ("M20xA-6g", "pitch 'A' is not a positive number"),
             ("", "not a form"),
             ("G9/16A", "not a size of ISO 228-1"),
+            ("ZI m5 z2", "a worm is Z<A|N|I> m<module>"),
+            ("ZI m5 z2 d50 q3", "a worm is Z<A|N|I> m<module>"),
+            ("ZK m5 z2 d50", "\"ZK\" is not ZA, ZN or ZI"),
+            ("ZI m5 z1.5 d50", "z1.5 is not a whole number"),
+            ("ZI m5 z1 d20", "above its base cylinder's diameter 11.09"),
+            ("ZA m0 z1 d20", "module '0' is not a positive number"),
         ] {
             let e = designated(t, &DRAWING).unwrap_err().to_string();
             assert!(
@@ -333,6 +398,19 @@ mod tests {
         .to_string();
         assert!(
             e.contains("an internal thread's, and the drawing says external"),
+            "{e}"
+        );
+        let e = designated(
+            "ZI m5 z2 d50",
+            &Drawing {
+                internal: Some(true),
+                ..DRAWING
+            },
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("an external thread's, and the drawing says internal"),
             "{e}"
         );
         assert!(designated(&"M".repeat(100), &DRAWING)

@@ -197,10 +197,19 @@ impl ThreadSection {
         (self.crest_diameter - self.root_diameter).abs() / 2.0
     }
 
+    /// Curved flanks' distance from the space's middle at radius `r`:
+    /// the form's curve moved radially with the pitch diameter (a section
+    /// [`Self::aimed`] deeper is the same form cut deeper); `None` for
+    /// straight flanks.
+    fn curve_at(&self, r: Real) -> Option<Real> {
+        let shift = self.pitch_diameter / 2.0 - self.form.reference()?;
+        self.form.half_space(r - shift)
+    }
+
     /// The space's width along the axis at radius `r` (its flanks
     /// extended beyond the root and crest).
     pub fn space_at(&self, r: Real) -> Real {
-        match self.form.half_space(r) {
+        match self.curve_at(r) {
             Some(half) => 2.0 * half,
             None => {
                 let spread = self.flanks[0].tan() + self.flanks[1].tan();
@@ -213,7 +222,7 @@ impl ThreadSection {
     /// of its root (where a radial pass puts the cutter's tip): towards -Z,
     /// then +Z, each flank at its own angle (or on its curve).
     pub fn reach(&self, r: Real) -> [Real; 2] {
-        if let Some(half) = self.form.half_space(r) {
+        if let Some(half) = self.curve_at(r) {
             return [half; 2];
         }
         let up = self.opening() * (r - self.root_diameter / 2.0);

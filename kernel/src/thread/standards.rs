@@ -323,7 +323,13 @@ pub struct StatedLimits {
 
 impl StatedLimits {
     /// The limits about basic pitch, crest and root diameters.
-    fn limits(&self, internal: bool, pitch: Real, crest: Real, root: Real) -> ThreadLimits {
+    pub(super) fn limits(
+        &self,
+        internal: bool,
+        pitch: Real,
+        crest: Real,
+        root: Real,
+    ) -> ThreadLimits {
         let s = if internal { 1.0 } else { -1.0 };
         let band = |basic: Real, tol: Real| {
             let near = basic + s * self.pitch_allowance;

@@ -1,8 +1,8 @@
 //! Worm threads cut in many passes on a CNC lathe (seed 004, MATH §4, with
 //! the corrections of issue 13).
 //!
-//! - [`WormSizes`]: the cylindrical worm with a ZA profile and its derived
-//!   sizes (standard practice, not the seed's words);
+//! - [`WormSizes`] (the thread module's): the cylindrical worm, ZA, ZN or
+//!   ZI, and its derived sizes (standard practice, not the seed's words);
 //! - [`approach_length`], [`runout_length`] and their lead errors: the
 //!   acceleration and deceleration lengths S1, S2 (Fanuc's exact form);
 //! - [`ThreadCutter`]: the cutter's section, full-profile or universal;
@@ -26,11 +26,11 @@ mod plots;
 mod script;
 mod servo;
 mod simulate;
-mod sizes;
 mod solid;
 mod thread_script;
 mod workbook;
 
+pub use crate::thread::{WormProfile, WormSizes};
 pub use crate::tool::{ThreadCutter, ARC_TOLERANCE};
 pub use blade::{cutter_outline, ThreadBlade, BLADE_RELIEF_DEG, BLADE_THICKNESS};
 pub use outcome::{WormOutcome, KIND};
@@ -45,7 +45,6 @@ pub use simulate::{
     simulate, SimulatedPass, StartProfile, WormCheck, WormRequest, WormStock, WormTolerances,
     LEAD_ERROR,
 };
-pub use sizes::{WormProfile, WormSizes};
 pub use solid::{worm_solid, WormSweep, MAX_AROUND};
 pub(crate) use thread_script::SCRIPT_API as THREAD_SCRIPT_API;
 pub use workbook::worm_pass_workbook;

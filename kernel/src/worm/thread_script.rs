@@ -12,7 +12,7 @@ use crate::math::Real;
 use crate::thread::standards::{LoadFlank, StatedLimits};
 use crate::thread::{Drawing, Hand, ThreadProfile};
 use crate::tool::Tool;
-use crate::worm::{self, WormTolerances};
+use crate::worm::{self, ThreadCutter, WormTolerances};
 use rhai::plugin::*;
 use rhai::{EvalAltResult, Map};
 
@@ -197,8 +197,13 @@ pub mod thread_api {
     /// symmetric profile; for an asymmetric one (a buttress) its steeper
     /// flank, `left` or `right`, so that the infeed runs along the load
     /// flank and the open flank takes the chip.
+    /// A worm's curved flanks (ZN, ZI): `radial`, its form cutter
+    /// plunging straight in.
     #[rhai_fn(get = "infeed", pure)]
     pub fn infeed(t: &mut ThreadProfile) -> String {
+        if !t.section.form.is_axial() {
+            return "radial".into();
+        }
         let [l, r] = t.section.flanks;
         match l.total_cmp(&r) {
             std::cmp::Ordering::Equal => "alternating",
@@ -206,6 +211,37 @@ pub mod thread_api {
             std::cmp::Ordering::Greater => "right",
         }
         .into()
+    }
+    /// Its flanks are curves in the axial section (a ZN or ZI worm's),
+    /// cut by `form_cutter`.
+    #[rhai_fn(get = "curved", pure)]
+    pub fn curved(t: &mut ThreadProfile) -> bool {
+        !t.section.form.is_axial()
+    }
+    /// The full-profile form cutter (tool `number`) ground to a worm's
+    /// curved flanks (ZN, ZI), `nose_radius` at its corners, reaching 2
+    /// mm above the crest: plunged to the root the cut aims at, it makes
+    /// the basic curve moved radially with the pitch diameter.
+    ///
+    /// ```rhai
+    /// let c = t.form_cutter("form cutter", 1, 0.2);
+    /// ```
+    #[rhai_fn(pure, return_raw)]
+    pub fn form_cutter(
+        t: &mut ThreadProfile,
+        name: &str,
+        number: i64,
+        nose_radius: Real,
+    ) -> Result<Tool, Box<EvalAltResult>> {
+        let number = crate::binding::tool_number(name, number)?;
+        let basic = &t.section;
+        let c = kernel(ThreadCutter::ground_to(
+            basic.form,
+            basic.root_diameter / 2.0,
+            nose_radius,
+            basic.depth() + 2.0,
+        ))?;
+        Ok(Tool::thread_cutter(name, number, c))
     }
     /// One space's area in the axial section, as the cut aims at it
     /// (mm^2).

@@ -1,10 +1,11 @@
 //! The worm's sizes (MATH §4.1): standard cylindrical-worm practice, not
 //! the seed's words (the seed names the inputs only).
 
+use super::standards::StatedLimits;
+use super::{Hand, Limits, ThreadLimits, ThreadProfile, ThreadSection};
 use crate::input::InputError;
 use crate::math::{positive, Real};
 use crate::profile::FlankForm;
-use crate::thread::{Hand, Limits, ThreadLimits, ThreadProfile, ThreadSection};
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -287,7 +288,7 @@ impl WormSizes {
             min: v - t,
             max: v + t,
         };
-        let number = crate::thread::standards::number;
+        let number = super::standards::number;
         ThreadProfile {
             designation: format!(
                 "{} m{} z{} d{}",
@@ -310,6 +311,34 @@ impl WormSizes {
                 root: band(self.root_diameter(), diameter),
                 source: "stated".into(),
             },
+        }
+    }
+
+    /// The worm as the thread family reads it from its designation
+    /// (`ZI m5 z2 d50`): its section of `hand`, its diameters within the
+    /// drawing's `stated` limits (external), named as read.
+    pub fn drawn(&self, hand: Hand, stated: &StatedLimits) -> ThreadProfile {
+        let basic = self.profile(0.0, 0.0);
+        let mut designation = basic.designation;
+        if self.alpha != 20f64.to_radians() {
+            designation += &format!(" a{}", super::standards::number(self.alpha.to_degrees()));
+        }
+        if hand == Hand::Left {
+            designation += "-LH";
+        }
+        ThreadProfile {
+            designation,
+            section: ThreadSection {
+                hand,
+                ..basic.section
+            },
+            limits: stated.limits(
+                false,
+                self.pitch_diameter,
+                self.tip_diameter(),
+                self.root_diameter(),
+            ),
+            ..basic
         }
     }
 }
