@@ -60,7 +60,11 @@ fn thread_job(c: &mut Criterion) {
         ),
         ("m20_g76_linuxcnc_end_to_end", g76, &linuxcnc),
         ("g1_2a_end_to_end", example("thread-g1-2a.toml"), &options),
-        ("worm_zi_end_to_end", example("thread-worm-zi.toml"), &options),
+        (
+            "worm_zi_end_to_end",
+            example("thread-worm-zi.toml"),
+            &options,
+        ),
     ] {
         let run = || {
             let family = ScriptFamily::load(
