@@ -57,6 +57,7 @@ pub mod caliber;
 pub mod catalog;
 mod chart;
 pub mod collision;
+pub mod compensate;
 pub mod error;
 mod families;
 pub mod family;

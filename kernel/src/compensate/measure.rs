@@ -1,0 +1,193 @@
+//! A measurement read from a table (CSV or spreadsheet, [`Table`]): a
+//! coordinate column and a value column, each named with its unit
+//! (`z_mm`, `d_mm`), every row inside the part, dense enough to say
+//! something everywhere along it.
+
+use super::CompensateError;
+use crate::math::Real;
+use crate::profile::Table;
+
+/// The fewest distinct places a measurement may have.
+pub const MIN_POINTS: usize = 5;
+
+/// What a family accepts as a measurement of its part.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasuredSpec<'a> {
+    /// The coordinate's column (`z_mm`).
+    pub coordinate: &'a str,
+    /// The value's columns, each with the factor that makes the quantity
+    /// of it (`("r_mm", 1.0)`, `("d_mm", 0.5)`): the first the table has
+    /// is read.
+    pub values: &'a [(&'a str, Real)],
+    /// The part's extent along the coordinate.
+    pub range: (Real, Real),
+    /// The longest stretch of the range left without a measured place
+    /// (its ends included).
+    pub max_gap: Real,
+}
+
+/// A measurement: the quantity at each distinct place, in increasing
+/// order (the rows at one place, as at several angular positions,
+/// averaged).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Measured {
+    /// The file, as messages name it.
+    pub file: String,
+    /// The value's column read.
+    pub column: String,
+    /// The places, increasing.
+    pub at: Vec<Real>,
+    /// The quantity at each (the column's value times its factor).
+    pub value: Vec<Real>,
+    /// How many rows each place averages.
+    pub rows: Vec<usize>,
+}
+
+/// Reads `table` as `spec` asks.
+///
+/// # Failures
+/// The coordinate's column missing, or none of the value's; a cell empty
+/// or not a number (named by row and column); a row outside the part;
+/// fewer than [`MIN_POINTS`] places; a stretch longer than
+/// `spec.max_gap` without one (named by where it runs).
+pub fn read_measured(table: &Table, spec: &MeasuredSpec<'_>) -> Result<Measured, CompensateError> {
+    let file = table.source().to_owned();
+    let at = table.column(spec.coordinate)?;
+    let (column, factor) = spec
+        .values
+        .iter()
+        .find(|(c, _)| table.column_index(c).is_ok())
+        .ok_or_else(|| CompensateError::NoValueColumn {
+            file: file.clone(),
+            wanted: spec
+                .values
+                .iter()
+                .map(|(c, _)| format!("'{c}'"))
+                .collect::<Vec<_>>()
+                .join(" or "),
+            available: table.headers().join(", "),
+        })?;
+    let value = table.column(column)?;
+    let (from, to) = spec.range;
+    let mut rows: Vec<(Real, Real)> = Vec::with_capacity(at.len());
+    for (i, (&s, &v)) in at.iter().zip(&value).enumerate() {
+        if !(from..=to).contains(&s) {
+            return Err(CompensateError::Outside {
+                file,
+                row: table.row_number(i),
+                column: spec.coordinate.to_owned(),
+                value: s,
+                from,
+                to,
+            });
+        }
+        rows.push((s, v * factor));
+    }
+    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut m = Measured {
+        file: file.clone(),
+        column: (*column).to_owned(),
+        at: Vec::new(),
+        value: Vec::new(),
+        rows: Vec::new(),
+    };
+    for (s, v) in rows {
+        match m.at.last() {
+            Some(&last) if last == s => {
+                let k = m.rows.len() - 1;
+                let n = m.rows[k] as Real;
+                m.value[k] = (m.value[k] * n + v) / (n + 1.0);
+                m.rows[k] += 1;
+            }
+            _ => {
+                m.at.push(s);
+                m.value.push(v);
+                m.rows.push(1);
+            }
+        }
+    }
+    if m.at.len() < MIN_POINTS {
+        return Err(CompensateError::TooSparse {
+            file,
+            what: format!(
+                "{} distinct places in column '{}': at least {MIN_POINTS} are needed to fit the error",
+                m.at.len(),
+                spec.coordinate
+            ),
+        });
+    }
+    // The ends of the part count as the gaps' bounds.
+    let mut edges = vec![from];
+    edges.extend(&m.at);
+    edges.push(to);
+    if let Some(w) = edges.windows(2).find(|w| w[1] - w[0] > spec.max_gap) {
+        return Err(CompensateError::TooSparse {
+            file,
+            what: format!(
+                "nothing measured from {} = {} to {}: at most {} may be left between measured places (the part runs from {from} to {to})",
+                spec.coordinate, w[0], w[1], spec.max_gap
+            ),
+        });
+    }
+    Ok(m)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::profile::read_table_str;
+
+    const SPEC: MeasuredSpec<'static> = MeasuredSpec {
+        coordinate: "z_mm",
+        values: &[("r_mm", 1.0), ("d_mm", 0.5)],
+        range: (0.0, 100.0),
+        max_gap: 30.0,
+    };
+
+    fn table(text: &str) -> Table {
+        read_table_str(text, "bench.csv").unwrap()
+    }
+
+    /// Diameters read as radii, sorted, the rows at one place averaged.
+    #[test]
+    fn a_measurement_is_read_by_its_columns() {
+        let m = read_measured(
+            &table(
+                "z_mm,d_mm,note\n50,40.004,\n0,38,a\n25,39.002,\n50,40.000,b\n75,41,\n100,42,\n",
+            ),
+            &SPEC,
+        )
+        .unwrap();
+        assert_eq!(m.column, "d_mm");
+        assert_eq!(m.at, vec![0.0, 25.0, 50.0, 75.0, 100.0]);
+        assert_eq!(m.rows, vec![1, 1, 2, 1, 1]);
+        assert!((m.value[2] - 20.001).abs() < 1e-12, "{:?}", m.value);
+        assert!((m.value[1] - 19.501).abs() < 1e-12);
+    }
+
+    /// Each bad measurement is named: the column, the row, where the part
+    /// is left unmeasured.
+    #[test]
+    fn bad_measurements_are_named() {
+        let e = |t: &str| read_measured(&table(t), &SPEC).unwrap_err().to_string();
+        let s = e("z_mm,x_mm\n0,1\n");
+        assert!(
+            s.contains("no column 'r_mm' or 'd_mm' (columns: z_mm, x_mm)"),
+            "{s}"
+        );
+        let s = e("z_mm,d_mm\n0,38\n25,39\n120,40\n");
+        assert!(
+            s.contains("bench.csv, row 4, column z_mm: 120 is outside the part (0 to 100)"),
+            "{s}"
+        );
+        let s = e("z_mm,d_mm\n0,38\n10,39\n20,40\n");
+        assert!(s.contains("3 distinct places"), "{s}");
+        let s = e("z_mm,d_mm\n0,38\n10,39\n20,40\n30,40\n40,41\n");
+        assert!(s.contains("nothing measured from z_mm = 40 to 100"), "{s}");
+        let s = e("z_mm,d_mm\n0,38\n10,x\n");
+        assert!(
+            s.contains("row 3") && s.contains("'x' is not a number"),
+            "{s}"
+        );
+    }
+}
