@@ -4,6 +4,7 @@
 //! kernel call. Exit codes: 0 done, 1 the job failed (the message says
 //! why, naming file, line, parameter or block), 2 a bad command line.
 
+mod compensate;
 mod counting;
 mod run;
 
@@ -167,6 +168,39 @@ enum Command {
         /// Also write the scene as scene.gltf + scene.bin.
         #[arg(long)]
         gltf: bool,
+    },
+    /// Correct a run by its finished part as measured: the measured minus
+    /// the nominal fitted within the measurement's uncertainty (a cubic
+    /// smoothing spline), the target moved against it by the gain, and the
+    /// job run again on the corrected target into --out, verified as
+    /// usual; `compensation.json` and `correction.csv` beside its files.
+    Compensate {
+        /// The run's output directory.
+        dir: PathBuf,
+        /// The measurement: a table (CSV, XLSX, ODS) whose columns the
+        /// family names (the mandrel: z_mm and d_mm or r_mm).
+        #[arg(long, value_name = "FILE")]
+        measured: PathBuf,
+        /// The share of the measured error the target moves against (1:
+        /// all of it).
+        #[arg(long, default_value_t = 1.0)]
+        gain: f64,
+        /// The measurement's uncertainty (mm): the fit's residual.
+        #[arg(long, value_name = "MM", default_value_t = 0.001)]
+        uncertainty: f64,
+        /// The largest correction accepted (mm); a larger one is refused,
+        /// naming where.
+        #[arg(long, value_name = "MM", default_value_t = 0.05)]
+        limit: f64,
+        /// Where the corrected run goes. Default: DIR-compensated.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Wall-clock limit of each call of the family's script (seconds).
+        #[arg(long, value_name = "S", default_value_t = 60.0)]
+        script_seconds: f64,
+        /// Wall-clock limit of the whole compensation (seconds).
+        #[arg(long, value_name = "S", default_value_t = 600.0)]
+        run_seconds: f64,
     },
     /// List the built-in machines; with --plugin or --file, those too.
     Machines {
@@ -462,6 +496,29 @@ fn main() -> ExitCode {
                     o.push(".verify");
                     PathBuf::from(o)
                 }),
+                script_seconds: *script_seconds,
+                run_seconds: *run_seconds,
+            },
+            &catalog,
+        )
+        .map(|s| s + "\n"),
+        Command::Compensate {
+            dir,
+            measured,
+            gain,
+            uncertainty,
+            limit,
+            out,
+            script_seconds,
+            run_seconds,
+        } => compensate::compensate(
+            &compensate::CompensateArgs {
+                dir: dir.clone(),
+                measured: measured.clone(),
+                gain: *gain,
+                uncertainty: *uncertainty,
+                limit: *limit,
+                out: out.clone().unwrap_or_else(|| compensate::default_out(dir)),
                 script_seconds: *script_seconds,
                 run_seconds: *run_seconds,
             },

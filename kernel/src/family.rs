@@ -51,6 +51,12 @@ impl Verification {
         Self(Box::new(request))
     }
 
+    /// What a measurement of the finished part holds and its nominal
+    /// ([`Verifier::nominal`]).
+    pub fn nominal(&self) -> Option<crate::compensate::Nominal> {
+        self.0.nominal()
+    }
+
     /// The request, as its own type (`None` if it is of another kind).
     pub fn request<T: 'static>(&self) -> Option<&T> {
         self.0.as_any().downcast_ref()
@@ -93,6 +99,13 @@ pub trait Verifier: AnyVerifier + std::fmt::Debug {
     /// The replay failing; a tool of the wrong kind
     /// ([`crate::replay::VerifyError::Replay`], naming what it needs).
     fn verify(&self, ctx: &ReplayContext<'_>) -> Result<Verified, crate::replay::VerifyError>;
+
+    /// What a measurement of the finished part holds and its nominal, if
+    /// the family's part can be measured and corrected (`pilgrim
+    /// compensate`); `None` by default.
+    fn nominal(&self) -> Option<crate::compensate::Nominal> {
+        None
+    }
 }
 
 /// A request as [`std::any::Any`], for callers that know its type: every

@@ -530,6 +530,7 @@ fn scripts_reach_the_caliber_geometry() {
          }";
     let access = Access {
         input_dirs: vec![examples.clone()],
+        ..Access::default()
     };
     let fam = ScriptFamily::from_source(src, "probe.rhai", &Limits::default(), &access).unwrap();
     let values = pilgrim_kernel::params::resolve(

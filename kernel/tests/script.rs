@@ -179,6 +179,7 @@ fn files_only_beside_the_input_files() {
     std::fs::write(dir.join("secret.csv"), "z,x\n0,1\n").unwrap();
     let access = Access {
         input_dirs: vec![inside.clone()],
+        ..Access::default()
     };
     let src = format!("{HEAD}fn toolpath(p) {{ let t = read_table(\"t.csv\"); if t.x.len != 3 {{ throw \"bad\"; }} read_table(\"../secret.csv\") }}");
     let fam = ScriptFamily::from_source(&src, "f.rhai", &Limits::default(), &access).unwrap();
@@ -384,6 +385,7 @@ fn tables_are_read_column_by_column() {
     .unwrap();
     let access = Access {
         input_dirs: vec![dir.clone()],
+        ..Access::default()
     };
     let src = format!(
         "{HEAD}fn toolpath(p) {{\n  let t = read_table(\"t.csv\");\n  if t.rows != 3 || t[\"Hp\"][1] != 9.5 {{ throw \"read\"; }}\n  t[\"depth\"]\n}}"

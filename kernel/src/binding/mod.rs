@@ -20,6 +20,11 @@ use std::path::PathBuf;
 pub struct Access {
     /// Directories scripts may read tables from (and below).
     pub input_dirs: Vec<PathBuf>,
+    /// Tables given by the host, not read from a file: `(name, CSV
+    /// text)`, found by `read_table(name)` before any directory (a
+    /// correction `pilgrim compensate` made, written beside the run's
+    /// files when the run succeeds).
+    pub tables: Vec<(String, String)>,
 }
 
 /// A group of the script API: its heading, its types (by the names

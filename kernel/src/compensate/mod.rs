@@ -18,8 +18,42 @@
 mod fit;
 mod measure;
 
+use crate::math::Real;
+use crate::profile::Profile;
+
 pub use fit::{fit_error, ErrorFit};
 pub use measure::{read_measured, Measured, MeasuredSpec, MIN_POINTS};
+
+/// What a measurement of a family's finished part holds and what it is
+/// held against, as the family's verification gives it
+/// (`Verifier::nominal`): a quantity along a coordinate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Nominal {
+    /// The coordinate's column (`z_mm`).
+    pub coordinate: &'static str,
+    /// The columns the quantity may be read from, each with the factor
+    /// that makes the quantity of it (`r_mm` 1, `d_mm` 0.5).
+    pub values: &'static [(&'static str, Real)],
+    /// The quantity's name in messages and files (`radius`).
+    pub quantity: &'static str,
+    /// The nominal quantity along the coordinate.
+    pub profile: Profile,
+    /// The part's extent along the coordinate that is measured.
+    pub range: (Real, Real),
+}
+
+impl Nominal {
+    /// The measurement's spec: a stretch of at most a quarter of the range
+    /// left without a measured place.
+    pub fn spec(&self) -> MeasuredSpec<'static> {
+        MeasuredSpec {
+            coordinate: self.coordinate,
+            values: self.values,
+            range: self.range,
+            max_gap: 0.25 * (self.range.1 - self.range.0),
+        }
+    }
+}
 
 /// Errors reading a measurement and turning it into a correction; each
 /// names the file, and the row and column or the place along the part.

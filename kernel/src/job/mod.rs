@@ -312,21 +312,20 @@ pub fn verify(
     run_on(family, machine, sources, options, stage, Some(text))
 }
 
-/// [`run`] of the program the run builds (`text` `None`), or [`verify`] of
-/// `text`.
-fn run_on(
+/// The parameter values of `sources` for `family` on `machine`, as a run
+/// takes them. Parameters tied to machine constants default to this
+/// machine's; set otherwise, they set the machine's for the whole run (its
+/// chains, its bodies, the scene), so that the family and the machine
+/// cannot differ. A parameter that restates where a machine body stands
+/// takes its default from the machine's chain when no constant states it.
+///
+/// # Failures
+/// A value refused ([`resolve`]); a body's place the machine cannot give.
+pub fn params_on(
     family: &dyn PartFamily,
     machine: &OpenMachine,
     sources: &[ParamSource],
-    options: &JobOptions,
-    stage: &mut dyn FnMut(&str),
-    text: Option<&str>,
-) -> Result<JobOutput, Error> {
-    // Parameters tied to machine constants default to this machine's; set
-    // otherwise, they set the machine's for the whole run (its chains, its
-    // bodies, the scene), so that the family and the machine cannot differ.
-    // A parameter that restates where a machine body stands takes its
-    // default from the machine's chain when no constant states it.
+) -> Result<Params, Error> {
     let mut constants = machine.kinematics.info().constants.clone();
     for s in family.params() {
         if let (Some((body, along)), Some(c)) = (s.body_place(), &s.machine) {
@@ -339,7 +338,20 @@ fn run_on(
             }
         }
     }
-    let values = resolve(family.params(), &constants, sources)?;
+    Ok(resolve(family.params(), &constants, sources)?)
+}
+
+/// [`run`] of the program the run builds (`text` `None`), or [`verify`] of
+/// `text`.
+fn run_on(
+    family: &dyn PartFamily,
+    machine: &OpenMachine,
+    sources: &[ParamSource],
+    options: &JobOptions,
+    stage: &mut dyn FnMut(&str),
+    text: Option<&str>,
+) -> Result<JobOutput, Error> {
+    let values = params_on(family, machine, sources)?;
     let overrides: Vec<(String, f64)> = family
         .params()
         .iter()

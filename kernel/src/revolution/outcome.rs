@@ -44,6 +44,19 @@ impl Verifier for VerifyRequest {
             stock: ground.map(|g| Box::new(g) as Box<dyn crate::process::Stock>),
         })
     }
+
+    /// A body of revolution measured along z: radii (`r_mm`) or diameters
+    /// (`d_mm`) at `z_mm`, over the range held to the tolerance, against
+    /// the nominal profile.
+    fn nominal(&self) -> Option<crate::compensate::Nominal> {
+        Some(crate::compensate::Nominal {
+            coordinate: "z_mm",
+            values: &[("r_mm", 1.0), ("d_mm", 0.5)],
+            quantity: "radius",
+            profile: self.profile.clone(),
+            range: (self.from, self.to),
+        })
+    }
 }
 
 /// A grinding program replayed against its body of revolution.

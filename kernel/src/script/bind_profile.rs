@@ -90,6 +90,19 @@ pub mod profile_api {
         kernel(p.raised(z_from, z_to, dx))
     }
 
+    /// The profile moved by the profile `d` along x at each z (`d` held
+    /// at its end values beyond its range): a target corrected by a
+    /// measured error, as `pilgrim compensate` gives it.
+    ///
+    /// ```rhai
+    /// let t = read_table(p.correction);
+    /// let target = ground.offset_by(profile(t["z_mm"], t["dr_mm"]));
+    /// ```
+    #[rhai_fn(pure, return_raw)]
+    pub fn offset_by(p: &mut Profile, d: Profile) -> Result<Profile, Box<EvalAltResult>> {
+        kernel(p.offset_by(&d))
+    }
+
     /// Three-point smoothing of the derivative (seed 001): `iterations`
     /// passes, the profile rebuilt from node `anchor`. The result has
     /// `.profile`, `.max_change` (mm) and `.max_change_z`.

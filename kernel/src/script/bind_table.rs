@@ -66,6 +66,7 @@ pub(super) fn register(engine: &mut Engine, access: &Access) {
         .iter()
         .filter_map(|d| d.canonicalize().ok())
         .collect();
+    let given = access.tables.clone();
     rhai::FuncRegistration::new("read_table")
         .with_params_info(["name: &str", "Table"])
         .with_comments([
@@ -94,6 +95,9 @@ pub(super) fn register(engine: &mut Engine, access: &Access) {
                     && name != "..";
                 if !plain {
                     return Err(refused());
+                }
+                if let Some((_, text)) = given.iter().find(|(n, _)| n == name) {
+                    return kernel(crate::profile::read_table_str(text, name));
                 }
                 let found = dirs
                     .iter()

@@ -1,0 +1,203 @@
+//! `pilgrim compensate` on the default mandrel: a measured part in, a
+//! corrected program out.
+
+use crate::common::{self, pilgrim, s, scratch};
+use std::path::Path;
+
+/// The default mandrel's nominal diameter at z (mm): the law over the
+/// working part, the end cone after it (scripts/mandrel.rhai's defaults),
+/// written here from MATH §2.1, not taken from the kernel.
+fn law(z: f64) -> f64 {
+    let (d_min, d_max, l, k, n) = (38.0, 52.0, 400.0, 0.012, 2.3);
+    if z <= l {
+        d_min + (d_max - d_min - k * l) * (z / l).powf(n) + k * z
+    } else {
+        d_max + (44.0 - d_max) * (z - l) / 40.0
+    }
+}
+
+/// The error a wheel leaves that wears linearly along its finishing pass
+/// (6 um of radius over the pass, which runs from z = 450 to -10): the part
+/// larger where the pass ends.
+fn wear(z: f64) -> f64 {
+    0.006 * (450.0 - z) / 460.0
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
+}
+
+/// The example measurement (`scripts/examples/mandrel-measured.csv`) is
+/// the default mandrel as a wearing wheel leaves it: each row the law plus
+/// the wear, to its 10 nm. `compensate` fits the error (a straight line
+/// here: its residual 0.0 um), moves the target against it by the whole
+/// of it, and runs the job again: the corrected run is verified within the
+/// tolerance of the corrected target, its correction the wear's negative
+/// within 0.01 um, the wheel's X moved by it and the rest's U with it. The
+/// part the corrected program makes with the same wear, the corrected
+/// target plus the corrected run's finish deviation plus the wear, is
+/// within the 1 um tolerance of the nominal, where the first run's part
+/// is 5.9 um off.
+#[test]
+fn the_mandrel_is_corrected_by_its_measured_error() {
+    let dir = scratch("compensate", "mandrel");
+    let run = dir.join("run");
+    let (code, _, err) = pilgrim(&["run", "scripts/mandrel.rhai", "--out", s(&run), "--quiet"]);
+    assert_eq!(code, 0, "{err}");
+    let measured = common::root().join("scripts/examples/mandrel-measured.csv");
+    let text = std::fs::read_to_string(&measured).unwrap();
+    let rows: Vec<(f64, f64)> = text
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with('z'))
+        .map(|l| {
+            let (z, d) = l.split_once(',').unwrap();
+            (z.parse().unwrap(), d.parse().unwrap())
+        })
+        .collect();
+    assert_eq!(rows.len(), 45);
+    for &(z, d) in &rows {
+        assert!((d - law(z) - 2.0 * wear(z)).abs() < 6e-6, "z {z}: {d}");
+    }
+    let out = dir.join("corrected");
+    let (code, said, err) = pilgrim(&[
+        "compensate",
+        s(&run),
+        "--measured",
+        s(&measured),
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(said.contains("measured 45 places of radius"), "{said}");
+    let report = common::report_of(&out);
+    assert_eq!(
+        report["verdict"]["status"], "passed",
+        "{}",
+        report["verdict"]
+    );
+    assert_eq!(
+        report["parameters"]["correction"]["value"],
+        "correction.csv"
+    );
+    let finish = report["verification"]["passes"]
+        .as_array()
+        .unwrap()
+        .last()
+        .unwrap()["deviation"]["max_abs"]
+        .as_f64()
+        .unwrap();
+    let tolerance = report["verification"]["tolerance"].as_f64().unwrap();
+    // The correction, every 1.1 mm along the ground length: the wear's
+    // negative.
+    let correction = std::fs::read_to_string(out.join("correction.csv")).unwrap();
+    let mut worst: f64 = 0.0;
+    for l in correction.lines().skip(1) {
+        let (z, dr) = l.split_once(',').unwrap();
+        let (z, dr): (f64, f64) = (z.parse().unwrap(), dr.parse().unwrap());
+        worst = worst.max((dr + wear(z)).abs());
+    }
+    assert!(
+        worst < 1e-5,
+        "the correction strays {worst} mm from the wear"
+    );
+    // The same wear on the corrected program's part: the corrected target
+    // (nominal - fit), its finish within `finish` of it, plus the wear.
+    let after = finish + worst;
+    assert!(
+        after <= tolerance,
+        "{after} mm after, tolerance {tolerance}"
+    );
+    let before = rows
+        .iter()
+        .map(|&(z, d)| (d / 2.0 - law(z) / 2.0).abs())
+        .fold(0.0, f64::max);
+    assert!(before > 5.8e-3 && before > 5.0 * tolerance, "{before}");
+    let c = json(&out.join("compensation.json"));
+    assert_eq!(c["places"].as_array().unwrap().len(), 45);
+    assert!(c["rms_residual_mm"].as_f64().unwrap() < 1e-5);
+    // The program: its path moved by the correction. The wheel's X (its
+    // centre, on radius) and the rest's U (riding the part) by the most
+    // the correction asks (5.87 um at z = 0), Z by under a micrometre (the
+    // nearest point of a sloped path).
+    let moved = &c["program"]["path_moved"];
+    let most = c["max_correction_mm"].as_f64().unwrap();
+    for axis in ["X", "U"] {
+        let m = moved[axis].as_f64().unwrap();
+        assert!(
+            (m - most).abs() < 2e-4,
+            "{axis} moved {m}, the correction {most}"
+        );
+    }
+    assert!(moved["Z"].as_f64().unwrap() < 1e-3, "{moved}");
+    assert!(c["program"]["lines_added"].as_u64().unwrap() > 0);
+    common::check_page(&out, "program.mpf", 8.0);
+}
+
+/// Bad measurements and asks are refused, naming what, and nothing is
+/// written: a row outside the part, a stretch left unmeasured, a
+/// correction beyond its limit (naming where), a family that takes no
+/// correction.
+#[test]
+fn bad_measurements_are_refused_and_nothing_is_written() {
+    let dir = scratch("compensate", "bad");
+    let run = dir.join("run");
+    let (code, _, err) = pilgrim(&["run", "scripts/mandrel.rhai", "--out", s(&run), "--quiet"]);
+    assert_eq!(code, 0, "{err}");
+    let table = |name: &str, rows: &[(f64, f64)]| {
+        let p = dir.join(name);
+        let mut t = String::from("z_mm,d_mm\n");
+        for (z, d) in rows {
+            t += &format!("{z},{d}\n");
+        }
+        std::fs::write(&p, t).unwrap();
+        p
+    };
+    let every = |f: &dyn Fn(f64) -> f64| -> Vec<(f64, f64)> {
+        (0..=44)
+            .map(|i| (10.0 * i as f64, law(10.0 * i as f64) + f(10.0 * i as f64)))
+            .collect()
+    };
+    let mut outside = every(&|_| 0.0);
+    outside.push((470.0, 44.0));
+    let sparse: Vec<(f64, f64)> = every(&|_| 0.0)
+        .into_iter()
+        .filter(|r| r.0 < 200.0)
+        .collect();
+    let large = every(&|z| 0.2 * z / 440.0);
+    for (name, rows, says) in [
+        (
+            "outside.csv",
+            outside,
+            "row 47, column z_mm: 470 is outside the part (0 to 440)",
+        ),
+        (
+            "sparse.csv",
+            sparse,
+            "nothing measured from z_mm = 190 to 440",
+        ),
+        ("large.csv", large, "beyond its limit of 0.05 mm"),
+    ] {
+        let f = table(name, &rows);
+        let out = dir.join(format!("{name}.out"));
+        let (code, _, err) =
+            pilgrim(&["compensate", s(&run), "--measured", s(&f), "--out", s(&out)]);
+        assert_ne!(code, 0, "{name}");
+        assert!(err.contains(says), "{name}: {err}");
+        assert!(!out.exists(), "{name}: {} written", out.display());
+    }
+    // The largest's place: the first z of the correction's grid (every
+    // 1.1 mm) where it passes 0.05 mm on radius (0.1 z / 440).
+    let f = dir.join("large.csv");
+    let (_, _, err) = pilgrim(&["compensate", s(&run), "--measured", s(&f)]);
+    assert!(err.contains("at z = 221.100 mm"), "{err}");
+    assert!(!Path::new(&format!("{}-compensated", run.display())).exists());
+    // The worm's family takes no correction (yet): refused, naming why.
+    let worm = dir.join("worm");
+    let (code, _, err) = pilgrim(&["run", "scripts/worm.rhai", "--out", s(&worm), "--quiet"]);
+    assert_eq!(code, 0, "{err}");
+    let f = dir.join("outside.csv");
+    let (code, _, err) = pilgrim(&["compensate", s(&worm), "--measured", s(&f)]);
+    assert_ne!(code, 0);
+    assert!(err.contains("the family takes no correction"), "{err}");
+    assert!(!Path::new(&format!("{}-compensated", worm.display())).exists());
+}
