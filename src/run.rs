@@ -51,9 +51,6 @@ pub fn run(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
     pilgrim_kernel::budget::with_limit(args.run_seconds, "the run's", || run_within(args, catalog))
 }
 
-/// A stage callback that shows nothing.
-pub(crate) fn progress_free(_: &str) {}
-
 /// `--script-seconds` and `--run-seconds`, each refused unless positive.
 pub(crate) fn positive_seconds(script: f64, run: f64) -> Result<(), String> {
     for (flag, v) in [("--script-seconds", script), ("--run-seconds", run)] {
@@ -139,21 +136,7 @@ fn load_family(
     params: Option<&Path>,
     limits: &Limits,
 ) -> Result<ScriptFamily, String> {
-    load_family_with(script, params, limits, Vec::new())
-}
-
-/// [`load_family`], `tables` given to its `read_table` by name before any
-/// file.
-pub(crate) fn load_family_with(
-    script: &Path,
-    params: Option<&Path>,
-    limits: &Limits,
-    tables: Vec<(String, String)>,
-) -> Result<ScriptFamily, String> {
-    let mut access = Access {
-        tables,
-        ..Access::default()
-    };
+    let mut access = Access::default();
     if let Some(dir) = params.and_then(Path::parent) {
         access.input_dirs.push(if dir.as_os_str().is_empty() {
             PathBuf::from(".")

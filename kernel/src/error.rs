@@ -43,6 +43,9 @@ pub enum Error {
     /// A table import failure.
     #[error(transparent)]
     Table(#[from] TableError),
+    /// A measurement refused, or its correction.
+    #[error(transparent)]
+    Compensate(#[from] crate::compensate::CompensateError),
     /// A parameter that cannot be resolved.
     #[error(transparent)]
     Params(#[from] ParamError),

@@ -11,6 +11,7 @@
 //! (the `pilgrim` program writes them atomically). [`export`] places a
 //! finished run's tool at another block.
 
+mod compensate;
 mod export;
 mod page;
 mod scene;
@@ -18,6 +19,9 @@ mod solids;
 mod spin;
 
 pub use crate::report::{axis_ranges, block_table, FailedRun, Report, ReportParam};
+pub use compensate::{
+    compensate, CompensateOptions, Compensation, Place, ProgramChange, CORRECTION, CORRECTION_FILE,
+};
 pub use export::{export, run_machine, Exported};
 pub use scene::{default_pose_block, BodyFile, Formats, PosePlace, SceneError};
 pub use solids::SolidFile;
