@@ -93,6 +93,7 @@ fn run_within(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
         program_number: args.program_number,
         also_post: args.also_post.clone(),
         program_file: None,
+        annex: Default::default(),
     };
     let out = match job::run(&family, &machine, &sources, &options, &mut |s| next(s)) {
         Ok(out) => out,

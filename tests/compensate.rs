@@ -130,7 +130,42 @@ fn the_mandrel_is_corrected_by_its_measured_error() {
     }
     assert!(moved["Z"].as_f64().unwrap() < 1e-3, "{moved}");
     assert!(c["program"]["lines_added"].as_u64().unwrap() > 0);
+    // The report's table and the page's chart: the error before and after.
+    let table = &report["tables"]["compensation"];
+    let after = table["expected_after_um"].as_array().unwrap();
+    assert_eq!(after.len(), 45);
+    assert!(
+        after.iter().all(|a| a.as_f64().unwrap().abs() < 0.01),
+        "{after:?}"
+    );
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(out.join("compensation.svg").is_file() && page.contains("alt=\"compensation.svg\""));
     common::check_page(&out, "program.mpf", 8.0);
+    // The corrected run's part measured in its turn, the wear repeating:
+    // on the nominal. Compensating the corrected run keeps its correction
+    // (the wear's negative), adding what the new measurement asks: none.
+    let again = dir.join("again.csv");
+    let mut t = String::from("z_mm,d_mm\n");
+    for &(z, _) in &rows {
+        t += &format!("{z},{}\n", law(z));
+    }
+    std::fs::write(&again, t).unwrap();
+    let twice = dir.join("twice");
+    let (code, _, err) = pilgrim(&[
+        "compensate",
+        s(&out),
+        "--measured",
+        s(&again),
+        "--out",
+        s(&twice),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let kept = std::fs::read_to_string(twice.join("correction.csv")).unwrap();
+    for l in kept.lines().skip(1) {
+        let (z, dr) = l.split_once(',').unwrap();
+        let (z, dr): (f64, f64) = (z.parse().unwrap(), dr.parse().unwrap());
+        assert!((dr + wear(z)).abs() < 1e-5, "z {z}: {dr}");
+    }
 }
 
 /// Bad measurements and asks are refused, naming what, and nothing is

@@ -8,7 +8,6 @@
 
 use super::CompensateError;
 use crate::math::Real;
-use crate::profile::Profile;
 use csaps::CubicSmoothingSpline;
 
 /// The error fitted: see the module's docs.
@@ -100,35 +99,44 @@ impl ErrorFit {
         evaluate(&self.at, &self.error, self.smooth, xi)
     }
 
-    /// The target's shift against the error: `-gain` times the fit on
-    /// `grid`, as a profile of the shift along the coordinate (named
-    /// `what`, as `z`).
+    /// The target's shift against the error: `-gain` times the fit at
+    /// each place of `grid`.
     ///
     /// # Failures
-    /// A gain outside (0, 2]; a shift larger than `limit` anywhere (named
-    /// by where, the first such place); the spline failing.
-    pub fn correction(
-        &self,
-        grid: &[Real],
-        gain: Real,
-        limit: Real,
-        what: &str,
-    ) -> Result<Profile, CompensateError> {
+    /// A gain outside (0, 2]; the spline failing.
+    pub fn correction(&self, grid: &[Real], gain: Real) -> Result<Vec<Real>, CompensateError> {
         if !(gain > 0.0 && gain <= 2.0) {
             return Err(CompensateError::Fit(format!(
                 "the gain {gain} is out of range: above 0, at most 2 (1: the whole measured error)"
             )));
         }
-        let shift: Vec<Real> = self.at(grid)?.iter().map(|e| -gain * e).collect();
-        if let Some((s, c)) = grid.iter().zip(&shift).find(|(_, c)| c.abs() > limit) {
-            return Err(CompensateError::TooLarge {
-                at: format!("{what} = {s:.3} mm"),
-                correction: *c,
-                limit,
-                why: "an error this large is not the process's drift: look at the measurement or the part".into(),
-            });
-        }
-        Profile::new(grid.to_vec(), shift).map_err(|e| CompensateError::Fit(e.to_string()))
+        Ok(self.at(grid)?.iter().map(|e| -gain * e).collect())
+    }
+}
+
+/// Refuses a correction `shift` at the places `at` (along `what`) larger
+/// than `limit` anywhere, naming the first such place and the `file`
+/// measured.
+///
+/// # Failures
+/// That.
+pub fn within_limit(
+    at: &[Real],
+    shift: &[Real],
+    limit: Real,
+    what: &str,
+    file: &str,
+) -> Result<(), CompensateError> {
+    match at.iter().zip(shift).find(|(_, c)| c.abs() > limit) {
+        Some((s, c)) => Err(CompensateError::TooLarge {
+            at: format!("{what} = {s:.3} mm"),
+            correction: *c,
+            limit,
+            why: format!(
+                "an error this large is not the process's drift: look at the measurement ({file}) or the part"
+            ),
+        }),
+        None => Ok(()),
     }
 }
 
@@ -169,18 +177,18 @@ mod tests {
         assert_eq!(fit.smooth, 0.0);
         assert!(fit.rms_residual < 1e-12);
         // The correction: against the error, bounded.
-        let c = fit
-            .correction(&[0.0, 200.0, 400.0], 1.0, 0.01, "z")
-            .unwrap();
-        assert!((c.x()[2] + 0.006).abs() < 1e-12, "{:?}", c.x());
-        let e = fit
-            .correction(&[0.0, 400.0], 1.0, 0.005, "z")
+        let grid = [0.0, 200.0, 400.0];
+        let c = fit.correction(&grid, 1.0).unwrap();
+        assert!((c[2] + 0.006).abs() < 1e-12, "{c:?}");
+        within_limit(&grid, &c, 0.01, "z", "bench.csv").unwrap();
+        let e = within_limit(&grid, &c, 0.005, "z", "bench.csv")
             .unwrap_err()
             .to_string();
         assert!(
             e.contains("-0.0060 mm at z = 400.000 mm is beyond its limit of 0.005 mm"),
             "{e}"
         );
-        assert!(fit.correction(&[0.0], 0.0, 1.0, "z").is_err());
+        assert!(e.contains("(bench.csv)"), "{e}");
+        assert!(fit.correction(&grid, 0.0).is_err());
     }
 }

@@ -12,8 +12,8 @@
 //!   with their units), every row inside the part, dense enough;
 //! - [`fit_error`]: a cubic smoothing spline (de Boor's, the `csaps`
 //!   crate) whose residual is the measurement's uncertainty;
-//! - [`ErrorFit::correction`]: the target's shift, `-gain` times the fit,
-//!   refused where it exceeds its limit.
+//! - [`ErrorFit::correction`]: the target's shift, `-gain` times the fit;
+//!   [`within_limit`] refuses one that exceeds its limit, naming where.
 
 mod fit;
 mod measure;
@@ -21,7 +21,7 @@ mod measure;
 use crate::math::Real;
 use crate::profile::Profile;
 
-pub use fit::{fit_error, ErrorFit};
+pub use fit::{fit_error, within_limit, ErrorFit};
 pub use measure::{read_measured, Measured, MeasuredSpec, MIN_POINTS};
 
 /// What a measurement of a family's finished part holds and what it is

@@ -11,9 +11,9 @@
 //! its nominal ([`crate::family::Verifier::nominal`]); the run knows no
 //! family by name.
 
-use super::{params_on, run as run_job, run_machine, JobOptions, JobOutput, Report};
+use super::{params_on, run as run_job, run_machine, Annex, JobOptions, JobOutput, Report};
 use crate::catalog::Catalog;
-use crate::compensate::{fit_error, read_measured};
+use crate::compensate::{fit_error, read_measured, within_limit};
 use crate::error::Error;
 use crate::output::RunDir;
 use crate::params::ParamSource;
@@ -202,9 +202,23 @@ pub fn compensate(
         .map(|i| from + (to - from) * i as f64 / GRID as f64)
         .collect();
     let coordinate = nominal.coordinate.trim_end_matches("_mm");
-    let correction = fit
-        .correction(&grid, options.gain, options.limit, coordinate)
-        .map_err(|e| Error::Options(format!("{}: {e}", m.file)))?;
+    // A compensated run's correction stays, the new one added: the
+    // measured error is then the first correction's and the process's.
+    let previous = match report.parameters.get(CORRECTION).map(|p| &p.value) {
+        Some(crate::params::ParamValue::Text(name)) if !name.is_empty() => {
+            let t = crate::profile::read_table_str(&read(name)?, &format!("{shown}/{name}"))?;
+            let p = t.profile("z_mm", "dr_mm")?;
+            let (lo, hi) = p.z_range();
+            grid.iter()
+                .map(|z| p.eval(z.clamp(lo, hi)))
+                .collect::<Result<Vec<f64>, _>>()?
+        }
+        _ => vec![0.0; grid.len()],
+    };
+    let shift = fit.correction(&grid, options.gain)?;
+    let total: Vec<f64> = shift.iter().zip(&previous).map(|(s, p)| s + p).collect();
+    within_limit(&grid, &total, options.limit, coordinate, &m.file)?;
+    let correction = crate::profile::Profile::new(grid.clone(), total)?;
     let mut csv = String::from("z_mm,dr_mm\n");
     for (z, d) in correction.z().iter().zip(correction.x()) {
         csv += &format!("{z:.6},{d:.9}\n");
@@ -218,15 +232,51 @@ pub fn compensate(
             pairs: vec![(CORRECTION.into(), CORRECTION_FILE.into())],
         },
     ];
+    let fitted = fit.at(&m.at)?;
+    // The table and chart the corrected run's report and page show: the
+    // measured error, its fit, the target's shift and the error expected
+    // after it (the same error on the corrected target, before the
+    // corrected run's own finish, which its verification reports).
+    let um = |v: &[f64]| v.iter().map(|x| 1e3 * x).collect::<Vec<f64>>();
+    let shift: Vec<f64> = fitted.iter().map(|f| -options.gain * f).collect();
+    let after: Vec<f64> = error.iter().zip(&shift).map(|(e, c)| e + c).collect();
+    let mut annex = Annex::default();
+    annex.tables.insert(
+        "compensation".into(),
+        BTreeMap::from([
+            (nominal.coordinate.to_owned(), m.at.clone()),
+            ("measured_error_um".into(), um(&error)),
+            ("fit_um".into(), um(&fitted)),
+            ("correction_um".into(), um(&shift)),
+            ("expected_after_um".into(), um(&after)),
+        ]),
+    );
+    annex.plots.push(crate::toolpath::PlotSpec {
+        file: "compensation".into(),
+        title: format!(
+            "The measured {}'s error from the nominal, its fit, the correction and the error expected after it",
+            nominal.quantity
+        ),
+        table: "compensation".into(),
+        x: nominal.coordinate.to_owned(),
+        y: vec![
+            "measured_error_um".into(),
+            "fit_um".into(),
+            "correction_um".into(),
+            "expected_after_um".into(),
+        ],
+        x_label: format!("{}, mm", coordinate),
+        y_label: format!("{}, um", nominal.quantity),
+    });
     let job_options = JobOptions {
         program_name: script
             .file_stem()
             .and_then(|s| s.to_str())
             .unwrap_or("pilgrim")
             .to_owned(),
+        annex,
         ..JobOptions::default()
     };
-    let fitted = fit.at(&m.at)?;
     let program_file = crate::program::post::dialect(&report.control)
         .map(|d| format!("program.{}", d.extension))
         .ok_or_else(|| {
@@ -261,7 +311,7 @@ pub fn compensate(
                 nominal: at_nominal[i],
                 error: error[i],
                 fitted: fitted[i],
-                correction: -options.gain * fitted[i],
+                correction: shift[i],
             })
             .collect(),
         program: ProgramChange {

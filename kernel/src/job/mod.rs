@@ -61,6 +61,19 @@ pub struct JobOptions {
     /// The file the program [`verify`] reads came from, as messages show
     /// it: named in the report and on the page.
     pub program_file: Option<String>,
+    /// Tables and charts the caller adds to the family's (a compensated
+    /// run's measured error, its fit and the correction): in the report,
+    /// drawn and shown on the page as the family's own.
+    pub annex: Annex,
+}
+
+/// Tables and charts a run's caller adds ([`JobOptions::annex`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Annex {
+    /// Tables by name (columns of equal length).
+    pub tables: std::collections::BTreeMap<String, std::collections::BTreeMap<String, Vec<f64>>>,
+    /// Charts of them.
+    pub plots: Vec<crate::toolpath::PlotSpec>,
 }
 
 impl Default for JobOptions {
@@ -74,6 +87,7 @@ impl Default for JobOptions {
             also_post: Vec::new(),
             program_number: None,
             program_file: None,
+            annex: Annex::default(),
         }
     }
 }
@@ -409,7 +423,9 @@ fn run_on(
         return Err(failed_run(report, Vec::new(), None));
     }
     stage(STAGES[1]);
-    let toolpath = family.toolpath(&values)?;
+    let mut toolpath = family.toolpath(&values)?;
+    toolpath.tables.extend(options.annex.tables.clone());
+    toolpath.plots.extend(options.annex.plots.iter().cloned());
     stage(STAGES[2]);
     let control = dialect(&info.control).ok_or_else(|| Error::UnknownControl {
         machine: info.name.clone(),
