@@ -156,13 +156,17 @@ fn bad_mandrel_parameters_are_refused_and_nothing_is_written() {
         (vec!["rest_r=140"], "axis U at 1"),
         (
             vec!["d_mn=40"],
-            "unknown parameter 'd_mn' from --set (parameters: clearance, cone_d, cone_len, cuts, d_max, d_min",
+            "unknown parameter 'd_mn' from --set (parameters: clearance, cone_d, cone_len, correction, cuts, d_max, d_min",
         ),
         (
             vec!["cuts=[0.15,0.1]"],
             "the cuts add up to the stock (cuts add up to 0.25 mm, stock 0.3 mm)",
         ),
         (vec!["cuts=[0.4,-0.1]"], "no cut is negative"),
+        (
+            vec!["correction=nothere.csv"],
+            "nothere.csv: not a readable file beside the script or the parameter file",
+        ),
         (
             vec!["shank_len=100"],
             "pass 1: the steady rest's support at point 1 of the pass (z_r = z + B, B = -180.0000 mm) has nothing under it: its centre at z = -190.1200",

@@ -36,14 +36,7 @@ pub mod worm_api {
         alpha_deg: Real,
         s_a1: Real,
     ) -> Result<WormSizes, Box<EvalAltResult>> {
-        kernel(WormSizes::new(
-            m,
-            z1,
-            d1,
-            c,
-            alpha_deg.to_radians(),
-            (s_a1 != 0.0).then_some(s_a1),
-        ))
+        worm_of(m, z1, d1, c, alpha_deg, s_a1, "ZA")
     }
 
     /// A cylindrical worm of flank kind `profile` (DIN 3975): `ZA`
