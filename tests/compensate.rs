@@ -141,6 +141,7 @@ fn the_mandrel_is_corrected_by_its_measured_error() {
     let page = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(out.join("compensation.svg").is_file() && page.contains("alt=\"compensation.svg\""));
     common::check_page(&out, "program.mpf", 8.0);
+    common::leave_page_for_chromium(&out, "compensated-mandrel");
     // The corrected run's part measured in its turn, the wear repeating:
     // on the nominal. Compensating the corrected run keeps its correction
     // (the wear's negative), adding what the new measurement asks: none.
