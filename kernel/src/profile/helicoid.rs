@@ -210,15 +210,6 @@ impl FlankForm {
     pub fn is_axial(&self) -> bool {
         *self == FlankForm::Axial
     }
-
-    /// The form's name as DIN 3975 gives it: `ZA`, `ZN`, `ZI`.
-    pub fn name(&self) -> &'static str {
-        match self {
-            FlankForm::Axial => "ZA",
-            FlankForm::Normal { .. } => "ZN",
-            FlankForm::Involute { .. } => "ZI",
-        }
-    }
 }
 
 #[cfg(test)]
@@ -337,6 +328,5 @@ mod tests {
     fn the_axial_form_has_no_curve() {
         assert_eq!(FlankForm::Axial.half_space(20.0), None);
         assert_eq!(FlankForm::Axial.axial_angle(20.0), None);
-        assert_eq!(FlankForm::Axial.name(), "ZA");
     }
 }

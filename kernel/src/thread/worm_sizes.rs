@@ -47,6 +47,15 @@ pub enum WormProfile {
 }
 
 impl WormProfile {
+    /// Its name as DIN 3975 writes it: `ZA`, `ZN`, `ZI`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::ZA => "ZA",
+            Self::ZN => "ZN",
+            Self::ZI => "ZI",
+        }
+    }
+
     /// The kind named `ZA`, `ZN` or `ZI` (any case).
     ///
     /// # Failures
@@ -241,9 +250,7 @@ impl WormSizes {
     /// a ZA worm's `alpha`; a ZN or ZI worm's from its normal angle and
     /// its flanks' curve.
     pub fn axial_alpha(&self) -> Real {
-        self.form()
-            .axial_angle(self.pitch_radius())
-            .unwrap_or(self.alpha)
+        self.section().flanks[0]
     }
 
     /// The flanks' form ([`FlankForm`]): the space's half at the pitch
@@ -263,6 +270,9 @@ impl WormSizes {
     /// space at the pitch diameter the pitch less the thread's thickness
     /// there.
     pub fn section(&self) -> ThreadSection {
+        // A ZN form is solved for (Newton's): once here.
+        let form = self.form();
+        let alpha = form.axial_angle(self.pitch_radius()).unwrap_or(self.alpha);
         ThreadSection {
             internal: false,
             pitch: self.axial_pitch(),
@@ -272,10 +282,10 @@ impl WormSizes {
             pitch_diameter: self.pitch_diameter,
             root_diameter: self.root_diameter(),
             crest_diameter: self.tip_diameter(),
-            flanks: [self.axial_alpha(); 2],
+            flanks: [alpha; 2],
             space_at_pitch: self.axial_pitch() - self.thickness,
             root_radius: 0.0,
-            form: self.form(),
+            form,
         }
     }
 
@@ -289,24 +299,23 @@ impl WormSizes {
             max: v + t,
         };
         let number = super::standards::number;
+        let section = self.section();
+        let alpha = section.flanks[0];
         ThreadProfile {
             designation: format!(
                 "{} m{} z{} d{}",
-                self.form().name(),
+                self.profile.name(),
                 number(self.module),
                 self.starts,
                 number(self.pitch_diameter)
             ),
             standard: match self.profile {
                 WormProfile::ZA => "MATH §4.1 (ZA worm)".into(),
-                _ => format!("MATH §4.1, DIN 3975 ({} worm)", self.form().name()),
+                _ => format!("MATH §4.1, DIN 3975 ({} worm)", self.profile.name()),
             },
-            section: self.section(),
+            section,
             limits: ThreadLimits {
-                pitch_diameter: band(
-                    self.pitch_diameter,
-                    thickness / (2.0 * self.axial_alpha().tan()),
-                ),
+                pitch_diameter: band(self.pitch_diameter, thickness / (2.0 * alpha.tan())),
                 crest: band(self.tip_diameter(), diameter),
                 root: band(self.root_diameter(), diameter),
                 source: "stated".into(),
@@ -415,7 +424,10 @@ mod tests {
             let w = WormSizes::with_profile(5.0, 2, 50.0, 0.2, a, None, profile).unwrap();
             let t = w.section();
             assert!((t.space_at(25.0) - (w.axial_pitch() - w.thickness)).abs() < 1e-12);
-            assert!(w.profile(0.05, 0.02).designation.starts_with(t.form.name()));
+            assert!(w
+                .profile(0.05, 0.02)
+                .designation
+                .starts_with(profile.name()));
             assert!((w.height() - 11.0).abs() < 1e-12);
         }
         let zi = WormSizes::with_profile(5.0, 2, 50.0, 0.2, a, None, WormProfile::ZI).unwrap();

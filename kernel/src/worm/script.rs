@@ -72,7 +72,7 @@ pub mod worm_api {
     /// The flanks' kind: `ZA`, `ZN` or `ZI`.
     #[rhai_fn(get = "profile", pure)]
     pub fn profile(w: &mut WormSizes) -> String {
-        format!("{:?}", w.profile)
+        w.profile.name().into()
     }
 
     /// The flanks' half-angle in the axial section at the pitch diameter
