@@ -37,12 +37,10 @@ pub fn compensate(args: &CompensateArgs, catalog: &Catalog) -> Result<String, St
         let (out, c) = match job::compensate(&args.dir, catalog, &table, &options) {
             Ok(done) => done,
             Err(pilgrim_kernel::Error::Failed(failed)) => {
-                let message = failed.report.verdict.message();
-                let dir = pilgrim_kernel::output::write_failed(&args.out, &failed.files)
-                    .map_err(|e| format!("{message}\nthe report could not be written: {e}"))?;
-                return Err(format!(
-                    "{message}\nthe corrected run FAILED: no program was written; see {}",
-                    dir.join("report.html").display()
+                return Err(crate::run::failed_run(
+                    &args.out,
+                    &failed,
+                    "the corrected run",
                 ));
             }
             Err(e) => return Err(e.to_string()),

@@ -98,26 +98,8 @@ fn run_within(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
     let out = match job::run(&family, &machine, &sources, &options, &mut |s| next(s)) {
         Ok(out) => out,
         Err(pilgrim_kernel::Error::Failed(failed)) => {
-            // What failed is written where the user looks, marked FAILED
-            // and with no program; an earlier good output stays.
             bar.finish_and_clear();
-            let message = failed.report.verdict.message();
-            let dir =
-                pilgrim_kernel::output::write_failed(&args.out, &failed.files).map_err(|e| {
-                    format!("{message}\nthe diagnostic report could not be written: {e}")
-                })?;
-            let kept = if dir != args.out {
-                format!(
-                    "; {} (the last run that succeeded) is as it was",
-                    args.out.display()
-                )
-            } else {
-                String::new()
-            };
-            return Err(format!(
-                "{message}\nthe run FAILED: no program was written; see {}{kept}",
-                dir.join("report.html").display()
-            ));
+            return Err(failed_run(&args.out, &failed, "the run"));
         }
         Err(e) => return Err(e.to_string()),
     };
@@ -129,6 +111,34 @@ fn run_within(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
         said += &format!("\nwarning: {}", w.message);
     }
     Ok(said)
+}
+
+/// Writes what a run that failed a check or its verification leaves
+/// (marked FAILED, no program) where the user looks, `out` or beside it
+/// when an earlier good output is there; the message naming it. `what`
+/// names the run (`the run`, `the corrected run`).
+pub(crate) fn failed_run(
+    out: &Path,
+    failed: &pilgrim_kernel::job::FailedRun,
+    what: &str,
+) -> String {
+    let message = failed.report.verdict.message();
+    let dir = match pilgrim_kernel::output::write_failed(out, &failed.files) {
+        Ok(dir) => dir,
+        Err(e) => return format!("{message}\nthe diagnostic report could not be written: {e}"),
+    };
+    let kept = if dir != out {
+        format!(
+            "; {} (the last run that succeeded) is as it was",
+            out.display()
+        )
+    } else {
+        String::new()
+    };
+    format!(
+        "{message}\n{what} FAILED: no program was written; see {}{kept}",
+        dir.join("report.html").display()
+    )
 }
 
 /// The family of `script`, reading files (its tables) beside `params`.
