@@ -365,63 +365,55 @@ fn change(file: &str, before: &str, after: &str) -> ProgramChange {
 }
 
 /// How far each axis of `after`'s blocks stands from `before`'s path in
-/// the same pass (see [`ProgramChange::path_moved`]).
+/// the same pass (see [`ProgramChange::path_moved`]). Both programs run
+/// along their passes the same way, so each block's nearest segment is
+/// sought near the one before's ([`WINDOW`] segments either side): the
+/// work grows with the blocks, not with their square (a caliber's 52,000).
 fn path_moved(
     before: &AxisProgram,
     before_passes: &[ProgramPass],
     after: &AxisProgram,
     after_passes: &[ProgramPass],
 ) -> Option<BTreeMap<String, f64>> {
+    use nalgebra::DVector;
     if before.axes != after.axes || before_passes.len() != after_passes.len() {
         return None;
     }
-    let mut moved = vec![0.0f64; after.axes.len()];
+    let mut moved = DVector::<f64>::zeros(after.axes.len());
     for (p, q) in before_passes.iter().zip(after_passes) {
-        let line: Vec<&[f64]> = before
+        let mut line: Vec<DVector<f64>> = before
             .blocks
             .get(p.blocks.clone())?
             .iter()
-            .map(|b| &b.values[..])
+            .map(|b| DVector::from_column_slice(&b.values))
             .collect();
+        if line.len() == 1 {
+            line.push(line[0].clone());
+        }
+        let mut near: usize = 0;
         for b in after.blocks.get(q.blocks.clone())? {
-            // The nearest point of the polyline, segment by segment.
-            let mut best: Option<(f64, Vec<f64>)> = None;
-            for w in line
-                .windows(2)
-                .chain(line.get(..1).into_iter().filter(|_| line.len() == 1))
-            {
-                let (a, c) = (w[0], *w.get(1).unwrap_or(&w[0]));
-                let d: Vec<f64> = a.iter().zip(c).map(|(a, c)| c - a).collect();
-                let l2: f64 = d.iter().map(|x| x * x).sum();
+            let v = DVector::from_column_slice(&b.values);
+            // The offset from segment k's nearest point.
+            let offset = |k: usize| {
+                let (a, d) = (&line[k], &line[k + 1] - &line[k]);
+                let l2 = d.norm_squared();
                 let t = if l2 > 0.0 {
-                    (b.values
-                        .iter()
-                        .zip(a)
-                        .zip(&d)
-                        .map(|((v, a), d)| (v - a) * d)
-                        .sum::<f64>()
-                        / l2)
-                        .clamp(0.0, 1.0)
+                    ((&v - a).dot(&d) / l2).clamp(0.0, 1.0)
                 } else {
                     0.0
                 };
-                let off: Vec<f64> = b
-                    .values
-                    .iter()
-                    .zip(a)
-                    .zip(&d)
-                    .map(|((v, a), d)| v - a - t * d)
-                    .collect();
-                let dist: f64 = off.iter().map(|x| x * x).sum();
-                if best.as_ref().is_none_or(|(bd, _)| dist < *bd) {
-                    best = Some((dist, off));
-                }
-            }
-            if let Some((_, off)) = best {
-                for (m, o) in moved.iter_mut().zip(off) {
-                    *m = m.max(o.abs());
-                }
-            }
+                &v - a - d * t
+            };
+            let segments = line.len() - 1;
+            let (lo, hi) = (
+                near.saturating_sub(WINDOW),
+                (near + WINDOW + 1).min(segments),
+            );
+            let (k, off) = (lo..hi)
+                .map(|k| (k, offset(k)))
+                .min_by(|a, b| a.1.norm_squared().total_cmp(&b.1.norm_squared()))?;
+            near = k;
+            moved = moved.zip_map(&off, |m, o| m.max(o.abs()));
         }
     }
     Some(
@@ -429,7 +421,11 @@ fn path_moved(
             .axes
             .iter()
             .map(|a| a.name.clone())
-            .zip(moved)
+            .zip(moved.iter().copied())
             .collect(),
     )
 }
+
+/// How many segments either side of the last block's nearest one a block's
+/// nearest is sought among.
+const WINDOW: usize = 64;
