@@ -23,6 +23,39 @@ fn wear(z: f64) -> f64 {
     0.006 * (450.0 - z) / 460.0
 }
 
+/// The default mandrel run into `dir/run`.
+fn mandrel_run(dir: &Path) -> std::path::PathBuf {
+    let run = dir.join("run");
+    let (code, _, err) = pilgrim(&["run", "scripts/mandrel.rhai", "--out", s(&run), "--quiet"]);
+    assert_eq!(code, 0, "{err}");
+    run
+}
+
+/// The finishing pass's largest deviation from its target (mm), as a
+/// run's report says it.
+fn finish_of(report: &serde_json::Value) -> f64 {
+    report["verification"]["passes"]
+        .as_array()
+        .unwrap()
+        .last()
+        .unwrap()["deviation"]["max_abs"]
+        .as_f64()
+        .unwrap()
+}
+
+/// The largest distance of the run's `correction.csv` from `-error(z)`.
+fn correction_off(out: &Path, error: &dyn Fn(f64) -> f64) -> f64 {
+    let text = std::fs::read_to_string(out.join("correction.csv")).unwrap();
+    text.lines()
+        .skip(1)
+        .map(|l| {
+            let (z, dr) = l.split_once(',').unwrap();
+            let (z, dr): (f64, f64) = (z.parse().unwrap(), dr.parse().unwrap());
+            (dr + error(z)).abs()
+        })
+        .fold(0.0, f64::max)
+}
+
 fn json(path: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
 }
@@ -41,9 +74,7 @@ fn json(path: &Path) -> serde_json::Value {
 #[test]
 fn the_mandrel_is_corrected_by_its_measured_error() {
     let dir = scratch("compensate", "mandrel");
-    let run = dir.join("run");
-    let (code, _, err) = pilgrim(&["run", "scripts/mandrel.rhai", "--out", s(&run), "--quiet"]);
-    assert_eq!(code, 0, "{err}");
+    let run = mandrel_run(&dir);
     let measured = common::root().join("scripts/examples/mandrel-measured.csv");
     let text = std::fs::read_to_string(&measured).unwrap();
     let rows: Vec<(f64, f64)> = text
@@ -79,23 +110,11 @@ fn the_mandrel_is_corrected_by_its_measured_error() {
         report["parameters"]["correction"]["value"],
         "correction.csv"
     );
-    let finish = report["verification"]["passes"]
-        .as_array()
-        .unwrap()
-        .last()
-        .unwrap()["deviation"]["max_abs"]
-        .as_f64()
-        .unwrap();
+    let finish = finish_of(&report);
     let tolerance = report["verification"]["tolerance"].as_f64().unwrap();
     // The correction, every 1.1 mm along the ground length: the wear's
     // negative.
-    let correction = std::fs::read_to_string(out.join("correction.csv")).unwrap();
-    let mut worst: f64 = 0.0;
-    for l in correction.lines().skip(1) {
-        let (z, dr) = l.split_once(',').unwrap();
-        let (z, dr): (f64, f64) = (z.parse().unwrap(), dr.parse().unwrap());
-        worst = worst.max((dr + wear(z)).abs());
-    }
+    let worst = correction_off(&out, &wear);
     assert!(
         worst < 1e-5,
         "the correction strays {worst} mm from the wear"
@@ -161,12 +180,11 @@ fn the_mandrel_is_corrected_by_its_measured_error() {
         s(&twice),
     ]);
     assert_eq!(code, 0, "{err}");
-    let kept = std::fs::read_to_string(twice.join("correction.csv")).unwrap();
-    for l in kept.lines().skip(1) {
-        let (z, dr) = l.split_once(',').unwrap();
-        let (z, dr): (f64, f64) = (z.parse().unwrap(), dr.parse().unwrap());
-        assert!((dr + wear(z)).abs() < 1e-5, "z {z}: {dr}");
-    }
+    let kept = correction_off(&twice, &wear);
+    assert!(
+        kept < 1e-5,
+        "the kept correction strays {kept} mm from the wear"
+    );
 }
 
 /// Bad measurements and asks are refused, naming what, and nothing is
@@ -176,9 +194,7 @@ fn the_mandrel_is_corrected_by_its_measured_error() {
 #[test]
 fn bad_measurements_are_refused_and_nothing_is_written() {
     let dir = scratch("compensate", "bad");
-    let run = dir.join("run");
-    let (code, _, err) = pilgrim(&["run", "scripts/mandrel.rhai", "--out", s(&run), "--quiet"]);
-    assert_eq!(code, 0, "{err}");
+    let run = mandrel_run(&dir);
     let table = |name: &str, rows: &[(f64, f64)]| {
         let p = dir.join(name);
         let mut t = String::from("z_mm,d_mm\n");
@@ -251,9 +267,7 @@ fn bad_measurements_are_refused_and_nothing_is_written() {
 #[test]
 fn a_deflection_is_corrected_along_its_curve() {
     let dir = scratch("compensate", "deflection");
-    let run = dir.join("run");
-    let (code, _, err) = pilgrim(&["run", "scripts/mandrel.rhai", "--out", s(&run), "--quiet"]);
-    assert_eq!(code, 0, "{err}");
+    let run = mandrel_run(&dir);
     let bend = |z: f64| 0.004 * ((z + 300.0) / 740.0).powi(3);
     let measured = dir.join("bent.csv");
     let mut t = String::from("z_mm,r_mm\n");
@@ -280,23 +294,8 @@ fn a_deflection_is_corrected_along_its_curve() {
         "{}",
         report["verdict"]
     );
-    let finish = report["verification"]["passes"]
-        .as_array()
-        .unwrap()
-        .last()
-        .unwrap()["deviation"]["max_abs"]
-        .as_f64()
-        .unwrap();
-    let correction = std::fs::read_to_string(out.join("correction.csv")).unwrap();
-    let worst = correction
-        .lines()
-        .skip(1)
-        .map(|l| {
-            let (z, dr) = l.split_once(',').unwrap();
-            let (z, dr): (f64, f64) = (z.parse().unwrap(), dr.parse().unwrap());
-            (dr + bend(z)).abs()
-        })
-        .fold(0.0, f64::max);
+    let finish = finish_of(&report);
+    let worst = correction_off(&out, &bend);
     assert!(
         worst < 5e-5,
         "the correction strays {worst} mm from the deflection"
