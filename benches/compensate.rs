@@ -49,7 +49,7 @@ fn compensate(c: &mut Criterion) {
     };
     let run = || job::compensate(&dir, &catalog, &measured, &options).unwrap();
     let (_, record) = run();
-    assert_eq!(record.places.len(), 45);
+    assert_eq!(record.quantities[0].places.len(), 45);
     let mut g = c.benchmark_group("compensate");
     g.sample_size(20).measurement_time(Duration::from_secs(12));
     g.bench_function("mandrel_end_to_end", |b| b.iter(|| black_box(run())));

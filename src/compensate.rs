@@ -47,15 +47,10 @@ pub fn compensate(args: &CompensateArgs, catalog: &Catalog) -> Result<String, St
         };
         pilgrim_kernel::output::write_dir(&args.out, &out.files).map_err(|e| e.to_string())?;
         Ok(format!(
-            "{}: measured {} places of {} ({}), the error up to {:.4} mm fitted within {} mm (RMS residual {:.4} mm); the target moved by up to {:.4} mm; {}; written to {}",
+            "{}: measured by {}: {}; {}; written to {}",
             c.run,
-            c.places.len(),
-            c.quantity,
             c.measured_file,
-            c.max_error_mm,
-            c.uncertainty_mm,
-            c.rms_residual_mm,
-            c.max_correction_mm,
+            c.summary(),
             out.summary(),
             args.out.display()
         ))

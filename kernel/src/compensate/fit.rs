@@ -24,6 +24,9 @@ pub struct ErrorFit {
     pub smooth: Real,
     /// The residual's root mean square.
     pub rms_residual: Real,
+    /// A quantity corrected as one value: the errors' mean, the fit
+    /// everywhere ([`fit_mean`]).
+    pub mean: Option<Real>,
 }
 
 /// Fits `error` at the places `at` (increasing, at least 3) within
@@ -44,6 +47,7 @@ pub fn fit_error(
         uncertainty,
         smooth: 0.0,
         rms_residual: 0.0,
+        mean: None,
     };
     let rms = |p: Real| -> Result<Real, CompensateError> {
         let f = evaluate(at, error, p, at)?;
@@ -74,6 +78,35 @@ pub fn fit_error(
     Ok(fit)
 }
 
+/// The errors `error` at `at` (one place at least) as one value, their
+/// mean: a quantity whose correction is one value (a thread start's
+/// passes move as one). Its residual says how far the error varies along
+/// the part beyond that, which such a correction leaves.
+///
+/// # Failures
+/// An uncertainty not positive; no place.
+pub fn fit_mean(
+    at: &[Real],
+    error: &[Real],
+    uncertainty: Real,
+) -> Result<ErrorFit, CompensateError> {
+    crate::math::positive("the measurement's uncertainty", uncertainty)
+        .map_err(|e| CompensateError::Fit(e.to_string()))?;
+    if error.is_empty() {
+        return Err(CompensateError::Fit("no place measured".into()));
+    }
+    let n = error.len() as Real;
+    let mean = error.iter().sum::<Real>() / n;
+    Ok(ErrorFit {
+        at: at.to_vec(),
+        error: error.to_vec(),
+        uncertainty,
+        smooth: 0.0,
+        rms_residual: (error.iter().map(|e| (e - mean).powi(2)).sum::<Real>() / n).sqrt(),
+        mean: Some(mean),
+    })
+}
+
 /// The smoothing spline of `error` at `at` with parameter `p`, evaluated
 /// at `xi`.
 fn evaluate(
@@ -96,6 +129,9 @@ impl ErrorFit {
     /// # Failures
     /// The spline failing.
     pub fn at(&self, xi: &[Real]) -> Result<Vec<Real>, CompensateError> {
+        if let Some(mean) = self.mean {
+            return Ok(vec![mean; xi.len()]);
+        }
         evaluate(&self.at, &self.error, self.smooth, xi)
     }
 
@@ -114,9 +150,9 @@ impl ErrorFit {
     }
 }
 
-/// Refuses a correction `shift` at the places `at` (along `what`) larger
-/// than `limit` anywhere, naming the first such place and the `file`
-/// measured.
+/// Refuses a correction `shift` at the places `at` larger than `limit`
+/// anywhere, naming the first such place (`place` says it: `of the
+/// depth at theta = 12.000 deg`) and the `file` measured.
 ///
 /// # Failures
 /// That.
@@ -124,12 +160,12 @@ pub fn within_limit(
     at: &[Real],
     shift: &[Real],
     limit: Real,
-    what: &str,
+    place: &dyn Fn(Real) -> String,
     file: &str,
 ) -> Result<(), CompensateError> {
     match at.iter().zip(shift).find(|(_, c)| c.abs() > limit) {
         Some((s, c)) => Err(CompensateError::TooLarge {
-            at: format!("{what} = {s:.3} mm"),
+            at: place(*s),
             correction: *c,
             limit,
             why: format!(
@@ -180,8 +216,9 @@ mod tests {
         let grid = [0.0, 200.0, 400.0];
         let c = fit.correction(&grid, 1.0).unwrap();
         assert!((c[2] + 0.006).abs() < 1e-12, "{c:?}");
-        within_limit(&grid, &c, 0.01, "z", "bench.csv").unwrap();
-        let e = within_limit(&grid, &c, 0.005, "z", "bench.csv")
+        let place = |z: Real| format!("at z = {z:.3} mm");
+        within_limit(&grid, &c, 0.01, &place, "bench.csv").unwrap();
+        let e = within_limit(&grid, &c, 0.005, &place, "bench.csv")
             .unwrap_err()
             .to_string();
         assert!(
@@ -190,5 +227,9 @@ mod tests {
         );
         assert!(e.contains("(bench.csv)"), "{e}");
         assert!(fit.correction(&grid, 0.0).is_err());
+        // As one value: the mean, the rest its residual.
+        let fit = fit_mean(&[0.0, 10.0], &[0.010, 0.014], 1e-3).unwrap();
+        assert!((fit.at(&[5.0, 99.0]).unwrap()[1] - 0.012).abs() < 1e-15);
+        assert!((fit.rms_residual - 0.002).abs() < 1e-15);
     }
 }

@@ -19,11 +19,15 @@ pub struct MeasuredSpec<'a> {
     /// of it (`("r_mm", 1.0)`, `("d_mm", 0.5)`): the first the table has
     /// is read.
     pub values: &'a [(&'a str, Real)],
+    /// The rows read: those whose column holds the value (a thread's
+    /// `start`); `None`: every row.
+    pub select: Option<(&'a str, Real)>,
     /// The part's extent along the coordinate.
     pub range: (Real, Real),
-    /// The longest stretch of the range left without a measured place
-    /// (its ends included).
-    pub max_gap: Real,
+    /// Measured along the coordinate: the longest stretch of the range
+    /// left without a measured place (its ends included), and at least
+    /// [`MIN_POINTS`] places. `None`: one value (a row at least).
+    pub max_gap: Option<Real>,
 }
 
 /// A measurement: the quantity at each distinct place, in increasing
@@ -46,10 +50,12 @@ pub struct Measured {
 /// Reads `table` as `spec` asks.
 ///
 /// # Failures
-/// The coordinate's column missing, or none of the value's; a cell empty
-/// or not a number (named by row and column); a row outside the part;
-/// fewer than [`MIN_POINTS`] places; a stretch longer than
-/// `spec.max_gap` without one (named by where it runs).
+/// The coordinate's column missing, or none of the value's
+/// ([`CompensateError::NoValueColumn`]), or the selecting column; a cell
+/// empty or not a number (named by row and column); a row outside the
+/// part; no row selected; along the coordinate, fewer than [`MIN_POINTS`]
+/// places or a stretch longer than `spec.max_gap` without one (named by
+/// where it runs).
 pub fn read_measured(table: &Table, spec: &MeasuredSpec<'_>) -> Result<Measured, CompensateError> {
     let file = table.source().to_owned();
     let at = table.column(spec.coordinate)?;
@@ -68,9 +74,16 @@ pub fn read_measured(table: &Table, spec: &MeasuredSpec<'_>) -> Result<Measured,
             available: table.headers().join(", "),
         })?;
     let value = table.column(column)?;
+    let selected = match spec.select {
+        Some((c, want)) => table.column(c)?.iter().map(|&v| v == want).collect(),
+        None => vec![true; at.len()],
+    };
     let (from, to) = spec.range;
     let mut rows: Vec<(Real, Real)> = Vec::with_capacity(at.len());
     for (i, (&s, &v)) in at.iter().zip(&value).enumerate() {
+        if !selected[i] {
+            continue;
+        }
         if !(from..=to).contains(&s) {
             return Err(CompensateError::Outside {
                 file,
@@ -106,6 +119,16 @@ pub fn read_measured(table: &Table, spec: &MeasuredSpec<'_>) -> Result<Measured,
             }
         }
     }
+    if m.at.is_empty() {
+        let (c, want) = spec.select.unwrap_or(("", 0.0));
+        return Err(CompensateError::TooSparse {
+            file,
+            what: format!("no row measures {c} {want} (column '{c}')"),
+        });
+    }
+    let Some(max_gap) = spec.max_gap else {
+        return Ok(m);
+    };
     if m.at.len() < MIN_POINTS {
         return Err(CompensateError::TooSparse {
             file,
@@ -120,12 +143,12 @@ pub fn read_measured(table: &Table, spec: &MeasuredSpec<'_>) -> Result<Measured,
     let mut edges = vec![from];
     edges.extend(&m.at);
     edges.push(to);
-    if let Some(w) = edges.windows(2).find(|w| w[1] - w[0] > spec.max_gap) {
+    if let Some(w) = edges.windows(2).find(|w| w[1] - w[0] > max_gap) {
         return Err(CompensateError::TooSparse {
             file,
             what: format!(
                 "nothing measured from {} = {} to {}: at most {} may be left between measured places (the part runs from {from} to {to})",
-                spec.coordinate, w[0], w[1], spec.max_gap
+                spec.coordinate, w[0], w[1], max_gap
             ),
         });
     }
@@ -140,8 +163,9 @@ mod tests {
     const SPEC: MeasuredSpec<'static> = MeasuredSpec {
         coordinate: "z_mm",
         values: &[("r_mm", 1.0), ("d_mm", 0.5)],
+        select: None,
         range: (0.0, 100.0),
-        max_gap: 30.0,
+        max_gap: Some(30.0),
     };
 
     fn table(text: &str) -> Table {
@@ -188,6 +212,32 @@ mod tests {
         assert!(
             s.contains("row 3") && s.contains("'x' is not a number"),
             "{s}"
+        );
+    }
+
+    /// One value per selected rows: a thread's start, any places; a start
+    /// no row measures is named.
+    #[test]
+    fn a_selected_quantity_takes_its_rows() {
+        let spec = MeasuredSpec {
+            select: Some(("start", 2.0)),
+            max_gap: None,
+            values: &[("d2_mm", 1.0)],
+            ..SPEC
+        };
+        let m = read_measured(
+            &table("z_mm,start,d2_mm\n10,1,18.3\n10,2,18.31\n20,2,18.33\n"),
+            &spec,
+        )
+        .unwrap();
+        assert_eq!(m.at, vec![10.0, 20.0]);
+        assert_eq!(m.value, vec![18.31, 18.33]);
+        let e = read_measured(&table("z_mm,start,d2_mm\n10,1,18.3\n"), &spec)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("bench.csv: no row measures start 2 (column 'start')"),
+            "{e}"
         );
     }
 }

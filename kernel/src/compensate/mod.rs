@@ -21,36 +21,62 @@ mod measure;
 use crate::math::Real;
 use crate::profile::Profile;
 
-pub use fit::{fit_error, within_limit, ErrorFit};
+pub use fit::{fit_error, fit_mean, within_limit, ErrorFit};
 pub use measure::{read_measured, Measured, MeasuredSpec, MIN_POINTS};
 
 /// What a measurement of a family's finished part holds and what it is
 /// held against, as the family's verification gives it
-/// (`Verifier::nominal`): a quantity along a coordinate.
+/// (`Verifier::nominal`): quantities along one coordinate.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Nominal {
-    /// The coordinate's column (`z_mm`).
+    /// The coordinate's column (`z_mm`, `theta_deg`).
     pub coordinate: &'static str,
-    /// The columns the quantity may be read from, each with the factor
-    /// that makes the quantity of it (`r_mm` 1, `d_mm` 0.5).
-    pub values: &'static [(&'static str, Real)],
-    /// The quantity's name in messages and files (`radius`).
-    pub quantity: &'static str,
-    /// The nominal quantity along the coordinate.
-    pub profile: Profile,
     /// The part's extent along the coordinate that is measured.
     pub range: (Real, Real),
+    /// What may be measured: at least one of them in a measurement.
+    pub quantities: Vec<Quantity>,
+}
+
+/// One quantity a measurement may hold (a mandrel's radius, a groove's
+/// depth, a thread start's pitch diameter) and its nominal.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Quantity {
+    /// Its name in messages and files (`radius`, `start 2's pitch
+    /// diameter`).
+    pub name: String,
+    /// The columns it may be read from, each with the factor that makes
+    /// the quantity of it (`r_mm` 1, `d_mm` 0.5).
+    pub values: &'static [(&'static str, Real)],
+    /// The rows that measure it, where a column tells (`("start", 2.0)`);
+    /// `None`: every row.
+    pub select: Option<(&'static str, Real)>,
+    /// The nominal along the coordinate.
+    pub nominal: Profile,
+    /// Whether it is corrected along the coordinate (fitted by a
+    /// smoothing spline), or by one value (the measured rows' mean: a
+    /// thread start's passes move as one).
+    pub along: bool,
+    /// Its correction's column in the correction's table (`dr_mm`), the
+    /// target's shift in the quantity's own measure.
+    pub key: String,
 }
 
 impl Nominal {
-    /// The measurement's spec: a stretch of at most a quarter of the range
-    /// left without a measured place.
-    pub fn spec(&self) -> MeasuredSpec<'static> {
+    /// The measurement's spec for quantity `q`: along the coordinate, at
+    /// least [`MIN_POINTS`] places and no stretch longer than a quarter of
+    /// the range without one; as one value, a row at least.
+    pub fn spec(&self, q: &Quantity) -> MeasuredSpec<'static> {
+        let (from, to) = self.range;
         MeasuredSpec {
             coordinate: self.coordinate,
-            values: self.values,
+            values: q.values,
+            select: q.select,
             range: self.range,
-            max_gap: 0.25 * (self.range.1 - self.range.0),
+            max_gap: if q.along {
+                Some(0.25 * (to - from))
+            } else {
+                None
+            },
         }
     }
 }
@@ -97,9 +123,9 @@ pub enum CompensateError {
         what: String,
     },
     /// The correction asked for is beyond its limit somewhere.
-    #[error("the correction {correction:.4} mm at {at} is beyond its limit of {limit} mm: {why}")]
+    #[error("the correction {correction:.4} mm {at} is beyond its limit of {limit} mm: {why}")]
     TooLarge {
-        /// Where (`z = 120.000 mm`).
+        /// Of what and where (`of the radius at z = 120.000 mm`).
         at: String,
         /// The correction there (mm).
         correction: f64,
@@ -107,6 +133,17 @@ pub enum CompensateError {
         limit: f64,
         /// What to look at.
         why: String,
+    },
+    /// A measurement holds none of the quantities the part may be
+    /// measured by.
+    #[error("{file}: it measures none of {wanted} (columns: {available})")]
+    Nothing {
+        /// The file.
+        file: String,
+        /// The quantities and their columns, in words.
+        wanted: String,
+        /// The columns there are.
+        available: String,
     },
     /// The fit could not be made.
     #[error("the measured error could not be fitted: {0}")]

@@ -13,8 +13,12 @@
 
 use super::{params_on, run as run_job, run_machine, Annex, JobOptions, JobOutput, Report};
 use crate::catalog::Catalog;
-use crate::compensate::{fit_error, read_measured, within_limit};
+use crate::compensate::{
+    fit_error, fit_mean, read_measured, within_limit, CompensateError, ErrorFit, Measured, Nominal,
+    Quantity,
+};
 use crate::error::Error;
+use crate::math::Real;
 use crate::output::RunDir;
 use crate::params::ParamSource;
 use crate::profile::Table;
@@ -49,7 +53,7 @@ pub struct CompensateOptions {
 /// One measured place as `compensation.json` lists it.
 #[derive(Debug, Clone, Serialize)]
 pub struct Place {
-    /// The coordinate (mm).
+    /// The coordinate.
     pub at: f64,
     /// The quantity measured (the rows there averaged).
     pub measured: f64,
@@ -61,6 +65,38 @@ pub struct Place {
     pub fitted: f64,
     /// The target's shift there.
     pub correction: f64,
+    /// The error expected after it, the same error repeating (error plus
+    /// correction; the corrected run's own finish, which its verification
+    /// reports, besides).
+    pub expected_after: f64,
+}
+
+/// One quantity's measurement, fit and correction.
+#[derive(Debug, Clone, Serialize)]
+pub struct QuantityRecord {
+    /// The quantity (`radius`, `depth`, `start 2's pitch diameter`).
+    pub name: String,
+    /// The value's column read.
+    pub column: String,
+    /// The correction's column in `correction.csv`.
+    pub key: String,
+    /// Corrected along the coordinate (a smoothing spline), or by one
+    /// value (the measured errors' mean).
+    pub along: bool,
+    /// The smoothing parameter found (along the coordinate).
+    pub smooth: f64,
+    /// The fit's residual, RMS (mm). As one value: how far the error
+    /// varies along the part beyond its mean, which the correction leaves.
+    pub rms_residual_mm: f64,
+    /// The largest measured error (mm).
+    pub max_error_mm: f64,
+    /// The largest correction, an earlier one kept included (mm).
+    pub max_correction_mm: f64,
+    /// The largest error expected after the correction, the same error
+    /// repeating (mm).
+    pub max_expected_after_mm: f64,
+    /// Every measured place.
+    pub places: Vec<Place>,
 }
 
 /// `compensation.json`: see the module's docs.
@@ -68,32 +104,53 @@ pub struct Place {
 pub struct Compensation {
     /// The run corrected (as given).
     pub run: String,
-    /// The measurement's file and the column read.
+    /// The measurement's file.
     pub measured_file: String,
-    /// The value's column.
-    pub column: String,
     /// The coordinate's column.
     pub coordinate: &'static str,
-    /// The quantity measured.
-    pub quantity: &'static str,
     /// The uncertainty the fit was held to (mm).
     pub uncertainty_mm: f64,
     /// The gain.
     pub gain: f64,
     /// The largest correction accepted (mm).
     pub limit_mm: f64,
-    /// The smoothing parameter found.
-    pub smooth: f64,
-    /// The fit's residual, RMS (mm).
-    pub rms_residual_mm: f64,
-    /// The largest measured error (mm).
-    pub max_error_mm: f64,
-    /// The largest correction (mm).
-    pub max_correction_mm: f64,
-    /// Every measured place.
-    pub places: Vec<Place>,
+    /// The quantities measured.
+    pub quantities: Vec<QuantityRecord>,
+    /// The quantities the part may be measured by that the measurement
+    /// does not hold: not corrected (an earlier correction kept).
+    pub not_measured: Vec<String>,
     /// How the program changed.
     pub program: ProgramChange,
+}
+
+impl Compensation {
+    /// What was measured and corrected, in a line per quantity.
+    pub fn summary(&self) -> String {
+        let mut s: Vec<String> = self
+            .quantities
+            .iter()
+            .map(|q| {
+                format!(
+                    "{}: {} places, the error up to {:.4} mm {} (RMS residual {:.4} mm), the target moved by up to {:.4} mm, {:.4} mm expected after",
+                    q.name,
+                    q.places.len(),
+                    q.max_error_mm,
+                    if q.along {
+                        format!("fitted within {} mm", self.uncertainty_mm)
+                    } else {
+                        "corrected by its mean".to_owned()
+                    },
+                    q.rms_residual_mm,
+                    q.max_correction_mm,
+                    q.max_expected_after_mm
+                )
+            })
+            .collect();
+        if !self.not_measured.is_empty() {
+            s.push(format!("not measured: {}", self.not_measured.join(", ")));
+        }
+        s.join("; ")
+    }
 }
 
 /// How the program changed: its text (a line diff, `similar`: lines
@@ -187,41 +244,107 @@ pub fn compensate(
                 script.display()
             ))
         })?;
-    // The measurement against it.
-    let m = read_measured(measured, &nominal.spec())?;
-    let at_nominal = nominal.profile.eval_many(&m.at)?;
-    let error: Vec<f64> = m
-        .value
-        .iter()
-        .zip(&at_nominal)
-        .map(|(v, n)| v - n)
-        .collect();
-    let fit = fit_error(&m.at, &error, options.uncertainty)?;
+    // The measurement against it: each quantity it holds.
+    let mut fitted: Vec<Fitted> = Vec::new();
+    let mut not_measured = Vec::new();
+    for q in &nominal.quantities {
+        let m = match read_measured(measured, &nominal.spec(q)) {
+            Ok(m) => m,
+            Err(CompensateError::NoValueColumn { .. }) => {
+                not_measured.push(q.name.clone());
+                continue;
+            }
+            Err(e) => return Err(e.into()),
+        };
+        let at_nominal = q.nominal.eval_many(&m.at)?;
+        let error: Vec<f64> = m
+            .value
+            .iter()
+            .zip(&at_nominal)
+            .map(|(v, n)| v - n)
+            .collect();
+        let fit = if q.along {
+            fit_error(&m.at, &error, options.uncertainty)?
+        } else {
+            fit_mean(&m.at, &error, options.uncertainty)?
+        };
+        fitted.push(Fitted {
+            q: q.clone(),
+            m,
+            at_nominal,
+            error,
+            fit,
+        });
+    }
+    if fitted.is_empty() {
+        return Err(CompensateError::Nothing {
+            file: measured.source().to_owned(),
+            wanted: nominal
+                .quantities
+                .iter()
+                .map(|q| {
+                    let columns: Vec<String> =
+                        q.values.iter().map(|(c, _)| format!("'{c}'")).collect();
+                    format!("the {} ({})", q.name, columns.join(" or "))
+                })
+                .collect::<Vec<_>>()
+                .join(", "),
+            available: measured.headers().join(", "),
+        }
+        .into());
+    }
     let (from, to) = nominal.range;
-    let grid: Vec<f64> = (0..=GRID)
-        .map(|i| from + (to - from) * i as f64 / GRID as f64)
+    let places = if nominal.quantities.iter().any(|q| q.along) {
+        GRID
+    } else {
+        1
+    };
+    let grid: Vec<f64> = (0..=places)
+        .map(|i| from + (to - from) * i as f64 / places as f64)
         .collect();
-    let coordinate = nominal.coordinate.trim_end_matches("_mm");
+    let (coordinate, unit) = nominal
+        .coordinate
+        .rsplit_once('_')
+        .unwrap_or((nominal.coordinate, ""));
     // A compensated run's correction stays, the new one added: the
     // measured error is then the first correction's and the process's.
     let previous = match report.parameters.get(CORRECTION).map(|p| &p.value) {
-        Some(crate::params::ParamValue::Text(name)) if !name.is_empty() => {
-            let t = crate::profile::read_table_str(&read(name)?, &format!("{shown}/{name}"))?;
-            let p = t.profile("z_mm", "dr_mm")?;
-            let (lo, hi) = p.z_range();
-            grid.iter()
-                .map(|z| p.eval(z.clamp(lo, hi)))
-                .collect::<Result<Vec<f64>, _>>()?
-        }
-        _ => vec![0.0; grid.len()],
+        Some(crate::params::ParamValue::Text(name)) if !name.is_empty() => Some(
+            crate::profile::read_table_str(&read(name)?, &format!("{shown}/{name}"))?,
+        ),
+        _ => None,
     };
-    let shift = fit.correction(&grid, options.gain)?;
-    let total: Vec<f64> = shift.iter().zip(&previous).map(|(s, p)| s + p).collect();
-    within_limit(&grid, &total, options.limit, coordinate, &m.file)?;
-    let correction = crate::profile::Profile::new(grid.clone(), total)?;
-    let mut csv = String::from("z_mm,dr_mm\n");
-    for (z, d) in correction.z().iter().zip(correction.x()) {
-        csv += &format!("{z:.6},{d:.9}\n");
+    let mut csv = std::iter::once(nominal.coordinate)
+        .chain(nominal.quantities.iter().map(|q| q.key.as_str()))
+        .collect::<Vec<_>>()
+        .join(",")
+        + "\n";
+    let mut columns: Vec<Vec<f64>> = Vec::new();
+    for q in &nominal.quantities {
+        let mut total = match &previous {
+            Some(t) if t.column_index(&q.key).is_ok() => {
+                let p = t.profile(nominal.coordinate, &q.key)?;
+                let (lo, hi) = p.z_range();
+                grid.iter()
+                    .map(|z| p.eval(z.clamp(lo, hi)))
+                    .collect::<Result<Vec<f64>, _>>()?
+            }
+            _ => vec![0.0; grid.len()],
+        };
+        if let Some(f) = fitted.iter().find(|f| f.q.key == q.key) {
+            let shift = f.fit.correction(&grid, options.gain)?;
+            total.iter_mut().zip(&shift).for_each(|(t, s)| *t += s);
+            let place = |s: f64| format!("of the {} at {coordinate} = {s:.3} {unit}", q.name);
+            within_limit(&grid, &total, options.limit, &place, &f.m.file)?;
+        }
+        columns.push(total);
+    }
+    for (i, z) in grid.iter().enumerate() {
+        csv += &format!("{z:.6}");
+        for c in &columns {
+            csv += &format!(",{:.9}", c[i]);
+        }
+        csv += "\n";
     }
     // The corrected run.
     let family = load(vec![(CORRECTION_FILE.into(), csv.clone())])?;
@@ -232,42 +355,39 @@ pub fn compensate(
             pairs: vec![(CORRECTION.into(), CORRECTION_FILE.into())],
         },
     ];
-    let fitted = fit.at(&m.at)?;
-    // The table and chart the corrected run's report and page show: the
-    // measured error, its fit, the target's shift and the error expected
-    // after it (the same error on the corrected target, before the
-    // corrected run's own finish, which its verification reports).
-    let um = |v: &[f64]| v.iter().map(|x| 1e3 * x).collect::<Vec<f64>>();
-    let shift: Vec<f64> = fitted.iter().map(|f| -options.gain * f).collect();
-    let after: Vec<f64> = error.iter().zip(&shift).map(|(e, c)| e + c).collect();
-    let mut annex = Annex::default();
-    annex.tables.insert(
-        "compensation".into(),
-        BTreeMap::from([
-            (nominal.coordinate.to_owned(), m.at.clone()),
-            ("measured_error_um".into(), um(&error)),
-            ("fit_um".into(), um(&fitted)),
-            ("correction_um".into(), um(&shift)),
-            ("expected_after_um".into(), um(&after)),
-        ]),
-    );
-    annex.plots.push(crate::toolpath::PlotSpec {
-        file: "compensation".into(),
-        title: format!(
-            "The measured {}'s error from the nominal, its fit, the correction and the error expected after it",
-            nominal.quantity
-        ),
-        table: "compensation".into(),
-        x: nominal.coordinate.to_owned(),
-        y: vec![
-            "measured_error_um".into(),
-            "fit_um".into(),
-            "correction_um".into(),
-            "expected_after_um".into(),
-        ],
-        x_label: format!("{}, mm", coordinate),
-        y_label: format!("{}, um", nominal.quantity),
-    });
+    let mut records = Vec::new();
+    for (f, total) in fitted.iter().map(|f| {
+        let k = nominal.quantities.iter().position(|q| q.key == f.q.key);
+        (f, k.map(|k| &columns[k]))
+    }) {
+        let fit_at = f.fit.at(&f.m.at)?;
+        let shift: Vec<f64> = fit_at.iter().map(|v| -options.gain * v).collect();
+        let places: Vec<Place> = (0..f.m.at.len())
+            .map(|i| Place {
+                at: f.m.at[i],
+                measured: f.m.value[i],
+                nominal: f.at_nominal[i],
+                error: f.error[i],
+                fitted: fit_at[i],
+                correction: shift[i],
+                expected_after: f.error[i] + shift[i],
+            })
+            .collect();
+        let largest = |v: &mut dyn Iterator<Item = f64>| v.fold(0.0, |a: f64, x| a.max(x.abs()));
+        records.push(QuantityRecord {
+            name: f.q.name.clone(),
+            column: f.m.column.clone(),
+            key: f.q.key.clone(),
+            along: f.q.along,
+            smooth: f.fit.smooth,
+            rms_residual_mm: f.fit.rms_residual,
+            max_error_mm: largest(&mut f.error.iter().copied()),
+            max_correction_mm: largest(&mut total.into_iter().flatten().copied()),
+            max_expected_after_mm: largest(&mut places.iter().map(|p| p.expected_after)),
+            places,
+        });
+    }
+    let annex = annex(&nominal, &records, (coordinate, unit));
     let job_options = JobOptions {
         program_name: script
             .file_stem()
@@ -293,27 +413,13 @@ pub fn compensate(
     let mut out = run_job(&family, &machine, &sources, &job_options, &mut |_| {})?;
     let record = Compensation {
         run: shown.clone(),
-        measured_file: m.file.clone(),
-        column: m.column.clone(),
+        measured_file: measured.source().to_owned(),
         coordinate: nominal.coordinate,
-        quantity: nominal.quantity,
         uncertainty_mm: options.uncertainty,
         gain: options.gain,
         limit_mm: options.limit,
-        smooth: fit.smooth,
-        rms_residual_mm: fit.rms_residual,
-        max_error_mm: error.iter().fold(0.0, |a: f64, e| a.max(e.abs())),
-        max_correction_mm: correction.x().iter().fold(0.0, |a: f64, c| a.max(c.abs())),
-        places: (0..m.at.len())
-            .map(|i| Place {
-                at: m.at[i],
-                measured: m.value[i],
-                nominal: at_nominal[i],
-                error: error[i],
-                fitted: fitted[i],
-                correction: shift[i],
-            })
-            .collect(),
+        quantities: records,
+        not_measured,
         program: ProgramChange {
             path_moved: path_moved(
                 &old_program,
@@ -339,6 +445,114 @@ pub fn compensate(
             .into_bytes(),
     ));
     Ok((out, record))
+}
+
+/// One quantity measured and fitted.
+struct Fitted {
+    q: Quantity,
+    m: Measured,
+    at_nominal: Vec<f64>,
+    error: Vec<f64>,
+    fit: ErrorFit,
+}
+
+/// The tables and charts the corrected run's report and page show: per
+/// quantity along the coordinate, its measured error, fit, the target's
+/// shift and the error expected after it (the same error on the corrected
+/// target, before the corrected run's own finish, which its verification
+/// reports); the quantities corrected by one value together, by what
+/// selects them (a thread's starts).
+fn annex(nominal: &Nominal, records: &[QuantityRecord], (coordinate, unit): (&str, &str)) -> Annex {
+    let um = |v: &mut dyn Iterator<Item = f64>| v.map(|x| 1e3 * x).collect::<Vec<f64>>();
+    let columns = [
+        "measured_error_um",
+        "fit_um",
+        "correction_um",
+        "expected_after_um",
+    ];
+    let mut annex = Annex::default();
+    let along: Vec<&QuantityRecord> = records.iter().filter(|r| r.along).collect();
+    for r in &along {
+        let name = if along.len() == 1 {
+            "compensation".to_owned()
+        } else {
+            format!(
+                "compensation_{}",
+                r.key.trim_end_matches("_mm").trim_start_matches('d')
+            )
+        };
+        let p = &r.places;
+        annex.tables.insert(
+            name.clone(),
+            BTreeMap::from([
+                (
+                    nominal.coordinate.to_owned(),
+                    p.iter().map(|p| p.at).collect(),
+                ),
+                (columns[0].into(), um(&mut p.iter().map(|p| p.error))),
+                (columns[1].into(), um(&mut p.iter().map(|p| p.fitted))),
+                (columns[2].into(), um(&mut p.iter().map(|p| p.correction))),
+                (
+                    columns[3].into(),
+                    um(&mut p.iter().map(|p| p.expected_after)),
+                ),
+            ]),
+        );
+        annex.plots.push(crate::toolpath::PlotSpec {
+            file: name.clone(),
+            title: format!(
+                "The measured {}'s error from the nominal, its fit, the correction and the error expected after it",
+                r.name
+            ),
+            table: name,
+            x: nominal.coordinate.to_owned(),
+            y: columns.iter().map(|c| (*c).to_owned()).collect(),
+            x_label: format!("{coordinate}, {unit}"),
+            y_label: format!("{}, um", r.name),
+        });
+    }
+    // The quantities corrected by one value, by what selects them.
+    let ones: Vec<(&QuantityRecord, Real)> = records
+        .iter()
+        .filter(|r| !r.along)
+        .filter_map(|r| {
+            let q = nominal.quantities.iter().find(|q| q.key == r.key)?;
+            Some((r, q.select.map_or(1.0, |s| s.1)))
+        })
+        .collect();
+    if let Some((r0, _)) = ones.first() {
+        let by = nominal
+            .quantities
+            .iter()
+            .find_map(|q| q.select.map(|s| s.0))
+            .unwrap_or("quantity");
+        let mean = |r: &QuantityRecord, f: &dyn Fn(&Place) -> f64| {
+            1e3 * r.places.iter().map(f).sum::<f64>() / r.places.len() as f64
+        };
+        let column = |f: &dyn Fn(&Place) -> f64| ones.iter().map(|(r, _)| mean(r, f)).collect();
+        annex.tables.insert(
+            "compensation".into(),
+            BTreeMap::from([
+                (by.to_owned(), ones.iter().map(|(_, s)| *s).collect()),
+                (columns[0].into(), column(&|p| p.error)),
+                (columns[2].into(), column(&|p| p.correction)),
+                (columns[3].into(), column(&|p| p.expected_after)),
+            ]),
+        );
+        let quantity = r0.name.rsplit_once("'s ").map_or(r0.name.as_str(), |s| s.1);
+        annex.plots.push(crate::toolpath::PlotSpec {
+            file: "compensation".into(),
+            title: format!(
+                "The measured {quantity}'s error from the nominal (the mean of its places), the correction and the error expected after it, per {by}"
+            ),
+            table: "compensation".into(),
+            x: by.to_owned(),
+            y: [columns[0], columns[2], columns[3]].iter().map(|c| (*c).to_owned()).collect(),
+            x_label: by.to_owned(),
+            y_label: format!("{quantity}, um"),
+        });
+    }
+    annex
 }
 
 /// The program's text changes from `before` to `after` (`file`'s).

@@ -51,10 +51,15 @@ impl Verifier for VerifyRequest {
     fn nominal(&self) -> Option<crate::compensate::Nominal> {
         Some(crate::compensate::Nominal {
             coordinate: "z_mm",
-            values: &[("r_mm", 1.0), ("d_mm", 0.5)],
-            quantity: "radius",
-            profile: self.profile.clone(),
             range: (self.from, self.to),
+            quantities: vec![crate::compensate::Quantity {
+                name: "radius".into(),
+                values: &[("r_mm", 1.0), ("d_mm", 0.5)],
+                select: None,
+                nominal: self.profile.clone(),
+                along: true,
+                key: "dr_mm".into(),
+            }],
         })
     }
 }
