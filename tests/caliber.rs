@@ -132,7 +132,7 @@ fn report(dir: &Path) -> serde_json::Value {
 /// The groove the run ground: the example table, monotone between rows,
 /// smoothed as the family does (5 iterations from the middle of the sizing
 /// section, the section held).
-fn groove() -> Groove {
+pub(crate) fn groove() -> Groove {
     let t = pilgrim_kernel::profile::read_table(root().join("scripts/caliber-groove.csv")).unwrap();
     let g = Groove::from_tables(150.0, (&t, "theta_deg", "Hp_mm"), (&t, "theta_deg", "B_mm"))
         .unwrap()

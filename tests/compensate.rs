@@ -309,3 +309,118 @@ fn a_deflection_is_corrected_along_its_curve() {
     assert!(finish + worst <= tolerance, "{finish} + {worst}");
     assert!(bend(440.0) > 3.9e-3);
 }
+
+/// The groove 20 um shallow over its entry relief (theta to 20 deg), the
+/// error fading out by 40 deg along half a cosine (a wheel worn on its
+/// rounding as it starts, or a groove ground before the wheel came to
+/// size): measured minus nominal depth (mm) at theta (deg).
+fn shallow_entry(theta: f64) -> f64 {
+    if theta <= 20.0 {
+        -0.020
+    } else if theta >= 40.0 {
+        0.0
+    } else {
+        -0.010 * (1.0 + (std::f64::consts::PI * (theta - 20.0) / 20.0).cos())
+    }
+}
+
+/// The default caliber measured with its groove 20 um shallow over its
+/// entry (`scripts/examples/caliber-measured.csv`, checked here against
+/// the groove as ground and the error's formula): compensated, the depth's
+/// correction is the error's negative within the fit's reach, the width
+/// (measured as ground) is left, the corrected program verifies against
+/// the corrected groove, and the part it makes with the same error
+/// repeating is within the tolerance (the corrected run's own deviation
+/// plus what the correction leaves of the error), where the first was 20
+/// um out.
+#[test]
+fn the_caliber_is_corrected_by_its_measured_groove() {
+    let dir = scratch("compensate", "caliber");
+    let run = dir.join("run");
+    let (code, _, err) = pilgrim(&["run", "scripts/caliber.rhai", "--out", s(&run), "--quiet"]);
+    assert_eq!(code, 0, "{err}");
+    let g = crate::caliber::groove();
+    let measured = common::root().join("scripts/examples/caliber-measured.csv");
+    let text = std::fs::read_to_string(&measured).unwrap();
+    let rows: Vec<[f64; 3]> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|c| c.parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect();
+    assert_eq!(rows.len(), 57);
+    for [theta, hp, b] in &rows {
+        let r = theta.to_radians();
+        let want = g.depth().eval(r).unwrap() + shallow_entry(*theta);
+        assert!((hp - want).abs() < 1e-5, "theta {theta}: {hp} vs {want}");
+        assert!(
+            (b - g.width().eval(r).unwrap()).abs() < 1e-5,
+            "theta {theta}"
+        );
+    }
+    let out = dir.join("corrected");
+    let (code, said, err) = pilgrim(&[
+        "compensate",
+        s(&run),
+        "--measured",
+        s(&measured),
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(said.contains("depth: 57 places"), "{said}");
+    let report = common::report_of(&out);
+    assert_eq!(
+        report["verdict"]["status"], "passed",
+        "{}",
+        report["verdict"]
+    );
+    assert_eq!(
+        report["parameters"]["correction"]["value"],
+        "correction.csv"
+    );
+    let groove = &report["groove_verification"];
+    let finish = groove["max_abs_mm"].as_f64().unwrap();
+    let tolerance = groove["tolerance"].as_f64().unwrap();
+    // The correction: the depth deepened by the shallow entry, the width
+    // left as it was.
+    let table = std::fs::read_to_string(out.join("correction.csv")).unwrap();
+    let mut lines = table.lines();
+    assert_eq!(lines.next(), Some("theta_deg,dhp_mm,db_mm"));
+    let (mut left, mut width): (f64, f64) = (0.0, 0.0);
+    for l in lines {
+        let v: Vec<f64> = l.split(',').map(|c| c.parse().unwrap()).collect();
+        left = left.max((v[1] + shallow_entry(v[0])).abs());
+        width = width.max(v[2].abs());
+    }
+    // Within the file's last digit (0.01 um).
+    assert!(width < 1e-5, "the width moved {width} mm");
+    let c = json(&out.join("compensation.json"));
+    let depth = &c["quantities"][0];
+    assert_eq!(depth["name"], "depth");
+    let after = depth["max_expected_after_mm"].as_f64().unwrap();
+    // Where the error bends, a fit held to 1 um stays a few um off it.
+    assert!(left < 5e-3 && after < 5e-3, "{left} {after}");
+    let before = rows
+        .iter()
+        .map(|[theta, ..]| shallow_entry(*theta).abs())
+        .fold(0.0, f64::max);
+    assert!(before > tolerance, "{before}");
+    assert!(
+        finish + after < tolerance,
+        "the part after: {finish} + {after} mm against {tolerance} mm"
+    );
+    // The program: the same blocks, the groove's entry deepened.
+    assert!(c["program"]["blocks_moved"].as_u64().unwrap() > 0);
+    assert!(c["program"]["path_moved"]["Z"].as_f64().unwrap() > 0.015);
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    for svg in ["compensation_hp.svg", "compensation_b.svg"] {
+        assert!(
+            out.join(svg).is_file() && page.contains(&format!("alt=\"{svg}\"")),
+            "{svg}"
+        );
+    }
+}

@@ -90,6 +90,9 @@ pub struct Groove {
     hp: Profile,
     b: Profile,
     edge: Option<(EdgeKind, Profile)>,
+    /// A measured part's correction added to the depth and the width
+    /// (`pilgrim compensate`): theta (rad) to mm, held at its ends.
+    correction: Option<Box<[Profile; 2]>>,
 }
 
 /// Step of the numerical derivatives of the surface (rad).
@@ -157,6 +160,7 @@ impl Groove {
             hp: profile("Hp", hp)?,
             b: profile("B", b)?,
             edge: None,
+            correction: None,
         })
     }
 
@@ -602,6 +606,56 @@ impl Groove {
         self.hp.z_range()
     }
 
+    /// The groove with `dhp` added to its depth and `db` to its width
+    /// (mm) at the angles `theta_deg` (increasing), cubic between them
+    /// (monotone) and held at its ends beyond them: a measured part's
+    /// correction (`pilgrim compensate`). The tables ([`Self::depth`],
+    /// [`Self::width`]) stay the nominal; the sections are corrected. An
+    /// earlier correction is replaced.
+    ///
+    /// # Failures
+    /// Columns of different lengths, angles not increasing, a value not
+    /// finite (named as `dHp` or `dB`); a corrected section that cannot
+    /// be (a depth or width no longer positive), named by its angle.
+    pub fn corrected(
+        self,
+        theta_deg: &[Real],
+        dhp: &[Real],
+        db: &[Real],
+    ) -> Result<Self, GrooveError> {
+        let theta: Vec<Real> = theta_deg.iter().map(|t| t.to_radians()).collect();
+        let profile = |table, x: &[Real]| {
+            Profile::new(theta.clone(), x.to_vec())
+                .map(|p| p.with_interpolation(crate::profile::Interpolation::Monotone))
+                .map_err(|source| GrooveError::Table { table, source })
+        };
+        let g = Self {
+            correction: Some(Box::new([profile("dHp", dhp)?, profile("dB", db)?])),
+            ..self
+        };
+        for t in g.rows_and_midpoints().into_iter().chain(theta) {
+            if (g.theta_range().0..=g.theta_range().1).contains(&t) {
+                g.section(t)?;
+            }
+        }
+        Ok(g)
+    }
+
+    /// The correction added to the depth and the width at `theta` (rad),
+    /// (0, 0) without one.
+    fn correction_at(&self, theta: Real) -> Result<(Real, Real), GrooveError> {
+        match &self.correction {
+            None => Ok((0.0, 0.0)),
+            Some(c) => {
+                let at = |p: &Profile| {
+                    let (lo, hi) = p.z_range();
+                    p.eval(theta.clamp(lo, hi))
+                };
+                Ok((at(&c[0])?, at(&c[1])?))
+            }
+        }
+    }
+
     /// The depth table (theta in rad).
     pub fn depth(&self) -> &Profile {
         &self.hp
@@ -624,8 +678,9 @@ impl Groove {
     /// `theta` outside the tables; an edge interpolated to a size that
     /// cannot be.
     pub fn section(&self, theta: Real) -> Result<GrooveSection, GrooveError> {
-        let hp = self.hp.eval(theta)?;
-        let b = self.b.eval(theta)?;
+        let (dhp, db) = self.correction_at(theta)?;
+        let hp = self.hp.eval(theta)? + dhp;
+        let b = self.b.eval(theta)? + db;
         let edge = match &self.edge {
             None => Edge::Sharp,
             Some((kind, size)) => kind.of(size.eval(theta)?),

@@ -49,6 +49,49 @@ impl Verifier for GrooveRequest {
             stock,
         })
     }
+
+    /// The groove measured over theta (`theta_deg`, deg): its depth
+    /// (`Hp_mm` or `depth_mm`) and its width at the periphery (`B_mm` or
+    /// `width_mm`), as its tables give them, against the groove's tables
+    /// as ground (smoothed), over their range.
+    fn nominal(&self) -> Option<crate::compensate::Nominal> {
+        let g = &self.groove;
+        let in_deg = |p: &crate::profile::Profile| {
+            let deg: Vec<f64> = p.z().iter().map(|t| t.to_degrees()).collect();
+            crate::profile::Profile::new(deg, p.x().to_vec())
+                .ok()
+                .map(|d| d.with_interpolation(p.interpolation()))
+        };
+        let (lo, hi) = g.theta_range();
+        let quantity = |name: &str, values, p, key: &str| {
+            Some(crate::compensate::Quantity {
+                name: name.into(),
+                values,
+                select: None,
+                nominal: in_deg(p)?,
+                along: true,
+                key: key.into(),
+            })
+        };
+        Some(crate::compensate::Nominal {
+            coordinate: "theta_deg",
+            range: (lo.to_degrees(), hi.to_degrees()),
+            quantities: vec![
+                quantity(
+                    "depth",
+                    &[("Hp_mm", 1.0), ("depth_mm", 1.0)],
+                    g.depth(),
+                    "dhp_mm",
+                )?,
+                quantity(
+                    "width",
+                    &[("B_mm", 1.0), ("width_mm", 1.0)],
+                    g.width(),
+                    "db_mm",
+                )?,
+            ],
+        })
+    }
 }
 
 /// A caliber program replayed against its groove.

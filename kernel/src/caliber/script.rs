@@ -330,6 +330,18 @@ pub mod caliber_api {
         edge_from(g, EdgeKind::Rounding, &table, theta, column)
     }
 
+    /// The groove corrected by `table` (`pilgrim compensate`'s
+    /// `correction.csv`): its columns `theta_deg`, `dhp_mm` and `db_mm`
+    /// added to the depth and the width; errors name file, row and column.
+    #[rhai_fn(pure, return_raw)]
+    pub fn corrected(g: &mut Groove, table: Table) -> Result<Groove, Box<EvalAltResult>> {
+        let column = |c: &str| kernel(table.column(c));
+        kernel(
+            g.clone()
+                .corrected(&column("theta_deg")?, &column("dhp_mm")?, &column("db_mm")?),
+        )
+    }
+
     /// The groove with its edges rounded into the periphery by `radius`
     /// (mm) all round.
     #[rhai_fn(pure, return_raw)]
