@@ -44,7 +44,7 @@ fn compensate(c: &mut Criterion) {
     let options = CompensateOptions {
         gain: 1.0,
         uncertainty: 0.001,
-        limit: 0.05,
+        limit: 0.1,
         limits: Limits::default(),
     };
     let run = || job::compensate(&dir, &catalog, &measured, &options).unwrap();

@@ -178,7 +178,9 @@ enum Command {
         /// The run's output directory.
         dir: PathBuf,
         /// The measurement: a table (CSV, XLSX, ODS) whose columns the
-        /// family names (the mandrel: z_mm and d_mm or r_mm).
+        /// family names (the mandrel: z_mm and d_mm or r_mm; the caliber:
+        /// theta_deg and Hp_mm, B_mm or both; a thread: z_mm, d2_mm, and
+        /// start for several starts).
         #[arg(long, value_name = "FILE")]
         measured: PathBuf,
         /// The share of the measured error the target moves against (1:
@@ -189,8 +191,9 @@ enum Command {
         #[arg(long, value_name = "MM", default_value_t = 0.001)]
         uncertainty: f64,
         /// The largest correction accepted (mm); a larger one is refused,
-        /// naming where.
-        #[arg(long, value_name = "MM", default_value_t = 0.05)]
+        /// naming where: a bound against a wrong measurement (a diameter
+        /// read as a radius, another part's file), not the part's tolerance.
+        #[arg(long, value_name = "MM", default_value_t = 0.1)]
         limit: f64,
         /// Where the corrected run goes. Default: DIR-compensated.
         #[arg(long)]

@@ -215,7 +215,7 @@ fn bad_measurements_are_refused_and_nothing_is_written() {
         .into_iter()
         .filter(|r| r.0 < 200.0)
         .collect();
-    let large = every(&|z| 0.2 * z / 440.0);
+    let large = every(&|z| 0.4 * z / 440.0);
     for (name, rows, says) in [
         (
             "outside.csv",
@@ -227,7 +227,7 @@ fn bad_measurements_are_refused_and_nothing_is_written() {
             sparse,
             "nothing measured from z_mm = 190 to 440",
         ),
-        ("large.csv", large, "beyond its limit of 0.05 mm"),
+        ("large.csv", large, "beyond its limit of 0.1 mm"),
     ] {
         let f = table(name, &rows);
         let out = dir.join(format!("{name}.out"));
@@ -238,7 +238,7 @@ fn bad_measurements_are_refused_and_nothing_is_written() {
         assert!(!out.exists(), "{name}: {} written", out.display());
     }
     // The largest's place: the first z of the correction's grid (every
-    // 1.1 mm) where it passes 0.05 mm on radius (0.1 z / 440).
+    // 1.1 mm) where it passes 0.1 mm on radius (0.2 z / 440).
     let f = dir.join("large.csv");
     let (_, _, err) = pilgrim(&["compensate", s(&run), "--measured", s(&f)]);
     assert!(err.contains("at z = 221.100 mm"), "{err}");
@@ -423,4 +423,170 @@ fn the_caliber_is_corrected_by_its_measured_groove() {
             "{svg}"
         );
     }
+}
+
+/// The default thread (M20x2.5-6g) measured over wires as a bar bending
+/// away from the cutter by its unsupported length leaves it
+/// (`scripts/examples/thread-measured.csv`: the pitch diameter 0.120 mm
+/// large at the face, falling towards the chuck 50 mm away): out of 6g's
+/// band before; compensated by its mean (a start's passes move as one),
+/// the corrected program verifies against the band moved by the
+/// correction, and with the same error repeating the part is inside 6g's
+/// band. A two-start thread's starts, measured apart, are corrected each
+/// by its own.
+#[test]
+fn a_thread_is_corrected_start_by_start() {
+    let dir = scratch("compensate", "thread");
+    let run = dir.join("run");
+    let (code, _, err) = pilgrim(&["run", "scripts/thread.rhai", "--out", s(&run), "--quiet"]);
+    assert_eq!(code, 0, "{err}");
+    let first = common::report_of(&run);
+    let band = &first["thread_verification"]["limits"]["pitch_diameter"];
+    let (lo, hi) = (band["min"].as_f64().unwrap(), band["max"].as_f64().unwrap());
+    let aim = 0.5 * (lo + hi);
+    let bend = |z: f64| 0.120 * (z + 50.0) / 50.0;
+    let measured = common::root().join("scripts/examples/thread-measured.csv");
+    let rows: Vec<(f64, f64)> = std::fs::read_to_string(&measured)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(|l| {
+            let (z, d) = l.split_once(',').unwrap();
+            (z.parse().unwrap(), d.parse().unwrap())
+        })
+        .collect();
+    assert_eq!(rows.len(), 5);
+    for &(z, d2) in &rows {
+        assert!((d2 - aim - bend(z)).abs() < 1e-6, "z {z}: {d2}");
+    }
+    // Before: the part near the face is out of the band.
+    assert!(rows.iter().any(|r| r.1 > hi), "{rows:?} against {hi}");
+    let out = dir.join("corrected");
+    let (code, said, err) = pilgrim(&[
+        "compensate",
+        s(&run),
+        "--measured",
+        s(&measured),
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(said.contains("pitch diameter: 5 places"), "{said}");
+    let report = common::report_of(&out);
+    assert_eq!(
+        report["verdict"]["status"], "passed",
+        "{}",
+        report["verdict"]
+    );
+    let mean = rows.iter().map(|r| bend(r.0)).sum::<f64>() / 5.0;
+    let table = std::fs::read_to_string(out.join("correction.csv")).unwrap();
+    assert!(table.starts_with("z_mm,dd2_1_mm\n"), "{table}");
+    for l in table.lines().skip(1) {
+        let dd2: f64 = l.split_once(',').unwrap().1.parse().unwrap();
+        assert!((dd2 + mean).abs() < 1e-6, "{dd2} against {mean}");
+    }
+    // After: the corrected run's simulated pitch diameter (at the
+    // corrected target) with the same error repeating, at every place.
+    let d2 = report["thread_verification"]["starts"][0]["pitch_diameter"]
+        .as_f64()
+        .unwrap();
+    assert!((d2 - (aim - mean)).abs() < 0.01, "{d2}");
+    for &(z, _) in &rows {
+        let part = d2 + bend(z);
+        assert!(part > lo && part < hi, "z {z}: {part} outside {lo} to {hi}");
+    }
+    let c = json(&out.join("compensation.json"));
+    assert_eq!(c["quantities"][0]["along"], false);
+    assert!(out.join("compensation.svg").is_file());
+
+    // Two starts, each measured (start 2 cut after start 1 at each depth,
+    // by a cutter worn a little more): each corrected by its own.
+    let two = dir.join("two");
+    let (code, _, err) = pilgrim(&[
+        "run",
+        "scripts/thread.rhai",
+        "--set",
+        "designation=Tr40x14(P7)",
+        "--out",
+        s(&two),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let aim_of = |r: &serde_json::Value, k: usize| {
+        r["thread_verification"]["starts"][k]["pitch_diameter"]
+            .as_f64()
+            .unwrap()
+    };
+    let first = common::report_of(&two);
+    // About the pitch diameter the cut aims at (the family's note).
+    let d2 = first["notes"]["pitch_diameter_aimed_mm"].as_f64().unwrap();
+    let file = dir.join("two.csv");
+    let mut t = String::from("z_mm,start,d2_mm\n");
+    for z in [-5.0, -15.0, -25.0] {
+        t += &format!("{z},1,{}\n{z},2,{}\n", d2 + 0.02, d2 + 0.05);
+    }
+    std::fs::write(&file, t).unwrap();
+    let out = dir.join("two-corrected");
+    let (code, _, err) = pilgrim(&[
+        "compensate",
+        s(&two),
+        "--measured",
+        s(&file),
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let report = common::report_of(&out);
+    assert_eq!(
+        report["verdict"]["status"], "passed",
+        "{}",
+        report["verdict"]
+    );
+    for (k, e) in [(0, 0.02), (1, 0.05)] {
+        let moved = aim_of(&report, k) - aim_of(&first, k);
+        assert!((moved + e).abs() < 2e-3, "start {}: moved {moved}", k + 1);
+    }
+    let table = &report["tables"]["compensation"];
+    assert_eq!(table["start"], serde_json::json!([1.0, 2.0]));
+
+    // A nut (cut outwards from its bore) measured 0.02 mm large: its
+    // passes come in, its pitch diameter down by as much.
+    let nut = dir.join("nut");
+    let (code, _, err) = pilgrim(&[
+        "run",
+        "scripts/thread.rhai",
+        "--params",
+        "scripts/examples/thread-m30x2-6h.toml",
+        "--out",
+        s(&nut),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let first = common::report_of(&nut);
+    let d2 = first["notes"]["pitch_diameter_aimed_mm"].as_f64().unwrap();
+    let file = dir.join("nut.csv");
+    let rows: String = [-5, -15, -25]
+        .iter()
+        .map(|z| format!("{z},{}\n", d2 + 0.02))
+        .collect();
+    std::fs::write(&file, format!("z_mm,d2_mm\n{rows}")).unwrap();
+    let out = dir.join("nut-corrected");
+    let (code, _, err) = pilgrim(&[
+        "compensate",
+        s(&nut),
+        "--measured",
+        s(&file),
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let report = common::report_of(&out);
+    assert_eq!(
+        report["verdict"]["status"], "passed",
+        "{}",
+        report["verdict"]
+    );
+    let moved = aim_of(&report, 0) - aim_of(&first, 0);
+    assert!((moved + 0.02).abs() < 2e-3, "the nut: moved {moved}");
 }

@@ -304,10 +304,12 @@ pub fn compensate(
         .into());
     }
     let (from, to) = nominal.range;
+    // Along the coordinate, every GRID-th of the range; as one value,
+    // the ends and the middle (a profile's fewest).
     let places = if nominal.quantities.iter().any(|q| q.along) {
         GRID
     } else {
-        1
+        2
     };
     let grid: Vec<f64> = (0..=places)
         .map(|i| from + (to - from) * i as f64 / places as f64)
@@ -344,7 +346,13 @@ pub fn compensate(
         if let Some(f) = fitted.iter().find(|f| f.q.key == q.key) {
             let shift = f.fit.correction(&grid, options.gain)?;
             total.iter_mut().zip(&shift).for_each(|(t, s)| *t += s);
-            let place = |s: f64| format!("of the {} at {coordinate} = {s:.3} {unit}", q.name);
+            let place = |s: f64| {
+                if q.along {
+                    format!("of the {} at {coordinate} = {s:.3} {unit}", q.name)
+                } else {
+                    format!("of the {}", q.name)
+                }
+            };
             within_limit(&grid, &total, options.limit, &place, &f.m.file)?;
         }
         columns.push(total);

@@ -39,6 +39,42 @@ impl Verifier for WormRequest {
             stock: Some(Box::new(stock)),
         })
     }
+
+    /// Each start's pitch diameter (`d2_mm`, over wires), at any places
+    /// along the thread (`z_mm`, from -length to 0), against the one the
+    /// cut aims at; a thread of several starts names each row's start
+    /// (`start`, from 1). Corrected as one value per start: a start's
+    /// passes move as one (the section is simulated once for the thread's
+    /// length, so a taper along it is not followed).
+    fn nominal(&self) -> Option<crate::compensate::Nominal> {
+        let w = &self.section;
+        let several = w.starts > 1;
+        let quantities = (1..=w.starts)
+            .map(|k| {
+                Some(crate::compensate::Quantity {
+                    name: if several {
+                        format!("start {k}'s pitch diameter")
+                    } else {
+                        "pitch diameter".into()
+                    },
+                    values: &[("d2_mm", 1.0)],
+                    select: several.then_some(("start", f64::from(k))),
+                    nominal: crate::profile::Profile::new(
+                        vec![-self.length, -0.5 * self.length, 0.0],
+                        vec![w.pitch_diameter; 3],
+                    )
+                    .ok()?,
+                    along: false,
+                    key: format!("dd2_{k}_mm"),
+                })
+            })
+            .collect::<Option<Vec<_>>>()?;
+        Some(crate::compensate::Nominal {
+            coordinate: "z_mm",
+            range: (-self.length, 0.0),
+            quantities,
+        })
+    }
 }
 
 /// A worm's cut simulated against its thread.

@@ -86,6 +86,10 @@ pub struct WormRequest {
     /// An internal thread's part, a nut: its outside diameter (mm). `None`
     /// for an external thread, whose part is solid to its axis.
     pub outside_diameter: Option<Real>,
+    /// A measured part's correction of each start's pitch diameter (mm;
+    /// `pilgrim compensate`): start k's aimed space moved radially by half
+    /// of it. Empty: none.
+    pub pitch_shift: Vec<Real>,
 }
 
 impl WormRequest {
@@ -106,6 +110,7 @@ impl WormRequest {
             limits: None,
             part: "worm",
             outside_diameter: None,
+            pitch_shift: Vec::new(),
         }
     }
 }
@@ -131,8 +136,15 @@ impl WormRequest {
                 ..t.clone()
             },
             limits: self.limits.as_ref().map(mirrored_limits),
+            pitch_shift: self.pitch_shift.iter().map(|d| -d).collect(),
             ..self.clone()
         }
+    }
+
+    /// How far start `k`'s aimed space stands moved radially (mm): half
+    /// its pitch diameter's correction.
+    fn radial_shift(&self, k: u32) -> Real {
+        self.pitch_shift.get(k as usize).map_or(0.0, |d| d / 2.0)
     }
 }
 
@@ -565,8 +577,10 @@ fn thread_middle(t: &ThreadSection) -> [Real; 2] {
 
 /// The nominal spaces of one lead's window (and one either side), each an
 /// outline from the root to above the crest: a trapezoid, or curved
-/// flanks in chords of [`NOMINAL_CHORDS`] along the depth.
-fn nominal_spaces(t: &ThreadSection, c0: Real) -> Vec<Vec<[Real; 2]>> {
+/// flanks in chords of [`NOMINAL_CHORDS`] along the depth; each start's
+/// moved radially by its correction ([`WormRequest::pitch_shift`]).
+fn nominal_spaces(req: &WormRequest, c0: Real) -> Vec<Vec<[Real; 2]>> {
+    let t = &req.section;
     let (root, top) = (t.root_diameter / 2.0, t.crest_diameter / 2.0 + 2.0);
     let n = if t.form.is_axial() { 1 } else { NOMINAL_CHORDS };
     let radii: Vec<Real> = (0..=n)
@@ -576,10 +590,16 @@ fn nominal_spaces(t: &ThreadSection, c0: Real) -> Vec<Vec<[Real; 2]>> {
     (-1..=i64::from(t.starts))
         .map(|k| {
             let c = c0 + k as Real * t.pitch;
+            // The place's start (start_place is its own inverse).
+            let d = req.radial_shift(t.hand.start_place(k, t.starts));
             // From the -Z flank's root corner along the root, up the +Z
             // flank, back down the -Z flank.
-            let up = radii.iter().zip(&reach).map(|(&r, e)| [c + e[1], r]);
-            let down = radii.iter().zip(&reach).rev().map(|(&r, e)| [c - e[0], r]);
+            let up = radii.iter().zip(&reach).map(|(&r, e)| [c + e[1], r + d]);
+            let down = radii
+                .iter()
+                .zip(&reach)
+                .rev()
+                .map(|(&r, e)| [c - e[0], r + d]);
             let mut outline: Vec<[Real; 2]> = up.chain(down).collect();
             outline.rotate_right(1);
             outline
@@ -636,7 +656,7 @@ pub fn simulate(
     // space.
     let w0 = c0 - thread_middle(w)[0];
     let mut material = MultiPolygon::new(vec![rect(w0, w0 + lead, r_core, r_a)]);
-    let spaces = nominal_spaces(w, c0);
+    let spaces = nominal_spaces(req, c0);
     let nominal = MultiPolygon::new(spaces.iter().map(|s| poly(s)).collect());
     let mut passes = Vec::new();
     let mut chips = Vec::new();
@@ -1140,6 +1160,8 @@ fn measure(
     'starts: for k in 0..w.starts {
         // The start's place in the window (modulo the lead).
         let c = c0 + Real::from(w.hand.start_place(i64::from(k), w.starts)) * px;
+        // The start's aimed space, moved by its correction.
+        let moved = req.radial_shift(k);
         let space = |r: Real| {
             space_edges(m, r, c).ok_or_else(|| {
                 fail(format!(
@@ -1162,7 +1184,7 @@ fn measure(
             };
             left.push((r, zl));
             right.push((r, zr));
-            let reach = w.reach(r);
+            let reach = w.reach(r - moved);
             let dl = (zl - (c - reach[0])) * w.flanks[0].cos();
             let dr = ((c + reach[1]) - zr) * w.flanks[1].cos();
             if dl.abs() > left_form.abs() {
@@ -1199,7 +1221,7 @@ fn measure(
             // The pitch line's middle stands off the root's by half the
             // flanks' difference over the depth between them.
             position_error: 0.5 * (zl + zr) - c - {
-                let reach = w.reach(r1);
+                let reach = w.reach(r1 - moved);
                 0.5 * (reach[1] - reach[0])
             },
             thickness: next - zr,
@@ -1218,7 +1240,9 @@ fn measure(
                 w,
                 c,
                 (
-                    r_f + cutter.nose_radius * (1.0 - w.flanks[0].min(w.flanks[1]).sin()) + 1e-6,
+                    r_f + moved
+                        + cutter.nose_radius * (1.0 - w.flanks[0].min(w.flanks[1]).sin())
+                        + 1e-6,
                     r_a - 1e-6,
                 ),
             ),
@@ -1273,15 +1297,28 @@ fn measure(
             }
         }
         if let Some(l) = &req.limits {
-            for (what, v, d) in [
-                ("pitch diameter", p.pitch_diameter, &l.pitch_diameter),
-                ("root diameter", p.root_diameter, &l.root),
-                ("crest diameter", p.tip_diameter, &l.crest),
+            // A corrected start's pitch and root diameters are held to the
+            // standard's band moved by its correction: the part is to come
+            // out in the band when the measured error repeats.
+            let by = 2.0 * moved;
+            for (what, v, d, by) in [
+                ("pitch diameter", p.pitch_diameter, &l.pitch_diameter, by),
+                ("root diameter", p.root_diameter, &l.root, by),
+                ("crest diameter", p.tip_diameter, &l.crest, 0.0),
             ] {
-                if !d.holds(v, 0.0) {
-                    let (lo, hi) = (d.min.abs().min(d.max.abs()), d.min.abs().max(d.max.abs()));
+                if !d.holds(v - by, 0.0) {
+                    let (lo, hi) = (d.min + by, d.max + by);
+                    let (lo, hi) = (lo.abs().min(hi.abs()), lo.abs().max(hi.abs()));
+                    let corrected = if by == 0.0 {
+                        String::new()
+                    } else {
+                        format!(
+                            ", moved by {:+.4} mm for the correction",
+                            by * w.pitch_diameter.signum()
+                        )
+                    };
                     failures.push(fail(format!(
-                        "start {s}: {what} {:.4} mm, outside {lo:.4} to {hi:.4} mm ({})",
+                        "start {s}: {what} {:.4} mm, outside {lo:.4} to {hi:.4} mm ({}{corrected})",
                         v.abs(),
                         l.source
                     )));
@@ -1449,6 +1486,7 @@ mod tests {
             limits: Some(profile.limits.clone()),
             part: "thread",
             outside_diameter: None,
+            pitch_shift: Vec::new(),
         };
         simulate(&program, &lathe, &Default::default(), &cutter, &req)
     }

@@ -331,6 +331,20 @@ fn verification(m: &Map) -> Result<Verification, Option<String>> {
                 ))
             })?),
         },
+        // A measured part's correction of each start's pitch diameter,
+        // where the script gives it.
+        pitch_shift: match m.get("correction") {
+            None => Vec::new(),
+            Some(d) => match crate::binding::floats::numbers(d, "correction") {
+                Ok(c) if c.len() == section.starts as usize => c.to_vec(),
+                _ => {
+                    return Err(Some(format!(
+                        "fn verify(p): correction must be {} numbers, each start's pitch diameter's (mm), not {d}",
+                        section.starts
+                    )))
+                }
+            },
+        },
         section,
     }))
 }
