@@ -56,6 +56,27 @@ fn correction_off(out: &Path, error: &dyn Fn(f64) -> f64) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// `pilgrim compensate RUN --measured FILE --out OUT`, which must pass:
+/// what it said and the corrected run's report.
+fn compensated(run: &Path, measured: &Path, out: &Path) -> (String, serde_json::Value) {
+    let (code, said, err) = pilgrim(&[
+        "compensate",
+        s(run),
+        "--measured",
+        s(measured),
+        "--out",
+        s(out),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let report = common::report_of(out);
+    assert_eq!(
+        report["verdict"]["status"], "passed",
+        "{}",
+        report["verdict"]
+    );
+    (said, report)
+}
+
 fn json(path: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
 }
@@ -90,22 +111,8 @@ fn the_mandrel_is_corrected_by_its_measured_error() {
         assert!((d - law(z) - 2.0 * wear(z)).abs() < 6e-6, "z {z}: {d}");
     }
     let out = dir.join("corrected");
-    let (code, said, err) = pilgrim(&[
-        "compensate",
-        s(&run),
-        "--measured",
-        s(&measured),
-        "--out",
-        s(&out),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let (said, report) = compensated(&run, &measured, &out);
     assert!(said.contains("radius: 45 places"), "{said}");
-    let report = common::report_of(&out);
-    assert_eq!(
-        report["verdict"]["status"], "passed",
-        "{}",
-        report["verdict"]
-    );
     assert_eq!(
         report["parameters"]["correction"]["value"],
         "correction.csv"
@@ -362,22 +369,8 @@ fn the_caliber_is_corrected_by_its_measured_groove() {
         );
     }
     let out = dir.join("corrected");
-    let (code, said, err) = pilgrim(&[
-        "compensate",
-        s(&run),
-        "--measured",
-        s(&measured),
-        "--out",
-        s(&out),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let (said, report) = compensated(&run, &measured, &out);
     assert!(said.contains("depth: 57 places"), "{said}");
-    let report = common::report_of(&out);
-    assert_eq!(
-        report["verdict"]["status"], "passed",
-        "{}",
-        report["verdict"]
-    );
     assert_eq!(
         report["parameters"]["correction"]["value"],
         "correction.csv"
@@ -463,22 +456,8 @@ fn a_thread_is_corrected_start_by_start() {
     // Before: the part near the face is out of the band.
     assert!(rows.iter().any(|r| r.1 > hi), "{rows:?} against {hi}");
     let out = dir.join("corrected");
-    let (code, said, err) = pilgrim(&[
-        "compensate",
-        s(&run),
-        "--measured",
-        s(&measured),
-        "--out",
-        s(&out),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let (said, report) = compensated(&run, &measured, &out);
     assert!(said.contains("pitch diameter: 5 places"), "{said}");
-    let report = common::report_of(&out);
-    assert_eq!(
-        report["verdict"]["status"], "passed",
-        "{}",
-        report["verdict"]
-    );
     let mean = rows.iter().map(|r| bend(r.0)).sum::<f64>() / 5.0;
     let table = std::fs::read_to_string(out.join("correction.csv")).unwrap();
     assert!(table.starts_with("z_mm,dd2_1_mm\n"), "{table}");
@@ -528,21 +507,7 @@ fn a_thread_is_corrected_start_by_start() {
     }
     std::fs::write(&file, t).unwrap();
     let out = dir.join("two-corrected");
-    let (code, _, err) = pilgrim(&[
-        "compensate",
-        s(&two),
-        "--measured",
-        s(&file),
-        "--out",
-        s(&out),
-    ]);
-    assert_eq!(code, 0, "{err}");
-    let report = common::report_of(&out);
-    assert_eq!(
-        report["verdict"]["status"], "passed",
-        "{}",
-        report["verdict"]
-    );
+    let (_, report) = compensated(&two, &file, &out);
     for (k, e) in [(0, 0.02), (1, 0.05)] {
         let moved = aim_of(&report, k) - aim_of(&first, k);
         assert!((moved + e).abs() < 2e-3, "start {}: moved {moved}", k + 1);
@@ -572,21 +537,7 @@ fn a_thread_is_corrected_start_by_start() {
         .collect();
     std::fs::write(&file, format!("z_mm,d2_mm\n{rows}")).unwrap();
     let out = dir.join("nut-corrected");
-    let (code, _, err) = pilgrim(&[
-        "compensate",
-        s(&nut),
-        "--measured",
-        s(&file),
-        "--out",
-        s(&out),
-    ]);
-    assert_eq!(code, 0, "{err}");
-    let report = common::report_of(&out);
-    assert_eq!(
-        report["verdict"]["status"], "passed",
-        "{}",
-        report["verdict"]
-    );
+    let (_, report) = compensated(&nut, &file, &out);
     let moved = aim_of(&report, 0) - aim_of(&first, 0);
     assert!((moved + 0.02).abs() < 2e-3, "the nut: moved {moved}");
 }

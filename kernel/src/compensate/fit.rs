@@ -39,8 +39,7 @@ pub fn fit_error(
     error: &[Real],
     uncertainty: Real,
 ) -> Result<ErrorFit, CompensateError> {
-    crate::math::positive("the measurement's uncertainty", uncertainty)
-        .map_err(|e| CompensateError::Fit(e.to_string()))?;
+    positive_uncertainty(uncertainty)?;
     let mut fit = ErrorFit {
         at: at.to_vec(),
         error: error.to_vec(),
@@ -90,8 +89,7 @@ pub fn fit_mean(
     error: &[Real],
     uncertainty: Real,
 ) -> Result<ErrorFit, CompensateError> {
-    crate::math::positive("the measurement's uncertainty", uncertainty)
-        .map_err(|e| CompensateError::Fit(e.to_string()))?;
+    positive_uncertainty(uncertainty)?;
     if error.is_empty() {
         return Err(CompensateError::Fit("no place measured".into()));
     }
@@ -105,6 +103,13 @@ pub fn fit_mean(
         rms_residual: (error.iter().map(|e| (e - mean).powi(2)).sum::<Real>() / n).sqrt(),
         mean: Some(mean),
     })
+}
+
+/// Refuses an uncertainty that is not above 0, naming it.
+fn positive_uncertainty(uncertainty: Real) -> Result<(), CompensateError> {
+    crate::math::positive("the measurement's uncertainty", uncertainty)
+        .map(|_| ())
+        .map_err(|e| CompensateError::Fit(e.to_string()))
 }
 
 /// The smoothing spline of `error` at `at` with parameter `p`, evaluated
