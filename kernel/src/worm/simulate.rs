@@ -141,10 +141,15 @@ impl WormRequest {
         }
     }
 
-    /// How far start `k`'s aimed space stands moved radially (mm): half
-    /// its pitch diameter's correction.
-    fn radial_shift(&self, k: u32) -> Real {
-        self.pitch_shift.get(k as usize).map_or(0.0, |d| d / 2.0)
+    /// Start `k`'s section as the cut aims at it: the section aimed at its
+    /// pitch diameter moved by its correction (its space moved radially,
+    /// [`ThreadSection::aimed`]).
+    fn start_section(&self, k: u32) -> ThreadSection {
+        let w = &self.section;
+        match self.pitch_shift.get(k as usize) {
+            Some(&d) if d != 0.0 => w.aimed(w.pitch_diameter + d),
+            _ => w.clone(),
+        }
     }
 }
 
@@ -581,25 +586,21 @@ fn thread_middle(t: &ThreadSection) -> [Real; 2] {
 /// moved radially by its correction ([`WormRequest::pitch_shift`]).
 fn nominal_spaces(req: &WormRequest, c0: Real) -> Vec<Vec<[Real; 2]>> {
     let t = &req.section;
-    let (root, top) = (t.root_diameter / 2.0, t.crest_diameter / 2.0 + 2.0);
     let n = if t.form.is_axial() { 1 } else { NOMINAL_CHORDS };
-    let radii: Vec<Real> = (0..=n)
-        .map(|i| root + (top - root) * i as Real / n as Real)
-        .collect();
-    let reach: Vec<[Real; 2]> = radii.iter().map(|&r| t.reach(r)).collect();
     (-1..=i64::from(t.starts))
         .map(|k| {
             let c = c0 + k as Real * t.pitch;
             // The place's start (start_place is its own inverse).
-            let d = req.radial_shift(t.hand.start_place(k, t.starts));
+            let s = req.start_section(t.hand.start_place(k, t.starts));
+            let (root, top) = (s.root_diameter / 2.0, s.crest_diameter / 2.0 + 2.0);
+            let radii: Vec<Real> = (0..=n)
+                .map(|i| root + (top - root) * i as Real / n as Real)
+                .collect();
+            let reach: Vec<[Real; 2]> = radii.iter().map(|&r| s.reach(r)).collect();
             // From the -Z flank's root corner along the root, up the +Z
             // flank, back down the -Z flank.
-            let up = radii.iter().zip(&reach).map(|(&r, e)| [c + e[1], r + d]);
-            let down = radii
-                .iter()
-                .zip(&reach)
-                .rev()
-                .map(|(&r, e)| [c - e[0], r + d]);
+            let up = radii.iter().zip(&reach).map(|(&r, e)| [c + e[1], r]);
+            let down = radii.iter().zip(&reach).rev().map(|(&r, e)| [c - e[0], r]);
             let mut outline: Vec<[Real; 2]> = up.chain(down).collect();
             outline.rotate_right(1);
             outline
@@ -1147,12 +1148,7 @@ fn measure(
     let (w, tol) = (&req.section, &req.tolerances);
     let mut failures = Vec::new();
     let fail = |m: String| Finding::new("verification", VerifyError::Failed(m).to_string());
-    let (px, r_a, r_f, r1) = (
-        w.pitch,
-        w.crest_diameter / 2.0,
-        w.root_diameter / 2.0,
-        w.pitch_diameter / 2.0,
-    );
+    let (px, r_a, r1) = (w.pitch, w.crest_diameter / 2.0, w.pitch_diameter / 2.0);
     let radii = flank_radii(req, cutter);
     let nominal_angles = nominal_flanks_deg(w, &radii);
     let c0 = req.space_centre;
@@ -1161,7 +1157,7 @@ fn measure(
         // The start's place in the window (modulo the lead).
         let c = c0 + Real::from(w.hand.start_place(i64::from(k), w.starts)) * px;
         // The start's aimed space, moved by its correction.
-        let moved = req.radial_shift(k);
+        let aimed = req.start_section(k);
         let space = |r: Real| {
             space_edges(m, r, c).ok_or_else(|| {
                 fail(format!(
@@ -1184,7 +1180,7 @@ fn measure(
             };
             left.push((r, zl));
             right.push((r, zr));
-            let reach = w.reach(r - moved);
+            let reach = aimed.reach(r);
             let dl = (zl - (c - reach[0])) * w.flanks[0].cos();
             let dr = ((c + reach[1]) - zr) * w.flanks[1].cos();
             if dl.abs() > left_form.abs() {
@@ -1221,7 +1217,7 @@ fn measure(
             // The pitch line's middle stands off the root's by half the
             // flanks' difference over the depth between them.
             position_error: 0.5 * (zl + zr) - c - {
-                let reach = w.reach(r1 - moved);
+                let reach = aimed.reach(r1);
                 0.5 * (reach[1] - reach[0])
             },
             thickness: next - zr,
@@ -1240,7 +1236,7 @@ fn measure(
                 w,
                 c,
                 (
-                    r_f + moved
+                    aimed.root_diameter / 2.0
                         + cutter.nose_radius * (1.0 - w.flanks[0].min(w.flanks[1]).sin())
                         + 1e-6,
                     r_a - 1e-6,
@@ -1300,7 +1296,7 @@ fn measure(
             // A corrected start's pitch and root diameters are held to the
             // standard's band moved by its correction: the part is to come
             // out in the band when the measured error repeats.
-            let by = 2.0 * moved;
+            let by = aimed.pitch_diameter - w.pitch_diameter;
             for (what, v, d, by) in [
                 ("pitch diameter", p.pitch_diameter, &l.pitch_diameter, by),
                 ("root diameter", p.root_diameter, &l.root, by),
