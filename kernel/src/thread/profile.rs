@@ -177,6 +177,24 @@ impl ThreadSection {
         }
     }
 
+    /// The full-profile form cutter ground to this section's curved
+    /// flanks ([`crate::tool::ThreadCutter::ground_to`]): at its root, its
+    /// corners rounded by `nose_radius`, reaching 2 mm above the crest.
+    ///
+    /// # Failures
+    /// Straight flanks; those of `ground_to`.
+    pub fn form_cutter(
+        &self,
+        nose_radius: Real,
+    ) -> Result<crate::tool::ThreadCutter, crate::input::InputError> {
+        crate::tool::ThreadCutter::ground_to(
+            self.form,
+            self.root_diameter / 2.0,
+            nose_radius,
+            self.depth() + 2.0,
+        )
+    }
+
     /// The lead: the starts' pitches.
     pub fn lead(&self) -> Real {
         Real::from(self.starts) * self.pitch

@@ -95,12 +95,7 @@ pub mod worm_api {
         nose_radius: Real,
     ) -> Result<Tool, Box<EvalAltResult>> {
         let number = crate::binding::tool_number(name, number)?;
-        let c = kernel(ThreadCutter::ground_to(
-            w.section().form,
-            w.root_radius(),
-            nose_radius,
-            w.height() + 2.0,
-        ))?;
+        let c = kernel(w.section().form_cutter(nose_radius))?;
         Ok(Tool::thread_cutter(name, number, c))
     }
 

@@ -12,7 +12,7 @@ use crate::math::Real;
 use crate::thread::standards::{LoadFlank, StatedLimits};
 use crate::thread::{Drawing, Hand, ThreadProfile};
 use crate::tool::Tool;
-use crate::worm::{self, ThreadCutter, WormTolerances};
+use crate::worm::{self, WormTolerances};
 use rhai::plugin::*;
 use rhai::{EvalAltResult, Map};
 
@@ -234,13 +234,7 @@ pub mod thread_api {
         nose_radius: Real,
     ) -> Result<Tool, Box<EvalAltResult>> {
         let number = crate::binding::tool_number(name, number)?;
-        let basic = &t.section;
-        let c = kernel(ThreadCutter::ground_to(
-            basic.form,
-            basic.root_diameter / 2.0,
-            nose_radius,
-            basic.depth() + 2.0,
-        ))?;
+        let c = kernel(t.section.form_cutter(nose_radius))?;
         Ok(Tool::thread_cutter(name, number, c))
     }
     /// One space's area in the axial section, as the cut aims at it
