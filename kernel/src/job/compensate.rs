@@ -14,8 +14,7 @@
 use super::{params_on, run as run_job, run_machine, Annex, JobOptions, JobOutput, Report};
 use crate::catalog::Catalog;
 use crate::compensate::{
-    fit_error, fit_mean, read_measured, within_limit, CompensateError, ErrorFit, Measured, Nominal,
-    Quantity,
+    fit_error, fit_mean, read_measured, within_limit, CompensateError, ErrorFit, Measured, Quantity,
 };
 use crate::error::Error;
 use crate::math::Real;
@@ -255,13 +254,14 @@ pub fn compensate(
             ))
         })?;
     // The measurement against it: each quantity it holds.
-    let mut fitted: Vec<Fitted> = Vec::new();
-    let mut not_measured = Vec::new();
+    // One per quantity, in the nominal's order: `None` where the
+    // measurement has none of its columns.
+    let mut fitted: Vec<Option<Fitted>> = Vec::new();
     for q in &nominal.quantities {
         let m = match read_measured(measured, &nominal.spec(q)) {
             Ok(m) => m,
             Err(CompensateError::NoValueColumn { .. }) => {
-                not_measured.push(q.name.clone());
+                fitted.push(None);
                 continue;
             }
             Err(e) => return Err(e.into()),
@@ -278,15 +278,14 @@ pub fn compensate(
         } else {
             fit_mean(&m.at, &error, options.uncertainty)?
         };
-        fitted.push(Fitted {
-            q: q.clone(),
+        fitted.push(Some(Fitted {
             m,
             at_nominal,
             error,
             fit,
-        });
+        }));
     }
-    if fitted.is_empty() {
+    if fitted.iter().all(Option::is_none) {
         return Err(CompensateError::Nothing {
             file: measured.source().to_owned(),
             wanted: nominal
@@ -332,7 +331,7 @@ pub fn compensate(
         .join(",")
         + "\n";
     let mut columns: Vec<Vec<f64>> = Vec::new();
-    for q in &nominal.quantities {
+    for (q, f) in nominal.quantities.iter().zip(&fitted) {
         let mut total = match &previous {
             Some(t) if t.column_index(&q.key).is_ok() => {
                 let p = t.profile(nominal.coordinate, &q.key)?;
@@ -343,7 +342,7 @@ pub fn compensate(
             }
             _ => vec![0.0; grid.len()],
         };
-        if let Some(f) = fitted.iter().find(|f| f.q.key == q.key) {
+        if let Some(f) = f {
             let shift = f.fit.correction(&grid, options.gain)?;
             total.iter_mut().zip(&shift).for_each(|(t, s)| *t += s);
             let place = |s: f64| {
@@ -374,10 +373,13 @@ pub fn compensate(
         },
     ];
     let mut records = Vec::new();
-    for (f, total) in fitted.iter().map(|f| {
-        let k = nominal.quantities.iter().position(|q| q.key == f.q.key);
-        (f, k.map(|k| &columns[k]))
-    }) {
+    let mut of = Vec::new();
+    let mut not_measured = Vec::new();
+    for ((q, f), total) in nominal.quantities.iter().zip(&fitted).zip(&columns) {
+        let Some(f) = f else {
+            not_measured.push(q.name.clone());
+            continue;
+        };
         let fit_at = f.fit.at(&f.m.at)?;
         let shift: Vec<f64> = fit_at.iter().map(|v| -options.gain * v).collect();
         let places: Vec<Place> = (0..f.m.at.len())
@@ -392,20 +394,23 @@ pub fn compensate(
             })
             .collect();
         let largest = |v: &mut dyn Iterator<Item = f64>| v.fold(0.0, |a: f64, x| a.max(x.abs()));
+        of.push(q);
         records.push(QuantityRecord {
-            name: f.q.name.clone(),
+            name: q.name.clone(),
             column: f.m.column.clone(),
-            key: f.q.key.clone(),
-            along: f.q.along,
+            key: q.key.clone(),
+            along: q.along,
             smooth: f.fit.smooth,
             rms_residual_mm: f.fit.rms_residual,
             max_error_mm: largest(&mut f.error.iter().copied()),
-            max_correction_mm: largest(&mut total.into_iter().flatten().copied()),
+            max_correction_mm: largest(&mut total.iter().copied()),
             max_expected_after_mm: largest(&mut places.iter().map(|p| p.expected_after)),
             places,
         });
     }
-    let annex = annex(&nominal, &records, (coordinate, unit));
+    let measured_quantities: Vec<(&Quantity, &QuantityRecord)> =
+        of.into_iter().zip(&records).collect();
+    let annex = annex(nominal.coordinate, &measured_quantities, (coordinate, unit));
     let job_options = JobOptions {
         program_name: script
             .file_stem()
@@ -471,7 +476,6 @@ pub fn compensate(
 
 /// One quantity measured and fitted.
 struct Fitted {
-    q: Quantity,
     m: Measured,
     at_nominal: Vec<f64>,
     error: Vec<f64>,
@@ -484,7 +488,11 @@ struct Fitted {
 /// target, before the corrected run's own finish, which its verification
 /// reports); the quantities corrected by one value together, by what
 /// selects them (a thread's starts).
-fn annex(nominal: &Nominal, records: &[QuantityRecord], (coordinate, unit): (&str, &str)) -> Annex {
+fn annex(
+    column: &str,
+    records: &[(&Quantity, &QuantityRecord)],
+    (coordinate, unit): (&str, &str),
+) -> Annex {
     let um = |v: &mut dyn Iterator<Item = f64>| v.map(|x| 1e3 * x).collect::<Vec<f64>>();
     let columns = [
         "measured_error_um",
@@ -493,7 +501,7 @@ fn annex(nominal: &Nominal, records: &[QuantityRecord], (coordinate, unit): (&st
         "expected_after_um",
     ];
     let mut annex = Annex::default();
-    let along: Vec<&QuantityRecord> = records.iter().filter(|r| r.along).collect();
+    let along: Vec<&QuantityRecord> = records.iter().map(|p| p.1).filter(|r| r.along).collect();
     for r in &along {
         let name = if along.len() == 1 {
             "compensation".to_owned()
@@ -507,10 +515,7 @@ fn annex(nominal: &Nominal, records: &[QuantityRecord], (coordinate, unit): (&st
         annex.tables.insert(
             name.clone(),
             BTreeMap::from([
-                (
-                    nominal.coordinate.to_owned(),
-                    p.iter().map(|p| p.at).collect(),
-                ),
+                (column.to_owned(), p.iter().map(|p| p.at).collect()),
                 (columns[0].into(), um(&mut p.iter().map(|p| p.error))),
                 (columns[1].into(), um(&mut p.iter().map(|p| p.fitted))),
                 (columns[2].into(), um(&mut p.iter().map(|p| p.correction))),
@@ -527,7 +532,7 @@ fn annex(nominal: &Nominal, records: &[QuantityRecord], (coordinate, unit): (&st
                 r.name
             ),
             table: name,
-            x: nominal.coordinate.to_owned(),
+            x: column.to_owned(),
             y: columns.iter().map(|c| (*c).to_owned()).collect(),
             x_label: format!("{coordinate}, {unit}"),
             y_label: format!("{}, um", r.name),
@@ -536,29 +541,25 @@ fn annex(nominal: &Nominal, records: &[QuantityRecord], (coordinate, unit): (&st
     // The quantities corrected by one value, by what selects them.
     let ones: Vec<(&QuantityRecord, Real)> = records
         .iter()
-        .filter(|r| !r.along)
-        .filter_map(|r| {
-            let q = nominal.quantities.iter().find(|q| q.key == r.key)?;
-            Some((r, q.select.map_or(1.0, |s| s.1)))
-        })
+        .filter(|(_, r)| !r.along)
+        .map(|(q, r)| (*r, q.select.map_or(1.0, |s| s.1)))
         .collect();
     if let Some((r0, _)) = ones.first() {
-        let by = nominal
-            .quantities
+        let by = records
             .iter()
-            .find_map(|q| q.select.map(|s| s.0))
+            .find_map(|(q, _)| q.select.map(|s| s.0))
             .unwrap_or("quantity");
         let mean = |r: &QuantityRecord, f: &dyn Fn(&Place) -> f64| {
             1e3 * r.places.iter().map(f).sum::<f64>() / r.places.len() as f64
         };
-        let column = |f: &dyn Fn(&Place) -> f64| ones.iter().map(|(r, _)| mean(r, f)).collect();
+        let values = |f: &dyn Fn(&Place) -> f64| ones.iter().map(|(r, _)| mean(r, f)).collect();
         annex.tables.insert(
             "compensation".into(),
             BTreeMap::from([
                 (by.to_owned(), ones.iter().map(|(_, s)| *s).collect()),
-                (columns[0].into(), column(&|p| p.error)),
-                (columns[2].into(), column(&|p| p.correction)),
-                (columns[3].into(), column(&|p| p.expected_after)),
+                (columns[0].into(), values(&|p| p.error)),
+                (columns[2].into(), values(&|p| p.correction)),
+                (columns[3].into(), values(&|p| p.expected_after)),
             ]),
         );
         let quantity = r0.name.rsplit_once("'s ").map_or(r0.name.as_str(), |s| s.1);
