@@ -613,47 +613,64 @@ fn path_moved(
     after: &AxisProgram,
     after_passes: &[ProgramPass],
 ) -> Option<(BTreeMap<String, f64>, usize)> {
-    use nalgebra::DVector;
     if before.axes != after.axes || before_passes.len() != after_passes.len() {
         return None;
     }
-    let mut moved = DVector::<f64>::zeros(after.axes.len());
+    let n = after.axes.len();
+    let mut moved: Vec<f64> = vec![0.0; n];
     let mut blocks = 0;
     for (p, q) in before_passes.iter().zip(after_passes) {
-        let mut line: Vec<DVector<f64>> = before
+        let mut line: Vec<&[f64]> = before
             .blocks
             .get(p.blocks.clone())?
             .iter()
-            .map(|b| DVector::from_column_slice(&b.values))
+            .map(|b| b.values.as_slice())
             .collect();
         if line.len() == 1 {
-            line.push(line[0].clone());
+            line.push(line[0]);
         }
+        // Each segment's direction and squared length, once per pass.
+        let dirs: Vec<(Vec<f64>, f64)> = line
+            .windows(2)
+            .map(|w| {
+                let d: Vec<f64> = w[1].iter().zip(w[0]).map(|(b, a)| b - a).collect();
+                let l2 = d.iter().map(|x| x * x).sum();
+                (d, l2)
+            })
+            .collect();
         let mut near: usize = 0;
         for b in after.blocks.get(q.blocks.clone())? {
-            let v = DVector::from_column_slice(&b.values);
-            // The offset from segment k's nearest point.
-            let offset = |k: usize| {
-                let (a, d) = (&line[k], &line[k + 1] - &line[k]);
-                let l2 = d.norm_squared();
-                let t = if l2 > 0.0 {
-                    ((&v - a).dot(&d) / l2).clamp(0.0, 1.0)
+            let v = &b.values;
+            // Where on segment k the block's nearest point lies (0 to 1),
+            // and the squared distance to it; no allocation per segment.
+            let nearest = |k: usize| {
+                let (a, (d, l2)) = (line[k], &dirs[k]);
+                let t = if *l2 > 0.0 {
+                    let dot: f64 = v.iter().zip(a).zip(d).map(|((v, a), d)| (v - a) * d).sum();
+                    (dot / l2).clamp(0.0, 1.0)
                 } else {
                     0.0
                 };
-                &v - a - d * t
+                let dist2: f64 = v
+                    .iter()
+                    .zip(a)
+                    .zip(d)
+                    .map(|((v, a), d)| (v - a - d * t).powi(2))
+                    .sum();
+                (t, dist2)
             };
-            let segments = line.len() - 1;
             let (lo, hi) = (
                 near.saturating_sub(WINDOW),
-                (near + WINDOW + 1).min(segments),
+                (near + WINDOW + 1).min(dirs.len()),
             );
-            let (k, off) = (lo..hi)
-                .map(|k| (k, offset(k)))
-                .min_by(|a, b| a.1.norm_squared().total_cmp(&b.1.norm_squared()))?;
+            let (k, (t, dist2)) = (lo..hi)
+                .map(|k| (k, nearest(k)))
+                .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1))?;
             near = k;
-            blocks += usize::from(off.norm() > MOVED);
-            moved = moved.zip_map(&off, |m, o| m.max(o.abs()));
+            blocks += usize::from(dist2.sqrt() > MOVED);
+            for (i, m) in moved.iter_mut().enumerate() {
+                *m = m.max((v[i] - line[k][i] - dirs[k].0[i] * t).abs());
+            }
         }
     }
     Some((
@@ -661,7 +678,7 @@ fn path_moved(
             .axes
             .iter()
             .map(|a| a.name.clone())
-            .zip(moved.iter().copied())
+            .zip(moved)
             .collect(),
         blocks,
     ))
