@@ -479,6 +479,40 @@ fn a_thread_is_corrected_start_by_start() {
     assert_eq!(c["quantities"][0]["along"], false);
     assert!(out.join("compensation.svg").is_file());
 
+    // A G76 cycle places its passes itself: the corrected run fails its
+    // check, and leaves its FAILED report, which names it, and no program.
+    let g76 = dir.join("g76");
+    let (code, _, err) = pilgrim(&[
+        "run",
+        "scripts/thread.rhai",
+        "--set",
+        "cycle=g76",
+        "--out",
+        s(&g76),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let failed = dir.join("g76-corrected");
+    let (code, _, err) = pilgrim(&[
+        "compensate",
+        s(&g76),
+        "--measured",
+        s(&measured),
+        "--out",
+        s(&failed),
+    ]);
+    assert_ne!(code, 0);
+    assert!(err.contains("no program was written"), "{err}");
+    let report = common::report_of(&failed);
+    assert_eq!(report["verdict"]["status"], "failed");
+    assert!(
+        report
+            .to_string()
+            .contains("a correction moves thread blocks, not a G76 cycle's"),
+        "{report}"
+    );
+    assert!(!failed.join("program.nc").exists() && failed.join("report.html").is_file());
+
     // Two starts, each measured (start 2 cut after start 1 at each depth,
     // by a cutter worn a little more): each corrected by its own.
     let two = dir.join("two");
