@@ -900,7 +900,7 @@ pub fn simulate(
         return Err(VerifyError::NoCuttingPass);
     }
     let (starts, unmeasured) = measure(&material, req, cutter);
-    let nominal_flanks = nominal_flanks_deg(w, &flank_radii(req, cutter));
+    let nominal_flanks = nominal_flanks_deg(w, &flank_radii(w, req.flank_margin, cutter));
     failures.extend(unmeasured);
     let check = WormCheck {
         failures,
@@ -1110,12 +1110,11 @@ fn line(samples: &[(Real, Real)]) -> [Real; 2] {
     [mz - b * mr, b]
 }
 
-/// The radii the flanks are measured at: 21, clear of the root's fillet
-/// and the tip's edge.
-fn flank_radii(req: &WormRequest, cutter: &ThreadCutter) -> Vec<Real> {
-    let w = &req.section;
-    let r_lo = w.root_diameter / 2.0 + 2.0 * cutter.nose_radius + req.flank_margin;
-    let r_hi = w.crest_diameter / 2.0 - req.flank_margin;
+/// The radii the flanks of section `w` are measured at: 21, `margin`
+/// clear of the root's fillet and the tip's edge.
+fn flank_radii(w: &ThreadSection, margin: Real, cutter: &ThreadCutter) -> Vec<Real> {
+    let r_lo = w.root_diameter / 2.0 + 2.0 * cutter.nose_radius + margin;
+    let r_hi = w.crest_diameter / 2.0 - margin;
     (0..21)
         .map(|j| r_lo + (r_hi - r_lo) * j as Real / 20.0)
         .collect()
@@ -1149,15 +1148,16 @@ fn measure(
     let mut failures = Vec::new();
     let fail = |m: String| Finding::new("verification", VerifyError::Failed(m).to_string());
     let (px, r_a, r1) = (w.pitch, w.crest_diameter / 2.0, w.pitch_diameter / 2.0);
-    let radii = flank_radii(req, cutter);
-    let nominal_angles = nominal_flanks_deg(w, &radii);
     let c0 = req.space_centre;
     let mut out = Vec::new();
     'starts: for k in 0..w.starts {
         // The start's place in the window (modulo the lead).
         let c = c0 + Real::from(w.hand.start_place(i64::from(k), w.starts)) * px;
-        // The start's aimed space, moved by its correction.
+        // The start's aimed space, moved by its correction, and the radii
+        // its flanks are measured at.
         let aimed = req.start_section(k);
+        let radii = flank_radii(&aimed, req.flank_margin, cutter);
+        let nominal_angles = nominal_flanks_deg(&aimed, &radii);
         let space = |r: Real| {
             space_edges(m, r, c).ok_or_else(|| {
                 fail(format!(
