@@ -637,3 +637,46 @@ fn a_worm_named_by_its_designation_is_cut_on_its_curved_flanks() {
         "{err}"
     );
 }
+
+/// A start corrected so that the passes' depths, rounded to the program's
+/// digit, leave its root a little above the root it aims at (Tr40x14(P7),
+/// start 1 moved by -0.0231 mm of pitch diameter) is still measured: its
+/// pitch diameter is sought from the cut root up, where the aimed root's
+/// band would start below the material left and find no space.
+#[test]
+fn a_corrected_start_is_measured_from_its_cut_root() {
+    let dir = scratch("thread", "corrected-root");
+    let script = dir.join("thread.rhai");
+    std::fs::copy(common::root().join(SCRIPT), &script).unwrap();
+    std::fs::write(
+        dir.join("correction.csv"),
+        "z_mm,dd2_1_mm,dd2_2_mm\n-30,-0.0231,-0.05\n-15,-0.0231,-0.05\n0,-0.0231,-0.05\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let (code, _, err) = pilgrim(&[
+        "run",
+        s(&script),
+        "--set",
+        "designation=Tr40x14(P7)",
+        "--set",
+        "correction=correction.csv",
+        "--out",
+        s(&out),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let first = run(
+        "corrected-root-first",
+        &["--set", "designation=Tr40x14(P7)"],
+    );
+    let d2 = |dir: &std::path::Path, k: usize| {
+        common::report_of(dir)["thread_verification"]["starts"][k]["pitch_diameter"]
+            .as_f64()
+            .unwrap()
+    };
+    for (k, moved) in [(0, -0.0231), (1, -0.05)] {
+        let now = d2(&out, k) - d2(&first, k);
+        assert!((now - moved).abs() < 2e-3, "start {}: moved {now}", k + 1);
+    }
+}

@@ -1052,12 +1052,19 @@ impl crate::process::Stock for WormStock {
 }
 
 /// The diameter where the space round `c` is as wide as the basic
-/// section's at its pitch diameter, between the radii `band` (bisection on
-/// the space's width, which grows towards the crest; 0 if it is not
-/// within the band).
+/// section's at its pitch diameter, between the radii `band` (from the cut
+/// root, where it stands above the band's start; bisection on the space's
+/// width, which grows towards the crest; 0 if it is not within the band).
 fn pitch_diameter(m: &MultiPolygon<Real>, t: &ThreadSection, c: Real, band: (Real, Real)) -> Real {
     let width = |r: Real| space_edges(m, r, c).map(|(a, b)| b - a);
     let (mut lo, mut hi) = band;
+    // Where the cut's root stands above the band's start (the passes'
+    // depths rounded to the program's digit), the band starts at it.
+    if width(lo).is_none() {
+        if let Some(root) = vertical_top(m, c) {
+            lo = lo.max(root + 1e-6);
+        }
+    }
     let (Some(w_lo), Some(w_hi)) = (width(lo), width(hi)) else {
         return 0.0;
     };
