@@ -23,24 +23,122 @@ fn wear(z: f64) -> f64 {
     0.006 * (450.0 - z) / 460.0
 }
 
+/// How much of its radius the wheel wears over the mandrel's finishing
+/// pass (mm), dressed before it: the error of the mandrel's example.
+const WEAR: f64 = 0.006;
+
+/// The wheel of [`WEAR`]: what it has lost at `share` (0 to 1) of the
+/// finishing pass's path.
+fn worn(share: f64, _z: f64) -> f64 {
+    WEAR * share
+}
+
+/// The mandrel's finished part with an error of the process in the loop,
+/// replayed from the program's text by the replay of
+/// `tests/mandrel_fidelity.rs` (which shares no code with the kernel's):
+/// the wheel's true section placed at the moments each generatrix passes
+/// under it, the part turning at S, every axis straight between blocks at
+/// the block's F, the section standing higher by `error(share, z)` (mm)
+/// when the wheel has gone `share` of the finishing pass's path and stands
+/// at z (a wheel worn by as much, a part given way). At each z of `at`:
+/// the highest generatrix (what a micrometer's flat anvils touch) and the
+/// lowest, radii (mm). The finishing pass is the program's last `; pass`
+/// group, cutting below every pass before it over the ground length.
+fn finish_with(
+    run: &Path,
+    program: &str,
+    at: &[f64],
+    error: &dyn Fn(f64, f64) -> f64,
+) -> Vec<(f64, f64)> {
+    use crate::mandrel_fidelity::{phases_for, read_program, Pass, Section};
+    let report = common::report_of(run);
+    let param = |n: &str| report["parameters"][n]["value"].as_f64().unwrap();
+    let section = Section {
+        r: param("rounding_r"),
+        flat: (param("wheel_w") - 2.0 * param("rounding_r")).max(0.0),
+    };
+    let written = read_program(&std::fs::read_to_string(run.join(program)).unwrap());
+    let k = written
+        .groups
+        .iter()
+        .rposition(|g| g.0.starts_with("pass "))
+        .expect("a pass");
+    let before = *written.groups[..k]
+        .iter()
+        .rev()
+        .find_map(|g| g.1.last())
+        .unwrap();
+    let pass = Pass::new(before, &written.groups[k].1);
+    // The path's length at each of the pass's points (each block at its
+    // own feed: the length runs linearly in time within a block).
+    let mut length = vec![0.0];
+    for i in 1..pass.z.len() {
+        let d = (pass.z[i] - pass.z[i - 1]).hypot(pass.x[i] - pass.x[i - 1]);
+        length.push(length[i - 1] + d);
+    }
+    let total = length[length.len() - 1];
+    let at_time = |t: f64| {
+        let i = pass
+            .t
+            .partition_point(|&v| v < t)
+            .clamp(1, pass.t.len() - 1);
+        let (t0, t1) = (pass.t[i - 1], pass.t[i]);
+        let s = if t1 > t0 {
+            ((t - t0) / (t1 - t0)).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        let share = (length[i - 1] + s * (length[i] - length[i - 1])) / total;
+        error(share, pass.at(t).0)
+    };
+    let period = 1.0 / written.spindle;
+    let phases = phases_for(&pass, section, period);
+    at.iter()
+        .map(|&z| pass.cut_worn(section, period, phases, z, f64::INFINITY, &at_time))
+        .collect()
+}
+
+/// The largest distance of a replayed finish from the nominal radius
+/// (mm): its highest and lowest generatrices at the places `at`.
+fn off_nominal(finish: &[(f64, f64)], at: &[f64]) -> f64 {
+    finish
+        .iter()
+        .zip(at)
+        .map(|(&(hi, lo), &z)| (hi - law(z) / 2.0).abs().max((lo - law(z) / 2.0).abs()))
+        .fold(0.0, f64::max)
+}
+
+/// Every 0.5 mm over the default mandrel's ground length.
+fn fine() -> Vec<f64> {
+    (0..=880).map(|i| 0.5 * i as f64).collect()
+}
+
+/// The places of the mandrel's measurements: every 10 mm from 0 to 440
+/// but on the edge between the law and the end cone (z = 400), where a
+/// bench's anvils do not sit.
+fn bench_places() -> Vec<f64> {
+    (0..=44)
+        .map(|i| 10.0 * i as f64)
+        .filter(|&z| z != 400.0)
+        .collect()
+}
+
+/// A measuring bench's table of the part `finish` (its highest
+/// generatrices at [`bench_places`]): diameters to 0.1 um.
+fn bench_table(finish: &[(f64, f64)]) -> String {
+    let mut t = String::from("z_mm,d_mm\n");
+    for (z, (hi, _)) in bench_places().iter().zip(finish) {
+        t += &format!("{z:.1},{:.4}\n", 2.0 * hi);
+    }
+    t
+}
+
 /// The default mandrel run into `dir/run`.
 fn mandrel_run(dir: &Path) -> std::path::PathBuf {
     let run = dir.join("run");
     let (code, _, err) = pilgrim(&["run", "scripts/mandrel.rhai", "--out", s(&run), "--quiet"]);
     assert_eq!(code, 0, "{err}");
     run
-}
-
-/// The finishing pass's largest deviation from its target (mm), as a
-/// run's report says it.
-fn finish_of(report: &serde_json::Value) -> f64 {
-    report["verification"]["passes"]
-        .as_array()
-        .unwrap()
-        .last()
-        .unwrap()["deviation"]["max_abs"]
-        .as_f64()
-        .unwrap()
 }
 
 /// The largest distance of the run's `correction.csv` from `-error(z)`.
@@ -81,76 +179,93 @@ fn json(path: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
 }
 
-/// The example measurement (`scripts/examples/mandrel-measured.csv`) is
-/// the default mandrel as a wearing wheel leaves it: each row the law plus
-/// the wear, to its 10 nm. `compensate` fits the error (a straight line
-/// here: its residual 0.0 um), moves the target against it by the whole
-/// of it, and runs the job again: the corrected run is verified within the
-/// tolerance of the corrected target, its correction the wear's negative
-/// within 0.01 um, the wheel's X moved by it and the rest's U with it. The
-/// part the corrected program makes with the same wear, the corrected
-/// target plus the corrected run's finish deviation plus the wear, is
-/// within the 1 um tolerance of the nominal, where the first run's part
-/// is 5.9 um off.
+/// A wheel wearing [`WEAR`] of its radius along the default mandrel's
+/// finishing pass, in the loop: the first program replayed with the wear
+/// (`finish_with`) leaves the part 6.7 um off its nominal; measured at 44
+/// places (`scripts/examples/mandrel-measured.csv` is that measurement),
+/// `compensate` fits what the kernel's replay did not predict (the wear,
+/// within 0.3 um) and moves the target against it; the corrected program,
+/// replayed with the same wear, leaves the part within the 1 um tolerance
+/// of the nominal on every generatrix's highest and lowest, every 0.5 mm,
+/// and `compensation.json`'s expected part after is that replay's within
+/// 0.1 um. The wheel's X and the rest's U moved by the correction, Z by
+/// under a micrometre. Measured in its turn with the wear repeating, the
+/// corrected run compensated again keeps its correction.
 #[test]
 fn the_mandrel_is_corrected_by_its_measured_error() {
     let dir = scratch("compensate", "mandrel");
     let run = mandrel_run(&dir);
+    let fine = fine();
+    let tolerance = common::report_of(&run)["verification"]["tolerance"]
+        .as_f64()
+        .unwrap();
+    let before = off_nominal(&finish_with(&run, "program.mpf", &fine, &worn), &fine);
+    assert!(before > 5.0 * tolerance, "before: {before}");
+    // The example is the first program's part with the wear, measured.
     let measured = common::root().join("scripts/examples/mandrel-measured.csv");
-    let text = std::fs::read_to_string(&measured).unwrap();
-    let rows: Vec<(f64, f64)> = text
-        .lines()
-        .filter(|l| !l.starts_with('#') && !l.starts_with('z'))
-        .map(|l| {
-            let (z, d) = l.split_once(',').unwrap();
-            (z.parse().unwrap(), d.parse().unwrap())
-        })
-        .collect();
-    assert_eq!(rows.len(), 45);
-    for &(z, d) in &rows {
-        assert!((d - law(z) - 2.0 * wear(z)).abs() < 6e-6, "z {z}: {d}");
+    let bench = finish_with(&run, "program.mpf", &bench_places(), &worn);
+    let rows = |text: &str| -> Vec<(f64, f64)> {
+        text.lines()
+            .filter(|l| !l.starts_with('#') && !l.starts_with('z'))
+            .map(|l| {
+                let (z, d) = l.split_once(',').unwrap();
+                (z.parse().unwrap(), d.parse().unwrap())
+            })
+            .collect()
+    };
+    let example = rows(&std::fs::read_to_string(&measured).unwrap());
+    let replayed = rows(&bench_table(&bench));
+    assert_eq!(example.len(), 44);
+    for (e, r) in example.iter().zip(&replayed) {
+        assert!(
+            e.0 == r.0 && (e.1 - r.1).abs() < 1.5e-4,
+            "{e:?} replayed {r:?}"
+        );
     }
     let out = dir.join("corrected");
     let (said, report) = compensated(&run, &measured, &out);
-    assert!(said.contains("radius: 45 places"), "{said}");
+    assert!(said.contains("radius: 44 places"), "{said}");
     assert_eq!(
         report["parameters"]["correction"]["value"],
         "correction.csv"
     );
-    let finish = finish_of(&report);
-    let tolerance = report["verification"]["tolerance"].as_f64().unwrap();
-    // The correction, every 1.1 mm along the ground length: the wear's
-    // negative.
+    // The correction: the wear's negative, as the wheel wore it along z
+    // (the pass runs from z = 450 to -10), where the kernel's prediction
+    // and this replay's agree.
     let worst = correction_off(&out, &wear);
     assert!(
-        worst < 1e-5,
+        worst < 3e-4,
         "the correction strays {worst} mm from the wear"
     );
-    // The same wear on the corrected program's part: the corrected target
-    // (nominal - fit), its finish within `finish` of it, plus the wear.
-    let after = finish + worst;
+    // After: the corrected program with the same wear.
+    let after_part = finish_with(&out, "program.mpf", &fine, &worn);
+    let after = off_nominal(&after_part, &fine);
     assert!(
         after <= tolerance,
-        "{after} mm after, tolerance {tolerance}"
+        "after: {after} mm, tolerance {tolerance}"
     );
-    let before = rows
-        .iter()
-        .map(|&(z, d)| (d / 2.0 - law(z) / 2.0).abs())
-        .fold(0.0, f64::max);
-    assert!(before > 5.8e-3 && before > 5.0 * tolerance, "{before}");
     let c = json(&out.join("compensation.json"));
-    assert_eq!(c["quantities"][0]["places"].as_array().unwrap().len(), 45);
-    assert!(c["quantities"][0]["rms_residual_mm"].as_f64().unwrap() < 1e-5);
+    let places = c["quantities"][0]["places"].as_array().unwrap();
+    assert_eq!(places.len(), 44);
+    for p in places {
+        let z = p["at"].as_f64().unwrap();
+        let replay = after_part[(2.0 * z).round() as usize].0 - law(z) / 2.0;
+        let said = p["expected_after"].as_f64().unwrap();
+        assert!(
+            (said - replay).abs() < 1e-4,
+            "z {z}: expected {said}, replayed {replay}"
+        );
+    }
     // The program: its path moved by the correction. The wheel's X (its
     // centre, on radius) and the rest's U (riding the part) by the most
-    // the correction asks (5.87 um at z = 0), Z by under a micrometre (the
-    // nearest point of a sloped path).
+    // the correction asks, Z by under a micrometre (the nearest point of a
+    // sloped path).
     let moved = &c["program"]["path_moved"];
     let most = c["quantities"][0]["max_correction_mm"].as_f64().unwrap();
     for axis in ["X", "U"] {
         let m = moved[axis].as_f64().unwrap();
         assert!(
-            (m - most).abs() < 2e-4,
+            (m - most).abs() < 3e-4,
             "{axis} moved {m}, the correction {most}"
         );
     }
@@ -158,25 +273,27 @@ fn the_mandrel_is_corrected_by_its_measured_error() {
     assert!(c["program"]["lines_added"].as_u64().unwrap() > 0);
     // The report's table and the page's chart: the error before and after.
     let table = &report["tables"]["compensation"];
-    let after = table["expected_after_um"].as_array().unwrap();
-    assert_eq!(after.len(), 45);
+    let after_um = table["expected_after_um"].as_array().unwrap();
+    assert_eq!(after_um.len(), 44);
     assert!(
-        after.iter().all(|a| a.as_f64().unwrap().abs() < 0.01),
-        "{after:?}"
+        after_um
+            .iter()
+            .all(|a| a.as_f64().unwrap().abs() <= 1e3 * tolerance),
+        "{after_um:?}"
     );
     let page = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(out.join("compensation.svg").is_file() && page.contains("alt=\"compensation.svg\""));
     common::check_page(&out, "program.mpf", 8.0);
     common::leave_page_for_chromium(&out, "compensated-mandrel");
     // The corrected run's part measured in its turn, the wear repeating:
-    // on the nominal. Compensating the corrected run keeps its correction
-    // (the wear's negative), adding what the new measurement asks: none.
+    // compensated again, the correction is kept (its unmodelled error is
+    // the wear less the correction: nothing).
     let again = dir.join("again.csv");
-    let mut t = String::from("z_mm,d_mm\n");
-    for &(z, _) in &rows {
-        t += &format!("{z},{}\n", law(z));
-    }
-    std::fs::write(&again, t).unwrap();
+    std::fs::write(
+        &again,
+        bench_table(&finish_with(&out, "program.mpf", &bench_places(), &worn)),
+    )
+    .unwrap();
     let twice = dir.join("twice");
     let (code, _, err) = pilgrim(&[
         "compensate",
@@ -189,7 +306,7 @@ fn the_mandrel_is_corrected_by_its_measured_error() {
     assert_eq!(code, 0, "{err}");
     let kept = correction_off(&twice, &wear);
     assert!(
-        kept < 1e-5,
+        kept < 3e-4,
         "the kept correction strays {kept} mm from the wear"
     );
 }
@@ -245,10 +362,12 @@ fn bad_measurements_are_refused_and_nothing_is_written() {
         assert!(!out.exists(), "{name}: {} written", out.display());
     }
     // The largest's place: the first z of the correction's grid (every
-    // 1.1 mm) where it passes 0.1 mm on radius (0.2 z / 440).
+    // 1.1 mm) where it passes 0.1 mm on radius (0.2 z / 440, less the
+    // finish's own half micrometre above the nominal, which the run's
+    // replay predicted).
     let f = dir.join("large.csv");
     let (_, _, err) = pilgrim(&["compensate", s(&run), "--measured", s(&f)]);
-    assert!(err.contains("at z = 221.100 mm"), "{err}");
+    assert!(err.contains("at z = 222.200 mm"), "{err}");
     assert!(!Path::new(&format!("{}-compensated", run.display())).exists());
     // The worm's family takes no correction (yet): refused, naming why.
     let worm = dir.join("worm");
@@ -263,26 +382,34 @@ fn bad_measurements_are_refused_and_nothing_is_written() {
 
 /// A second error we can make: the part deflecting away from the wheel in
 /// proportion to its unsupported length's cube (a cantilever from the
-/// chuck's side at z = -300, 4 um at the far end), measured every 10 mm
-/// without scatter and held to an uncertainty of 0.01 um. The smoothing
-/// spline follows the curve: the correction is the deflection's negative
-/// within 0.05 um, and the corrected program's part, the same deflection
-/// repeating, is within the tolerance. (Held to 0.1 um, the fit strays
-/// 0.26 um at the ends: the spline spends the stated residual where the
-/// curve bends most, and the default finish's 0.92 um leaves the 1 um
-/// tolerance no room for it.)
+/// chuck's side at z = -300, 4 um at the far end), in the loop: the first
+/// program replayed with the wheel at z meeting the part given way by
+/// `bend(z)`, measured every 10 mm to 0.1 um of diameter, compensated
+/// with the measurement's uncertainty stated as 0.01 um; the smoothing
+/// spline follows the curve (the correction within 0.1 um of the
+/// deflection's negative), and the corrected program replayed with the
+/// same deflection leaves the part within the tolerance of the nominal.
+/// (Held to 0.1 um, the spline spends that residual at the ends, 0.25 um
+/// off the curve there: with the default finish at 0.93 um of its 1 um,
+/// the part after is 1.12 um off.)
 #[test]
 fn a_deflection_is_corrected_along_its_curve() {
     let dir = scratch("compensate", "deflection");
     let run = mandrel_run(&dir);
     let bend = |z: f64| 0.004 * ((z + 300.0) / 740.0).powi(3);
+    let bent = |_: f64, z: f64| bend(z);
+    let fine = fine();
+    let tolerance = common::report_of(&run)["verification"]["tolerance"]
+        .as_f64()
+        .unwrap();
+    let before = off_nominal(&finish_with(&run, "program.mpf", &fine, &bent), &fine);
+    assert!(before > 3.0 * tolerance, "before: {before}");
     let measured = dir.join("bent.csv");
-    let mut t = String::from("z_mm,r_mm\n");
-    for i in 0..=44 {
-        let z = 10.0 * i as f64;
-        t += &format!("{z},{:.7}\n", law(z) / 2.0 + bend(z));
-    }
-    std::fs::write(&measured, t).unwrap();
+    std::fs::write(
+        &measured,
+        bench_table(&finish_with(&run, "program.mpf", &bench_places(), &bent)),
+    )
+    .unwrap();
     let out = dir.join("corrected");
     let (code, _, err) = pilgrim(&[
         "compensate",
@@ -301,19 +428,21 @@ fn a_deflection_is_corrected_along_its_curve() {
         "{}",
         report["verdict"]
     );
-    let finish = finish_of(&report);
     let worst = correction_off(&out, &bend);
-    assert!(
-        worst < 5e-5,
-        "the correction strays {worst} mm from the deflection"
-    );
     let c = json(&out.join("compensation.json"));
     assert!(
         c["quantities"][0]["smooth"].as_f64().unwrap() > 0.0,
         "a curve, not the line"
     );
-    let tolerance = report["verification"]["tolerance"].as_f64().unwrap();
-    assert!(finish + worst <= tolerance, "{finish} + {worst}");
+    let after = off_nominal(&finish_with(&out, "program.mpf", &fine, &bent), &fine);
+    assert!(
+        worst < 1e-4,
+        "the correction strays {worst} mm from the deflection"
+    );
+    assert!(
+        after <= tolerance,
+        "after: {after} mm, tolerance {tolerance}"
+    );
     assert!(bend(440.0) > 3.9e-3);
 }
 
@@ -418,15 +547,73 @@ fn the_caliber_is_corrected_by_its_measured_groove() {
     }
 }
 
-/// The default thread (M20x2.5-6g) measured over wires as a bar bending
-/// away from the cutter by its unsupported length leaves it
-/// (`scripts/examples/thread-measured.csv`: the pitch diameter 0.120 mm
-/// large at the face, falling towards the chuck 50 mm away): out of 6g's
-/// band before; compensated by its mean (a start's passes move as one),
-/// the corrected program verifies against the band moved by the
-/// correction, and with the same error repeating the part is inside 6g's
-/// band. A two-start thread's starts, measured apart, are corrected each
-/// by its own.
+/// The bar's bending of the thread's example (mm on diameter at z): held
+/// in the chuck 50 mm from the face, it gives way to the cutter by its
+/// unsupported length, 0.120 mm at the face.
+fn bend(z: f64) -> f64 {
+    0.120 * (z + 50.0) / 50.0
+}
+
+/// Each start's pitch diameter (mm) that the thread program `program`
+/// cuts on a bar bent by [`bend`], at each z of `at`: the section at z is
+/// cut while the cutter stands over it, so every pass there meets the bar
+/// given way by `bend(z)`, which is the program with each X (on diameter)
+/// larger by as much. That program is replayed as its control reads it by
+/// `pilgrim verify` against the default thread (correction none), its
+/// report read whatever its verdict (a bent part may fail it).
+fn bent_pitch_diameters(dir: &Path, program: &Path, at: &[f64]) -> Vec<Vec<f64>> {
+    let text = std::fs::read_to_string(program).unwrap();
+    at.iter()
+        .enumerate()
+        .map(|(i, &z)| {
+            let bent: String = text
+                .lines()
+                .map(|l| {
+                    if l.starts_with('(') {
+                        return format!("{l}\n");
+                    }
+                    let words: Vec<String> = l
+                        .split_whitespace()
+                        .map(|w| match w.strip_prefix('X') {
+                            Some(v) => format!("X{:.3}", v.parse::<f64>().unwrap() + bend(z)),
+                            None => w.to_owned(),
+                        })
+                        .collect();
+                    words.join(" ") + "\n"
+                })
+                .collect();
+            let file = dir.join(format!("bent-{i}.nc"));
+            std::fs::write(&file, bent).unwrap();
+            let out = dir.join(format!("bent-{i}.verify"));
+            pilgrim(&[
+                "verify",
+                s(&file),
+                "--machine",
+                "fanuc-0i-tc",
+                "--family",
+                "scripts/thread.rhai",
+                "--out",
+                s(&out),
+            ]);
+            common::report_of(&out)["thread_verification"]["starts"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|st| st["pitch_diameter"].as_f64().unwrap())
+                .collect()
+        })
+        .collect()
+}
+
+/// The default thread (M20x2.5-6g) on a bar bending away from the cutter
+/// by its unsupported length ([`bend`]): its program replayed on the bent
+/// bar at five places is measured over wires there
+/// (`scripts/examples/thread-measured.csv` is that measurement), out of
+/// 6g's band near the face; compensated by its mean (a start's passes move
+/// as one), the corrected program verifies against the band moved by the
+/// correction, and replayed on the same bent bar its part is inside 6g's
+/// band at every place. A two-start thread's starts, measured apart, are
+/// corrected each by its own.
 #[test]
 fn a_thread_is_corrected_start_by_start() {
     let dir = scratch("compensate", "thread");
@@ -437,7 +624,22 @@ fn a_thread_is_corrected_start_by_start() {
     let band = &first["thread_verification"]["limits"]["pitch_diameter"];
     let (lo, hi) = (band["min"].as_f64().unwrap(), band["max"].as_f64().unwrap());
     let aim = 0.5 * (lo + hi);
-    let bend = |z: f64| 0.120 * (z + 50.0) / 50.0;
+    let cut = first["thread_verification"]["starts"][0]["pitch_diameter"]
+        .as_f64()
+        .unwrap();
+    // The first program on the bent bar: its pitch diameter the straight
+    // bar's plus the bend, to the program's last digit (1 um on X).
+    let places = [-2.0, -8.0, -14.0, -20.0, -26.0];
+    let bent = dir.join("before");
+    std::fs::create_dir_all(&bent).unwrap();
+    let before: Vec<f64> = bent_pitch_diameters(&bent, &run.join("program.nc"), &places)
+        .into_iter()
+        .map(|v| v[0])
+        .collect();
+    for (z, d2) in places.iter().zip(&before) {
+        assert!((d2 - cut - bend(*z)).abs() < 1.5e-3, "z {z}: {d2}");
+    }
+    // The example is that measurement, to its 0.1 um.
     let measured = common::root().join("scripts/examples/thread-measured.csv");
     let rows: Vec<(f64, f64)> = std::fs::read_to_string(&measured)
         .unwrap()
@@ -449,31 +651,44 @@ fn a_thread_is_corrected_start_by_start() {
             (z.parse().unwrap(), d.parse().unwrap())
         })
         .collect();
+    let replayed: Vec<(f64, f64)> = places.iter().copied().zip(before.iter().copied()).collect();
     assert_eq!(rows.len(), 5);
-    for &(z, d2) in &rows {
-        assert!((d2 - aim - bend(z)).abs() < 1e-6, "z {z}: {d2}");
+    for (&(z, d2), &(zr, r)) in rows.iter().zip(&replayed) {
+        assert!(
+            z == zr && (d2 - r).abs() < 0.6e-4,
+            "z {z}: {d2}, replayed {r}"
+        );
     }
     // Before: the part near the face is out of the band.
-    assert!(rows.iter().any(|r| r.1 > hi), "{rows:?} against {hi}");
+    assert!(before.iter().any(|&d| d > hi), "{before:?} against {hi}");
     let out = dir.join("corrected");
     let (said, report) = compensated(&run, &measured, &out);
     assert!(said.contains("pitch diameter: 5 places"), "{said}");
-    let mean = rows.iter().map(|r| bend(r.0)).sum::<f64>() / 5.0;
+    // What the replay did not predict: the measured less the simulated cut.
+    let mean = rows.iter().map(|r| r.1 - cut).sum::<f64>() / 5.0;
     let table = std::fs::read_to_string(out.join("correction.csv")).unwrap();
     assert!(table.starts_with("z_mm,dd2_1_mm\n"), "{table}");
     for l in table.lines().skip(1) {
         let dd2: f64 = l.split_once(',').unwrap().1.parse().unwrap();
         assert!((dd2 + mean).abs() < 1e-6, "{dd2} against {mean}");
     }
-    // After: the corrected run's simulated pitch diameter (at the
-    // corrected target) with the same error repeating, at every place.
+    // After: the corrected program replayed on the same bent bar, at
+    // every place inside 6g's band.
     let d2 = report["thread_verification"]["starts"][0]["pitch_diameter"]
         .as_f64()
         .unwrap();
     assert!((d2 - (aim - mean)).abs() < 0.01, "{d2}");
-    for &(z, _) in &rows {
-        let part = d2 + bend(z);
-        assert!(part > lo && part < hi, "z {z}: {part} outside {lo} to {hi}");
+    let bent = dir.join("after");
+    std::fs::create_dir_all(&bent).unwrap();
+    let after: Vec<f64> = bent_pitch_diameters(&bent, &out.join("program.nc"), &places)
+        .into_iter()
+        .map(|v| v[0])
+        .collect();
+    for (z, part) in places.iter().zip(&after) {
+        assert!(
+            *part > lo && *part < hi,
+            "z {z}: {part} outside {lo} to {hi}"
+        );
     }
     let c = json(&out.join("compensation.json"));
     assert_eq!(c["quantities"][0]["along"], false);
@@ -532,12 +747,13 @@ fn a_thread_is_corrected_start_by_start() {
             .unwrap()
     };
     let first = common::report_of(&two);
-    // About the pitch diameter the cut aims at (the family's note).
-    let d2 = first["notes"]["pitch_diameter_aimed_mm"].as_f64().unwrap();
+    // Each start as the first program cut it (its simulation), larger by
+    // what the replay did not model.
+    let (d1, d2) = (aim_of(&first, 0), aim_of(&first, 1));
     let file = dir.join("two.csv");
     let mut t = String::from("z_mm,start,d2_mm\n");
     for z in [-5.0, -15.0, -25.0] {
-        t += &format!("{z},1,{}\n{z},2,{}\n", d2 + 0.02, d2 + 0.05);
+        t += &format!("{z},1,{}\n{z},2,{}\n", d1 + 0.02, d2 + 0.05);
     }
     std::fs::write(&file, t).unwrap();
     let out = dir.join("two-corrected");
@@ -563,7 +779,7 @@ fn a_thread_is_corrected_start_by_start() {
     ]);
     assert_eq!(code, 0, "{err}");
     let first = common::report_of(&nut);
-    let d2 = first["notes"]["pitch_diameter_aimed_mm"].as_f64().unwrap();
+    let d2 = aim_of(&first, 0);
     let file = dir.join("nut.csv");
     let rows: String = [-5, -15, -25]
         .iter()

@@ -42,21 +42,21 @@ fn float(p: &Params, name: &str) -> f64 {
 /// A block as the program writes it: Z, X, U (mm) and F (mm/min), modal
 /// words carried over.
 #[derive(Debug, Clone, Copy)]
-struct Blk {
-    z: f64,
-    x: f64,
-    u: f64,
-    f: f64,
+pub(crate) struct Blk {
+    pub(crate) z: f64,
+    pub(crate) x: f64,
+    pub(crate) u: f64,
+    pub(crate) f: f64,
 }
 
 /// The program's text read as a control would: the spindle speed and the
 /// blocks of each group (split at the comments after the first block).
-struct Written {
-    spindle: f64,
-    groups: Vec<(String, Vec<Blk>)>,
+pub(crate) struct Written {
+    pub(crate) spindle: f64,
+    pub(crate) groups: Vec<(String, Vec<Blk>)>,
 }
 
-fn read_program(text: &str) -> Written {
+pub(crate) fn read_program(text: &str) -> Written {
     let mut at = Blk {
         z: f64::NAN,
         x: f64::NAN,
@@ -100,14 +100,14 @@ fn read_program(text: &str) -> Written {
 /// The wheel's axial section: roundings of radius `r` either side of a
 /// flat `flat` wide; X programs its lowest point, Z the middle of the flat.
 #[derive(Debug, Clone, Copy)]
-struct Section {
-    r: f64,
-    flat: f64,
+pub(crate) struct Section {
+    pub(crate) r: f64,
+    pub(crate) flat: f64,
 }
 
 impl Section {
     /// The lowest x of the wheel at z, the wheel at (cz, cx).
-    fn lower(&self, cz: f64, cx: f64, z: f64) -> f64 {
+    pub(crate) fn lower(&self, cz: f64, cx: f64, z: f64) -> f64 {
         let d = (z - cz).abs() - self.flat / 2.0;
         if d <= 0.0 {
             cx
@@ -119,7 +119,7 @@ impl Section {
     }
 
     /// How far along z from its reference the section reaches.
-    fn reach(&self) -> f64 {
+    pub(crate) fn reach(&self) -> f64 {
         self.r + self.flat / 2.0
     }
 }
@@ -128,14 +128,14 @@ impl Section {
 /// left the wheel (its infeed starts there), every axis straight between
 /// blocks at the block's F, Z and X against the time (minutes) each block
 /// ends.
-struct Pass {
-    z: Vec<f64>,
-    x: Vec<f64>,
-    t: Vec<f64>,
+pub(crate) struct Pass {
+    pub(crate) z: Vec<f64>,
+    pub(crate) x: Vec<f64>,
+    pub(crate) t: Vec<f64>,
 }
 
 impl Pass {
-    fn new(before: Blk, blocks: &[Blk]) -> Self {
+    pub(crate) fn new(before: Blk, blocks: &[Blk]) -> Self {
         let (mut z, mut x, mut t) = (vec![before.z], vec![before.x], vec![0.0]);
         for b in blocks {
             let (pz, px, pt) = (z[z.len() - 1], x[x.len() - 1], t[t.len() - 1]);
@@ -147,7 +147,7 @@ impl Pass {
     }
 
     /// The wheel's reference at time `t` (clamped to the pass).
-    fn at(&self, t: f64) -> (f64, f64) {
+    pub(crate) fn at(&self, t: f64) -> (f64, f64) {
         let k = self
             .t
             .partition_point(|&v| v < t)
@@ -165,7 +165,7 @@ impl Pass {
     }
 
     /// The first and last times the section reaches z (None: never).
-    fn covers(&self, z: f64, reach: f64) -> Option<(f64, f64)> {
+    pub(crate) fn covers(&self, z: f64, reach: f64) -> Option<(f64, f64)> {
         let mut span: Option<(f64, f64)> = None;
         for k in 1..self.z.len() {
             let (z0, z1, t0, t1) = (self.z[k - 1], self.z[k], self.t[k - 1], self.t[k]);
@@ -192,6 +192,20 @@ impl Pass {
     /// the spindle's phase) and the lowest (the swept envelope). Infinite
     /// where some generatrix is never touched.
     fn cut(&self, s: Section, period: f64, phases: usize, z: f64, until: f64) -> (f64, f64) {
+        self.cut_worn(s, period, phases, z, until, &|_| 0.0)
+    }
+
+    /// [`Pass::cut`] by a wheel worn by `wear(t)` (mm of its radius) at
+    /// time `t` of the pass: its section stands that much higher.
+    pub(crate) fn cut_worn(
+        &self,
+        s: Section,
+        period: f64,
+        phases: usize,
+        z: f64,
+        until: f64,
+        wear: &dyn Fn(f64) -> f64,
+    ) -> (f64, f64) {
         let Some((a, b)) = self.covers(z, s.reach()) else {
             return (f64::INFINITY, f64::INFINITY);
         };
@@ -203,9 +217,10 @@ impl Pass {
         }
         let mut low = vec![f64::INFINITY; phases];
         for m in first..=last {
-            let (cz, cx) = self.at(m as f64 * dt);
+            let t = m as f64 * dt;
+            let (cz, cx) = self.at(t);
             let i = m.rem_euclid(phases as i64) as usize;
-            low[i] = low[i].min(s.lower(cz, cx, z));
+            low[i] = low[i].min(s.lower(cz, cx + wear(t), z));
         }
         let crest = low.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         let valley = low.iter().copied().fold(f64::INFINITY, f64::min);
@@ -218,7 +233,7 @@ impl Pass {
 /// ridge at the pass's largest feed per revolution; the crest over phases
 /// moves by at most `f^2 / R = 8 h` per revolution of phase), so the
 /// sampling costs at most 0.1 um.
-fn phases_for(pass: &Pass, s: Section, period: f64) -> usize {
+pub(crate) fn phases_for(pass: &Pass, s: Section, period: f64) -> usize {
     let mut f: f64 = 0.0;
     for k in 1..pass.t.len() {
         let dt = pass.t[k] - pass.t[k - 1];

@@ -24,6 +24,18 @@ use crate::profile::Profile;
 pub use fit::{fit_error, fit_mean, within_limit, ErrorFit};
 pub use measure::{read_measured, Measured, MeasuredSpec, MIN_POINTS};
 
+/// The table a run's verification leaves in its report (`report.json`'s
+/// `tables`) with the part its replay predicts, as its deviation from the
+/// run's target (the nominal, moved by the run's correction where it was
+/// corrected), shaped as the correction's table: the coordinate's column
+/// ([`Nominal::coordinate`]) and a column per quantity named by its
+/// [`Quantity::key`], in the quantity's own measure (a mandrel's `z_mm`
+/// and `dr_mm`, its finish's highest generatrix, what a two-point
+/// instrument's anvils touch; a thread's each start's simulated pitch
+/// diameter as one value, `dd2_1_mm`, ...). `compensate` fits what the
+/// replay does not model: the measured minus the target and this.
+pub const PREDICTED: &str = "predicted_deviation";
+
 /// What a measurement of a family's finished part holds and what it is
 /// held against, as the family's verification gives it
 /// (`Verifier::nominal`): quantities along one coordinate.

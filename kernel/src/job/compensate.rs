@@ -14,7 +14,8 @@
 use super::{params_on, run as run_job, run_machine, Annex, JobOptions, JobOutput, Report};
 use crate::catalog::Catalog;
 use crate::compensate::{
-    fit_error, fit_mean, read_measured, within_limit, CompensateError, ErrorFit, Measured, Quantity,
+    fit_error, fit_mean, read_measured, within_limit, CompensateError, ErrorFit, Measured,
+    Quantity, PREDICTED,
 };
 use crate::error::Error;
 use crate::math::Real;
@@ -58,15 +59,24 @@ pub struct Place {
     pub measured: f64,
     /// The nominal there.
     pub nominal: f64,
-    /// Measured minus nominal.
+    /// Measured minus nominal: the part's error.
     pub error: f64,
+    /// The part the run's replay predicted there (none where its
+    /// verification predicts none: its target taken for it).
+    pub predicted: Option<f64>,
+    /// What the replay does not model, which is fitted: the measured minus
+    /// the prediction, plus the run's own correction where it was
+    /// corrected.
+    pub unmodelled: f64,
     /// The fit there.
     pub fitted: f64,
-    /// The target's shift there.
+    /// The correction there: the corrected target minus the nominal (as
+    /// `correction.csv` has it), the run's own correction replaced.
     pub correction: f64,
-    /// The error expected after it, the same error repeating (error plus
-    /// correction; the corrected run's own finish, which its verification
-    /// reports, besides).
+    /// The error from the nominal expected after it, the same unmodelled
+    /// error repeating: the corrected run's predicted part plus the
+    /// measured minus the first prediction (where both runs predict; else
+    /// the error plus the correction).
     pub expected_after: f64,
 }
 
@@ -253,6 +263,25 @@ pub fn compensate(
                 script.display()
             ))
         })?;
+    // A compensated run's correction: its target was the nominal moved by
+    // it, and the new correction replaces it (see `unmodelled`).
+    let previous = match report.parameters.get(CORRECTION).map(|p| &p.value) {
+        Some(crate::params::ParamValue::Text(name)) if !name.is_empty() => Some(
+            crate::profile::read_table_str(&read(name)?, &format!("{shown}/{name}"))?,
+        ),
+        _ => None,
+    };
+    let previous_at = |q: &Quantity, at: &[f64]| -> Result<Vec<f64>, Error> {
+        match &previous {
+            Some(t) if t.column_index(&q.key).is_ok() => {
+                let p = t.profile(nominal.coordinate, &q.key)?;
+                let (lo, hi) = p.z_range();
+                let at: Vec<f64> = at.iter().map(|z| z.clamp(lo, hi)).collect();
+                Ok(p.eval_many(&at)?)
+            }
+            _ => Ok(vec![0.0; at.len()]),
+        }
+    };
     // The measurement against it: each quantity it holds.
     // One per quantity, in the nominal's order: `None` where the
     // measurement has none of its columns.
@@ -267,21 +296,44 @@ pub fn compensate(
             Err(e) => return Err(e.into()),
         };
         let at_nominal = q.nominal.eval_many(&m.at)?;
+        let previous = previous_at(q, &m.at)?;
+        // The part the run's replay predicted: its target, the nominal
+        // moved by its correction, and its deviation from it.
+        let predicted = predicted(&report.tables, nominal.coordinate, q, &m.at)?.map(|d| {
+            (0..m.at.len())
+                .map(|i| at_nominal[i] + previous[i] + d[i])
+                .collect::<Vec<f64>>()
+        });
         let error: Vec<f64> = m
             .value
             .iter()
             .zip(&at_nominal)
             .map(|(v, n)| v - n)
             .collect();
+        // What the run's replay does not model: the measured minus the
+        // part it predicted (its target, the nominal moved by the run's own
+        // correction, where its verification predicts none), plus that
+        // correction. Fitted and corrected against, it replaces the run's
+        // correction, so a part measured as its run predicted keeps it.
+        let unmodelled: Vec<f64> = (0..m.at.len())
+            .map(|i| {
+                let expected = predicted
+                    .as_ref()
+                    .map_or(at_nominal[i] + previous[i], |p| p[i]);
+                m.value[i] - expected + previous[i]
+            })
+            .collect();
         let fit = if q.along {
-            fit_error(&m.at, &error, options.uncertainty)?
+            fit_error(&m.at, &unmodelled, options.uncertainty)?
         } else {
-            fit_mean(&m.at, &error, options.uncertainty)?
+            fit_mean(&m.at, &unmodelled, options.uncertainty)?
         };
         fitted.push(Some(Fitted {
             m,
             at_nominal,
             error,
+            predicted,
+            previous,
             fit,
         }));
     }
@@ -317,14 +369,6 @@ pub fn compensate(
         .coordinate
         .rsplit_once('_')
         .unwrap_or((nominal.coordinate, ""));
-    // A compensated run's correction stays, the new one added: the
-    // measured error is then the first correction's and the process's.
-    let previous = match report.parameters.get(CORRECTION).map(|p| &p.value) {
-        Some(crate::params::ParamValue::Text(name)) if !name.is_empty() => Some(
-            crate::profile::read_table_str(&read(name)?, &format!("{shown}/{name}"))?,
-        ),
-        _ => None,
-    };
     let mut csv = std::iter::once(nominal.coordinate)
         .chain(nominal.quantities.iter().map(|q| q.key.as_str()))
         .collect::<Vec<_>>()
@@ -332,16 +376,7 @@ pub fn compensate(
         + "\n";
     let mut columns: Vec<Vec<f64>> = Vec::new();
     for (q, f) in nominal.quantities.iter().zip(&fitted) {
-        let mut total = match &previous {
-            Some(t) if t.column_index(&q.key).is_ok() => {
-                let p = t.profile(nominal.coordinate, &q.key)?;
-                let (lo, hi) = p.z_range();
-                grid.iter()
-                    .map(|z| p.eval(z.clamp(lo, hi)))
-                    .collect::<Result<Vec<f64>, _>>()?
-            }
-            _ => vec![0.0; grid.len()],
-        };
+        let mut total = previous_at(q, &grid)?;
         if let Some(f) = f {
             let shift = f.fit.correction(&grid, options.gain)?;
             total.iter_mut().zip(&shift).for_each(|(t, s)| *t += s);
@@ -388,12 +423,13 @@ pub fn compensate(
                 measured: f.m.value[i],
                 nominal: f.at_nominal[i],
                 error: f.error[i],
+                predicted: f.predicted.as_ref().map(|p| p[i]),
+                unmodelled: f.fit.error[i],
                 fitted: fit_at[i],
-                correction: shift[i],
+                correction: f.previous[i] + shift[i],
                 expected_after: f.error[i] + shift[i],
             })
             .collect();
-        let largest = |v: &mut dyn Iterator<Item = f64>| v.fold(0.0, |a: f64, x| a.max(x.abs()));
         of.push(q);
         records.push(QuantityRecord {
             name: q.name.clone(),
@@ -402,22 +438,36 @@ pub fn compensate(
             along: q.along,
             smooth: f.fit.smooth,
             rms_residual_mm: f.fit.rms_residual,
-            max_error_mm: largest(&mut f.error.iter().copied()),
-            max_correction_mm: largest(&mut total.iter().copied()),
-            max_expected_after_mm: largest(&mut places.iter().map(|p| p.expected_after)),
+            max_error_mm: largest(f.error.iter().copied()),
+            max_correction_mm: largest(total.iter().copied()),
+            max_expected_after_mm: largest(places.iter().map(|p| p.expected_after)),
             places,
         });
     }
-    let measured_quantities: Vec<(&Quantity, &QuantityRecord)> =
-        of.into_iter().zip(&records).collect();
-    let annex = annex(nominal.coordinate, &measured_quantities, (coordinate, unit));
+    let quantities: Vec<Quantity> = of.into_iter().cloned().collect();
+    let mut made = annex(
+        nominal.coordinate,
+        &quantities,
+        &records,
+        (coordinate, unit),
+    );
+    // The part after, from the corrected run's own prediction once its
+    // verification has made it: the annex's tables made again with it.
+    let (column, names) = (nominal.coordinate, (coordinate.to_owned(), unit.to_owned()));
+    let (hook_quantities, hook_records) = (quantities.clone(), records.clone());
+    made.finish = Some(super::TablesHook(std::sync::Arc::new(move |tables| {
+        let mut records = hook_records.clone();
+        after_run(&mut records, &hook_quantities, column, tables);
+        let names = (names.0.as_str(), names.1.as_str());
+        tables.extend(annex(column, &hook_quantities, &records, names).tables);
+    })));
     let job_options = JobOptions {
         program_name: script
             .file_stem()
             .and_then(|s| s.to_str())
             .unwrap_or("pilgrim")
             .to_owned(),
-        annex,
+        annex: made,
         ..JobOptions::default()
     };
     let program_file = crate::program::post::dialect(&report.control)
@@ -434,6 +484,12 @@ pub fn compensate(
     let old_toolpath: Toolpath = serde_json::from_str(&read("toolpath.json")?)
         .map_err(|e| Error::Read(format!("{shown}/toolpath.json: {e}")))?;
     let mut out = run_job(&family, &machine, &sources, &job_options, &mut |_| {})?;
+    after_run(
+        &mut records,
+        &quantities,
+        nominal.coordinate,
+        &out.report.tables,
+    );
     let record = Compensation {
         run: shown.clone(),
         measured_file: measured.source().to_owned(),
@@ -478,9 +534,78 @@ pub fn compensate(
 struct Fitted {
     m: Measured,
     at_nominal: Vec<f64>,
+    /// Measured minus nominal.
     error: Vec<f64>,
+    /// The run's predicted part (none where its verification predicts
+    /// none).
+    predicted: Option<Vec<f64>>,
+    /// The run's own correction, at the measured places.
+    previous: Vec<f64>,
+    /// The fit of what the replay does not model (its `error`).
     fit: ErrorFit,
 }
+
+/// The largest value of `v` in size.
+fn largest(v: impl Iterator<Item = f64>) -> f64 {
+    v.fold(0.0, |a: f64, x| a.max(x.abs()))
+}
+
+/// The run's predicted deviation from its target for `q` at the places
+/// `at`: the table [`PREDICTED`] its verification left in `tables`, along
+/// `coordinate` (linearly between its rows, held at its ends). `None`
+/// where the table or the quantity's column is not there.
+///
+/// # Failures
+/// A table whose coordinate does not increase.
+fn predicted(
+    tables: &Tables,
+    coordinate: &str,
+    q: &Quantity,
+    at: &[f64],
+) -> Result<Option<Vec<f64>>, Error> {
+    let Some(t) = tables.get(PREDICTED) else {
+        return Ok(None);
+    };
+    let (Some(s), Some(values)) = (t.get(coordinate), t.get(&q.key)) else {
+        return Ok(None);
+    };
+    let p = crate::profile::Profile::new(s.clone(), values.clone())
+        .map_err(|e| Error::Read(format!("the run's table {PREDICTED}: {e}")))?
+        .with_interpolation(crate::profile::Interpolation::Linear);
+    let (lo, hi) = p.z_range();
+    let at: Vec<f64> = at.iter().map(|z| z.clamp(lo, hi)).collect();
+    Ok(Some(p.eval_many(&at)?))
+}
+
+/// Each record's error expected after the correction, the same
+/// unmodelled error repeating, from the corrected run's `tables`: the
+/// part its verification predicts ([`PREDICTED`]) plus the measured minus
+/// the first run's prediction, less the nominal. Where either run predicts
+/// none, it stays the error plus the correction (the corrected run's own
+/// deviation taken as the first's).
+fn after_run(
+    records: &mut [QuantityRecord],
+    quantities: &[Quantity],
+    coordinate: &str,
+    tables: &Tables,
+) {
+    for (r, q) in records.iter_mut().zip(quantities) {
+        let at: Vec<f64> = r.places.iter().map(|p| p.at).collect();
+        let Ok(Some(own)) = predicted(tables, coordinate, q, &at) else {
+            continue;
+        };
+        // The corrected target is the nominal moved by the correction.
+        for (p, own) in r.places.iter_mut().zip(own) {
+            if let Some(first) = p.predicted {
+                p.expected_after = p.correction + own + (p.measured - first);
+            }
+        }
+        r.max_expected_after_mm = largest(r.places.iter().map(|p| p.expected_after));
+    }
+}
+
+/// Tables by name, each its columns by name.
+type Tables = BTreeMap<String, BTreeMap<String, Vec<f64>>>;
 
 /// The tables and charts the corrected run's report and page show: per
 /// quantity along the coordinate, its measured error, fit, the target's
@@ -490,9 +615,12 @@ struct Fitted {
 /// selects them (a thread's starts).
 fn annex(
     column: &str,
-    records: &[(&Quantity, &QuantityRecord)],
+    quantities: &[Quantity],
+    records: &[QuantityRecord],
     (coordinate, unit): (&str, &str),
 ) -> Annex {
+    let records: Vec<(&Quantity, &QuantityRecord)> = quantities.iter().zip(records).collect();
+    let records = records.as_slice();
     let um = |v: &mut dyn Iterator<Item = f64>| v.map(|x| 1e3 * x).collect::<Vec<f64>>();
     let columns = [
         "measured_error_um",

@@ -74,6 +74,39 @@ pub struct Annex {
     pub tables: std::collections::BTreeMap<String, std::collections::BTreeMap<String, Vec<f64>>>,
     /// Charts of them.
     pub plots: Vec<crate::toolpath::PlotSpec>,
+    /// Called with the run's tables once its verification has added to
+    /// them, before anything is drawn: the caller's tables finished from
+    /// what the run found (a compensated run's part after, from its own
+    /// prediction).
+    pub finish: Option<TablesHook>,
+}
+
+/// A caller's function over a run's tables ([`Annex::finish`]); copies
+/// share it, and are equal only to themselves.
+#[derive(Clone)]
+#[allow(clippy::type_complexity)]
+pub struct TablesHook(
+    pub  std::sync::Arc<
+        dyn Fn(
+                &mut std::collections::BTreeMap<
+                    String,
+                    std::collections::BTreeMap<String, Vec<f64>>,
+                >,
+            ) + Send
+            + Sync,
+    >,
+);
+
+impl std::fmt::Debug for TablesHook {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("TablesHook")
+    }
+}
+
+impl PartialEq for TablesHook {
+    fn eq(&self, other: &Self) -> bool {
+        std::sync::Arc::ptr_eq(&self.0, &other.0)
+    }
 }
 
 impl Default for JobOptions {
@@ -726,6 +759,11 @@ fn run_on(
     let mut later = Vec::new();
     if let Some(o) = &outcome {
         o.extend_tables(&mut report.tables);
+    }
+    if let Some(finish) = &options.annex.finish {
+        (finish.0)(&mut report.tables);
+    }
+    if let Some(o) = &outcome {
         let ctx = FilesContext {
             replay: replay_ctx,
             parts: &parts,

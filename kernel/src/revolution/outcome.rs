@@ -101,6 +101,30 @@ impl Outcome for GrindingOutcome {
             .unwrap_or_default()
     }
 
+    /// The part the finish leaves ([`crate::compensate::PREDICTED`]): its
+    /// highest generatrix's deviation from the target along z, a row per
+    /// stretch of the finish's drawing (at most [`super::PROFILE_BUCKETS`]).
+    fn extend_tables(
+        &self,
+        tables: &mut std::collections::BTreeMap<
+            String,
+            std::collections::BTreeMap<String, Vec<f64>>,
+        >,
+    ) {
+        let (Some(finish), Some(nominal)) = (self.check.passes.last(), self.request.nominal())
+        else {
+            return;
+        };
+        let mut table = std::collections::BTreeMap::from([(
+            nominal.coordinate.to_owned(),
+            finish.along_z.iter().map(|b| b[0]).collect(),
+        )]);
+        for q in &nominal.quantities {
+            table.insert(q.key.clone(), finish.along_z.iter().map(|b| b[2]).collect());
+        }
+        tables.insert(crate::compensate::PREDICTED.into(), table);
+    }
+
     fn files(
         &self,
         ctx: &FilesContext<'_>,

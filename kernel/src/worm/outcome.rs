@@ -146,9 +146,23 @@ impl Outcome for WormOutcome {
     }
 
     fn extend_tables(&self, tables: &mut BTreeMap<String, BTreeMap<String, Vec<f64>>>) {
+        // Each start's simulated pitch diameter less the one the cut aimed
+        // at, its part's predicted deviation (crate::compensate::PREDICTED),
+        // the same along the thread.
+        let w = &self.check;
+        if let Some(nominal) = self.request.nominal() {
+            let (from, to) = nominal.range;
+            let along = vec![from, 0.5 * (from + to), to];
+            let mut table = BTreeMap::from([(nominal.coordinate.to_owned(), along)]);
+            for (k, (q, s)) in nominal.quantities.iter().zip(&w.starts).enumerate() {
+                let aimed = self.request.section.pitch_diameter
+                    + self.request.pitch_shift.get(k).copied().unwrap_or(0.0);
+                table.insert(q.key.clone(), vec![s.pitch_diameter - aimed; 3]);
+            }
+            tables.insert(crate::compensate::PREDICTED.into(), table);
+        }
         // The simulated areas beside the plan's, row for row, where the
         // family's "passes" table has one row per thread block.
-        let w = &self.check;
         if let Some(t) = tables.get_mut("passes") {
             if t.values().all(|c| c.len() == w.passes.len()) && !t.is_empty() {
                 t.insert(
