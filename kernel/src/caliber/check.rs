@@ -163,6 +163,14 @@ pub struct GrooveCheck {
     /// (for the heat map; not in the report).
     #[serde(skip)]
     pub map: DeviationMap,
+    /// The groove as cut at each theta of the grid, as a measurement takes
+    /// it: `[theta (deg), depth, width]`, the depth's and the width's
+    /// deviations from the nominal (mm): the depth less the material left
+    /// at the bottom (psi 0, between its grid points), the width less the
+    /// material left at both edges (psi -90 and 90 deg, where the section's
+    /// normal runs along the roll's axis). Not in the report.
+    #[serde(skip)]
+    pub along_theta: Vec<[Real; 3]>,
 }
 
 /// The most cells a [`DeviationMap`] has along theta and across the groove.
@@ -616,7 +624,23 @@ pub fn check_groove(
     } else {
         String::new()
     };
+    let bottom = psi_grid.partition_point(|p| p.0 < 0.0).clamp(1, np - 1);
+    let along_theta = dist
+        .chunks_exact(nc)
+        .zip(&thetas)
+        .map(|(row, t)| {
+            let (a, b) = (psi_grid[bottom - 1].0, psi_grid[bottom].0);
+            let s = if b > a {
+                (-a / (b - a)).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let at_bottom = row[bottom - 1].0 + s * (row[bottom].0 - row[bottom - 1].0);
+            [t.to_degrees(), -at_bottom, -(row[0].0 + row[np - 1].0)]
+        })
+        .collect();
     let check = GrooveCheck {
+        along_theta,
         tolerance: req.tolerance,
         resolution_mm: resolution,
         sampling_resolution_mm: sampling,
@@ -934,6 +958,7 @@ mod failure_tests {
             why: String::new(),
             patch: None,
             map: DeviationMap::default(),
+            along_theta: Vec::new(),
         }
     }
 

@@ -118,6 +118,24 @@ impl Outcome for GrooveOutcome {
         self.check.findings()
     }
 
+    /// The groove as cut ([`crate::compensate::PREDICTED`]): its depth's
+    /// and its width's deviations from the target over theta
+    /// ([`GrooveCheck::along_theta`]).
+    fn extend_tables(&self, tables: &mut BTreeMap<String, BTreeMap<String, Vec<f64>>>) {
+        let Some(nominal) = self.request.nominal() else {
+            return;
+        };
+        let rows = &self.check.along_theta;
+        let mut table = BTreeMap::from([(
+            nominal.coordinate.to_owned(),
+            rows.iter().map(|r| r[0]).collect(),
+        )]);
+        for (q, k) in nominal.quantities.iter().zip([1, 2]) {
+            table.insert(q.key.clone(), rows.iter().map(|r| r[k]).collect());
+        }
+        tables.insert(crate::compensate::PREDICTED.into(), table);
+    }
+
     fn summary(&self) -> String {
         let g = &self.check;
         format!(
