@@ -260,6 +260,7 @@ fn the_mandrel_is_corrected_by_its_measured_error() {
     // centre, on radius) and the rest's U (riding the part) by the most
     // the correction asks, Z by under a micrometre (the nearest point of a
     // sloped path).
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
     let moved = &c["program"]["path_moved"];
     let most = c["quantities"][0]["max_correction_mm"].as_f64().unwrap();
     for axis in ["X", "U"] {
@@ -271,6 +272,20 @@ fn the_mandrel_is_corrected_by_its_measured_error() {
     }
     assert!(moved["Z"].as_f64().unwrap() < 1e-3, "{moved}");
     assert!(c["program"]["lines_added"].as_u64().unwrap() > 0);
+    // On the page, per pass: the finish's X moved by the most.
+    let per_pass = &report["tables"]["compensation_moves"];
+    let x: Vec<f64> = per_pass["X_um"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!(x.len(), per_pass["pass"].as_array().unwrap().len());
+    assert!(
+        (x[x.len() - 1] - 1e3 * moved["X"].as_f64().unwrap()).abs() < 1e-6,
+        "{x:?}"
+    );
+    assert!(page.contains("alt=\"compensation_moves.svg\""));
     // The report's table and the page's chart: the error before and after.
     let table = &report["tables"]["compensation"];
     let after_um = table["expected_after_um"].as_array().unwrap();
@@ -281,7 +296,6 @@ fn the_mandrel_is_corrected_by_its_measured_error() {
             .all(|a| a.as_f64().unwrap().abs() <= 1e3 * tolerance),
         "{after_um:?}"
     );
-    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(out.join("compensation.svg").is_file() && page.contains("alt=\"compensation.svg\""));
     common::check_page(&out, "program.mpf", 8.0);
     common::leave_page_for_chromium(&out, "compensated-mandrel");

@@ -11,7 +11,7 @@
 //! its nominal ([`crate::family::Verifier::nominal`]); the run knows no
 //! family by name.
 
-use super::{params_on, run as run_job, run_machine, Annex, JobOptions, JobOutput, Report};
+use super::{params_on, run as run_job, run_machine, Annex, JobOptions, JobOutput, Report, Tables};
 use crate::catalog::Catalog;
 use crate::compensate::{
     fit_error, fit_mean, read_measured, within_limit, CompensateError, ErrorFit, Measured,
@@ -451,25 +451,6 @@ pub fn compensate(
         &records,
         (coordinate, unit),
     );
-    // The part after, from the corrected run's own prediction once its
-    // verification has made it: the annex's tables made again with it.
-    let (column, names) = (nominal.coordinate, (coordinate.to_owned(), unit.to_owned()));
-    let (hook_quantities, hook_records) = (quantities.clone(), records.clone());
-    made.finish = Some(super::TablesHook(std::sync::Arc::new(move |tables| {
-        let mut records = hook_records.clone();
-        after_run(&mut records, &hook_quantities, column, tables);
-        let names = (names.0.as_str(), names.1.as_str());
-        tables.extend(annex(column, &hook_quantities, &records, names).tables);
-    })));
-    let job_options = JobOptions {
-        program_name: script
-            .file_stem()
-            .and_then(|s| s.to_str())
-            .unwrap_or("pilgrim")
-            .to_owned(),
-        annex: made,
-        ..JobOptions::default()
-    };
     let program_file = crate::program::post::dialect(&report.control)
         .map(|d| format!("program.{}", d.extension))
         .ok_or_else(|| {
@@ -483,6 +464,38 @@ pub fn compensate(
         .map_err(|e| Error::Read(format!("{shown}/program.json: {e}")))?;
     let old_toolpath: Toolpath = serde_json::from_str(&read("toolpath.json")?)
         .map_err(|e| Error::Read(format!("{shown}/toolpath.json: {e}")))?;
+    let old_passes = pass_blocks(&old_program, &old_toolpath.passes);
+    // Once the corrected run's verification has predicted its part: the
+    // annex's tables made again with the part after, and how far the
+    // corrected program's path moved, per pass (its chart), kept for
+    // compensation.json.
+    let (column, names) = (nominal.coordinate, (coordinate.to_owned(), unit.to_owned()));
+    let (hook_quantities, hook_records) = (quantities.clone(), records.clone());
+    let moved_slot: std::sync::Arc<std::sync::Mutex<Option<Moved>>> = Default::default();
+    let slot = moved_slot.clone();
+    made.finish = Some(super::TablesHook(std::sync::Arc::new(
+        move |tables, program, passes| {
+            let mut records = hook_records.clone();
+            after_run(&mut records, &hook_quantities, column, tables);
+            let names = (names.0.as_str(), names.1.as_str());
+            tables.extend(annex(column, &hook_quantities, &records, names).tables);
+            let moved = path_moved(&old_program, &old_passes, program, passes);
+            let plots = moved.as_ref().map(|m| moves_chart(m, tables));
+            if let Ok(mut s) = slot.lock() {
+                *s = moved;
+            }
+            plots.into_iter().collect()
+        },
+    )));
+    let job_options = JobOptions {
+        program_name: script
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("pilgrim")
+            .to_owned(),
+        annex: made,
+        ..JobOptions::default()
+    };
     let mut out = run_job(&family, &machine, &sources, &job_options, &mut |_| {})?;
     after_run(
         &mut records,
@@ -500,15 +513,10 @@ pub fn compensate(
         quantities: records,
         not_measured,
         program: {
-            let moved = path_moved(
-                &old_program,
-                &pass_blocks(&old_program, &old_toolpath.passes),
-                &out.program,
-                &pass_blocks(&out.program, &out.toolpath.passes),
-            );
+            let moved = moved_slot.lock().ok().and_then(|mut s| s.take());
             ProgramChange {
-                path_moved: moved.as_ref().map(|m| m.0.clone()),
-                blocks_moved: moved.map(|m| m.1),
+                path_moved: moved.as_ref().map(|m| m.largest.clone()),
+                blocks_moved: moved.map(|m| m.blocks),
                 ..change(
                     &program_file,
                     &before,
@@ -603,9 +611,6 @@ fn after_run(
         r.max_expected_after_mm = largest(r.places.iter().map(|p| p.expected_after));
     }
 }
-
-/// Tables by name, each its columns by name.
-type Tables = BTreeMap<String, BTreeMap<String, Vec<f64>>>;
 
 /// The tables and charts the corrected run's report and page show: per
 /// quantity along the coordinate, its measured error, fit, the target's
@@ -740,14 +745,15 @@ fn path_moved(
     before_passes: &[ProgramPass],
     after: &AxisProgram,
     after_passes: &[ProgramPass],
-) -> Option<(BTreeMap<String, f64>, usize)> {
+) -> Option<Moved> {
     if before.axes != after.axes || before_passes.len() != after_passes.len() {
         return None;
     }
     let n = after.axes.len();
-    let mut moved: Vec<f64> = vec![0.0; n];
+    let mut by_pass: Vec<Vec<f64>> = Vec::with_capacity(after_passes.len());
     let mut blocks = 0;
     for (p, q) in before_passes.iter().zip(after_passes) {
+        let mut moved: Vec<f64> = vec![0.0; n];
         let mut line: Vec<&[f64]> = before
             .blocks
             .get(p.blocks.clone())?
@@ -800,16 +806,65 @@ fn path_moved(
                 *m = m.max((v[i] - line[k][i] - dirs[k].0[i] * t).abs());
             }
         }
+        by_pass.push(moved);
     }
-    Some((
-        after
-            .axes
-            .iter()
-            .map(|a| a.name.clone())
-            .zip(moved)
-            .collect(),
+    let names: Vec<String> = after.axes.iter().map(|a| a.name.clone()).collect();
+    let largest = (0..n)
+        .map(|i| by_pass.iter().map(|m| m[i]).fold(0.0, f64::max))
+        .collect::<Vec<f64>>();
+    Some(Moved {
+        largest: names.iter().cloned().zip(largest).collect(),
         blocks,
-    ))
+        axes: names,
+        by_pass,
+    })
+}
+
+/// How far a corrected program's path moved from the first's
+/// ([`path_moved`]).
+#[derive(Debug, Clone)]
+struct Moved {
+    /// The largest move of each axis.
+    largest: BTreeMap<String, f64>,
+    /// The blocks moved more than [`MOVED`].
+    blocks: usize,
+    /// The axes, in the program's order.
+    axes: Vec<String>,
+    /// Each pass's largest move per axis (mm), in that order.
+    by_pass: Vec<Vec<f64>>,
+}
+
+/// The table `compensation_moves` of `moved` (each pass's largest move
+/// per axis, um) added to `tables`, and its chart.
+fn moves_chart(moved: &Moved, tables: &mut Tables) -> crate::toolpath::PlotSpec {
+    const TABLE: &str = "compensation_moves";
+    let mut table = BTreeMap::from([(
+        "pass".to_owned(),
+        (1..=moved.by_pass.len()).map(|k| k as f64).collect(),
+    )]);
+    let mut y = Vec::new();
+    for (i, axis) in moved.axes.iter().enumerate() {
+        let column = format!("{axis}_um");
+        table.insert(
+            column.clone(),
+            moved.by_pass.iter().map(|m| 1e3 * m[i]).collect(),
+        );
+        y.push(column);
+    }
+    tables.insert(TABLE.into(), table);
+    crate::toolpath::PlotSpec {
+        file: TABLE.into(),
+        title: format!(
+            "How far the corrected program's path moved from the first's, each pass's largest per axis ({} blocks moved more than {} um)",
+            moved.blocks,
+            1e3 * MOVED
+        ),
+        table: TABLE.into(),
+        x: "pass".into(),
+        y,
+        x_label: "pass".into(),
+        y_label: "moved, um (deg on a rotary axis: mdeg)".into(),
+    }
 }
 
 /// How many segments either side of the last block's nearest one a block's

@@ -77,22 +77,27 @@ pub struct Annex {
     /// Called with the run's tables once its verification has added to
     /// them, before anything is drawn: the caller's tables finished from
     /// what the run found (a compensated run's part after, from its own
-    /// prediction).
+    /// prediction; how far its program moved), and charts of them.
     pub finish: Option<TablesHook>,
 }
 
-/// A caller's function over a run's tables ([`Annex::finish`]); copies
-/// share it, and are equal only to themselves.
+/// The tables a run keeps by name, each its columns by name.
+pub type Tables = std::collections::BTreeMap<String, std::collections::BTreeMap<String, Vec<f64>>>;
+
+/// A caller's function over a run's tables, given its program and its
+/// passes' blocks ([`Annex::finish`]): it may add to the tables and
+/// returns charts of them to draw besides. Copies share it, and are equal
+/// only to themselves.
 #[derive(Clone)]
 #[allow(clippy::type_complexity)]
 pub struct TablesHook(
     pub  std::sync::Arc<
         dyn Fn(
-                &mut std::collections::BTreeMap<
-                    String,
-                    std::collections::BTreeMap<String, Vec<f64>>,
-                >,
-            ) + Send
+                &mut Tables,
+                &AxisProgram,
+                &[crate::program::ProgramPass],
+            ) -> Vec<crate::toolpath::PlotSpec>
+            + Send
             + Sync,
     >,
 );
@@ -760,9 +765,10 @@ fn run_on(
     if let Some(o) = &outcome {
         o.extend_tables(&mut report.tables);
     }
-    if let Some(finish) = &options.annex.finish {
-        (finish.0)(&mut report.tables);
-    }
+    let finishing_plots = match &options.annex.finish {
+        Some(finish) => (finish.0)(&mut report.tables, &program, &passes),
+        None => Vec::new(),
+    };
     if let Some(o) = &outcome {
         let ctx = FilesContext {
             replay: replay_ctx,
@@ -804,7 +810,7 @@ fn run_on(
         tables: report.tables.clone(),
         ..toolpath.clone()
     };
-    for plot in &toolpath.plots {
+    for plot in toolpath.plots.iter().chain(&finishing_plots) {
         let text = crate::chart::chart_svg(&charted, plot).map_err(|message| {
             Error::Family(crate::family::FamilyError::Contract {
                 family: family.name().to_owned(),
