@@ -398,7 +398,8 @@ fn bad_measurements_are_refused_and_nothing_is_written() {
 /// proportion to its unsupported length's cube (a cantilever from the
 /// chuck's side at z = -300, 4 um at the far end), in the loop: the first
 /// program replayed with the wheel at z meeting the part given way by
-/// `bend(z)`, measured every 10 mm to 0.1 um of diameter, compensated
+/// `bend(z)`, measured every 10 mm to 0.1 um of diameter (at two angular
+/// positions 1 um apart: out of round, averaged and said), compensated
 /// with the measurement's uncertainty stated as 0.01 um; the smoothing
 /// spline follows the curve (the correction within 0.1 um of the
 /// deflection's negative), and the corrected program replayed with the
@@ -418,14 +419,18 @@ fn a_deflection_is_corrected_along_its_curve() {
         .unwrap();
     let before = off_nominal(&finish_with(&run, "program.mpf", &fine, &bent), &fine);
     assert!(before > 3.0 * tolerance, "before: {before}");
+    // Measured at two angular positions, 1 um apart on the radius (out of
+    // round): averaged, and said.
     let measured = dir.join("bent.csv");
-    std::fs::write(
-        &measured,
-        bench_table(&finish_with(&run, "program.mpf", &bench_places(), &bent)),
-    )
-    .unwrap();
+    let mut t = String::from("z_mm,angle_deg,d_mm\n");
+    let bench = finish_with(&run, "program.mpf", &bench_places(), &bent);
+    for (z, (hi, _)) in bench_places().iter().zip(&bench) {
+        let d = 2.0 * hi;
+        t += &format!("{z:.1},0,{:.4}\n{z:.1},90,{:.4}\n", d + 0.001, d - 0.001);
+    }
+    std::fs::write(&measured, t).unwrap();
     let out = dir.join("corrected");
-    let (code, _, err) = pilgrim(&[
+    let (code, said, err) = pilgrim(&[
         "compensate",
         s(&run),
         "--measured",
@@ -442,8 +447,14 @@ fn a_deflection_is_corrected_along_its_curve() {
         "{}",
         report["verdict"]
     );
+    assert!(
+        said.contains("the rows at one place differ by up to 0.0010 mm: out of round"),
+        "{said}"
+    );
     let worst = correction_off(&out, &bend);
     let c = json(&out.join("compensation.json"));
+    let spread = c["quantities"][0]["max_spread_mm"].as_f64().unwrap();
+    assert!((spread - 0.001).abs() < 1e-9, "{spread}");
     assert!(
         c["quantities"][0]["smooth"].as_f64().unwrap() > 0.0,
         "a curve, not the line"

@@ -45,6 +45,10 @@ pub struct Measured {
     pub value: Vec<Real>,
     /// How many rows each place averages.
     pub rows: Vec<usize>,
+    /// How far the rows at each place differ, the largest less the least
+    /// (0 for one row): a mandrel measured at several angular positions is
+    /// that far out of round there, which its mean does not show.
+    pub spread: Vec<Real>,
 }
 
 /// Reads `table` as `spec` asks.
@@ -103,7 +107,10 @@ pub fn read_measured(table: &Table, spec: &MeasuredSpec<'_>) -> Result<Measured,
         at: Vec::new(),
         value: Vec::new(),
         rows: Vec::new(),
+        spread: Vec::new(),
     };
+    // Each place's least and largest row.
+    let mut bounds: Vec<(Real, Real)> = Vec::new();
     for (s, v) in rows {
         match m.at.last() {
             Some(&last) if last == s => {
@@ -111,14 +118,17 @@ pub fn read_measured(table: &Table, spec: &MeasuredSpec<'_>) -> Result<Measured,
                 let n = m.rows[k] as Real;
                 m.value[k] = (m.value[k] * n + v) / (n + 1.0);
                 m.rows[k] += 1;
+                bounds[k] = (bounds[k].0.min(v), bounds[k].1.max(v));
             }
             _ => {
                 m.at.push(s);
                 m.value.push(v);
                 m.rows.push(1);
+                bounds.push((v, v));
             }
         }
     }
+    m.spread = bounds.iter().map(|(lo, hi)| hi - lo).collect();
     if m.at.is_empty() {
         let (c, want) = spec.select.unwrap_or(("", 0.0));
         return Err(CompensateError::TooSparse {
@@ -186,6 +196,8 @@ mod tests {
         assert_eq!(m.at, vec![0.0, 25.0, 50.0, 75.0, 100.0]);
         assert_eq!(m.rows, vec![1, 1, 2, 1, 1]);
         assert!((m.value[2] - 20.001).abs() < 1e-12, "{:?}", m.value);
+        // Out of round by 2 um on the radius at z = 50.
+        assert!((m.spread[2] - 0.002).abs() < 1e-12 && m.spread[0] == 0.0);
         assert!((m.value[1] - 19.501).abs() < 1e-12);
     }
 

@@ -57,6 +57,9 @@ pub struct Place {
     pub at: f64,
     /// The quantity measured (the rows there averaged).
     pub measured: f64,
+    /// How far the rows there differ (several angular positions: out of
+    /// round), the largest less the least: averaged, not corrected.
+    pub spread: f64,
     /// The nominal there.
     pub nominal: f64,
     /// Measured minus nominal: the part's error.
@@ -99,6 +102,9 @@ pub struct QuantityRecord {
     pub rms_residual_mm: f64,
     /// The largest measured error (mm).
     pub max_error_mm: f64,
+    /// The largest spread of the rows at one place (mm): out of round,
+    /// averaged, not corrected.
+    pub max_spread_mm: f64,
     /// The largest correction, an earlier one kept included (mm).
     pub max_correction_mm: f64,
     /// The largest error expected after the correction, the same error
@@ -139,8 +145,16 @@ impl Compensation {
             .quantities
             .iter()
             .map(|q| {
+                let spread = if q.max_spread_mm > 0.0 {
+                    format!(
+                        " (the rows at one place differ by up to {:.4} mm: out of round, averaged, not corrected)",
+                        q.max_spread_mm
+                    )
+                } else {
+                    String::new()
+                };
                 format!(
-                    "{}: {} places, the error up to {:.4} mm {} (RMS residual {:.4} mm), the target moved by up to {:.4} mm, {:.4} mm expected after",
+                    "{}: {} places{spread}, the error up to {:.4} mm {} (RMS residual {:.4} mm), the target moved by up to {:.4} mm, {:.4} mm expected after",
                     q.name,
                     q.places.len(),
                     q.max_error_mm,
@@ -421,6 +435,7 @@ pub fn compensate(
             .map(|i| Place {
                 at: f.m.at[i],
                 measured: f.m.value[i],
+                spread: f.m.spread[i],
                 nominal: f.at_nominal[i],
                 error: f.error[i],
                 predicted: f.predicted.as_ref().map(|p| p[i]),
@@ -439,6 +454,7 @@ pub fn compensate(
             smooth: f.fit.smooth,
             rms_residual_mm: f.fit.rms_residual,
             max_error_mm: largest(f.error.iter().copied()),
+            max_spread_mm: largest(f.m.spread.iter().copied()),
             max_correction_mm: largest(total.iter().copied()),
             max_expected_after_mm: largest(places.iter().map(|p| p.expected_after)),
             places,
