@@ -146,8 +146,9 @@ impl Pass {
         Self { z, x, t }
     }
 
-    /// The wheel's reference at time `t` (clamped to the pass).
-    pub(crate) fn at(&self, t: f64) -> (f64, f64) {
+    /// Where the pass is at time `t` (clamped to it): the move `k` (from
+    /// point `k - 1` to `k`) and how far along it (0 to 1).
+    pub(crate) fn segment_at(&self, t: f64) -> (usize, f64) {
         let k = self
             .t
             .partition_point(|&v| v < t)
@@ -158,6 +159,12 @@ impl Pass {
         } else {
             1.0
         };
+        (k, s)
+    }
+
+    /// The wheel's reference at time `t` (clamped to the pass).
+    pub(crate) fn at(&self, t: f64) -> (f64, f64) {
+        let (k, s) = self.segment_at(t);
         (
             self.z[k - 1] + s * (self.z[k] - self.z[k - 1]),
             self.x[k - 1] + s * (self.x[k] - self.x[k - 1]),
