@@ -78,16 +78,7 @@ fn finish_with(
     }
     let total = length[length.len() - 1];
     let at_time = |t: f64| {
-        let i = pass
-            .t
-            .partition_point(|&v| v < t)
-            .clamp(1, pass.t.len() - 1);
-        let (t0, t1) = (pass.t[i - 1], pass.t[i]);
-        let s = if t1 > t0 {
-            ((t - t0) / (t1 - t0)).clamp(0.0, 1.0)
-        } else {
-            1.0
-        };
+        let (i, s) = pass.segment_at(t);
         let share = (length[i - 1] + s * (length[i] - length[i - 1])) / total;
         error(share, pass.at(t).0)
     };
@@ -327,8 +318,8 @@ fn the_mandrel_is_corrected_by_its_measured_error() {
 
 /// Bad measurements and asks are refused, naming what, and nothing is
 /// written: a row outside the part, a stretch left unmeasured, a
-/// correction beyond its limit (naming where), a family that takes no
-/// correction.
+/// correction beyond its limit (naming where), one the wheel cannot
+/// follow (naming where), a family that takes no correction.
 #[test]
 fn bad_measurements_are_refused_and_nothing_is_written() {
     let dir = scratch("compensate", "bad");
@@ -375,6 +366,40 @@ fn bad_measurements_are_refused_and_nothing_is_written() {
         assert!(err.contains(says), "{name}: {err}");
         assert!(!out.exists(), "{name}: {} written", out.display());
     }
+    // A narrow bump the part was measured with (60 um, sigma 0.8 mm at z
+    // = 200, measured every 0.25 mm over it, held to 0.1 um): the target
+    // corrected by it bends tighter than the wheel's 20 mm rounding can
+    // follow, and the wheel's path refuses it, named by z.
+    let mut t = String::from("z_mm,d_mm\n");
+    let mut zs: Vec<f64> = (0..=44).map(|i| 10.0 * i as f64).collect();
+    zs.extend((0..=32).map(|i| 196.0 + 0.25 * i as f64));
+    zs.sort_by(f64::total_cmp);
+    zs.dedup();
+    for z in zs {
+        let bump = 0.06 * (-0.5 * ((z - 200.0) / 0.8).powi(2)).exp();
+        t += &format!("{z},{:.5}\n", law(z) + 2.0 * bump);
+    }
+    let f = dir.join("bump.csv");
+    std::fs::write(&f, t).unwrap();
+    let out = dir.join("bump.out");
+    let (code, _, err) = pilgrim(&[
+        "compensate",
+        s(&run),
+        "--measured",
+        s(&f),
+        "--uncertainty",
+        "0.0001",
+        "--out",
+        s(&out),
+    ]);
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("bump.csv is refused")
+            && err.contains("tool radius 20 mm exceeds the profile's radius of curvature")
+            && err.contains("z = 200.0000"),
+        "{err}"
+    );
+    assert!(!out.exists() && !dir.join("bump.out.failed").exists());
     // The largest's place: the first z of the correction's grid (every
     // 1.1 mm) where it passes 0.1 mm on radius (0.2 z / 440, less the
     // finish's own half micrometre above the nominal, which the run's
@@ -675,6 +700,7 @@ fn bend(z: f64) -> f64 {
 /// `pilgrim verify` against the default thread (correction none), its
 /// report read whatever its verdict (a bent part may fail it).
 fn bent_pitch_diameters(dir: &Path, program: &Path, at: &[f64]) -> Vec<Vec<f64>> {
+    std::fs::create_dir_all(dir).unwrap();
     let text = std::fs::read_to_string(program).unwrap();
     at.iter()
         .enumerate()
@@ -743,12 +769,11 @@ fn a_thread_is_corrected_start_by_start() {
     // The first program on the bent bar: its pitch diameter the straight
     // bar's plus the bend, to the program's last digit (1 um on X).
     let places = [-2.0, -8.0, -14.0, -20.0, -26.0];
-    let bent = dir.join("before");
-    std::fs::create_dir_all(&bent).unwrap();
-    let before: Vec<f64> = bent_pitch_diameters(&bent, &run.join("program.nc"), &places)
-        .into_iter()
-        .map(|v| v[0])
-        .collect();
+    let before: Vec<f64> =
+        bent_pitch_diameters(&dir.join("before"), &run.join("program.nc"), &places)
+            .into_iter()
+            .map(|v| v[0])
+            .collect();
     for (z, d2) in places.iter().zip(&before) {
         assert!((d2 - cut - bend(*z)).abs() < 1.5e-3, "z {z}: {d2}");
     }
@@ -791,12 +816,11 @@ fn a_thread_is_corrected_start_by_start() {
         .as_f64()
         .unwrap();
     assert!((d2 - (aim - mean)).abs() < 0.01, "{d2}");
-    let bent = dir.join("after");
-    std::fs::create_dir_all(&bent).unwrap();
-    let after: Vec<f64> = bent_pitch_diameters(&bent, &out.join("program.nc"), &places)
-        .into_iter()
-        .map(|v| v[0])
-        .collect();
+    let after: Vec<f64> =
+        bent_pitch_diameters(&dir.join("after"), &out.join("program.nc"), &places)
+            .into_iter()
+            .map(|v| v[0])
+            .collect();
     for (z, part) in places.iter().zip(&after) {
         assert!(
             *part > lo && *part < hi,

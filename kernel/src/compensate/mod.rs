@@ -160,4 +160,13 @@ pub enum CompensateError {
     /// The fit could not be made.
     #[error("the measured error could not be fitted: {0}")]
     Fit(String),
+    /// The job refused the corrected target (a wheel that cannot follow
+    /// it, named where).
+    #[error("the target corrected by {file} is refused: {why} (the correction bends the part more than the process can follow: look at the measurement, or state its uncertainty, --uncertainty, for a smoother fit)")]
+    Corrected {
+        /// The measurement's file.
+        file: String,
+        /// The job's refusal.
+        why: String,
+    },
 }

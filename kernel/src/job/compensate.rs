@@ -512,7 +512,16 @@ pub fn compensate(
         annex: made,
         ..JobOptions::default()
     };
-    let mut out = run_job(&family, &machine, &sources, &job_options, &mut |_| {})?;
+    let mut out =
+        run_job(&family, &machine, &sources, &job_options, &mut |_| {}).map_err(|e| match e {
+            // A corrected run that fails its checks leaves its report.
+            Error::Failed(failed) => Error::Failed(failed),
+            refused => CompensateError::Corrected {
+                file: measured.source().to_owned(),
+                why: refused.to_string(),
+            }
+            .into(),
+        })?;
     after_run(
         &mut records,
         &quantities,

@@ -585,11 +585,12 @@ impl Profile {
     }
 
     /// The profile moved by `d` along x: each node's x plus `d` at its z
-    /// (held at `d`'s end values beyond its range), its slopes with `d`'s
-    /// (a central difference over 1e-3 of z), its second derivatives kept
-    /// (a correction of micrometres bends it by nothing the wheel's
-    /// rounding sees). A target corrected by a measured error
-    /// (`pilgrim compensate`).
+    /// (held at `d`'s end values beyond its range), its slopes and second
+    /// derivatives with `d`'s (central differences over 1e-3 of z; a kink
+    /// stays one). A target corrected by a measured error (`pilgrim
+    /// compensate`): a correction that bends the target more than a
+    /// wheel's rounding can follow is then refused by the curvature check
+    /// of the wheel's path ([`crate::offset::equidistant`]), named by z.
     ///
     /// # Failures
     /// `d` failing to evaluate.
@@ -598,12 +599,14 @@ impl Profile {
         let at = |z: Real| d.eval(z.clamp(lo, hi));
         let mut x = Vec::with_capacity(self.len());
         let mut slopes = self.slopes().into_owned();
+        let mut d2x = self.second_derivatives().into_owned();
+        let h = 1e-3;
         for (i, &z) in self.z.iter().enumerate() {
-            x.push(self.x[i] + at(z)?);
-            let h = 1e-3;
-            slopes[i] += (at(z + h)? - at(z - h)?) / (2.0 * h);
+            let (before, here, after) = (at(z - h)?, at(z)?, at(z + h)?);
+            x.push(self.x[i] + here);
+            slopes[i] += (after - before) / (2.0 * h);
+            d2x[i] += (after - 2.0 * here + before) / (h * h);
         }
-        let d2x = self.second_derivatives().into_owned();
         Profile::with_derivatives(self.z.clone(), x, slopes, d2x)
     }
 
@@ -693,6 +696,33 @@ pub(crate) fn hermite(t: &[Real], v: &[Real], s: &[Real], tq: Real) -> Real {
 mod tests {
     use super::*;
     use crate::assert_near;
+
+    /// A profile moved by a narrow dip bends as the dip does: its second
+    /// derivatives are the dip's too, so a wheel rounder than the dip is
+    /// refused by the equidistant's curvature check, naming where, rather
+    /// than folding its path.
+    #[test]
+    fn an_offset_bends_the_profile_by_its_own_curvature() {
+        let z: Vec<Real> = (0..=100).map(|i| i as Real).collect();
+        let line = Profile::with_derivatives(
+            z.clone(),
+            vec![20.0; z.len()],
+            vec![0.0; z.len()],
+            vec![0.0; z.len()],
+        )
+        .unwrap();
+        // A dip 0.06 mm deep, sigma 0.8 mm, at z = 50: x'' = 0.06 / 0.64
+        // at its bottom.
+        let dz: Vec<Real> = (0..=400).map(|i| 40.0 + 0.05 * i as Real).collect();
+        let dip = |z: Real| -0.06 * (-0.5 * ((z - 50.0) / 0.8).powi(2)).exp();
+        let d = Profile::new(dz.clone(), dz.iter().map(|&z| dip(z)).collect()).unwrap();
+        let moved = line.offset_by(&d).unwrap();
+        assert_near!(moved.second_derivatives()[50], 0.06 / 0.64, 1e-3);
+        let e = crate::offset::equidistant(&moved, 20.0, crate::offset::Side::Outside)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("z = 50"), "{e}");
+    }
 
     fn cubic() -> Profile {
         // x = z^3 - z on a non-uniform grid.
