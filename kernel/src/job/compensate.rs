@@ -670,28 +670,36 @@ fn annex(
             )
         };
         let p = &r.places;
-        annex.tables.insert(
-            name.clone(),
-            BTreeMap::from([
-                (column.to_owned(), p.iter().map(|p| p.at).collect()),
-                (columns[0].into(), um(&mut p.iter().map(|p| p.error))),
-                (columns[1].into(), um(&mut p.iter().map(|p| p.fitted))),
-                (columns[2].into(), um(&mut p.iter().map(|p| p.correction))),
-                (
-                    columns[3].into(),
-                    um(&mut p.iter().map(|p| p.expected_after)),
-                ),
-            ]),
-        );
+        let mut table = BTreeMap::from([
+            (column.to_owned(), p.iter().map(|p| p.at).collect()),
+            (columns[0].into(), um(&mut p.iter().map(|p| p.error))),
+            (columns[1].into(), um(&mut p.iter().map(|p| p.fitted))),
+            (columns[2].into(), um(&mut p.iter().map(|p| p.correction))),
+            (
+                columns[3].into(),
+                um(&mut p.iter().map(|p| p.expected_after)),
+            ),
+        ]);
+        let mut y: Vec<String> = columns.iter().map(|c| (*c).to_owned()).collect();
+        // Beside the measured error, the one the run's replay predicted.
+        if let Some(predicted) = p
+            .iter()
+            .map(|p| p.predicted.map(|v| v - p.nominal))
+            .collect::<Option<Vec<f64>>>()
+        {
+            table.insert("predicted_error_um".into(), um(&mut predicted.into_iter()));
+            y.insert(1, "predicted_error_um".into());
+        }
+        annex.tables.insert(name.clone(), table);
         annex.plots.push(crate::toolpath::PlotSpec {
             file: name.clone(),
             title: format!(
-                "The measured {}'s error from the nominal, its fit, the correction and the error expected after it",
+                "The {}'s error from the nominal, measured and as the run predicted it; the fit of their difference, the correction and the error expected after it",
                 r.name
             ),
             table: name,
             x: column.to_owned(),
-            y: columns.iter().map(|c| (*c).to_owned()).collect(),
+            y,
             x_label: format!("{coordinate}, {unit}"),
             y_label: format!("{}, um", r.name),
         });
