@@ -74,7 +74,7 @@ fn run_within(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
         max_memory_mb: args.script_memory_mb,
         ..Limits::default()
     };
-    let family = load_family(&args.script, args.params.as_deref(), &limits)?;
+    let family = load_family(&args.script, args.params.as_deref(), &limits, Vec::new())?;
     let sources = sources(Vec::new(), args.params.as_deref(), &args.sets)?;
     let machine = catalog
         .open(&machine_spec(args.machine.as_deref(), &family)?)
@@ -146,8 +146,12 @@ fn load_family(
     script: &Path,
     params: Option<&Path>,
     limits: &Limits,
+    tables: Vec<(String, String)>,
 ) -> Result<ScriptFamily, String> {
-    let mut access = Access::default();
+    let mut access = Access {
+        tables,
+        ..Access::default()
+    };
     if let Some(dir) = params.and_then(Path::parent) {
         access.input_dirs.push(if dir.as_os_str().is_empty() {
             PathBuf::from(".")
@@ -243,7 +247,12 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
                 ))
             }
         };
-        let family = load_family(&script, args.params.as_deref(), &limits)?;
+        // A compensated run's correction, read beside its files.
+        let tables = job::run_correction(&run, &report)
+            .map_err(|e| e.to_string())?
+            .into_iter()
+            .collect();
+        let family = load_family(&script, args.params.as_deref(), &limits, tables)?;
         let label = format!("{}/report.json", args.target.display());
         let first = vec![report.params_source(&label)?];
         let shown = args.target.display().to_string();
@@ -268,7 +277,7 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
                 args.target.display()
             )
         })?;
-        let family = load_family(script, args.params.as_deref(), &limits)?;
+        let family = load_family(script, args.params.as_deref(), &limits, Vec::new())?;
         let spec = machine_spec(args.machine.as_deref(), &family)?;
         let text =
             pilgrim_kernel::files::read_text(&args.target, pilgrim_kernel::files::MAX_DATA_BYTES)

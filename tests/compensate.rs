@@ -290,6 +290,10 @@ fn the_mandrel_is_corrected_by_its_measured_error() {
     assert!(out.join("compensation.svg").is_file() && page.contains("alt=\"compensation.svg\""));
     common::check_page(&out, "program.mpf", 8.0);
     common::leave_page_for_chromium(&out, "compensated-mandrel");
+    // The corrected run verified again as it stands (after a hand edit):
+    // its correction read beside its files.
+    let (code, _, err) = pilgrim(&["verify", s(&out), "--out", s(&dir.join("reverified"))]);
+    assert_eq!(code, 0, "{err}");
     // The corrected run's part measured in its turn, the wear repeating:
     // compensated again, the correction is kept (its unmodelled error is
     // the wear less the correction: nothing).

@@ -279,11 +279,12 @@ pub fn compensate(
         })?;
     // A compensated run's correction: its target was the nominal moved by
     // it, and the new correction replaces it (see `unmodelled`).
-    let previous = match report.parameters.get(CORRECTION).map(|p| &p.value) {
-        Some(crate::params::ParamValue::Text(name)) if !name.is_empty() => Some(
-            crate::profile::read_table_str(&read(name)?, &format!("{shown}/{name}"))?,
-        ),
-        _ => None,
+    let previous = match run_correction(&run, &report)? {
+        Some((name, text)) => Some(crate::profile::read_table_str(
+            &text,
+            &format!("{shown}/{name}"),
+        )?),
+        None => None,
     };
     let previous_at = |q: &Quantity, at: &[f64]| -> Result<Vec<f64>, Error> {
         match &previous {
@@ -561,6 +562,25 @@ pub fn compensate(
             .into_bytes(),
     ));
     Ok((out, record))
+}
+
+/// The correction table a run keeps beside its files, as its parameters
+/// name it (a compensated run's [`CORRECTION_FILE`]): `(name, text)`, to
+/// give its family ([`crate::script::Access::tables`]) when the run is
+/// made or verified again; none where the run took no correction.
+///
+/// # Failures
+/// The table named but not there, or unreadable.
+pub fn run_correction(run: &RunDir, report: &Report) -> Result<Option<(String, String)>, Error> {
+    match report.parameters.get(CORRECTION).map(|p| &p.value) {
+        Some(crate::params::ParamValue::Text(name)) if !name.is_empty() => {
+            let text = run
+                .read_text(name, crate::files::MAX_DATA_BYTES)
+                .map_err(|e| Error::Read(e.to_string()))?;
+            Ok(Some((name.clone(), text)))
+        }
+        _ => Ok(None),
+    }
 }
 
 /// One quantity measured and fitted.

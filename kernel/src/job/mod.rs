@@ -20,7 +20,8 @@ mod spin;
 
 pub use crate::report::{axis_ranges, block_table, FailedRun, Report, ReportParam};
 pub use compensate::{
-    compensate, CompensateOptions, Compensation, Place, ProgramChange, CORRECTION, CORRECTION_FILE,
+    compensate, run_correction, CompensateOptions, Compensation, Place, ProgramChange, CORRECTION,
+    CORRECTION_FILE,
 };
 pub use export::{export, run_machine, Exported};
 pub use scene::{default_pose_block, BodyFile, Formats, PosePlace, SceneError};
