@@ -180,8 +180,9 @@ fn json(path: &Path) -> serde_json::Value {
 /// of the nominal on every generatrix's highest and lowest, every 0.5 mm,
 /// and `compensation.json`'s expected part after is that replay's within
 /// 0.1 um. The wheel's X and the rest's U moved by the correction, Z by
-/// under a micrometre. Measured in its turn with the wear repeating, the
-/// corrected run compensated again keeps its correction.
+/// under a micrometre. Measured in its turn with the wear repeating (a
+/// workbook this time), the corrected run compensated again keeps its
+/// correction.
 #[test]
 fn the_mandrel_is_corrected_by_its_measured_error() {
     let dir = scratch("compensate", "mandrel");
@@ -297,12 +298,20 @@ fn the_mandrel_is_corrected_by_its_measured_error() {
     // The corrected run's part measured in its turn, the wear repeating:
     // compensated again, the correction is kept (its unmodelled error is
     // the wear less the correction: nothing).
-    let again = dir.join("again.csv");
-    std::fs::write(
-        &again,
-        bench_table(&finish_with(&out, "program.mpf", &bench_places(), &worn)),
-    )
-    .unwrap();
+    // Measured on a CMM that writes a workbook: z_mm and d_mm as headers.
+    let again = dir.join("again.xlsx");
+    let mut book = rust_xlsxwriter::Workbook::new();
+    let sheet = book.add_worksheet();
+    sheet.write_string(0, 0, "z_mm").unwrap();
+    sheet.write_string(0, 1, "d_mm").unwrap();
+    let part = finish_with(&out, "program.mpf", &bench_places(), &worn);
+    for (row, (z, (hi, _))) in (1u32..).zip(bench_places().iter().zip(&part)) {
+        sheet.write_number(row, 0, *z).unwrap();
+        sheet
+            .write_number(row, 1, (2e4 * hi).round() / 1e4)
+            .unwrap();
+    }
+    book.save(&again).unwrap();
     let twice = dir.join("twice");
     let (code, _, err) = pilgrim(&[
         "compensate",
