@@ -818,11 +818,16 @@ fn a_thread_is_corrected_start_by_start() {
     // What the replay did not predict: the measured less the simulated cut.
     let mean = rows.iter().map(|r| r.1 - cut).sum::<f64>() / 5.0;
     let table = std::fs::read_to_string(out.join("correction.csv")).unwrap();
-    assert!(table.starts_with("z_mm,dd2_1_mm\n"), "{table}");
+    // The start's place, not measured, left where it was.
+    assert!(table.starts_with("z_mm,dd2_1_mm,dz_1_mm\n"), "{table}");
     for l in table.lines().skip(1) {
-        let dd2: f64 = l.split_once(',').unwrap().1.parse().unwrap();
-        assert!((dd2 + mean).abs() < 1e-6, "{dd2} against {mean}");
+        let v: Vec<f64> = l.split(',').map(|c| c.parse().unwrap()).collect();
+        assert!(
+            (v[1] + mean).abs() < 1e-6 && v[2] == 0.0,
+            "{v:?} against {mean}"
+        );
     }
+    assert!(said.contains("not measured: place"), "{said}");
     // After: the corrected program replayed on the same bent bar, at
     // every place inside 6g's band.
     let d2 = report["thread_verification"]["starts"][0]["pitch_diameter"]
@@ -940,4 +945,115 @@ fn a_thread_is_corrected_start_by_start() {
     let (_, report) = compensated(&nut, &file, &out);
     let moved = aim_of(&report, 0) - aim_of(&first, 0);
     assert!((moved + 0.02).abs() < 2e-3, "the nut: moved {moved}");
+}
+
+/// Tr40x14(P7)'s program with start 2's passes `dz` mm along the axis from
+/// where it puts them (its index late, as a control's start angle off by
+/// as much of the lead leaves it), replayed as its control reads it by
+/// `pilgrim verify` against the thread (correction none), into `out`:
+/// each start's place from where it should stand (mm).
+fn start_two_off(program: &Path, dz: f64, out: &Path) -> Vec<f64> {
+    let mut two = false;
+    let text: String = std::fs::read_to_string(program)
+        .unwrap()
+        .lines()
+        .map(|l| {
+            if l.starts_with('(') {
+                two = l.starts_with("(PASS") && l.contains(", START 2,");
+                return format!("{l}\n");
+            }
+            let words: Vec<String> = l
+                .split_whitespace()
+                .map(|w| match w.strip_prefix('Z') {
+                    Some(v) if two => format!("Z{:.3}", v.parse::<f64>().unwrap() + dz),
+                    _ => w.to_owned(),
+                })
+                .collect();
+            words.join(" ") + "\n"
+        })
+        .collect();
+    let file = out.with_extension("nc");
+    std::fs::write(&file, text).unwrap();
+    pilgrim(&[
+        "verify",
+        s(&file),
+        "--machine",
+        "fanuc-0i-tc",
+        "--family",
+        "scripts/thread.rhai",
+        "--set",
+        "designation=Tr40x14(P7)",
+        "--out",
+        s(out),
+    ]);
+    common::report_of(out)["thread_verification"]["starts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|st| st["position_error"].as_f64().unwrap())
+        .collect()
+}
+
+/// A two-start thread whose second start is cut 30 um along the axis from
+/// its place (its index late), in the loop: measured (each start's place,
+/// `dz_mm`, the mean of its flanks' axial errors at the pitch line),
+/// compensated, start 2's passes move back by it and start 1's stay; the
+/// corrected program replayed with the same error leaves both starts in
+/// their places within a micrometre, where start 2 was 30 um off.
+#[test]
+fn a_start_out_of_its_place_is_moved_back() {
+    let dir = scratch("compensate", "place");
+    let run = dir.join("run");
+    let (code, _, err) = pilgrim(&[
+        "run",
+        "scripts/thread.rhai",
+        "--set",
+        "designation=Tr40x14(P7)",
+        "--out",
+        s(&run),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let before = start_two_off(&run.join("program.nc"), 0.03, &dir.join("before"));
+    assert!(
+        (before[1] - 0.03).abs() < 2e-3 && before[0].abs() < 1e-3,
+        "{before:?}"
+    );
+    let measured = dir.join("places.csv");
+    let mut t = String::from("z_mm,start,dz_mm\n");
+    for (k, dz) in before.iter().enumerate() {
+        t += &format!("-15,{},{dz:.4}\n", k + 1);
+    }
+    std::fs::write(&measured, t).unwrap();
+    let out = dir.join("corrected");
+    let (said, _) = compensated(&run, &measured, &out);
+    assert!(said.contains("start 2's place: 1 places"), "{said}");
+    assert!(
+        said.contains("not measured: start 1's pitch diameter"),
+        "{said}"
+    );
+    let table = std::fs::read_to_string(out.join("correction.csv")).unwrap();
+    assert!(
+        table.starts_with("z_mm,dd2_1_mm,dd2_2_mm,dz_1_mm,dz_2_mm\n"),
+        "{table}"
+    );
+    let row: Vec<f64> = table
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .map(|c| c.parse().unwrap())
+        .collect();
+    assert!(row[1] == 0.0 && row[2] == 0.0, "{row:?}");
+    assert!(
+        row[3].abs() < 1e-3 && (row[4] + 0.03).abs() < 1e-3,
+        "{row:?}"
+    );
+    let after = start_two_off(&out.join("program.nc"), 0.03, &dir.join("after"));
+    assert!(after.iter().all(|p| p.abs() < 1e-3), "after: {after:?}");
+    // The page's chart, per start: start 2 moved back by 30 um.
+    let table = &common::report_of(&out)["tables"]["compensation"];
+    assert_eq!(table["start"], serde_json::json!([1.0, 2.0]));
+    let moved = table["correction_um"][1].as_f64().unwrap();
+    assert!((moved + 30.0).abs() < 1.0, "{table}");
 }

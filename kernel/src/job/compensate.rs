@@ -724,37 +724,52 @@ fn annex(
             y_label: format!("{}, um", r.name),
         });
     }
-    // The quantities corrected by one value, by what selects them.
+    // The quantities corrected by one value, by what selects them: one
+    // table and chart per kind (a thread's starts' pitch diameters, their
+    // places), each named by its quantity's name ("start 2's place").
     let ones: Vec<(&QuantityRecord, Real)> = records
         .iter()
         .filter(|(_, r)| !r.along)
         .map(|(q, r)| (*r, q.select.map_or(1.0, |s| s.1)))
         .collect();
-    if let Some((r0, _)) = ones.first() {
-        let by = records
-            .iter()
-            .find_map(|(q, _)| q.select.map(|s| s.0))
-            .unwrap_or("quantity");
+    let kind = |r: &QuantityRecord| {
+        r.name
+            .rsplit_once("'s ")
+            .map_or(r.name.clone(), |s| s.1.to_owned())
+    };
+    let mut kinds: Vec<String> = ones.iter().map(|(r, _)| kind(r)).collect();
+    kinds.dedup();
+    let by = records
+        .iter()
+        .find_map(|(q, _)| q.select.map(|s| s.0))
+        .unwrap_or("quantity");
+    for quantity in &kinds {
+        let these: Vec<&(&QuantityRecord, Real)> =
+            ones.iter().filter(|(r, _)| &kind(r) == quantity).collect();
+        let name = if kinds.len() == 1 {
+            "compensation".to_owned()
+        } else {
+            format!("compensation_{}", quantity.replace(' ', "_"))
+        };
         let mean = |r: &QuantityRecord, f: &dyn Fn(&Place) -> f64| {
             1e3 * r.places.iter().map(f).sum::<f64>() / r.places.len() as f64
         };
-        let values = |f: &dyn Fn(&Place) -> f64| ones.iter().map(|(r, _)| mean(r, f)).collect();
+        let values = |f: &dyn Fn(&Place) -> f64| these.iter().map(|(r, _)| mean(r, f)).collect();
         annex.tables.insert(
-            "compensation".into(),
+            name.clone(),
             BTreeMap::from([
-                (by.to_owned(), ones.iter().map(|(_, s)| *s).collect()),
+                (by.to_owned(), these.iter().map(|(_, s)| *s).collect()),
                 (columns[0].into(), values(&|p| p.error)),
                 (columns[2].into(), values(&|p| p.correction)),
                 (columns[3].into(), values(&|p| p.expected_after)),
             ]),
         );
-        let quantity = r0.name.rsplit_once("'s ").map_or(r0.name.as_str(), |s| s.1);
         annex.plots.push(crate::toolpath::PlotSpec {
-            file: "compensation".into(),
+            file: name.clone(),
             title: format!(
                 "The measured {quantity}'s error from the nominal (the mean of its places), the correction and the error expected after it, per {by}"
             ),
-            table: "compensation".into(),
+            table: name,
             x: by.to_owned(),
             y: [columns[0], columns[2], columns[3]].iter().map(|c| (*c).to_owned()).collect(),
             x_label: by.to_owned(),

@@ -13,7 +13,7 @@ use crate::family::{
     Verified, Verifier,
 };
 use crate::html::{escape, row};
-use crate::math::fixed;
+use crate::math::{fixed, Real};
 use crate::mesh::SceneError;
 use crate::program::AxisProgram;
 use crate::replay::VerifyError;
@@ -46,28 +46,41 @@ impl Verifier for WormRequest {
     /// (`start`, from 1). Corrected as one value per start: a start's
     /// passes move as one (the section is simulated once for the thread's
     /// length, so a taper along it is not followed).
+    ///
+    /// And each start's place along the axis (`dz_mm`: its space's middle
+    /// at the pitch line from where it should stand, + towards +Z, the
+    /// mean of its two flanks' axial errors there, as a CMM measures
+    /// them), against 0, corrected as one value: its passes move along
+    /// the axis.
     fn nominal(&self) -> Option<crate::compensate::Nominal> {
         let w = &self.section;
         let several = w.starts > 1;
+        let along = vec![-self.length, -0.5 * self.length, 0.0];
+        let quantity = |k: u32, what: &str, values, nominal: Real, key: &str| {
+            Some(crate::compensate::Quantity {
+                name: if several {
+                    format!("start {k}'s {what}")
+                } else {
+                    what.into()
+                },
+                values,
+                select: several.then_some(("start", f64::from(k))),
+                nominal: crate::profile::Profile::new(along.clone(), vec![nominal; 3]).ok()?,
+                along: false,
+                key: format!("{key}_{k}_mm"),
+            })
+        };
         let quantities = (1..=w.starts)
             .map(|k| {
-                Some(crate::compensate::Quantity {
-                    name: if several {
-                        format!("start {k}'s pitch diameter")
-                    } else {
-                        "pitch diameter".into()
-                    },
-                    values: &[("d2_mm", 1.0)],
-                    select: several.then_some(("start", f64::from(k))),
-                    nominal: crate::profile::Profile::new(
-                        vec![-self.length, -0.5 * self.length, 0.0],
-                        vec![w.pitch_diameter; 3],
-                    )
-                    .ok()?,
-                    along: false,
-                    key: format!("dd2_{k}_mm"),
-                })
+                quantity(
+                    k,
+                    "pitch diameter",
+                    &[("d2_mm", 1.0)],
+                    w.pitch_diameter,
+                    "dd2",
+                )
             })
+            .chain((1..=w.starts).map(|k| quantity(k, "place", &[("dz_mm", 1.0)], 0.0, "dz")))
             .collect::<Option<Vec<_>>>()?;
         Some(crate::compensate::Nominal {
             coordinate: "z_mm",
@@ -154,10 +167,14 @@ impl Outcome for WormOutcome {
             let (from, to) = nominal.range;
             let along = vec![from, 0.5 * (from + to), to];
             let mut table = BTreeMap::from([(nominal.coordinate.to_owned(), along)]);
-            for (k, (q, s)) in nominal.quantities.iter().zip(&w.starts).enumerate() {
+            // The quantities are each start's pitch diameter, then each
+            // start's place.
+            let (pitch, place) = nominal.quantities.split_at(w.starts.len());
+            for (k, ((d2, dz), s)) in pitch.iter().zip(place).zip(&w.starts).enumerate() {
                 let aimed = self.request.section.pitch_diameter
                     + self.request.pitch_shift.get(k).copied().unwrap_or(0.0);
-                table.insert(q.key.clone(), vec![s.pitch_diameter - aimed; 3]);
+                table.insert(d2.key.clone(), vec![s.pitch_diameter - aimed; 3]);
+                table.insert(dz.key.clone(), vec![s.position_error; 3]);
             }
             tables.insert(crate::compensate::PREDICTED.into(), table);
         }

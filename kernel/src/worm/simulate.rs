@@ -90,6 +90,10 @@ pub struct WormRequest {
     /// `pilgrim compensate`): start k's aimed space moved radially by half
     /// of it. Empty: none.
     pub pitch_shift: Vec<Real>,
+    /// A measured part's correction of each start's place along the axis
+    /// (mm, + towards +Z; `pilgrim compensate`): start k's aimed space
+    /// moved by it, as its passes are. Empty: none.
+    pub place_shift: Vec<Real>,
 }
 
 impl WormRequest {
@@ -111,6 +115,7 @@ impl WormRequest {
             part: "worm",
             outside_diameter: None,
             pitch_shift: Vec::new(),
+            place_shift: Vec::new(),
         }
     }
 }
@@ -139,6 +144,12 @@ impl WormRequest {
             pitch_shift: self.pitch_shift.iter().map(|d| -d).collect(),
             ..self.clone()
         }
+    }
+
+    /// How far start `k`'s aimed space stands along the axis from its
+    /// nominal place: its place's correction ([`Self::place_shift`]).
+    fn start_shift(&self, k: u32) -> Real {
+        self.place_shift.get(k as usize).copied().unwrap_or(0.0)
     }
 
     /// Start `k`'s section as the cut aims at it: the section aimed at its
@@ -589,9 +600,11 @@ fn nominal_spaces(req: &WormRequest, c0: Real) -> Vec<Vec<[Real; 2]>> {
     let n = if t.form.is_axial() { 1 } else { NOMINAL_CHORDS };
     (-1..=i64::from(t.starts))
         .map(|k| {
-            let c = c0 + k as Real * t.pitch;
-            // The place's start (start_place is its own inverse).
-            let s = req.start_section(t.hand.start_place(k, t.starts));
+            // The place's start (start_place is its own inverse), its
+            // space moved by its corrections.
+            let start = t.hand.start_place(k, t.starts);
+            let c = c0 + k as Real * t.pitch + req.start_shift(start);
+            let s = req.start_section(start);
             let (root, top) = (s.root_diameter / 2.0, s.crest_diameter / 2.0 + 2.0);
             let radii: Vec<Real> = (0..=n)
                 .map(|i| root + (top - root) * i as Real / n as Real)
@@ -1159,7 +1172,8 @@ fn measure(
     let mut out = Vec::new();
     'starts: for k in 0..w.starts {
         // The start's place in the window (modulo the lead).
-        let c = c0 + Real::from(w.hand.start_place(i64::from(k), w.starts)) * px;
+        let c =
+            c0 + Real::from(w.hand.start_place(i64::from(k), w.starts)) * px + req.start_shift(k);
         // The start's aimed space, moved by its correction, and the radii
         // its flanks are measured at.
         let aimed = req.start_section(k);
@@ -1490,6 +1504,7 @@ mod tests {
             part: "thread",
             outside_diameter: None,
             pitch_shift: Vec::new(),
+            place_shift: Vec::new(),
         };
         simulate(&program, &lathe, &Default::default(), &cutter, &req)
     }

@@ -325,20 +325,24 @@ fn verification(m: &Map) -> Result<Verification, Option<String>> {
                 ))
             })?),
         },
-        // A measured part's correction of each start's pitch diameter,
-        // where the script gives it.
-        pitch_shift: match m.get("correction") {
-            None => Vec::new(),
-            Some(d) => match crate::binding::floats::numbers(d, "correction") {
-                Ok(c) if c.len() == section.starts as usize => c.to_vec(),
-                _ => {
-                    return Err(Some(format!(
-                        "fn verify(p): correction must be {} numbers, each start's pitch diameter's (mm), not {d}",
-                        section.starts
-                    )))
-                }
-            },
-        },
+        // A measured part's correction of each start's pitch diameter and
+        // place along the axis, where the script gives them.
+        pitch_shift: per_start(m, "correction", "pitch diameter's", section.starts)?,
+        place_shift: per_start(m, "place_correction", "place's along the axis", section.starts)?,
         section,
     }))
+}
+
+/// The numbers under `key` of a verification's map, one per start (`what`
+/// each is, for the message); none where the script gives none.
+fn per_start(m: &Map, key: &str, what: &str, starts: u32) -> Result<Vec<Real>, Option<String>> {
+    match m.get(key) {
+        None => Ok(Vec::new()),
+        Some(d) => match crate::binding::floats::numbers(d, key) {
+            Ok(c) if c.len() == starts as usize => Ok(c.to_vec()),
+            _ => Err(Some(format!(
+                "fn verify(p): {key} must be {starts} numbers, each start's {what} (mm), not {d}"
+            ))),
+        },
+    }
 }
