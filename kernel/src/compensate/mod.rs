@@ -2,9 +2,10 @@
 //! compensate`.
 //!
 //! A shop measures the finished part (a mandrel's diameters along z on a
-//! measuring bench or a CMM); the measured minus the nominal is the error
-//! the process left (wheel wear, deflection, heat), which the replay of
-//! the program does not model. Fitted smoothly within the measurement's
+//! measuring bench or a CMM); the measured minus the part the replay of
+//! its program predicted ([`PREDICTED`]) is the error the process left
+//! (wheel wear, deflection, heat), which the replay does not model.
+//! Fitted smoothly within the measurement's
 //! stated uncertainty ([`fit_error`]), the error shifts the target the
 //! next run aims at against it ([`ErrorFit::correction`]), bounded.
 //!

@@ -1,6 +1,8 @@
-//! `pilgrim compensate`: a run's finished part measured, the error fitted
-//! within the measurement's uncertainty, the target moved against it, and
-//! the job run again on the corrected target ([`compensate`]). The new run
+//! `pilgrim compensate`: a run's finished part measured, the error its
+//! replay did not predict (the measured minus the part its verification
+//! predicted, the table [`PREDICTED`] in its report) fitted within the
+//! measurement's uncertainty, the target moved against it, and the job
+//! run again on the corrected target ([`compensate`]). The new run
 //! is verified as usual, against the corrected target; `compensation.json`
 //! beside its files holds the measurement, the nominal, the fit, the
 //! correction and the program's changes, `correction.csv` the correction
