@@ -532,46 +532,73 @@ fn shallow_entry(theta: f64) -> f64 {
 /// (correction none), into `out`; its report, whatever its verdict.
 fn held_back(program: &Path, out: &Path) -> serde_json::Value {
     let (mut a, mut grinding) = (0.0, false);
+    let mut by = |l: &str| {
+        if !l.starts_with('N') {
+            return 0.0;
+        }
+        if let Some(v) = common::word(l, 'A') {
+            a = v;
+        }
+        let words: Vec<&str> = l.split_whitespace().collect();
+        if words.contains(&"G1") {
+            grinding = true;
+        } else if words.contains(&"G0") {
+            grinding = false;
+        }
+        if grinding {
+            -shallow_entry(-a)
+        } else {
+            0.0
+        }
+    };
+    let args = [
+        "--machine",
+        "Mannesmann",
+        "--family",
+        "scripts/caliber.rhai",
+    ];
+    replayed_with(program, 'Z', &mut by, out, &args)
+}
+
+/// `program` as the machine runs it with an error of the process: each
+/// block's `axis` word moved by `by(line)` (mm; called on every line in
+/// order, comments too, so that it can follow modal words and pass names;
+/// a word it moves by 0 is kept as written, one it moves is written to
+/// the program's 3 decimals), saved beside `out` and replayed as its
+/// control reads it by `pilgrim verify` with `args` (the machine, the
+/// family, its parameters) into `out`: the report, whatever its verdict.
+fn replayed_with(
+    program: &Path,
+    axis: char,
+    by: &mut dyn FnMut(&str) -> f64,
+    out: &Path,
+    args: &[&str],
+) -> serde_json::Value {
     let text: String = std::fs::read_to_string(program)
         .unwrap()
         .lines()
         .map(|l| {
-            if !l.starts_with('N') {
+            let d = by(l);
+            if d == 0.0 || l.starts_with('(') || l.starts_with(';') {
                 return format!("{l}\n");
             }
-            if let Some(v) = common::word(l, 'A') {
-                a = v;
-            }
-            let words: Vec<&str> = l.split_whitespace().collect();
-            if words.contains(&"G1") {
-                grinding = true;
-            } else if words.contains(&"G0") {
-                grinding = false;
-            }
-            let words: Vec<String> = words
-                .iter()
-                .map(|w| match w.strip_prefix('Z') {
-                    Some(v) if grinding => {
-                        format!("Z{:.3}", v.parse::<f64>().unwrap() - shallow_entry(-a))
-                    }
-                    _ => (*w).to_owned(),
+            let words: Vec<String> = l
+                .split_whitespace()
+                .map(|w| match w.strip_prefix(axis) {
+                    Some(v) => format!("{axis}{:.3}", v.parse::<f64>().unwrap() + d),
+                    None => w.to_owned(),
                 })
                 .collect();
             words.join(" ") + "\n"
         })
         .collect();
-    let file = out.with_extension("mpf");
+    let extension = program.extension().and_then(|e| e.to_str()).unwrap();
+    let file = out.with_extension(extension);
     std::fs::write(&file, text).unwrap();
-    pilgrim(&[
-        "verify",
-        s(&file),
-        "--machine",
-        "Mannesmann",
-        "--family",
-        "scripts/caliber.rhai",
-        "--out",
-        s(out),
-    ]);
+    let mut all = vec!["verify", s(&file)];
+    all.extend(args);
+    all.extend(["--out", s(out)]);
+    pilgrim(&all);
     common::report_of(out)
 }
 
@@ -714,40 +741,18 @@ fn bend(z: f64) -> f64 {
 /// report read whatever its verdict (a bent part may fail it).
 fn bent_pitch_diameters(dir: &Path, program: &Path, at: &[f64]) -> Vec<Vec<f64>> {
     std::fs::create_dir_all(dir).unwrap();
-    let text = std::fs::read_to_string(program).unwrap();
+    let args = [
+        "--machine",
+        "fanuc-0i-tc",
+        "--family",
+        "scripts/thread.rhai",
+    ];
     at.iter()
         .enumerate()
         .map(|(i, &z)| {
-            let bent: String = text
-                .lines()
-                .map(|l| {
-                    if l.starts_with('(') {
-                        return format!("{l}\n");
-                    }
-                    let words: Vec<String> = l
-                        .split_whitespace()
-                        .map(|w| match w.strip_prefix('X') {
-                            Some(v) => format!("X{:.3}", v.parse::<f64>().unwrap() + bend(z)),
-                            None => w.to_owned(),
-                        })
-                        .collect();
-                    words.join(" ") + "\n"
-                })
-                .collect();
-            let file = dir.join(format!("bent-{i}.nc"));
-            std::fs::write(&file, bent).unwrap();
-            let out = dir.join(format!("bent-{i}.verify"));
-            pilgrim(&[
-                "verify",
-                s(&file),
-                "--machine",
-                "fanuc-0i-tc",
-                "--family",
-                "scripts/thread.rhai",
-                "--out",
-                s(&out),
-            ]);
-            common::report_of(&out)["thread_verification"]["starts"]
+            let out = dir.join(format!("bent-{i}"));
+            replayed_with(program, 'X', &mut |_| bend(z), &out, &args)["thread_verification"]
+                ["starts"]
                 .as_array()
                 .unwrap()
                 .iter()
@@ -954,39 +959,25 @@ fn a_thread_is_corrected_start_by_start() {
 /// each start's place from where it should stand (mm).
 fn start_two_off(program: &Path, dz: f64, out: &Path) -> Vec<f64> {
     let mut two = false;
-    let text: String = std::fs::read_to_string(program)
-        .unwrap()
-        .lines()
-        .map(|l| {
-            if l.starts_with('(') {
-                two = l.starts_with("(PASS") && l.contains(", START 2,");
-                return format!("{l}\n");
-            }
-            let words: Vec<String> = l
-                .split_whitespace()
-                .map(|w| match w.strip_prefix('Z') {
-                    Some(v) if two => format!("Z{:.3}", v.parse::<f64>().unwrap() + dz),
-                    _ => w.to_owned(),
-                })
-                .collect();
-            words.join(" ") + "\n"
-        })
-        .collect();
-    let file = out.with_extension("nc");
-    std::fs::write(&file, text).unwrap();
-    pilgrim(&[
-        "verify",
-        s(&file),
+    let mut by = |l: &str| {
+        if l.starts_with('(') {
+            two = l.starts_with("(PASS") && l.contains(", START 2,");
+        }
+        if two {
+            dz
+        } else {
+            0.0
+        }
+    };
+    let args = [
         "--machine",
         "fanuc-0i-tc",
         "--family",
         "scripts/thread.rhai",
         "--set",
         "designation=Tr40x14(P7)",
-        "--out",
-        s(out),
-    ]);
-    common::report_of(out)["thread_verification"]["starts"]
+    ];
+    replayed_with(program, 'Z', &mut by, out, &args)["thread_verification"]["starts"]
         .as_array()
         .unwrap()
         .iter()
