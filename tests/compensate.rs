@@ -145,17 +145,25 @@ fn correction_off(out: &Path, error: &dyn Fn(f64) -> f64) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// `pilgrim compensate RUN --measured FILE --out OUT`, which must pass:
-/// what it said and the corrected run's report.
-fn compensated(run: &Path, measured: &Path, out: &Path) -> (String, serde_json::Value) {
-    let (code, said, err) = pilgrim(&[
+/// `pilgrim compensate RUN --measured FILE --out OUT` with `extra`
+/// options: its exit code, what it said and its errors.
+fn compensate(run: &Path, measured: &Path, out: &Path, extra: &[&str]) -> (i32, String, String) {
+    let mut args = vec![
         "compensate",
         s(run),
         "--measured",
         s(measured),
         "--out",
         s(out),
-    ]);
+    ];
+    args.extend(extra);
+    pilgrim(&args)
+}
+
+/// [`compensate`] with no options, which must pass: what it said and the
+/// corrected run's report.
+fn compensated(run: &Path, measured: &Path, out: &Path) -> (String, serde_json::Value) {
+    let (code, said, err) = compensate(run, measured, out, &[]);
     assert_eq!(code, 0, "{err}");
     let report = common::report_of(out);
     assert_eq!(
@@ -313,14 +321,7 @@ fn the_mandrel_is_corrected_by_its_measured_error() {
     }
     book.save(&again).unwrap();
     let twice = dir.join("twice");
-    let (code, _, err) = pilgrim(&[
-        "compensate",
-        s(&out),
-        "--measured",
-        s(&again),
-        "--out",
-        s(&twice),
-    ]);
+    let (code, _, err) = compensate(&out, &again, &twice, &[]);
     assert_eq!(code, 0, "{err}");
     let kept = correction_off(&twice, &wear);
     assert!(
@@ -373,8 +374,7 @@ fn bad_measurements_are_refused_and_nothing_is_written() {
     ] {
         let f = table(name, &rows);
         let out = dir.join(format!("{name}.out"));
-        let (code, _, err) =
-            pilgrim(&["compensate", s(&run), "--measured", s(&f), "--out", s(&out)]);
+        let (code, _, err) = compensate(&run, &f, &out, &[]);
         assert_ne!(code, 0, "{name}");
         assert!(err.contains(says), "{name}: {err}");
         assert!(!out.exists(), "{name}: {} written", out.display());
@@ -395,16 +395,7 @@ fn bad_measurements_are_refused_and_nothing_is_written() {
     let f = dir.join("bump.csv");
     std::fs::write(&f, t).unwrap();
     let out = dir.join("bump.out");
-    let (code, _, err) = pilgrim(&[
-        "compensate",
-        s(&run),
-        "--measured",
-        s(&f),
-        "--uncertainty",
-        "0.0001",
-        "--out",
-        s(&out),
-    ]);
+    let (code, _, err) = compensate(&run, &f, &out, &["--uncertainty", "0.0001"]);
     assert_ne!(code, 0);
     assert!(
         err.contains("bump.csv is refused")
@@ -468,16 +459,7 @@ fn a_deflection_is_corrected_along_its_curve() {
     }
     std::fs::write(&measured, t).unwrap();
     let out = dir.join("corrected");
-    let (code, said, err) = pilgrim(&[
-        "compensate",
-        s(&run),
-        "--measured",
-        s(&measured),
-        "--uncertainty",
-        "0.00001",
-        "--out",
-        s(&out),
-    ]);
+    let (code, said, err) = compensate(&run, &measured, &out, &["--uncertainty", "0.00001"]);
     assert_eq!(code, 0, "{err}");
     let report = common::report_of(&out);
     assert_eq!(
@@ -868,14 +850,7 @@ fn a_thread_is_corrected_start_by_start() {
     ]);
     assert_eq!(code, 0, "{err}");
     let failed = dir.join("g76-corrected");
-    let (code, _, err) = pilgrim(&[
-        "compensate",
-        s(&g76),
-        "--measured",
-        s(&measured),
-        "--out",
-        s(&failed),
-    ]);
+    let (code, _, err) = compensate(&g76, &measured, &failed, &[]);
     assert_ne!(code, 0);
     assert!(err.contains("no program was written"), "{err}");
     let report = common::report_of(&failed);
