@@ -126,10 +126,18 @@ fn bench_table(finish: &[(f64, f64)]) -> String {
 
 /// The default mandrel run into `dir/run`.
 fn mandrel_run(dir: &Path) -> std::path::PathBuf {
-    let run = dir.join("run");
-    let (code, _, err) = pilgrim(&["run", "scripts/mandrel.rhai", "--out", s(&run), "--quiet"]);
-    assert_eq!(code, 0, "{err}");
-    run
+    ran(&dir.join("run"), "mandrel", &[])
+}
+
+/// `pilgrim run scripts/<family>.rhai` with `extra` options into `out`,
+/// which must pass: `out`.
+fn ran(out: &Path, family: &str, extra: &[&str]) -> std::path::PathBuf {
+    let script = format!("scripts/{family}.rhai");
+    let mut args = vec!["run", &script, "--out", s(out), "--quiet"];
+    args.extend(extra);
+    let (code, _, err) = pilgrim(&args);
+    assert_eq!(code, 0, "{family}: {err}");
+    out.to_owned()
 }
 
 /// The largest distance of the run's `correction.csv` from `-error(z)`.
@@ -414,8 +422,7 @@ fn bad_measurements_are_refused_and_nothing_is_written() {
     assert!(!Path::new(&format!("{}-compensated", run.display())).exists());
     // The worm's family takes no correction (yet): refused, naming why.
     let worm = dir.join("worm");
-    let (code, _, err) = pilgrim(&["run", "scripts/worm.rhai", "--out", s(&worm), "--quiet"]);
-    assert_eq!(code, 0, "{err}");
+    ran(&worm, "worm", &[]);
     let f = dir.join("outside.csv");
     let (code, _, err) = pilgrim(&["compensate", s(&worm), "--measured", s(&f)]);
     assert_ne!(code, 0);
@@ -622,8 +629,7 @@ fn groove_at(
 fn the_caliber_is_corrected_by_its_measured_groove() {
     let dir = scratch("compensate", "caliber");
     let run = dir.join("run");
-    let (code, _, err) = pilgrim(&["run", "scripts/caliber.rhai", "--out", s(&run), "--quiet"]);
-    assert_eq!(code, 0, "{err}");
+    ran(&run, "caliber", &[]);
     let g = crate::caliber::groove();
     let tolerance = common::report_of(&run)["groove_verification"]["tolerance"]
         .as_f64()
@@ -757,8 +763,7 @@ fn bent_pitch_diameters(dir: &Path, program: &Path, at: &[f64]) -> Vec<Vec<f64>>
 fn a_thread_is_corrected_start_by_start() {
     let dir = scratch("compensate", "thread");
     let run = dir.join("run");
-    let (code, _, err) = pilgrim(&["run", "scripts/thread.rhai", "--out", s(&run), "--quiet"]);
-    assert_eq!(code, 0, "{err}");
+    ran(&run, "thread", &[]);
     let first = common::report_of(&run);
     let band = &first["thread_verification"]["limits"]["pitch_diameter"];
     let (lo, hi) = (band["min"].as_f64().unwrap(), band["max"].as_f64().unwrap());
@@ -839,16 +844,7 @@ fn a_thread_is_corrected_start_by_start() {
     // A G76 cycle places its passes itself: the corrected run fails its
     // check, and leaves its FAILED report, which names it, and no program.
     let g76 = dir.join("g76");
-    let (code, _, err) = pilgrim(&[
-        "run",
-        "scripts/thread.rhai",
-        "--set",
-        "cycle=g76",
-        "--out",
-        s(&g76),
-        "--quiet",
-    ]);
-    assert_eq!(code, 0, "{err}");
+    ran(&g76, "thread", &["--set", "cycle=g76"]);
     let failed = dir.join("g76-corrected");
     let (code, _, err) = compensate(&g76, &measured, &failed, &[]);
     assert_ne!(code, 0);
@@ -866,16 +862,7 @@ fn a_thread_is_corrected_start_by_start() {
     // Two starts, each measured (start 2 cut after start 1 at each depth,
     // by a cutter worn a little more): each corrected by its own.
     let two = dir.join("two");
-    let (code, _, err) = pilgrim(&[
-        "run",
-        "scripts/thread.rhai",
-        "--set",
-        "designation=Tr40x14(P7)",
-        "--out",
-        s(&two),
-        "--quiet",
-    ]);
-    assert_eq!(code, 0, "{err}");
+    ran(&two, "thread", &["--set", "designation=Tr40x14(P7)"]);
     let aim_of = |r: &serde_json::Value, k: usize| {
         r["thread_verification"]["starts"][k]["pitch_diameter"]
             .as_f64()
@@ -903,16 +890,11 @@ fn a_thread_is_corrected_start_by_start() {
     // A nut (cut outwards from its bore) measured 0.02 mm large: its
     // passes come in, its pitch diameter down by as much.
     let nut = dir.join("nut");
-    let (code, _, err) = pilgrim(&[
-        "run",
-        "scripts/thread.rhai",
-        "--params",
-        "scripts/examples/thread-m30x2-6h.toml",
-        "--out",
-        s(&nut),
-        "--quiet",
-    ]);
-    assert_eq!(code, 0, "{err}");
+    ran(
+        &nut,
+        "thread",
+        &["--params", "scripts/examples/thread-m30x2-6h.toml"],
+    );
     let first = common::report_of(&nut);
     let d2 = aim_of(&first, 0);
     let file = dir.join("nut.csv");
@@ -970,16 +952,7 @@ fn start_two_off(program: &Path, dz: f64, out: &Path) -> Vec<f64> {
 fn a_start_out_of_its_place_is_moved_back() {
     let dir = scratch("compensate", "place");
     let run = dir.join("run");
-    let (code, _, err) = pilgrim(&[
-        "run",
-        "scripts/thread.rhai",
-        "--set",
-        "designation=Tr40x14(P7)",
-        "--out",
-        s(&run),
-        "--quiet",
-    ]);
-    assert_eq!(code, 0, "{err}");
+    ran(&run, "thread", &["--set", "designation=Tr40x14(P7)"]);
     let before = start_two_off(&run.join("program.nc"), 0.03, &dir.join("before"));
     assert!(
         (before[1] - 0.03).abs() < 2e-3 && before[0].abs() < 1e-3,
