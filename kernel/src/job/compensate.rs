@@ -488,10 +488,14 @@ pub fn compensate(
     // annex's tables made again with the part after, and how far the
     // corrected program's path moved, per pass (its chart), kept for
     // compensation.json.
+    // What the hook found, for compensation.json: the records with the
+    // part after, and the moves.
+    type Found = (Vec<QuantityRecord>, Option<Moved>);
     let (column, names) = (nominal.coordinate, (coordinate.to_owned(), unit.to_owned()));
-    let (hook_quantities, hook_records) = (quantities.clone(), records.clone());
-    let moved_slot: std::sync::Arc<std::sync::Mutex<Option<Moved>>> = Default::default();
-    let slot = moved_slot.clone();
+    let hook_quantities = quantities.clone();
+    let found: std::sync::Arc<std::sync::Mutex<Option<Found>>> = Default::default();
+    let slot = found.clone();
+    let hook_records = records;
     made.finish = Some(super::TablesHook(std::sync::Arc::new(
         move |tables, program, passes| {
             let mut records = hook_records.clone();
@@ -501,7 +505,7 @@ pub fn compensate(
             let moved = path_moved(&old_program, &old_passes, program, passes);
             let plots = moved.as_ref().map(|m| moves_chart(m, tables));
             if let Ok(mut s) = slot.lock() {
-                *s = moved;
+                *s = Some((records, moved));
             }
             plots.into_iter().collect()
         },
@@ -525,12 +529,12 @@ pub fn compensate(
             }
             .into(),
         })?;
-    after_run(
-        &mut records,
-        &quantities,
-        nominal.coordinate,
-        &out.report.tables,
-    );
+    // The run calls its hook once it has verified.
+    let (records, moved) = found
+        .lock()
+        .ok()
+        .and_then(|mut s| s.take())
+        .ok_or_else(|| Error::Output("the corrected run did not finish its tables".into()))?;
     let record = Compensation {
         run: shown.clone(),
         measured_file: measured.source().to_owned(),
@@ -541,7 +545,6 @@ pub fn compensate(
         quantities: records,
         not_measured,
         program: {
-            let moved = moved_slot.lock().ok().and_then(|mut s| s.take());
             ProgramChange {
                 path_moved: moved.as_ref().map(|m| m.largest.clone()),
                 blocks_moved: moved.map(|m| m.blocks),
