@@ -494,21 +494,28 @@ impl Profile {
 
     /// x at any z of the range, by cubic Hermite interpolation with the
     /// node slopes of [`Self::slopes`] (linear beside a kink, where a node's
-    /// slope is ambiguous). Without analytic derivatives the
-    /// slopes are estimated on each call: for many points use
-    /// [`Self::eval_many`].
+    /// slope is ambiguous); the slopes are estimated once per profile.
     ///
     /// # Failures
     /// z outside the profile's range, or not finite.
     pub fn eval(&self, z: Real) -> Result<Real, ProfileError> {
-        Ok(self.eval_many(&[z])?[0])
+        self.check_inside(std::slice::from_ref(&z))?;
+        Ok(self.value_at(&self.slopes(), z))
     }
 
-    /// x at many z (as [`Self::eval`]), the slopes estimated once.
+    /// x at many z (as [`Self::eval`]).
     ///
     /// # Failures
     /// A z outside the profile's range, or not finite (the first one).
     pub fn eval_many(&self, zs: &[Real]) -> Result<Vec<Real>, ProfileError> {
+        self.check_inside(zs)?;
+        let slopes = self.slopes();
+        Ok(zs.iter().map(|&z| self.value_at(&slopes, z)).collect())
+    }
+
+    /// Every z of `zs` finite and inside the range, or the first that is
+    /// not.
+    fn check_inside(&self, zs: &[Real]) -> Result<(), ProfileError> {
         let (lo, hi) = self.z_range();
         if let Some(&z) = zs.iter().find(|z| !(lo..=hi).contains(*z)) {
             crate::math::finite("profile query z", z)?;
@@ -519,31 +526,55 @@ impl Profile {
                 z_max: hi,
             });
         }
-        let slopes = self.slopes();
-        let kinks = self.d2x.as_deref();
-        let linear = self.interpolation == Interpolation::Linear && self.dx.is_none();
-        Ok(zs
-            .iter()
-            .map(|&z| {
-                // Beside a kink (marked by an infinite second derivative) the
-                // node's slope is only the mean of its two sides: interpolate
-                // that interval linearly rather than bend it.
-                let i = crate::math::floor_index(&self.z, z)
-                    .unwrap_or(0)
-                    .min(self.z.len() - 2);
-                match kinks {
-                    _ if linear => {
-                        let t = ((z - self.z[i]) / (self.z[i + 1] - self.z[i])).clamp(0.0, 1.0);
-                        self.x[i] + t * (self.x[i + 1] - self.x[i])
-                    }
-                    Some(d2) if d2[i].is_infinite() || d2[i + 1].is_infinite() => {
-                        let t = (z - self.z[i]) / (self.z[i + 1] - self.z[i]);
-                        self.x[i] + t * (self.x[i + 1] - self.x[i])
-                    }
-                    _ => hermite(&self.z, &self.x, &slopes, z),
-                }
-            })
-            .collect())
+        Ok(())
+    }
+
+    /// The interval `z` lies in: the last node at or below it, at most the
+    /// last interval's (the first for a z below the range). Guessed as if
+    /// the nodes were evenly spaced and checked, two neighbours tried, then
+    /// sought by bisection: a table at an even step (the groove's, a
+    /// correction's grid) is evaluated millions of times a run.
+    fn interval(&self, z: Real) -> usize {
+        let zs = &self.z;
+        let last = zs.len() - 2;
+        let fits = |i: usize| (i == 0 || zs[i] <= z) && (i == last || zs[i + 1] > z);
+        let span = zs[last + 1] - zs[0];
+        let guess = ((z - zs[0]) / span * (last + 1) as Real).floor();
+        let mut i = if guess.is_nan() || guess < 0.0 {
+            0
+        } else {
+            (guess as usize).min(last)
+        };
+        for _ in 0..3 {
+            if fits(i) {
+                return i;
+            }
+            if i > 0 && zs[i] > z {
+                i -= 1;
+            } else {
+                i = (i + 1).min(last);
+            }
+        }
+        crate::math::floor_index(zs, z).unwrap_or(0).min(last)
+    }
+
+    /// x at `z` (inside the range) with the node `slopes`.
+    fn value_at(&self, slopes: &[Real], z: Real) -> Real {
+        let i = self.interval(z);
+        let linear = |i: usize| {
+            let t = ((z - self.z[i]) / (self.z[i + 1] - self.z[i])).clamp(0.0, 1.0);
+            self.x[i] + t * (self.x[i + 1] - self.x[i])
+        };
+        if self.interpolation == Interpolation::Linear && self.dx.is_none() {
+            return linear(i);
+        }
+        // Beside a kink (marked by an infinite second derivative) the
+        // node's slope is only the mean of its two sides: interpolate
+        // that interval linearly rather than bend it.
+        match self.d2x.as_deref() {
+            Some(d2) if d2[i].is_infinite() || d2[i + 1].is_infinite() => linear(i),
+            _ => hermite_in(&self.z, &self.x, slopes, i, z),
+        }
     }
 
     /// The profile with `dx` added where `z_from <= z <= z_to` (a stock
@@ -682,6 +713,11 @@ pub fn curvature_of(d1: Real, d2: Real) -> Real {
 pub(crate) fn hermite(t: &[Real], v: &[Real], s: &[Real], tq: Real) -> Real {
     let n = t.len();
     let i = crate::math::floor_index(t, tq).unwrap_or(0).min(n - 2);
+    hermite_in(t, v, s, i, tq)
+}
+
+/// [`hermite`] on the interval `i` (`t[i] <= tq <= t[i + 1]`, clamped).
+fn hermite_in(t: &[Real], v: &[Real], s: &[Real], i: usize, tq: Real) -> Real {
     let h = t[i + 1] - t[i];
     let u = ((tq - t[i]) / h).clamp(0.0, 1.0);
     let (u2, u3) = (u * u, u * u * u);
@@ -696,6 +732,32 @@ pub(crate) fn hermite(t: &[Real], v: &[Real], s: &[Real], tq: Real) -> Real {
 mod tests {
     use super::*;
     use crate::assert_near;
+
+    /// The interval guessed from an even step is the one bisection finds,
+    /// for even, nearly even and uneven nodes, inside, at and beyond the
+    /// ends.
+    #[test]
+    fn interval_agrees_with_bisection() {
+        let tables: Vec<Vec<Real>> = vec![
+            (0..=400).map(|i| -1.2 + 2.4 * i as Real / 400.0).collect(),
+            (0..=50).map(|i| (i as Real).powi(2) * 0.01).collect(),
+            (0..=30)
+                .map(|i| i as Real + 0.3 * ((i * 7) % 5) as Real / 5.0)
+                .collect(),
+            vec![0.0, 1.0, 5.0],
+        ];
+        for z in tables {
+            let p = Profile::new(z.clone(), z.iter().map(|v| v.sin()).collect()).unwrap();
+            let (lo, hi) = p.z_range();
+            let last = z.len() - 2;
+            let mut at: Vec<Real> = z.clone();
+            at.extend((0..=1000).map(|k| lo - 0.1 + (hi - lo + 0.2) * k as Real / 1000.0));
+            for q in at {
+                let want = crate::math::floor_index(&z, q).unwrap_or(0).min(last);
+                assert_eq!(p.interval(q), want, "z = {q}");
+            }
+        }
+    }
 
     /// A profile moved by a narrow dip bends as the dip does: its second
     /// derivatives are the dip's too, so a wheel rounder than the dip is
