@@ -293,43 +293,12 @@ fn samples(
     // Between samples no point of the wheel moves more than `step`.
     let target = req.tolerance / SAMPLING_SHARE;
     let step = (8.0 * r_k * target).sqrt();
-    let mut out = Vec::new();
-    let mut worst: Real = 0.0;
-    let mut count = 0;
-    for blocks in passes.iter().filter(|p| p.cuts).map(|p| p.blocks.clone()) {
-        crate::budget::check("the groove's replay")?;
-        let mut rows_sub: Vec<Real> = Vec::new();
-        let mut owner = Vec::new();
-        for k in blocks.start.max(1)..blocks.end {
-            let (a, b) = (at(&poses[6 * (k - 1)..6 * k]), at(&poses[6 * k..6 * k + 6]));
-            let turned = a.axis.dot(&b.axis).clamp(-1.0, 1.0).acos();
-            let moved = (b.centre - a.centre).norm() + r_k0 * turned;
-            let subs = ((moved / step).ceil() as usize).max(1);
-            worst = worst.max(moved / subs as Real);
-            count += subs;
-            if count > MAX_SAMPLES {
-                return Err(VerifyError::Replay(format!(
-                    "more than {MAX_SAMPLES} wheel positions to replay: a coarser tolerance or fewer blocks"
-                )));
-            }
-            let (ra, rb) = (
-                &rows[(k - 1) * width..k * width],
-                &rows[k * width..(k + 1) * width],
-            );
-            for s in 1..=subs {
-                let t = s as Real / subs as Real;
-                rows_sub.extend(ra.iter().zip(rb).map(|(x, y)| x + (y - x) * t));
-                owner.push(k);
-            }
-        }
-        let mut sub_poses = Vec::new();
-        machine
-            .forward(&rows_sub, tool, &mut sub_poses)
-            .map_err(|source| VerifyError::Kinematics {
-                first: blocks.start + 1,
-                last: blocks.end,
-                source,
-            })?;
+    // A pass's wheel positions from its poses, unwrapped from the first
+    // (taken within half a turn of the groove's middle), then in order of
+    // turn: made on a second thread while this one replays the next pass
+    // (the machine's kinematics stay on this one).
+    let mid = groove_middle(&req.groove);
+    let finish = |sub_poses: Vec<Real>, owner: Vec<usize>| -> Vec<Sample> {
         let mut list: Vec<Sample> = sub_poses
             .chunks_exact(6)
             .zip(owner)
@@ -339,9 +308,6 @@ fn samples(
                 turn: p[1].atan2(p[0]),
             })
             .collect();
-        // Unwrapped from the first (taken within half a turn of the
-        // groove's middle), then in order of turn.
-        let mid = groove_middle(&req.groove);
         let mut prev = list
             .first()
             .map_or(0.0, |s| mid + crate::math::wrap_angle(s.turn - mid));
@@ -350,8 +316,65 @@ fn samples(
             prev = s.turn;
         }
         list.sort_by(|a, b| a.turn.total_cmp(&b.turn));
-        out.push(list);
-    }
+        list
+    };
+    let mut worst: Real = 0.0;
+    let mut count = 0;
+    let out = std::thread::scope(|s| {
+        let (send, receive) = std::sync::mpsc::channel::<(Vec<Real>, Vec<usize>)>();
+        let lists = s.spawn(move || {
+            receive
+                .into_iter()
+                .map(|(p, o)| finish(p, o))
+                .collect::<Vec<_>>()
+        });
+        let replayed = (|| {
+            for blocks in passes.iter().filter(|p| p.cuts).map(|p| p.blocks.clone()) {
+                crate::budget::check("the groove's replay")?;
+                let mut rows_sub: Vec<Real> = Vec::new();
+                let mut owner = Vec::new();
+                for k in blocks.start.max(1)..blocks.end {
+                    let (a, b) = (at(&poses[6 * (k - 1)..6 * k]), at(&poses[6 * k..6 * k + 6]));
+                    let turned = a.axis.dot(&b.axis).clamp(-1.0, 1.0).acos();
+                    let moved = (b.centre - a.centre).norm() + r_k0 * turned;
+                    let subs = ((moved / step).ceil() as usize).max(1);
+                    worst = worst.max(moved / subs as Real);
+                    count += subs;
+                    if count > MAX_SAMPLES {
+                        return Err(VerifyError::Replay(format!(
+                            "more than {MAX_SAMPLES} wheel positions to replay: a coarser tolerance or fewer blocks"
+                        )));
+                    }
+                    let (ra, rb) = (
+                        &rows[(k - 1) * width..k * width],
+                        &rows[k * width..(k + 1) * width],
+                    );
+                    for s in 1..=subs {
+                        let t = s as Real / subs as Real;
+                        rows_sub.extend(ra.iter().zip(rb).map(|(x, y)| x + (y - x) * t));
+                        owner.push(k);
+                    }
+                }
+                let mut sub_poses = Vec::new();
+                machine
+                    .forward(&rows_sub, tool, &mut sub_poses)
+                    .map_err(|source| VerifyError::Kinematics {
+                        first: blocks.start + 1,
+                        last: blocks.end,
+                        source,
+                    })?;
+                // A send fails only where the second thread panicked, and
+                // its join passes that on.
+                let _ = send.send((sub_poses, owner));
+            }
+            Ok(())
+        })();
+        drop(send);
+        let lists = lists
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        replayed.map(|()| lists)
+    })?;
     Ok((out, worst * worst / (8.0 * r_k), count))
 }
 
