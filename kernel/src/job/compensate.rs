@@ -479,18 +479,29 @@ pub fn compensate(
             ))
         })?;
     let before = read(&program_file)?;
-    let old_program: AxisProgram = serde_json::from_str(&read("program.json")?)
-        .map_err(|e| Error::Read(format!("{shown}/program.json: {e}")))?;
-    let old_toolpath: Toolpath = serde_json::from_str(&read("toolpath.json")?)
-        .map_err(|e| Error::Read(format!("{shown}/toolpath.json: {e}")))?;
-    let old_passes = pass_blocks(&old_program, &old_toolpath.passes);
+    // The first run's program and its passes, read and parsed on a thread
+    // of their own while the corrected run starts (tens of megabytes of
+    // JSON for a caliber); its hook takes them.
+    let first = {
+        let (run, shown) = (run.clone(), shown.clone());
+        std::thread::spawn(move || {
+            let parse = |name: &str| run.read_text(name, limit).map_err(|e| e.to_string());
+            let program: AxisProgram = serde_json::from_str(&parse("program.json")?)
+                .map_err(|e| format!("{shown}/program.json: {e}"))?;
+            let toolpath: Toolpath = serde_json::from_str(&parse("toolpath.json")?)
+                .map_err(|e| format!("{shown}/toolpath.json: {e}"))?;
+            let passes = pass_blocks(&program, &toolpath.passes);
+            Ok::<_, String>((program, passes))
+        })
+    };
+    let first = std::sync::Mutex::new(Some(first));
     // Once the corrected run's verification has predicted its part: the
     // annex's tables made again with the part after, and how far the
     // corrected program's path moved, per pass (its chart), kept for
     // compensation.json.
     // What the hook found, for compensation.json: the records with the
     // part after, and the moves.
-    type Found = (Vec<QuantityRecord>, Option<Moved>);
+    type Found = (Vec<QuantityRecord>, Result<Option<Moved>, String>);
     let (column, names) = (nominal.coordinate, (coordinate.to_owned(), unit.to_owned()));
     let hook_quantities = quantities.clone();
     let found: std::sync::Arc<std::sync::Mutex<Option<Found>>> = Default::default();
@@ -502,8 +513,22 @@ pub fn compensate(
             after_run(&mut records, &hook_quantities, column, tables);
             let names = (names.0.as_str(), names.1.as_str());
             tables.extend(annex(column, &hook_quantities, &records, names).tables);
-            let moved = path_moved(&old_program, &old_passes, program, passes);
-            let plots = moved.as_ref().map(|m| moves_chart(m, tables));
+            let parsed = first.lock().ok().and_then(|mut h| h.take()).map(|h| {
+                h.join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+            });
+            let moved = match parsed {
+                Some(Ok((old_program, old_passes))) => {
+                    Ok(path_moved(&old_program, &old_passes, program, passes))
+                }
+                Some(Err(e)) => Err(e),
+                None => Err("the first run's program was taken twice".into()),
+            };
+            let plots = moved
+                .as_ref()
+                .ok()
+                .and_then(Option::as_ref)
+                .map(|m| moves_chart(m, tables));
             if let Ok(mut s) = slot.lock() {
                 *s = Some((records, moved));
             }
@@ -535,6 +560,7 @@ pub fn compensate(
         .ok()
         .and_then(|mut s| s.take())
         .ok_or_else(|| Error::Output("the corrected run did not finish its tables".into()))?;
+    let moved = moved.map_err(Error::Read)?;
     let record = Compensation {
         run: shown.clone(),
         measured_file: measured.source().to_owned(),
@@ -870,9 +896,24 @@ fn path_moved(
                 near.saturating_sub(WINDOW),
                 (near + WINDOW + 1).min(dirs.len()),
             );
-            let (k, (t, dist2)) = (lo..hi)
-                .map(|k| (k, nearest(k)))
-                .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1))?;
+            // The last block's segment first; a segment whose start lies
+            // farther than its length beyond the best so far cannot be
+            // nearer (nor tie), and is passed over. The same segment as a
+            // search of every one in the window.
+            let first = near.clamp(lo, hi.saturating_sub(1));
+            let mut best = (first, nearest(first));
+            for k in lo..hi {
+                let from: f64 = v.iter().zip(line[k]).map(|(v, a)| (v - a).powi(2)).sum();
+                let reach = best.1 .1.sqrt() + dirs[k].1.sqrt();
+                if from > reach * reach * (1.0 + 1e-9) {
+                    continue;
+                }
+                let got = nearest(k);
+                if got.1 < best.1 .1 || (got.1 == best.1 .1 && k < best.0) {
+                    best = (k, got);
+                }
+            }
+            let (k, (t, dist2)) = best;
             near = k;
             blocks += usize::from(dist2.sqrt() > MOVED);
             for (i, m) in moved.iter_mut().enumerate() {
