@@ -36,6 +36,10 @@ pub struct Shaped {
     pub shape: SharedShape,
     /// Its frame in the body's.
     pub local: Mat4,
+    /// The axis through its own frame's origin (in its own frame) about
+    /// which it is a solid of revolution, if it is one: turning it about
+    /// that axis changes no distance to it.
+    pub axis: Option<Vec3>,
 }
 
 impl std::fmt::Debug for Shaped {
@@ -63,14 +67,18 @@ pub fn solid(s: &Solid) -> Shaped {
     let here = |shape| Shaped {
         shape,
         local: Mat4::identity(),
+        axis: None,
+    };
+    // parry's cylinders stand along Y in their own frame.
+    let cylinder = |half: Real, radius: Real, local: Mat4| Shaped {
+        shape: SharedShape::cylinder(half, radius),
+        local,
+        axis: Some(Vec3::y()),
     };
     match *s {
         // parry's cylinders stand along Y, as a roller does.
-        Solid::Roller { radius, length } => here(SharedShape::cylinder(length / 2.0, radius)),
-        Solid::Cylinder { radius, length } => Shaped {
-            shape: SharedShape::cylinder(length / 2.0, radius),
-            local: along_z(),
-        },
+        Solid::Roller { radius, length } => cylinder(length / 2.0, radius, Mat4::identity()),
+        Solid::Cylinder { radius, length } => cylinder(length / 2.0, radius, along_z()),
         Solid::Cone {
             radius,
             end_radius,
@@ -93,10 +101,7 @@ pub fn solid(s: &Solid) -> Shaped {
                 Some(hull) => here(hull),
                 // Points that span no volume cannot come of sizes above 0;
                 // the cylinder that holds the frustum, were they to.
-                None => Shaped {
-                    shape: SharedShape::cylinder(length / 2.0, radius.max(end_radius)),
-                    local: along_z(),
-                },
+                None => cylinder(length / 2.0, radius.max(end_radius), along_z()),
             }
         }
         Solid::Block { size } => here(SharedShape::cuboid(
@@ -168,6 +173,7 @@ pub fn tool(tool: &crate::tool::Tool, mesh: Option<&TriMesh>, centre: Vec3) -> O
                     r,
                 ),
                 local: Mat4::new_translation(&centre) * along_z(),
+                axis: Some(Vec3::y()),
             })
         }
         _ => {
@@ -179,6 +185,7 @@ pub fn tool(tool: &crate::tool::Tool, mesh: Option<&TriMesh>, centre: Vec3) -> O
             SharedShape::convex_hull(&points).map(|shape| Shaped {
                 shape,
                 local: Mat4::identity(),
+                axis: None,
             })
         }
     }
@@ -260,6 +267,9 @@ pub fn envelope(mesh: &TriMesh, tol: Real, bore: bool) -> Option<Shaped> {
         vec![true; stack.len()]
     };
     let mut pieces = Vec::new();
+    // A stack of cylinders only (no ring's polygonal sectors) is a solid
+    // of revolution about Z.
+    let mut round = true;
     for ((z0, z1, r), solid) in stack.into_iter().zip(inside) {
         let half = ((z1 - z0) / 2.0).max(1e-6);
         let centre = Mat4::new_translation(&Vec3::new(0.0, 0.0, (z0 + z1) / 2.0));
@@ -274,11 +284,12 @@ pub fn envelope(mesh: &TriMesh, tol: Real, bore: bool) -> Option<Shaped> {
             })
             .filter(|h| h.is_finite() && *h > tol);
         match hole {
-            Some(h) => pieces.extend(
+            Some(h) => pieces.extend({
+                round = false;
                 ring_sectors(h, r + tol, 2.0 * half, std::f64::consts::TAU, tol)
                     .into_iter()
-                    .map(|s| (pose(&centre), s)),
-            ),
+                    .map(|s| (pose(&centre), s))
+            }),
             None => pieces.push((
                 pose(&(centre * along_z())),
                 SharedShape::cylinder(half, r + tol),
@@ -288,6 +299,7 @@ pub fn envelope(mesh: &TriMesh, tol: Real, bore: bool) -> Option<Shaped> {
     Some(Shaped {
         shape: SharedShape::compound(pieces),
         local: Mat4::identity(),
+        axis: round.then(Vec3::z),
     })
 }
 

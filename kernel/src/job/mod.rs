@@ -232,9 +232,26 @@ fn post_all(
         control: info.control.clone(),
     })?;
     let control_text = machine.post.post(program, control.name)?;
-    let cld_text = machine.post.post(program, CLD.name)?;
-    let read = crate::program::lint::lint_read(&control_text, program, control, &info.axes)?;
-    crate::program::lint::lint(&cld_text, program, &CLD, &info.axes)?;
+    // The control's text read back on a second thread while the CL file
+    // is written and linted (the machine's post stays on this one).
+    let deadline = crate::budget::current();
+    let (read, cld_text) = std::thread::scope(|s| {
+        let read = s.spawn(|| {
+            crate::budget::with_deadline(deadline, || {
+                crate::program::lint::lint_read(&control_text, program, control, &info.axes)
+            })
+        });
+        let cld = machine.post.post(program, CLD.name).map_err(Error::from);
+        let cld = cld.and_then(|text| {
+            crate::program::lint::lint(&text, program, &CLD, &info.axes)?;
+            Ok(text)
+        });
+        let read = read
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (read, cld)
+    });
+    let (read, cld_text) = (read?, cld_text?);
     let mut files = vec![
         (
             format!("program.{}", control.extension),
@@ -286,7 +303,7 @@ fn failed_run(
 /// The tool's mesh failing; the check's own ([`crate::collision::check`]).
 fn collisions(
     program: &AxisProgram,
-    machine: &dyn crate::machine::MachineKinematics,
+    machine: &crate::machine::MachineInfo,
     placement: &crate::collision::Placement,
     tool: &crate::tool::Tool,
     parts: &[(String, crate::mesh::TriMesh)],
@@ -584,23 +601,6 @@ fn run_on(
         .iter()
         .map(|w| Finding::new("the family", w.clone()))
         .collect();
-    // The process, checked as well as the geometry.
-    let process = crate::process::check(
-        verified,
-        kin,
-        &toolpath.tool.reference,
-        stock.as_deref(),
-        &crate::process::ProcessLimits::of(info),
-    )?;
-    failures.extend(process.errors);
-    warnings.extend(process.warnings);
-    figures.extend(process.figures);
-    if stock.is_none() {
-        warnings.push(Finding::new(
-            "the process",
-            "the rules that need the material (rapids through air only, into the stock at the infeed feed, the steady rest's approach, the finishing stock) were not checked: the family's verification gives no blank",
-        ));
-    }
     let mut parts = family.part(&values)?;
     if let Some(b) = parts.iter().find(|b| !crate::files::is_plain_name(&b.name)) {
         return Err(Error::Family(crate::family::FamilyError::Contract {
@@ -620,11 +620,40 @@ fn run_on(
         family: family.name().to_owned(),
         source,
     })?;
-    // The machine's bodies, the tool and the part clear of each other
-    // along the whole program.
     // One placement of the machine's bodies for the check and the scene.
     let placement = scene::placement(kin, &program, &toolpath.tool, &meshes)?;
-    let collisions = collisions(verified, kin, &placement, &toolpath.tool, &meshes, tol)?;
+    // The process, checked as well as the geometry; and, on a second
+    // thread, the machine's bodies, the tool and the part clear of each
+    // other along the whole program (neither reads the other).
+    let deadline = crate::budget::current();
+    let (process, collisions) = std::thread::scope(|s| {
+        let collisions = s.spawn(|| {
+            crate::budget::with_deadline(deadline, || {
+                collisions(verified, info, &placement, &toolpath.tool, &meshes, tol)
+            })
+        });
+        let process = crate::process::check(
+            verified,
+            kin,
+            &toolpath.tool.reference,
+            stock.as_deref(),
+            &crate::process::ProcessLimits::of(info),
+        );
+        let collisions = collisions
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (process, collisions)
+    });
+    let (process, collisions) = (process?, collisions?);
+    failures.extend(process.errors);
+    warnings.extend(process.warnings);
+    figures.extend(process.figures);
+    if stock.is_none() {
+        warnings.push(Finding::new(
+            "the process",
+            "the rules that need the material (rapids through air only, into the stock at the infeed feed, the steady rest's approach, the finishing stock) were not checked: the family's verification gives no blank",
+        ));
+    }
     failures.extend(collisions.findings.iter().cloned());
     // The scene shows the tool where asked; a failed run's, where it
     // failed; else the middle of the last cutting pass.
@@ -665,48 +694,75 @@ fn run_on(
     // The times of the program as its control reads it (feeds and
     // positions as written), as every other check takes it.
     let times = crate::timing::times(verified, info, &passes);
+    // The verification's own tables, then the caller's hook over them, on
+    // a second thread while this one stages the scene and its solids
+    // (neither reads the other).
+    let mut tables = toolpath.tables.clone();
+    if let Some(o) = &outcome {
+        o.extend_tables(&mut tables);
+    }
     let mut playback = Vec::new();
-    let (pose_block, bodies, solids, part_box) = if parts.is_empty() {
-        (None, vec![], vec![], None)
-    } else {
-        // The part's extent: the page's camera frames its contact with the
-        // tool.
-        let part_box = scene::bounds_of(meshes.iter().map(|(_, m)| m));
-        let index = pose_index;
-        let overlays = overlay
-            .map(|m| ("contact_patch".to_owned(), m, crate::math::Mat4::identity()))
-            .into_iter()
-            .collect();
-        let staged = scene::stage(
-            kin,
-            &program,
-            &toolpath.tool,
-            (&meshes, &placement),
-            pose_place,
-            &times.block_s,
-            overlays,
-            (tol, options.formats),
-        )?;
-        let (mesh_files, bodies, pose) = (staged.files, staged.bodies, staged.pose);
-        playback = staged.playback;
-        files.extend(mesh_files);
-        // A failed run's scene shows where it failed; its exact solids,
-        // for checking a program in CAD, would check none.
-        let solids = if failures.is_empty() {
-            let (step_files, solids) =
-                solids::step_files(&parts, &toolpath.tool, &pose, options.step_tolerance)?;
-            files.extend(step_files);
-            solids
-        } else {
-            Vec::new()
-        };
-        (
-            Some(index + 1),
-            bodies,
-            solids,
-            part_box.map(|b| scene::contact_box(b, &toolpath.tool, &pose)),
-        )
-    };
+    let deadline = crate::budget::current();
+    let (scene, (tables, finishing_plots)) = std::thread::scope(|s| {
+        let hooked = s.spawn(|| {
+            crate::budget::with_deadline(deadline, || {
+                let mut tables = tables;
+                let plots = match &options.annex.finish {
+                    Some(finish) => (finish.0)(&mut tables, &program, &passes),
+                    None => Vec::new(),
+                };
+                (tables, plots)
+            })
+        });
+        let scene = (|| -> Result<_, Error> {
+            Ok(if parts.is_empty() {
+                (None, vec![], vec![], None)
+            } else {
+                // The part's extent: the page's camera frames its contact
+                // with the tool.
+                let part_box = scene::bounds_of(meshes.iter().map(|(_, m)| m));
+                let index = pose_index;
+                let overlays = overlay
+                    .map(|m| ("contact_patch".to_owned(), m, crate::math::Mat4::identity()))
+                    .into_iter()
+                    .collect();
+                let staged = scene::stage(
+                    kin,
+                    &program,
+                    &toolpath.tool,
+                    (&meshes, &placement),
+                    pose_place,
+                    &times.block_s,
+                    overlays,
+                    (tol, options.formats),
+                )?;
+                let (mesh_files, bodies, pose) = (staged.files, staged.bodies, staged.pose);
+                playback = staged.playback;
+                files.extend(mesh_files);
+                // A failed run's scene shows where it failed; its exact
+                // solids, for checking a program in CAD, would check none.
+                let solids = if failures.is_empty() {
+                    let (step_files, solids) =
+                        solids::step_files(&parts, &toolpath.tool, &pose, options.step_tolerance)?;
+                    files.extend(step_files);
+                    solids
+                } else {
+                    Vec::new()
+                };
+                (
+                    Some(index + 1),
+                    bodies,
+                    solids,
+                    part_box.map(|b| scene::contact_box(b, &toolpath.tool, &pose)),
+                )
+            })
+        })();
+        let hooked = hooked
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (scene, hooked)
+    });
+    let (pose_block, bodies, solids, part_box) = scene?;
     let mut report = Report {
         passes: passes.len(),
         cutting_passes: passes.iter().filter(|p| p.cuts).count(),
@@ -745,7 +801,7 @@ fn run_on(
         },
         warnings: toolpath.warnings.clone(),
         notes: toolpath.notes.clone(),
-        tables: toolpath.tables.clone(),
+        tables,
         verdict: Verdict::of(requested_any, failures, warnings, figures),
         collisions: Some(collisions),
         times: Some(times),
@@ -763,13 +819,6 @@ fn run_on(
     // The verification's own files: the tables it adds to, then its
     // plots (before the family's charts where it leads them, else after).
     let mut later = Vec::new();
-    if let Some(o) = &outcome {
-        o.extend_tables(&mut report.tables);
-    }
-    let finishing_plots = match &options.annex.finish {
-        Some(finish) => (finish.0)(&mut report.tables, &program, &passes),
-        None => Vec::new(),
-    };
     if let Some(o) = &outcome {
         let ctx = FilesContext {
             replay: replay_ctx,
