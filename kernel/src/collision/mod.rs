@@ -305,7 +305,9 @@ fn rigid_inverse(m: &Mat4) -> Mat4 {
 struct Facing {
     mover: usize,
     other: usize,
-    axis: Option<crate::math::Vec3>,
+    /// The other's axis of revolution and two perpendiculars of it, the
+    /// second the first turned by 90 deg about it.
+    axis: Option<[crate::math::Vec3; 3]>,
 }
 
 impl Facing {
@@ -319,17 +321,23 @@ impl Facing {
             (Some(_), None) => (j, i),
             _ => (i, j),
         };
-        Self {
-            mover,
-            other,
-            axis: entities[other].shaped.axis.map(|a| a.normalize()),
-        }
+        let axis = entities[other].shaped.axis.map(|a| {
+            let a = a.normalize();
+            let e1 = if a.x.abs() < 0.9 {
+                crate::math::Vec3::x()
+            } else {
+                crate::math::Vec3::y()
+            };
+            let e1 = (e1 - a * a.dot(&e1)).normalize();
+            [a, e1, a.cross(&e1)]
+        });
+        Self { mover, other, axis }
     }
 
     /// The mover's frame as the pair sees it, the entities at `frames`.
     fn placed(&self, frames: &[Mat4]) -> Mat4 {
         let rel = rigid_inverse(&frames[self.other]) * frames[self.mover];
-        let Some(a) = self.axis else {
+        let Some([a, e1, e2]) = self.axis else {
             return rel;
         };
         let o = rel.fixed_view::<3, 1>(0, 3).into_owned();
@@ -338,16 +346,8 @@ impl Facing {
         if rho < 1e-9 {
             return rel;
         }
-        // A fixed perpendicular of the axis and its turn by 90 deg; the
-        // origin's angle phi about the axis from them, turned back by
-        // Rodrigues' formula (cos and sin of -phi from the origin itself).
-        let e1 = if a.x.abs() < 0.9 {
-            crate::math::Vec3::x()
-        } else {
-            crate::math::Vec3::y()
-        };
-        let e1 = (e1 - a * a.dot(&e1)).normalize();
-        let e2 = a.cross(&e1);
+        // The origin's angle phi about the axis, turned back by Rodrigues'
+        // formula (cos and sin of -phi from the origin itself).
         let (c, s) = (across.dot(&e1) / rho, -across.dot(&e2) / rho);
         let k = crate::math::Mat3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0);
         let turn = crate::math::Mat3::identity() * c + k * s + (a * a.transpose()) * (1.0 - c);
