@@ -60,6 +60,21 @@ pub fn with_deadline<T>(deadline: Option<Deadline>, f: impl FnOnce() -> T) -> T 
     f()
 }
 
+/// `here` on this thread and, at the same time, `there` on a second one
+/// that keeps this thread's deadline; both results. Both may borrow from
+/// the caller (a scoped thread); a panic on the second is passed on.
+pub fn beside<A, B: Send>(here: impl FnOnce() -> A, there: impl FnOnce() -> B + Send) -> (A, B) {
+    let deadline = current();
+    std::thread::scope(|s| {
+        let second = s.spawn(|| with_deadline(deadline, there));
+        let a = here();
+        let b = second
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (a, b)
+    })
+}
+
 /// This thread's deadline, if any.
 pub fn current() -> Option<Deadline> {
     DEADLINE.with(Cell::get)

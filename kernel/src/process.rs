@@ -232,15 +232,7 @@ pub fn check(
             b
         };
         let q: Vec<Real> = a.iter().zip(b).map(|(a, b)| a + (b - a) * t).collect();
-        let mut p = Vec::with_capacity(6);
-        machine.forward(&q, tool, &mut p).map_err(|source| {
-            crate::replay::VerifyError::Kinematics {
-                first: k + 1,
-                last: k + 1,
-                source,
-            }
-        })?;
-        Ok(p)
+        crate::replay::forward_rows(machine, &q, tool, k..k + 1)
     };
     let ends = crate::replay::replay(&written, machine, tool)?;
     let mut ticker = crate::budget::Ticker::new("the process's rules", 64);

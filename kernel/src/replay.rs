@@ -102,9 +102,24 @@ pub fn replay_blocks(
     let info = machine.info();
     let rows =
         axis_rows(program, info, &info.solved_axes, blocks.clone()).map_err(VerifyError::Replay)?;
+    forward_rows(machine, &rows, tool, blocks)
+}
+
+/// The tool's poses (rows of 6) at `rows` of the machine's solved axes,
+/// values of the program's `blocks` (indices from 0, named in the error
+/// as the program counts them, from 1) or between them.
+///
+/// # Failures
+/// The machine's kinematics failing, naming the blocks.
+pub fn forward_rows(
+    machine: &dyn MachineKinematics,
+    rows: &[Real],
+    tool: &ToolFrame,
+    blocks: std::ops::Range<usize>,
+) -> Result<Vec<Real>, VerifyError> {
     let mut poses = Vec::new();
     machine
-        .forward(&rows, tool, &mut poses)
+        .forward(rows, tool, &mut poses)
         .map_err(|source| VerifyError::Kinematics {
             first: blocks.start + 1,
             last: blocks.end,

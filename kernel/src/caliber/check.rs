@@ -355,14 +355,8 @@ fn samples(
                         owner.push(k);
                     }
                 }
-                let mut sub_poses = Vec::new();
-                machine
-                    .forward(&rows_sub, tool, &mut sub_poses)
-                    .map_err(|source| VerifyError::Kinematics {
-                        first: blocks.start + 1,
-                        last: blocks.end,
-                        source,
-                    })?;
+                let sub_poses =
+                    crate::replay::forward_rows(machine, &rows_sub, tool, blocks.clone())?;
                 // A send fails only where the second thread panicked, and
                 // its join passes that on.
                 let _ = send.send((sub_poses, owner));
@@ -554,16 +548,9 @@ pub fn check_groove(
         Ok(out)
     };
     let half = n_theta / 2;
-    // The second thread keeps the run's deadline.
-    let deadline = crate::budget::current();
-    let mut dist = std::thread::scope(|s| {
-        let h = s.spawn(|| crate::budget::with_deadline(deadline, || measure(half..n_theta)));
-        let a = measure(0..half);
-        let b = h.join().expect("the measuring thread does not panic");
-        let mut a = a?;
-        a.extend(b?);
-        Ok::<_, OverTime>(a)
-    })?;
+    let (a, b) = crate::budget::beside(|| measure(0..half), || measure(half..n_theta));
+    let mut dist = a?;
+    dist.extend(b?);
     // Each block's wheel across the whole section at its own theta; the
     // two threads take the two halves of the rows again.
     let across = |rows: std::ops::Range<usize>, dist: &mut [(Real, usize)]| {
@@ -591,13 +578,9 @@ pub fn check_groove(
     };
     {
         let (first, second) = dist.split_at_mut(half * nc);
-        std::thread::scope(|s| {
-            let h = s
-                .spawn(|| crate::budget::with_deadline(deadline, || across(half..n_theta, second)));
-            let a = across(0..half, first);
-            let b = h.join().expect("the measuring thread does not panic");
-            a.and(b)
-        })?;
+        let (a, b) =
+            crate::budget::beside(|| across(0..half, first), || across(half..n_theta, second));
+        a.and(b)?;
     }
     let place = |idx: usize| {
         let (i, j) = (idx / nc, idx % nc);

@@ -234,23 +234,14 @@ fn post_all(
     let control_text = machine.post.post(program, control.name)?;
     // The control's text read back on a second thread while the CL file
     // is written and linted (the machine's post stays on this one).
-    let deadline = crate::budget::current();
-    let (read, cld_text) = std::thread::scope(|s| {
-        let read = s.spawn(|| {
-            crate::budget::with_deadline(deadline, || {
-                crate::program::lint::lint_read(&control_text, program, control, &info.axes)
-            })
-        });
-        let cld = machine.post.post(program, CLD.name).map_err(Error::from);
-        let cld = cld.and_then(|text| {
+    let (cld_text, read) = crate::budget::beside(
+        || {
+            let text = machine.post.post(program, CLD.name)?;
             crate::program::lint::lint(&text, program, &CLD, &info.axes)?;
-            Ok(text)
-        });
-        let read = read
-            .join()
-            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        (read, cld)
-    });
+            Ok::<_, Error>(text)
+        },
+        || crate::program::lint::lint_read(&control_text, program, control, &info.axes),
+    );
     let (read, cld_text) = (read?, cld_text?);
     let mut files = vec![
         (
@@ -499,17 +490,10 @@ fn run_on(
             stage(STAGES[3]);
             // The data files need only the toolpath and the program: a
             // second thread writes them while this one posts and lints.
-            let deadline = crate::budget::current();
-            let (data, posted) = std::thread::scope(|s| {
-                let data = s.spawn(|| {
-                    crate::budget::with_deadline(deadline, || data_files(&toolpath, &program))
-                });
-                let posted = post_all(machine, info, &program, &options.also_post);
-                let data = data
-                    .join()
-                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-                (data, posted)
-            });
+            let (posted, data) = crate::budget::beside(
+                || post_all(machine, info, &program, &options.also_post),
+                || data_files(&toolpath, &program),
+            );
             let [toolpath_json, program_json, csv] = data?;
             let data = vec![
                 ("toolpath.json".into(), toolpath_json),
@@ -625,25 +609,18 @@ fn run_on(
     // The process, checked as well as the geometry; and, on a second
     // thread, the machine's bodies, the tool and the part clear of each
     // other along the whole program (neither reads the other).
-    let deadline = crate::budget::current();
-    let (process, collisions) = std::thread::scope(|s| {
-        let collisions = s.spawn(|| {
-            crate::budget::with_deadline(deadline, || {
-                collisions(verified, info, &placement, &toolpath.tool, &meshes, tol)
-            })
-        });
-        let process = crate::process::check(
-            verified,
-            kin,
-            &toolpath.tool.reference,
-            stock.as_deref(),
-            &crate::process::ProcessLimits::of(info),
-        );
-        let collisions = collisions
-            .join()
-            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        (process, collisions)
-    });
+    let (process, collisions) = crate::budget::beside(
+        || {
+            crate::process::check(
+                verified,
+                kin,
+                &toolpath.tool.reference,
+                stock.as_deref(),
+                &crate::process::ProcessLimits::of(info),
+            )
+        },
+        || collisions(verified, info, &placement, &toolpath.tool, &meshes, tol),
+    );
     let (process, collisions) = (process?, collisions?);
     failures.extend(process.errors);
     warnings.extend(process.warnings);
@@ -702,19 +679,8 @@ fn run_on(
         o.extend_tables(&mut tables);
     }
     let mut playback = Vec::new();
-    let deadline = crate::budget::current();
-    let (scene, (tables, finishing_plots)) = std::thread::scope(|s| {
-        let hooked = s.spawn(|| {
-            crate::budget::with_deadline(deadline, || {
-                let mut tables = tables;
-                let plots = match &options.annex.finish {
-                    Some(finish) => (finish.0)(&mut tables, &program, &passes),
-                    None => Vec::new(),
-                };
-                (tables, plots)
-            })
-        });
-        let scene = (|| -> Result<_, Error> {
+    let (scene, (tables, finishing_plots)) = crate::budget::beside(
+        || -> Result<_, Error> {
             Ok(if parts.is_empty() {
                 (None, vec![], vec![], None)
             } else {
@@ -756,12 +722,16 @@ fn run_on(
                     part_box.map(|b| scene::contact_box(b, &toolpath.tool, &pose)),
                 )
             })
-        })();
-        let hooked = hooked
-            .join()
-            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        (scene, hooked)
-    });
+        },
+        || {
+            let mut tables = tables;
+            let plots = match &options.annex.finish {
+                Some(finish) => (finish.0)(&mut tables, &program, &passes),
+                None => Vec::new(),
+            };
+            (tables, plots)
+        },
+    );
     let (pose_block, bodies, solids, part_box) = scene?;
     let mut report = Report {
         passes: passes.len(),
