@@ -179,3 +179,58 @@ impl crate::process::Stock for GrooveStock {
         self.passes.clone()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assert_near;
+    use crate::caliber::{pass_poses, SwivelPlane};
+    use crate::process::Stock;
+
+    /// Block after block along a pass, each search starting warm from the
+    /// block before's point, the wheel's depth in the stock is what the
+    /// geometry makes it: wheels posed to touch a groove that deepens round
+    /// the roll, then moved 0.02 mm off it along the contact's normal, are
+    /// 0.02 mm off the groove, so `stock - 0.02` deep in its allowance.
+    #[test]
+    fn the_warm_search_finds_each_blocks_depth() {
+        let theta: Vec<Real> = (0..=36).map(|i| i as Real * 5.0).collect();
+        let hp: Vec<Real> = theta.iter().map(|t| 24.0 - 0.05 * t).collect();
+        let b: Vec<Real> = hp.iter().map(|h| 2.1 * h).collect();
+        let groove = Groove::new(150.0, (&theta, &theta), &hp, &b).unwrap();
+        let wheel = Wheel {
+            diameter: 200.0,
+            rounding_radius: 8.0,
+            width: 16.0,
+        };
+        let req = GrooveRequest {
+            groove,
+            psi: vec![0.0],
+            tolerance: 0.01,
+            grid_theta: 0.5f64.to_radians(),
+            grid_per_step: 1,
+            patch_gap: 0.01,
+            stock: Some(0.05),
+        };
+        let stock = GrooveStock::new(&req, 0.05, &wheel, &[]);
+        let mut block = 0;
+        for psi in [-1.2, -0.4, 0.0, 0.6, 1.3] {
+            let poses = pass_poses(
+                &req.groove,
+                psi,
+                1f64.to_radians(),
+                100.0,
+                8.0,
+                SwivelPlane::Contact,
+            )
+            .unwrap();
+            for p in &poses {
+                let c = p.wheel.centre + 0.02 * p.normal;
+                let a = p.wheel.axis;
+                let depth = stock.tool_depth(block, &[c.x, c.y, c.z, a.x, a.y, a.z]);
+                assert_near!(depth, 0.03, 1e-6);
+                block += 1;
+            }
+        }
+    }
+}
