@@ -341,7 +341,8 @@ fn the_mandrel_is_corrected_by_its_measured_error() {
 /// Bad measurements and asks are refused, naming what, and nothing is
 /// written: a row outside the part, a stretch left unmeasured, a
 /// correction beyond its limit (naming where), one the wheel cannot
-/// follow (naming where), a family that takes no correction.
+/// follow (naming where), a run whose program was altered, a family that
+/// takes no correction.
 #[test]
 fn bad_measurements_are_refused_and_nothing_is_written() {
     let dir = scratch("compensate", "bad");
@@ -420,6 +421,22 @@ fn bad_measurements_are_refused_and_nothing_is_written() {
     let (_, _, err) = pilgrim(&["compensate", s(&run), "--measured", s(&f)]);
     assert!(err.contains("at z = 222.200 mm"), "{err}");
     assert!(!Path::new(&format!("{}-compensated", run.display())).exists());
+    // The first run's program altered after it was written (it is read
+    // while the corrected run is made): refused, naming the file, and
+    // nothing written.
+    let altered = dir.join("altered");
+    std::fs::create_dir_all(&altered).unwrap();
+    for entry in std::fs::read_dir(&run).unwrap() {
+        let from = entry.unwrap().path();
+        std::fs::copy(&from, altered.join(from.file_name().unwrap())).unwrap();
+    }
+    std::fs::write(altered.join("program.json"), "{").unwrap();
+    let f = table("as-nominal.csv", &every(&|_| 0.0));
+    let out = dir.join("altered.out");
+    let (code, _, err) = compensate(&altered, &f, &out, &[]);
+    assert_ne!(code, 0);
+    assert!(err.contains("program.json"), "{err}");
+    assert!(!out.exists(), "{} written", out.display());
     // The worm's family takes no correction (yet): refused, naming why.
     let worm = dir.join("worm");
     ran(&worm, "worm", &[]);
