@@ -288,3 +288,87 @@ fn a_program_file_is_verified_for_a_machine_and_a_family() {
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("--family"), "{err}");
 }
+
+/// The steady rest pressed into the turning part is refused at any depth,
+/// naming the block: the finishing pass with the rest at `U40` (about
+/// 7 mm into the part) and at `U0` (its whole radius in), and the rest fed
+/// 22 mm in after the finish, on a move that starts on the part and on one
+/// that starts clear of it.
+#[test]
+fn the_rest_pressed_into_the_part_is_refused_at_any_depth() {
+    let out = default_run("mandrel", "rest-deep");
+    let dir = out.parent().unwrap();
+    let text = std::fs::read_to_string(out.join("program.mpf")).unwrap();
+    let finish_from = text.find("; pass 4").unwrap();
+    let end_from = text.find("; end").unwrap();
+    // Every U of the finishing pass set to `u`.
+    let rest_at = |u: &str| {
+        let pass: String = text[finish_from..end_from]
+            .lines()
+            .map(|l| {
+                let words: Vec<String> = l
+                    .split_whitespace()
+                    .map(|w| {
+                        if w.starts_with('U') && !l.starts_with(';') {
+                            format!("U{u}")
+                        } else {
+                            w.to_owned()
+                        }
+                    })
+                    .collect();
+                format!("{}\n", words.join(" "))
+            })
+            .collect();
+        format!("{}{pass}{}", &text[..finish_from], &text[end_from..])
+    };
+    let verify = |name: &str, program: String| {
+        let file = dir.join(name);
+        std::fs::write(&file, program).unwrap();
+        let (code, _, err) = pilgrim(&["verify", s(&file), "--family", "scripts/mandrel.rhai"]);
+        (code, err)
+    };
+    for u in ["40.0", "0.0"] {
+        let (code, err) = verify(&format!("REST_U{}.MPF", &u[..1]), rest_at(u));
+        assert_eq!(code, 1, "U{u}: {err}");
+        assert!(
+            err.contains("rest") && err.contains("into the highest surface"),
+            "U{u}: {err}"
+        );
+    }
+    // After the finish, the rest fed 22 mm further in: from on the part,
+    // and from clear of it (back at its clearance first).
+    let last = text[..end_from]
+        .lines()
+        .rev()
+        .find(|l| l.contains(" U"))
+        .unwrap();
+    let u: f64 = last
+        .split_whitespace()
+        .find_map(|w| w.strip_prefix('U'))
+        .unwrap()
+        .parse()
+        .unwrap();
+    for (name, extra) in [
+        (
+            "REST_FED.MPF",
+            format!("N3441 G1 U{:.4} F100.0\n", u - 22.0),
+        ),
+        (
+            "REST_BACK_FED.MPF",
+            format!(
+                "N3441 G0 U{:.4}\nN3442 G1 U{:.4} F100.0\n",
+                u + 2.0,
+                u - 22.0
+            ),
+        ),
+    ] {
+        let fed = format!("{}{extra}{}", &text[..end_from], &text[end_from..]);
+        let (code, err) = verify(name, fed);
+        assert_eq!(code, 1, "{name}: {err}");
+        assert!(
+            err.contains("N3442") || err.contains("N3441"),
+            "{name}: {err}"
+        );
+        assert!(err.contains("into the"), "{name}: {err}");
+    }
+}
