@@ -23,10 +23,14 @@
 //!   clearance off it) onto it is a feed move at most that fast, never a
 //!   rapid;
 //! - **a body that rides the part stays on it** ([`RIDING`]): while such a
-//!   body is on the part (both ends of a move within the rapid clearance),
-//!   at every block and between blocks it stands off the highest surface
-//!   any spindle phase leaves, or presses into it, by at most the
-//!   machine's `rest_tolerance`;
+//!   body is on the part (both ends of a move within the rapid clearance
+//!   of it or into it, however deep), at every block and between blocks
+//!   it stands off the highest surface any spindle phase leaves, or
+//!   presses into it, by at most the machine's `rest_tolerance`; on every
+//!   other move (onto the part, off it, fed or rapid) it presses into it
+//!   by no more than that. Riding is where the body is along the program,
+//!   not a window of distances: a rest 46 mm into the part rides it, and
+//!   fails;
 //! - **the spindle turns and the coolant flows before cutting**
 //!   ([`SPINDLE`]): every cutting block runs at a speed the program writes
 //!   as at least 1 rpm and the spindle's least, with the coolant on where
@@ -405,24 +409,38 @@ fn bodies(
             let v: Vec<Real> = a.iter().zip(b).map(|(p, q)| p + along * (q - p)).collect();
             body.chain().matrix(&v).ok()
         };
-        // While it rides: its worst stand-off (+) or press (-), where.
+        // While it rides: its worst stand-off (+) or press (-), where; and
+        // the deepest it presses into the part on any other move.
         let mut worst: Option<(Real, usize)> = None;
+        let mut deepest: Option<(Real, usize)> = None;
         let mut gap_before = frame(0).and_then(|f| stock.body_gap(0, 1.0, &roller, &f));
+        if let Some(g) = gap_before.filter(|g| *g < 0.0) {
+            deepest = Some((g, 0));
+        }
         for k in 1..written.blocks.len() {
             let gap = frame(k).and_then(|f| stock.body_gap(k, 1.0, &roller, &f));
-            if let (Some(g0), Some(g1)) = (gap_before, gap) {
-                if g0.abs() <= clear && g1.abs() <= clear {
-                    // It rides: at the block and at the quarters before it.
-                    let inside = (1..RIDING_CHECKS).filter_map(|i| {
-                        let along = i as Real / RIDING_CHECKS as Real;
-                        between(k, along).and_then(|f| stock.body_gap(k, along, &roller, &f))
-                    });
-                    for g in std::iter::once(g1).chain(inside) {
-                        if worst.is_none_or(|w| g.abs() > w.0.abs()) {
-                            worst = Some((g, k));
-                        }
+            // The body at the block and at the quarters before it: the
+            // whole move, whatever the depth, fed or rapid.
+            let inside = (1..RIDING_CHECKS).filter_map(|i| {
+                let along = i as Real / RIDING_CHECKS as Real;
+                between(k, along).and_then(|f| stock.body_gap(k, along, &roller, &f))
+            });
+            let gaps: Vec<Real> = gap.into_iter().chain(inside).collect();
+            // It rides from the block where it comes within the clearance
+            // (or into the part, however deep) to the one that takes it
+            // clear again.
+            let rides =
+                gap_before.is_some_and(|g0| g0 <= clear) && gap.is_some_and(|g1| g1 <= clear);
+            for &g in &gaps {
+                if rides {
+                    if worst.is_none_or(|w| g.abs() > w.0.abs()) {
+                        worst = Some((g, k));
                     }
+                } else if deepest.is_none_or(|w| g < w.0) {
+                    deepest = Some((g, k));
                 }
+            }
+            if let (Some(g0), Some(g1)) = (gap_before, gap) {
                 if g0 > clear && g1 <= clear {
                     // It comes onto the part in this block: how fast.
                     let b = &written.blocks[k];
@@ -502,6 +520,23 @@ fn bodies(
                     .at(k, name),
                 );
             }
+        }
+        // Pressed into the part on a move on which it does not ride: onto
+        // the part from clear of it, or off it.
+        if let Some((g, k)) = deepest.filter(|(g, _)| *g < -limits.rest_tolerance * (1.0 + 1e-9)) {
+            let name = block_name(program, k);
+            out.errors.push(
+                Finding::new(
+                    RIDING,
+                    format!(
+                        "{name}: {} {} mm into the highest surface the part can have there, on its way onto or off the part (it may press at most the machine's rest_tolerance, {} mm)",
+                        spec.name,
+                        crate::math::fixed(-g, 4),
+                        limits.rest_tolerance
+                    ),
+                )
+                .at(k, name),
+            );
         }
     }
     Ok(())
