@@ -372,3 +372,26 @@ fn the_rest_pressed_into_the_part_is_refused_at_any_depth() {
         assert!(err.contains("into the"), "{name}: {err}");
     }
 }
+
+/// "Verified" is said only of a program that was verified: `verify` of a
+/// run whose family declares no verification (the demo's end mill) exits
+/// 1 saying so, and `run` of one says "not verified" in its summary.
+#[test]
+fn a_family_without_a_verification_is_not_called_verified() {
+    let out = scratch("verify", "unverified").join("mill");
+    let (code, said, err) = pilgrim(&[
+        "run",
+        "scripts/examples/mill_circle.rhai",
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(said.contains("not verified"), "{said}");
+    let (code, said, err) = pilgrim(&["verify", s(&out)]);
+    assert_eq!(code, 1, "{said}");
+    assert!(!said.contains("verified"), "{said}");
+    assert!(
+        err.contains("not verified") && err.contains("fn verify"),
+        "{err}"
+    );
+}
