@@ -319,6 +319,13 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
     match job::verify(&family, &machine, &first, &program, &options, &mut |_| {}) {
         Ok(out) => {
             pilgrim_kernel::output::write_dir(&args.out, &out.files).map_err(|e| e.to_string())?;
+            if out.report.verdict.status == pilgrim_kernel::verdict::Status::NotVerified {
+                return Err(format!(
+                    "{what}: {}; report in {}",
+                    job::NOT_VERIFIED,
+                    args.out.display()
+                ));
+            }
             let mut said = format!(
                 "{what}: verified{}; report in {}",
                 out.summary()

@@ -379,12 +379,8 @@ fn the_rest_pressed_into_the_part_is_refused_at_any_depth() {
 #[test]
 fn a_family_without_a_verification_is_not_called_verified() {
     let out = scratch("verify", "unverified").join("mill");
-    let (code, said, err) = pilgrim(&[
-        "run",
-        "scripts/examples/mill_circle.rhai",
-        "--out",
-        s(&out),
-    ]);
+    let (code, said, err) =
+        pilgrim(&["run", "scripts/examples/mill_circle.rhai", "--out", s(&out)]);
     assert_eq!(code, 0, "{err}");
     assert!(said.contains("not verified"), "{said}");
     let (code, said, err) = pilgrim(&["verify", s(&out)]);

@@ -158,6 +158,11 @@ pub struct JobOutput {
     pub files: Vec<(String, Vec<u8>)>,
 }
 
+/// What a run of a family that declares no verification says of its
+/// program: nothing says it makes the part.
+pub const NOT_VERIFIED: &str =
+    "not verified: the family declares no verification (fn verify), so nothing says the program makes the part";
+
 impl JobOutput {
     /// The verification's outcome as its own type (`None` if the family
     /// asked for none, or for one of another kind): e.g.
@@ -175,8 +180,13 @@ impl JobOutput {
             .as_ref()
             .map(|o| o.summary())
             .unwrap_or_default();
+        let unverified = if r.verdict.status == crate::verdict::Status::NotVerified {
+            format!("; {NOT_VERIFIED}")
+        } else {
+            String::new()
+        };
         format!(
-            "{}: {} cutting passes ({} in all), {} blocks for {} ({}), about {:.1} min{verified}",
+            "{}: {} cutting passes ({} in all), {} blocks for {} ({}), about {:.1} min{verified}{unverified}",
             r.script, r.cutting_passes, r.passes, r.blocks, r.machine, r.control, r.cycle_time_min,
         )
     }
