@@ -21,6 +21,7 @@ mod machine_files;
 mod mandrel;
 mod mandrel_fidelity;
 mod plugins;
+mod reader;
 mod ring;
 mod sdk;
 mod thread;

@@ -1,0 +1,261 @@
+//! The reader `verify` and the run's read-back share, held to what the
+//! control does with a program one edit away from one pilgrim wrote: a
+//! code's decimals, a tool or work offset, Fanuc's single modal F and its
+//! per-block Q, numbers without a decimal point, the setup words a program
+//! must state. Each edit is verified or refused as the control would run
+//! it, never passed as something else.
+
+use crate::common::{pilgrim, s, scratch};
+use std::path::{Path, PathBuf};
+
+/// A program pilgrim wrote, and how `verify` is asked about its edits.
+struct Written {
+    dir: PathBuf,
+    text: String,
+    ext: &'static str,
+    /// `verify`'s arguments after the file.
+    args: Vec<String>,
+}
+
+impl Written {
+    /// `verify` of `text` saved as `name` beside the run.
+    fn verify(&self, name: &str, text: &str) -> (i32, String, String) {
+        let file = self.dir.join(format!("{name}.{}", self.ext));
+        std::fs::write(&file, text).unwrap();
+        let mut args = vec!["verify".to_owned(), s(&file).to_owned()];
+        args.extend(self.args.iter().cloned());
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        pilgrim(&args)
+    }
+
+    /// `verify` of the program with `from` replaced (once) by `to`.
+    fn edited(&self, name: &str, from: &str, to: &str) -> (i32, String, String) {
+        assert!(self.text.contains(from), "{from} not in the program");
+        self.verify(name, &self.text.replacen(from, to, 1))
+    }
+}
+
+/// A default run of `script` (with `extra` arguments) into `dir`, its
+/// program in `ext`, and the arguments that verify a file of it.
+fn written(dir: &Path, script: &str, ext: &'static str, extra: &[&str]) -> Written {
+    let out = dir.join(ext);
+    let mut args = vec!["run", script, "--out", s(&out), "-q"];
+    args.extend(extra);
+    let (code, _, err) = pilgrim(&args);
+    assert_eq!(code, 0, "{err}");
+    let text = std::fs::read_to_string(out.join(format!("program.{ext}"))).unwrap();
+    let mut verify = vec!["--family".to_owned(), script.to_owned(), "-q".to_owned()];
+    let mut it = extra.iter();
+    while let Some(a) = it.next() {
+        if *a == "--machine" || *a == "--set" {
+            verify.push((*a).to_owned());
+            verify.push(it.next().unwrap().to_string());
+        }
+    }
+    Written {
+        dir: dir.to_owned(),
+        text,
+        ext,
+        args: verify,
+    }
+}
+
+/// The 3K152VF20 with a LinuxCNC control, as a machine file in `dir`.
+fn linuxcnc_grinder(dir: &Path) -> PathBuf {
+    let (code, toml, err) = pilgrim(&["machines", "--toml", "3K152VF20"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(toml.contains("control = \"sinumerik\""), "{toml}");
+    let file = dir.join("grinder-linuxcnc.toml");
+    std::fs::write(
+        &file,
+        toml.replace("control = \"sinumerik\"", "control = \"linuxcnc\""),
+    )
+    .unwrap();
+    file
+}
+
+/// Asserts `verify` refused, naming `word`.
+fn refused(said: (i32, String, String), word: &str, case: &str) {
+    let (code, out, err) = said;
+    assert_eq!(code, 1, "{case}: not refused: {out}{err}");
+    assert!(
+        err.contains(word),
+        "{case}: the refusal names not {word}: {err}"
+    );
+}
+
+/// The mandrel's Sinumerik program, the same on LinuxCNC, the worm's whole
+/// Fanuc program.
+fn three(name: &str) -> (Written, Written, Written) {
+    let dir = scratch("reader", name);
+    let machine = linuxcnc_grinder(&dir);
+    let mpf = written(&dir, "scripts/mandrel.rhai", "mpf", &[]);
+    let ngc = written(
+        &dir,
+        "scripts/mandrel.rhai",
+        "ngc",
+        &["--machine", s(&machine)],
+    );
+    let nc = written(&dir, "scripts/worm.rhai", "nc", &["--program-number", "1"]);
+    (mpf, ngc, nc)
+}
+
+/// A code whose decimals the control reads (`G91.000010` is G91 on
+/// LinuxCNC: every later move incremental) or that is another code than
+/// its integer part (`G33.1`, rigid tapping) is refused naming it, in every
+/// dialect; the harmless spellings of the codes pilgrim writes (`G01`,
+/// `G1.0`) are read as the codes they are.
+#[test]
+fn codes_are_read_with_their_decimals() {
+    let (mpf, ngc, nc) = three("decimals");
+    for (w, setup) in [
+        (&mpf, "N1 G90 G94 G71\n"),
+        (&ngc, "N1 G21 G40 G90 G94 G97\n"),
+        (&nc, "G21 G40 G97 G98\n"),
+    ] {
+        let first = setup.trim_end();
+        for code in [
+            "G91.000010",
+            "G20.000010",
+            "M9.000010",
+            "G92.000010",
+            "G59.300010",
+            "G33.1",
+            "G0.1",
+            "G1.5",
+            "M3.5",
+            "G94.1",
+        ] {
+            let said = w.edited(code, setup, &format!("{first} {code}\n"));
+            refused(said, code, &format!("{} {code}", w.ext));
+        }
+    }
+    // A move's code spelled with its zeros is the same code.
+    for (w, from, to) in [
+        (&mpf, "N50 G1 U", "N50 G01.000 U"),
+        (&ngc, " G1 ", " G01.0 "),
+        (&nc, "G00 X300.000", "G0 X300.000"),
+    ] {
+        let (code, _, err) = w.edited("zeros", from, to);
+        assert_eq!(code, 0, "{}: {err}", w.ext);
+    }
+}
+
+/// A tool offset other than the one the program's tool call selects (the
+/// model's tool), or one cancelled, is refused: Sinumerik's `D0`, `D2`,
+/// `D99`; Fanuc's `T0100` (offset cancelled) and `T0105`.
+#[test]
+fn another_tool_offset_is_refused() {
+    let (mpf, _, nc) = three("offsets");
+    for d in ["D0", "D2", "D99"] {
+        refused(mpf.edited(d, "N3 T1 D1\n", &format!("N3 T1 {d}\n")), d, d);
+        // Anywhere among the moves.
+        refused(
+            mpf.edited(d, "N50 G1 U", &format!("N45 {d}\nN50 G1 U")),
+            d,
+            d,
+        );
+    }
+    for t in ["T0100", "T0105"] {
+        refused(nc.edited(t, "T0101\n", &format!("{t}\n")), t, t);
+    }
+}
+
+/// A work offset switched before the finish (another part zero) is
+/// refused naming it, in every dialect.
+#[test]
+fn a_work_offset_switched_is_refused() {
+    let (mpf, ngc, nc) = three("work-offsets");
+    for code in ["G55", "G56", "G57", "G58", "G59"] {
+        let at = mpf.text.find("; pass 4").unwrap();
+        let text = format!("{}N2615 {code}\n{}", &mpf.text[..at], &mpf.text[at..]);
+        refused(mpf.verify(code, &text), code, &format!("mpf {code}"));
+        let at = ngc.text.find("(pass 4").unwrap();
+        let text = format!("{}N2615 {code}\n{}", &ngc.text[..at], &ngc.text[at..]);
+        refused(ngc.verify(code, &text), code, &format!("ngc {code}"));
+        let at = nc.text.rfind("(PASS ").unwrap();
+        let text = format!("{}{code}\n{}", &nc.text[..at], &nc.text[at..]);
+        refused(nc.verify(code, &text), code, &format!("nc {code}"));
+    }
+}
+
+/// Fanuc has one modal F: a feed written on a G01 is the lead of the next
+/// G32 that writes none (`F2.` on a M20x2.5 cuts lead 2.0); its start angle
+/// Q holds for its own block (on a rapid it starts no thread); a number
+/// without a decimal point is in the least input unit (`X64` is 0.064 mm
+/// on a 0i-TC, whose decimal-point input is off as it leaves the factory).
+#[test]
+fn fanucs_modal_words_are_read_as_fanuc_reads_them() {
+    let dir = scratch("reader", "fanuc");
+    let thread = written(
+        &dir,
+        "scripts/thread.rhai",
+        "nc",
+        &["--program-number", "1"],
+    );
+    let retract = thread
+        .text
+        .lines()
+        .skip_while(|l| !l.starts_with("G32"))
+        .nth(1)
+        .unwrap()
+        .to_owned();
+    assert!(retract.starts_with("G00 X"), "{retract}");
+    let x = retract.trim_start_matches("G00 ");
+    let (code, said, err) = thread.edited(
+        "shared-f",
+        &format!("{retract}\n"),
+        &format!("G01 {x} F2.\n{retract}\n"),
+    );
+    assert_eq!(code, 1, "verified at lead 2.5: {said}");
+    assert!(err.contains("lead 2"), "{err}");
+    // Q on the rapid before a pass of the second start.
+    let worm = written(&dir, "scripts/worm.rhai", "nc", &["--program-number", "1"]);
+    let g32 = worm
+        .text
+        .lines()
+        .find(|l| l.starts_with("G32") && l.contains(" Q"))
+        .unwrap()
+        .to_owned();
+    let (before, q) = g32.split_once(" Q").unwrap();
+    let at = worm.text.find(&format!("{g32}\n")).unwrap();
+    let start = worm.text[..at].trim_end().rfind('\n').unwrap() + 1;
+    let rapid = worm.text[start..at].trim_end().to_owned();
+    let text = format!(
+        "{}{rapid} Q{q}\n{before}\n{}",
+        &worm.text[..start],
+        &worm.text[at + g32.len() + 1..]
+    );
+    refused(
+        worm.verify("carried-q", &text),
+        &format!("Q{q}"),
+        "carried Q",
+    );
+    // X without its decimal point.
+    let (code, said, err) = worm.edited("no-point", "G00 X300.000", "G00 X300");
+    assert_eq!(code, 1, "X300 read as 300 mm: {said}");
+    assert!(err.contains("X300") || err.contains("0.3"), "{err}");
+}
+
+/// A program that leaves a modal group to the control's power-on state is
+/// refused, naming the word it must state: on Sinumerik `G90`, `G94`,
+/// `G71`; on Fanuc `G21`, `G98` (a Fanuc lathe powers up in feed per
+/// revolution: `F100` is 100 mm a turn); on LinuxCNC `G21`, `G90`, `G94`.
+#[test]
+fn the_power_on_state_is_never_assumed() {
+    let (mpf, ngc, nc) = three("power-on");
+    for (w, line, words) in [
+        (&mpf, "N1 G90 G94 G71", ["G90", "G94", "G71"].as_slice()),
+        (&ngc, "N1 G21 G40 G90 G94 G97", &["G21", "G90", "G94"]),
+        (&nc, "G21 G40 G97 G98", &["G21", "G98"]),
+    ] {
+        for word in words {
+            let without = line.replacen(&format!(" {word}"), "", 1);
+            refused(
+                w.edited(word, line, &without),
+                word,
+                &format!("{} without {word}", w.ext),
+            );
+        }
+    }
+}
