@@ -1013,3 +1013,43 @@ fn a_start_out_of_its_place_is_moved_back() {
     let moved = table["correction_um"][1].as_f64().unwrap();
     assert!((moved + 30.0).abs() < 1.0, "{table}");
 }
+
+/// The options that would let a correction run away are refused before
+/// anything is read or written, naming the option and its value: a limit
+/// that is not a positive finite number (`--limit NaN` turned the limit
+/// off), a gain outside (0, 1] (`--gain 2` oscillates for ever), an
+/// uncertainty that is not positive; and `--out` equal to the run, or
+/// holding it, which would replace the measured run.
+#[test]
+fn options_that_run_away_or_overwrite_are_refused() {
+    let dir = scratch("compensate", "options");
+    let run = mandrel_run(&dir);
+    let measured = std::path::Path::new("scripts/examples/mandrel-measured.csv");
+    for (flag, value, says) in [
+        ("--limit", "NaN", "the correction's limit"),
+        ("--limit", "inf", "the correction's limit"),
+        ("--limit=-1", "", "the correction's limit"),
+        ("--limit", "0", "the correction's limit"),
+        ("--gain", "2", "the gain"),
+        ("--gain", "0", "the gain"),
+        ("--gain", "NaN", "the gain"),
+        ("--uncertainty", "0", "uncertainty"),
+    ] {
+        let out = dir.join("out");
+        let extra: Vec<&str> = [flag, value]
+            .into_iter()
+            .filter(|a| !a.is_empty())
+            .collect();
+        let (code, _, err) = compensate(&run, measured, &out, &extra);
+        assert_eq!(code, 1, "{flag} {value}: {err}");
+        assert!(err.contains(says), "{flag} {value}: {err}");
+        assert!(!out.exists(), "{flag} {value}");
+    }
+    let before = std::fs::read(run.join("program.mpf")).unwrap();
+    for out in [run.clone(), run.parent().unwrap().to_owned()] {
+        let (code, _, err) = compensate(&run, measured, &out, &[]);
+        assert_eq!(code, 1, "{}: {err}", out.display());
+        assert!(err.contains("--out"), "{err}");
+    }
+    assert_eq!(std::fs::read(run.join("program.mpf")).unwrap(), before);
+}

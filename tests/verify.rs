@@ -391,3 +391,32 @@ fn a_family_without_a_verification_is_not_called_verified() {
         "{err}"
     );
 }
+
+/// `verify` never writes over what it was asked to check: `--out` equal
+/// to the run's directory, or holding it, is refused, and the
+/// hand-edited program stays.
+#[test]
+fn verify_never_writes_over_its_target() {
+    let out = default_run("mandrel", "onto-itself");
+    let program = out.join("program.mpf");
+    let before = std::fs::read(&program).unwrap();
+    for into in [out.clone(), out.parent().unwrap().to_owned()] {
+        let (code, _, err) = pilgrim(&["verify", s(&out), "--out", s(&into)]);
+        assert_eq!(code, 1, "{}: {err}", into.display());
+        assert!(err.contains("--out"), "{err}");
+        assert_eq!(std::fs::read(&program).unwrap(), before);
+    }
+    let file = out.parent().unwrap().join("SHOP.MPF");
+    std::fs::write(&file, &before).unwrap();
+    let (code, _, err) = pilgrim(&[
+        "verify",
+        s(&file),
+        "--family",
+        "scripts/mandrel.rhai",
+        "--out",
+        s(out.parent().unwrap()),
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("--out"), "{err}");
+    assert_eq!(std::fs::read(&file).unwrap(), before);
+}
