@@ -540,3 +540,34 @@ fn api_reference_is_current() {
         assert!(out.contains(&format!("## `{f}(")), "{f} missing");
     }
 }
+
+/// A family whose name begins like a word LinuxCNC acts on in a comment
+/// (`(PY,..)`, `(LOG,..)`, `(PRINT,..)`), without the comma that makes it
+/// one, writes its LinuxCNC program: the header's comment is a name, not
+/// an instruction.
+#[test]
+fn families_named_like_active_comments_write_linuxcnc_programs() {
+    let dir = common::scratch("cli", "active-names");
+    let script = std::fs::read_to_string("scripts/examples/mill_circle.rhai").unwrap();
+    for name in ["pyramid", "logo", "printer", "message", "debugger"] {
+        let family = dir.join(format!("{name}.rhai"));
+        std::fs::write(&family, &script).unwrap();
+        let out = dir.join(name);
+        let (code, _, err) = pilgrim(&[
+            "run",
+            common::s(&family),
+            "--post",
+            "linuxcnc",
+            "--out",
+            common::s(&out),
+            "-q",
+        ]);
+        assert_eq!(code, 0, "{name}: {err}");
+        let ngc = std::fs::read_to_string(out.join("program.ngc")).unwrap();
+        let header = ngc.lines().nth(1).unwrap();
+        assert!(
+            header.starts_with(&format!("({} for ", name.to_uppercase())),
+            "{ngc:.200}"
+        );
+    }
+}
