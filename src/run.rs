@@ -216,6 +216,7 @@ pub struct VerifyArgs {
 /// (then the error names the block).
 pub fn verify(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String> {
     positive_seconds(args.script_seconds, args.run_seconds)?;
+    pilgrim_kernel::output::apart(&args.out, &args.target).map_err(|e| e.to_string())?;
     pilgrim_kernel::budget::with_limit(args.run_seconds, "the verification's", || {
         verify_within(args, catalog)
     })

@@ -144,6 +144,41 @@ fn is_real_dir(path: &Path) -> bool {
     std::fs::symlink_metadata(path).is_ok_and(|m| m.is_dir())
 }
 
+/// Checks that `out`, where a command writes its directory, neither is
+/// nor holds `input`, what the command reads (a run's directory, a
+/// program file): writing there would replace what it was asked to check
+/// or correct. Links and relative paths are resolved first.
+///
+/// # Failures
+/// `out` equal to `input` or one of its parents, named with both.
+pub fn apart(out: &Path, input: &Path) -> Result<(), OutputError> {
+    let (o, i) = (resolved(out), resolved(input));
+    if i.starts_with(&o) {
+        return Err(err(
+            out,
+            format!(
+                "{} {}: writing there would replace what this command reads; give --out another directory",
+                if i == o { "is" } else { "holds" },
+                input.display()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// `path` absolute, links resolved as far as it exists.
+fn resolved(path: &Path) -> PathBuf {
+    if let Ok(p) = std::fs::canonicalize(path) {
+        return p;
+    }
+    match (path.parent(), path.file_name()) {
+        (Some(parent), Some(name)) if !parent.as_os_str().is_empty() => resolved(parent).join(name),
+        _ => std::env::current_dir()
+            .map(|d| d.join(path))
+            .unwrap_or_else(|_| path.to_owned()),
+    }
+}
+
 /// Checks that `out` may be replaced: it does not exist, or it is a
 /// directory pilgrim wrote, holding only the marker and the files it lists.
 ///

@@ -158,6 +158,16 @@ pub enum CompensateError {
         /// The columns there are.
         available: String,
     },
+    /// An option bounding the correction out of its range.
+    #[error("{what} is {value}; it must be {range}")]
+    Option {
+        /// The option, in words and by its flag.
+        what: String,
+        /// Its value.
+        value: f64,
+        /// What it must be.
+        range: String,
+    },
     /// The fit could not be made.
     #[error("the measured error could not be fitted: {0}")]
     Fit(String),

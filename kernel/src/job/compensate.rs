@@ -52,6 +52,47 @@ pub struct CompensateOptions {
     pub limits: Limits,
 }
 
+impl CompensateOptions {
+    /// Checks the options that bound the correction: a gain in (0, 1] (a
+    /// larger one overshoots, round after round, and never settles), a
+    /// positive finite limit (NaN would compare false and turn the limit
+    /// off) and uncertainty.
+    ///
+    /// # Failures
+    /// The first option out of its range, named with its value.
+    pub fn check(&self) -> Result<(), CompensateError> {
+        let bad = |what: &str, value: f64, range: &str| {
+            Err(CompensateError::Option {
+                what: what.to_owned(),
+                value,
+                range: range.to_owned(),
+            })
+        };
+        if !(self.gain > 0.0 && self.gain <= 1.0) {
+            return bad(
+                "the gain (--gain), the share of the error corrected,",
+                self.gain,
+                "in (0, 1]: above 1 each correction overshoots the last",
+            );
+        }
+        if !(self.limit > 0.0 && self.limit.is_finite()) {
+            return bad(
+                "the correction's limit (--limit)",
+                self.limit,
+                "a positive finite number of mm",
+            );
+        }
+        if !(self.uncertainty > 0.0 && self.uncertainty.is_finite()) {
+            return bad(
+                "the measurement's uncertainty (--uncertainty)",
+                self.uncertainty,
+                "a positive finite number of mm",
+            );
+        }
+        Ok(())
+    }
+}
+
 /// One measured place as `compensation.json` lists it.
 #[derive(Debug, Clone, Serialize)]
 pub struct Place {
@@ -226,6 +267,7 @@ pub fn compensate(
     measured: &Table,
     options: &CompensateOptions,
 ) -> Result<(JobOutput, Compensation), Error> {
+    options.check()?;
     let shown = dir.display().to_string();
     let run = RunDir::open(dir).map_err(|e| Error::Read(e.to_string()))?;
     let limit = crate::files::MAX_DATA_BYTES;
