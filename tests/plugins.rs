@@ -382,7 +382,7 @@ fn toolpath(p) {
     // to paste (which has none), no moves, no end.
     assert!(
         err.contains("lint of the fanuc program")
-            && err.contains("line 1: '%' is not a block the lint can account for"),
+            && err.contains("line 1: '%': a tape's start or end"),
         "{err}"
     );
     // What failed is in the output, marked FAILED; no program is.

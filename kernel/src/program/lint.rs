@@ -1,30 +1,36 @@
 //! Every program pilgrim writes, read back and checked before it is
-//! written (issue 14 §4): the text is parsed again (G-code with the
-//! `gcode` crate; the APT CL file by its records) and held to the dialect
-//! and to the axis program it came from.
+//! written, and every program `verify` reads: one reader, as strict as the
+//! control. The text is read word by word (G-code by [`super::words`],
+//! every character accounted for; the APT CL file by its records) and
+//! held to the dialect and, for a program pilgrim wrote, to the axis
+//! program it came from.
 //!
 //! The checks: every block numbered in order where the dialect numbers
-//! blocks; only the words the dialect allows (its G and M codes, the
-//! program's axes, F, S, T, the lead's and the start angle's addresses);
-//! modal state (a feed before the first G1, the spindle on before cutting,
-//! constant speed G97 before a thread on the lathe dialects, a lead on a
-//! thread block where the dialect wants one); every axis value within the
+//! blocks; only the words the dialect's table lists (its G and M codes
+//! with their decimals exactly as written: `G33.1` is not G33, `G91.000010`
+//! not a G code the table has; the program's axes, F, S, T, the lead's and
+//! the start angle's addresses; no address twice in a block, no two
+//! motions); the control's number rules (Fanuc: an axis value without a
+//! decimal point in its least input unit, F with its point, Q without);
+//! modal state (the setup's units, distance and feed mode stated before
+//! the first move, never the power-on state assumed; one work offset, the
+//! first selected; the tool with its own offset, `D1` or `T0101`; a feed
+//! before the first G1, one modal F where the lead's address is F; the
+//! spindle on before cutting, constant speed G97 before a thread on the
+//! lathe dialects, a lead on a thread block where the dialect wants one, a
+//! start angle on a thread block only); every axis value within the
 //! machine's travel; the end (M30, LinuxCNC's M2, the `%` framing); and
 //! every move read back, the modal values carried, equal to the axis
-//! program's block within half the output's last decimal. The parser's
-//! numbers are `f32`: the values are read again from the text the parser
-//! located (its spans), in `f64`.
+//! program's block within half the output's last decimal.
 //!
 //! Sinumerik's own words (`DIAMON`, `DIAMOF`, `FGROUP(..)`, `SF=`) and the
-//! `%_N_.._MPF` header are read here, not by the crate, which knows the
-//! ISO words only.
+//! `%_N_.._MPF` header are read here, before the ISO words.
 
 use super::post::{Dialect, Style};
 use super::{name_in, AxisProgram, ProgramSetup};
 use crate::machine::{Axis, AxisKind};
 use crate::math::Real;
 use crate::toolpath::Motion;
-use gcode::{Code, Value};
 use pilgrim_plugin_abi::types::Radial;
 
 /// A program that fails its lint: which program, where, what.
@@ -257,6 +263,10 @@ struct State {
     start_deg: Real,
     values: Vec<Option<Real>>,
     ended: bool,
+    /// The G codes stated so far (the setup's modal states among them).
+    stated: Vec<u32>,
+    /// The work offset selected (G54..), once selected.
+    work_offset: Option<u32>,
 }
 
 /// A word of Sinumerik's own, outside the ISO words the parser reads.
@@ -409,7 +419,7 @@ fn lint_gcode(
     // parser (blanked in place, so spans stay valid) and checked, the
     // header's own lines recognised where they stand, Sinumerik's own
     // words read.
-    let mut iso = String::with_capacity(text.len());
+    let mut code_lines: Vec<String> = Vec::with_capacity(lines.len());
     let mut own: Vec<Vec<OwnWord>> = vec![Vec::new(); lines.len()];
     // The comment of each line that holds nothing else.
     let mut comments: Vec<Option<String>> = vec![None; lines.len()];
@@ -489,8 +499,7 @@ fn lint_gcode(
             }
         }
         has_code[i] = !l.trim().is_empty() || !own[i].is_empty();
-        iso.push_str(&l);
-        iso.push('\n');
+        code_lines.push(l);
     }
     let mut consumed = vec![false; lines.len()];
     let spindle = axes.iter().find(|a| a.kind == AxisKind::Spindle);
@@ -506,18 +515,6 @@ fn lint_gcode(
             ));
         }
     }
-    let parsed = gcode::parse(&iso).map_err(|diags| {
-        let first = diags.iter().next();
-        let line = first.map(|x| x.span.line).unwrap_or(0);
-        fault(
-            at_line(line),
-            format!(
-                "not G-code the control reads: {:?} in '{}'",
-                first.map(|x| &x.kind),
-                crate::files::excerpt(lines.get(line).unwrap_or(&""))
-            ),
-        )
-    })?;
     let mut st = State {
         values: vec![None; names.len()],
         ..State::default()
@@ -527,17 +524,45 @@ fn lint_gcode(
                    // Read: the first line not yet searched for a move's comment, and a
                    // speed set among the moves for the next move.
     let (mut comment_from, mut speed_next) = (0, None);
-    for block in &parsed.blocks {
-        let line = block.span.line;
+    for (line, code_text) in code_lines.iter().enumerate() {
         ticker
             .tick()
             .map_err(|e| fault(at_line(line), e.to_string()))?;
+        // The block's words, every character accounted for.
+        let at_block = || {
+            code_text
+                .split_whitespace()
+                .next()
+                .filter(|w| {
+                    w.len() > 1 && w.starts_with('N') && w[1..].bytes().all(|b| b.is_ascii_digit())
+                })
+                .map_or_else(|| at_line(line), str::to_owned)
+        };
+        let mut tokens = super::words::words(code_text).map_err(|m| fault(at_block(), m))?;
+        let line_number = match tokens.first() {
+            Some(w) if w.letter == 'N' => {
+                let n = w
+                    .whole()
+                    .filter(|_| !w.number.starts_with('+'))
+                    .ok_or_else(|| {
+                        fault(
+                            at_line(line),
+                            format!("{}: a block number is a whole number", w.text()),
+                        )
+                    })?;
+                tokens.remove(0);
+                Some(n)
+            }
+            _ => None,
+        };
+        if let Some(w) = tokens.iter().find(|w| w.letter == 'N') {
+            return Err(fault(
+                at_block(),
+                format!("{}: a block number that does not open its block", w.text()),
+            ));
+        }
         let own_here = own.get_mut(line).map(std::mem::take).unwrap_or_default();
-        if block.codes.is_empty()
-            && block.word_addresses.is_empty()
-            && block.line_number.is_none()
-            && own_here.is_empty()
-        {
+        if tokens.is_empty() && line_number.is_none() && own_here.is_empty() {
             continue;
         }
         if let Some(c) = consumed.get_mut(line) {
@@ -545,9 +570,7 @@ fn lint_gcode(
         }
         let place = |k: usize| {
             if reading {
-                block
-                    .line_number
-                    .map_or_else(|| at_line(line), |n| format!("N{n}"))
+                line_number.map_or_else(|| at_line(line), |n| format!("N{n}"))
             } else if k < program.blocks.len() {
                 name_in(d.name, &program.blocks, k)
             } else {
@@ -557,7 +580,7 @@ fn lint_gcode(
         if st.ended {
             return Err(fault(place(k), "a block after the program's end".into()));
         }
-        match (d.numbering, block.line_number) {
+        match (d.numbering, line_number) {
             (Some(_), None) => {
                 return Err(fault(at_line(line), "a block without its number".into()))
             }
@@ -578,7 +601,7 @@ fn lint_gcode(
             }
             (None, None) => {}
         }
-        // The block's words: codes and their arguments, bare addresses.
+        // The block's words: codes, the tool call, addresses with values.
         let mut radial_here: Vec<bool> = Vec::new();
         let mut feed_group_here: Vec<&str> = Vec::new();
         let mut sf_here = None;
@@ -589,86 +612,153 @@ fn lint_gcode(
                 OwnWord::StartAngle(v) => sf_here = Some(*v),
             }
         }
-        let mut words: Vec<(char, &gcode::Argument)> = Vec::new();
-        let mut bare: Vec<&gcode::WordAddress> = Vec::new();
         let mut motion_here = None;
-        for c in &block.codes {
-            match c {
-                Code::General(g) => {
-                    let n = number(&g.number.to_string());
-                    if !g_ok.contains(&n) {
-                        return Err(fault(place(k), not_read(reading, d, 'G', &g.number)));
+        let mut read = Vec::new();
+        let mut letters_here: Vec<char> = Vec::new();
+        let mut start_word: Option<String> = sf_here.map(|v| format!("SF={v}"));
+        for w in &tokens {
+            match w.letter {
+                'G' | 'M' => {
+                    let listed = if w.letter == 'G' { g_ok } else { m_ok };
+                    let Some(n) = w.whole().filter(|n| listed.contains(n)) else {
+                        return Err(fault(place(k), not_read(reading, d, w.letter, &w.number)));
+                    };
+                    if w.letter == 'M' {
+                        match n {
+                            3 => st.spindle_on = true,
+                            5 => st.spindle_on = false,
+                            8 => st.coolant = true,
+                            9 => st.coolant = false,
+                            n if n == d.reading.end_code => st.ended = true,
+                            _ => {}
+                        }
+                        continue;
                     }
                     match n {
-                        0 | 1 | 32 | 33 | 76 => motion_here = Some(n),
+                        0 | 1 | 32 | 33 | 76 => {
+                            if let Some(m) = motion_here {
+                                return Err(fault(
+                                    place(k),
+                                    format!("G{m} and {} in one block: two motions", w.text()),
+                                ));
+                            }
+                            motion_here = Some(n)
+                        }
                         97 => st.constant_speed = true,
                         // LinuxCNC's diameter (G7) and radius (G8) modes.
                         7 | 8 => radial_here.push(n == 7),
+                        n if d.reading.work_offsets.contains(&n) => {
+                            // The part zero is the work offset the program
+                            // selects first (before its moves: the one in
+                            // force at power-on, the first listed, if none).
+                            let current = st
+                                .work_offset
+                                .or((k > 0).then(|| d.reading.work_offsets[0]));
+                            match current {
+                                Some(c) if c != n => {
+                                    return Err(fault(
+                                        place(k),
+                                        format!(
+                                            "{}: a switch of the work offset from G{c}, the part zero the verification places the part at (another part zero moves every later block); verify a program that keeps one",
+                                            w.text()
+                                        ),
+                                    ))
+                                }
+                                _ => st.work_offset = Some(n),
+                            }
+                        }
                         _ => {}
                     }
-                    words.extend(g.args.iter().map(|a| (a.letter, a)));
-                }
-                Code::Miscellaneous(m) => {
-                    let n = number(&m.number.to_string());
-                    if !m_ok.contains(&n) {
-                        return Err(fault(place(k), not_read(reading, d, 'M', &m.number)));
+                    if !st.stated.contains(&n) {
+                        st.stated.push(n);
                     }
-                    match n {
-                        3 => st.spindle_on = true,
-                        5 => st.spindle_on = false,
-                        8 => st.coolant = true,
-                        9 => st.coolant = false,
-                        n if n == d.reading.end_code => st.ended = true,
-                        _ => {}
-                    }
-                    words.extend(m.args.iter().map(|a| (a.letter, a)));
                 }
-                Code::ToolChange(t) => {
+                'T' => {
                     if k > 0 {
                         return Err(fault(
                             place(k),
-                            format!("a tool call T{} among the moves", t.number),
+                            format!("a tool call {} among the moves", w.text()),
                         ));
                     }
-                    // A lathe's T names the tool and its offset (`T0303`).
-                    let n = number(&t.number.to_string());
-                    out.tool = Some(if d.reading.tool_and_offset && n >= 100 {
-                        n / 100
+                    let n = w.whole().ok_or_else(|| {
+                        fault(
+                            place(k),
+                            format!("{}: a tool call is a whole number", w.text()),
+                        )
+                    })?;
+                    // A lathe's T names the tool and its offset (`T0303`):
+                    // the model's tool is the tool with its own offset.
+                    out.tool = Some(if d.reading.tool_and_offset {
+                        let (tool, offset) = (n / 100, n % 100);
+                        if n < 100 || offset != tool {
+                            return Err(fault(
+                                place(k),
+                                format!(
+                                    "{}: tool {tool:02} with offset {offset:02}; the verification's tool is a tool with its own offset (T{tool:02}{tool:02}: 00 cancels the offset, another number is another tool's)",
+                                    w.text()
+                                ),
+                            ));
+                        }
+                        tool
                     } else {
                         n
                     });
-                    words.extend(t.args.iter().map(|a| (a.letter, a)));
                 }
-                _ => return Err(fault(place(k), "a code the lint does not know".into())),
+                letter => {
+                    if letters_here.contains(&letter) {
+                        return Err(fault(
+                            place(k),
+                            format!("{}: {letter} twice in one block", w.text()),
+                        ));
+                    }
+                    letters_here.push(letter);
+                    if d.reading.point_needed.contains(letter) && !w.has_point() {
+                        return Err(fault(
+                            place(k),
+                            format!(
+                                "{}: a number without its decimal point, which {} reads by a parameter of the control; write {}.",
+                                w.text(),
+                                d.name,
+                                w.text()
+                            ),
+                        ));
+                    }
+                    if d.reading.no_point.contains(letter) && w.has_point() {
+                        return Err(fault(
+                            place(k),
+                            format!(
+                                "{}: a decimal point in a word {} reads as a whole number",
+                                w.text(),
+                                d.name
+                            ),
+                        ));
+                    }
+                    // An axis value without a decimal point is in the
+                    // control's least input unit where it says so.
+                    let v = match d.reading.least_input {
+                        Some(unit) if !w.has_point() && names.contains(&letter) => w.value() * unit,
+                        _ => w.value(),
+                    };
+                    if start_letter == Some(letter) {
+                        start_word = Some(w.text());
+                    }
+                    if d.reading.offset_word == Some(letter) && w.whole() != Some(1) {
+                        return Err(fault(
+                            place(k),
+                            format!(
+                                "{}: another tool offset than {letter}1, the tool call's, which is the verification's tool ({letter}0 cancels it, another number is another edge's)",
+                                w.text()
+                            ),
+                        ));
+                    }
+                    read.push((letter, v, w.text()));
+                }
             }
-        }
-        bare.extend(block.word_addresses.iter());
-        // Values from the text at the parser's spans (f64, as written).
-        let value_at = |span: gcode::core::Span, letter: char| -> Result<Real, LintError> {
-            let t = iso.get(span.start..span.start + span.length).unwrap_or("");
-            let digits = t.trim_start_matches(|c: char| c.is_ascii_alphabetic());
-            digits
-                .parse()
-                .map_err(|_| fault(place(k), format!("{letter}: '{t}' is not a number")))
-        };
-        let mut axis_here = vec![None; names.len()];
-        let mut read = Vec::new();
-        for (letter, v, span) in words
-            .iter()
-            .map(|(l, a)| (*l, &a.value, a.span))
-            .chain(bare.iter().map(|w| (w.letter, &w.value, w.span)))
-        {
-            if let Value::Variable(_) = v {
-                return Err(fault(
-                    place(k),
-                    format!("{letter}: a variable, which pilgrim never writes"),
-                ));
-            }
-            read.push((letter, value_at(span, letter)?));
         }
         if let Some(s) = sf_here {
-            read.push(('@', s));
+            read.push(('@', s, format!("SF={s}")));
         }
+        let mut axis_here = vec![None; names.len()];
         // The machine's setup words, once, before the first move, and as
         // the setup says.
         for diameter in radial_here {
@@ -709,7 +799,8 @@ fn lint_gcode(
         // A threading cycle (LinuxCNC's G76): the moves it makes, each
         // held and read as a block of its own.
         if motion_here == Some(76) {
-            let (cycle, end_x) = cycle_words(&read, d).map_err(|m| fault(place(k), m))?;
+            let values: Vec<(char, Real)> = read.iter().map(|(c, v, _)| (*c, *v)).collect();
+            let (cycle, end_x) = cycle_words(&values, d).map_err(|m| fault(place(k), m))?;
             let what = "a threading cycle";
             let needs_g97 = (d.reading.thread_needs_constant_speed && !st.constant_speed)
                 .then(|| format!("{what} before constant spindle speed (G97)"));
@@ -800,7 +891,7 @@ fn lint_gcode(
                     },
                     spindle: if n == 0 { speed_next.take() } else { None },
                     comment: if n == 0 { comment.clone() } else { None },
-                    number: block.line_number,
+                    number: line_number,
                     line,
                 });
                 k += 1;
@@ -810,13 +901,20 @@ fn lint_gcode(
         }
         let mut lead_here = None;
         let mut s_here = None;
-        for (letter, v) in read {
+        for (letter, v, text) in read {
             if let Some(i) = names.iter().position(|n| *n == letter) {
                 axis_here[i] = Some(v);
                 continue;
             }
             match letter {
-                'F' if motion_here.or(st.motion).is_some_and(|m| m == 32) => lead_here = Some(v),
+                // One modal F where the lead's address is the feed's
+                // (Fanuc): a feed written on a G01 is the next thread's
+                // lead, and a lead the next G01's feed.
+                'F' if lead_letter == 'F' => {
+                    st.feed = true;
+                    st.f = Some(v);
+                    lead_here = Some(v);
+                }
                 'F' => {
                     st.feed = true;
                     st.f = Some(v);
@@ -826,11 +924,11 @@ fn lint_gcode(
                 c if start_letter == Some(c) => st.start_deg = v / start_scale,
                 '@' => st.start_deg = v,
                 c if c == lead_letter => lead_here = Some(v),
-                c if reading => {
+                _ if reading => {
                     return Err(fault(
                         place(k),
                         format!(
-                            "{c}{v}: a word the verification cannot simulate ({} on {} reads the axes {}, F, S, T{})",
+                            "{text}: a word the verification cannot simulate ({} on {} reads the axes {}, F, S, T{})",
                             d.name,
                             program.machine,
                             names.iter().collect::<String>(),
@@ -838,10 +936,10 @@ fn lint_gcode(
                         ),
                     ))
                 }
-                c => {
+                _ => {
                     return Err(fault(
                         place(k),
-                        format!("{c}{v}: not a word of {} on {}", d.name, program.machine),
+                        format!("{text}: not a word of {} on {}", d.name, program.machine),
                     ))
                 }
             }
@@ -897,11 +995,8 @@ fn lint_gcode(
             if motion_here.is_some() {
                 return Err(fault(place(k), "a motion word with no axis".into()));
             }
-            if sf_here.is_some() {
-                return Err(fault(
-                    place(k),
-                    "SF= outside a thread block, where the writer never puts it".into(),
-                ));
+            if let Some(w) = &start_word {
+                return Err(fault(place(k), outside_thread(w, d)));
             }
             continue;
         }
@@ -956,11 +1051,8 @@ fn lint_gcode(
         {
             return Err(fault(place(k), m));
         }
-        if sf_here.is_some() && !is_thread {
-            return Err(fault(
-                place(k),
-                "SF= outside a thread block, where the writer never puts it".into(),
-            ));
+        if let Some(w) = start_word.as_ref().filter(|_| !is_thread) {
+            return Err(fault(place(k), outside_thread(w, d)));
         }
         if let Some(m) = setup_fault(&st, d, &program.setup, "a move") {
             return Err(fault(place(k), m));
@@ -1060,7 +1152,7 @@ fn lint_gcode(
                 },
                 spindle: speed_next.take(),
                 comment,
-                number: block.line_number,
+                number: line_number,
                 line,
             });
         }
@@ -1119,12 +1211,31 @@ fn cutting_fault(st: &State, d: &Dialect, setup: &ProgramSetup, what: &str) -> O
     }
 }
 
+/// The refusal of a thread's start angle `word` on a block that cuts no
+/// thread: Fanuc's Q holds for its own thread block only, and a start
+/// angle elsewhere would be verified as a start the control never cuts.
+fn outside_thread(word: &str, d: &Dialect) -> String {
+    format!(
+        "{word}: a thread's start angle outside a thread block ({} reads it on the thread block it stands on); write it on the {} block",
+        d.name, d.thread
+    )
+}
+
 /// What the modal state `st` lacks for `what` (any move) of the machine's
 /// `setup`, where the dialect has words for it: radius or diameter
 /// programming, the feed's group, each set before the first move.
 fn setup_fault(st: &State, d: &Dialect, setup: &ProgramSetup, what: &str) -> Option<String> {
     let radial_word = d.radial_words.is_some() && d.style == Style::GCode;
-    if radial_word && setup.radial.is_some() && st.radial.is_none() {
+    if let Some(c) = d
+        .reading
+        .setup_codes
+        .iter()
+        .find(|c| !st.stated.contains(c))
+    {
+        Some(format!(
+            "{what} before G{c} is stated: the program leaves it to the control's power-on state, which the verification does not assume; write G{c} before the moves"
+        ))
+    } else if radial_word && setup.radial.is_some() && st.radial.is_none() {
         Some(format!(
             "{what} before the radial axis's programming (radius or diameter) is set, which the machine's setup states"
         ))
@@ -1240,14 +1351,6 @@ fn is_g_code(word: &str) -> bool {
 /// The first word of a line (before a comment).
 fn first_code(line: &str) -> Option<&str> {
     line.split('(').next()?.split_whitespace().next()
-}
-
-/// The integer part of a G or M number as the crate prints it (`1`, `33`).
-fn number(text: &str) -> u32 {
-    text.split('.')
-        .next()
-        .and_then(|t| t.parse().ok())
-        .unwrap_or(u32::MAX)
 }
 
 /// The APT CL file: each record one the writer makes, in the form it
@@ -1619,7 +1722,7 @@ mod tests {
             &FANUC,
             "G00 X50.000 Z5.000",
             "G00 X50.000 Z5.000 Y3.000",
-            &["block 1", "Y3: not a word of fanuc"],
+            &["block 1", "Y3.000: not a word of fanuc"],
         );
         case(
             &SINUMERIK,
@@ -1766,7 +1869,7 @@ mod tests {
             &SINUMERIK,
             "N1 G90 G94 G71\n",
             "N1 G90 G94 G71 SF=90\n",
-            &["SF= outside"],
+            &["SF=90: a thread's start angle outside a thread block"],
         );
         case(
             &SINUMERIK,
@@ -1902,7 +2005,7 @@ mod tests {
         for (from, to, says) in [
             ("J0.6000", "J0.6100", "the threading cycle's move"),
             (" H1\n", " H1 E1.0\n", "tapered ends"),
-            (" H1\n", " H1 J0.7\n", "G76 gives J twice"),
+            (" H1\n", " H1 J0.7\n", "J twice in one block"),
             (" I-4.0000", "", "G76 without its I word"),
             (
                 "G0 X50.000",

@@ -154,6 +154,24 @@ pub struct Reading {
     pub offset_word: Option<char>,
     /// Whether a thread block needs constant spindle speed (G97) in force.
     pub thread_needs_constant_speed: bool,
+    /// The G codes a program must state before its first move (units,
+    /// absolute or incremental, the feed's mode): the reader never assumes
+    /// the control's power-on state, which a machine's parameters set.
+    pub setup_codes: &'static [u32],
+    /// The G codes that select a work offset, the one in force at power-on
+    /// first: the first a program selects is its part zero, a switch to
+    /// another is refused.
+    pub work_offsets: &'static [u32],
+    /// The unit of an axis value written without a decimal point (Fanuc's
+    /// least input increment, 0.001 mm, with decimal-point input off as the
+    /// control leaves the factory), or `None`: a whole number of mm.
+    pub least_input: Option<f64>,
+    /// Addresses refused without their decimal point (Fanuc's F, which a
+    /// parameter scales).
+    pub point_needed: &'static str,
+    /// Addresses refused with a decimal point (Fanuc's start angle Q, a
+    /// whole number of 0.001 deg).
+    pub no_point: &'static str,
 }
 
 /// The word of a thread block's spindle start angle.
@@ -220,6 +238,11 @@ pub const SINUMERIK: Dialect = Dialect {
         tool_and_offset: false,
         offset_word: Some('D'),
         thread_needs_constant_speed: false,
+        setup_codes: &[90, 94, 71],
+        work_offsets: &[54, 55, 56, 57, 58, 59],
+        least_input: None,
+        point_needed: "",
+        no_point: "",
     },
 };
 
@@ -277,6 +300,11 @@ pub const FANUC: Dialect = Dialect {
         tool_and_offset: true,
         offset_word: None,
         thread_needs_constant_speed: true,
+        setup_codes: &[21, 98],
+        work_offsets: &[54, 55, 56, 57, 58, 59],
+        least_input: Some(0.001),
+        point_needed: "F",
+        no_point: "Q",
     },
 };
 
@@ -323,6 +351,11 @@ pub const LINUXCNC: Dialect = Dialect {
         tool_and_offset: false,
         offset_word: None,
         thread_needs_constant_speed: true,
+        setup_codes: &[21, 90, 94],
+        work_offsets: &[54, 55, 56, 57, 58, 59],
+        least_input: None,
+        point_needed: "",
+        no_point: "",
     },
 };
 
@@ -369,6 +402,11 @@ pub const CLD: Dialect = Dialect {
         tool_and_offset: false,
         offset_word: None,
         thread_needs_constant_speed: false,
+        setup_codes: &[],
+        work_offsets: &[],
+        least_input: None,
+        point_needed: "",
+        no_point: "",
     },
 };
 
@@ -471,12 +509,28 @@ pub const ACTIVE_COMMENTS: [&str; 8] = [
     "MSG", "DEBUG", "PRINT", "LOG", "PROBE", "ABORT", "PY", "AXIS",
 ];
 
-/// Whether a comment's text would make `d`'s control act: it starts (case
-/// and leading spaces aside) with one of [`ACTIVE_COMMENTS`] on LinuxCNC.
+/// Whether a comment's text would make `d`'s control act: on LinuxCNC it
+/// starts (case and leading spaces aside) with one of [`ACTIVE_COMMENTS`]
+/// followed by what makes it an instruction: a comma (`MSG,`, `PY,`,
+/// spaces before it allowed), or a probe's or log's word of its own
+/// (`PROBEOPEN`, `PROBECLOSE`, `LOGOPEN`, `LOGCLOSE`, `LOGAPPEND`). A name
+/// that only begins like one (`pyramid`, `logo`, `printer`) is text.
 pub fn is_active_comment(d: &Dialect, text: &str) -> bool {
     d.name == LINUXCNC.name && {
         let t = text.trim_start().to_ascii_uppercase();
-        ACTIVE_COMMENTS.iter().any(|k| t.starts_with(k))
+        [
+            "PROBEOPEN",
+            "PROBECLOSE",
+            "LOGOPEN",
+            "LOGCLOSE",
+            "LOGAPPEND",
+        ]
+        .iter()
+        .any(|k| t.starts_with(k))
+            || ACTIVE_COMMENTS.iter().any(|k| {
+                t.strip_prefix(k)
+                    .is_some_and(|rest| rest.trim_start().starts_with(','))
+            })
     }
 }
 
@@ -833,6 +887,30 @@ mod tests {
 
     fn program() -> AxisProgram {
         crate::program::test_program()
+    }
+
+    /// LinuxCNC acts on a comment that opens with its word and a comma (or
+    /// a probe's or log's word), never on a name that only begins like one.
+    #[test]
+    fn active_comments_are_instructions_not_names() {
+        for (text, active) in [
+            ("MSG, hello", true),
+            (" msg ,hello", true),
+            ("PY,import os", true),
+            ("LOG,x", true),
+            ("LOGOPEN,f", true),
+            ("PROBEOPEN f", true),
+            ("logclose", true),
+            ("DEBUG,#1", true),
+            ("PYRAMID for vertical-mill", false),
+            ("LOGO for mill", false),
+            ("PRINTER for mill", false),
+            ("MESSAGE for mill", false),
+            ("pass 1, stock 0.0 um", false),
+        ] {
+            assert_eq!(is_active_comment(&LINUXCNC, text), active, "{text}");
+            assert!(!is_active_comment(&FANUC, text), "{text}");
+        }
     }
 
     #[test]
