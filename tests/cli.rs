@@ -571,3 +571,67 @@ fn families_named_like_active_comments_write_linuxcnc_programs() {
         );
     }
 }
+
+/// A reader that closes the pipe early (`pilgrim api-docs | head -0`) ends
+/// the output, not in a panic: no "internal error", exit 0 (what was
+/// wanted of the output was read). `--quiet` silences every command whose
+/// output is a status line (run, verify, compensate, export,
+/// plugin-check), never the data a command was asked for (params).
+#[test]
+fn a_closed_pipe_and_quiet_are_honoured() {
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pilgrim"))
+        .current_dir(common::root())
+        .arg("api-docs")
+        .stdout(writer)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(err.is_empty(), "{err}");
+    let dir = common::scratch("cli", "quiet");
+    let run = dir.join("run");
+    let (code, said, err) = pilgrim(&["run", DEMO, "--out", s(&run), "-q"]);
+    assert_eq!((code, said.as_str()), (0, ""), "{err}");
+    let (code, said, err) = pilgrim(&["export", s(&run), "--block", "10", "-q"]);
+    assert_eq!((code, said.as_str()), (0, ""), "{err}");
+    let (code, said, _) = pilgrim(&["params", DEMO, "-q"]);
+    assert!(code == 0 && !said.is_empty());
+}
+
+/// A name from outside reaches the terminal escaped (a carriage return,
+/// an escape sequence, an OSC 52 clipboard write, a right-to-left
+/// override shown as `\u{..}`), so no name can make "FAILED" display as
+/// something else; and a message is cut at a stated length (20,000
+/// column names do not make a 2 MB message).
+#[test]
+fn names_reach_the_terminal_escaped_and_messages_are_bounded() {
+    let dir = common::scratch("cli", "escaped");
+    let evil = dir.join("a\rverified\u{1b}]52;c;aGk=\u{7}\u{202e}FPM.MPF");
+    std::fs::write(&evil, "%_N_A_MPF\nN1 G4711\n").unwrap();
+    let (code, said, err) = pilgrim(&["verify", s(&evil), "--family", "scripts/mandrel.rhai"]);
+    assert_eq!(code, 1, "{said}");
+    for bad in ['\r', '\u{1b}', '\u{7}', '\u{202e}'] {
+        assert!(
+            !err.contains(bad) && !said.contains(bad),
+            "{bad:?} in {err:?}"
+        );
+    }
+    assert!(err.contains("\\r") && err.contains("\\u{202e}"), "{err}");
+    // A measurement with 20,000 columns, none the one wanted.
+    let run = dir.join("run");
+    let (code, _, err) = pilgrim(&["run", "scripts/mandrel.rhai", "--out", s(&run), "-q"]);
+    assert_eq!(code, 0, "{err}");
+    let wide = dir.join("wide.csv");
+    let header: Vec<String> = (0..20_000).map(|i| format!("column_{i}")).collect();
+    std::fs::write(
+        &wide,
+        format!("{}\n{}\n", header.join(","), vec!["1"; 20_000].join(",")),
+    )
+    .unwrap();
+    let (code, _, err) = pilgrim(&["compensate", s(&run), "--measured", s(&wide)]);
+    assert_eq!(code, 1);
+    assert!(err.len() < 10_000, "{} bytes: {:.300}", err.len(), err);
+    assert!(err.contains("characters cut"), "{:.500}", err);
+}
