@@ -15,6 +15,7 @@ use pilgrim_kernel::machine::{machine_file, AxisKind, MachineInfo};
 use pilgrim_kernel::plugin::PluginMachine;
 use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
 use pilgrim_kernel::PartFamily;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -545,13 +546,40 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(text) => {
-            if !cli.quiet || !matches!(cli.command, Command::Run { .. }) {
-                print!("{text}");
+            // --quiet silences a status line, never the data asked for.
+            let status = matches!(
+                cli.command,
+                Command::Run { .. }
+                    | Command::Verify { .. }
+                    | Command::Compensate { .. }
+                    | Command::Export { .. }
+                    | Command::PluginCheck { .. }
+            );
+            if cli.quiet && status {
+                return ExitCode::SUCCESS;
             }
-            ExitCode::SUCCESS
+            // A status line is a message, cut at its length; data is whole.
+            let cut = status.then_some(pilgrim_kernel::files::MAX_MESSAGE);
+            let text = pilgrim_kernel::files::terminal(&text, cut);
+            let mut stdout = std::io::stdout().lock();
+            match stdout
+                .write_all(text.as_bytes())
+                .and_then(|()| stdout.flush())
+            {
+                Ok(()) => ExitCode::SUCCESS,
+                // The reader closed the pipe: it has read what it wanted.
+                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("pilgrim: the output could not be written: {e}");
+                    ExitCode::FAILURE
+                }
+            }
         }
         Err(e) => {
-            eprintln!("pilgrim: {e}");
+            eprintln!(
+                "pilgrim: {}",
+                pilgrim_kernel::files::terminal(&e, Some(pilgrim_kernel::files::MAX_MESSAGE))
+            );
             ExitCode::FAILURE
         }
     }

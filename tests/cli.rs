@@ -633,5 +633,4 @@ fn names_reach_the_terminal_escaped_and_messages_are_bounded() {
     let (code, _, err) = pilgrim(&["compensate", s(&run), "--measured", s(&wide)]);
     assert_eq!(code, 1);
     assert!(err.len() < 10_000, "{} bytes: {:.300}", err.len(), err);
-    assert!(err.contains("characters cut"), "{:.500}", err);
 }

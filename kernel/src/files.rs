@@ -151,6 +151,33 @@ pub fn excerpt(text: &str) -> String {
     out
 }
 
+/// The most characters of one message pilgrim prints (an error, a status
+/// line): past it the message is cut, saying how much was.
+pub const MAX_MESSAGE: usize = 4000;
+
+/// `text` as pilgrim prints it to a terminal: every control character but
+/// the line feed and the tab (a carriage return, an escape sequence, a bell) and every
+/// bidirectional override escaped as `\r`, `\u{1b}`, `\u{202e}`, so that no
+/// name from outside (a file's, a column's, a machine's) can move the
+/// cursor, write the clipboard or make one word display as another; cut
+/// after `max` characters, if given, with the count of those cut.
+pub fn terminal(text: &str, max: Option<usize>) -> String {
+    let mut out = String::with_capacity(text.len());
+    for (n, c) in text.chars().enumerate() {
+        if max.is_some_and(|m| n >= m) {
+            let rest = text.chars().count() - n;
+            out.push_str(&format!("... ({rest} more characters cut)"));
+            break;
+        }
+        if c == '\n' || c == '\t' {
+            out.push(c);
+        } else {
+            shown_char(c, &mut out);
+        }
+    }
+    out
+}
+
 /// A path as a message shows it: control characters escaped, and a path
 /// longer than [`MAX_EXCERPT`] characters cut in the middle, so that both
 /// where it starts and the file's name show.
@@ -175,6 +202,22 @@ pub fn shown_path(path: &Path) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A message for the terminal: control characters and overrides
+    /// escaped, the line feed and tab kept, cut at its length saying so.
+    #[test]
+    fn messages_reach_the_terminal_escaped_and_cut() {
+        let said = terminal("a\rb\u{1b}[2J\u{202e}c\nd\te", None);
+        assert_eq!(said, "a\\rb\\u{1b}[2J\\u{202e}c\nd\te");
+        let long = "x".repeat(5000);
+        let said = terminal(&long, Some(MAX_MESSAGE));
+        assert!(said.starts_with(&"x".repeat(MAX_MESSAGE)));
+        assert!(
+            said.ends_with("... (1000 more characters cut)"),
+            "{}",
+            &said[3990..]
+        );
+    }
 
     #[test]
     fn excerpts_are_short() {
