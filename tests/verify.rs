@@ -420,3 +420,38 @@ fn verify_never_writes_over_its_target() {
     assert!(err.contains("--out"), "{err}");
     assert_eq!(std::fs::read(&file).unwrap(), before);
 }
+
+/// A run's files are not trusted: `parameters.tolerance` raised to 1.0 in
+/// its `report.json` does not pass a finish 0.5 mm into the part; the
+/// verification names the file and the parameter. Given on the verifying
+/// command's own line, the looser tolerance is the user's decision.
+/// (Before, the report's tolerance was taken and the verification failed
+/// on another finding, the finishing stock, naming neither.)
+#[test]
+fn a_tolerance_loosened_in_the_report_is_refused() {
+    let out = default_run("mandrel", "loosened");
+    let text = std::fs::read_to_string(out.join("program.mpf")).unwrap();
+    let (line, x) = move_after(&text, "pass 4", 3);
+    let deeper = line.replacen(&format!("X{x:.4}"), &format!("X{:.4}", x - 0.5), 1);
+    std::fs::write(out.join("program.mpf"), text.replacen(&line, &deeper, 1)).unwrap();
+    let mut r = report(&out);
+    assert_eq!(r["parameters"]["tolerance"]["value"], 0.001);
+    r["parameters"]["tolerance"]["value"] = serde_json::json!(1.0);
+    std::fs::write(
+        out.join("report.json"),
+        serde_json::to_string_pretty(&r).unwrap(),
+    )
+    .unwrap();
+    let (code, said, err) = pilgrim(&["verify", s(&out)]);
+    assert_eq!(code, 1, "{said}");
+    assert!(
+        err.contains("report.json") && err.contains("tolerance = 1") && err.contains("looser"),
+        "{err}"
+    );
+    // Given on the command line, the tolerance is taken, and the program
+    // verified against it (with every pass then "finishing", the process's
+    // finishing stock refuses it: it is verified, not waved through).
+    let (_, _, err) = pilgrim(&["verify", s(&out), "--set", "tolerance=1.0"]);
+    assert!(!err.contains("looser"), "{err}");
+    assert!(err.contains("finishing stock"), "{err}");
+}
