@@ -228,7 +228,7 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
         max_seconds: args.script_seconds,
         ..Limits::default()
     };
-    let (family, mut first, spec, program, file) = if args.target.is_dir() {
+    let (family, mut first, spec, program, file, report_label) = if args.target.is_dir() {
         // A run's directory: its program in the control's dialect, its
         // family, parameters and (built-in) machine as its report says.
         let run = pilgrim_kernel::output::RunDir::open(&args.target).map_err(|e| e.to_string())?;
@@ -270,7 +270,14 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
         let text = run
             .read_text(&name, pilgrim_kernel::files::MAX_DATA_BYTES)
             .map_err(|e| e.to_string())?;
-        (family, first, spec, text, args.target.join(&name))
+        (
+            family,
+            first,
+            spec,
+            text,
+            args.target.join(&name),
+            Some(label),
+        )
     } else {
         let script = args.family.as_ref().ok_or_else(|| {
             format!(
@@ -283,10 +290,29 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
         let text =
             pilgrim_kernel::files::read_text(&args.target, pilgrim_kernel::files::MAX_DATA_BYTES)
                 .map_err(|e| e.to_string())?;
-        (family, Vec::new(), spec, text, args.target.clone())
+        (family, Vec::new(), spec, text, args.target.clone(), None)
     };
     first = sources(first, args.params.as_deref(), &args.sets)?;
     let machine = catalog.open(&spec).map_err(|e| e.to_string())?;
+    // A run's report says what the run was asked; a tolerance looser than
+    // the family's is taken only from this command's own line.
+    if let Some(label) = &report_label {
+        let values = job::params_on(&family, &machine, &first).map_err(|e| e.to_string())?;
+        for s in family.params().iter().filter(|s| s.tolerance) {
+            let (Some(v), Some(d)) = (
+                values.get(&s.name).and_then(|v| v.as_number()),
+                s.default.as_number(),
+            ) else {
+                continue;
+            };
+            if v > d && pilgrim_kernel::params::set_by(&s.name, &first) == Some(label.as_str()) {
+                return Err(format!(
+                    "{label}: {} = {v} {} is looser than the family's {d}: a verification takes a looser tolerance only from its own command line (--set {}={v}, or --params), never from a file a run wrote",
+                    s.name, s.unit, s.name
+                ));
+            }
+        }
+    }
     // A program file is read in its machine's control's dialect: one whose
     // extension is another dialect's was written for another control.
     let control = &machine.kinematics.info().control;

@@ -166,6 +166,12 @@ pub struct ParamSpec {
     /// The most values a list may hold.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_len: Option<usize>,
+    /// Whether it is a tolerance the verification holds the part to (a
+    /// larger value is looser): a verification takes a value looser than
+    /// the default only from its own command line, never from a file a
+    /// run wrote.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub tolerance: bool,
 }
 
 impl ParamSpec {
@@ -181,6 +187,7 @@ impl ParamSpec {
             min: None,
             max: None,
             max_len: None,
+            tolerance: false,
         }
     }
 
@@ -293,6 +300,21 @@ pub enum ParamError {
         /// What is wrong.
         message: String,
     },
+}
+
+/// The label of the last of `sources` that sets `name`, if any (a source
+/// that does not parse sets nothing here: [`resolve`] names its fault).
+pub fn set_by<'a>(name: &str, sources: &'a [ParamSource]) -> Option<&'a str> {
+    sources.iter().rev().find_map(|s| match s {
+        ParamSource::Toml { label, text } => toml::from_str::<toml::Table>(text)
+            .ok()?
+            .contains_key(name)
+            .then_some(label.as_str()),
+        ParamSource::Pairs { label, pairs } => pairs
+            .iter()
+            .any(|(k, _)| k == name)
+            .then_some(label.as_str()),
+    })
 }
 
 /// The values of the parameters `specs`: defaults (a machine constant's

@@ -5,7 +5,8 @@
 //! - `fn params()`: a map of parameters, each `#{ value, unit, doc }` (the
 //!   default, its unit, a one-line description), optionally `min`, `max`
 //!   (bounds; a quantity that drives work has a ceiling) and `max_len` (for
-//!   a list), and `machine` (the machine constant that gives the default);
+//!   a list), `machine` (the machine constant that gives the default) and
+//!   `tolerance: true` (a tolerance the verification holds the part to);
 //! - `fn toolpath(p)`: the toolpath for the parameter values `p` (a map);
 //! - optionally `fn part(p)` (the part's geometry, for export),
 //!   `fn checks(p)` (an array of `#{ name, ok, detail }`), `fn verify(p)`
@@ -479,12 +480,27 @@ impl ScriptFamily {
                     .map_err(|e| fam.contract(e.to_string()))?;
             }
             let body = Some(text("body")).filter(|b| !b.is_empty());
+            let tolerance = match field("tolerance") {
+                None => false,
+                Some(d) => d.as_bool().map_err(|_| {
+                    fam.contract(format!(
+                        "parameter '{name}': tolerance must be true or false (true: a tolerance the verification holds the part to)"
+                    ))
+                })?,
+            };
+            if tolerance && default.as_number().is_none() {
+                return Err(fam.contract(format!(
+                    "parameter '{name}' is a tolerance, so it must be a number, not {}",
+                    default.kind()
+                )));
+            }
             let spec = ParamSpec {
                 machine,
                 body,
                 min,
                 max,
                 max_len,
+                tolerance,
                 ..ParamSpec::new(&name, default, &text("unit"), &text("doc"))
             };
             if spec.body.is_some()
