@@ -1053,3 +1053,35 @@ fn options_that_run_away_or_overwrite_are_refused() {
     }
     assert_eq!(std::fs::read(run.join("program.mpf")).unwrap(), before);
 }
+
+/// A measurement is applied once: `compensation.json` records the
+/// corrected run's lineage (its generation, the run it corrected, the
+/// measurement's digest, the gain and limit), and the same measurement
+/// (by content, whatever its file is called) given to the corrected run
+/// is refused, naming the run that applied it (applied again, it grew
+/// the correction each time while saying the part would be right).
+#[test]
+fn a_measurement_is_applied_once() {
+    let dir = scratch("compensate", "applied-once");
+    let run = mandrel_run(&dir);
+    let measured = std::path::Path::new("scripts/examples/mandrel-measured.csv");
+    let first = dir.join("first");
+    compensated(&run, measured, &first);
+    let record = json(&first.join("compensation.json"));
+    let lineage = &record["lineage"];
+    assert_eq!(lineage["generation"], 1, "{record}");
+    assert_eq!(lineage["parent"].as_str(), Some(s(&run)));
+    let digest = lineage["measurement_sha256"].as_str().unwrap();
+    assert_eq!(digest.len(), 64);
+    assert_eq!(lineage["applied"].as_array().unwrap().len(), 1);
+    let copy = dir.join("again.csv");
+    std::fs::copy(measured, &copy).unwrap();
+    let out = dir.join("second");
+    let (code, _, err) = compensate(&first, &copy, &out, &[]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("applied already") && err.contains(s(&first)),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
