@@ -179,6 +179,60 @@ pub struct Compensation {
     pub not_measured: Vec<String>,
     /// How the program changed.
     pub program: ProgramChange,
+    /// Where the corrected run comes from.
+    pub lineage: Lineage,
+}
+
+/// A corrected run's line of descent: how many corrections it carries,
+/// the run it corrected and every measurement applied along the line.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Lineage {
+    /// How many corrections the run's target carries (1: the first
+    /// corrected run of a run that had none).
+    pub generation: u32,
+    /// The run corrected (as given).
+    pub parent: String,
+    /// The measurement's content digest ([`Table::digest`]).
+    pub measurement_sha256: String,
+    /// Every measurement's digest applied along the line, oldest first,
+    /// this one last.
+    pub applied: Vec<String>,
+    /// The gain.
+    pub gain: f64,
+    /// The correction's limit (mm).
+    pub limit_mm: f64,
+}
+
+/// The lineage a run records in its `compensation.json` (none where it
+/// was not corrected): its generation and the measurements applied.
+///
+/// # Failures
+/// A `compensation.json` that is not what `compensate` writes, named.
+fn lineage_of(run: &RunDir, shown: &str) -> Result<Option<(u32, Vec<String>)>, Error> {
+    if !run.files().iter().any(|f| f == "compensation.json") {
+        return Ok(None);
+    }
+    let text = run
+        .read_text("compensation.json", crate::files::MAX_DATA_BYTES)
+        .map_err(|e| Error::Read(e.to_string()))?;
+    let bad = |what: &str| Error::Read(format!("{shown}/compensation.json: {what}"));
+    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| bad(&e.to_string()))?;
+    let l = &v["lineage"];
+    let generation = l["generation"]
+        .as_u64()
+        .and_then(|g| u32::try_from(g).ok())
+        .ok_or_else(|| bad("no lineage.generation"))?;
+    let applied = l["applied"]
+        .as_array()
+        .ok_or_else(|| bad("no lineage.applied"))?
+        .iter()
+        .map(|d| {
+            d.as_str()
+                .map(str::to_owned)
+                .ok_or_else(|| bad("a digest in lineage.applied is not text"))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(Some((generation, applied)))
 }
 
 impl Compensation {
@@ -277,6 +331,25 @@ pub fn compensate(
     };
     let report: Report = serde_json::from_str(&read("report.json")?)
         .map_err(|e| Error::Read(format!("{shown}/report.json: {e}")))?;
+    // A measurement is applied once along a line of corrections: the part
+    // a corrected program made is measured anew.
+    let digest = measured.digest();
+    let (generation, mut applied) = lineage_of(&run, &shown)?.unwrap_or_default();
+    if applied.contains(&digest) {
+        return Err(Error::Options(format!(
+            "{}: this measurement was applied already, in the line of corrections that made {shown} (its compensation.json): measure the part its corrected program made, and correct by that",
+            measured.source()
+        )));
+    }
+    applied.push(digest.clone());
+    let lineage = Lineage {
+        generation: generation + 1,
+        parent: shown.clone(),
+        measurement_sha256: digest,
+        applied,
+        gain: options.gain,
+        limit_mm: options.limit,
+    };
     let script = PathBuf::from(&report.script);
     if !script.is_file() {
         return Err(Error::Read(format!(
@@ -627,6 +700,7 @@ pub fn compensate(
                 )
             }
         },
+        lineage,
     };
     out.files.push((CORRECTION_FILE.into(), csv.into_bytes()));
     out.files.push((
