@@ -893,3 +893,32 @@ fn spreadsheets_are_bounded_before_they_expand() {
     assert!(m.peak_mb < 200.0, "{} MB at its peak", m.peak_mb);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A deadline already past stops every default job's verification at its
+/// first look at the clock, naming the limit and where it was, never a
+/// verdict, never a panic: each loop that grows with the program (the
+/// reader, the replays, the process's rules, the steady rest's ride, the
+/// collisions) looks at the clock.
+#[test]
+fn a_deadline_already_past_stops_every_verification() {
+    let dir = common::scratch("trust", "deadline");
+    for job in ["mandrel", "caliber", "worm", "thread"] {
+        let out = dir.join(job);
+        let (code, _, err) = crate::common::pilgrim(&[
+            "run",
+            &format!("scripts/{job}.rhai"),
+            "--out",
+            s(&out),
+            "-q",
+        ]);
+        assert_eq!(code, 0, "{err}");
+        let (code, said, err) =
+            crate::common::pilgrim(&["verify", s(&out), "--run-seconds", "1e-9"]);
+        assert_eq!(code, 1, "{job}: {said}");
+        assert!(
+            err.contains("the verification's time limit of 0.000000001 s passed"),
+            "{job}: {err}"
+        );
+        assert!(!err.contains("internal error"), "{job}: {err}");
+    }
+}

@@ -417,7 +417,9 @@ fn bodies(
         if let Some(g) = gap_before.filter(|g| *g < 0.0) {
             deepest = Some((g, 0));
         }
+        let mut ticker = crate::budget::Ticker::new("the steady rest's ride", 16);
         for k in 1..written.blocks.len() {
+            ticker.tick()?;
             let gap = frame(k).and_then(|f| stock.body_gap(k, 1.0, &roller, &f));
             // The body at the block and at the quarters before it: the
             // whole move, whatever the depth, fed or rapid.
