@@ -1085,3 +1085,40 @@ fn a_measurement_is_applied_once() {
     );
     assert!(!out.exists());
 }
+
+/// A measurement that contradicts itself is refused, naming both sides:
+/// two rows at one place further apart than 3 times the stated
+/// uncertainty (averaged, a diameter's whole error would pass), and two
+/// value columns of one quantity (`r_mm` and `d_mm` 50 um apart) further
+/// apart than the uncertainty (one was used, without a word).
+#[test]
+fn a_measurement_that_contradicts_itself_is_refused() {
+    let dir = scratch("compensate", "contradicts");
+    let run = mandrel_run(&dir);
+    let zs: Vec<f64> = (0..=44).map(|i| 10.0 * i as f64).collect();
+    let mut rows = String::from("z_mm,d_mm\n");
+    for &z in &zs {
+        rows += &format!("{z},{}\n", law(z));
+    }
+    rows += &format!("200,{}\n", law(200.0) + 0.01);
+    let apart = dir.join("apart.csv");
+    std::fs::write(&apart, rows).unwrap();
+    let out = dir.join("out");
+    let (code, _, err) = compensate(&run, &apart, &out, &[]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("z_mm = 200") && err.contains("rows 22 and 47"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let mut both = String::from("z_mm,d_mm,r_mm\n");
+    for &z in &zs {
+        both += &format!("{z},{},{}\n", law(z), law(z) / 2.0 + 0.05);
+    }
+    let columns = dir.join("both.csv");
+    std::fs::write(&columns, both).unwrap();
+    let (code, _, err) = compensate(&run, &columns, &out, &[]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("'d_mm'") && err.contains("'r_mm'"), "{err}");
+    assert!(!out.exists());
+}
