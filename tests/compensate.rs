@@ -451,8 +451,9 @@ fn bad_measurements_are_refused_and_nothing_is_written() {
 /// proportion to its unsupported length's cube (a cantilever from the
 /// chuck's side at z = -300, 4 um at the far end), in the loop: the first
 /// program replayed with the wheel at z meeting the part given way by
-/// `bend(z)`, measured every 10 mm to 0.1 um of diameter (at two angular
-/// positions 1 um apart: out of round, averaged and said), compensated
+/// `bend(z)`, measured every 10 mm to 1 nm of diameter (at two angular
+/// positions 0.01 um apart: out of round, averaged and said; 1 um apart,
+/// beyond 3 times the uncertainty stated, refused), compensated
 /// with the measurement's uncertainty stated as 0.01 um; the smoothing
 /// spline follows the curve (the correction within 0.1 um of the
 /// deflection's negative), and the corrected program replayed with the
@@ -472,17 +473,25 @@ fn a_deflection_is_corrected_along_its_curve() {
         .unwrap();
     let before = off_nominal(&finish_with(&run, "program.mpf", &fine, &bent), &fine);
     assert!(before > 3.0 * tolerance, "before: {before}");
-    // Measured at two angular positions, 1 um apart on the radius (out of
-    // round): averaged, and said.
+    // Measured at two angular positions: 1 um apart on the radius (out of
+    // round), more than 3 times the stated uncertainty, refused naming
+    // the rows; 0.01 um apart, within it, averaged and said.
     let measured = dir.join("bent.csv");
-    let mut t = String::from("z_mm,angle_deg,d_mm\n");
     let bench = finish_with(&run, "program.mpf", &bench_places(), &bent);
-    for (z, (hi, _)) in bench_places().iter().zip(&bench) {
-        let d = 2.0 * hi;
-        t += &format!("{z:.1},0,{:.4}\n{z:.1},90,{:.4}\n", d + 0.001, d - 0.001);
-    }
-    std::fs::write(&measured, t).unwrap();
+    let table = |apart: f64| {
+        let mut t = String::from("z_mm,angle_deg,d_mm\n");
+        for (z, (hi, _)) in bench_places().iter().zip(&bench) {
+            let d = 2.0 * hi;
+            t += &format!("{z:.1},0,{:.6}\n{z:.1},90,{:.6}\n", d + apart, d - apart);
+        }
+        std::fs::write(&measured, t).unwrap();
+    };
+    table(0.001);
     let out = dir.join("corrected");
+    let (code, _, err) = compensate(&run, &measured, &out, &["--uncertainty", "0.00001"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("rows 2 and 3 are 0.0010 mm apart"), "{err}");
+    table(0.00001);
     let (code, said, err) = compensate(&run, &measured, &out, &["--uncertainty", "0.00001"]);
     assert_eq!(code, 0, "{err}");
     let report = common::report_of(&out);
@@ -492,13 +501,13 @@ fn a_deflection_is_corrected_along_its_curve() {
         report["verdict"]
     );
     assert!(
-        said.contains("the rows at one place differ by up to 0.0010 mm: out of round"),
+        said.contains("the rows at one place differ by up to 0.0000 mm: out of round"),
         "{said}"
     );
     let worst = correction_off(&out, &bend);
     let c = json(&out.join("compensation.json"));
     let spread = c["quantities"][0]["max_spread_mm"].as_f64().unwrap();
-    assert!((spread - 0.001).abs() < 1e-9, "{spread}");
+    assert!((spread - 0.00001).abs() < 1e-9, "{spread}");
     assert!(
         c["quantities"][0]["smooth"].as_f64().unwrap() > 0.0,
         "a curve, not the line"

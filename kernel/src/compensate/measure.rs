@@ -30,6 +30,10 @@ pub struct MeasuredSpec<'a> {
     pub max_gap: Option<Real>,
 }
 
+/// How far apart the rows at one place may be, in stated uncertainties:
+/// further, one of them is wrong.
+pub const SPREAD_ALLOWED: Real = 3.0;
+
 /// A measurement: the quantity at each distinct place, in increasing
 /// order (the rows at one place, as at several angular positions,
 /// averaged).
@@ -60,7 +64,11 @@ pub struct Measured {
 /// part; no row selected; along the coordinate, fewer than [`MIN_POINTS`]
 /// places or a stretch longer than `spec.max_gap` without one (named by
 /// where it runs).
-pub fn read_measured(table: &Table, spec: &MeasuredSpec<'_>) -> Result<Measured, CompensateError> {
+pub fn read_measured(
+    table: &Table,
+    spec: &MeasuredSpec<'_>,
+    uncertainty: Real,
+) -> Result<Measured, CompensateError> {
     let file = table.source().to_owned();
     let at = table.column(spec.coordinate)?;
     let (column, factor) = spec
@@ -78,12 +86,35 @@ pub fn read_measured(table: &Table, spec: &MeasuredSpec<'_>) -> Result<Measured,
             available: table.headers().join(", "),
         })?;
     let value = table.column(column)?;
+    // Another column of the same quantity must say the same, within the
+    // uncertainty: one of two that disagree is not the part.
+    for (other, f) in spec.values.iter().filter(|(c, _)| c != column) {
+        if table.column_index(other).is_err() {
+            continue;
+        }
+        let theirs = table.column(other)?;
+        if let Some(i) = (0..value.len())
+            .find(|&i| (value[i] * factor - theirs[i] * f).abs() > uncertainty * (1.0 + 1e-9))
+        {
+            return Err(CompensateError::Inconsistent {
+                file,
+                what: format!(
+                    "row {}: '{column}' {} and '{other}' {} measure the same quantity {} mm apart, more than the uncertainty {uncertainty} mm: give one of them",
+                    table.row_number(i),
+                    value[i],
+                    theirs[i],
+                    crate::math::fixed((value[i] * factor - theirs[i] * f).abs(), 4)
+                ),
+            });
+        }
+    }
     let selected = match spec.select {
         Some((c, want)) => table.column(c)?.iter().map(|&v| v == want).collect(),
         None => vec![true; at.len()],
     };
     let (from, to) = spec.range;
-    let mut rows: Vec<(Real, Real)> = Vec::with_capacity(at.len());
+    // (place, value, row number)
+    let mut rows: Vec<(Real, Real, usize)> = Vec::with_capacity(at.len());
     for (i, (&s, &v)) in at.iter().zip(&value).enumerate() {
         if !selected[i] {
             continue;
@@ -98,7 +129,7 @@ pub fn read_measured(table: &Table, spec: &MeasuredSpec<'_>) -> Result<Measured,
                 to,
             });
         }
-        rows.push((s, v * factor));
+        rows.push((s, v * factor, table.row_number(i)));
     }
     rows.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut m = Measured {
@@ -109,26 +140,52 @@ pub fn read_measured(table: &Table, spec: &MeasuredSpec<'_>) -> Result<Measured,
         rows: Vec::new(),
         spread: Vec::new(),
     };
-    // Each place's least and largest row.
+    // Each place's least and largest row, and their rows' numbers.
     let mut bounds: Vec<(Real, Real)> = Vec::new();
-    for (s, v) in rows {
+    let mut bound_rows: Vec<(usize, usize)> = Vec::new();
+    for (s, v, row) in rows {
         match m.at.last() {
             Some(&last) if last == s => {
                 let k = m.rows.len() - 1;
                 let n = m.rows[k] as Real;
                 m.value[k] = (m.value[k] * n + v) / (n + 1.0);
                 m.rows[k] += 1;
-                bounds[k] = (bounds[k].0.min(v), bounds[k].1.max(v));
+                if v < bounds[k].0 {
+                    bounds[k].0 = v;
+                    bound_rows[k].0 = row;
+                }
+                if v > bounds[k].1 {
+                    bounds[k].1 = v;
+                    bound_rows[k].1 = row;
+                }
             }
             _ => {
                 m.at.push(s);
                 m.value.push(v);
                 m.rows.push(1);
                 bounds.push((v, v));
+                bound_rows.push((row, row));
             }
         }
     }
     m.spread = bounds.iter().map(|(lo, hi)| hi - lo).collect();
+    // Rows at one place further apart than the uncertainty allows are not
+    // an out-of-round part measured at several angles but a wrong row.
+    if let Some(k) =
+        (0..m.at.len()).find(|&k| m.spread[k] > SPREAD_ALLOWED * uncertainty * (1.0 + 1e-9))
+    {
+        let (lo, hi) = bound_rows[k];
+        let (a, b) = (lo.min(hi), lo.max(hi));
+        return Err(CompensateError::Inconsistent {
+            file,
+            what: format!(
+                "{} = {}: rows {a} and {b} are {} mm apart, more than {SPREAD_ALLOWED} times the uncertainty {uncertainty} mm (averaged, they would hide a wrong row): correct the measurement, or state its uncertainty",
+                spec.coordinate,
+                m.at[k],
+                crate::math::fixed(m.spread[k], 4)
+            ),
+        });
+    }
     if m.at.is_empty() {
         let (c, want) = spec.select.unwrap_or(("", 0.0));
         return Err(CompensateError::TooSparse {
@@ -190,6 +247,7 @@ mod tests {
                 "z_mm,d_mm,note\n50,40.004,\n0,38,a\n25,39.002,\n50,40.000,b\n75,41,\n100,42,\n",
             ),
             &SPEC,
+            1e-3,
         )
         .unwrap();
         assert_eq!(m.column, "d_mm");
@@ -205,7 +263,11 @@ mod tests {
     /// is left unmeasured.
     #[test]
     fn bad_measurements_are_named() {
-        let e = |t: &str| read_measured(&table(t), &SPEC).unwrap_err().to_string();
+        let e = |t: &str| {
+            read_measured(&table(t), &SPEC, 1e-3)
+                .unwrap_err()
+                .to_string()
+        };
         let s = e("z_mm,x_mm\n0,1\n");
         assert!(
             s.contains("no column 'r_mm' or 'd_mm' (columns: z_mm, x_mm)"),
@@ -240,11 +302,12 @@ mod tests {
         let m = read_measured(
             &table("z_mm,start,d2_mm\n10,1,18.3\n10,2,18.31\n20,2,18.33\n"),
             &spec,
+            1e-3,
         )
         .unwrap();
         assert_eq!(m.at, vec![10.0, 20.0]);
         assert_eq!(m.value, vec![18.31, 18.33]);
-        let e = read_measured(&table("z_mm,start,d2_mm\n10,1,18.3\n"), &spec)
+        let e = read_measured(&table("z_mm,start,d2_mm\n10,1,18.3\n"), &spec, 1e-3)
             .unwrap_err()
             .to_string();
         assert!(

@@ -158,6 +158,15 @@ pub enum CompensateError {
         /// The columns there are.
         available: String,
     },
+    /// A measurement that contradicts itself: rows at one place, or two
+    /// columns of one quantity, further apart than its uncertainty allows.
+    #[error("{file}: {what}")]
+    Inconsistent {
+        /// The file.
+        file: String,
+        /// Where and what, both sides named.
+        what: String,
+    },
     /// An option bounding the correction out of its range.
     #[error("{what} is {value}; it must be {range}")]
     Option {

@@ -419,7 +419,7 @@ pub fn compensate(
     // measurement has none of its columns.
     let mut fitted: Vec<Option<Fitted>> = Vec::new();
     for q in &nominal.quantities {
-        let m = match read_measured(measured, &nominal.spec(q)) {
+        let m = match read_measured(measured, &nominal.spec(q), options.uncertainty) {
             Ok(m) => m,
             Err(CompensateError::NoValueColumn { .. }) => {
                 fitted.push(None);
