@@ -313,3 +313,42 @@ fn scripts_read_only_beside_the_script_and_the_parameter_file() {
     assert!(run("t.csv").contains("read 2 rows"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A command that writes a directory holds it for the whole command: a
+/// second command on it (an export racing a run put the older run's
+/// program back after the new run said "written") fails at once, naming
+/// the command and process that hold it, and writes nothing; a lock whose
+/// process is gone is taken over.
+#[test]
+fn a_directory_being_written_is_held() {
+    let dir = scratch("locked");
+    let run = demo_run(&dir);
+    let before = snapshot(&run);
+    let lock = dir.join(format!(
+        ".{}.lock",
+        run.file_name().unwrap().to_str().unwrap()
+    ));
+    // Held by a live process (this test's).
+    std::fs::write(&lock, format!("{}\npilgrim run\n", std::process::id())).unwrap();
+    for args in [
+        vec!["export", s(&run), "--block", "3"],
+        vec!["run", DEMO, "--out", s(&run)],
+    ] {
+        let (code, _, err) = pilgrim(&args);
+        assert_eq!(code, 1, "{args:?}: {err}");
+        assert!(
+            err.contains("pilgrim run") && err.contains(&std::process::id().to_string()),
+            "{args:?}: {err}"
+        );
+    }
+    assert_eq!(snapshot(&run), before);
+    // Held by a process that is gone: taken over, and let go after.
+    let gone = std::process::Command::new("true").spawn().unwrap();
+    let pid = gone.id();
+    let mut gone = gone;
+    gone.wait().unwrap();
+    std::fs::write(&lock, format!("{pid}\npilgrim export\n")).unwrap();
+    let (code, _, err) = pilgrim(&["export", s(&run), "--block", "3"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!lock.exists());
+}
