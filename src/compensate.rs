@@ -23,6 +23,8 @@ pub struct CompensateArgs {
 pub fn compensate(args: &CompensateArgs, catalog: &Catalog) -> Result<String, String> {
     crate::run::positive_seconds(args.script_seconds, args.run_seconds)?;
     pilgrim_kernel::output::apart(&args.out, &args.dir).map_err(|e| e.to_string())?;
+    let _held = pilgrim_kernel::output::DirLock::take(&args.out, "pilgrim compensate")
+        .map_err(|e| e.to_string())?;
     pilgrim_kernel::budget::with_limit(args.run_seconds, "the compensation's", || {
         let table =
             pilgrim_kernel::profile::read_table(&args.measured).map_err(|e| e.to_string())?;

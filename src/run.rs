@@ -4,6 +4,7 @@
 use indicatif::{ProgressBar, ProgressStyle};
 use pilgrim_kernel::catalog::Catalog;
 use pilgrim_kernel::job::{self, Formats, JobOptions};
+use pilgrim_kernel::output::DirLock;
 use pilgrim_kernel::params::ParamSource;
 use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
 use pilgrim_kernel::PartFamily;
@@ -48,6 +49,7 @@ fn progress(quiet: bool) -> ProgressBar {
 /// is written and the previous output directory is left as it was.
 pub fn run(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
     positive_seconds(args.script_seconds, args.run_seconds)?;
+    let _held = DirLock::take(&args.out, "pilgrim run").map_err(|e| e.to_string())?;
     pilgrim_kernel::budget::with_limit(args.run_seconds, "the run's", || run_within(args, catalog))
 }
 
@@ -217,6 +219,7 @@ pub struct VerifyArgs {
 pub fn verify(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String> {
     positive_seconds(args.script_seconds, args.run_seconds)?;
     pilgrim_kernel::output::apart(&args.out, &args.target).map_err(|e| e.to_string())?;
+    let _held = DirLock::take(&args.out, "pilgrim verify").map_err(|e| e.to_string())?;
     pilgrim_kernel::budget::with_limit(args.run_seconds, "the verification's", || {
         verify_within(args, catalog)
     })
@@ -386,6 +389,7 @@ pub fn export(
     block: Option<usize>,
     formats: Formats,
 ) -> Result<String, String> {
+    let _held = DirLock::take(dir, "pilgrim export").map_err(|e| e.to_string())?;
     let run = pilgrim_kernel::output::RunDir::open(dir).map_err(|e| e.to_string())?;
     let e = job::export(&run, catalog, machine, block, formats).map_err(|e| e.to_string())?;
     pilgrim_kernel::output::update_dir(&run, &e.files).map_err(|e| e.to_string())?;

@@ -144,6 +144,66 @@ fn is_real_dir(path: &Path) -> bool {
     std::fs::symlink_metadata(path).is_ok_and(|m| m.is_dir())
 }
 
+/// A directory held by one command for the whole of it: `.<name>.lock`
+/// beside the directory, holding the process's id and the command, made
+/// only where no such file is (`O_EXCL`) and removed when dropped. A
+/// second command on the directory fails at once, naming the holder; a
+/// lock whose process is gone (killed) is taken over.
+#[derive(Debug)]
+pub struct DirLock {
+    path: PathBuf,
+}
+
+impl DirLock {
+    /// Holds `dir` for `command` (`pilgrim run`, shown to a second one).
+    ///
+    /// # Failures
+    /// The directory held by a live process (named with its command), or
+    /// the lock file not writable.
+    pub fn take(dir: &Path, command: &str) -> Result<Self, OutputError> {
+        let (parent, base) = parent_and_base(dir)?;
+        std::fs::create_dir_all(&parent).map_err(|e| err(&parent, e.to_string()))?;
+        let path = parent.join(format!(".{base}.lock"));
+        let text = format!("{}\n{}\n", std::process::id(), command);
+        for _ in 0..2 {
+            match create_file(&path, text.as_bytes()) {
+                Ok(()) => return Ok(Self { path }),
+                Err(_) if std::fs::symlink_metadata(&path).is_ok() => {}
+                Err(e) => return Err(e),
+            }
+            let held = crate::files::read_text(&path, 4096).unwrap_or_default();
+            let mut lines = held.lines();
+            let pid = lines.next().and_then(|p| p.trim().parse::<u32>().ok());
+            let by = lines.next().unwrap_or("another command");
+            match pid {
+                Some(pid) if !process_gone(pid) => {
+                    return Err(err(
+                        dir,
+                        format!(
+                            "is being written by `{}` (process {pid}): wait for it to end, or write elsewhere",
+                            crate::files::excerpt(by)
+                        ),
+                    ))
+                }
+                // A killed command's lock (or one that says no process).
+                _ => {
+                    let _ = std::fs::remove_file(&path);
+                }
+            }
+        }
+        Err(err(
+            &path,
+            "could not be taken: another command took it first",
+        ))
+    }
+}
+
+impl Drop for DirLock {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.path);
+    }
+}
+
 /// Checks that `out`, where a command writes its directory, neither is
 /// nor holds `input`, what the command reads (a run's directory, a
 /// program file): writing there would replace what it was asked to check
