@@ -1131,3 +1131,52 @@ fn a_measurement_that_contradicts_itself_is_refused() {
     assert!(err.contains("'d_mm'") && err.contains("'r_mm'"), "{err}");
     assert!(!out.exists());
 }
+
+/// The run's prediction is recomputed, not read: `predicted_deviation` in
+/// its `report.json` shifted by 0.09 mm (which would grind the part 0.18
+/// mm undersize on diameter while saying "0.0009 mm expected after") is
+/// refused, naming the file and the table; so is a program edited after
+/// its run (its prediction is not the file's).
+#[test]
+fn the_runs_prediction_is_recomputed() {
+    let dir = scratch("compensate", "prediction");
+    let run = mandrel_run(&dir);
+    let measured = std::path::Path::new("scripts/examples/mandrel-measured.csv");
+    let original = std::fs::read_to_string(run.join("report.json")).unwrap();
+    let mut r: serde_json::Value = serde_json::from_str(&original).unwrap();
+    for v in r["tables"]["predicted_deviation"]["dr_mm"]
+        .as_array_mut()
+        .unwrap()
+    {
+        *v = serde_json::json!(v.as_f64().unwrap() + 0.09);
+    }
+    std::fs::write(run.join("report.json"), r.to_string()).unwrap();
+    let out = dir.join("out");
+    let (code, _, err) = compensate(&run, measured, &out, &[]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("report.json") && err.contains("predicted_deviation"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    // The report as written, the program edited by hand.
+    std::fs::write(run.join("report.json"), &original).unwrap();
+    let program = std::fs::read_to_string(run.join("program.mpf")).unwrap();
+    let line = program
+        .lines()
+        .skip_while(|l| !l.starts_with("; pass 4"))
+        .nth(4)
+        .unwrap()
+        .to_owned();
+    let x: f64 = line
+        .split_whitespace()
+        .find_map(|w| w.strip_prefix('X'))
+        .unwrap()
+        .parse()
+        .unwrap();
+    let edited = line.replacen(&format!("X{x:.4}"), &format!("X{:.4}", x + 0.0005), 1);
+    std::fs::write(run.join("program.mpf"), program.replacen(&line, &edited, 1)).unwrap();
+    let (code, _, err) = compensate(&run, measured, &out, &[]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("predicted_deviation"), "{err}");
+}
