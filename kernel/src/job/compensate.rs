@@ -394,6 +394,38 @@ pub fn compensate(
                 script.display()
             ))
         })?;
+    let program_file = crate::program::post::dialect(&report.control)
+        .map(|d| format!("program.{}", d.extension))
+        .ok_or_else(|| {
+            Error::Read(format!(
+                "{label}: the control '{}' is not a dialect pilgrim reads",
+                report.control
+            ))
+        })?;
+    let before = read(&program_file)?;
+    // The part the run's program makes, predicted again from the family,
+    // the run's parameters and its program as the control reads it: the
+    // report's copy is compared, never taken (edited, it would move the
+    // target by its edit while saying the part will be right).
+    let first_family = load(run_correction(&run, &report)?.into_iter().collect())?;
+    let again = super::verify(
+        &first_family,
+        &machine,
+        std::slice::from_ref(&base),
+        &before,
+        &JobOptions {
+            program_name: "compensate".into(),
+            ..JobOptions::default()
+        },
+        &mut |_| {},
+    )
+    .map_err(|e| {
+        Error::Read(format!(
+            "{shown}/{program_file}: the run's program, verified again to predict its part, is refused: {e}"
+        ))
+    })?;
+    let first_tables = again.report.tables;
+    same_prediction(&report.tables, &first_tables, &label)?;
     // A compensated run's correction: its target was the nominal moved by
     // it, and the new correction replaces it (see `unmodelled`).
     let previous = match run_correction(&run, &report)? {
@@ -431,7 +463,7 @@ pub fn compensate(
         let previous = previous_at(q, &m.at)?;
         // The part the run's replay predicted: its target, the nominal
         // moved by its correction, and its deviation from it.
-        let predicted = predicted(&report.tables, nominal.coordinate, q, &m.at)?.map(|d| {
+        let predicted = predicted(&first_tables, nominal.coordinate, q, &m.at)?.map(|d| {
             (0..m.at.len())
                 .map(|i| at_nominal[i] + previous[i] + d[i])
                 .collect::<Vec<f64>>()
@@ -585,15 +617,6 @@ pub fn compensate(
         &records,
         (coordinate, unit),
     );
-    let program_file = crate::program::post::dialect(&report.control)
-        .map(|d| format!("program.{}", d.extension))
-        .ok_or_else(|| {
-            Error::Read(format!(
-                "{label}: the control '{}' is not a dialect pilgrim reads",
-                report.control
-            ))
-        })?;
-    let before = read(&program_file)?;
     // The first run's program and its passes, read and parsed on a thread
     // of their own while the corrected run starts (tens of megabytes of
     // JSON for a caliber); its hook takes them.
@@ -775,6 +798,50 @@ fn predicted(
     let (lo, hi) = p.z_range();
     let at: Vec<f64> = at.iter().map(|z| z.clamp(lo, hi)).collect();
     Ok(Some(p.eval_many(&at)?))
+}
+
+/// Checks the run's `file` (its `report.json`, shown as `label`) says
+/// the prediction its program gives when verified again (`again`): every
+/// column of [`PREDICTED`], value for value, within 1e-7 mm.
+///
+/// # Failures
+/// A column missing or of another length, or a value that differs: named
+/// with the place and both values.
+fn same_prediction(file: &Tables, again: &Tables, label: &str) -> Result<(), Error> {
+    let empty = BTreeMap::new();
+    let (theirs, ours) = (
+        file.get(PREDICTED).unwrap_or(&empty),
+        again.get(PREDICTED).unwrap_or(&empty),
+    );
+    let changed = |what: String| {
+        Err(Error::Read(format!(
+            "{label}: its table {PREDICTED} {what}: the report or the program was changed since the run (run the job again, and measure the part its program makes)"
+        )))
+    };
+    for (column, want) in ours {
+        let Some(have) = theirs.get(column) else {
+            return changed(format!("has no column {column}"));
+        };
+        if have.len() != want.len() {
+            return changed(format!(
+                "holds {} values of {column} where the run's program gives {}",
+                have.len(),
+                want.len()
+            ));
+        }
+        if let Some(i) = (0..want.len()).find(|&i| !((have[i] - want[i]).abs() <= 1e-7)) {
+            return changed(format!(
+                "says {column} = {} at its row {}, where the run's program, verified again, gives {}",
+                have[i],
+                i + 1,
+                want[i]
+            ));
+        }
+    }
+    if let Some(extra) = theirs.keys().find(|c| !ours.contains_key(*c)) {
+        return changed(format!("has a column {extra} the run's program does not give"));
+    }
+    Ok(())
 }
 
 /// Each record's error expected after the correction, the same
