@@ -901,19 +901,9 @@ fn spreadsheets_are_bounded_before_they_expand() {
 /// collisions) looks at the clock.
 #[test]
 fn a_deadline_already_past_stops_every_verification() {
-    let dir = common::scratch("trust", "deadline");
     for job in ["mandrel", "caliber", "worm", "thread"] {
-        let out = dir.join(job);
-        let (code, _, err) = crate::common::pilgrim(&[
-            "run",
-            &format!("scripts/{job}.rhai"),
-            "--out",
-            s(&out),
-            "-q",
-        ]);
-        assert_eq!(code, 0, "{err}");
-        let (code, said, err) =
-            crate::common::pilgrim(&["verify", s(&out), "--run-seconds", "1e-9"]);
+        let out = common::default_run("trust", job, &format!("deadline-{job}"));
+        let (code, said, err) = pilgrim(&["verify", s(&out), "--run-seconds", "1e-9"]);
         assert_eq!(code, 1, "{job}: {said}");
         assert!(
             err.contains("the verification's time limit of 0.000000001 s passed"),

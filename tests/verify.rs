@@ -24,16 +24,7 @@ fn report(dir: &Path) -> Value {
 
 /// A default run of `job` into a scratch directory.
 fn default_run(job: &str, name: &str) -> std::path::PathBuf {
-    let out = scratch("verify", name).join(job);
-    let (code, _, err) = pilgrim(&[
-        "run",
-        &format!("scripts/{job}.rhai"),
-        "--out",
-        s(&out),
-        "-q",
-    ]);
-    assert_eq!(code, 0, "{err}");
-    out
+    crate::common::default_run("verify", job, name)
 }
 
 /// The three default jobs: `verify` of each run's directory passes with the

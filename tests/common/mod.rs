@@ -143,6 +143,22 @@ fn remove_ended_scratch() {
     }
 }
 
+/// A default run of `scripts/<job>.rhai` into a fresh scratch directory
+/// of `suite` named `name`: the run's directory, which must pass.
+#[allow(dead_code)]
+pub fn default_run(suite: &str, job: &str, name: &str) -> PathBuf {
+    let out = scratch(suite, name).join(job);
+    let (code, _, err) = pilgrim(&[
+        "run",
+        &format!("scripts/{job}.rhai"),
+        "--out",
+        s(&out),
+        "-q",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    out
+}
+
 /// A path as the text an argument takes.
 #[allow(dead_code)]
 pub fn s(p: &Path) -> &str {

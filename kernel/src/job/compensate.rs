@@ -404,334 +404,348 @@ pub fn compensate(
         })?;
     let before = read(&program_file)?;
     // The part the run's program makes, predicted again from the family,
-    // the run's parameters and its program as the control reads it: the
-    // report's copy is compared, never taken (edited, it would move the
-    // target by its edit while saying the part will be right).
-    let first_family = load(run_correction(&run, &report)?.into_iter().collect())?;
-    let again = super::verify(
-        &first_family,
-        &machine,
-        std::slice::from_ref(&base),
-        &before,
-        &JobOptions {
-            program_name: "compensate".into(),
-            ..JobOptions::default()
-        },
-        &mut |_| {},
-    )
-    .map_err(|e| {
-        Error::Read(format!(
-            "{shown}/{program_file}: the run's program, verified again to predict its part, is refused: {e}"
-        ))
-    })?;
-    let first_tables = again.report.tables;
-    same_prediction(&report.tables, &first_tables, &label)?;
-    // A compensated run's correction: its target was the nominal moved by
-    // it, and the new correction replaces it (see `unmodelled`).
-    let previous = match run_correction(&run, &report)? {
-        Some((name, text)) => Some(crate::profile::read_table_str(
-            &text,
-            &format!("{shown}/{name}"),
-        )?),
-        None => None,
-    };
-    let previous_at = |q: &Quantity, at: &[f64]| -> Result<Vec<f64>, Error> {
-        match &previous {
-            Some(t) if t.column_index(&q.key).is_ok() => {
-                let p = t.profile(nominal.coordinate, &q.key)?;
-                let (lo, hi) = p.z_range();
-                let at: Vec<f64> = at.iter().map(|z| z.clamp(lo, hi)).collect();
-                Ok(p.eval_many(&at)?)
-            }
-            _ => Ok(vec![0.0; at.len()]),
-        }
-    };
-    // The measurement against it: each quantity it holds.
-    // One per quantity, in the nominal's order: `None` where the
-    // measurement has none of its columns.
-    let mut fitted: Vec<Option<Fitted>> = Vec::new();
-    for q in &nominal.quantities {
-        let m = match read_measured(measured, &nominal.spec(q), options.uncertainty) {
-            Ok(m) => m,
-            Err(CompensateError::NoValueColumn { .. }) => {
-                fitted.push(None);
-                continue;
-            }
-            Err(e) => return Err(e.into()),
-        };
-        let at_nominal = q.nominal.eval_many(&m.at)?;
-        let previous = previous_at(q, &m.at)?;
-        // The part the run's replay predicted: its target, the nominal
-        // moved by its correction, and its deviation from it.
-        let predicted = predicted(&first_tables, nominal.coordinate, q, &m.at)?.map(|d| {
-            (0..m.at.len())
-                .map(|i| at_nominal[i] + previous[i] + d[i])
-                .collect::<Vec<f64>>()
-        });
-        let error: Vec<f64> = m
-            .value
-            .iter()
-            .zip(&at_nominal)
-            .map(|(v, n)| v - n)
-            .collect();
-        // What the run's replay does not model: the measured minus the
-        // part it predicted (its target, the nominal moved by the run's own
-        // correction, where its verification predicts none), plus that
-        // correction. Fitted and corrected against, it replaces the run's
-        // correction, so a part measured as its run predicted keeps it.
-        let unmodelled: Vec<f64> = (0..m.at.len())
-            .map(|i| {
-                let expected = predicted
-                    .as_ref()
-                    .map_or(at_nominal[i] + previous[i], |p| p[i]);
-                m.value[i] - expected + previous[i]
-            })
-            .collect();
-        let fit = if q.along {
-            fit_error(&m.at, &unmodelled, options.uncertainty)?
-        } else {
-            fit_mean(&m.at, &unmodelled, options.uncertainty)?
-        };
-        fitted.push(Some(Fitted {
-            m,
-            at_nominal,
-            error,
-            predicted,
-            previous,
-            fit,
-        }));
-    }
-    if fitted.iter().all(Option::is_none) {
-        return Err(CompensateError::Nothing {
-            file: measured.source().to_owned(),
-            wanted: nominal
-                .quantities
-                .iter()
-                .map(|q| {
-                    let columns: Vec<String> =
-                        q.values.iter().map(|(c, _)| format!("'{c}'")).collect();
-                    format!("the {} ({})", q.name, columns.join(" or "))
-                })
-                .collect::<Vec<_>>()
-                .join(", "),
-            available: measured.headers().join(", "),
-        }
-        .into());
-    }
-    let (from, to) = nominal.range;
-    // Along the coordinate, every GRID-th of the range; as one value,
-    // the ends and the middle (a profile's fewest).
-    let places = if nominal.quantities.iter().any(|q| q.along) {
-        GRID
-    } else {
-        2
-    };
-    let grid: Vec<f64> = (0..=places)
-        .map(|i| from + (to - from) * i as f64 / places as f64)
-        .collect();
-    let (coordinate, unit) = nominal
-        .coordinate
-        .rsplit_once('_')
-        .unwrap_or((nominal.coordinate, ""));
-    let mut csv = std::iter::once(nominal.coordinate)
-        .chain(nominal.quantities.iter().map(|q| q.key.as_str()))
-        .collect::<Vec<_>>()
-        .join(",")
-        + "\n";
-    let mut columns: Vec<Vec<f64>> = Vec::new();
-    for (q, f) in nominal.quantities.iter().zip(&fitted) {
-        let mut total = previous_at(q, &grid)?;
-        if let Some(f) = f {
-            let shift = f.fit.correction(&grid, options.gain)?;
-            total.iter_mut().zip(&shift).for_each(|(t, s)| *t += s);
-            let place = |s: f64| {
-                if q.along {
-                    format!("of the {} at {coordinate} = {s:.3} {unit}", q.name)
-                } else {
-                    format!("of the {}", q.name)
-                }
-            };
-            within_limit(&grid, &total, options.limit, &place, &f.m.file)?;
-        }
-        columns.push(total);
-    }
-    for (i, z) in grid.iter().enumerate() {
-        csv += &format!("{z:.6}");
-        for c in &columns {
-            csv += &format!(",{:.9}", c[i]);
-        }
-        csv += "\n";
-    }
-    // The corrected run.
-    let family = load(vec![(CORRECTION_FILE.into(), csv.clone())])?;
-    let sources = vec![
-        base,
-        ParamSource::Pairs {
-            label: "compensate".into(),
-            pairs: vec![(CORRECTION.into(), CORRECTION_FILE.into())],
-        },
-    ];
-    let mut records = Vec::new();
-    let mut of = Vec::new();
-    let mut not_measured = Vec::new();
-    for ((q, f), total) in nominal.quantities.iter().zip(&fitted).zip(&columns) {
-        let Some(f) = f else {
-            not_measured.push(q.name.clone());
-            continue;
-        };
-        let fit_at = f.fit.at(&f.m.at)?;
-        let shift: Vec<f64> = fit_at.iter().map(|v| -options.gain * v).collect();
-        let places: Vec<Place> = (0..f.m.at.len())
-            .map(|i| Place {
-                at: f.m.at[i],
-                measured: f.m.value[i],
-                spread: f.m.spread[i],
-                nominal: f.at_nominal[i],
-                error: f.error[i],
-                predicted: f.predicted.as_ref().map(|p| p[i]),
-                unmodelled: f.fit.error[i],
-                fitted: fit_at[i],
-                correction: f.previous[i] + shift[i],
-                expected_after: f.error[i] + shift[i],
-            })
-            .collect();
-        of.push(q);
-        records.push(QuantityRecord {
-            name: q.name.clone(),
-            column: f.m.column.clone(),
-            key: q.key.clone(),
-            along: q.along,
-            smooth: f.fit.smooth,
-            rms_residual_mm: f.fit.rms_residual,
-            max_error_mm: largest(f.error.iter().copied()),
-            max_spread_mm: largest(f.m.spread.iter().copied()),
-            max_correction_mm: largest(total.iter().copied()),
-            max_expected_after_mm: largest(places.iter().map(|p| p.expected_after)),
-            places,
-        });
-    }
-    let quantities: Vec<Quantity> = of.into_iter().cloned().collect();
-    let mut made = annex(
-        nominal.coordinate,
-        &quantities,
-        &records,
-        (coordinate, unit),
-    );
-    // The first run's program and its passes, read and parsed on a thread
-    // of their own while the corrected run starts (tens of megabytes of
-    // JSON for a caliber); its hook takes them.
-    let first = {
-        let (run, shown) = (run.clone(), shown.clone());
-        std::thread::spawn(move || {
-            let parse = |name: &str| run.read_text(name, limit).map_err(|e| e.to_string());
-            let program: AxisProgram = serde_json::from_str(&parse("program.json")?)
-                .map_err(|e| format!("{shown}/program.json: {e}"))?;
-            let toolpath: Toolpath = serde_json::from_str(&parse("toolpath.json")?)
-                .map_err(|e| format!("{shown}/toolpath.json: {e}"))?;
-            let passes = pass_blocks(&program, &toolpath.passes);
-            Ok::<_, String>((program, passes))
-        })
-    };
-    let first = std::sync::Mutex::new(Some(first));
-    // Once the corrected run's verification has predicted its part: the
-    // annex's tables made again with the part after, and how far the
-    // corrected program's path moved, per pass (its chart), kept for
-    // compensation.json.
-    // What the hook found, for compensation.json: the records with the
-    // part after, and the moves.
-    type Found = (Vec<QuantityRecord>, Result<Option<Moved>, String>);
-    let (column, names) = (nominal.coordinate, (coordinate.to_owned(), unit.to_owned()));
-    let hook_quantities = quantities.clone();
-    let found: std::sync::Arc<std::sync::Mutex<Option<Found>>> = Default::default();
-    let slot = found.clone();
-    let hook_records = records;
-    made.finish = Some(super::TablesHook(std::sync::Arc::new(
-        move |tables, program, passes| {
-            let mut records = hook_records.clone();
-            after_run(&mut records, &hook_quantities, column, tables);
-            let names = (names.0.as_str(), names.1.as_str());
-            tables.extend(annex(column, &hook_quantities, &records, names).tables);
-            let parsed = first.lock().ok().and_then(|mut h| h.take()).map(|h| {
-                h.join()
-                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
-            });
-            let moved = match parsed {
-                Some(Ok((old_program, old_passes))) => {
-                    Ok(path_moved(&old_program, &old_passes, program, passes))
-                }
-                Some(Err(e)) => Err(e),
-                None => Err("the first run's program was taken twice".into()),
-            };
-            let plots = moved
-                .as_ref()
-                .ok()
-                .and_then(Option::as_ref)
-                .map(|m| moves_chart(m, tables));
-            if let Ok(mut s) = slot.lock() {
-                *s = Some((records, moved));
-            }
-            plots.into_iter().collect()
-        },
-    )));
-    let job_options = JobOptions {
-        program_name: script
-            .file_stem()
-            .and_then(|s| s.to_str())
-            .unwrap_or("pilgrim")
-            .to_owned(),
-        annex: made,
-        ..JobOptions::default()
-    };
-    let mut out =
-        run_job(&family, &machine, &sources, &job_options, &mut |_| {}).map_err(|e| match e {
-            // A corrected run that fails its checks leaves its report.
-            Error::Failed(failed) => Error::Failed(failed),
-            refused => CompensateError::Corrected {
-                file: measured.source().to_owned(),
-                why: refused.to_string(),
-            }
-            .into(),
+    // the run's parameters and its program as the control reads it, on a
+    // second thread while the correction is made from the report's copy;
+    // the two are compared before anything is returned (an edited report
+    // or program would move the target by its edit while saying the part
+    // will be right). The family and the machine are opened on that
+    // thread: a script's engine and a machine stay where they were made.
+    let correction_text = run_correction(&run, &report)?;
+    let recompute = || -> Result<Tables, Error> {
+        let family = load(correction_text.iter().cloned().collect())?;
+        let machine = catalog.open(&spec)?;
+        let again = super::verify(
+            &family,
+            &machine,
+            std::slice::from_ref(&base),
+            &before,
+            &JobOptions {
+                program_name: "compensate".into(),
+                ..JobOptions::default()
+            },
+            &mut |_| {},
+        )
+        .map_err(|e| {
+            Error::Read(format!(
+                "{shown}/{program_file}: the run's program, verified again to predict its part, is refused: {e}"
+            ))
         })?;
-    // The run calls its hook once it has verified.
-    let (records, moved) = found
-        .lock()
-        .ok()
-        .and_then(|mut s| s.take())
-        .ok_or_else(|| Error::Output("the corrected run did not finish its tables".into()))?;
-    let moved = moved.map_err(Error::Read)?;
-    let record = Compensation {
-        run: shown.clone(),
-        measured_file: measured.source().to_owned(),
-        coordinate: nominal.coordinate,
-        uncertainty_mm: options.uncertainty,
-        gain: options.gain,
-        limit_mm: options.limit,
-        quantities: records,
-        not_measured,
-        program: {
-            ProgramChange {
-                path_moved: moved.as_ref().map(|m| m.largest.clone()),
-                blocks_moved: moved.map(|m| m.blocks),
-                ..change(
-                    &program_file,
-                    &before,
-                    &out.files
-                        .iter()
-                        .find(|(n, _)| *n == program_file)
-                        .map(|(_, b)| String::from_utf8_lossy(b).into_owned())
-                        .unwrap_or_default(),
-                )
-            }
-        },
-        lineage,
+        Ok(again.report.tables)
     };
-    out.files.push((CORRECTION_FILE.into(), csv.into_bytes()));
-    out.files.push((
-        "compensation.json".into(),
-        (serde_json::to_string_pretty(&record).map_err(|e| Error::Output(e.to_string()))? + "\n")
-            .into_bytes(),
-    ));
-    Ok((out, record))
+    let first_tables = &report.tables;
+    let correct = || -> Result<(JobOutput, Compensation), Error> {
+        // A compensated run's correction: its target was the nominal moved by
+        // it, and the new correction replaces it (see `unmodelled`).
+        let previous = match run_correction(&run, &report)? {
+            Some((name, text)) => Some(crate::profile::read_table_str(
+                &text,
+                &format!("{shown}/{name}"),
+            )?),
+            None => None,
+        };
+        let previous_at = |q: &Quantity, at: &[f64]| -> Result<Vec<f64>, Error> {
+            match &previous {
+                Some(t) if t.column_index(&q.key).is_ok() => {
+                    let p = t.profile(nominal.coordinate, &q.key)?;
+                    let (lo, hi) = p.z_range();
+                    let at: Vec<f64> = at.iter().map(|z| z.clamp(lo, hi)).collect();
+                    Ok(p.eval_many(&at)?)
+                }
+                _ => Ok(vec![0.0; at.len()]),
+            }
+        };
+        // The measurement against it: each quantity it holds.
+        // One per quantity, in the nominal's order: `None` where the
+        // measurement has none of its columns.
+        let mut fitted: Vec<Option<Fitted>> = Vec::new();
+        for q in &nominal.quantities {
+            let m = match read_measured(measured, &nominal.spec(q), options.uncertainty) {
+                Ok(m) => m,
+                Err(CompensateError::NoValueColumn { .. }) => {
+                    fitted.push(None);
+                    continue;
+                }
+                Err(e) => return Err(e.into()),
+            };
+            let at_nominal = q.nominal.eval_many(&m.at)?;
+            let previous = previous_at(q, &m.at)?;
+            // The part the run's replay predicted: its target, the nominal
+            // moved by its correction, and its deviation from it.
+            let predicted = predicted(first_tables, nominal.coordinate, q, &m.at)?.map(|d| {
+                (0..m.at.len())
+                    .map(|i| at_nominal[i] + previous[i] + d[i])
+                    .collect::<Vec<f64>>()
+            });
+            let error: Vec<f64> = m
+                .value
+                .iter()
+                .zip(&at_nominal)
+                .map(|(v, n)| v - n)
+                .collect();
+            // What the run's replay does not model: the measured minus the
+            // part it predicted (its target, the nominal moved by the run's own
+            // correction, where its verification predicts none), plus that
+            // correction. Fitted and corrected against, it replaces the run's
+            // correction, so a part measured as its run predicted keeps it.
+            let unmodelled: Vec<f64> = (0..m.at.len())
+                .map(|i| {
+                    let expected = predicted
+                        .as_ref()
+                        .map_or(at_nominal[i] + previous[i], |p| p[i]);
+                    m.value[i] - expected + previous[i]
+                })
+                .collect();
+            let fit = if q.along {
+                fit_error(&m.at, &unmodelled, options.uncertainty)?
+            } else {
+                fit_mean(&m.at, &unmodelled, options.uncertainty)?
+            };
+            fitted.push(Some(Fitted {
+                m,
+                at_nominal,
+                error,
+                predicted,
+                previous,
+                fit,
+            }));
+        }
+        if fitted.iter().all(Option::is_none) {
+            return Err(CompensateError::Nothing {
+                file: measured.source().to_owned(),
+                wanted: nominal
+                    .quantities
+                    .iter()
+                    .map(|q| {
+                        let columns: Vec<String> =
+                            q.values.iter().map(|(c, _)| format!("'{c}'")).collect();
+                        format!("the {} ({})", q.name, columns.join(" or "))
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                available: measured.headers().join(", "),
+            }
+            .into());
+        }
+        let (from, to) = nominal.range;
+        // Along the coordinate, every GRID-th of the range; as one value,
+        // the ends and the middle (a profile's fewest).
+        let places = if nominal.quantities.iter().any(|q| q.along) {
+            GRID
+        } else {
+            2
+        };
+        let grid: Vec<f64> = (0..=places)
+            .map(|i| from + (to - from) * i as f64 / places as f64)
+            .collect();
+        let (coordinate, unit) = nominal
+            .coordinate
+            .rsplit_once('_')
+            .unwrap_or((nominal.coordinate, ""));
+        let mut csv = std::iter::once(nominal.coordinate)
+            .chain(nominal.quantities.iter().map(|q| q.key.as_str()))
+            .collect::<Vec<_>>()
+            .join(",")
+            + "\n";
+        let mut columns: Vec<Vec<f64>> = Vec::new();
+        for (q, f) in nominal.quantities.iter().zip(&fitted) {
+            let mut total = previous_at(q, &grid)?;
+            if let Some(f) = f {
+                let shift = f.fit.correction(&grid, options.gain)?;
+                total.iter_mut().zip(&shift).for_each(|(t, s)| *t += s);
+                let place = |s: f64| {
+                    if q.along {
+                        format!("of the {} at {coordinate} = {s:.3} {unit}", q.name)
+                    } else {
+                        format!("of the {}", q.name)
+                    }
+                };
+                within_limit(&grid, &total, options.limit, &place, &f.m.file)?;
+            }
+            columns.push(total);
+        }
+        for (i, z) in grid.iter().enumerate() {
+            csv += &format!("{z:.6}");
+            for c in &columns {
+                csv += &format!(",{:.9}", c[i]);
+            }
+            csv += "\n";
+        }
+        // The corrected run.
+        let family = load(vec![(CORRECTION_FILE.into(), csv.clone())])?;
+        let sources = vec![
+            base.clone(),
+            ParamSource::Pairs {
+                label: "compensate".into(),
+                pairs: vec![(CORRECTION.into(), CORRECTION_FILE.into())],
+            },
+        ];
+        let mut records = Vec::new();
+        let mut of = Vec::new();
+        let mut not_measured = Vec::new();
+        for ((q, f), total) in nominal.quantities.iter().zip(&fitted).zip(&columns) {
+            let Some(f) = f else {
+                not_measured.push(q.name.clone());
+                continue;
+            };
+            let fit_at = f.fit.at(&f.m.at)?;
+            let shift: Vec<f64> = fit_at.iter().map(|v| -options.gain * v).collect();
+            let places: Vec<Place> = (0..f.m.at.len())
+                .map(|i| Place {
+                    at: f.m.at[i],
+                    measured: f.m.value[i],
+                    spread: f.m.spread[i],
+                    nominal: f.at_nominal[i],
+                    error: f.error[i],
+                    predicted: f.predicted.as_ref().map(|p| p[i]),
+                    unmodelled: f.fit.error[i],
+                    fitted: fit_at[i],
+                    correction: f.previous[i] + shift[i],
+                    expected_after: f.error[i] + shift[i],
+                })
+                .collect();
+            of.push(q);
+            records.push(QuantityRecord {
+                name: q.name.clone(),
+                column: f.m.column.clone(),
+                key: q.key.clone(),
+                along: q.along,
+                smooth: f.fit.smooth,
+                rms_residual_mm: f.fit.rms_residual,
+                max_error_mm: largest(f.error.iter().copied()),
+                max_spread_mm: largest(f.m.spread.iter().copied()),
+                max_correction_mm: largest(total.iter().copied()),
+                max_expected_after_mm: largest(places.iter().map(|p| p.expected_after)),
+                places,
+            });
+        }
+        let quantities: Vec<Quantity> = of.into_iter().cloned().collect();
+        let mut made = annex(
+            nominal.coordinate,
+            &quantities,
+            &records,
+            (coordinate, unit),
+        );
+        // The first run's program and its passes, read and parsed on a thread
+        // of their own while the corrected run starts (tens of megabytes of
+        // JSON for a caliber); its hook takes them.
+        let first = {
+            let (run, shown) = (run.clone(), shown.clone());
+            std::thread::spawn(move || {
+                let parse = |name: &str| run.read_text(name, limit).map_err(|e| e.to_string());
+                let program: AxisProgram = serde_json::from_str(&parse("program.json")?)
+                    .map_err(|e| format!("{shown}/program.json: {e}"))?;
+                let toolpath: Toolpath = serde_json::from_str(&parse("toolpath.json")?)
+                    .map_err(|e| format!("{shown}/toolpath.json: {e}"))?;
+                let passes = pass_blocks(&program, &toolpath.passes);
+                Ok::<_, String>((program, passes))
+            })
+        };
+        let first = std::sync::Mutex::new(Some(first));
+        // Once the corrected run's verification has predicted its part: the
+        // annex's tables made again with the part after, and how far the
+        // corrected program's path moved, per pass (its chart), kept for
+        // compensation.json.
+        // What the hook found, for compensation.json: the records with the
+        // part after, and the moves.
+        type Found = (Vec<QuantityRecord>, Result<Option<Moved>, String>);
+        let (column, names) = (nominal.coordinate, (coordinate.to_owned(), unit.to_owned()));
+        let hook_quantities = quantities.clone();
+        let found: std::sync::Arc<std::sync::Mutex<Option<Found>>> = Default::default();
+        let slot = found.clone();
+        let hook_records = records;
+        made.finish = Some(super::TablesHook(std::sync::Arc::new(
+            move |tables, program, passes| {
+                let mut records = hook_records.clone();
+                after_run(&mut records, &hook_quantities, column, tables);
+                let names = (names.0.as_str(), names.1.as_str());
+                tables.extend(annex(column, &hook_quantities, &records, names).tables);
+                let parsed = first.lock().ok().and_then(|mut h| h.take()).map(|h| {
+                    h.join()
+                        .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+                });
+                let moved = match parsed {
+                    Some(Ok((old_program, old_passes))) => {
+                        Ok(path_moved(&old_program, &old_passes, program, passes))
+                    }
+                    Some(Err(e)) => Err(e),
+                    None => Err("the first run's program was taken twice".into()),
+                };
+                let plots = moved
+                    .as_ref()
+                    .ok()
+                    .and_then(Option::as_ref)
+                    .map(|m| moves_chart(m, tables));
+                if let Ok(mut s) = slot.lock() {
+                    *s = Some((records, moved));
+                }
+                plots.into_iter().collect()
+            },
+        )));
+        let job_options = JobOptions {
+            program_name: script
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("pilgrim")
+                .to_owned(),
+            annex: made,
+            ..JobOptions::default()
+        };
+        let mut out = run_job(&family, &machine, &sources, &job_options, &mut |_| {}).map_err(
+            |e| match e {
+                // A corrected run that fails its checks leaves its report.
+                Error::Failed(failed) => Error::Failed(failed),
+                refused => CompensateError::Corrected {
+                    file: measured.source().to_owned(),
+                    why: refused.to_string(),
+                }
+                .into(),
+            },
+        )?;
+        // The run calls its hook once it has verified.
+        let (records, moved) = found
+            .lock()
+            .ok()
+            .and_then(|mut s| s.take())
+            .ok_or_else(|| Error::Output("the corrected run did not finish its tables".into()))?;
+        let moved = moved.map_err(Error::Read)?;
+        let record = Compensation {
+            run: shown.clone(),
+            measured_file: measured.source().to_owned(),
+            coordinate: nominal.coordinate,
+            uncertainty_mm: options.uncertainty,
+            gain: options.gain,
+            limit_mm: options.limit,
+            quantities: records,
+            not_measured,
+            program: {
+                ProgramChange {
+                    path_moved: moved.as_ref().map(|m| m.largest.clone()),
+                    blocks_moved: moved.map(|m| m.blocks),
+                    ..change(
+                        &program_file,
+                        &before,
+                        &out.files
+                            .iter()
+                            .find(|(n, _)| *n == program_file)
+                            .map(|(_, b)| String::from_utf8_lossy(b).into_owned())
+                            .unwrap_or_default(),
+                    )
+                }
+            },
+            lineage,
+        };
+        out.files.push((CORRECTION_FILE.into(), csv.into_bytes()));
+        out.files.push((
+            "compensation.json".into(),
+            (serde_json::to_string_pretty(&record).map_err(|e| Error::Output(e.to_string()))?
+                + "\n")
+                .into_bytes(),
+        ));
+        Ok((out, record))
+    };
+    let (corrected, again) = crate::budget::beside(correct, recompute);
+    same_prediction(&report.tables, &again?, &label)?;
+    corrected
 }
 
 /// The correction table a run keeps beside its files, as its parameters
@@ -839,7 +853,9 @@ fn same_prediction(file: &Tables, again: &Tables, label: &str) -> Result<(), Err
         }
     }
     if let Some(extra) = theirs.keys().find(|c| !ours.contains_key(*c)) {
-        return changed(format!("has a column {extra} the run's program does not give"));
+        return changed(format!(
+            "has a column {extra} the run's program does not give"
+        ));
     }
     Ok(())
 }
