@@ -1180,3 +1180,67 @@ fn the_runs_prediction_is_recomputed() {
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("predicted_deviation"), "{err}");
 }
+
+/// Corrections converge: a constant error of the process (the wheel's
+/// wear along the finishing pass, in the loop), the part measured (with a
+/// bench's repeatability) and compensated round after round, is within the tolerance after 3 rounds,
+/// and the correction then changes by less than the measurement's
+/// uncertainty (a measurement of a corrected part is judged against the
+/// corrected target: the new correction replaces the old, never adds to
+/// it).
+#[test]
+fn corrections_converge_round_after_round() {
+    let dir = scratch("compensate", "rounds");
+    let mut run = mandrel_run(&dir);
+    let fine = fine();
+    let tolerance = common::report_of(&run)["verification"]["tolerance"]
+        .as_f64()
+        .unwrap();
+    let uncertainty = 0.001;
+    let mut corrections: Vec<Vec<f64>> = Vec::new();
+    for round in 1..=4 {
+        // Measured as a bench measures: the part, and its repeatability
+        // (0.1 um either way, a fixed sequence that differs each round:
+        // two measurements are never the same numbers).
+        let bench: Vec<(f64, f64)> = finish_with(&run, "program.mpf", &bench_places(), &worn)
+            .into_iter()
+            .enumerate()
+            .map(|(i, (hi, lo))| {
+                let scatter = 5e-5 * [-1.0, 0.0, 1.0][(i + round) % 3];
+                (hi + scatter, lo)
+            })
+            .collect();
+        let measured = dir.join(format!("round-{round}.csv"));
+        std::fs::write(&measured, bench_table(&bench)).unwrap();
+        let out = dir.join(format!("round-{round}"));
+        compensated(&run, &measured, &out);
+        let c = json(&out.join("compensation.json"));
+        assert_eq!(c["lineage"]["generation"], round);
+        corrections.push(
+            c["quantities"][0]["places"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|p| p["correction"].as_f64().unwrap())
+                .collect(),
+        );
+        run = out;
+        let after = off_nominal(&finish_with(&run, "program.mpf", &fine, &worn), &fine);
+        if round >= 3 {
+            assert!(
+                after <= tolerance,
+                "round {round}: {after} mm off, tolerance {tolerance}"
+            );
+            let (a, b) = (&corrections[round - 2], &corrections[round - 1]);
+            let moved = a
+                .iter()
+                .zip(b)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f64::max);
+            assert!(
+                moved < uncertainty,
+                "round {round}: the correction moved {moved} mm"
+            );
+        }
+    }
+}
