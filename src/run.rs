@@ -366,6 +366,13 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
             for w in &out.report.verdict.warnings {
                 said += &format!("\nwarning: {}", w.message);
             }
+            let set = out.report.not_defaults();
+            if !set.is_empty() {
+                said += &format!(
+                    "\nverified with parameters not the family's defaults: {}",
+                    set.join(", ")
+                );
+            }
             Ok(said)
         }
         Err(pilgrim_kernel::Error::Failed(failed)) => {

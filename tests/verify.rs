@@ -446,3 +446,27 @@ fn a_tolerance_loosened_in_the_report_is_refused() {
     assert!(!err.contains("looser"), "{err}");
     assert!(err.contains("finishing stock"), "{err}");
 }
+
+/// The verdict says which parameters are not the family's defaults and
+/// where each came from: none for a default run; a tighter tolerance set
+/// on the verifying command is listed with `--set`, in the report too.
+#[test]
+fn parameters_not_the_defaults_are_listed_with_their_source() {
+    let out = default_run("mandrel", "listed");
+    assert!(report(&out)["parameters"]["tolerance"]
+        .get("from")
+        .is_none());
+    let (code, said, err) = pilgrim(&["verify", s(&out)]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!said.contains("not the family's defaults"), "{said}");
+    let (code, said, err) = pilgrim(&["verify", s(&out), "--set", "tolerance=0.002"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        said.contains(
+            "verified with parameters not the family's defaults: tolerance = 0.002 mm (--set)"
+        ),
+        "{said}"
+    );
+    let verified = report(&out.with_extension("verify"));
+    assert_eq!(verified["parameters"]["tolerance"]["from"], "--set");
+}

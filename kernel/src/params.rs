@@ -332,6 +332,19 @@ pub fn resolve(
     constants: &BTreeMap<String, Real>,
     sources: &[ParamSource],
 ) -> Result<Params, ParamError> {
+    resolve_traced(specs, constants, sources).map(|(values, _)| values)
+}
+
+/// [`resolve`], and where each value came from: `its default`, `the
+/// machine's constant NAME`, or the label of the last source that set it.
+///
+/// # Failures
+/// As [`resolve`].
+pub fn resolve_traced(
+    specs: &[ParamSpec],
+    constants: &BTreeMap<String, Real>,
+    sources: &[ParamSource],
+) -> Result<(Params, BTreeMap<String, String>), ParamError> {
     let mut values = BTreeMap::new();
     let mut came_from: BTreeMap<String, String> = BTreeMap::new();
     for s in specs {
@@ -424,7 +437,7 @@ pub fn resolve(
             .and_then(|_| s.check(v))
             .map_err(|m| bad(&s.name, &came_from[&s.name], m))?;
     }
-    Ok(values)
+    Ok((values, came_from))
 }
 
 #[cfg(test)]

@@ -20,6 +20,11 @@ pub struct ReportParam {
     pub value: ParamValue,
     /// Its unit.
     pub unit: String,
+    /// Where a value other than the family's default came from (`--set`,
+    /// a parameter file, a run's report, a machine's constant); none for
+    /// the default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub from: Option<String>,
 }
 
 /// `report.json`: what a run did, with what, and what it found.
@@ -137,6 +142,26 @@ impl Report {
         }
     }
 
+    /// The parameters whose values are not the family's defaults, each
+    /// with where it came from: `tolerance = 0.005 mm (--set)`.
+    pub fn not_defaults(&self) -> Vec<String> {
+        self.parameters
+            .iter()
+            .filter_map(|(k, p)| {
+                let from = p.from.as_ref()?;
+                let value = toml::Value::try_from(&p.value)
+                    .map(|v| v.to_string())
+                    .unwrap_or_default();
+                let unit = if p.unit.is_empty() {
+                    String::new()
+                } else {
+                    format!(" {}", p.unit)
+                };
+                Some(format!("{k} = {value}{unit} ({from})"))
+            })
+            .collect()
+    }
+
     /// The parameter values the run used, as a source a run or a
     /// verification takes (`label`: where they come from, for messages).
     ///
@@ -156,13 +181,14 @@ impl Report {
     }
 
     /// The report of a run of `family` on `machine` (described by `info`,
-    /// its constants as the run set them) with `values`, its `checks`
-    /// made: what a run knows before its toolpath, the rest empty.
+    /// its constants as the run set them) with `values` (and where each
+    /// came from), its `checks` made: what a run knows before its
+    /// toolpath, the rest empty.
     pub fn of_run(
         family: &dyn crate::family::PartFamily,
         machine: &crate::catalog::OpenMachine,
         info: &MachineInfo,
-        values: &crate::params::Params,
+        (values, origins): (&crate::params::Params, &BTreeMap<String, String>),
         checks: Vec<Check>,
     ) -> Self {
         Self {
@@ -178,11 +204,15 @@ impl Report {
                 .iter()
                 .filter_map(|s| {
                     let value = values.get(&s.name)?.clone();
+                    let from = (value != s.default)
+                        .then(|| origins.get(&s.name).cloned())
+                        .flatten();
                     Some((
                         s.name.clone(),
                         ReportParam {
                             value,
                             unit: s.unit.clone(),
+                            from,
                         },
                     ))
                 })

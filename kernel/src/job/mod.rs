@@ -30,7 +30,7 @@ pub use solids::SolidFile;
 use crate::catalog::OpenMachine;
 use crate::error::Error;
 use crate::family::{FilesContext, Outcome, PartFamily, ReplayContext};
-use crate::params::{resolve, ParamSource, ParamValue, Params};
+use crate::params::{ParamSource, ParamValue, Params};
 use crate::program::post::{dialect, CLD};
 use crate::program::{build, AxisProgram};
 use crate::toolpath::Toolpath;
@@ -401,6 +401,19 @@ pub fn params_on(
     machine: &OpenMachine,
     sources: &[ParamSource],
 ) -> Result<Params, Error> {
+    params_traced(family, machine, sources).map(|(values, _)| values)
+}
+
+/// [`params_on`], and where each value came from
+/// ([`crate::params::resolve_traced`]).
+///
+/// # Failures
+/// As [`params_on`].
+pub fn params_traced(
+    family: &dyn PartFamily,
+    machine: &OpenMachine,
+    sources: &[ParamSource],
+) -> Result<(Params, std::collections::BTreeMap<String, String>), Error> {
     let mut constants = machine.kinematics.info().constants.clone();
     for s in family.params() {
         if let (Some((body, along)), Some(c)) = (s.body_place(), &s.machine) {
@@ -413,7 +426,11 @@ pub fn params_on(
             }
         }
     }
-    Ok(resolve(family.params(), &constants, sources)?)
+    Ok(crate::params::resolve_traced(
+        family.params(),
+        &constants,
+        sources,
+    )?)
 }
 
 /// [`run`] of the program the run builds (`text` `None`), or [`verify`] of
@@ -426,7 +443,7 @@ fn run_on(
     stage: &mut dyn FnMut(&str),
     text: Option<&str>,
 ) -> Result<JobOutput, Error> {
-    let values = params_on(family, machine, sources)?;
+    let (values, origins) = params_traced(family, machine, sources)?;
     let overrides: Vec<(String, f64)> = family
         .params()
         .iter()
@@ -474,7 +491,7 @@ fn run_on(
     if !failed.is_empty() {
         // Nothing to replay or draw: the report says which checks failed,
         // with every parameter.
-        let mut report = Report::of_run(family, machine, info, &values, checks);
+        let mut report = Report::of_run(family, machine, info, (&values, &origins), checks);
         report.program_file = text.and(options.program_file.clone());
         report.verdict = Verdict::of(false, failed, Vec::new(), Vec::new());
         return Err(failed_run(report, Vec::new(), None));
@@ -520,7 +537,8 @@ fn run_on(
             // A text the verification cannot take leaves its report: what
             // was refused and where, every parameter; nothing verified.
             let refused = |message: String| {
-                let mut report = Report::of_run(family, machine, info, &values, checks.clone());
+                let mut report =
+                    Report::of_run(family, machine, info, (&values, &origins), checks.clone());
                 report.program_file.clone_from(&options.program_file);
                 report.verdict = Verdict::of(
                     true,
@@ -794,7 +812,7 @@ fn run_on(
             .map(|b| b.number)
             .collect::<Option<Vec<u32>>>()
             .unwrap_or_default(),
-        ..Report::of_run(family, machine, info, &values, checks)
+        ..Report::of_run(family, machine, info, (&values, &origins), checks)
     };
     // The verification's own files: the tables it adds to, then its
     // plots (before the family's charts where it leads them, else after).
