@@ -634,3 +634,21 @@ fn names_reach_the_terminal_escaped_and_messages_are_bounded() {
     assert_eq!(code, 1);
     assert!(err.len() < 10_000, "{} bytes: {:.300}", err.len(), err);
 }
+
+/// A value typed far out of range is named short: `--set tolerance=1e308`
+/// is refused as `1e308`, not as 309 digits.
+#[test]
+fn huge_values_are_named_short() {
+    let out = common::scratch("cli", "huge").join("run");
+    let (code, _, err) = pilgrim(&[
+        "run",
+        "scripts/mandrel.rhai",
+        "--set",
+        "tolerance=1e308",
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("1e308 is above the ceiling 1"), "{err}");
+    assert!(err.len() < 300, "{err}");
+}

@@ -85,6 +85,18 @@ pub fn all_finite(what: &str, values: &[Real]) -> Result<(), InputError> {
     }
 }
 
+/// `v` as a message shows a number from outside: as written in plain
+/// decimals where that is short (1e-4 <= |v| < 1e15, and 0), in exponent
+/// form beyond (`1e308`, not 309 digits), so that a value typed by a user
+/// cannot swamp the message that names it.
+pub fn shown(v: Real) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e15).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
 /// `v` with `decimals` digits after the point, never printing `-0.000`
 /// (a value that rounds to zero prints unsigned).
 ///
@@ -298,6 +310,19 @@ pub fn simpson(samples: &[Real], h: Real) -> Real {
 
 #[cfg(test)]
 mod tests {
+    /// A number from outside is shown short: plain where that is short, in
+    /// exponent form beyond.
+    #[test]
+    fn numbers_are_shown_short() {
+        use super::shown;
+        assert_eq!(shown(0.001), "0.001");
+        assert_eq!(shown(-25.5), "-25.5");
+        assert_eq!(shown(0.0), "0");
+        assert_eq!(shown(1e308), "1e308");
+        assert_eq!(shown(-2.5e-7), "-2.5e-7");
+        assert!(shown(f64::MAX).len() < 30);
+    }
+
     /// Simpson is exact for a cubic: int of x^3 - x over [0, 2] = 2.
     #[test]
     fn simpson_is_exact_for_cubics() {

@@ -219,12 +219,18 @@ impl ParamSpec {
         let check_one = |x: f64| -> Result<(), String> {
             if let Some(max) = self.max {
                 if x > max {
-                    return Err(format!("{x} is above the ceiling {max}"));
+                    return Err(format!(
+                        "{} is above the ceiling {max}",
+                        crate::math::shown(x)
+                    ));
                 }
             }
             if let Some(min) = self.min {
                 if x < min {
-                    return Err(format!("{x} is below the least value allowed, {min}"));
+                    return Err(format!(
+                        "{} is below the least value allowed, {min}",
+                        crate::math::shown(x)
+                    ));
                 }
             }
             Ok(())
