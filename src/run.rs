@@ -300,7 +300,8 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
     // A run's report says what the run was asked; a tolerance looser than
     // the family's is taken only from this command's own line.
     if let Some(label) = &report_label {
-        let values = job::params_on(&family, &machine, &first).map_err(|e| e.to_string())?;
+        let (values, origins) =
+            job::params_traced(&family, &machine, &first).map_err(|e| e.to_string())?;
         for s in family.params().iter().filter(|s| s.tolerance) {
             let (Some(v), Some(d)) = (
                 values.get(&s.name).and_then(|v| v.as_number()),
@@ -308,7 +309,7 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
             ) else {
                 continue;
             };
-            if v > d && pilgrim_kernel::params::set_by(&s.name, &first) == Some(label.as_str()) {
+            if v > d && origins.get(&s.name) == Some(label) {
                 return Err(format!(
                     "{label}: {} = {v} {} is looser than the family's {d}: a verification takes a looser tolerance only from its own command line (--set {}={v}, or --params), never from a file a run wrote",
                     s.name, s.unit, s.name

@@ -308,21 +308,6 @@ pub enum ParamError {
     },
 }
 
-/// The label of the last of `sources` that sets `name`, if any (a source
-/// that does not parse sets nothing here: [`resolve`] names its fault).
-pub fn set_by<'a>(name: &str, sources: &'a [ParamSource]) -> Option<&'a str> {
-    sources.iter().rev().find_map(|s| match s {
-        ParamSource::Toml { label, text } => toml::from_str::<toml::Table>(text)
-            .ok()?
-            .contains_key(name)
-            .then_some(label.as_str()),
-        ParamSource::Pairs { label, pairs } => pairs
-            .iter()
-            .any(|(k, _)| k == name)
-            .then_some(label.as_str()),
-    })
-}
-
 /// The values of the parameters `specs`: defaults (a machine constant's
 /// value for a parameter tied to one that `constants` has), then each
 /// source in order; then every value against its spec's bounds.

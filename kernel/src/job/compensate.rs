@@ -436,9 +436,9 @@ pub fn compensate(
     let correct = || -> Result<(JobOutput, Compensation), Error> {
         // A compensated run's correction: its target was the nominal moved by
         // it, and the new correction replaces it (see `unmodelled`).
-        let previous = match run_correction(&run, &report)? {
+        let previous = match &correction_text {
             Some((name, text)) => Some(crate::profile::read_table_str(
-                &text,
+                text,
                 &format!("{shown}/{name}"),
             )?),
             None => None,

@@ -1265,32 +1265,28 @@ fn comment_before(comments: &[Option<String>], from: &mut usize, line: usize) ->
 /// (-1, no compound), `H` 0.
 ///
 /// # Failures
-/// A word missing or given twice, `H` not a whole number, the tapered
+/// A word missing (the block's reader refuses one given twice), `H` not a whole number, the tapered
 /// ends (`E`, `L`), which are not simulated, or a word the cycle has not.
 fn cycle_words(
     read: &[(char, Real)],
     d: &Dialect,
 ) -> Result<(super::cycle::ThreadCycle, Option<Real>), String> {
     let mut seen: Vec<char> = Vec::new();
-    let mut get = |c: char| -> Result<Option<Real>, String> {
-        let mut found = read.iter().filter(|(l, _)| *l == c).map(|(_, v)| *v);
-        let v = found.next();
-        if found.next().is_some() {
-            return Err(format!("G76 gives {c} twice"));
-        }
+    // The block's reader refuses an address given twice: the first is it.
+    let mut get = |c: char| -> Option<Real> {
         seen.push(c);
-        Ok(v)
+        read.iter().find(|(l, _)| *l == c).map(|(_, v)| *v)
     };
     let need = |c: char, v: Option<Real>| v.ok_or_else(|| format!("G76 without its {c} word"));
-    let pitch = need('P', get('P')?)?;
-    let z = need('Z', get('Z')?)?;
-    let i = need('I', get('I')?)?;
-    let j = need('J', get('J')?)?;
-    let k = need('K', get('K')?)?;
-    let r = get('R')?.unwrap_or(1.0);
-    let q = get('Q')?.unwrap_or(-1.0);
-    let h = get('H')?.unwrap_or(0.0);
-    let end_x = get('X')?;
+    let pitch = need('P', get('P'))?;
+    let z = need('Z', get('Z'))?;
+    let i = need('I', get('I'))?;
+    let j = need('J', get('J'))?;
+    let k = need('K', get('K'))?;
+    let r = get('R').unwrap_or(1.0);
+    let q = get('Q').unwrap_or(-1.0);
+    let h = get('H').unwrap_or(0.0);
+    let end_x = get('X');
     if !(h >= 0.0 && h.fract() == 0.0 && h <= 1000.0) {
         return Err(format!(
             "G76 H{h}: the spring passes must be a whole number from 0 to 1000"
