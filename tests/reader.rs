@@ -143,7 +143,8 @@ fn codes_are_read_with_their_decimals() {
 
 /// A tool offset other than the one the program's tool call selects (the
 /// model's tool), or one cancelled, is refused: Sinumerik's `D0`, `D2`,
-/// `D99`; Fanuc's `T0100` (offset cancelled) and `T0105`.
+/// `D99`; Fanuc's `T0100` (offset cancelled) and `T0105`; and so is
+/// another tool (`T2`, `T0202`).
 #[test]
 fn another_tool_offset_is_refused() {
     let (mpf, _, nc) = three("offsets");
@@ -159,6 +160,9 @@ fn another_tool_offset_is_refused() {
     for t in ["T0100", "T0105"] {
         refused(nc.edited(t, "T0101\n", &format!("{t}\n")), t, t);
     }
+    // Another tool: its own offsets and shape, not the one modelled.
+    refused(mpf.edited("T2", "N3 T1 D1\n", "N3 T2 D1\n"), "T2", "T2");
+    refused(nc.edited("T0202", "T0101\n", "T0202\n"), "T0202", "T0202");
 }
 
 /// A work offset switched before the finish (another part zero) is
