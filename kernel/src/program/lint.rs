@@ -703,6 +703,18 @@ fn lint_gcode(
                     } else {
                         n
                     });
+                    // Another tool has its own shape and offsets: the
+                    // verification models the family's.
+                    if out.tool != Some(program.tool_number) {
+                        return Err(fault(
+                            place(k),
+                            format!(
+                                "{}: another tool than T{}, the family's, whose shape the verification models",
+                                w.text(),
+                                program.tool_number
+                            ),
+                        ));
+                    }
                 }
                 letter => {
                     if letters_here.contains(&letter) {
