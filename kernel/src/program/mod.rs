@@ -11,6 +11,7 @@
 pub mod cycle;
 pub mod lint;
 pub mod post;
+pub mod reader;
 pub mod words;
 
 pub use pilgrim_plugin_abi::types::{AxisProgram, Block, Plane, ProgramAxis, ProgramSetup, Radial};
