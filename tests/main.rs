@@ -20,6 +20,7 @@ mod docs;
 mod machine_files;
 mod mandrel;
 mod mandrel_fidelity;
+mod mutants;
 mod plugins;
 mod reader;
 mod ring;
