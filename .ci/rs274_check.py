@@ -1,14 +1,17 @@
 """LinuxCNC's own interpreter on every program the tests left.
 
 For each directory under the given root holding program.ngc and
-program.json (tests/common `leave_for_rs274`): `rs274 -g` reads the
+program.json (tests/common `leave_for_rs274`, and the mutation test's
+sample of edited programs the reader read): `rs274 -g` reads the
 program; it must say nothing but "executing", its canonical output must
 end the program, and every spindle-synchronised move
 (START_SPEED_FEED_SYNC then STRAIGHT_FEED) must have the lead and the
-place (X as a radius: the program is on diameter, G7) of the axis
+place (X as a radius where the program is on diameter, G7) of the axis
 program's thread blocks, in order, within the program's 0.001 mm; and
 every move, rapid or cut, must be the axis program's block in order (a
-threading cycle's moves, G76, as LinuxCNC makes them).
+threading cycle's moves, G76, as LinuxCNC makes them). Each axis is
+found in the canonical call by its name (X Y Z A B C, the order rs274
+writes them).
 """
 import json
 import pathlib
@@ -22,8 +25,25 @@ def args(line):
     return [float(v) for v in inner.split(",")]
 
 
+CANON = "XYZABC"
+
+
+def places(program):
+    """(name, index in the canonical call, scale to it) of each axis."""
+    setup = program.get("setup", {})
+    diameter = setup.get("radial") == "diameter"
+    out = []
+    for a in program["axes"]:
+        name = a["name"]
+        scale = 0.5 if diameter and name == setup.get("radial_axis", "X") else 1.0
+        out.append((name, CANON.index(name), scale))
+    return out
+
+
 def check(d):
     program = json.loads((d / "program.json").read_text())
+    axes = places(program)
+    ix = {name: (i, k, scale) for i, (name, k, scale) in enumerate(axes)}
     threads = [b for b in program["blocks"] if b["motion"]["type"] == "thread"]
     with tempfile.TemporaryDirectory() as tmp:
         canon_path = pathlib.Path(tmp) / "canon.txt"
@@ -50,10 +70,12 @@ def check(d):
         if "STRAIGHT_FEED(" not in move:
             return f"synchronised move is not a straight feed: {move}"
         lead = args(line)[0]
-        x, _, z = args(move)[:3]
+        got = args(move)
+        x, z = got[0], got[2]
         b = threads[synced]
         want_lead = b["motion"]["lead"]
-        want_x, want_z = b["values"][0] / 2.0, b["values"][1]
+        want_x = b["values"][ix["X"][0]] * ix["X"][2]
+        want_z = b["values"][ix["Z"][0]]
         if abs(lead - want_lead) > 1e-4 or abs(x - want_x) > 1e-3 or abs(z - want_z) > 1e-3:
             return (
                 f"synchronised move {synced + 1}: lead {lead}, x {x}, z {z}; "
@@ -73,9 +95,10 @@ def check(d):
         rapid = "STRAIGHT_TRAVERSE(" in line
         if rapid != (b["motion"]["type"] == "rapid"):
             return f"move {n + 1} is {'a rapid' if rapid else 'a feed'}, the axis program's block {n + 1} a {b['motion']['type']}"
-        x, _, z = args(line)[:3]
+        got_all = args(line)
         keep = b.get("keep", [])
-        for name, got, want in (("X", x, b["values"][0] / 2.0), ("Z", z, b["values"][1])):
+        for name, (i, k, scale) in ix.items():
+            got, want = got_all[k], b["values"][i] * scale
             if name not in keep and abs(got - want) > 1e-3:
                 return f"move {n + 1}: {name} {got}, the axis program's block {n + 1} says {want}"
     return None

@@ -109,18 +109,26 @@ enum Outcome {
     /// Refused.
     Refused(LintError),
     /// Read: the moves of lines `from..to`, after which the reading stands
-    /// where the program's does.
-    Read { moves: Vec<ReadMove>, to: usize },
+    /// where the program's does, or (`lasting`) still differs at the
+    /// reading's bound.
+    Read {
+        moves: Vec<ReadMove>,
+        to: usize,
+        lasting: bool,
+    },
 }
 
 /// `text` in place of line `line`, read from the program's standing
-/// before it, on until the reading stands where the program's does.
+/// before it, on until the reading stands where the program's does, or
+/// `bound` lines on (an edit whose effect lasts: a lead or an axis the
+/// program writes once changes every move after it).
 fn read_mutant(
     reader: &mut Reader<'_>,
     subject: &Subject,
     base: &Baseline,
     line: usize,
     text: &str,
+    bound: usize,
 ) -> Outcome {
     let mut at = base.before[line].clone();
     let mut moves = Vec::new();
@@ -130,11 +138,26 @@ fn read_mutant(
     let mut i = line + 1;
     loop {
         if at == base.before[i] {
-            return Outcome::Read { moves, to: i };
+            return Outcome::Read {
+                moves,
+                to: i,
+                lasting: false,
+            };
+        }
+        if i - line > bound {
+            return Outcome::Read {
+                moves,
+                to: i,
+                lasting: true,
+            };
         }
         if i == subject.lines.len() {
             return match reader.end(&at) {
-                Ok(_) => Outcome::Read { moves, to: i },
+                Ok(_) => Outcome::Read {
+                    moves,
+                    to: i,
+                    lasting: false,
+                },
                 Err(e) => Outcome::Refused(e),
             };
         }
@@ -406,7 +429,7 @@ const FANUC: Rules = Rules {
     lead_every_block: false,
     one_f: true,
     start_q: Some(('Q', 1000.0)),
-    stated: &[21, 98],
+    stated: &[21, 40, 98],
 };
 
 /// LinuxCNC G-code reference, "G Codes" (G0, G1, G33 with K each block;
@@ -449,7 +472,7 @@ const LINUXCNC: Rules = Rules {
     lead_every_block: true,
     one_f: false,
     start_q: None,
-    stated: &[21, 90, 94],
+    stated: &[21, 40, 90, 94],
 };
 
 fn rules(d: &Dialect) -> &'static Rules {
@@ -533,6 +556,9 @@ fn expect_line(
     let mut axis = vec![None; names.len()];
     let mut letters: Vec<char> = Vec::new();
     let (mut lead_here, mut start_here, mut s_here) = (None, None, None);
+    // A lead by its own address (K) is read on a thread block only
+    // (LinuxCNC: "K word with no G2, G3, G33 ... to use it").
+    let mut lead_word = false;
     // The tape's framing and Sinumerik's name line are no blocks.
     if text == "%" || text.starts_with("%_N_") {
         return Ok(());
@@ -547,7 +573,7 @@ fn expect_line(
             continue;
         }
         if let Some(v) = w.strip_prefix("SF=") {
-            at.start = v.parse().map_err(|_| format!("{w}"))?;
+            at.start = v.parse().map_err(|_| format!("{w}: not a start angle"))?;
             start_here = Some(at.start);
             continue;
         }
@@ -605,7 +631,7 @@ fn expect_line(
                         at.offset = Some(o);
                     }
                     Setup(c) => {
-                        if !at.stated.contains(&c) {
+                        if r.stated.contains(&c) && !at.stated.contains(&c) {
                             at.stated.push(c);
                         }
                     }
@@ -640,6 +666,7 @@ fn expect_line(
             continue;
         }
         match letter {
+            'F' if !(value > 0.0) => return Err(format!("{w}: a feed not positive")),
             'F' if r.one_f => {
                 if !number.contains('.') {
                     return Err(format!("{w}: F without its point"));
@@ -649,7 +676,10 @@ fn expect_line(
             }
             'F' => at.f = Some(value),
             'S' => s_here = Some(value),
-            c if c == r.lead => lead_here = Some(value),
+            c if c == r.lead => {
+                lead_here = Some(value);
+                lead_word = true;
+            }
             c if r.start_q.is_some_and(|(q, _)| q == c) => {
                 if number.contains('.') {
                     return Err(format!("{w}: Q with a point"));
@@ -686,6 +716,9 @@ fn expect_line(
         at.lead = Some(l);
     }
     if axis.iter().all(Option::is_none) {
+        if lead_word && !r.one_f {
+            return Err("a lead without a thread block".into());
+        }
         if motion_here.is_some() {
             return Err("a motion without an axis".into());
         }
@@ -709,6 +742,9 @@ fn expect_line(
     }
     if kind == Linear && at.f.is_none() {
         return Err("a feed move before any F".into());
+    }
+    if kind != Thread && lead_word && !r.one_f {
+        return Err("a lead without a thread block".into());
     }
     if kind == Thread && r.lead_every_block && lead_here.is_none() {
         return Err("a thread block without its lead".into());
@@ -769,6 +805,150 @@ fn expect_program(subject: &Subject) -> (Vec<Expect>, Vec<Move>) {
     (before, moves)
 }
 
+/// The harmless edits of line `line` of `subject` (each the whole line):
+/// a comment after the words, spaces doubled and one after the last word,
+/// the block renumbered within the gap to the next, a leading zero on
+/// every number, a trailing zero on every number with a point.
+fn harmless(subject: &Subject, line: usize) -> Vec<String> {
+    let text = &subject.lines[line];
+    let d = subject.dialect;
+    // The tape's framing and Sinumerik's name line are no blocks.
+    if text.starts_with('%') {
+        return Vec::new();
+    }
+    let mut out = vec![
+        commented(text, d),
+        spaced(text),
+        zeros(text, d, true),
+        zeros(text, d, false),
+    ];
+    // The block renumbered where the numbering leaves room.
+    let number = |l: &str| -> Option<u32> { l.strip_prefix('N')?.split(' ').next()?.parse().ok() };
+    if let Some(n) = number(text) {
+        let next = subject.lines[line + 1..].iter().find_map(|l| number(l));
+        if next.is_none_or(|m| m > n + 1) {
+            out.push(text.replacen(&format!("N{n}"), &format!("N{}", n + 1), 1));
+        }
+    }
+    out.retain(|v| v != text);
+    out
+}
+
+/// A block with a comment after its words.
+fn commented(text: &str, d: &Dialect) -> String {
+    format!("{text} {}NOTE{}", d.comment.0, d.comment.1)
+}
+
+/// A block with its spaces doubled and one after its last word.
+fn spaced(text: &str) -> String {
+    format!("{} ", text.replace(' ', "  "))
+}
+
+/// A block with a leading zero on every number (`leading`), or a trailing
+/// zero on every number with a point.
+fn zeros(text: &str, d: &Dialect, leading: bool) -> String {
+    let mut t = text.to_owned();
+    for w in tokens(text, d).iter().rev().filter(|w| iso(&w.text)) {
+        let (l, n) = w.text.split_at(1);
+        let v = if leading {
+            match n.strip_prefix('-') {
+                Some(n) => format!("{l}-0{n}"),
+                None => format!("{l}0{n}"),
+            }
+        } else if n.contains('.') {
+            format!("{}0", w.text)
+        } else {
+            continue;
+        };
+        t.replace_range(w.start..w.end, &v);
+    }
+    t
+}
+
+/// Every block of `text` (a program in `d`) with every harmless edit but
+/// the renumbering (which renames the blocks a report names).
+fn all_harmless(text: &str, d: &Dialect) -> String {
+    text.lines()
+        .map(|l| {
+            if l.starts_with('%') || tokens(l, d).is_empty() {
+                l.to_owned()
+            } else {
+                commented(&spaced(&zeros(&zeros(l, d, true), d, false)), d)
+            }
+        })
+        .map(|l| l + "\n")
+        .collect()
+}
+
+/// The program of each default job verified as a whole with every
+/// harmless edit on every block (a comment, spaces, leading and trailing
+/// zeros): the verification's figures are the program's own.
+#[test]
+fn a_program_with_every_harmless_edit_verifies_with_identical_figures() {
+    let mandrel = default_run("mutants", "mandrel", "harmless-mandrel");
+    let thread = posted("thread", "harmless-thread", &[]);
+    // The lathe with a LinuxCNC control, for the program posted for it.
+    let lathe = pilgrim_kernel::machine::machine_file(&fanuc_0i_tc::describe(), "its crate");
+    assert!(lathe.contains("control = \"fanuc\""));
+    let linuxcnc_lathe = thread.parent().unwrap().join("linuxcnc-lathe.toml");
+    std::fs::write(
+        &linuxcnc_lathe,
+        lathe.replace("control = \"fanuc\"", "control = \"linuxcnc\""),
+    )
+    .unwrap();
+    for (dir, file, machine, family) in [
+        (&mandrel, "program.mpf", "3K152VF20", "scripts/mandrel.rhai"),
+        (&thread, "program.nc", "fanuc-0i-tc", "scripts/thread.rhai"),
+        (
+            &thread,
+            "program.ngc",
+            s(&linuxcnc_lathe),
+            "scripts/thread.rhai",
+        ),
+    ] {
+        let d = post::DIALECTS
+            .iter()
+            .find(|d| file.ends_with(d.extension))
+            .unwrap();
+        let text = std::fs::read_to_string(dir.join(file)).unwrap();
+        let edited = all_harmless(&text, d);
+        assert_ne!(edited, text);
+        let verified = |name: &str, text: &str| {
+            let path = dir.parent().unwrap().join(name);
+            std::fs::write(&path, text).unwrap();
+            let (code, _, err) = pilgrim(&[
+                "verify",
+                s(&path),
+                "--machine",
+                machine,
+                "--family",
+                family,
+                "-q",
+            ]);
+            assert_eq!(code, 0, "{name}: {err}");
+            let report = path
+                .with_file_name(format!("{name}.verify"))
+                .join("report.json");
+            let report: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
+            // The family's verification, and the verdict's figures.
+            let key = ["verification", "groove_verification", "thread_verification"]
+                .into_iter()
+                .find(|k| report.get(k).is_some())
+                .unwrap_or_else(|| panic!("{name}: no verification in its report"));
+            (report[key].clone(), report["verdict"].clone())
+        };
+        let ext = file.rsplit('.').next().unwrap();
+        let own = verified(&format!("OWN.{ext}"), &text);
+        assert!(own.0.is_object() && own.1["status"] == "passed", "{own:?}");
+        assert_eq!(
+            verified(&format!("EDITED.{ext}"), &edited),
+            own,
+            "{file} with every harmless edit"
+        );
+    }
+}
+
 /// The statistics of a subject's mutants.
 #[derive(Default, Debug)]
 struct Tally {
@@ -776,23 +956,40 @@ struct Tally {
     refused: usize,
     same: usize,
     changed: usize,
+    /// Read edits whose effect lasts past the reading's bound.
+    lasting: usize,
+    /// Harmless edits, each read as the program.
+    harmless: usize,
 }
+
+/// How far past its line a mutant is read and compared line by line
+/// while its reading differs from the program's (every 64th to the end).
+const BOUND: usize = 400;
 
 /// Whether the refusal `e` names the edit: the word `word` (as written,
 /// or as a code without its leading zeros: `M03` is named `M3`), or the
 /// block `block` it stands in (its `N`, or its line where the program
 /// numbers no blocks), where the refusal is of what the edit took away.
 fn names_edit(e: &LintError, word: &str, block: &str) -> bool {
-    let said = e.to_string();
-    if e.place == block || said.contains(&format!("{block} ")) || said.ends_with(block) {
+    let said = &e.message;
+    // The block by its whole name: N4 is not N40.
+    let whole_name = said
+        .match_indices(block)
+        .any(|(i, _)| !said[i + block.len()..].starts_with(|c: char| c.is_ascii_digit()));
+    if e.place == block || whole_name {
         return true;
     }
     if said.contains(word) {
         return true;
     }
+    // A code as its dialect compares it: `M03` is M3, LinuxCNC's `G8.0` G8.
     iso(word) && {
         let (l, n) = word.split_at(1);
         let n = n.trim_start_matches('0');
+        let n = match n.split_once('.') {
+            Some((i, f)) if f.chars().all(|c| c == '0') => i,
+            _ => n,
+        };
         !n.is_empty() && said.contains(&format!("{l}{n}"))
     }
 }
@@ -815,6 +1012,9 @@ fn mutate(subject: &Subject) -> (Tally, Vec<String>) {
     }
     let mut reader = subject.reader();
     let mut tally = Tally::default();
+    // The first changed reading of each kind of edit, for LinuxCNC's own
+    // interpreter.
+    let mut sampled: Vec<(String, usize, String)> = Vec::new();
     let mut failures: std::collections::BTreeMap<String, (usize, String)> = Default::default();
     let mut fail = |key: String, what: String| {
         failures.entry(key).or_insert((0, what)).0 += 1;
@@ -826,6 +1026,34 @@ fn mutate(subject: &Subject) -> (Tally, Vec<String>) {
             Some(n) if n.starts_with('N') && n.len() > 1 => n.to_owned(),
             _ => format!("line {}", line + 1),
         };
+        // The harmless edits read as the program.
+        for edit in harmless(subject, line) {
+            tally.harmless += 1;
+            let same = match read_mutant(&mut reader, subject, &base, line, &edit, usize::MAX) {
+                Outcome::Refused(e) => Err(e.to_string()),
+                Outcome::Read { moves, to, .. } => {
+                    let got: Vec<Move> = moves.iter().map(Move::of).collect();
+                    let want: Vec<Move> = base.moves[line..to]
+                        .iter()
+                        .flatten()
+                        .map(Move::of)
+                        .collect();
+                    if got == want {
+                        Ok(())
+                    } else {
+                        Err(format!("read as {got:?}, the program as {want:?}"))
+                    }
+                }
+            };
+            if let Err(why) = same {
+                fail(
+                    format!("harmless {}", edit.len() as isize - text.len() as isize),
+                    format!(
+                        "'{edit}' for '{text}': a harmless edit not read as the program: {why}"
+                    ),
+                );
+            }
+        }
         for t in tokens(text, subject.dialect) {
             for v in variants(&t.text) {
                 let mutant = format!("{}{v}{}", &text[..t.start], &text[t.end..]);
@@ -835,7 +1063,16 @@ fn mutate(subject: &Subject) -> (Tally, Vec<String>) {
                     t.text.chars().next().unwrap(),
                     v.chars().next().unwrap()
                 );
-                match read_mutant(&mut reader, subject, &base, line, &mutant) {
+                // Every 64th edit whose effect lasts is read to the end.
+                let mut outcome = read_mutant(&mut reader, subject, &base, line, &mutant, BOUND);
+                if let Outcome::Read { lasting: true, .. } = outcome {
+                    tally.lasting += 1;
+                    if tally.lasting % 64 == 0 {
+                        outcome =
+                            read_mutant(&mut reader, subject, &base, line, &mutant, usize::MAX);
+                    }
+                }
+                match outcome {
                     Outcome::Refused(e) => {
                         tally.refused += 1;
                         if !names_edit(&e, &v, &block) && !names_edit(&e, &t.text, &block) {
@@ -851,7 +1088,7 @@ fn mutate(subject: &Subject) -> (Tally, Vec<String>) {
                             );
                         }
                     }
-                    Outcome::Read { moves, to } => {
+                    Outcome::Read { moves, to, lasting } => {
                         let got: Vec<Move> = moves.iter().map(Move::of).collect();
                         let mut at = rules_before[line].clone();
                         let mut want = Vec::new();
@@ -879,7 +1116,7 @@ fn mutate(subject: &Subject) -> (Tally, Vec<String>) {
                                 format!("misread {class}"),
                                 format!("'{mutant}' ({} for {v}): read as {got:?}, the rules read {want:?}", t.text),
                             );
-                        } else if to < subject.lines.len() && at != rules_before[to] {
+                        } else if !lasting && to < subject.lines.len() && at != rules_before[to] {
                             fail(
                                 format!("unfollowed {class}"),
                                 format!("'{mutant}' ({} for {v}): the reader stands as the program does after line {to}, the control does not: {at:?}", t.text),
@@ -894,17 +1131,67 @@ fn mutate(subject: &Subject) -> (Tally, Vec<String>) {
                             tally.same += 1;
                         } else {
                             tally.changed += 1;
+                            if sampled.len() < 40 && !sampled.iter().any(|(c, _, _)| *c == class) {
+                                sampled.push((class.clone(), line, mutant.clone()));
+                            }
                         }
                     }
                 }
             }
         }
     }
+    if subject.dialect.name == "linuxcnc" {
+        leave_for_rs274(subject, &sampled);
+    }
     let failures = failures
         .into_iter()
         .map(|(k, (n, what))| format!("{} x{n} [{k}]: {what}", subject.label))
         .collect();
     (tally, failures)
+}
+
+/// Each mutant of `sampled` (its line and text) as a whole program with
+/// the reader's reading of it, for CI's `rs274` check
+/// (`.ci/rs274_check.py`: LinuxCNC's interpreter must make the moves the
+/// reader read), where rs274's standalone axes (X Y Z A B C) hold the
+/// program's.
+fn leave_for_rs274(subject: &Subject, sampled: &[(String, usize, String)]) {
+    if !subject
+        .frame
+        .axes
+        .iter()
+        .all(|a| "XYZABC".contains(a.name.as_str()))
+    {
+        return;
+    }
+    let exe = std::env::current_exe().unwrap();
+    let root = exe.ancestors().nth(3).unwrap().join("linuxcnc-check");
+    let tag = subject.label.replace(['/', '.'], "-");
+    for (n, (_, line, mutant)) in sampled.iter().enumerate() {
+        let mut lines = subject.lines.clone();
+        lines[*line] = mutant.clone();
+        let text = lines.join("\n") + "\n";
+        let read = pilgrim_kernel::program::lint::read(
+            &text,
+            &subject.frame,
+            subject.dialect,
+            &subject.axes,
+        )
+        .unwrap_or_else(|e| {
+            panic!(
+                "{}: '{mutant}' read line by line, not whole: {e}",
+                subject.label
+            )
+        });
+        let dir = root.join(format!("mutant-{tag}-{n:02}"));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("program.ngc"), &text).unwrap();
+        std::fs::write(
+            dir.join("program.json"),
+            serde_json::to_string(&read.program).unwrap(),
+        )
+        .unwrap();
+    }
 }
 
 /// A run of `scripts/<job>.rhai` with `sets`, posted for LinuxCNC too.
@@ -933,7 +1220,7 @@ fn every_one_word_edit_of_the_default_programs_is_refused_by_name_or_read_as_the
     let thread = posted("thread", "thread", &[]);
     let filter = std::env::var("PILGRIM_MUTANTS").unwrap_or_default();
     let mut failures = Vec::new();
-    for (dir, file, info) in [
+    let subjects = [
         (&mandrel, "program.mpf", &grinder),
         (&mandrel, "program.ngc", &grinder),
         (&caliber, "program.mpf", &mannesmann),
@@ -942,15 +1229,25 @@ fn every_one_word_edit_of_the_default_programs_is_refused_by_name_or_read_as_the
         (&worm1, "program.ngc", &lathe),
         (&thread, "program.nc", &lathe),
         (&thread, "program.ngc", &lathe),
-    ] {
-        let subject = Subject::open(dir, file, info);
-        if !subject.label.contains(&filter) {
-            continue;
+    ];
+    // The subjects side by side: each reads its own program.
+    std::thread::scope(|scope| {
+        let running: Vec<_> = subjects
+            .iter()
+            .map(|(dir, file, info)| Subject::open(dir, file, info))
+            .filter(|subject| subject.label.contains(&filter))
+            .map(|subject| {
+                scope.spawn(move || {
+                    let (tally, failed) = mutate(&subject);
+                    eprintln!("{}: {tally:?}", subject.label);
+                    failed
+                })
+            })
+            .collect();
+        for r in running {
+            failures.extend(r.join().unwrap());
         }
-        let (tally, failed) = mutate(&subject);
-        eprintln!("{}: {tally:?}", subject.label);
-        failures.extend(failed);
-    }
+    });
     assert!(
         failures.is_empty(),
         "{} kinds of mutant failed:\n{}",

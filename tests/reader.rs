@@ -243,15 +243,20 @@ fn fanucs_modal_words_are_read_as_fanuc_reads_them() {
 
 /// A program that leaves a modal group to the control's power-on state is
 /// refused, naming the word it must state: on Sinumerik `G90`, `G94`,
-/// `G71`; on Fanuc `G21`, `G98` (a Fanuc lathe powers up in feed per
-/// revolution: `F100` is 100 mm a turn); on LinuxCNC `G21`, `G90`, `G94`.
+/// `G71`; on Fanuc `G21`, `G40`, `G98` (a Fanuc lathe powers up in feed
+/// per revolution: `F100` is 100 mm a turn); on LinuxCNC `G21`, `G40`,
+/// `G90`, `G94` (no cutter compensation left on from a program before).
 #[test]
 fn the_power_on_state_is_never_assumed() {
     let (mpf, ngc, nc) = three("power-on");
     for (w, line, words) in [
         (&mpf, "N1 G90 G94 G71", ["G90", "G94", "G71"].as_slice()),
-        (&ngc, "N1 G21 G40 G90 G94 G97", &["G21", "G90", "G94"]),
-        (&nc, "G21 G40 G97 G98", &["G21", "G98"]),
+        (
+            &ngc,
+            "N1 G21 G40 G90 G94 G97",
+            &["G21", "G40", "G90", "G94"],
+        ),
+        (&nc, "G21 G40 G97 G98", &["G21", "G40", "G98"]),
     ] {
         for word in words {
             let without: Vec<&str> = line.split(' ').filter(|w| w != word).collect();
