@@ -155,8 +155,9 @@ pub struct Reading {
     /// Whether a thread block needs constant spindle speed (G97) in force.
     pub thread_needs_constant_speed: bool,
     /// The G codes a program must state before its first move (units,
-    /// absolute or incremental, the feed's mode): the reader never assumes
-    /// the control's power-on state, which a machine's parameters set.
+    /// absolute or incremental, the feed's mode, no cutter compensation):
+    /// the reader never assumes the control's power-on state, which a
+    /// machine's parameters set.
     pub setup_codes: &'static [u32],
     /// The G codes that select a work offset, the one in force at power-on
     /// first: the first a program selects is its part zero, a switch to
@@ -172,6 +173,10 @@ pub struct Reading {
     /// Addresses refused with a decimal point (Fanuc's start angle Q, a
     /// whole number of 0.001 deg).
     pub no_point: &'static str,
+    /// Whether the control reads a G or M code to its tenths (LinuxCNC:
+    /// `G1.0` is G1, `G33.1` another code); elsewhere a code is a whole
+    /// number and a point in it is refused (`G1.0` on Sinumerik).
+    pub code_tenths: bool,
 }
 
 /// The word of a thread block's spindle start angle.
@@ -243,6 +248,7 @@ pub const SINUMERIK: Dialect = Dialect {
         least_input: None,
         point_needed: "",
         no_point: "",
+        code_tenths: false,
     },
 };
 
@@ -300,11 +306,12 @@ pub const FANUC: Dialect = Dialect {
         tool_and_offset: true,
         offset_word: None,
         thread_needs_constant_speed: true,
-        setup_codes: &[21, 98],
+        setup_codes: &[21, 40, 98],
         work_offsets: &[54, 55, 56, 57, 58, 59],
         least_input: Some(0.001),
         point_needed: "F",
         no_point: "Q",
+        code_tenths: false,
     },
 };
 
@@ -351,11 +358,12 @@ pub const LINUXCNC: Dialect = Dialect {
         tool_and_offset: false,
         offset_word: None,
         thread_needs_constant_speed: true,
-        setup_codes: &[21, 90, 94],
+        setup_codes: &[21, 40, 90, 94],
         work_offsets: &[54, 55, 56, 57, 58, 59],
         least_input: None,
         point_needed: "",
         no_point: "",
+        code_tenths: true,
     },
 };
 
@@ -407,8 +415,18 @@ pub const CLD: Dialect = Dialect {
         least_input: None,
         point_needed: "",
         no_point: "",
+        code_tenths: false,
     },
 };
+
+/// The ISO G code selecting plane `p` (G17, G18, G19).
+pub fn plane_code(p: Plane) -> u32 {
+    match p {
+        Plane::Xy => 17,
+        Plane::Zx => 18,
+        Plane::Yz => 19,
+    }
+}
 
 /// Every dialect.
 pub const DIALECTS: [&Dialect; 4] = [&SINUMERIK, &FANUC, &LINUXCNC, &CLD];
@@ -605,14 +623,7 @@ fn setup_words(setup: &ProgramSetup, d: &Dialect) -> Vec<String> {
         words.push(format!("G{}", 53 + u16::from(n)));
     }
     if let Some(p) = setup.plane {
-        words.push(
-            match p {
-                Plane::Xy => "G17",
-                Plane::Zx => "G18",
-                Plane::Yz => "G19",
-            }
-            .to_owned(),
-        );
+        words.push(format!("G{}", plane_code(p)));
     }
     if let (false, Some(word)) = (setup.feed_group.is_empty(), d.feed_group) {
         words.push(format!("{word}({})", setup.feed_group.join(",")));

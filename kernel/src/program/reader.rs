@@ -112,6 +112,8 @@ pub struct Reader<'a> {
     start: Option<&'static str>,
     spindle: Option<&'a Axis>,
     ticker: crate::budget::Ticker,
+    /// The refusal of a code the dialect's table has not ([`not_read`]).
+    not_read: String,
 }
 
 /// Whether a G-code text is held to an axis program (the lint of a
@@ -133,9 +135,14 @@ struct State {
     f: Option<Real>,
     lead: Option<Real>,
     spindle_on: bool,
+    /// The word and block that last started or stopped the spindle
+    /// (`M5 at N70`), for a refusal to name.
+    spindle_by: Option<String>,
     /// The spindle's speed as written (S), none before the first.
     speed: Option<Real>,
     coolant: bool,
+    /// The word and block that last turned the coolant on or off.
+    coolant_by: Option<String>,
     constant_speed: bool,
     /// Diameter (true) or radius programming, once set.
     radial: Option<bool>,
@@ -143,10 +150,15 @@ struct State {
     start_deg: Real,
     values: Vec<Option<Real>>,
     ended: bool,
-    /// The G codes stated so far (the setup's modal states among them).
+    /// The word and block that ended the program.
+    ended_by: Option<String>,
+    /// The setup's G codes stated so far (`Reading::setup_codes`).
     stated: Vec<u32>,
-    /// The work offset selected (G54..), once selected.
-    work_offset: Option<u32>,
+    /// The work offset selected (G54..) and the block that selected it,
+    /// once selected.
+    work_offset: Option<(u32, String)>,
+    /// The plane selected (G17, G18, G19) and the block that selected it.
+    plane: Option<(u32, String)>,
 }
 
 /// A word of Sinumerik's own, outside the ISO words the parser reads.
@@ -311,6 +323,7 @@ impl<'a> Reader<'a> {
             start: d.thread_start.map(|t| t.address).filter(|a| a.len() > 1),
             spindle: axes.iter().find(|a| a.kind == AxisKind::Spindle),
             ticker: crate::budget::Ticker::new("the program's lint", 1024),
+            not_read: not_read(reading, d),
             names,
         };
         // The framing: % first and last where the dialect frames.
@@ -471,15 +484,12 @@ impl<'a> Reader<'a> {
         let mut tokens = super::words::words(code_text).map_err(|m| fault(at_block(), m))?;
         let line_number = match tokens.first() {
             Some(w) if w.letter == 'N' => {
-                let n = w
-                    .whole()
-                    .filter(|_| !w.number.starts_with('+'))
-                    .ok_or_else(|| {
-                        fault(
-                            at_line(line),
-                            format!("{}: a block number is a whole number", w.text()),
-                        )
-                    })?;
+                let n = w.integer().ok_or_else(|| {
+                    fault(
+                        at_line(line),
+                        format!("{}: a block number is a whole number", w.text()),
+                    )
+                })?;
                 tokens.remove(0);
                 Some(n)
             }
@@ -515,11 +525,23 @@ impl<'a> Reader<'a> {
             }
         };
         if st.ended {
-            return Err(fault(place(k), "a block after the program's end".into()));
+            return Err(fault(
+                place(k),
+                format!(
+                    "a block after the program's end ({})",
+                    st.ended_by.as_deref().unwrap_or("")
+                ),
+            ));
         }
         match (d.numbering, line_number) {
             (Some(_), None) => {
-                return Err(fault(at_line(line), "a block without its number".into()))
+                return Err(fault(
+                    at_line(line),
+                    format!(
+                        "a block without its number ('{}' opens it)",
+                        code_text.split_whitespace().next().unwrap_or_default()
+                    ),
+                ))
             }
             (Some(_), Some(n)) => {
                 if at.last_n.is_some_and(|m| n <= m) {
@@ -539,12 +561,18 @@ impl<'a> Reader<'a> {
             (None, None) => {}
         }
         // The block's words: codes, the tool call, addresses with values.
-        let mut radial_here: Vec<bool> = Vec::new();
+        let mut radial_here: Vec<(bool, String)> = Vec::new();
         let mut feed_group_here: Vec<&str> = Vec::new();
         let mut sf_here = None;
         for w in &own_here {
             match w {
-                OwnWord::Radial(diameter) => radial_here.push(*diameter),
+                OwnWord::Radial(diameter) => {
+                    let (radius, on_diameter) = d.radial_words.unwrap_or_default();
+                    radial_here.push((
+                        *diameter,
+                        if *diameter { on_diameter } else { radius }.into(),
+                    ))
+                }
                 OwnWord::FeedGroup(list) => feed_group_here.push(list),
                 OwnWord::StartAngle(v) => sf_here = Some(*v),
             }
@@ -557,16 +585,31 @@ impl<'a> Reader<'a> {
             match w.letter {
                 'G' | 'M' => {
                     let listed = if w.letter == 'G' { g_ok } else { m_ok };
-                    let Some(n) = w.whole().filter(|n| listed.contains(n)) else {
-                        return Err(fault(place(k), not_read(reading, d, w.letter, &w.number)));
+                    // A code as the dialect reads it: to a tenth where it
+                    // does (LinuxCNC's G1.0 is G1), else a whole number.
+                    let code = if d.reading.code_tenths {
+                        w.whole()
+                    } else {
+                        w.integer()
                     };
+                    let Some(n) = code.filter(|n| listed.contains(n)) else {
+                        return Err(fault(place(k), format!("{}{}", w.text(), self.not_read)));
+                    };
+                    let by = || Some(format!("{} at {}", w.text(), place(k)));
                     if w.letter == 'M' {
                         match n {
-                            3 => st.spindle_on = true,
-                            5 => st.spindle_on = false,
-                            8 => st.coolant = true,
-                            9 => st.coolant = false,
-                            n if n == d.reading.end_code => st.ended = true,
+                            3 | 5 if st.spindle_on != (n == 3) => {
+                                st.spindle_on = n == 3;
+                                st.spindle_by = by();
+                            }
+                            8 | 9 if st.coolant != (n == 8) => {
+                                st.coolant = n == 8;
+                                st.coolant_by = by();
+                            }
+                            n if n == d.reading.end_code => {
+                                st.ended = true;
+                                st.ended_by = by();
+                            }
                             _ => {}
                         }
                         continue;
@@ -583,41 +626,79 @@ impl<'a> Reader<'a> {
                         }
                         97 => st.constant_speed = true,
                         // LinuxCNC's diameter (G7) and radius (G8) modes.
-                        7 | 8 => radial_here.push(n == 7),
+                        7 | 8 => radial_here.push((n == 7, w.text())),
                         n if d.reading.work_offsets.contains(&n) => {
                             // The part zero is the work offset the program
                             // selects first (before its moves: the one in
                             // force at power-on, the first listed, if none).
-                            let current = st
-                                .work_offset
-                                .or((k > 0).then(|| d.reading.work_offsets[0]));
+                            let current = st.work_offset.clone().or((k > 0).then(|| {
+                                (
+                                    d.reading.work_offsets[0],
+                                    "power-on, before the moves".into(),
+                                )
+                            }));
                             match current {
-                                Some(c) if c != n => {
+                                Some((c, at)) if c != n => {
                                     return Err(fault(
                                         place(k),
                                         format!(
-                                            "{}: a switch of the work offset from G{c}, the part zero the verification places the part at (another part zero moves every later block); verify a program that keeps one",
+                                            "{}: a switch of the work offset from G{c} ({at}), the part zero the verification places the part at (another part zero moves every later block); verify a program that keeps one",
                                             w.text()
                                         ),
                                     ))
                                 }
-                                _ => st.work_offset = Some(n),
+                                Some(_) => {}
+                                None => st.work_offset = Some((n, place(k))),
+                            }
+                        }
+                        17..=19 => {
+                            // The plane the machine's setup states (the
+                            // tool's length offsets and arcs follow it), or
+                            // the first selected: another is refused.
+                            let current = st.plane.clone().or_else(|| {
+                                program.setup.plane.map(|p| {
+                                    (super::post::plane_code(p), "the machine's setup".into())
+                                })
+                            });
+                            match current {
+                                Some((c, at)) if c != n => {
+                                    return Err(fault(
+                                        place(k),
+                                        format!(
+                                            "{}: another plane than G{c} ({at}); the tool's length offsets and arcs follow the plane, which the verification keeps",
+                                            w.text()
+                                        ),
+                                    ))
+                                }
+                                _ if st.plane.is_none() => {
+                                    st.plane = Some((n, format!("{} at {}", w.text(), place(k))))
+                                }
+                                _ => {}
                             }
                         }
                         _ => {}
                     }
-                    if !st.stated.contains(&n) {
+                    // The setup's codes stated (a code restated, or one
+                    // the setup does not need, changes nothing kept).
+                    if d.reading.setup_codes.contains(&n) && !st.stated.contains(&n) {
                         st.stated.push(n);
                     }
                 }
                 'T' => {
+                    if letters_here.contains(&'T') {
+                        return Err(fault(
+                            place(k),
+                            format!("{}: T twice in one block", w.text()),
+                        ));
+                    }
+                    letters_here.push('T');
                     if k > 0 {
                         return Err(fault(
                             place(k),
                             format!("a tool call {} among the moves", w.text()),
                         ));
                     }
-                    let n = w.whole().ok_or_else(|| {
+                    let n = w.integer().ok_or_else(|| {
                         fault(
                             place(k),
                             format!("{}: a tool call is a whole number", w.text()),
@@ -691,7 +772,7 @@ impl<'a> Reader<'a> {
                     if start_letter == Some(letter) {
                         start_word = Some(w.text());
                     }
-                    if d.reading.offset_word == Some(letter) && w.whole() != Some(1) {
+                    if d.reading.offset_word == Some(letter) && w.integer() != Some(1) {
                         return Err(fault(
                             place(k),
                             format!(
@@ -710,20 +791,20 @@ impl<'a> Reader<'a> {
         let mut axis_here = vec![None; names.len()];
         // The machine's setup words, once, before the first move, and as
         // the setup says.
-        for diameter in radial_here {
+        for (diameter, word) in radial_here {
             let want = program.setup.radial.map(|r| r == Radial::Diameter);
             if k > 0 || st.radial.is_some() || want != Some(diameter) {
                 return Err(fault(
                     place(k),
                     format!(
-                        "{} where the machine's setup {}",
+                        "{word}: {} where the machine's setup {}",
                         if diameter {
                             "diameter programming"
                         } else {
                             "radius programming"
                         },
                         match (want, k > 0 || st.radial.is_some()) {
-                            (_, true) => "set it before the moves, once".to_owned(),
+                            (_, true) => "sets it once, before the moves".to_owned(),
                             (Some(true), _) => "programs the radial axis on diameter".to_owned(),
                             (Some(false), _) => "programs the radial axis on radius".to_owned(),
                             (None, _) => "says nothing of it".to_owned(),
@@ -850,11 +931,19 @@ impl<'a> Reader<'a> {
             return Ok(());
         }
         let mut lead_here = None;
+        // A lead by its own address (K), which only a thread block reads.
+        let mut lead_word: Option<String> = None;
         let mut s_here = None;
         for (letter, v, text) in read {
             if let Some(i) = names.iter().position(|n| *n == letter) {
                 axis_here[i] = Some(v);
                 continue;
+            }
+            if letter == 'F' && !(v > 0.0) {
+                return Err(fault(
+                    place(k),
+                    format!("{text}: a feed is a positive number"),
+                ));
             }
             match letter {
                 // One modal F where the lead's address is the feed's
@@ -873,7 +962,10 @@ impl<'a> Reader<'a> {
                 c if d.reading.offset_word == Some(c) => {}
                 c if start_letter == Some(c) => st.start_deg = v / start_scale,
                 '@' => st.start_deg = v,
-                c if c == lead_letter => lead_here = Some(v),
+                c if c == lead_letter => {
+                    lead_here = Some(v);
+                    lead_word = Some(text);
+                }
                 _ if reading => {
                     return Err(fault(
                         place(k),
@@ -941,9 +1033,18 @@ impl<'a> Reader<'a> {
             }
             st.speed = Some(v);
         }
+        let lead_outside = |w: &str| {
+            format!(
+                "{w}: a thread's lead outside a thread block ({} reads {lead_letter} as the lead of {} only)",
+                d.name, d.thread
+            )
+        };
         if !moves {
             if motion_here.is_some() {
                 return Err(fault(place(k), "a motion word with no axis".into()));
+            }
+            if let Some(w) = &lead_word {
+                return Err(fault(place(k), lead_outside(w)));
             }
             if let Some(w) = &start_word {
                 return Err(fault(place(k), outside_thread(w, d)));
@@ -979,6 +1080,9 @@ impl<'a> Reader<'a> {
             ));
         }
         let is_thread = m == 32 || m == 33;
+        if let Some(w) = lead_word.as_ref().filter(|_| !is_thread) {
+            return Err(fault(place(k), lead_outside(w)));
+        }
         if let Some(b) = b {
             let want = match b.motion {
                 Motion::Rapid => m == 0,
@@ -1150,14 +1254,25 @@ impl<'a> Reader<'a> {
 /// machine's `setup` turns it on.
 fn cutting_fault(st: &State, d: &Dialect, setup: &ProgramSetup, what: &str) -> Option<String> {
     if !st.spindle_on {
-        Some(format!("{what} with the spindle stopped (no M3)"))
+        Some(match &st.spindle_by {
+            Some(by) => format!("{what} with the spindle stopped ({by})"),
+            None => format!("{what} with the spindle stopped (no M3)"),
+        })
     } else if !st.speed.is_some_and(|v| v >= 1.0) {
-        Some(format!("{what} with no spindle speed S written"))
-    } else if setup.coolant && !st.coolant {
         Some(format!(
-            "{what} with the coolant off ({} not written), which the machine's setup turns on",
-            d.coolant.0
+            "{what} with no spindle speed S written (the spindle turned on by {})",
+            st.spindle_by.as_deref().unwrap_or("M3")
         ))
+    } else if setup.coolant && !st.coolant {
+        Some(match &st.coolant_by {
+            Some(by) => {
+                format!("{what} with the coolant off ({by}), which the machine's setup turns on")
+            }
+            None => format!(
+                "{what} with the coolant off ({} not written), which the machine's setup turns on",
+                d.coolant.0
+            ),
+        })
     } else {
         None
     }
@@ -1187,13 +1302,18 @@ fn setup_fault(st: &State, d: &Dialect, setup: &ProgramSetup, what: &str) -> Opt
         Some(format!(
             "{what} before G{c} is stated: the program leaves it to the control's power-on state, which the verification does not assume; write G{c} before the moves"
         ))
-    } else if radial_word && setup.radial.is_some() && st.radial.is_none() {
+    } else if let Some(r) = setup.radial.filter(|_| radial_word && st.radial.is_none()) {
+        let (radius, diameter) = d.radial_words.unwrap_or_default();
         Some(format!(
-            "{what} before the radial axis's programming (radius or diameter) is set, which the machine's setup states"
+            "{what} before {} sets the radial axis's programming ({}), which the machine's setup states",
+            if r == Radial::Diameter { diameter } else { radius },
+            if r == Radial::Diameter { "diameter" } else { "radius" }
         ))
     } else if d.feed_group.is_some() && !setup.feed_group.is_empty() && !st.feed_group {
         Some(format!(
-            "{what} before the feed group the machine's setup states"
+            "{what} before {}({}), the feed group the machine's setup states",
+            d.feed_group.unwrap_or_default(),
+            setup.feed_group.join(",")
         ))
     } else {
         None
@@ -1256,10 +1376,11 @@ fn cycle_words(
     ))
 }
 
-/// Why the reader refuses the word `letter number` in `d`: in a program
-/// pilgrim wrote, a word its dialect does not write; in a program read as
-/// it stands, a word the verification cannot simulate.
-fn not_read(reading: bool, d: &Dialect, letter: char, number: &dyn std::fmt::Display) -> String {
+/// Why the reader refuses a code: in a program pilgrim wrote, a word its
+/// dialect does not write; in a program read as it stands, a word the
+/// verification cannot simulate. The text after the word, made once per
+/// reader (a mutation test refuses millions of codes).
+fn not_read(reading: bool, d: &Dialect) -> String {
     let (g, m) = (d.reading.g_codes, d.reading.m_codes);
     if reading {
         let list = |l: char, c: &[u32]| {
@@ -1269,13 +1390,13 @@ fn not_read(reading: bool, d: &Dialect, letter: char, number: &dyn std::fmt::Dis
                 .join(" ")
         };
         format!(
-            "{letter}{number}: a word the verification cannot simulate (it reads {} and {} in {} programs); verify a program without it",
+            ": a word the verification cannot simulate (it reads {} and {} in {} programs); verify a program without it",
             list('G', g),
             list('M', m),
             d.name
         )
     } else {
-        format!("{letter}{number} is not a word of {}", d.name)
+        format!(" is not a word of {}", d.name)
     }
 }
 

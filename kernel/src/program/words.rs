@@ -67,7 +67,19 @@ impl Word {
         })
     }
 
-    /// The word as a whole number (`N`, `T`, a code without decimals):
+    /// The word as a whole number written as one (`N`, `T`, `D`, a code
+    /// where the dialect reads codes as whole numbers): digits only, no
+    /// sign, no point (`D1.` is refused where `D1` is read), or `None`.
+    pub fn integer(&self) -> Option<u32> {
+        if !self.number.is_empty() && self.number.bytes().all(|b| b.is_ascii_digit()) {
+            self.number.parse().ok()
+        } else {
+            None
+        }
+    }
+
+    /// The word as a code read to its decimals, a whole one (LinuxCNC's
+    /// `G1.0` is G1):
     /// digits only, or `None`.
     pub fn whole(&self) -> Option<u32> {
         let c = self.code()?;
@@ -198,6 +210,9 @@ mod tests {
         assert_eq!(one("G-1").code(), None);
         assert_eq!(one("T0101").whole(), Some(101));
         assert_eq!(one("N1.5").whole(), None);
+        assert_eq!(one("G01").integer(), Some(1));
+        assert_eq!(one("G1.0").integer(), None);
+        assert_eq!(one("D+1").integer(), None);
     }
 
     #[test]
