@@ -103,8 +103,10 @@ fn three(name: &str) -> (Written, Written, Written) {
 /// A code whose decimals the control reads (`G91.000010` is G91 on
 /// LinuxCNC: every later move incremental) or that is another code than
 /// its integer part (`G33.1`, rigid tapping) is refused naming it, in every
-/// dialect; the harmless spellings of the codes pilgrim writes (`G01`,
-/// `G1.0`) are read as the codes they are.
+/// dialect; the harmless spellings of the codes pilgrim writes (`G01`, and
+/// `G1.0` on LinuxCNC, which reads codes to their tenths) are read as the
+/// codes they are; Sinumerik and Fanuc read codes as whole numbers, and a
+/// point in one is refused.
 #[test]
 fn codes_are_read_with_their_decimals() {
     let (mpf, ngc, nc) = three("decimals");
@@ -130,14 +132,25 @@ fn codes_are_read_with_their_decimals() {
             refused(said, code, &format!("{} {code}", w.ext));
         }
     }
-    // A move's code spelled with its zeros is the same code.
+    // A move's code spelled with its zeros is the same code; a point in
+    // it only where the control reads codes to their tenths (LinuxCNC).
     for (w, from, to) in [
-        (&mpf, "N50 G1 U", "N50 G01.000 U"),
+        (&mpf, "N50 G1 U", "N50 G01 U"),
         (&ngc, " G1 ", " G01.0 "),
         (&nc, "G00 X300.000", "G0 X300.000"),
     ] {
         let (code, _, err) = w.edited("zeros", from, to);
         assert_eq!(code, 0, "{}: {err}", w.ext);
+    }
+    for (w, from, to, word) in [
+        (&mpf, "N50 G1 U", "N50 G01.000 U", "G01.000"),
+        (&nc, "G00 X300.000", "G00.0 X300.000", "G00.0"),
+    ] {
+        refused(
+            w.edited("point", from, to),
+            word,
+            &format!("{} point", w.ext),
+        );
     }
 }
 
