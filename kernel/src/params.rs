@@ -172,6 +172,12 @@ pub struct ParamSpec {
     /// run wrote.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub tolerance: bool,
+    /// The machine axis a true value needs (a mode of the family only a
+    /// machine with that axis runs, e.g. the caliber's `cross_axis` and
+    /// Y): the run refuses the value before any planning on a machine
+    /// without the axis.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub needs_axis: Option<String>,
 }
 
 impl ParamSpec {
@@ -188,6 +194,7 @@ impl ParamSpec {
             max: None,
             max_len: None,
             tolerance: false,
+            needs_axis: None,
         }
     }
 

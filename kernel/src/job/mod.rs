@@ -466,6 +466,7 @@ fn run_on(
     };
     let info = kin.info();
     body_places_agree(family, machine.kinematics.info(), info, &values)?;
+    needed_axes_present(family, info, &values)?;
     stage(STAGES[0]);
     let checks = family.checks(&values)?;
     for c in &checks {
@@ -899,6 +900,42 @@ fn run_on(
         report,
         files,
     })
+}
+
+/// Checks that the machine has every axis a parameter's value needs
+/// ([`crate::params::ParamSpec::needs_axis`]): a mode the machine cannot
+/// run is refused before any planning, naming the parameter, the axis and
+/// the machine's axes.
+///
+/// # Failures
+/// [`crate::machine::MachineError::Description`].
+fn needed_axes_present(
+    family: &dyn PartFamily,
+    info: &crate::machine::MachineInfo,
+    values: &Params,
+) -> Result<(), Error> {
+    for s in family.params() {
+        let Some(axis) = &s.needs_axis else { continue };
+        if values.get(&s.name) != Some(&ParamValue::Bool(true))
+            || info.axes.iter().any(|a| &a.name == axis)
+        {
+            continue;
+        }
+        let has: Vec<&str> = info.axes.iter().map(|a| a.name.as_str()).collect();
+        return Err(crate::machine::MachineError::Description {
+            machine: info.name.clone(),
+            message: format!(
+                "family {}'s parameter {} = true needs the machine's axis {axis}, which {} has not (its axes: {}): set {} = false, or run it on a machine with {axis}",
+                family.name(),
+                s.name,
+                info.name,
+                has.join(", "),
+                s.name
+            ),
+        }
+        .into());
+    }
+    Ok(())
 }
 
 /// Checks every parameter that restates a machine body's place against the

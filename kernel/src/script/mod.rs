@@ -7,6 +7,8 @@
 //!   (bounds; a quantity that drives work has a ceiling) and `max_len` (for
 //!   a list), `machine` (the machine constant that gives the default) and
 //!   `tolerance: true` (a tolerance the verification holds the part to);
+//!   `needs_axis: "Y"` (on a true/false parameter: the machine axis a
+//!   true value needs, refused before planning on a machine without it);
 //! - `fn toolpath(p)`: the toolpath for the parameter values `p` (a map);
 //! - optionally `fn part(p)` (the part's geometry, for export),
 //!   `fn checks(p)` (an array of `#{ name, ok, detail }`), `fn verify(p)`
@@ -494,6 +496,17 @@ impl ScriptFamily {
                     default.kind()
                 )));
             }
+            let needs_axis = Some(text("needs_axis")).filter(|a| !a.is_empty());
+            if let Some(a) = &needs_axis {
+                if !matches!(default, ParamValue::Bool(_))
+                    || !a.chars().all(|c| c.is_ascii_uppercase())
+                    || a.len() > 3
+                {
+                    return Err(fam.contract(format!(
+                        "parameter '{name}': needs_axis names the machine axis a true value needs (e.g. \"Y\"), on a true/false parameter"
+                    )));
+                }
+            }
             let spec = ParamSpec {
                 machine,
                 body,
@@ -501,6 +514,7 @@ impl ScriptFamily {
                 max,
                 max_len,
                 tolerance,
+                needs_axis,
                 ..ParamSpec::new(&name, default, &text("unit"), &text("doc"))
             };
             if spec.body.is_some()
