@@ -631,50 +631,43 @@ impl<'a> Reader<'a> {
                             // The part zero is the work offset the program
                             // selects first (before its moves: the one in
                             // force at power-on, the first listed, if none).
-                            let current = st.work_offset.clone().or((k > 0).then(|| {
+                            let power_on = (k > 0).then(|| {
                                 (
                                     d.reading.work_offsets[0],
                                     "power-on, before the moves".into(),
                                 )
-                            }));
-                            match current {
-                                Some((c, at)) if c != n => {
-                                    return Err(fault(
+                            });
+                            keep_first(&mut st.work_offset, power_on, n, || place(k)).map_err(
+                                |(c, at)| {
+                                    fault(
                                         place(k),
                                         format!(
                                             "{}: a switch of the work offset from G{c} ({at}), the part zero the verification places the part at (another part zero moves every later block); verify a program that keeps one",
                                             w.text()
                                         ),
-                                    ))
-                                }
-                                Some(_) => {}
-                                None => st.work_offset = Some((n, place(k))),
-                            }
+                                    )
+                                },
+                            )?;
                         }
                         17..=19 => {
                             // The plane the machine's setup states (the
                             // tool's length offsets and arcs follow it), or
                             // the first selected: another is refused.
-                            let current = st.plane.clone().or_else(|| {
-                                program.setup.plane.map(|p| {
-                                    (super::post::plane_code(p), "the machine's setup".into())
-                                })
+                            let setup = program.setup.plane.map(|p| {
+                                (super::post::plane_code(p), "the machine's setup".into())
                             });
-                            match current {
-                                Some((c, at)) if c != n => {
-                                    return Err(fault(
-                                        place(k),
-                                        format!(
-                                            "{}: another plane than G{c} ({at}); the tool's length offsets and arcs follow the plane, which the verification keeps",
-                                            w.text()
-                                        ),
-                                    ))
-                                }
-                                _ if st.plane.is_none() => {
-                                    st.plane = Some((n, format!("{} at {}", w.text(), place(k))))
-                                }
-                                _ => {}
-                            }
+                            keep_first(&mut st.plane, setup, n, || {
+                                format!("{} at {}", w.text(), place(k))
+                            })
+                            .map_err(|(c, at)| {
+                                fault(
+                                    place(k),
+                                    format!(
+                                        "{}: another plane than G{c} ({at}); the tool's length offsets and arcs follow the plane, which the verification keeps",
+                                        w.text()
+                                    ),
+                                )
+                            })?;
                         }
                         _ => {}
                     }
@@ -1246,6 +1239,30 @@ impl<'a> Reader<'a> {
             moves: at.k,
             lines: self.lines,
         })
+    }
+}
+
+/// Code `n` of a modal group that must stay what it first was (a work
+/// offset, the plane): `kept` holds the code selected and where, `before`
+/// the one in force before any selection (at power-on, by the machine's
+/// setup). The first selection is kept, `set_at` naming it.
+///
+/// # Failures
+/// A switch: the code in force and where it was set.
+fn keep_first(
+    kept: &mut Option<(u32, String)>,
+    before: Option<(u32, String)>,
+    n: u32,
+    set_at: impl FnOnce() -> String,
+) -> Result<(), (u32, String)> {
+    match kept.clone().or(before) {
+        Some((c, at)) if c != n => Err((c, at)),
+        _ => {
+            if kept.is_none() {
+                *kept = Some((n, set_at()));
+            }
+            Ok(())
+        }
     }
 }
 
