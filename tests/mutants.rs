@@ -691,7 +691,7 @@ fn expect_line(
                     return Err(format!("{w}: another tool, or a tool call among the moves"));
                 }
             }
-            'D' if d.name == "sinumerik" => {
+            c if d.reading.offset_word == Some(c) => {
                 if number != "1" {
                     return Err(format!("{w}: another offset"));
                 }

@@ -107,11 +107,7 @@ pub fn read(
     axes: &[Axis],
 ) -> Result<TextProgram, LintError> {
     if d.style != Style::GCode {
-        return Err(LintError {
-            dialect: d.name.to_owned(),
-            place: "line 1".into(),
-            message: "a CL file is not a program a control runs: read the control's program".into(),
-        });
+        return Err(not_a_control_program(d));
     }
     Ok(assemble(
         lint_gcode(text, frame, d, axes, Mode::Read)?,

@@ -161,7 +161,7 @@ struct State {
     plane: Option<(u32, String)>,
 }
 
-/// A word of Sinumerik's own, outside the ISO words the parser reads.
+/// A word of Sinumerik's own, outside the ISO words [`super::words`] reads.
 #[derive(Debug, Clone, PartialEq)]
 enum OwnWord {
     /// `DIAMON` (true) or `DIAMOF`.
@@ -173,7 +173,7 @@ enum OwnWord {
 }
 
 /// Line `i` of a G-code program in `d` as its control reads it: the code
-/// with its comments blanked in place (the same length, so the parser's
+/// with its comments blanked in place (the same length, so the words'
 /// spans index the line), after checking that every comment is one the
 /// dialect's comment writer makes ([`super::post::comment_text`]): closed
 /// on its line, nothing but names' characters, nothing LinuxCNC acts on;
