@@ -26,7 +26,7 @@ use pilgrim_kernel::machine::{Axis, MachineInfo};
 use pilgrim_kernel::program::lint::LintError;
 use pilgrim_kernel::program::post::{self, Dialect};
 use pilgrim_kernel::program::reader::{Mode, ReadMove, Reader, Standing};
-use pilgrim_kernel::program::{AxisProgram, Radial};
+use pilgrim_kernel::program::{AxisProgram, PowerOn, Radial};
 use pilgrim_kernel::toolpath::Motion;
 use std::path::{Path, PathBuf};
 
@@ -38,6 +38,9 @@ struct Subject {
     dialect: &'static Dialect,
     frame: AxisProgram,
     axes: Vec<Axis>,
+    /// The control's power-on state as the machine states it (its
+    /// parameters), where the program is in the machine's own dialect.
+    power_on: PowerOn,
 }
 
 impl Subject {
@@ -61,6 +64,11 @@ impl Subject {
             dialect,
             frame: pilgrim_kernel::program::frame(info),
             axes: info.axes.clone(),
+            power_on: if info.control == dialect.name {
+                info.setup.power_on.clone()
+            } else {
+                PowerOn::default()
+            },
         }
     }
 
@@ -624,7 +632,11 @@ fn expect_line(
                         at.plane = Some(p);
                     }
                     Offset(o) => {
-                        let now = at.offset.or(at.moved.then_some(54));
+                        // Before a selection, moves run in the power-on
+                        // offset (the machine's, else G54).
+                        let on = (subject.power_on.g.iter().copied())
+                            .find(|c| *c == 500 || (54..=59).contains(c));
+                        let now = at.offset.or(at.moved.then(|| on.unwrap_or(54)));
                         if now.is_some_and(|q| q != o) {
                             return Err(format!("{w}: a switch of the work offset"));
                         }
@@ -658,7 +670,13 @@ fn expect_line(
         }
         letters.push(letter);
         if let Some(i) = names.iter().position(|n| *n == letter) {
-            let v = match r.least_input {
+            // The machine's decimal-point parameter, else the dialect's.
+            let unit = match subject.power_on.no_point {
+                Some(u) if u == 1.0 => None,
+                Some(u) => Some(u),
+                None => r.least_input,
+            };
+            let v = match unit {
                 Some(unit) if !number.contains('.') => value * unit,
                 _ => value,
             };
@@ -790,8 +808,11 @@ fn expect_line(
 
 /// The rules' state before each line of the program, and its moves.
 fn expect_program(subject: &Subject) -> (Vec<Expect>, Vec<Move>) {
+    // The setup codes the control is in at power-on, by the machine.
+    let stated = rules(subject.dialect).stated.iter().copied();
     let mut at = Expect {
         values: vec![None; subject.frame.axes.len()],
+        stated: stated.filter(|c| subject.power_on.g.contains(c)).collect(),
         ..Expect::default()
     };
     let mut before = Vec::new();
@@ -893,7 +914,7 @@ fn a_program_with_every_harmless_edit_verifies_with_identical_figures() {
     let linuxcnc_lathe = thread.parent().unwrap().join("linuxcnc-lathe.toml");
     std::fs::write(
         &linuxcnc_lathe,
-        lathe.replace("control = \"fanuc\"", "control = \"linuxcnc\""),
+        crate::common::with_control(&lathe, "linuxcnc"),
     )
     .unwrap();
     for (dir, file, machine, family) in [

@@ -66,11 +66,7 @@ fn linuxcnc_grinder(dir: &Path) -> PathBuf {
     assert_eq!(code, 0, "{err}");
     assert!(toml.contains("control = \"sinumerik\""), "{toml}");
     let file = dir.join("grinder-linuxcnc.toml");
-    std::fs::write(
-        &file,
-        toml.replace("control = \"sinumerik\"", "control = \"linuxcnc\""),
-    )
-    .unwrap();
+    std::fs::write(&file, crate::common::with_control(&toml, "linuxcnc")).unwrap();
     file
 }
 
@@ -254,32 +250,152 @@ fn fanucs_modal_words_are_read_as_fanuc_reads_them() {
     assert!(err.contains("in \"START\""), "{err}");
 }
 
-/// A program that leaves a modal group to the control's power-on state is
-/// refused, naming the word it must state: on Sinumerik `G90`, `G94`,
-/// `G71`; on Fanuc `G21`, `G40`, `G98` (a Fanuc lathe powers up in feed
-/// per revolution: `F100` is 100 mm a turn); on LinuxCNC `G21`, `G40`,
-/// `G90`, `G94` (no cutter compensation left on from a program before).
+/// A program that leaves a modal group to the control's power-on state
+/// gets the state the machine states for it, and is refused naming the
+/// word it must state where the machine states none or one the
+/// verification does not model: the 3K152VF20 is in G90 G94 G71 at
+/// power-on (a program without them verifies), the lathe in G21 G40 but
+/// feed per revolution, G99 (without G98, `F100` would be 100 mm a turn);
+/// the LinuxCNC grinder's file states none, so a program on it states
+/// G21, G40, G90 and G94 (no cutter compensation left on from a program
+/// before), and so does one on the 3K152VF20 once its file states none.
 #[test]
-fn the_power_on_state_is_never_assumed() {
+fn the_power_on_state_is_the_machines() {
     let (mpf, ngc, nc) = three("power-on");
+    let without = |line: &str, word: &str| -> String {
+        let kept: Vec<&str> = line.split(' ').filter(|w| *w != word).collect();
+        kept.join(" ")
+    };
     for (w, line, words) in [
-        (&mpf, "N1 G90 G94 G71", ["G90", "G94", "G71"].as_slice()),
         (
             &ngc,
             "N1 G21 G40 G90 G94 G97",
-            &["G21", "G40", "G90", "G94"],
+            ["G21", "G40", "G90", "G94"].as_slice(),
         ),
-        (&nc, "G21 G40 G97 G98", &["G21", "G40", "G98"]),
+        (&nc, "G21 G40 G97 G98", &["G98"]),
     ] {
         for word in words {
-            let without: Vec<&str> = line.split(' ').filter(|w| w != word).collect();
-            let without = without.join(" ");
-            assert_ne!(without, line);
             refused(
-                w.edited(word, line, &without),
+                w.edited(word, line, &without(line, word)),
                 word,
                 &format!("{} without {word}", w.ext),
             );
         }
     }
+    let (_, _, err) = nc.edited("g99", "G21 G40 G97 G98", "G21 G40 G97");
+    assert!(err.contains("G99 at power-on"), "{err}");
+    // What the machine states at power-on, the program may leave out, and
+    // the figures stay.
+    for (w, line, words) in [
+        (&mpf, "N1 G90 G94 G71", ["G90", "G94", "G71"].as_slice()),
+        (&nc, "G21 G40 G97 G98", &["G21", "G40", "G97"]),
+    ] {
+        let (code, out, err) = w.verify("as-written", &w.text);
+        assert_eq!(code, 0, "{out}{err}");
+        for word in words {
+            let (code2, out2, err2) = w.edited(word, line, &without(line, word));
+            assert_eq!(code2, 0, "{} without {word}: {out2}{err2}", w.ext);
+            assert_eq!(
+                out2.replace(&format!("{word}.{}", w.ext), ""),
+                out.replace(&format!("as-written.{}", w.ext), ""),
+                "{} without {word}: other figures",
+                w.ext
+            );
+        }
+    }
+    // The 3K152VF20 whose file states no power-on state.
+    let (code, toml, err) = pilgrim(&["machines", "--toml", "3K152VF20"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(toml.contains("[setup.power_on]"), "{toml}");
+    let file = mpf.dir.join("unstated.toml");
+    let toml = crate::common::with_control(&toml, "linuxcnc");
+    std::fs::write(
+        &file,
+        toml.replace("control = \"linuxcnc\"", "control = \"sinumerik\""),
+    )
+    .unwrap();
+    let unstated = Written {
+        args: [
+            "--family",
+            "scripts/mandrel.rhai",
+            "-q",
+            "--machine",
+            s(&file),
+        ]
+        .map(str::to_owned)
+        .to_vec(),
+        dir: mpf.dir.clone(),
+        text: mpf.text.clone(),
+        ext: "mpf",
+    };
+    let (code, out, err) = unstated.verify("unstated-as-written", &mpf.text);
+    assert_eq!(code, 0, "{out}{err}");
+    let line = "N1 G90 G94 G71";
+    for word in ["G90", "G94", "G71"] {
+        let said = unstated.edited(&format!("unstated-{word}"), line, &without(line, word));
+        assert!(said.2.contains("does not state"), "{}", said.2);
+        refused(
+            said,
+            word,
+            &format!("mpf without {word}, no power-on state"),
+        );
+    }
+}
+
+/// A machine's power-on state is checked against its control: codes of
+/// the dialect's modal groups, one per group; a decimal-point parameter
+/// only where the control has one, above 0 and at most 1 mm; the G-code
+/// system the reader follows. With calculator-type input (`no_point =
+/// 1`), `X300` is 300 mm.
+#[test]
+fn a_machines_power_on_state_is_checked_and_followed() {
+    let dir = scratch("reader", "power-on-data");
+    let (code, toml, err) = pilgrim(&["machines", "--toml", "fanuc-0i-tc"]);
+    assert_eq!(code, 0, "{err}");
+    let stated = "g = [18, 21, 40, 54, 97, 99]\nno_point = 0.001\nsystem = \"A\"";
+    assert!(toml.contains(stated), "{toml}");
+    for (case, with, words) in [
+        (
+            "two-feeds",
+            "g = [18, 21, 40, 54, 97, 98, 99]",
+            ["G98", "G99", "one modal group"].as_slice(),
+        ),
+        ("unknown", "g = [18, 33]", &["G33", "modal group"]),
+        (
+            "system-b",
+            "system = \"B\"",
+            &["system = \"B\"", "system A"],
+        ),
+        ("no-point-0", "no_point = 0.0", &["no_point = 0"]),
+    ] {
+        let file = dir.join(format!("{case}.toml"));
+        std::fs::write(&file, toml.replace(stated, with)).unwrap();
+        let (code, out, err) = pilgrim(&["machines", "--only-files", "--file", s(&file)]);
+        assert_eq!(code, 1, "{case}: {out}");
+        for w in words {
+            assert!(err.contains(w), "{case}: {w} not in {err}");
+        }
+    }
+    // No decimal-point parameter on Sinumerik.
+    let (_, grinder, _) = pilgrim(&["machines", "--toml", "3K152VF20"]);
+    assert!(grinder.trim_end().ends_with("500]"), "{grinder}");
+    let file = dir.join("sinumerik-no-point.toml");
+    std::fs::write(&file, format!("{grinder}no_point = 0.001\n")).unwrap();
+    let (code, _, err) = pilgrim(&["machines", "--only-files", "--file", s(&file)]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("no_point") && err.contains("sinumerik"),
+        "{err}"
+    );
+    // Calculator-type input: X300 is 300 mm, and the program verifies.
+    let file = dir.join("calculator.toml");
+    std::fs::write(&file, toml.replace("no_point = 0.001", "no_point = 1.0")).unwrap();
+    let nc = written(
+        &dir,
+        "scripts/worm.rhai",
+        "nc",
+        &["--program-number", "1", "--machine", s(&file)],
+    );
+    let (code, out, err) = nc.edited("calculator", "G00 X300.000", "G00 X300");
+    assert_eq!(code, 0, "X300 with calculator-type input: {out}{err}");
 }

@@ -429,11 +429,7 @@ fn a_g76_cycle_is_verified_as_the_control_makes_it() {
     assert_eq!(code, 0, "{err}");
     assert!(toml.contains("control = \"fanuc\""), "{toml}");
     let machine = dir.join("lathe.toml");
-    std::fs::write(
-        &machine,
-        toml.replace("control = \"fanuc\"", "control = \"linuxcnc\""),
-    )
-    .unwrap();
+    std::fs::write(&machine, crate::common::with_control(&toml, "linuxcnc")).unwrap();
     let sets = ["--set", "cycle=g76", "--set", "designation=Tr40x14(P7)"];
     let mut args = vec!["--machine", s(&machine), "--post", "fanuc"];
     args.extend(sets);

@@ -579,12 +579,13 @@ fn lathe(control: &str, name: &str, description: &str) -> String {
             .collect();
         format!("\"{body}\"")
     };
-    text.replace("name = \"fanuc-0i-tc\"", &format!("name = {}", quote(name)))
+    let text = text
+        .replace("name = \"fanuc-0i-tc\"", &format!("name = {}", quote(name)))
         .replace(
             "description = \"two-axis CNC lathe, Fanuc 0i-TC, X on diameter\"",
             &format!("description = {}", quote(description)),
-        )
-        .replace("control = \"fanuc\"", &format!("control = {control:?}"))
+        );
+    crate::common::with_control(&text, control)
 }
 
 /// A turning family whose tool and pass are named by the script's text

@@ -633,3 +633,33 @@ pub fn word(code: &str, a: char) -> Option<f64> {
         .find(|w| w.starts_with(a) && w[1..].parse::<f64>().is_ok())
         .map(|w| w[1..].parse().unwrap())
 }
+
+#[allow(dead_code)]
+/// A machine file `toml` (as `pilgrim machines --toml` writes it) with its
+/// control changed to `control`: the power-on state, which is the old
+/// control's (its modal groups, its parameters), is taken out unless the
+/// control stays, so the program must state its setup itself.
+pub fn with_control(toml: &str, control: &str) -> String {
+    let mut out = String::with_capacity(toml.len());
+    let mut skipping = false;
+    let mut same = false;
+    for line in toml.lines() {
+        if let Some(v) = line.strip_prefix("control = ") {
+            same = v == format!("{control:?}");
+            out.push_str(&format!("control = {control:?}\n"));
+            continue;
+        }
+        if line.starts_with('[') {
+            skipping = line == "[setup.power_on]";
+        }
+        if !skipping {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    if same {
+        toml.to_owned()
+    } else {
+        out
+    }
+}

@@ -14,7 +14,9 @@ pub mod post;
 pub mod reader;
 pub mod words;
 
-pub use pilgrim_plugin_abi::types::{AxisProgram, Block, Plane, ProgramAxis, ProgramSetup, Radial};
+pub use pilgrim_plugin_abi::types::{
+    AxisProgram, Block, Plane, PowerOn, ProgramAxis, ProgramSetup, Radial,
+};
 pub use post::{post, Dialect, PostError, PostProcessor, SharedPost};
 
 use crate::machine::{Axis, AxisKind, MachineError, MachineInfo, MachineKinematics};

@@ -177,6 +177,14 @@ pub struct Reading {
     /// `G1.0` is G1, `G33.1` another code); elsewhere a code is a whole
     /// number and a point in it is refused (`G1.0` on Sinumerik).
     pub code_tenths: bool,
+    /// The modal groups of G codes a machine may state in force at
+    /// power-on ([`super::PowerOn`]), each group's codes as its manual
+    /// lists them (whether or not the reader reads them): a machine states
+    /// at most one of each.
+    pub modal_groups: &'static [&'static [u32]],
+    /// The G-code systems the reader follows, where the control has
+    /// several (a Fanuc lathe's A; `&[]`: the control has none).
+    pub systems: &'static [&'static str],
 }
 
 /// The word of a thread block's spindle start angle.
@@ -249,6 +257,19 @@ pub const SINUMERIK: Dialect = Dialect {
         point_needed: "",
         no_point: "",
         code_tenths: false,
+        // Programming Manual, Fundamentals, "List of G functions": group 6
+        // (plane), 7 (cutter radius compensation), 8 (settable work
+        // offset, G500 none), 13 (inch/metric), 14 (absolute/incremental),
+        // 15 (feed type).
+        modal_groups: &[
+            &[17, 18, 19],
+            &[40, 41, 42],
+            &[500, 54, 55, 56, 57, 58, 59],
+            &[70, 71, 700, 710],
+            &[90, 91],
+            &[93, 94, 95, 96, 97],
+        ],
+        systems: &[],
     },
 };
 
@@ -312,6 +333,20 @@ pub const FANUC: Dialect = Dialect {
         point_needed: "F",
         no_point: "Q",
         code_tenths: false,
+        // 0i-TC Operator's Manual, "G code list" (system A): group 16
+        // (plane), 06 (inch/metric), 07 (tool nose radius compensation),
+        // 14 (work coordinate system), 02 (constant surface speed), 05
+        // (feed per minute/revolution). Systems B and C give G90..G99 other
+        // meanings (absolute/incremental, G94/G95 feeds, return levels).
+        modal_groups: &[
+            &[17, 18, 19],
+            &[20, 21],
+            &[40, 41, 42],
+            &[54, 55, 56, 57, 58, 59],
+            &[96, 97],
+            &[98, 99],
+        ],
+        systems: &["A"],
     },
 };
 
@@ -364,6 +399,20 @@ pub const LINUXCNC: Dialect = Dialect {
         point_needed: "",
         no_point: "",
         code_tenths: true,
+        // G-code reference, "Modal groups": 2 (plane), 6 (units), 7
+        // (cutter compensation), 12 (coordinate system), 3 (distance), 5
+        // (feed rate mode), lathe diameter/radius and spindle speed modes.
+        modal_groups: &[
+            &[17, 18, 19],
+            &[20, 21],
+            &[40, 41, 42],
+            &[54, 55, 56, 57, 58, 59],
+            &[90, 91],
+            &[93, 94, 95],
+            &[96, 97],
+            &[7, 8],
+        ],
+        systems: &[],
     },
 };
 
@@ -416,6 +465,8 @@ pub const CLD: Dialect = Dialect {
         point_needed: "",
         no_point: "",
         code_tenths: false,
+        modal_groups: &[],
+        systems: &[],
     },
 };
 

@@ -114,6 +114,9 @@ pub struct Reader<'a> {
     ticker: crate::budget::Ticker,
     /// The refusal of a code the dialect's table has not ([`not_read`]).
     not_read: String,
+    /// The unit of an axis number without its decimal point, where it is
+    /// not a millimetre (the machine's power-on state, else the dialect's).
+    least_input: Option<Real>,
 }
 
 /// Whether a G-code text is held to an axis program (the lint of a
@@ -324,6 +327,11 @@ impl<'a> Reader<'a> {
             spindle: axes.iter().find(|a| a.kind == AxisKind::Spindle),
             ticker: crate::budget::Ticker::new("the program's lint", 1024),
             not_read: not_read(reading, d),
+            least_input: match power_on_of(d, program).no_point {
+                Some(unit) if unit == 1.0 => None,
+                Some(unit) => Some(unit),
+                None => d.reading.least_input,
+            },
             names,
         };
         // The framing: % first and last where the dialect frames.
@@ -338,9 +346,17 @@ impl<'a> Reader<'a> {
                 ));
             }
         }
+        // What the control is in at power-on, as the machine states it: its
+        // setup codes stated, constant rpm.
+        let on = &power_on_of(d, program).g;
         let standing = Standing {
             st: State {
                 values: vec![None; reader.names.len()],
+                stated: (d.reading.setup_codes.iter())
+                    .filter(|c| on.contains(c))
+                    .copied()
+                    .collect(),
+                constant_speed: on.contains(&97),
                 ..State::default()
             },
             last_n: None,
@@ -633,7 +649,8 @@ impl<'a> Reader<'a> {
                             // force at power-on, the first listed, if none).
                             let power_on = (k > 0).then(|| {
                                 (
-                                    d.reading.work_offsets[0],
+                                    power_on_code(d, program, d.reading.work_offsets)
+                                        .unwrap_or(d.reading.work_offsets[0]),
                                     "power-on, before the moves".into(),
                                 )
                             });
@@ -653,9 +670,13 @@ impl<'a> Reader<'a> {
                             // The plane the machine's setup states (the
                             // tool's length offsets and arcs follow it), or
                             // the first selected: another is refused.
-                            let setup = program.setup.plane.map(|p| {
-                                (super::post::plane_code(p), "the machine's setup".into())
-                            });
+                            let setup = match program.setup.plane {
+                                Some(p) => {
+                                    Some((super::post::plane_code(p), "the machine's setup".into()))
+                                }
+                                None => power_on_code(d, program, &[17, 18, 19])
+                                    .map(|c| (c, "the machine's power-on state".into())),
+                            };
                             keep_first(&mut st.plane, setup, n, || {
                                 format!("{} at {}", w.text(), place(k))
                             })
@@ -758,7 +779,7 @@ impl<'a> Reader<'a> {
                     }
                     // An axis value without a decimal point is in the
                     // control's least input unit where it says so.
-                    let v = match d.reading.least_input {
+                    let v = match self.least_input {
                         Some(unit) if !w.has_point() && names.contains(&letter) => w.value() * unit,
                         _ => w.value(),
                     };
@@ -829,7 +850,7 @@ impl<'a> Reader<'a> {
                 .then(|| format!("{what} before constant spindle speed (G97)"));
             if let Some(m) = cutting_fault(st, d, &program.setup, what)
                 .or(needs_g97)
-                .or_else(|| setup_fault(st, d, &program.setup, what))
+                .or_else(|| setup_fault(st, d, program, what))
             {
                 return Err(fault(place(k), m));
             }
@@ -1101,7 +1122,7 @@ impl<'a> Reader<'a> {
         if let Some(w) = start_word.as_ref().filter(|_| !is_thread) {
             return Err(fault(place(k), outside_thread(w, d)));
         }
-        if let Some(m) = setup_fault(st, d, &program.setup, "a move") {
+        if let Some(m) = setup_fault(st, d, program, "a move") {
             return Err(fault(place(k), m));
         }
         let read_lead = st.lead.unwrap_or(Real::NAN);
@@ -1242,6 +1263,31 @@ impl<'a> Reader<'a> {
     }
 }
 
+/// The control's power-on state as the machine states it, where the
+/// program is in the machine's own dialect (a program posted for another
+/// control, `--post linuxcnc` on a Sinumerik machine, assumes none).
+fn power_on_of<'p>(d: &Dialect, program: &'p AxisProgram) -> &'p super::PowerOn {
+    static NONE: super::PowerOn = super::PowerOn {
+        g: Vec::new(),
+        no_point: None,
+        system: None,
+    };
+    if program.control == d.name {
+        &program.setup.power_on
+    } else {
+        &NONE
+    }
+}
+
+/// The code of `group` in force at power-on, if the machine states one.
+fn power_on_code(d: &Dialect, program: &AxisProgram, group: &[u32]) -> Option<u32> {
+    power_on_of(d, program)
+        .g
+        .iter()
+        .copied()
+        .find(|c| group.contains(c))
+}
+
 /// Code `n` of a modal group that must stay what it first was (a work
 /// offset, the plane): `kept` holds the code selected and where, `before`
 /// the one in force before any selection (at power-on, by the machine's
@@ -1308,7 +1354,8 @@ fn outside_thread(word: &str, d: &Dialect) -> String {
 /// What the modal state `st` lacks for `what` (any move) of the machine's
 /// `setup`, where the dialect has words for it: radius or diameter
 /// programming, the feed's group, each set before the first move.
-fn setup_fault(st: &State, d: &Dialect, setup: &ProgramSetup, what: &str) -> Option<String> {
+fn setup_fault(st: &State, d: &Dialect, program: &AxisProgram, what: &str) -> Option<String> {
+    let setup = &program.setup;
     let radial_word = d.radial_words.is_some() && d.style == Style::GCode;
     if let Some(c) = d
         .reading
@@ -1316,9 +1363,15 @@ fn setup_fault(st: &State, d: &Dialect, setup: &ProgramSetup, what: &str) -> Opt
         .iter()
         .find(|c| !st.stated.contains(c))
     {
-        Some(format!(
-            "{what} before G{c} is stated: the program leaves it to the control's power-on state, which the verification does not assume; write G{c} before the moves"
-        ))
+        let group = d.reading.modal_groups.iter().find(|g| g.contains(c));
+        Some(match group.and_then(|g| power_on_code(d, program, g)) {
+            Some(on) => format!(
+                "{what} before G{c} is stated: the machine's control is in G{on} at power-on, which the verification does not model; write G{c} before the moves"
+            ),
+            None => format!(
+                "{what} before G{c} is stated: the program leaves it to the control's power-on state, which the machine does not state; write G{c} before the moves, or state the power-on state in the machine's setup"
+            ),
+        })
     } else if let Some(r) = setup.radial.filter(|_| radial_word && st.radial.is_none()) {
         let (radius, diameter) = d.radial_words.unwrap_or_default();
         Some(format!(

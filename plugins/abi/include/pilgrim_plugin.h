@@ -24,8 +24,8 @@
 // `box` and `guard`; 1.7: a body's `mount`, a constant factor's `scale`,
 // an axis's `max_accel`; 1.8: an axis's `turns_part`; 1.9: the body
 // shape `cone`; 1.10: a body's `reach`; 1.11: a program's threading
-// `cycles`).
-#define PILGRIM_ABI_MINOR 11
+// `cycles`; 1.12: the setup's `power_on`).
+#define PILGRIM_ABI_MINOR 12
 
 // The call succeeded.
 #define PILGRIM_STATUS_OK 0

@@ -646,6 +646,43 @@ pub struct ProgramSetup {
     /// axes' path feed.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub feed_group: Vec<String>,
+    /// Since 1.12: the control's state at power-on and reset, as the
+    /// machine's parameters set it, where the machine states it. A program
+    /// that relies on it gets it; where the machine states none, a program
+    /// must state its setup codes itself.
+    #[serde(default, skip_serializing_if = "PowerOn::is_unstated")]
+    pub power_on: PowerOn,
+}
+
+/// The control's state at power-on and reset (since 1.12), as the
+/// machine's parameters set it.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PowerOn {
+    /// The G codes in force, one for each modal group the machine states
+    /// (`21`: millimetres, `90`: absolute, `94` or Fanuc's `98`: feed per
+    /// minute, `99`: per revolution, `40`: no cutter compensation, `97`:
+    /// constant rpm, `18`: the plane, `54`: the work offset). A group not
+    /// listed is not stated.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub g: Vec<u32>,
+    /// The value in millimetres of an axis number written without a
+    /// decimal point, where the control has a parameter for it (Fanuc:
+    /// `0.001`, the least input increment, with decimal-point input off;
+    /// `1` with calculator-type input). `None`: the dialect's default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub no_point: Option<f64>,
+    /// The control's G-code system where it has several (a Fanuc lathe's
+    /// `A`, `B` or `C`), if stated.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub system: Option<String>,
+}
+
+impl PowerOn {
+    /// Whether the machine states nothing of its power-on state.
+    pub fn is_unstated(&self) -> bool {
+        *self == Self::default()
+    }
 }
 
 impl MachineInfo {

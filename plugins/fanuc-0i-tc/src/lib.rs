@@ -21,7 +21,7 @@
 
 use pilgrim_plugin_abi::types::{
     Axis, AxisKind, BodyShape, BodySpec, FactorKind, FactorSpec, MachineInfo, Mount, Plane,
-    ProgramSetup, Quantity, Radial, Reach, ToolSpec,
+    PowerOn, ProgramSetup, Quantity, Radial, Reach, ToolSpec,
 };
 use pilgrim_plugin_abi::{check_axial_section, export_plugin, Plugin, PluginError};
 
@@ -48,6 +48,17 @@ fn setup() -> ProgramSetup {
         approach: vec![vec!["Z".into()]],
         retract: vec![vec!["X".into()]],
         feed_group: vec![],
+        // The 0i-TC as it leaves the factory (Operator's Manual, "G code
+        // list": the codes marked as in force at power-on; parameters
+        // 3401 DPI = 0, 3402 FPM = 0): G-code system A, the ZX plane,
+        // metric, no tool nose compensation, G54, constant rpm, feed per
+        // revolution (G99: a program feeding per minute states G98), an
+        // axis number without its point in 0.001 mm.
+        power_on: PowerOn {
+            g: vec![18, 21, 40, 54, 97, 99],
+            no_point: Some(0.001),
+            system: Some("A".into()),
+        },
     }
 }
 

@@ -30,7 +30,7 @@
 
 use pilgrim_plugin_abi::types::{
     Axis, AxisKind, BodyShape, BodySpec, FactorKind, FactorSpec, MachineInfo, Mount, Plane,
-    ProgramSetup, Quantity, Radial, ToolSpec,
+    PowerOn, ProgramSetup, Quantity, Radial, ToolSpec,
 };
 use pilgrim_plugin_abi::{check_axial_section, export_plugin, Plugin, PluginError};
 
@@ -62,6 +62,13 @@ fn setup() -> ProgramSetup {
         approach: vec![group(&["Z"]), group(&["X"])],
         retract: vec![group(&["X"]), group(&["U"])],
         feed_group: vec![],
+        // The 840D's reset values as the machine maker sets them
+        // ($MC_GCODE_RESET_VALUES): the ZX plane, no cutter compensation,
+        // metric, absolute, feed per minute, no settable work offset.
+        power_on: PowerOn {
+            g: vec![18, 40, 71, 90, 94, 500],
+            ..PowerOn::default()
+        },
     }
 }
 

@@ -38,7 +38,7 @@ pub use kinematics::CaliberKinematics;
 
 use pilgrim_plugin_abi::types::{
     Axis, AxisKind, BodyShape, BodySpec, FactorKind, FactorSpec, MachineInfo, Mount, Plane,
-    ProgramSetup, Quantity, Radial, ToolSpec,
+    PowerOn, ProgramSetup, Quantity, Radial, ToolSpec,
 };
 use pilgrim_plugin_abi::{export_plugin, Plugin, PluginError};
 
@@ -195,6 +195,13 @@ pub fn caliber_grinder(name: &str, description: &str, cross: bool) -> MachineInf
             retract: vec![vec!["Z".into()]],
             // F is the roll's turn in deg/min (FGROUP(A)).
             feed_group: vec!["A".into()],
+            // The 840D's reset values as the machine maker sets them
+            // ($MC_GCODE_RESET_VALUES): the ZX plane, no cutter compensation,
+            // metric, absolute, feed per minute, no settable work offset.
+            power_on: PowerOn {
+                g: vec![18, 40, 71, 90, 94, 500],
+                ..PowerOn::default()
+            },
         },
     }
 }
