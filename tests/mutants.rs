@@ -672,7 +672,7 @@ fn expect_line(
         if let Some(i) = names.iter().position(|n| *n == letter) {
             // The machine's decimal-point parameter, else the dialect's.
             let unit = match subject.power_on.no_point {
-                Some(u) if u == 1.0 => None,
+                Some(1.0) => None,
                 Some(u) => Some(u),
                 None => r.least_input,
             };

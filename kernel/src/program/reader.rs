@@ -328,7 +328,7 @@ impl<'a> Reader<'a> {
             ticker: crate::budget::Ticker::new("the program's lint", 1024),
             not_read: not_read(reading, d),
             least_input: match power_on_of(d, program).no_point {
-                Some(unit) if unit == 1.0 => None,
+                Some(1.0) => None,
                 Some(unit) => Some(unit),
                 None => d.reading.least_input,
             },
