@@ -76,7 +76,14 @@ fn run_within(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
         max_memory_mb: args.script_memory_mb,
         ..Limits::default()
     };
-    let family = load_family(&args.script, args.params.as_deref(), &limits, Vec::new())?;
+    let read = pilgrim_kernel::script::ReadLog::default();
+    let family = load_family(
+        &args.script,
+        args.params.as_deref(),
+        &limits,
+        Vec::new(),
+        &read,
+    )?;
     let sources = sources(Vec::new(), args.params.as_deref(), &args.sets)?;
     let machine = catalog
         .open(&machine_spec(args.machine.as_deref(), &family)?)
@@ -96,6 +103,12 @@ fn run_within(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
         also_post: args.also_post.clone(),
         program_file: None,
         annex: Default::default(),
+        // The script, its tables and the machine file beside the run's
+        // files, for `verify DIR` and `compensate`.
+        keep: Some(job::Keep {
+            script: args.script.clone(),
+            tables: read,
+        }),
     };
     let out = match job::run(&family, &machine, &sources, &options, &mut |s| next(s)) {
         Ok(out) => out,
@@ -149,9 +162,11 @@ fn load_family(
     params: Option<&Path>,
     limits: &Limits,
     tables: Vec<(String, String)>,
+    read: &pilgrim_kernel::script::ReadLog,
 ) -> Result<ScriptFamily, String> {
     let mut access = Access {
         tables,
+        read: read.clone(),
         ..Access::default()
     };
     if let Some(dir) = params.and_then(Path::parent) {
@@ -240,10 +255,22 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
                 .map_err(|e| e.to_string())?,
         )
         .map_err(|e| format!("{}/report.json: {e}", args.target.display()))?;
-        let script = match &args.family {
-            Some(f) => f.clone(),
-            None if Path::new(&report.script).is_file() => PathBuf::from(&report.script),
-            None => {
+        let shown = args.target.display().to_string();
+        // The script and machine the run kept (an older run's: the paths
+        // its report names).
+        let kept = job::kept::kept(
+            &run,
+            &report,
+            args.family.as_deref(),
+            args.machine.as_deref(),
+            &shown,
+        )
+        .map_err(|e| e.to_string())?;
+        let script = match (&kept, &args.family) {
+            (Some((s, _)), _) => s.clone(),
+            (None, Some(f)) => f.clone(),
+            (None, None) if Path::new(&report.script).is_file() => PathBuf::from(&report.script),
+            (None, None) => {
                 return Err(format!(
                     "{}: the run's family '{}' (its report names it from where the run was made) is not there: name its script with --family",
                     args.target.display(),
@@ -256,12 +283,20 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
             .map_err(|e| e.to_string())?
             .into_iter()
             .collect();
-        let family = load_family(&script, args.params.as_deref(), &limits, tables)?;
+        let family = load_family(
+            &script,
+            args.params.as_deref(),
+            &limits,
+            tables,
+            &Default::default(),
+        )?;
         let label = format!("{}/report.json", args.target.display());
         let first = vec![report.params_source(&label)?];
-        let shown = args.target.display().to_string();
-        let spec = job::run_machine(&report, catalog, args.machine.as_deref(), &shown)
-            .map_err(|e| e.to_string())?;
+        let spec = match kept.and_then(|k| k.1) {
+            Some(spec) => spec,
+            None => job::run_machine(&report, catalog, args.machine.as_deref(), &shown)
+                .map_err(|e| e.to_string())?,
+        };
         let name = pilgrim_kernel::program::post::dialect(&report.control)
             .map(|d| format!("program.{}", d.extension))
             .ok_or_else(|| {
@@ -288,7 +323,13 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
                 args.target.display()
             )
         })?;
-        let family = load_family(script, args.params.as_deref(), &limits, Vec::new())?;
+        let family = load_family(
+            script,
+            args.params.as_deref(),
+            &limits,
+            Vec::new(),
+            &Default::default(),
+        )?;
         let spec = machine_spec(args.machine.as_deref(), &family)?;
         let text =
             pilgrim_kernel::files::read_text(&args.target, pilgrim_kernel::files::MAX_DATA_BYTES)

@@ -17,6 +17,7 @@ mod collisions;
 mod compensate;
 mod containment;
 mod docs;
+mod kept;
 mod machine_files;
 mod mandrel;
 mod mandrel_fidelity;

@@ -66,6 +66,10 @@ pub struct Report {
     pub cycle_time_min: f64,
     /// The files written.
     pub files: Vec<String>,
+    /// The inputs the run kept beside its files, each with its digest
+    /// ([`crate::job::kept`]); empty for a run made before runs kept them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub inputs: Vec<crate::job::KeptInput>,
     /// The family's checks.
     pub checks: Vec<Check>,
     /// The block (from 1) the 3-D scene places the tool at.
@@ -223,6 +227,7 @@ impl Report {
             blocks: 0,
             cycle_time_min: 0.0,
             files: Vec::new(),
+            inputs: Vec::new(),
             checks,
             pose_block: None,
             pose_along: 1.0,

@@ -13,7 +13,8 @@ use crate::family::Verification;
 use floats::{err, kernel};
 use rhai::{Engine, EvalAltResult, Map};
 use std::cell::RefCell;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 
 /// Where scripts may read files.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -25,6 +26,39 @@ pub struct Access {
     /// correction `pilgrim compensate` made, written beside the run's
     /// files when the run succeeds).
     pub tables: Vec<(String, String)>,
+    /// The files `read_table` read, for the run to keep beside its files
+    /// ([`crate::job::Keep`]).
+    pub read: ReadLog,
+}
+
+/// The files a script read its tables from, in the order read: a log
+/// shared by the clones of an [`Access`] (equal whatever
+/// it holds: it records, it does not configure).
+#[derive(Debug, Clone, Default)]
+pub struct ReadLog(Arc<Mutex<Vec<PathBuf>>>);
+
+impl PartialEq for ReadLog {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl Eq for ReadLog {}
+
+impl ReadLog {
+    /// Records `path` as read.
+    pub fn record(&self, path: &Path) {
+        if let Ok(mut v) = self.0.lock() {
+            if !v.iter().any(|p| p == path) {
+                v.push(path.to_owned());
+            }
+        }
+    }
+
+    /// The files read so far.
+    pub fn paths(&self) -> Vec<PathBuf> {
+        self.0.lock().map(|v| v.clone()).unwrap_or_default()
+    }
 }
 
 /// A group of the script API: its heading, its types (by the names

@@ -350,7 +350,13 @@ pub fn compensate(
         gain: options.gain,
         limit_mm: options.limit,
     };
-    let script = PathBuf::from(&report.script);
+    // The script and machine the run kept beside its files (an older
+    // run's: the paths its report names).
+    let kept = super::kept::kept(&run, &report, None, None, &shown)?;
+    let script = match &kept {
+        Some((s, _)) => s.clone(),
+        None => PathBuf::from(&report.script),
+    };
     if !script.is_file() {
         return Err(Error::Read(format!(
             "{shown}: the run's family '{}' is not there (its report names it from where the run was made)",
@@ -358,9 +364,11 @@ pub fn compensate(
         )));
     }
     // The script reads its tables beside itself; the correction is given.
+    let tables_read = crate::script::ReadLog::default();
     let load = |tables: Vec<(String, String)>| {
         let access = Access {
             tables,
+            read: tables_read.clone(),
             ..Access::default()
         };
         ScriptFamily::load(&script, &options.limits, &access)
@@ -374,7 +382,10 @@ pub fn compensate(
     }
     let label = format!("{shown}/report.json");
     let base = report.params_source(&label).map_err(Error::Read)?;
-    let spec = run_machine(&report, catalog, None, &shown)?;
+    let spec = match kept.and_then(|k| k.1) {
+        Some(spec) => spec,
+        None => run_machine(&report, catalog, None, &shown)?,
+    };
     let machine = catalog.open(&spec)?;
     // The nominal: the run's parameters with no correction.
     let nominal_sources = vec![
@@ -688,6 +699,10 @@ pub fn compensate(
                 .unwrap_or("pilgrim")
                 .to_owned(),
             annex: made,
+            keep: Some(super::Keep {
+                script: script.clone(),
+                tables: tables_read.clone(),
+            }),
             ..JobOptions::default()
         };
         let mut out = run_job(&family, &machine, &sources, &job_options, &mut |_| {}).map_err(

@@ -13,6 +13,7 @@
 
 mod compensate;
 mod export;
+pub mod kept;
 mod page;
 mod scene;
 mod solids;
@@ -24,6 +25,7 @@ pub use compensate::{
     CORRECTION_FILE,
 };
 pub use export::{export, run_machine, Exported};
+pub use kept::{Keep, KeptInput};
 pub use scene::{default_pose_block, BodyFile, Formats, PosePlace, SceneError};
 pub use solids::SolidFile;
 
@@ -66,6 +68,9 @@ pub struct JobOptions {
     /// run's measured error, its fit and the correction): in the report,
     /// drawn and shown on the page as the family's own.
     pub annex: Annex,
+    /// What the run keeps of its inputs beside its files, if it keeps them
+    /// (`pilgrim run` and `compensate` do; [`kept`]).
+    pub keep: Option<Keep>,
 }
 
 /// Tables and charts a run's caller adds ([`JobOptions::annex`]).
@@ -127,6 +132,7 @@ impl Default for JobOptions {
             program_number: None,
             program_file: None,
             annex: Annex::default(),
+            keep: None,
         }
     }
 }
@@ -879,6 +885,18 @@ fn run_on(
     for (name, bytes) in later {
         report.files.push(name.clone());
         files.push((name, bytes));
+    }
+    if let Some(keep) = &options.keep {
+        let taken: Vec<String> = (report.files.iter().cloned())
+            .chain(["report.html".into(), "report.json".into()])
+            .collect();
+        for (input, bytes) in kept::inputs(keep, &machine.origin, &taken)? {
+            if input.role != "plugin" {
+                report.files.push(input.file.clone());
+                files.push((input.file.clone(), bytes));
+            }
+            report.inputs.push(input);
+        }
     }
     if report.verdict.failed() {
         return Err(failed_run(report, files, part_box));

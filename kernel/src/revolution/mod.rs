@@ -12,7 +12,7 @@
 //!   every block through the machine's forward kinematics, and simulates
 //!   what the machine makes of it: the part turning while the wheel moves
 //!   in straight lines between blocks, the wheel's section where each of
-//!   [`GENERATRICES`] generatrices meets it. Each pass's surface is
+//!   generatrices (doubled from 16 until the finish stands to 0.1 um) meets it. Each pass's surface is
 //!   compared with the nominal profile, the helical ridge included, and
 //!   the worst place is named by z, block and pass;
 //! - its outcome in the report ([`GrindingOutcome`]), its plots
@@ -35,6 +35,14 @@ use crate::verdict::{Figure, Finding};
 use phases::{Infeed, TimedPath};
 use serde::{Deserialize, Serialize};
 use surface::{touches, GroundSurface, PartLayer, PassLayer, WheelSection, GENERATRICES};
+
+/// The most the finish's worst may move when the generatrices double for
+/// the sampling to stand (mm): 0.1 um.
+pub const SAMPLING_STEP: Real = 1e-4;
+
+/// The most generatrices a replay doubles to; a finish whose worst still
+/// moves there is reported with its last change.
+pub const MAX_GENERATRICES: usize = 128;
 
 pub use crate::replay::{as_written, passes_in, replay, replay_blocks, VerifyError};
 pub use plots::deviation_svgs;
@@ -142,8 +150,15 @@ fn bucketed(zs: &[Real], lo: &[Real], hi: &[Real], n: usize) -> Vec<[Real; 3]> {
 pub struct GrindingCheck {
     /// The tolerance held (mm).
     pub tolerance: Real,
-    /// The generatrices each pass was simulated on.
+    /// The generatrices each pass was simulated on: doubled from
+    /// [`GENERATRICES`] until the finish's worst moves by less than
+    /// [`SAMPLING_STEP`] between half of them and all, or
+    /// [`MAX_GENERATRICES`].
     pub generatrices: usize,
+    /// How far the finish's worst (its largest deviation in size) moved
+    /// from half the generatrices to all (mm).
+    #[serde(default)]
+    pub sampling_change_mm: Real,
     /// The smallest step the program's values carry (mm), which the replay
     /// reads them at.
     pub resolution_mm: Real,
@@ -154,7 +169,8 @@ pub struct GrindingCheck {
 /// Replays a grinding program as the machine runs it (MATH §2.4): the
 /// values rounded as written, every axis moving in a straight line between
 /// blocks at the block's feed while the part turns at the program's
-/// spindle speed; on each of [`GENERATRICES`] generatrices the wheel's true
+/// spindle speed; on each generatrix (16, doubled while the finish's worst moves by
+/// 0.1 um or more, up to [`MAX_GENERATRICES`]) the wheel's true
 /// section (its flat and roundings; its tracked point is the middle of the
 /// flat) left at the moments it passed under the wheel, cut into the
 /// surface the passes before left on that generatrix (into `blank`, where
@@ -205,6 +221,37 @@ pub fn replay_grinding(
     range: (Real, Real),
     tolerance: Real,
 ) -> Result<(GrindingCheck, Option<GroundStock>), VerifyError> {
+    // Every other generatrix of `m` is one of `m / 2`: one replay on `m`
+    // says how far doubling from `m / 2` moved the finish's worst.
+    let mut m = 2 * GENERATRICES;
+    loop {
+        let (mut check, stock, half) = replay_on(
+            program, machine, tool, wheel, passes, nominal, blank, range, tolerance, m,
+        )?;
+        let worst = check.passes.last().map_or(0.0, |p| p.deviation.max_abs);
+        check.sampling_change_mm = (worst - half).abs();
+        if check.sampling_change_mm < SAMPLING_STEP || m >= MAX_GENERATRICES {
+            return Ok((check, stock));
+        }
+        m *= 2;
+    }
+}
+
+/// [`replay_grinding`] on `m` generatrices (even), with the finish's worst
+/// over every other one.
+#[allow(clippy::too_many_arguments)]
+fn replay_on(
+    program: &AxisProgram,
+    machine: &dyn MachineKinematics,
+    tool: &ToolFrame,
+    wheel: &Wheel,
+    passes: &[ProgramPass],
+    nominal: &Profile,
+    blank: Option<&Profile>,
+    range: (Real, Real),
+    tolerance: Real,
+    m: usize,
+) -> Result<(GrindingCheck, Option<GroundStock>, Real), VerifyError> {
     positive("verification tolerance", tolerance)?;
     let (written, resolution) = as_written(program);
     if tolerance < 2.0 * resolution {
@@ -227,18 +274,20 @@ pub fn replay_grinding(
         .fold(Real::INFINITY, Real::min);
     let mut out = GrindingCheck {
         tolerance,
-        generatrices: GENERATRICES,
+        generatrices: m,
+        sampling_change_mm: 0.0,
         resolution_mm: resolution,
         passes: Vec::new(),
     };
     let mut rpm = written.spindle_rpm;
     // Each generatrix's earlier sweeps, with the block (from 1) of each of
     // their touches: the surface a pass cuts into is their lowest.
-    let mut earlier: Vec<Vec<(CapsuleEnvelope, Vec<usize>)>> =
-        (0..GENERATRICES).map(|_| Vec::new()).collect();
+    let mut earlier: Vec<Vec<(CapsuleEnvelope, Vec<usize>)>> = (0..m).map(|_| Vec::new()).collect();
     // Each generatrix's sweeps' cutting passes (from 0), and each cutting
     // pass's blocks (from 0).
-    let mut ordinals: Vec<Vec<usize>> = vec![Vec::new(); GENERATRICES];
+    let mut ordinals: Vec<Vec<usize>> = vec![Vec::new(); m];
+    // The last pass's worst over every other generatrix.
+    let mut half_worst = 0.0;
     let mut cut_blocks: Vec<std::ops::Range<usize>> = Vec::new();
     // The surface over every spindle phase: before each cutting pass, and
     // the time of each of its blocks (the cutting pass, from 0, and
@@ -321,7 +370,7 @@ pub fn replay_grinding(
             _ => None,
         };
         let timed = TimedPath::entered(infeed, &z, &x, &feeds)?;
-        let t = touches(&timed, rpm, GENERATRICES)?;
+        let t = touches(&timed, rpm, m)?;
         phase_states.push(phases.clone());
         // The same section at the same moments, over every spindle phase.
         let section = WheelSection {
@@ -381,6 +430,7 @@ pub fn replay_grinding(
         };
         // The generatrix of the largest value above and below.
         let (mut g_above, mut g_below) = (0, 0);
+        let (mut half_above, mut half_below) = (Real::NEG_INFINITY, Real::INFINITY);
         let mut lo = vec![Real::INFINITY; zs.len()];
         let mut hi = vec![Real::NEG_INFINITY; zs.len()];
         for (g, env) in envs.iter().enumerate() {
@@ -402,8 +452,8 @@ pub fn replay_grinding(
                         pass: pass.name.clone(),
                         source: ProfileError::OutsideProfile {
                             what: format!(
-                                "generatrix {} of {GENERATRICES}: the wheel never reached the profile",
-                                g + 1
+                                "generatrix {} of {m}: the wheel never reached the profile",
+                                met[g] + 1
                             ),
                             z,
                             z_min: range.0,
@@ -419,6 +469,9 @@ pub fn replay_grinding(
                 if e < d.max_below {
                     (d.max_below, d.below_z, g_below) = (e, z, g);
                 }
+                if met[g].is_multiple_of(2) {
+                    (half_above, half_below) = (half_above.max(e), half_below.min(e));
+                }
             }
         }
         // The phases' surface against the highest generatrix.
@@ -430,6 +483,11 @@ pub fn replay_grinding(
                 (stand_off, stand_off_z) = (s, zs[i]);
             }
         }
+        half_worst = if half_above >= -half_below {
+            half_above.abs()
+        } else {
+            half_below.abs()
+        };
         let gen_at = if d.max_above >= -d.max_below {
             (d.max_abs, d.at_z) = (d.max_above.abs(), d.above_z);
             g_above
@@ -486,7 +544,7 @@ pub fn replay_grinding(
         }
         None => None,
     };
-    Ok((out, stock))
+    Ok((out, stock, half_worst))
 }
 
 /// The spacing of [`GroundStock`]'s grid along z (mm): the wheel's and the

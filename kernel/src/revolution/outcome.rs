@@ -175,9 +175,11 @@ fn section(entry: &serde_json::Value, label: &dyn Fn(usize) -> String) -> Result
     let mut out = String::new();
     let _ = write!(
         out,
-        "<h2>Verification: the program replayed</h2>\n<p>Tolerance {} mm; {} generatrices; values read at {} mm as written.</p>\n",
+        "<h2>Verification: the program replayed</h2>\n<p>Tolerance {} mm; {} generatrices (the finish's worst moved {} um from {}); values read at {} mm as written.</p>\n",
         fixed(v.tolerance, 4),
         v.generatrices,
+        fixed(v.sampling_change_mm * 1e3, 4),
+        v.generatrices / 2,
         fixed(v.resolution_mm, 4)
     );
     if let Some(f) = v.passes.last() {

@@ -18,17 +18,22 @@
 //!   lowered by each pass's crest.
 //!
 //! # Generatrices
-//! [`GENERATRICES`] = 8, 45 degrees apart. On a straight generatrix the
-//! ridge pattern is the same on every one, shifted by `f/8` along the
-//! part: the highest of the 8 is within `h (1 - (1 - 1/8)^2) < h / 4` of
-//! the true crest `h` (0.1 um for the default finish's 0.4 um ridge), and
-//! the lowest of them reaches the valleys (the touches themselves).
+//! The replay starts from 16 generatrices and doubles them until the
+//! finish's worst moves by less than 0.1 um from every other one to all
+//! ([`crate::revolution::replay_grinding`]); [`GENERATRICES`] = 8 is the
+//! half it first compares with. On a straight generatrix the ridge
+//! pattern is the same on every one, shifted by `f/m` along the part: the
+//! highest of `m` is within `h (1 - (1 - 1/m)^2) < 2 h / m` of the true
+//! crest `h`, and the lowest of them reaches the valleys (the touches
+//! themselves); where the path turns or its feed changes the pattern
+//! shifts, which the doubling measures.
 
 use super::phases::{Infeed, PhaseCrest, TimedPath};
 use crate::math::Real;
 use crate::profile::{Profile, ProfileError};
 
-/// The generatrices a pass is simulated on.
+/// The fewest generatrices a pass is compared on: the replay simulates
+/// twice as many and doubles from there.
 pub const GENERATRICES: usize = 8;
 
 /// The wheel's reference at the moments each generatrix passes under it.

@@ -67,6 +67,7 @@ pub(super) fn register(engine: &mut Engine, access: &Access) {
         .filter_map(|d| d.canonicalize().ok())
         .collect();
     let given = access.tables.clone();
+    let log = access.read.clone();
     rhai::FuncRegistration::new("read_table")
         .with_params_info(["name: &str", "Table"])
         .with_comments([
@@ -106,6 +107,7 @@ pub(super) fn register(engine: &mut Engine, access: &Access) {
                 let Some((_, canon)) = found else {
                     return Err(refused());
                 };
+                log.record(&canon);
                 kernel(crate::profile::read_table(&canon))
             },
         );

@@ -33,7 +33,7 @@ mod compat;
 mod docs;
 
 use crate::binding::{floats, ApiGroup};
-pub use crate::binding::{Access, Floats};
+pub use crate::binding::{Access, Floats, ReadLog};
 pub use docs::api_reference;
 
 use crate::family::{
