@@ -4,7 +4,10 @@
 //!   Rhai, against the same computation written in Rust (target: ratio <= 1.5);
 //! - `plugin_batch`: inverse kinematics of 10k poses through the 3K152VF20
 //!   plugin loaded as a shared library, against the compiled-in machine
-//!   (target: <= 5% slower).
+//!   (target: <= 5% slower);
+//! - `verify_deadline`: the demo family's program of 1M blocks verified
+//!   under `--run-seconds 1` (the whole verification takes several): how
+//!   long until the run's deadline stops it (target: within 2x the limit).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pilgrim_kernel::params::{resolve, ParamSource};
@@ -174,5 +177,53 @@ fn plugin_batch(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(runtime, rhai_overhead, plugin_batch);
+/// The time limit the 1M-block verification is given (s).
+const LIMIT_SECONDS: f64 = 1.0;
+
+fn verify_deadline(c: &mut Criterion) {
+    use pilgrim_kernel::job::{self, JobOptions};
+    let family = ScriptFamily::load(
+        Path::new("scripts/examples/mill_circle.rhai"),
+        &Limits::default(),
+        &Access::default(),
+    )
+    .unwrap();
+    let catalog = pilgrim_kernel::catalog::Catalog::new(&[]).unwrap();
+    let machine = catalog.open("vertical-mill").unwrap();
+    let sources = vec![ParamSource::Pairs {
+        label: "the bench".into(),
+        pairs: vec![("points".into(), "1000000".into())],
+    }];
+    let options = JobOptions::default();
+    let out = job::run(&family, &machine, &sources, &options, &mut |_| {}).unwrap();
+    let text = out
+        .files
+        .iter()
+        .find(|f| f.0 == "program.mpf")
+        .map(|f| String::from_utf8(f.1.clone()).unwrap())
+        .unwrap();
+    assert!(text.lines().count() > 1_000_000);
+    let stopped = || {
+        pilgrim_kernel::budget::with_limit(LIMIT_SECONDS, "the run's", || {
+            job::verify(&family, &machine, &sources, &text, &options, &mut |_| {})
+        })
+    };
+    // It stops, and by the deadline, not by a fault.
+    let started = std::time::Instant::now();
+    let e = stopped().map(|_| ()).unwrap_err().to_string();
+    assert!(e.contains("time limit"), "{e}");
+    eprintln!(
+        "verify_deadline: 1M blocks under a {LIMIT_SECONDS} s limit stopped after {:.3} s ({:.2}x): {e}",
+        started.elapsed().as_secs_f64(),
+        started.elapsed().as_secs_f64() / LIMIT_SECONDS
+    );
+    let mut g = c.benchmark_group("verify_deadline");
+    g.sample_size(10).measurement_time(Duration::from_secs(15));
+    g.bench_function("verify_1m_blocks_limit_1s", |b| {
+        b.iter(|| black_box(stopped().is_err()))
+    });
+    g.finish();
+}
+
+criterion_group!(runtime, rhai_overhead, plugin_batch, verify_deadline);
 criterion_main!(runtime);

@@ -159,6 +159,19 @@ impl Catalog {
     /// [`CatalogError`]: the plugin, file or script's error; an unknown
     /// name, listing the built-ins.
     pub fn open(&self, spec: &str) -> Result<OpenMachine, CatalogError> {
+        let m = self.open_unchecked(spec)?;
+        // The power-on state against the control's modal groups: machine
+        // data the machine module cannot judge, the dialects being the
+        // programs'.
+        let info = m.kinematics.info();
+        crate::program::check_power_on(info).map_err(|message| MachineError::Description {
+            machine: info.name.clone(),
+            message,
+        })?;
+        Ok(m)
+    }
+
+    fn open_unchecked(&self, spec: &str) -> Result<OpenMachine, CatalogError> {
         let path = Path::new(spec);
         let ext = path
             .extension()

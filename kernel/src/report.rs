@@ -27,6 +27,20 @@ pub struct ReportParam {
     pub from: Option<String>,
 }
 
+/// An input a run kept: `report.json`'s `inputs`.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct KeptInput {
+    /// What it is: `family` (the script), `table` (a table the script
+    /// read), `machine` (a machine file or script), `plugin` (a machine
+    /// library: its digest only).
+    pub role: String,
+    /// Its name among the run's files (a plugin: the library's file name
+    /// as the run found it, not a file of the run).
+    pub file: String,
+    /// The SHA-256 of its bytes, in hexadecimal.
+    pub sha256: String,
+}
+
 /// `report.json`: what a run did, with what, and what it found.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Report {
@@ -67,9 +81,9 @@ pub struct Report {
     /// The files written.
     pub files: Vec<String>,
     /// The inputs the run kept beside its files, each with its digest
-    /// ([`crate::job::kept`]); empty for a run made before runs kept them.
+    /// (`job::kept`); empty for a run made before runs kept them.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub inputs: Vec<crate::job::KeptInput>,
+    pub inputs: Vec<KeptInput>,
     /// The family's checks.
     pub checks: Vec<Check>,
     /// The block (from 1) the 3-D scene places the tool at.

@@ -12,25 +12,11 @@
 use super::Error;
 use crate::catalog::Origin;
 use crate::output::RunDir;
+pub use crate::report::KeptInput;
 use crate::report::Report;
 use crate::script::ReadLog;
-use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
-
-/// An input a run kept: `report.json`'s `inputs`.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
-pub struct KeptInput {
-    /// What it is: `family` (the script), `table` (a table the script
-    /// read), `machine` (a machine file or script), `plugin` (a machine
-    /// library: its digest only).
-    pub role: String,
-    /// Its name among the run's files (a plugin: the library's file name
-    /// as the run found it, not a file of the run).
-    pub file: String,
-    /// The SHA-256 of its bytes, in hexadecimal.
-    pub sha256: String,
-}
 
 /// What a run keeps: the script, the log of the tables it reads, and
 /// where its machine came from ([`super::JobOptions::keep`]).

@@ -1014,6 +1014,90 @@ pub fn frame(info: &MachineInfo) -> AxisProgram {
 
 /// A small lathe program of every motion (the post-processor's and the
 /// lint's tests).
+
+/// Checks a machine's power-on state ([`PowerOn`]) against its control's
+/// dialect (the catalog does, for every machine it opens): each code
+/// in one of the dialect's modal groups, one per group; a number's value
+/// without its point only where the dialect has the parameter, positive
+/// and at most 1 mm; a G-code system the reader follows.
+///
+/// # Failures
+/// The first of these that does not hold, naming the key and the value.
+pub fn check_power_on(info: &MachineInfo) -> Result<(), String> {
+    let p = &info.setup.power_on;
+    if p.is_unstated() {
+        return Ok(());
+    }
+    let Some(d) = post::dialect(&info.control) else {
+        return Err(format!(
+            "setup: power_on is stated for the control '{}', whose modal groups pilgrim does not know",
+            crate::files::excerpt(&info.control)
+        ));
+    };
+    let mut seen: Vec<(usize, u32)> = Vec::new();
+    for &c in &p.g {
+        let Some(group) = d.reading.modal_groups.iter().position(|g| g.contains(&c)) else {
+            return Err(format!(
+                "setup: power_on.g lists G{c}, which is in no modal group of {} pilgrim knows (groups: {})",
+                d.name,
+                groups_text(d.reading.modal_groups)
+            ));
+        };
+        if let Some((_, other)) = seen.iter().find(|(g, _)| *g == group) {
+            return Err(format!(
+                "setup: power_on.g lists G{other} and G{c}, two codes of one modal group"
+            ));
+        }
+        seen.push((group, c));
+    }
+    if let Some(v) = p.no_point {
+        if d.reading.least_input.is_none() {
+            return Err(format!(
+                "setup: power_on.no_point = {v}: a number without its decimal point is millimetres on {}, which has no such parameter",
+                d.name
+            ));
+        }
+        if !(v > 0.0 && v <= 1.0) {
+            return Err(format!(
+                "setup: power_on.no_point = {v} must be above 0 and at most 1 (mm)"
+            ));
+        }
+    }
+    if let Some(sys) = &p.system {
+        if !d.reading.systems.contains(&sys.as_str()) {
+            return Err(if d.reading.systems.is_empty() {
+                format!(
+                    "setup: power_on.system = \"{}\": {} has no G-code systems",
+                    crate::files::excerpt(sys),
+                    d.name
+                )
+            } else {
+                format!(
+                    "setup: power_on.system = \"{}\": pilgrim reads and writes {} programs in G-code system {} only (another system gives G90..G99 other meanings); set the control to it",
+                    crate::files::excerpt(sys),
+                    d.name,
+                    d.reading.systems.join(", ")
+                )
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The modal groups as a reader would list them (`G17/G18/G19, ...`).
+fn groups_text(groups: &[&[u32]]) -> String {
+    groups
+        .iter()
+        .map(|g| {
+            g.iter()
+                .map(|c| format!("G{c}"))
+                .collect::<Vec<_>>()
+                .join("/")
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 #[cfg(test)]
 pub(crate) fn test_program() -> AxisProgram {
     let axis = |n: &str| ProgramAxis {

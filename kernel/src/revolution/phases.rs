@@ -173,6 +173,20 @@ impl TimedPath {
         )
     }
 
+    /// The path's own point (from 0) nearest in time to `t`: the block
+    /// whose written position the reference is nearest then (a touch just
+    /// after a corner is the corner's block's, whose words place it).
+    pub fn nearest_point(&self, t: Real) -> usize {
+        let own = &self.time[self.lead..];
+        let k = own.partition_point(|&v| v < t);
+        match k {
+            0 => 0,
+            k if k >= own.len() => own.len() - 1,
+            k if t - own[k - 1] < own[k] - t => k - 1,
+            k => k,
+        }
+    }
+
     /// The first and last times the reference is within `reach` of `z`
     /// along z, if ever.
     fn coverage(&self, z: Real, reach: Real) -> Option<(Real, Real)> {

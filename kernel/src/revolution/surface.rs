@@ -43,9 +43,9 @@ pub struct Touches {
     pub z: Vec<Vec<Real>>,
     /// For each generatrix: the touches' x.
     pub x: Vec<Vec<Real>>,
-    /// For each generatrix and touch: the move (block index in the path,
-    /// from 1: the move from point k-1 to k; 0 for a touch at the first
-    /// point) that placed it.
+    /// For each generatrix and touch: the path's point (from 0) nearest in
+    /// time to it, whose block's words place the wheel there (a touch just
+    /// past a corner is the corner's: the block to edit).
     pub block: Vec<Vec<usize>>,
     /// The time at each point of the path (minutes from the pass's start).
     pub time: Vec<Real>,
@@ -95,10 +95,10 @@ pub fn touches(path: &TimedPath, rpm: Real, m: usize) -> Result<Touches, Profile
             if t > total {
                 break;
             }
-            let (zz, xx, k) = path.at(t);
+            let (zz, xx, _) = path.at(t);
             out.z[g].push(zz);
             out.x[g].push(xx);
-            out.block[g].push(k);
+            out.block[g].push(path.nearest_point(t));
             j += 1;
         }
     }
