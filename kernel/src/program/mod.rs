@@ -1012,9 +1012,6 @@ pub fn frame(info: &MachineInfo) -> AxisProgram {
     }
 }
 
-/// A small lathe program of every motion (the post-processor's and the
-/// lint's tests).
-
 /// Checks a machine's power-on state ([`PowerOn`]) against its control's
 /// dialect (the catalog does, for every machine it opens): each code
 /// in one of the dialect's modal groups, one per group; a number's value
@@ -1098,6 +1095,8 @@ fn groups_text(groups: &[&[u32]]) -> String {
         .join(", ")
 }
 
+/// A small lathe program of every motion (the post-processor's and the
+/// lint's tests).
 #[cfg(test)]
 pub(crate) fn test_program() -> AxisProgram {
     let axis = |n: &str| ProgramAxis {
