@@ -140,6 +140,11 @@ enum Command {
         /// A parameter value (repeatable); wins over --params.
         #[arg(long = "set", value_name = "NAME=VALUE", value_parser = parse_set)]
         sets: Vec<(String, String)>,
+        /// The shop's offset table (TOML): the shift of each tool offset
+        /// other than the tool call's (D2, T0102) and each work offset
+        /// other than the first (G55); the program may then select them.
+        #[arg(long, value_name = "FILE.toml")]
+        offsets: Option<PathBuf>,
         /// Where the report goes. Default: TARGET.verify beside the target.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -485,6 +490,7 @@ fn main() -> ExitCode {
             machine,
             params,
             sets,
+            offsets,
             out,
             script_seconds,
             run_seconds,
@@ -495,6 +501,7 @@ fn main() -> ExitCode {
                 machine: machine.clone(),
                 params: params.clone(),
                 sets: sets.clone(),
+                offsets: offsets.clone(),
                 out: out.clone().unwrap_or_else(|| {
                     let mut o = target.clone().into_os_string();
                     o.push(".verify");

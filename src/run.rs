@@ -109,6 +109,7 @@ fn run_within(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
             script: args.script.clone(),
             tables: read,
         }),
+        offsets: None,
     };
     let out = match job::run(&family, &machine, &sources, &options, &mut |s| next(s)) {
         Ok(out) => out,
@@ -222,6 +223,7 @@ pub struct VerifyArgs {
     pub machine: Option<String>,
     pub params: Option<PathBuf>,
     pub sets: Vec<(String, String)>,
+    pub offsets: Option<PathBuf>,
     pub out: PathBuf,
     pub script_seconds: f64,
     pub run_seconds: f64,
@@ -382,9 +384,32 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
             ));
         }
     }
+    let offsets = match &args.offsets {
+        Some(f) => {
+            let text = pilgrim_kernel::files::read_text(f, pilgrim_kernel::files::MAX_TEXT_BYTES)
+                .map_err(|e| e.to_string())?;
+            let o = pilgrim_kernel::program::offsets::Offsets::from_toml_str(
+                &text,
+                &pilgrim_kernel::files::shown_path(f),
+            )?;
+            let axes: Vec<char> = (machine.kinematics.info().axes.iter())
+                .filter_map(|a| a.name.chars().next())
+                .collect();
+            if let Some(a) = o.unknown_axes(&axes).first() {
+                return Err(format!(
+                    "{}: {a} names an axis the machine {} has not",
+                    pilgrim_kernel::files::shown_path(f),
+                    machine.kinematics.info().name
+                ));
+            }
+            Some(o)
+        }
+        None => None,
+    };
     let options = JobOptions {
         program_name: "verify".into(),
         program_file: Some(pilgrim_kernel::files::shown_path(&file)),
+        offsets,
         ..JobOptions::default()
     };
     let what = args.target.display();

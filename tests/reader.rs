@@ -399,3 +399,68 @@ fn a_machines_power_on_state_is_checked_and_followed() {
     let (code, out, err) = nc.edited("calculator", "G00 X300.000", "G00 X300");
     assert_eq!(code, 0, "X300 with calculator-type input: {out}{err}");
 }
+
+/// `w`'s verification with the offsets table `toml` (saved as `name`).
+fn with_offsets(w: &Written, name: &str, toml: &str) -> Written {
+    let file = w.dir.join(format!("{name}.toml"));
+    std::fs::write(&file, toml).unwrap();
+    let mut args = w.args.clone();
+    args.extend(["--offsets".to_owned(), s(&file).to_owned()]);
+    Written {
+        dir: w.dir.clone(),
+        text: w.text.clone(),
+        ext: w.ext,
+        args,
+    }
+}
+
+/// The shop's offset table (`--offsets`) gives the tool and work offsets
+/// the reader refuses without it, and the verification follows their
+/// shifts: `D2` with no shift verifies, `D2` 20 um lower in X gouges the
+/// finish by 20 um and fails naming the deviation; a `G55` before the
+/// finish likewise; a word the table does not give is still refused,
+/// naming the table; Fanuc's `T0102`; an axis the machine has not is
+/// refused naming it.
+#[test]
+fn an_offsets_table_gives_other_offsets_and_their_shifts() {
+    let (mpf, _, nc) = three("offsets-table");
+    let (code, out, err) = with_offsets(&mpf, "d2-zero", "[tool]\nD2 = { X = 0.0 }\n").edited(
+        "d2-zero",
+        "N3 T1 D1\n",
+        "N3 T1 D2\n",
+    );
+    assert_eq!(code, 0, "D2 with no shift: {out}{err}");
+    let lower = with_offsets(&mpf, "d2-lower", "[tool]\nD2 = { X = -0.02 }\n");
+    let (code, _, err) = lower.edited("d2-lower", "N3 T1 D1\n", "N3 T1 D2\n");
+    assert_eq!(code, 1, "D2 20 um lower passed: {err}");
+    assert!(err.contains("strays -0.02"), "{err}");
+    // A word the table does not give.
+    let (code, _, err) = lower.edited("d3", "N3 T1 D1\n", "N3 T1 D3\n");
+    assert_eq!(code, 1);
+    assert!(err.contains("D3") && err.contains("--offsets"), "{err}");
+    // A work offset before the finish.
+    let at = mpf.text.find("; pass 4").unwrap();
+    let switched = format!("{}N2615 G55\n{}", &mpf.text[..at], &mpf.text[at..]);
+    let g55 = with_offsets(&mpf, "g55-zero", "[work]\nG55 = { Z = 0.0 }\n");
+    let (code, out, err) = g55.verify("g55-zero", &switched);
+    assert_eq!(code, 0, "G55 with no shift: {out}{err}");
+    let g55 = with_offsets(&mpf, "g55-lower", "[work]\nG55 = { X = -0.02 }\n");
+    let (code, _, err) = g55.verify("g55-lower", &switched);
+    assert_eq!(code, 1, "G55 20 um lower passed: {err}");
+    assert!(err.contains("strays -0.02"), "{err}");
+    let (code, _, err) = g55.verify("g56", &switched.replace("N2615 G55", "N2615 G56"));
+    assert_eq!(code, 1);
+    assert!(err.contains("G56") && err.contains("--offsets"), "{err}");
+    // Fanuc's offset 02 of tool 01.
+    let t0102 = with_offsets(&nc, "t0102", "[tool]\nT0102 = { X = 0.0, Z = 0.0 }\n");
+    let (code, out, err) = t0102.edited("t0102", "T0101\n", "T0102\n");
+    assert_eq!(code, 0, "T0102 with no shift: {out}{err}");
+    // An axis the machine has not.
+    let (code, _, err) = with_offsets(&mpf, "q", "[tool]\nD2 = { Q = 0.1 }\n").edited(
+        "q",
+        "N3 T1 D1\n",
+        "N3 T1 D2\n",
+    );
+    assert_eq!(code, 1);
+    assert!(err.contains("D2.Q") && err.contains("3K152VF20"), "{err}");
+}

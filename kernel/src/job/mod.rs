@@ -71,6 +71,9 @@ pub struct JobOptions {
     /// What the run keeps of its inputs beside its files, if it keeps them
     /// (`pilgrim run` and `compensate` do; [`kept`]).
     pub keep: Option<Keep>,
+    /// The shop's offset table a verified program's tool and work offsets
+    /// are read by (`--offsets`), if given.
+    pub offsets: Option<crate::program::offsets::Offsets>,
 }
 
 /// Tables and charts a run's caller adds ([`JobOptions::annex`]).
@@ -133,6 +136,7 @@ impl Default for JobOptions {
             program_file: None,
             annex: Annex::default(),
             keep: None,
+            offsets: None,
         }
     }
 }
@@ -559,8 +563,14 @@ fn run_on(
             let crate::program::lint::TextProgram {
                 program: read,
                 lines,
-            } = crate::program::lint::read(text, &frame, control, &info.axes)
-                .map_err(|e| refused(e.to_string()))?;
+            } = crate::program::lint::read_with(
+                text,
+                &frame,
+                control,
+                &info.axes,
+                options.offsets.as_ref(),
+            )
+            .map_err(|e| refused(e.to_string()))?;
             // No more blocks than a run writes: the replays' work is bounded.
             crate::program::check_shape(&read).map_err(|m| refused(format!("the program: {m}")))?;
             let passes = crate::replay::passes_in(&read, kin, &toolpath.tool.reference)

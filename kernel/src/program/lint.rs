@@ -68,7 +68,7 @@ pub fn lint(
 ) -> Result<Linted, LintError> {
     match d.style {
         Style::Apt => lint_apt(text, program, d),
-        Style::GCode => lint_gcode(text, program, d, axes, Mode::Lint).map(|r| r.linted),
+        Style::GCode => lint_gcode(text, program, d, axes, Mode::Lint, None).map(|r| r.linted),
     }
 }
 
@@ -106,11 +106,27 @@ pub fn read(
     d: &Dialect,
     axes: &[Axis],
 ) -> Result<TextProgram, LintError> {
+    read_with(text, frame, d, axes, None)
+}
+
+/// [`read`] with the shop's offset table: a tool or work offset it gives
+/// is followed, each later position shifted by it
+/// ([`super::offsets`]), where [`read`] refuses it.
+///
+/// # Failures
+/// As [`read`].
+pub fn read_with(
+    text: &str,
+    frame: &AxisProgram,
+    d: &Dialect,
+    axes: &[Axis],
+    offsets: Option<&super::offsets::Offsets>,
+) -> Result<TextProgram, LintError> {
     if d.style != Style::GCode {
         return Err(not_a_control_program(d));
     }
     Ok(assemble(
-        lint_gcode(text, frame, d, axes, Mode::Read)?,
+        lint_gcode(text, frame, d, axes, Mode::Read, offsets)?,
         frame,
     ))
 }
@@ -132,7 +148,10 @@ pub fn lint_read(
     if d.style != Style::GCode {
         return Err(not_a_control_program(d));
     }
-    let mut read = assemble(lint_gcode(text, program, d, axes, Mode::Lint)?, program);
+    let mut read = assemble(
+        lint_gcode(text, program, d, axes, Mode::Lint, None)?,
+        program,
+    );
     for (r, b) in read.program.blocks.iter_mut().zip(&program.blocks) {
         r.comment.clone_from(&b.comment);
     }
@@ -227,6 +246,7 @@ fn lint_gcode(
     d: &Dialect,
     axes: &[Axis],
     mode: Mode,
+    offsets: Option<&super::offsets::Offsets>,
 ) -> Result<ReadText, LintError> {
     let lines: Vec<&str> = text.split('\n').collect();
     if lines.last() != Some(&"") {
@@ -237,7 +257,8 @@ fn lint_gcode(
         });
     }
     let lines = &lines[..lines.len() - 1];
-    let (mut reader, mut at) = Reader::new(lines, program, d, axes, mode)?;
+    let (reader, mut at) = Reader::new(lines, program, d, axes, mode)?;
+    let mut reader = reader.with_offsets(offsets);
     let mut blocks = Vec::new();
     for (i, line) in lines.iter().enumerate() {
         reader.line(&mut at, i, line, &mut blocks)?;

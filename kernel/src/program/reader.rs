@@ -117,6 +117,8 @@ pub struct Reader<'a> {
     /// The unit of an axis number without its decimal point, where it is
     /// not a millimetre (the machine's power-on state, else the dialect's).
     least_input: Option<Real>,
+    /// The shop's offset table, where the caller gives one (read only).
+    offsets: Option<&'a super::offsets::Offsets>,
 }
 
 /// Whether a G-code text is held to an axis program (the lint of a
@@ -162,6 +164,12 @@ struct State {
     work_offset: Option<(u32, String)>,
     /// The plane selected (G17, G18, G19) and the block that selected it.
     plane: Option<(u32, String)>,
+    /// Each axis's shift by the tool offset in force, where the offsets
+    /// table gives another than the tool call's own (empty: none).
+    tool_shift: Vec<Real>,
+    /// Each axis's shift by the work offset in force, against the first
+    /// (empty: none).
+    work_shift: Vec<Real>,
 }
 
 /// A word of Sinumerik's own, outside the ISO words [`super::words`] reads.
@@ -332,6 +340,7 @@ impl<'a> Reader<'a> {
                 Some(unit) => Some(unit),
                 None => d.reading.least_input,
             },
+            offsets: None,
             names,
         };
         // The framing: % first and last where the dialect frames.
@@ -369,6 +378,24 @@ impl<'a> Reader<'a> {
             rpm: None,
         };
         Ok((reader, standing))
+    }
+
+    /// The reader with the shop's offset table `offsets`: a tool or work
+    /// offset the table gives is followed (its shift added to every later
+    /// position) where the reader would refuse it.
+    pub fn with_offsets(mut self, offsets: Option<&'a super::offsets::Offsets>) -> Self {
+        self.offsets = offsets;
+        self
+    }
+
+    /// The shifts of tool word `word` by the offsets table, if it gives it.
+    fn tool_shift(&self, word: &str) -> Option<Vec<Real>> {
+        self.offsets?.tool_shift(word, &self.names)
+    }
+
+    /// The shifts of work offset `word` by the offsets table, if it gives it.
+    fn work_shift(&self, word: &str) -> Option<Vec<Real>> {
+        self.offsets?.work_shift(word, &self.names)
     }
 
     /// A fault at line `i` (from 0).
@@ -654,12 +681,26 @@ impl<'a> Reader<'a> {
                                     "power-on, before the moves".into(),
                                 )
                             });
+                            // A switch the offsets table gives: its shift
+                            // (back to the first: none).
+                            let first = st.work_offset.as_ref().map(|(c, _)| *c);
+                            let table = first
+                                .filter(|c| *c != n)
+                                .and_then(|_| self.work_shift(&format!("G{n}")));
+                            if first == Some(n) {
+                                st.work_shift = Vec::new();
+                                continue;
+                            }
+                            if let Some(shift) = table {
+                                st.work_shift = shift;
+                                continue;
+                            }
                             keep_first(&mut st.work_offset, power_on, n, || place(k)).map_err(
                                 |(c, at)| {
                                     fault(
                                         place(k),
                                         format!(
-                                            "{}: a switch of the work offset from G{c} ({at}), the part zero the verification places the part at (another part zero moves every later block); verify a program that keeps one",
+                                            "{}: a switch of the work offset from G{c} ({at}), the part zero the verification places the part at (another part zero moves every later block); verify a program that keeps one, or give the offset's shift in an --offsets file",
                                             w.text()
                                         ),
                                     )
@@ -722,11 +763,16 @@ impl<'a> Reader<'a> {
                     // the model's tool is the tool with its own offset.
                     at.tool = Some(if d.reading.tool_and_offset {
                         let (tool, offset) = (n / 100, n % 100);
-                        if n < 100 || offset != tool {
+                        let table = (n >= 100 && offset != tool)
+                            .then(|| self.tool_shift(&format!("T{n:04}")))
+                            .flatten();
+                        if let Some(shift) = table {
+                            st.tool_shift = shift;
+                        } else if n < 100 || offset != tool {
                             return Err(fault(
                                 place(k),
                                 format!(
-                                    "{}: tool {tool:02} with offset {offset:02}; the verification's tool is a tool with its own offset (T{tool:02}{tool:02}: 00 cancels the offset, another number is another tool's)",
+                                    "{}: tool {tool:02} with offset {offset:02}; the verification's tool is a tool with its own offset (T{tool:02}{tool:02}: 00 cancels the offset, another number is another tool's), or one an --offsets file gives",
                                     w.text()
                                 ),
                             ));
@@ -786,14 +832,28 @@ impl<'a> Reader<'a> {
                     if start_letter == Some(letter) {
                         start_word = Some(w.text());
                     }
-                    if d.reading.offset_word == Some(letter) && w.integer() != Some(1) {
-                        return Err(fault(
-                            place(k),
-                            format!(
-                                "{}: another tool offset than {letter}1, the tool call's, which is the verification's tool ({letter}0 cancels it, another number is another edge's)",
-                                w.text()
-                            ),
-                        ));
+                    if d.reading.offset_word == Some(letter) {
+                        st.tool_shift = match w.integer() {
+                            Some(1) => Vec::new(),
+                            Some(n) => self.tool_shift(&format!("{letter}{n}")).ok_or_else(|| {
+                                fault(
+                                    place(k),
+                                    format!(
+                                        "{}: another tool offset than {letter}1, the tool call's, which is the verification's tool ({letter}0 cancels it, another number is another edge's); an --offsets file that gives {letter}{n} says where it moves the tool",
+                                        w.text()
+                                    ),
+                                )
+                            })?,
+                            None => {
+                                return Err(fault(
+                                    place(k),
+                                    format!(
+                                        "{}: another tool offset than {letter}1, the tool call's, which is the verification's tool ({letter}0 cancels it, another number is another edge's)",
+                                        w.text()
+                                    ),
+                                ))
+                            }
+                        };
                     }
                     read.push((letter, v, w.text()));
                 }
@@ -928,7 +988,7 @@ impl<'a> Reader<'a> {
                 st.values = values;
                 out.push(ReadMove {
                     motion: mv.motion,
-                    values: st.values.clone(),
+                    values: placed(st),
                     feed: match mv.motion {
                         Motion::Thread { lead, .. } => lead * st.speed.unwrap_or_default(),
                         _ => 0.0,
@@ -1212,7 +1272,7 @@ impl<'a> Reader<'a> {
             let comment = at.pending.take();
             out.push(ReadMove {
                 motion,
-                values: st.values.clone(),
+                values: placed(st),
                 feed: match motion {
                     Motion::Rapid => 0.0,
                     Motion::Linear => st.f.unwrap_or_default(),
@@ -1261,6 +1321,17 @@ impl<'a> Reader<'a> {
             lines: self.lines,
         })
     }
+}
+
+/// Where the moves reach: each axis's value as written, shifted by the
+/// tool and work offsets in force where an offsets table gives them.
+fn placed(st: &State) -> Vec<Option<Real>> {
+    let shift = |v: &Vec<Real>, i: usize| v.get(i).copied().unwrap_or(0.0);
+    st.values
+        .iter()
+        .enumerate()
+        .map(|(i, v)| v.map(|v| v + shift(&st.tool_shift, i) + shift(&st.work_shift, i)))
+        .collect()
 }
 
 /// The control's power-on state as the machine states it, where the
