@@ -464,3 +464,64 @@ fn an_offsets_table_gives_other_offsets_and_their_shifts() {
     assert_eq!(code, 1);
     assert!(err.contains("D2.Q") && err.contains("3K152VF20"), "{err}");
 }
+
+/// A code is refused with what it means on its own control, never
+/// another's: on a Fanuc lathe in system A `G90`, `G92`, `G94` are the
+/// turning, threading and facing cycles and `G50` a coordinate setting or
+/// speed clamp; on Sinumerik `G91` is incremental dimensions and `G95`
+/// feed per revolution; on LinuxCNC `G98` a canned cycle's return level
+/// and `G92` a coordinate system offset.
+#[test]
+fn a_refused_code_is_named_with_its_dialects_meaning() {
+    let (mpf, ngc, nc) = three("meanings");
+    for (w, after, code, meaning) in [
+        (&nc, "T0101\n", "G90", "cutting cycle (system A) on fanuc"),
+        (
+            &nc,
+            "T0101\n",
+            "G92",
+            "the threading cycle (system A) on fanuc",
+        ),
+        (
+            &nc,
+            "T0101\n",
+            "G94",
+            "end face turning cycle (system A) on fanuc",
+        ),
+        (&nc, "T0101\n", "G50", "coordinate system setting"),
+        (
+            &mpf,
+            "N3 T1 D1\n",
+            "G91",
+            "incremental dimensions on sinumerik",
+        ),
+        (
+            &mpf,
+            "N3 T1 D1\n",
+            "G95",
+            "feed per revolution on sinumerik",
+        ),
+        (
+            &ngc,
+            "N1 G21 G40 G90 G94 G97\n",
+            "G98",
+            "return to the initial level on linuxcnc",
+        ),
+        (
+            &ngc,
+            "N1 G21 G40 G90 G94 G97\n",
+            "G92",
+            "coordinate system offset on linuxcnc",
+        ),
+    ] {
+        // The code added to a block before the moves.
+        let with = format!("{} {code}\n", after.trim_end());
+        let (code_, _, err) = w.edited(&format!("{}-{code}", w.ext), after, &with);
+        assert_eq!(code_, 1, "{code} on {}", w.ext);
+        assert!(
+            err.contains(code) && err.contains(meaning),
+            "{code} on {}: {err}",
+            w.ext
+        );
+    }
+}

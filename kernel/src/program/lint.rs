@@ -648,7 +648,10 @@ mod tests {
             &SINUMERIK,
             "N20 G1 X40.000",
             "N20 G2 X40.000",
-            &["N20", "G2 is not a word of sinumerik"],
+            &[
+                "N20",
+                "G2 (circular interpolation clockwise on sinumerik) is not a word of sinumerik",
+            ],
         );
         // Modal state: no feed before G1, no spindle, no lead, no G97.
         case(&SINUMERIK, " F100.0", "", &["N20", "G1 before any feed"]);

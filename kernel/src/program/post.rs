@@ -185,6 +185,10 @@ pub struct Reading {
     /// The G-code systems the reader follows, where the control has
     /// several (a Fanuc lathe's A; `&[]`: the control has none).
     pub systems: &'static [&'static str],
+    /// What codes the reader refuses mean on this control (`G90` is a
+    /// turning cycle on a Fanuc lathe in system A, absolute dimensions
+    /// elsewhere), for the refusal to say: never another dialect's meaning.
+    pub meanings: &'static [(&'static str, &'static str)],
 }
 
 /// The word of a thread block's spindle start angle.
@@ -270,6 +274,23 @@ pub const SINUMERIK: Dialect = Dialect {
             &[93, 94, 95, 96, 97],
         ],
         systems: &[],
+        // Programming Manual, Fundamentals.
+        meanings: &[
+            ("G2", "circular interpolation clockwise"),
+            ("G3", "circular interpolation counter-clockwise"),
+            ("G4", "a dwell"),
+            ("G70", "inch dimensions"),
+            ("G91", "incremental dimensions"),
+            ("G93", "inverse-time feed"),
+            ("G95", "feed per revolution"),
+            ("G96", "constant cutting speed"),
+            ("G500", "the settable work offsets cancelled"),
+            ("G41", "cutter radius compensation left"),
+            ("G42", "cutter radius compensation right"),
+            ("M0", "a programmed stop"),
+            ("M4", "the spindle counter-clockwise"),
+            ("M17", "the end of a subprogram"),
+        ],
     },
 };
 
@@ -347,6 +368,33 @@ pub const FANUC: Dialect = Dialect {
             &[98, 99],
         ],
         systems: &["A"],
+        // 0i-TC Operator's Manual, "G code list", system A.
+        meanings: &[
+            ("G2", "circular interpolation clockwise"),
+            ("G3", "circular interpolation counter-clockwise"),
+            ("G4", "a dwell"),
+            ("G20", "inch input"),
+            ("G41", "tool nose radius compensation left"),
+            ("G42", "tool nose radius compensation right"),
+            (
+                "G50",
+                "a coordinate system setting or the spindle's speed clamp",
+            ),
+            ("G70", "the finishing cycle"),
+            ("G71", "the stock removal cycle in turning"),
+            ("G72", "the stock removal cycle in facing"),
+            ("G76", "the multiple threading cycle"),
+            (
+                "G90",
+                "the outer or inner diameter cutting cycle (system A)",
+            ),
+            ("G92", "the threading cycle (system A)"),
+            ("G94", "the end face turning cycle (system A)"),
+            ("G96", "constant surface speed"),
+            ("G99", "feed per revolution"),
+            ("M98", "a subprogram call"),
+            ("M99", "the end of a subprogram"),
+        ],
     },
 };
 
@@ -413,6 +461,23 @@ pub const LINUXCNC: Dialect = Dialect {
             &[7, 8],
         ],
         systems: &[],
+        // G-code reference, "G Codes".
+        meanings: &[
+            ("G2", "an arc clockwise"),
+            ("G3", "an arc counter-clockwise"),
+            ("G4", "a dwell"),
+            ("G20", "inch units"),
+            ("G33.1", "rigid tapping (it reverses the spindle)"),
+            ("G41", "cutter compensation left"),
+            ("G42", "cutter compensation right"),
+            ("G91", "incremental distance"),
+            ("G92", "a coordinate system offset"),
+            ("G93", "inverse-time feed"),
+            ("G95", "feed per revolution"),
+            ("G96", "constant surface speed"),
+            ("G98", "the canned cycles' return to the initial level"),
+            ("G99", "the canned cycles' return to the R level"),
+        ],
     },
 };
 
@@ -467,6 +532,7 @@ pub const CLD: Dialect = Dialect {
         code_tenths: false,
         modal_groups: &[],
         systems: &[],
+        meanings: &[],
     },
 };
 

@@ -636,7 +636,17 @@ impl<'a> Reader<'a> {
                         w.integer()
                     };
                     let Some(n) = code.filter(|n| listed.contains(n)) else {
-                        return Err(fault(place(k), format!("{}{}", w.text(), self.not_read)));
+                        // What the code means on this control, where the
+                        // dialect's table says: never another dialect's.
+                        let named = w
+                            .code()
+                            .map(|c| format!("{}{c}", w.letter))
+                            .and_then(|c| d.reading.meanings.iter().find(|m| m.0 == c))
+                            .map_or_else(String::new, |m| format!(" ({} on {})", m.1, d.name));
+                        return Err(fault(
+                            place(k),
+                            format!("{}{named}{}", w.text(), self.not_read),
+                        ));
                     };
                     let by = || Some(format!("{} at {}", w.text(), place(k)));
                     if w.letter == 'M' {
