@@ -899,7 +899,8 @@ fn spreadsheets_are_bounded_before_they_expand() {
 /// first look at the clock, naming the limit and where it was, never a
 /// verdict, never a panic: each loop that grows with the program (the
 /// reader, the replays, the process's rules, the steady rest's ride, the
-/// collisions) looks at the clock.
+/// collisions) looks at the clock, and so does every stage of the run as
+/// it starts. The verification leaves its report, FAILED, saying so.
 #[test]
 fn a_deadline_already_past_stops_every_verification() {
     for job in ["mandrel", "caliber", "worm", "thread"] {
@@ -911,5 +912,16 @@ fn a_deadline_already_past_stops_every_verification() {
             "{job}: {err}"
         );
         assert!(!err.contains("internal error"), "{job}: {err}");
+        // It leaves its report, FAILED, saying why.
+        let verified = out.with_extension("verify");
+        let report = common::report_of(&verified);
+        let failures = report["verdict"]["failures"].as_array().unwrap();
+        assert!(
+            failures
+                .iter()
+                .any(|f| f["message"].as_str().unwrap().contains("time limit")),
+            "{job}: {report}"
+        );
+        assert!(verified.join("report.html").is_file(), "{job}");
     }
 }

@@ -315,7 +315,9 @@ pub fn block_table(program: &AxisProgram) -> Result<String, String> {
     w.write_record(&header).map_err(|e| e.to_string())?;
     let decimals = program.decimals.unwrap_or(3);
     let mut pass = "";
+    let mut ticker = crate::budget::Ticker::new("report.csv", 4096);
     for (i, b) in program.blocks.iter().enumerate() {
+        ticker.tick().map_err(|e| e.to_string())?;
         if let Some(c) = &b.comment {
             pass = c;
         }

@@ -284,6 +284,15 @@ fn post_all(
     Ok((files, read))
 }
 
+/// Enters the run's stage `name`, told to `stage`, once the run's deadline
+/// allows: every stage starts within its time limit, so a run ends at most
+/// one stage past it (the loops inside a stage check it too).
+fn enter(stage: &mut dyn FnMut(&str), name: &'static str) -> Result<(), Error> {
+    crate::budget::check(name)?;
+    stage(name);
+    Ok(())
+}
+
 /// The failed run of `report` with the `files` made so far: the page and
 /// `report.json` added.
 fn failed_run(
@@ -454,6 +463,35 @@ fn run_on(
     text: Option<&str>,
 ) -> Result<JobOutput, Error> {
     let (values, origins) = params_traced(family, machine, sources)?;
+    match run_with(family, machine, (&values, &origins), options, stage, text) {
+        // A run stopped by its time limit after its inputs were read
+        // leaves its report, FAILED, saying where it stopped.
+        Err(Error::OverTime(o)) => {
+            let info = machine.kinematics.info();
+            let mut report = Report::of_run(family, machine, info, (&values, &origins), Vec::new());
+            report.program_file = text.and(options.program_file.clone());
+            let message = format!("{o}; nothing was verified (give it more time: --run-seconds)");
+            report.verdict = Verdict::of(
+                true,
+                vec![Finding::new("the run's time limit", message)],
+                Vec::new(),
+                Vec::new(),
+            );
+            Err(failed_run(report, Vec::new(), None))
+        }
+        other => other,
+    }
+}
+
+/// [`run_on`] with the parameters' `values` and where each came from.
+fn run_with(
+    family: &dyn PartFamily,
+    machine: &OpenMachine,
+    (values, origins): (&Params, &std::collections::BTreeMap<String, String>),
+    options: &JobOptions,
+    stage: &mut dyn FnMut(&str),
+    text: Option<&str>,
+) -> Result<JobOutput, Error> {
     let overrides: Vec<(String, f64)> = family
         .params()
         .iter()
@@ -477,7 +515,7 @@ fn run_on(
     let info = kin.info();
     body_places_agree(family, machine.kinematics.info(), info, &values)?;
     needed_axes_present(family, info, &values)?;
-    stage(STAGES[0]);
+    enter(stage, STAGES[0])?;
     let checks = family.checks(&values)?;
     for c in &checks {
         for (what, t) in [("a check's name", &c.name), ("a check's detail", &c.detail)] {
@@ -507,11 +545,11 @@ fn run_on(
         report.verdict = Verdict::of(false, failed, Vec::new(), Vec::new());
         return Err(failed_run(report, Vec::new(), None));
     }
-    stage(STAGES[1]);
+    enter(stage, STAGES[1])?;
     let mut toolpath = family.toolpath(&values)?;
     toolpath.tables.extend(options.annex.tables.clone());
     toolpath.plots.extend(options.annex.plots.iter().cloned());
-    stage(STAGES[2]);
+    enter(stage, STAGES[2])?;
     let control = dialect(&info.control).ok_or_else(|| Error::UnknownControl {
         machine: info.name.clone(),
         control: info.control.clone(),
@@ -525,7 +563,7 @@ fn run_on(
             let mut program = build(&toolpath, kin, &options.program_name)?;
             program.number = options.program_number.unwrap_or(0);
             let passes = crate::program::pass_blocks(&program, &toolpath.passes);
-            stage(STAGES[3]);
+            enter(stage, STAGES[3])?;
             // The data files need only the toolpath and the program: a
             // second thread writes them while this one posts and lints.
             let (posted, data) = crate::budget::beside(
@@ -575,7 +613,7 @@ fn run_on(
             crate::program::check_shape(&read).map_err(|m| refused(format!("the program: {m}")))?;
             let passes = crate::replay::passes_in(&read, kin, &toolpath.tool.reference)
                 .map_err(|e| refused(e.to_string()))?;
-            stage(STAGES[3]);
+            enter(stage, STAGES[3])?;
             let data = vec![
                 ("program.json".into(), json(&read)?),
                 (
@@ -712,7 +750,7 @@ fn run_on(
     let (table, mut files): (Vec<_>, Vec<_>) = data.into_iter().partition(|f| f.0 == "report.csv");
     files.extend(programs);
     files.extend(table);
-    stage(STAGES[4]);
+    enter(stage, STAGES[4])?;
     // The times of the program as its control reads it (feeds and
     // positions as written), as every other check takes it.
     let times = crate::timing::times(verified, info, &passes);
@@ -896,6 +934,7 @@ fn run_on(
         report.files.push(name.clone());
         files.push((name, bytes));
     }
+    crate::budget::check("the report")?;
     if let Some(keep) = &options.keep {
         let taken: Vec<String> = (report.files.iter().cloned())
             .chain(["report.html".into(), "report.json".into()])
@@ -921,7 +960,7 @@ fn run_on(
     files.push(("report.html".into(), html.into_bytes()));
     files.push(("report.json".into(), report_json(&report)?));
     Ok(JobOutput {
-        params: values,
+        params: values.clone(),
         toolpath,
         program,
         outcome,
