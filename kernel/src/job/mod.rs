@@ -513,10 +513,10 @@ fn run_with(
         changed.as_ref()
     };
     let info = kin.info();
-    body_places_agree(family, machine.kinematics.info(), info, &values)?;
-    needed_axes_present(family, info, &values)?;
+    body_places_agree(family, machine.kinematics.info(), info, values)?;
+    needed_axes_present(family, info, values)?;
     enter(stage, STAGES[0])?;
-    let checks = family.checks(&values)?;
+    let checks = family.checks(values)?;
     for c in &checks {
         for (what, t) in [("a check's name", &c.name), ("a check's detail", &c.detail)] {
             crate::names::check_text(what, t).map_err(|e| {
@@ -540,13 +540,13 @@ fn run_with(
     if !failed.is_empty() {
         // Nothing to replay or draw: the report says which checks failed,
         // with every parameter.
-        let mut report = Report::of_run(family, machine, info, (&values, &origins), checks);
+        let mut report = Report::of_run(family, machine, info, (values, origins), checks);
         report.program_file = text.and(options.program_file.clone());
         report.verdict = Verdict::of(false, failed, Vec::new(), Vec::new());
         return Err(failed_run(report, Vec::new(), None));
     }
     enter(stage, STAGES[1])?;
-    let mut toolpath = family.toolpath(&values)?;
+    let mut toolpath = family.toolpath(values)?;
     toolpath.tables.extend(options.annex.tables.clone());
     toolpath.plots.extend(options.annex.plots.iter().cloned());
     enter(stage, STAGES[2])?;
@@ -587,7 +587,7 @@ fn run_with(
             // was refused and where, every parameter; nothing verified.
             let refused = |message: String| {
                 let mut report =
-                    Report::of_run(family, machine, info, (&values, &origins), checks.clone());
+                    Report::of_run(family, machine, info, (values, origins), checks.clone());
                 report.program_file.clone_from(&options.program_file);
                 report.verdict = Verdict::of(
                     true,
@@ -625,7 +625,7 @@ fn run_with(
         }
     };
     let verified = read_back.as_ref().unwrap_or(&program);
-    let requested = family.verification(&values)?;
+    let requested = family.verification(values)?;
     let requested_any = requested.is_some();
     if options.pose_block == Some(0) {
         return Err(Error::Options("--pose-block counts blocks from 1".into()));
@@ -668,7 +668,7 @@ fn run_with(
         .iter()
         .map(|w| Finding::new("the family", w.clone()))
         .collect();
-    let mut parts = family.part(&values)?;
+    let mut parts = family.part(values)?;
     if let Some(b) = parts.iter().find(|b| !crate::files::is_plain_name(&b.name)) {
         return Err(Error::Family(crate::family::FamilyError::Contract {
             family: family.name().to_owned(),
@@ -867,7 +867,7 @@ fn run_with(
             .map(|b| b.number)
             .collect::<Option<Vec<u32>>>()
             .unwrap_or_default(),
-        ..Report::of_run(family, machine, info, (&values, &origins), checks)
+        ..Report::of_run(family, machine, info, (values, origins), checks)
     };
     // The verification's own files: the tables it adds to, then its
     // plots (before the family's charts where it leads them, else after).
