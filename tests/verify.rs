@@ -150,7 +150,7 @@ fn a_hand_edited_program_is_verified_as_it_stands() {
     assert_eq!(code, 1, "{err}");
     assert!(
         err.contains(&format!(
-            "{block}: G2: a word the verification cannot simulate"
+            "{block}: G2 (circular interpolation clockwise on sinumerik): a word the verification cannot simulate"
         )),
         "{err}"
     );
