@@ -925,3 +925,33 @@ fn a_deadline_already_past_stops_every_verification() {
         assert!(verified.join("report.html").is_file(), "{job}");
     }
 }
+
+/// A caller's cancel token (`budget::Cancel`, what a workbench fires when
+/// a newer calculation replaces an older one) stops a run at its next
+/// look at the clock: fired before the run, the run ends at its first
+/// stage naming the cancel, and leaves no report; the same run without
+/// the token completes.
+#[test]
+fn a_cancelled_run_stops_at_its_first_look_at_the_clock() {
+    use pilgrim_kernel::budget::{with_cancel, Cancel};
+    use pilgrim_kernel::catalog::{OpenMachine, Origin};
+    use pilgrim_kernel::job::{self, JobOptions};
+    use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
+    let family = ScriptFamily::load(
+        Path::new("scripts/mandrel.rhai"),
+        &Limits::default(),
+        &Access::default(),
+    )
+    .unwrap();
+    let machine = OpenMachine::plugin(common::grinder(), "3K152VF20", Origin::BuiltinPlugin);
+    let token = Cancel::new();
+    token.fire();
+    let run = || job::run(&family, &machine, &[], &JobOptions::default(), &mut |_| {});
+    let e = with_cancel(Some(token), run).unwrap_err();
+    assert!(
+        matches!(&e, pilgrim_kernel::Error::OverTime(o) if o.cancelled),
+        "{e}"
+    );
+    assert!(e.to_string().contains("cancelled by its caller"), "{e}");
+    assert!(run().is_ok());
+}

@@ -8,8 +8,15 @@
 //! [`OverTime`] once the deadline has passed: a limit holds wherever the
 //! work is done, not only between a script's operations. Threads a loop
 //! spawns take the deadline along ([`current`], [`with_deadline`]).
+//!
+//! A caller may also stop the work at any time by a [`Cancel`] token it
+//! keeps (a workbench replacing an older calculation with a newer one):
+//! [`with_cancel`] hands it to the work, and every look at the clock sees
+//! it fired.
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// A deadline: when, the limit (s) it came from, and whose limit it is
@@ -18,18 +25,80 @@ pub type Deadline = (Instant, f64, &'static str);
 
 thread_local! {
     static DEADLINE: Cell<Option<Deadline>> = const { Cell::new(None) };
+    static CANCEL: RefCell<Option<Cancel>> = const { RefCell::new(None) };
 }
 
-/// The work ran past its time limit.
+/// A token the caller of some work keeps and fires to stop it: the work's
+/// next look at the clock ([`check`], [`Ticker::tick`]) ends it with
+/// [`OverTime`] saying it was cancelled. Clones share the one flag.
+#[derive(Debug, Clone, Default)]
+pub struct Cancel(Arc<AtomicBool>);
+
+impl Cancel {
+    /// A token not fired.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Stops the work the token was given to, from any thread.
+    pub fn fire(&self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether it was fired.
+    pub fn fired(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+}
+
+/// The work ran past its time limit, or its caller cancelled it.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
-#[error("{whose} time limit of {seconds} s passed (in {stage}) and the work was stopped")]
+#[error("{}", self.text())]
 pub struct OverTime {
-    /// The limit (s).
+    /// The limit (s); 0 for a cancel.
     pub seconds: f64,
     /// Whose limit it is (`"the run's"`).
     pub whose: &'static str,
     /// What was being done.
     pub stage: &'static str,
+    /// Whether the caller cancelled the work ([`Cancel`]) rather than
+    /// its time running out.
+    pub cancelled: bool,
+}
+
+impl OverTime {
+    fn text(&self) -> String {
+        if self.cancelled {
+            format!(
+                "the work was cancelled by its caller (in {}) and stopped",
+                self.stage
+            )
+        } else {
+            format!(
+                "{} time limit of {} s passed (in {}) and the work was stopped",
+                self.whose, self.seconds, self.stage
+            )
+        }
+    }
+}
+
+/// Runs `f` with `cancel` (`None`: none) as the token its looks at the
+/// clock see, restoring the one before afterwards.
+pub fn with_cancel<T>(cancel: Option<Cancel>, f: impl FnOnce() -> T) -> T {
+    struct Restore(Option<Cancel>);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            let before = self.0.take();
+            CANCEL.with(|c| *c.borrow_mut() = before);
+        }
+    }
+    let _restore = Restore(CANCEL.with(|c| c.replace(cancel)));
+    f()
+}
+
+/// This thread's cancel token, if any.
+pub fn current_cancel() -> Option<Cancel> {
+    CANCEL.with(|c| c.borrow().clone())
 }
 
 /// Runs `f` with `whose` time limit of `seconds` from now (or the one
@@ -64,9 +133,9 @@ pub fn with_deadline<T>(deadline: Option<Deadline>, f: impl FnOnce() -> T) -> T 
 /// that keeps this thread's deadline; both results. Both may borrow from
 /// the caller (a scoped thread); a panic on the second is passed on.
 pub fn beside<A, B: Send>(here: impl FnOnce() -> A, there: impl FnOnce() -> B + Send) -> (A, B) {
-    let deadline = current();
+    let (deadline, cancel) = (current(), current_cancel());
     std::thread::scope(|s| {
-        let second = s.spawn(|| with_deadline(deadline, there));
+        let second = s.spawn(|| with_cancel(cancel, || with_deadline(deadline, there)));
         let a = here();
         let b = second
             .join()
@@ -88,11 +157,20 @@ pub fn expired() -> Option<(f64, &'static str)> {
 
 /// An error once the deadline has passed, naming `stage`.
 pub fn check(stage: &'static str) -> Result<(), OverTime> {
+    if CANCEL.with(|c| c.borrow().as_ref().is_some_and(Cancel::fired)) {
+        return Err(OverTime {
+            seconds: 0.0,
+            whose: "the caller's",
+            stage,
+            cancelled: true,
+        });
+    }
     match expired() {
         Some((seconds, whose)) => Err(OverTime {
             seconds,
             whose,
             stage,
+            cancelled: false,
         }),
         None => Ok(()),
     }
@@ -163,5 +241,41 @@ mod tests {
             assert!(check("x").is_ok());
         });
         assert!(current().is_none());
+    }
+
+    /// A token fired from another thread stops the work at its next look
+    /// at the clock, in this thread and in one it spawns beside; a token
+    /// fired before the work starts stops it at its first look.
+    #[test]
+    fn a_cancel_stops_the_work_at_its_next_check() {
+        // Work that ends only when it is stopped.
+        let spin = |stage| -> Result<(), OverTime> {
+            let mut ticker = Ticker::new(stage, 16);
+            loop {
+                ticker.tick()?;
+                std::hint::spin_loop();
+            }
+        };
+        let token = Cancel::new();
+        let firing = token.clone();
+        let (here, there) = std::thread::scope(|s| {
+            s.spawn(move || {
+                std::thread::sleep(Duration::from_millis(20));
+                firing.fire();
+            });
+            with_cancel(Some(token.clone()), || {
+                beside(|| spin("here"), || spin("there"))
+            })
+        });
+        let e = here.unwrap_err();
+        assert!(e.cancelled, "{e}");
+        assert_eq!(
+            e.to_string(),
+            "the work was cancelled by its caller (in here) and stopped"
+        );
+        assert!(there.unwrap_err().cancelled);
+        // Fired before: the first look stops it; without the token, no stop.
+        assert!(with_cancel(Some(token), || check("first")).is_err());
+        assert!(check("after").is_ok());
     }
 }

@@ -262,9 +262,13 @@ pub mod caliber_api {
                 .collect()
         };
         let half = psis.len() / 2;
-        let deadline = crate::budget::current();
+        let (deadline, cancel) = (crate::budget::current(), crate::budget::current_cancel());
         let (a, b) = std::thread::scope(|s| {
-            let h = s.spawn(|| crate::budget::with_deadline(deadline, || run(&psis[half..])));
+            let h = s.spawn(|| {
+                crate::budget::with_cancel(cancel, || {
+                    crate::budget::with_deadline(deadline, || run(&psis[half..]))
+                })
+            });
             let a = run(&psis[..half]);
             (
                 a,

@@ -466,7 +466,8 @@ fn run_on(
     match run_with(family, machine, (&values, &origins), options, stage, text) {
         // A run stopped by its time limit after its inputs were read
         // leaves its report, FAILED, saying where it stopped.
-        Err(Error::OverTime(o)) => {
+        // (A caller's cancel asked for nothing more: no report.)
+        Err(Error::OverTime(o)) if !o.cancelled => {
             let info = machine.kinematics.info();
             let mut report = Report::of_run(family, machine, info, (&values, &origins), Vec::new());
             report.program_file = text.and(options.program_file.clone());
