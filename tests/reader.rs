@@ -467,8 +467,8 @@ fn an_offsets_table_gives_other_offsets_and_their_shifts() {
 
 /// A code is refused with what it means on its own control, never
 /// another's: on a Fanuc lathe in system A `G90`, `G92`, `G94` are the
-/// turning, threading and facing cycles and `G50` a coordinate setting or
-/// speed clamp; on Sinumerik `G91` is incremental dimensions and `G95`
+/// turning, threading and facing cycles, `G50` a coordinate setting or
+/// speed clamp and `W` an incremental Z; on Sinumerik `G91` is incremental dimensions and `G95`
 /// feed per revolution; on LinuxCNC `G98` a canned cycle's return level
 /// and `G92` a coordinate system offset.
 #[test]
@@ -489,6 +489,12 @@ fn a_refused_code_is_named_with_its_dialects_meaning() {
             "end face turning cycle (system A) on fanuc",
         ),
         (&nc, "T0101\n", "G50", "coordinate system setting"),
+        (
+            &nc,
+            "G00 X300.000\n",
+            "W-5.",
+            "Z incremental, in G-code system A",
+        ),
         (
             &mpf,
             "N3 T1 D1\n",

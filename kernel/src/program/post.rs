@@ -185,9 +185,10 @@ pub struct Reading {
     /// The G-code systems the reader follows, where the control has
     /// several (a Fanuc lathe's A; `&[]`: the control has none).
     pub systems: &'static [&'static str],
-    /// What codes the reader refuses mean on this control (`G90` is a
-    /// turning cycle on a Fanuc lathe in system A, absolute dimensions
-    /// elsewhere), for the refusal to say: never another dialect's meaning.
+    /// What codes and addresses the reader refuses mean on this control
+    /// (`G90` is a turning cycle on a Fanuc lathe in system A, absolute
+    /// dimensions elsewhere; its `U` an incremental X), for the refusal to
+    /// say: never another dialect's meaning.
     pub meanings: &'static [(&'static str, &'static str)],
 }
 
@@ -394,6 +395,8 @@ pub const FANUC: Dialect = Dialect {
             ("G99", "feed per revolution"),
             ("M98", "a subprogram call"),
             ("M99", "the end of a subprogram"),
+            ("U", "X incremental, in G-code system A"),
+            ("W", "Z incremental, in G-code system A"),
         ],
     },
 };

@@ -1050,17 +1050,22 @@ impl<'a> Reader<'a> {
                     lead_here = Some(v);
                     lead_word = Some(text);
                 }
-                _ if reading => {
+                c if reading => {
+                    // What the address means on this control, where its
+                    // table says (Fanuc system A's U and W).
+                    let named = (d.reading.meanings.iter())
+                        .find(|m| m.0.len() == 1 && m.0.starts_with(c))
+                        .map_or_else(String::new, |m| format!(" ({} on {})", m.1, d.name));
                     return Err(fault(
                         place(k),
                         format!(
-                            "{text}: a word the verification cannot simulate ({} on {} reads the axes {}, F, S, T{})",
+                            "{text}{named}: a word the verification cannot simulate ({} on {} reads the axes {}, F, S, T{})",
                             d.name,
                             program.machine,
                             names.iter().collect::<String>(),
                             start_letter.map(|c| format!(", {c}")).unwrap_or_default()
                         ),
-                    ))
+                    ));
                 }
                 _ => {
                     return Err(fault(
