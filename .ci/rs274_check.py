@@ -11,9 +11,14 @@ program's thread blocks, in order, within the program's 0.001 mm; and
 every move, rapid or cut, must be the axis program's block in order (a
 threading cycle's moves, G76, as LinuxCNC makes them). Each axis is
 found in the canonical call by its name (X Y Z A B C, the order rs274
-writes them).
+writes them). An axis standalone rs274 does not have (the mandrel
+grinder's steady rest U: its axis mask is X Y Z A B C, whatever the INI
+says) is read as a rotary letter the program leaves free, its words
+renamed in the program's code (never in comments): rs274 passes a
+rotary axis's values through unchanged, so the places compare alike.
 """
 import json
+import re
 import pathlib
 import subprocess
 import sys
@@ -28,15 +33,40 @@ def args(line):
 CANON = "XYZABC"
 
 
+def stand_ins(program):
+    """Each axis rs274 lacks, and the free rotary letter read in its place."""
+    names = [a["name"] for a in program["axes"]]
+    free = [c for c in "ABC" if c not in names]
+    lacking = [n for n in names if n not in CANON]
+    if len(lacking) > len(free):
+        raise SystemExit(f"rs274 check: axes {lacking} and too few free letters {free}")
+    return dict(zip(lacking, free))
+
+
+def renamed(text, instead):
+    """The program's text with each lacking axis's words renamed, in code only."""
+    if not instead:
+        return text
+    out = []
+    for line in text.split("\n"):
+        parts = re.split(r"(\([^)]*\))", line)
+        for i in range(0, len(parts), 2):
+            for old, new in instead.items():
+                parts[i] = re.sub(rf"(?i)(?<![A-Z]){old}(?=\s*[-+.0-9])", new, parts[i])
+        out.append("".join(parts))
+    return "\n".join(out)
+
+
 def places(program):
     """(name, index in the canonical call, scale to it) of each axis."""
     setup = program.get("setup", {})
     diameter = setup.get("radial") == "diameter"
+    instead = stand_ins(program)
     out = []
     for a in program["axes"]:
         name = a["name"]
         scale = 0.5 if diameter and name == setup.get("radial_axis", "X") else 1.0
-        out.append((name, CANON.index(name), scale))
+        out.append((name, CANON.index(instead.get(name, name)), scale))
     return out
 
 
@@ -47,8 +77,10 @@ def check(d):
     threads = [b for b in program["blocks"] if b["motion"]["type"] == "thread"]
     with tempfile.TemporaryDirectory() as tmp:
         canon_path = pathlib.Path(tmp) / "canon.txt"
+        ngc = pathlib.Path(tmp) / "program.ngc"
+        ngc.write_text(renamed((d / "program.ngc").read_text(), stand_ins(program)))
         run = subprocess.run(
-            ["rs274", "-g", str(d / "program.ngc"), str(canon_path)],
+            ["rs274", "-g", str(ngc), str(canon_path)],
             stdin=subprocess.DEVNULL,
             capture_output=True,
             text=True,
