@@ -1180,7 +1180,10 @@ fn mutate(subject: &Subject) -> (Tally, Vec<String>) {
 fn leave_for_rs274(subject: &Subject, sampled: &[(String, usize, String)]) {
     let names: Vec<&str> = subject.frame.axes.iter().map(|a| a.name.as_str()).collect();
     let lacking = names.iter().filter(|n| !"XYZABC".contains(**n)).count();
-    let free = ["A", "B", "C"].iter().filter(|c| !names.contains(c)).count();
+    let free = ["A", "B", "C"]
+        .iter()
+        .filter(|c| !names.contains(c))
+        .count();
     if lacking > free {
         return;
     }
