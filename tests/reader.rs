@@ -455,6 +455,17 @@ fn an_offsets_table_gives_other_offsets_and_their_shifts() {
     let t0102 = with_offsets(&nc, "t0102", "[tool]\nT0102 = { X = 0.0, Z = 0.0 }\n");
     let (code, out, err) = t0102.edited("t0102", "T0101\n", "T0102\n");
     assert_eq!(code, 0, "T0102 with no shift: {out}{err}");
+    // A shift that takes an axis past its travel: refused where it goes.
+    let (code, _, err) = with_offsets(&mpf, "far", "[tool]\nD2 = { U = 900.0 }\n").edited(
+        "far",
+        "N3 T1 D1\n",
+        "N3 T1 D2\n",
+    );
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("with the offsets' shift") && err.contains("outside the axis's travel"),
+        "{err}"
+    );
     // An axis the machine has not.
     let (code, _, err) = with_offsets(&mpf, "q", "[tool]\nD2 = { Q = 0.1 }\n").edited(
         "q",

@@ -1247,6 +1247,8 @@ impl<'a> Reader<'a> {
                 st.start_deg = 0.0; // Fanuc's Q holds for its block only
             }
         }
+        // Where each axis goes: its value with the offsets' shifts.
+        let going = placed(st);
         for (i, name) in program.axes.iter().enumerate() {
             if b.is_some_and(|b| b.keep.contains(&name.name)) {
                 continue;
@@ -1274,10 +1276,19 @@ impl<'a> Reader<'a> {
             }
             if let Some(a) = axes.iter().find(|a| a.name == name.name) {
                 let (lo, hi) = (a.to_user(a.min), a.to_user(a.max));
-                if v < lo - half || v > hi + half {
+                let shifted = going[i].unwrap_or(v);
+                if shifted < lo - half || shifted > hi + half {
+                    let by = if shifted == v {
+                        String::new()
+                    } else {
+                        format!(" (at {shifted} with the offsets' shift)")
+                    };
                     return Err(fault(
                         place(k),
-                        format!("{}{v} is outside the axis's travel [{lo}, {hi}]", name.name),
+                        format!(
+                            "{}{v}{by} is outside the axis's travel [{lo}, {hi}]",
+                            name.name
+                        ),
                     ));
                 }
             }
@@ -1287,7 +1298,7 @@ impl<'a> Reader<'a> {
             let comment = at.pending.take();
             out.push(ReadMove {
                 motion,
-                values: placed(st),
+                values: going,
                 feed: match motion {
                     Motion::Rapid => 0.0,
                     Motion::Linear => st.f.unwrap_or_default(),
