@@ -25,6 +25,7 @@ mod mutants;
 mod plugins;
 mod reader;
 mod ring;
+mod script_verify;
 mod sdk;
 mod thread;
 mod times;

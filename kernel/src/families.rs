@@ -9,10 +9,11 @@ use crate::binding::ApiGroup;
 use crate::family::OutcomeKind;
 
 /// Every kind of verification the kernel carries.
-pub const KINDS: [&OutcomeKind; 3] = [
+pub const KINDS: [&OutcomeKind; 4] = [
     &crate::revolution::KIND,
     &crate::caliber::KIND,
     &crate::worm::KIND,
+    &crate::judged::KIND,
 ];
 
 /// The script API of the families that have their own, listed in the

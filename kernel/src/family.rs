@@ -127,6 +127,38 @@ pub struct Verified {
     pub outcome: Box<dyn Outcome>,
     /// The material after each pass, for the process's rules.
     pub stock: Option<Box<dyn crate::process::Stock>>,
+    /// The part the replay left, pass by pass, for a family's own
+    /// judgement of it, where the verification gives it.
+    pub part: Option<Replayed>,
+}
+
+/// The part a replay left, pass by pass, in whole columns: what a
+/// family's own judgement reads (a script's `judge`, one call with every
+/// array, not a call per point).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Replayed {
+    /// What the columns are (`radius over angle at z = 0 mm`), for the
+    /// report.
+    pub what: String,
+    /// The passes, in order.
+    pub passes: Vec<ReplayedPass>,
+    /// How far (mm) the replay's last refinement moved what it found.
+    pub sampling_change: f64,
+}
+
+/// One pass of a [`Replayed`] part.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ReplayedPass {
+    /// The pass's name.
+    pub name: String,
+    /// Its blocks in the program (from 0).
+    pub blocks: std::ops::Range<usize>,
+    /// Whether it cuts.
+    pub cuts: bool,
+    /// Its columns (name with unit, `radius_mm`, to values; every
+    /// column of a pass is as long as the others; a block column holds
+    /// indices from 0, -1 where no block cut).
+    pub columns: std::collections::BTreeMap<String, Vec<f64>>,
 }
 
 /// The extra files of a verification: what it draws.

@@ -65,6 +65,7 @@ pub mod files;
 mod html;
 mod input;
 pub mod job;
+pub mod judged;
 pub mod machine;
 pub mod math;
 pub mod mesh;

@@ -86,6 +86,7 @@ impl Verifier for RingRequest {
                 picture: self.picture,
             }),
             stock: None,
+            part: None,
         })
     }
 }

@@ -82,6 +82,8 @@ pub(crate) struct VerifyForm {
     /// The map's form, for the message naming every form when a map fits
     /// none.
     pub form: &'static str,
+    /// Every key the map may hold: another is refused, naming these.
+    pub keys: &'static [&'static str],
     /// The request from the map: `Err(None)` for a map not of the form,
     /// `Err(Some(text))` saying what is wrong with one that is.
     pub read: fn(&Map) -> Result<Verification, Option<String>>,

@@ -47,6 +47,7 @@ impl Verifier for GrooveRequest {
                 wheel,
             }),
             stock,
+            part: None,
         })
     }
 

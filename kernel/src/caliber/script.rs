@@ -585,6 +585,15 @@ pub(crate) const SCRIPT_API: ApiGroup = ApiGroup {
     verify: Some(VerifyForm {
         key: "groove",
         form: "#{ groove, psi, tolerance, grid_theta, grid_per_step, patch_gap } (and optionally stock, the allowance)",
+        keys: &[
+            "groove",
+            "psi",
+            "tolerance",
+            "grid_theta",
+            "grid_per_step",
+            "patch_gap",
+            "stock",
+        ],
         read: verification,
     }),
 };

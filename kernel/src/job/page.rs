@@ -65,7 +65,11 @@ impl<'a> PageInputs<'a> {
 fn verification(out: &mut String, r: &Report) {
     for (key, entry) in &r.verifications {
         if let Some(kind) = crate::families::kind(key) {
-            match (kind.section)(entry, &|b| r.block_label(b)) {
+            let label = |b: usize| r.block_label(b);
+            let drawn = (kind.section)(entry, &label).and_then(|h| {
+                crate::judged::judged_section(entry, &label).map(|j| format!("{h}{j}"))
+            });
+            match drawn {
                 Ok(html) => out.push_str(&html),
                 Err(e) => {
                     let _ = writeln!(

@@ -6,8 +6,8 @@
 
 use super::GrindingCheck;
 use crate::family::{
-    FilesContext, Outcome, OutcomeKind, PartGeometry, ReplayContext, Verified, Verifier,
-    VerifyRequest,
+    FilesContext, Outcome, OutcomeKind, PartGeometry, ReplayContext, Replayed, ReplayedPass,
+    Verified, Verifier, VerifyRequest,
 };
 use crate::html::{escape, row};
 use crate::math::fixed;
@@ -35,6 +35,7 @@ impl Verifier for VerifyRequest {
             (self.from, self.to),
             self.tolerance,
         )?;
+        let part = replayed(&check, &self.profile, ctx.passes);
         Ok(Verified {
             outcome: Box::new(GrindingOutcome {
                 check,
@@ -42,6 +43,7 @@ impl Verifier for VerifyRequest {
                 rounding: wheel.rounding_radius,
             }),
             stock: ground.map(|g| Box::new(g) as Box<dyn crate::process::Stock>),
+            part: Some(part),
         })
     }
 
@@ -61,6 +63,59 @@ impl Verifier for VerifyRequest {
                 key: "dr_mm".into(),
             }],
         })
+    }
+}
+
+/// The surface each pass left, for a family's own judgement: over z
+/// (`z_mm`, in the stretches the pass's drawing keeps, at most
+/// [`super::PROFILE_BUCKETS`]), the lowest and highest radius over the
+/// generatrices (`radius_low_mm`, `radius_high_mm`) and their deviations
+/// from the nominal (`deviation_low_mm`, `deviation_high_mm`).
+fn replayed(
+    check: &GrindingCheck,
+    nominal: &crate::profile::Profile,
+    passes: &[crate::program::ProgramPass],
+) -> Replayed {
+    let passes = check
+        .passes
+        .iter()
+        .map(|p| {
+            let z: Vec<f64> = p.along_z.iter().map(|b| b[0]).collect();
+            let at = |b: &[f64; 3], k: usize| nominal.eval(b[0]).map_or(f64::NAN, |r| r + b[k]);
+            let columns = std::collections::BTreeMap::from([
+                ("z_mm".to_owned(), z),
+                (
+                    "deviation_low_mm".to_owned(),
+                    p.along_z.iter().map(|b| b[1]).collect(),
+                ),
+                (
+                    "deviation_high_mm".to_owned(),
+                    p.along_z.iter().map(|b| b[2]).collect(),
+                ),
+                (
+                    "radius_low_mm".to_owned(),
+                    p.along_z.iter().map(|b| at(b, 1)).collect(),
+                ),
+                (
+                    "radius_high_mm".to_owned(),
+                    p.along_z.iter().map(|b| at(b, 2)).collect(),
+                ),
+            ]);
+            ReplayedPass {
+                name: p.name.clone(),
+                blocks: passes
+                    .iter()
+                    .find(|q| q.blocks.start + 1 == p.first_block)
+                    .map_or(p.first_block - 1..p.first_block, |q| q.blocks.clone()),
+                cuts: true,
+                columns,
+            }
+        })
+        .collect();
+    Replayed {
+        what: "the surface's radius over z".into(),
+        passes,
+        sampling_change: check.sampling_change_mm,
     }
 }
 

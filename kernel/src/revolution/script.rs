@@ -7,7 +7,8 @@ use super::phases::Infeed;
 use super::rest::{self, RestSetup, RestTrack};
 use super::surface::{GroundSurface, PassLayer, WheelSection};
 use crate::binding::floats::{kernel, numbers, Floats, Numbers};
-use crate::binding::{deprecated, wheel_of, ApiGroup};
+use crate::binding::{deprecated, wheel_of, ApiGroup, VerifyForm};
+use crate::family::{Verification, VerifyRequest};
 use crate::math::Real;
 use crate::profile::{Polyline, Profile};
 use crate::tool::Tool;
@@ -331,5 +332,34 @@ pub(crate) const SCRIPT_API: ApiGroup = ApiGroup {
         e.register_global_module(rhai::exported_module!(revolution_api).into());
         e.register_global_module(rhai::exported_module!(revolution_compat_api).into());
     },
-    verify: None,
+    verify: Some(VerifyForm {
+        key: "profile",
+        form: "#{ profile, from, to, tolerance } (and optionally blank, a profile)",
+        keys: &["profile", "from", "to", "tolerance", "blank"],
+        read: verification,
+    }),
 };
+
+/// The body of revolution's request from the map of a script's
+/// `fn verify(p)`: the nominal profile held to the tolerance over `from`
+/// to `to`, the blank where the script gives it.
+fn verification(m: &rhai::Map) -> Result<Verification, Option<String>> {
+    let num = |k: &str| {
+        m.get(k)
+            .and_then(crate::binding::floats::number)
+            .ok_or(None)
+    };
+    let profile = |k: &str| m.get(k).and_then(|p| p.clone().try_cast::<Profile>());
+    Ok(Verification::new(VerifyRequest {
+        profile: profile("profile").ok_or(None)?,
+        from: num("from")?,
+        to: num("to")?,
+        tolerance: num("tolerance")?,
+        blank: match m.get("blank") {
+            None => None,
+            Some(_) => Some(Box::new(profile("blank").ok_or_else(|| {
+                Some("fn verify(p): blank must be a profile (the blank's)".to_owned())
+            })?)),
+        },
+    }))
+}

@@ -31,14 +31,13 @@ mod bind_toolpath;
 mod bind_transform;
 mod compat;
 mod docs;
+mod verify;
 
 use crate::binding::{floats, ApiGroup};
 pub use crate::binding::{Access, Floats, ReadLog};
 pub use docs::api_reference;
 
-use crate::family::{
-    Check, FamilyError, PartBody, PartFamily, PartGeometry, Verification, VerifyRequest,
-};
+use crate::family::{Check, FamilyError, PartBody, PartFamily, PartGeometry, Verification};
 use crate::machine::{Machine, MachineError};
 use crate::params::{ParamSpec, ParamValue, Params};
 use crate::profile::Profile;
@@ -116,17 +115,70 @@ fn resident_mb() -> Option<u64> {
 
 /// A part family written in Rhai: a script as a [`PartFamily`].
 pub struct ScriptFamily {
-    engine: Engine,
-    ast: AST,
-    file: String,
+    script: Script,
     specs: Vec<ParamSpec>,
+}
+
+/// A compiled script and the engine that runs it, shared: the family and
+/// the verification it declares call the same script (a verification
+/// judged by the script calls it after the replay).
+#[derive(Clone)]
+pub(crate) struct Script {
+    engine: std::rc::Rc<Engine>,
+    ast: std::rc::Rc<AST>,
+    file: String,
     max_seconds: f64,
+}
+
+impl std::fmt::Debug for Script {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Script").field("file", &self.file).finish()
+    }
+}
+
+impl Script {
+    /// Whether the script defines `fn name` with `arity` parameters.
+    pub(crate) fn has_fn(&self, name: &str, arity: usize) -> bool {
+        self.ast
+            .iter_functions()
+            .any(|f| f.name == name && f.params.len() == arity)
+    }
+
+    /// Calls `fn name(args)` within the run's limits.
+    pub(crate) fn call(
+        &self,
+        name: &str,
+        args: impl rhai::FuncArgs,
+    ) -> Result<Dynamic, FamilyError> {
+        let mut scope = Scope::new();
+        let got = crate::budget::with_limit(self.max_seconds, "the script's", || {
+            self.engine
+                .call_fn::<Dynamic>(&mut scope, &self.ast, name, args)
+        })
+        .map_err(|e| locate(&self.file, name, &e));
+        // Earlier releases' forms called outside the toolpath (which
+        // carries them into the report) are said on the error stream.
+        if name != "toolpath" {
+            for w in compat::take_warnings() {
+                eprintln!("{}: warning: {w}", self.file);
+            }
+        }
+        got
+    }
+
+    /// The script's contract broken: `message` naming its file.
+    pub(crate) fn contract(&self, message: String) -> FamilyError {
+        FamilyError::Contract {
+            family: self.file.clone(),
+            message,
+        }
+    }
 }
 
 impl std::fmt::Debug for ScriptFamily {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("ScriptFamily")
-            .field("file", &self.file)
+            .field("file", &self.script.file)
             .field("params", &self.specs)
             .finish()
     }
@@ -414,11 +466,13 @@ impl ScriptFamily {
             .map_err(|e| at(file, e.position(), e.err_type().to_string()))?;
         ast.set_source(file);
         let mut fam = Self {
-            engine,
-            ast,
-            file: file.to_owned(),
+            script: Script {
+                engine: std::rc::Rc::new(engine),
+                ast: std::rc::Rc::new(ast),
+                file: file.to_owned(),
+                max_seconds: limits.max_seconds,
+            },
             specs: vec![],
-            max_seconds: limits.max_seconds,
         };
         for (name, arity) in [("params", 0), ("toolpath", 1)] {
             if !fam.has_fn(name, arity) {
@@ -537,39 +591,21 @@ impl ScriptFamily {
     }
 
     fn contract(&self, message: String) -> FamilyError {
-        FamilyError::Contract {
-            family: self.file.clone(),
-            message,
-        }
+        self.script.contract(message)
     }
 
     /// Whether the script defines `fn name` with `arity` parameters.
     pub fn has_fn(&self, name: &str, arity: usize) -> bool {
-        self.ast
-            .iter_functions()
-            .any(|f| f.name == name && f.params.len() == arity)
+        self.script.has_fn(name, arity)
     }
 
     fn call(&self, name: &str, args: impl rhai::FuncArgs) -> Result<Dynamic, FamilyError> {
-        let mut scope = Scope::new();
-        let got = crate::budget::with_limit(self.max_seconds, "the script's", || {
-            self.engine
-                .call_fn::<Dynamic>(&mut scope, &self.ast, name, args)
-        })
-        .map_err(|e| locate(&self.file, name, &e));
-        // Earlier releases' forms called outside the toolpath (which
-        // carries them into the report) are said on the error stream.
-        if name != "toolpath" {
-            for w in compat::take_warnings() {
-                eprintln!("{}: warning: {w}", self.file);
-            }
-        }
-        got
+        self.script.call(name, args)
     }
 
     /// The script's file name.
     pub fn file(&self) -> &str {
-        &self.file
+        &self.script.file
     }
 
     fn param_map(values: &Params) -> Map {
@@ -624,7 +660,7 @@ fn param_value(d: &Dynamic) -> Option<ParamValue> {
 
 impl PartFamily for ScriptFamily {
     fn name(&self) -> &str {
-        &self.file
+        &self.script.file
     }
 
     fn params(&self) -> &[ParamSpec] {
@@ -731,55 +767,20 @@ impl PartFamily for ScriptFamily {
             .collect()
     }
 
-    /// `fn verify(p)`, if the script has it: `#{ profile, from, to,
-    /// tolerance }` (a body of revolution), or the map of a family with
-    /// its own verification (`#{ groove, ... }` a caliber, `#{ worm, ... }`
-    /// a worm thread: `families::SCRIPT_API`).
+    /// `fn verify(p)`, if the script has it: a family's form (each
+    /// family's folder reads its own map) or a verification of the
+    /// script's own, either with the script's judgement ([`verify`]).
     fn verification(&self, values: &Params) -> Result<Option<Verification>, FamilyError> {
         if !self.has_fn("verify", 1) {
             return Ok(None);
         }
         let d = self.call_with_params("verify", values)?;
-        let shape = || {
-            let mut forms =
-                vec!["#{ profile, from, to, tolerance } (and optionally blank, a profile)"];
-            forms.extend(
-                crate::families::SCRIPT_API
-                    .iter()
-                    .filter_map(|g| g.verify.as_ref().map(|v| v.form)),
-            );
-            let last = forms.pop().unwrap_or_default();
-            self.contract(format!(
-                "fn verify(p) must return {} or {last}",
-                forms.join(", ")
-            ))
-        };
-        let m = d.try_cast::<Map>().ok_or_else(shape)?;
-        for form in crate::families::SCRIPT_API
-            .iter()
-            .filter_map(|g| g.verify.as_ref())
-        {
-            if m.contains_key(form.key) {
-                return (form.read)(&m).map(Some).map_err(|e| match e {
-                    Some(message) => self.contract(message),
-                    None => shape(),
-                });
-            }
-        }
-        let num = |k: &str| m.get(k).and_then(floats::number).ok_or_else(shape);
-        Ok(Some(Verification::new(VerifyRequest {
-            profile: m
-                .get("profile")
-                .and_then(|p| p.clone().try_cast::<Profile>())
-                .ok_or_else(shape)?,
-            from: num("from")?,
-            to: num("to")?,
-            tolerance: num("tolerance")?,
-            blank: match m.get("blank") {
-                None => None,
-                Some(b) => Some(Box::new(b.clone().try_cast::<Profile>().ok_or_else(shape)?)),
-            },
-        })))
+        let m = d.try_cast::<Map>().ok_or_else(|| {
+            self.contract("fn verify(p) must return a map (the verification's form)".into())
+        })?;
+        verify::read(&self.script, Self::param_map(values), m)
+            .map(Some)
+            .map_err(|e| self.contract(e))
     }
 }
 

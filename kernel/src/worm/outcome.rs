@@ -37,6 +37,7 @@ impl Verifier for WormRequest {
                 request: self.clone(),
             }),
             stock: Some(Box::new(stock)),
+            part: None,
         })
     }
 

@@ -364,6 +364,7 @@ pub(crate) const SCRIPT_API: ApiGroup = ApiGroup {
     verify: Some(VerifyForm {
         key: "worm",
         form: "#{ worm, length, space_centre, tolerance: #{ form, thickness, diameter, position, flank_angle_deg, lead (optional) } }",
+        keys: &["worm", "length", "space_centre", "tolerance"],
         read: verification,
     }),
 };

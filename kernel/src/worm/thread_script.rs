@@ -277,6 +277,15 @@ pub(crate) const SCRIPT_API: ApiGroup = ApiGroup {
     verify: Some(VerifyForm {
         key: "thread_profile",
         form: "#{ thread_profile, length, space_centre, outside_diameter (a nut's, optional), tolerance: #{ form, position, flank_angle_deg, lead (optional) } }",
+        keys: &[
+            "thread_profile",
+            "length",
+            "space_centre",
+            "outside_diameter",
+            "tolerance",
+            "correction",
+            "place_correction",
+        ],
         read: verification,
     }),
 };

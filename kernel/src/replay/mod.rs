@@ -7,6 +7,8 @@
 //! [`crate::caliber`], [`crate::worm`]) builds on them and reports through
 //! [`VerifyError`].
 
+pub mod polar;
+
 use crate::input::InputError;
 use crate::machine::{KinematicsError, MachineKinematics};
 use crate::math::Real;
