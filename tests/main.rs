@@ -17,6 +17,7 @@ mod collisions;
 mod compensate;
 mod containment;
 mod docs;
+mod hygiene;
 mod kept;
 mod machine_files;
 mod mandrel;

@@ -89,10 +89,10 @@ pub fn chart_svg(toolpath: &Toolpath, spec: &PlotSpec) -> Result<String, String>
     if !(x0.is_finite() && y0.is_finite()) {
         return Err(format!("plot {}: nothing to draw", spec.file));
     }
-    if x1 - x0 < 1e-12 {
+    if x1 - x0 < crate::tolerance::ROUNDING {
         x1 = x0 + 1.0;
     }
-    let pad = ((y1 - y0) * 0.05).max(1e-9 * y1.abs().max(1.0));
+    let pad = ((y1 - y0) * 0.05).max(crate::tolerance::SAME_RATIO * y1.abs().max(1.0));
     let (y0, y1) = (y0 - pad, y1 + pad);
     let legend_rows = series.len().div_ceil(3) as u32;
     let mut svg = String::new();

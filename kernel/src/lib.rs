@@ -84,6 +84,7 @@ pub mod script;
 pub mod step;
 pub mod thread;
 pub mod timing;
+pub mod tolerance;
 pub mod tool;
 pub mod toolpath;
 pub mod transform;

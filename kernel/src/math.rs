@@ -90,7 +90,12 @@ pub fn all_finite(what: &str, values: &[Real]) -> Result<(), InputError> {
 /// form beyond (`1e308`, not 309 digits), so that a value typed by a user
 /// cannot swamp the message that names it.
 pub fn shown(v: Real) -> String {
-    if v == 0.0 || !v.is_finite() || (1e-4..1e15).contains(&v.abs()) {
+    /// The smallest size shown in plain decimals (four zeros after the
+    /// point at most).
+    const PLAIN_FROM: Real = 1e-4;
+    /// The size from which a number is shown in exponent form.
+    const PLAIN_TO: Real = 1e15;
+    if v == 0.0 || !v.is_finite() || (PLAIN_FROM..PLAIN_TO).contains(&v.abs()) {
         format!("{v}")
     } else {
         format!("{v:e}")

@@ -300,7 +300,7 @@ pub fn check(
                 };
                 if deeper > PLUNGE_MIN
                     && deeper >= 0.5 * inside
-                    && b.feed > limits.infeed_feed * (1.0 + 1e-9)
+                    && b.feed > limits.infeed_feed * (1.0 + crate::tolerance::LIMIT_SLACK)
                 {
                     out.errors.push(
                         Finding::new(
@@ -470,7 +470,7 @@ fn bodies(
                             0.0
                         }
                     };
-                    if speed > feed * (1.0 + 1e-9) {
+                    if speed > feed * (1.0 + crate::tolerance::LIMIT_SLACK) {
                         let name = block_name(program, k);
                         out.errors.push(
                             Finding::new(
@@ -508,7 +508,7 @@ fn bodies(
                 )
                 .at_block(k),
             );
-            if g.abs() > tol * (1.0 + 1e-9) {
+            if g.abs() > tol * (1.0 + crate::tolerance::LIMIT_SLACK) {
                 out.errors.push(
                     Finding::new(
                         RIDING,
@@ -525,7 +525,9 @@ fn bodies(
         }
         // Pressed into the part on a move on which it does not ride: onto
         // the part from clear of it, or off it.
-        if let Some((g, k)) = deepest.filter(|(g, _)| *g < -limits.rest_tolerance * (1.0 + 1e-9)) {
+        if let Some((g, k)) = deepest
+            .filter(|(g, _)| *g < -limits.rest_tolerance * (1.0 + crate::tolerance::LIMIT_SLACK))
+        {
             let name = block_name(program, k);
             out.errors.push(
                 Finding::new(
@@ -563,7 +565,7 @@ fn finishing(
             if worst.is_none_or(|w| p.cut > w.cut) {
                 worst = Some(p);
             }
-            if p.cut > limits.finish_stock * (1.0 + 1e-9) {
+            if p.cut > limits.finish_stock * (1.0 + crate::tolerance::LIMIT_SLACK) {
                 out.errors.push(
                     Finding::new(
                         FINISH,

@@ -135,7 +135,7 @@ pub fn times(program: &AxisProgram, info: &MachineInfo, passes: &[ProgramPass]) 
         // Every axis within its top speed and its acceleration.
         let (mut top, mut accel) = (Real::INFINITY, Real::INFINITY);
         for (ax, ui) in known.iter().zip(&u) {
-            if ui.abs() < 1e-12 {
+            if ui.abs() < crate::tolerance::ROUNDING {
                 continue;
             }
             top = top.min(ax.to_user(ax.max_feed) / 60.0 / ui.abs());
@@ -180,7 +180,7 @@ pub fn times(program: &AxisProgram, info: &MachineInfo, passes: &[ProgramPass]) 
         let mut v = m.speed.min(next.speed);
         for ((ax, a), b) in known.iter().zip(&dirs[k]).zip(&dirs[k + 1]) {
             let jump = (b - a).abs();
-            if jump > 1e-12 {
+            if jump > crate::tolerance::ROUNDING {
                 if let Some(acc) = ax.max_accel {
                     v = v.min(ax.to_user(acc) * ipo / jump);
                 }

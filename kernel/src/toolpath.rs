@@ -270,7 +270,7 @@ impl Toolpath {
                 return Err(err(format!("value {v} is not a finite number")));
             }
             let n = c.axis.iter().map(|a| a * a).sum::<Real>().sqrt();
-            if (n - 1.0).abs() > 1e-9 {
+            if (n - 1.0).abs() > crate::tolerance::SAME_RATIO {
                 return Err(err(format!("tool axis has length {n}, not 1")));
             }
             let feed_ok = c.feed.is_finite() && c.feed > 0.0;

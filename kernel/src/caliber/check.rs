@@ -464,7 +464,11 @@ pub fn check_groove(
         .map(|w| w[1].0 - w[0].0)
         .fold(EDGE_GRID_STEP, Real::min);
     let edge = std::f64::consts::FRAC_PI_2;
-    let spans = |from: Real, to: Real| ((to - from) / h - 1e-9).ceil().max(0.0) as usize;
+    let spans = |from: Real, to: Real| {
+        ((to - from) / h - crate::tolerance::COUNT_SLACK)
+            .ceil()
+            .max(0.0) as usize
+    };
     let below = spans(-edge, pass_range[0]);
     let above = spans(pass_range[1], edge);
     let mut grid: Vec<(Real, usize)> = (0..below)
@@ -682,7 +686,9 @@ pub fn check_groove(
 fn explain(g: &Groove, worst: &GroovePlace, pass_range: [Real; 2]) -> Result<String, VerifyError> {
     let (psi, theta) = (worst.psi_deg, worst.theta_deg.to_radians());
     let [a, b] = pass_range.map(Real::to_degrees);
-    if worst.mm > 0.0 && (psi < a - 1e-9 || psi > b + 1e-9) {
+    if worst.mm > 0.0
+        && (psi < a - crate::tolerance::SAME_ANGLE || psi > b + crate::tolerance::SAME_ANGLE)
+    {
         return Ok(format!(
             ": the outermost passes are at psi {} and {} deg, short of the groove's edges at -90 and 90 deg; \
              place the outermost passes at the edges",

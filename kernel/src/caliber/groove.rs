@@ -257,7 +257,9 @@ impl Groove {
                 ),
             });
         }
-        if let Some(i) = (0..deg.len()).find(|&i| (deg[i] - ours[i]).abs() > 1e-9) {
+        if let Some(i) =
+            (0..deg.len()).find(|&i| (deg[i] - ours[i]).abs() > crate::tolerance::SAME_ANGLE)
+        {
             return Err(GrooveError::File {
                 file: file(),
                 message: format!(
@@ -506,7 +508,10 @@ impl Groove {
     /// neighbouring rows have one depth and one width.
     pub fn sizing_rows(&self) -> Option<(usize, usize)> {
         let (h, b) = (self.hp.x(), self.b.x());
-        let same = |i: usize| (h[i] - h[i - 1]).abs() <= 1e-9 && (b[i] - b[i - 1]).abs() <= 1e-9;
+        let same = |i: usize| {
+            (h[i] - h[i - 1]).abs() <= crate::tolerance::SAME_LENGTH
+                && (b[i] - b[i - 1]).abs() <= crate::tolerance::SAME_LENGTH
+        };
         let (mut best, mut start) = ((0, 0), 0);
         for i in 1..=h.len() {
             if i == h.len() || !same(i) {
@@ -531,7 +536,10 @@ impl Groove {
     ) -> Result<(usize, usize), GrooveError> {
         let deg: Vec<Real> = self.hp.z().iter().map(|t| t.to_degrees()).collect();
         let inside: Vec<usize> = (0..deg.len())
-            .filter(|&i| deg[i] >= from_deg - 1e-9 && deg[i] <= to_deg + 1e-9)
+            .filter(|&i| {
+                deg[i] >= from_deg - crate::tolerance::SAME_ANGLE
+                    && deg[i] <= to_deg + crate::tolerance::SAME_ANGLE
+            })
             .collect();
         match (inside.first(), inside.last()) {
             (Some(&a), Some(&b)) if b > a => Ok((a, b)),
@@ -745,7 +753,7 @@ impl Groove {
         let phi = s.normal_angle(psi);
         let radial = Vec3::new(theta.cos(), theta.sin(), 0.0);
         let open = -phi.sin() * Vec3::z() + phi.cos() * radial;
-        if !(d_psi.norm() > 1e-9) {
+        if !(d_psi.norm() > crate::tolerance::SAME_LENGTH) {
             d_psi = phi.cos() * Vec3::z() + phi.sin() * radial;
         }
         let n = d_theta.cross(&d_psi).normalize();

@@ -8,6 +8,10 @@ use super::pose::{exact_pose_toward, seed_pose, TorusWheel};
 use crate::input::InputError;
 use crate::math::{Real, Vec3};
 
+/// An iteration whose turn (rad) moves less than this has converged to its
+/// rounding: 1e-13 rad moves a point 1 m from the axis by 0.1 nm.
+const TURN_STALL: Real = 1e-13;
+
 /// Which plane the wheel's axis keeps, besides keeping the wheel's own
 /// plane along the contact's trajectory (the seed's swivel, S001-11).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -86,7 +90,7 @@ fn exact_at(
     let (p, n, tangent) = groove.frame(theta, psi)?;
     let axis_for = |turn: Real| -> Result<Vec3, GrooveError> {
         let w = tangent.cross(&radial(turn));
-        if !(w.norm() > 1e-9 * tangent.norm()) {
+        if !(w.norm() > crate::tolerance::SAME_RATIO * tangent.norm()) {
             return Err(InputError::out_of_range(
                 "the contact's trajectory against the radius (sine of the angle)",
                 w.norm() / tangent.norm(),
@@ -114,7 +118,7 @@ fn exact_at(
                 let moved = (next - turn).abs();
                 turn = next;
                 wheel = place(axis_for(turn)?, turn)?;
-                if moved < 1e-13 {
+                if moved < TURN_STALL {
                     break;
                 }
             }
@@ -177,7 +181,9 @@ pub fn pass_poses(
     let at = |t: Real| exact_at(groove, t, psi, r_k0, r_k, plane);
     let (first, last) = (at(lo)?, at(hi)?);
     let span = last.turn - first.turn;
-    let steps = (span / step - 1e-9).ceil().max(1.0);
+    let steps = (span / step - crate::tolerance::COUNT_SLACK)
+        .ceil()
+        .max(1.0);
     if !(steps <= MAX_PASS_BLOCKS as Real) {
         return Err(InputError::out_of_range(
             "blocks of one pass (the groove's turn over the theta step)",
@@ -205,7 +211,7 @@ pub fn pass_poses(
             b = (t, at(t)?);
             widen *= 2.0;
         }
-        if !(b.1.turn >= target - 1e-12) {
+        if !(b.1.turn >= target - crate::tolerance::ROUNDING) {
             return Err(InputError::out_of_range(
                 "the roll's turn a pass reaches (deg)",
                 target.to_degrees(),
@@ -223,7 +229,7 @@ pub fn pass_poses(
         };
         let mut side = 0;
         for _ in 0..200 {
-            if (best.turn - target).abs() < TURN_TOLERANCE || b.0 - a.0 < 1e-13 {
+            if (best.turn - target).abs() < TURN_TOLERANCE || b.0 - a.0 < TURN_STALL {
                 break;
             }
             let span = b.1.turn - a.1.turn;
@@ -320,7 +326,7 @@ fn split(
     let (ca, cb, cm) = (centre(&a.1), centre(&b.1), centre(&pm));
     let chord = cb - ca;
     let v = cm - ca;
-    let off = v - v.dot(&chord) / chord.norm_squared().max(1e-300) * chord;
+    let off = v - v.dot(&chord) / chord.norm_squared().max(crate::tolerance::TINY) * chord;
     if off.norm() <= sag || depth >= MAX_STEP_OVER_DEPTH {
         return Ok(());
     }

@@ -79,10 +79,10 @@ pub fn exact_pose_toward(
     }
     let (n, w) = (n.normalize(), w.normalize());
     let mut across = n - n.dot(&w) * w;
-    if !(across.norm() > 1e-9) {
+    if !(across.norm() > crate::tolerance::SAME_LENGTH) {
         across = away - away.dot(&w) * w;
     }
-    if !(across.norm() > 1e-9) {
+    if !(across.norm() > crate::tolerance::SAME_LENGTH) {
         return Err(InputError::out_of_range(
             "wheel axis against the surface normal (sine of the angle)",
             across.norm(),

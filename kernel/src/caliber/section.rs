@@ -356,7 +356,10 @@ fn rounding(e: &EllipseSection, r: Real) -> Shape {
     let (mut v, mut dv) = (-r, -b - r * a / b);
     for _ in 0..MAX_ITERATIONS {
         let newton = t - v / dv;
-        if (newton - t).abs() <= 1e-15 || v == 0.0 || hi - lo <= 1e-15 {
+        if (newton - t).abs() <= crate::tolerance::ULP
+            || v == 0.0
+            || hi - lo <= crate::tolerance::ULP
+        {
             break;
         }
         t = if newton > lo && newton < hi {

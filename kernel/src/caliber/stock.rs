@@ -9,6 +9,11 @@ use crate::math::{Real, Vec3};
 use crate::program::ProgramPass;
 use crate::tool::Wheel;
 
+/// The least step (rad) of the search for the least distance: 2.5 um
+/// along the groove, where the distance's error is of second order
+/// (hundredths of a micron).
+const LEAST_STEP: Real = 1e-5;
+
 /// The groove's material for the process's rules ([`crate::process`]):
 /// the roll with its groove as turned, before any pass grinds it (its
 /// surface `stock` into the groove's open space from the nominal
@@ -114,7 +119,7 @@ impl GrooveStock {
         // the error is of second order, hundredths of a micron.
         let (mut st, mut sp) = (0.01 * scale, 2f64.to_radians() * scale);
         let mut streak = 0;
-        while st > 1e-5 {
+        while st > LEAST_STEP {
             let (t, p) = best.1;
             let next = [(t, p + sp), (t, p - sp), (t + st, p), (t - st, p)]
                 .into_iter()

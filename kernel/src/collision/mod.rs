@@ -343,7 +343,7 @@ impl Facing {
         let o = rel.fixed_view::<3, 1>(0, 3).into_owned();
         let across = o - a * a.dot(&o);
         let rho = across.norm();
-        if rho < 1e-9 {
+        if rho < crate::tolerance::SAME_LENGTH {
             return rel;
         }
         // The origin's angle phi about the axis, turned back by Rodrigues'

@@ -14,6 +14,16 @@ use crate::mesh::TriMesh;
 use parry3d_f64::math::{Pose, Rot3, Vector};
 use parry3d_f64::shape::SharedShape;
 
+/// The least half-length (mm) of a cylinder of the stack: a disc of no
+/// thickness is not a solid the collision library accepts, and a
+/// nanometre of thickness changes no distance it gives.
+const THINNEST_HALF: Real = 1e-6;
+
+/// How far (mm) the rays that tell inside from outside are lifted off
+/// the stations' heights: an odd amount far below any feature, so that no
+/// ray runs through a vertex of the mesh.
+const RAY_OFFSET: Real = 1.234_567e-7;
+
 /// How far a guard's convex sectors may fill its inner side, toward the
 /// wheel (mm): the sectors are as many as that takes (at most
 /// [`MAX_SECTORS`]).
@@ -229,7 +239,7 @@ pub fn envelope(mesh: &TriMesh, tol: Real, bore: bool) -> Option<Shaped> {
     let mut merged: Vec<(Real, Real)> = Vec::new();
     for (z, r) in rings {
         match merged.last_mut() {
-            Some(last) if z - last.0 <= 1e-9 => last.1 = last.1.max(r),
+            Some(last) if z - last.0 <= crate::tolerance::SAME_LENGTH => last.1 = last.1.max(r),
             _ => merged.push((z, r)),
         }
     }
@@ -271,13 +281,16 @@ pub fn envelope(mesh: &TriMesh, tol: Real, bore: bool) -> Option<Shaped> {
     // of revolution about Z.
     let mut round = true;
     for ((z0, z1, r), solid) in stack.into_iter().zip(inside) {
-        let half = ((z1 - z0) / 2.0).max(1e-6);
+        let half = ((z1 - z0) / 2.0).max(THINNEST_HALF);
         let centre = Mat4::new_translation(&Vec3::new(0.0, 0.0, (z0 + z1) / 2.0));
         let hole = (!solid)
             .then(|| {
                 mesh.positions
                     .iter()
-                    .filter(|p| p[2] >= z0 - 1e-9 && p[2] <= z1 + 1e-9)
+                    .filter(|p| {
+                        p[2] >= z0 - crate::tolerance::SAME_LENGTH
+                            && p[2] <= z1 + crate::tolerance::SAME_LENGTH
+                    })
                     .map(|p| p[0].hypot(p[1]))
                     .fold(Real::INFINITY, Real::min)
                     - tol
@@ -318,7 +331,7 @@ fn axis_inside(mesh: &TriMesh, zs: &[Real]) -> Vec<bool> {
     // own span of z only.
     let mut order: Vec<usize> = (0..zs.len()).collect();
     order.sort_by(|&i, &j| zs[i].total_cmp(&zs[j]));
-    let heights: Vec<Real> = order.iter().map(|&k| zs[k] + 1.234_567e-7).collect();
+    let heights: Vec<Real> = order.iter().map(|&k| zs[k] + RAY_OFFSET).collect();
     let mut crossings = vec![0usize; zs.len()];
     for t in &mesh.triangles {
         let [a, b, d] = t.map(|i| mesh.positions[i as usize]);

@@ -93,9 +93,10 @@ pub fn read_measured(
             continue;
         }
         let theirs = table.column(other)?;
-        if let Some(i) = (0..value.len())
-            .find(|&i| (value[i] * factor - theirs[i] * f).abs() > uncertainty * (1.0 + 1e-9))
-        {
+        if let Some(i) = (0..value.len()).find(|&i| {
+            (value[i] * factor - theirs[i] * f).abs()
+                > uncertainty * (1.0 + crate::tolerance::LIMIT_SLACK)
+        }) {
             return Err(CompensateError::Inconsistent {
                 file,
                 what: format!(
@@ -171,9 +172,9 @@ pub fn read_measured(
     m.spread = bounds.iter().map(|(lo, hi)| hi - lo).collect();
     // Rows at one place further apart than the uncertainty allows are not
     // an out-of-round part measured at several angles but a wrong row.
-    if let Some(k) =
-        (0..m.at.len()).find(|&k| m.spread[k] > SPREAD_ALLOWED * uncertainty * (1.0 + 1e-9))
-    {
+    if let Some(k) = (0..m.at.len()).find(|&k| {
+        m.spread[k] > SPREAD_ALLOWED * uncertainty * (1.0 + crate::tolerance::LIMIT_SLACK)
+    }) {
         let (lo, hi) = bound_rows[k];
         let (a, b) = (lo.min(hi), lo.max(hi));
         return Err(CompensateError::Inconsistent {

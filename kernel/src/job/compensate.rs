@@ -32,6 +32,12 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
+/// How far (mm) a value of the run's report may be from the same value
+/// predicted again and still be the same prediction: the report's values
+/// are written to well below it, and a changed run moves them by far
+/// more.
+const SAME_PREDICTION: Real = 1e-7;
+
 /// The parameter a family takes its correction by: a table's name.
 pub const CORRECTION: &str = "correction";
 /// The correction's table, beside the new run's files.
@@ -858,7 +864,8 @@ fn same_prediction(file: &Tables, again: &Tables, label: &str) -> Result<(), Err
                 want.len()
             ));
         }
-        if let Some(i) = (0..want.len()).find(|&i| !((have[i] - want[i]).abs() <= 1e-7)) {
+        if let Some(i) = (0..want.len()).find(|&i| !((have[i] - want[i]).abs() <= SAME_PREDICTION))
+        {
             return changed(format!(
                 "says {column} = {} at its row {}, where the run's program, verified again, gives {}",
                 have[i],
@@ -1119,7 +1126,7 @@ fn path_moved(
             for k in lo..hi {
                 let from: f64 = v.iter().zip(line[k]).map(|(v, a)| (v - a).powi(2)).sum();
                 let reach = best.1 .1.sqrt() + dirs[k].1.sqrt();
-                if from > reach * reach * (1.0 + 1e-9) {
+                if from > reach * reach * (1.0 + crate::tolerance::LIMIT_SLACK) {
                     continue;
                 }
                 let got = nearest(k);

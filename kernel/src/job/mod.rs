@@ -1040,7 +1040,7 @@ fn body_places_agree(
         let Some(value) = values.get(&s.name).and_then(ParamValue::as_number) else {
             continue;
         };
-        if (value - chain).abs() <= 1e-9 * chain.abs().max(1.0) {
+        if (value - chain).abs() <= crate::tolerance::SAME_RATIO * chain.abs().max(1.0) {
             continue;
         }
         let constant = s

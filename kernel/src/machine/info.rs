@@ -12,6 +12,12 @@ use crate::transform::{Chain, FactorKind, ToolFrame};
 use pilgrim_plugin_abi::types::{FactorKind as SpecFactor, Radial};
 use std::collections::BTreeMap;
 
+/// How far a rotary axis's stated direction (a unit vector) may be from
+/// the one its chain turns it about, found by a central difference
+/// ([`crate::tolerance::DERIVATIVE_STEP`], exact to 1e-12): far below any
+/// misstated direction, far above the difference's error.
+const TURNS_AGREE: Real = 1e-5;
+
 /// A moving body other than the tool (a steady rest): its description and
 /// the chain placing its frame in the part frame.
 #[derive(Debug, Clone, PartialEq)]
@@ -571,7 +577,7 @@ fn sign_error(m: &Machine, a: &Axis) -> Result<(), (&'static str, String)> {
             let d =
                 chain.frame_unchecked(&q1).transform_point(&origin) - f0.transform_point(&origin);
             let stated = Vec3::from(a.moves.unwrap_or_default());
-            if (d - stated).norm() > 1e-9 {
+            if (d - stated).norm() > crate::tolerance::SAME_RATIO {
                 return Err((
                     "moves",
                     format!("axis {}: moves = [{}, {}, {}] but the chain moves it by [{:.6}, {:.6}, {:.6}]", a.name, stated.x, stated.y, stated.z, d.x, d.y, d.z),
@@ -579,7 +585,7 @@ fn sign_error(m: &Machine, a: &Axis) -> Result<(), (&'static str, String)> {
             }
         }
         _ => {
-            let h = 1e-6;
+            let h = crate::tolerance::DERIVATIVE_STEP;
             q1[i] += h;
             let r = chain.frame_unchecked(&q1).rot * f0.rot.transpose();
             let w = Vec3::new(
@@ -588,7 +594,7 @@ fn sign_error(m: &Machine, a: &Axis) -> Result<(), (&'static str, String)> {
                 r[(1, 0)] - r[(0, 1)],
             ) / (2.0 * h);
             let stated = Vec3::from(a.turns.unwrap_or_default()).normalize();
-            if (w - stated).norm() > 1e-5 {
+            if (w - stated).norm() > TURNS_AGREE {
                 return Err((
                     "turns",
                     format!("axis {}: turns = [{}, {}, {}] but the chain turns it about [{:.4}, {:.4}, {:.4}]", a.name, stated.x, stated.y, stated.z, w.x, w.y, w.z),
@@ -715,7 +721,10 @@ fn check_setup(info: &MachineInfo) -> Result<(), Invalid> {
             Radial::Diameter => ("diameter", 0.5),
         };
         if let Some(m) = a.moves {
-            if (m[0].abs() - per_mm).abs() > 1e-9 || m[1] != 0.0 || m[2] != 0.0 {
+            if (m[0].abs() - per_mm).abs() > crate::tolerance::SAME_RATIO
+                || m[1] != 0.0
+                || m[2] != 0.0
+            {
                 return bad(format!(
                     "setup: radial = \"{word}\" says 1 mm of {name} moves the tool {per_mm} mm from the part's axis, but the axis states moves = [{}, {}, {}]",
                     m[0], m[1], m[2]

@@ -217,7 +217,7 @@ impl ChainMachine {
         // pose is seeded by the last, or by extrapolating both where it
         // continues their step.
         let mut solved: [Option<(Vec<Real>, &[Real])>; 2] = [None, None];
-        let tol_dir = self.options.tol_dir.max(1e-9);
+        let tol_dir = self.options.tol_dir.max(crate::tolerance::SAME_RATIO);
         out.clear();
         let mut ticker = crate::budget::Ticker::new("inverse kinematics", 64);
         for (k, p) in poses.chunks_exact(6).enumerate() {

@@ -382,7 +382,7 @@ pub fn feed_length(axes: &[&Axis], deltas: &[Real], group: &[String]) -> Real {
             .map(|(_, d)| d * d)
             .sum::<Real>()
             .sqrt();
-        if g > 1e-9 {
+        if g > crate::tolerance::SAME_LENGTH {
             return g;
         }
     }
@@ -460,7 +460,7 @@ pub fn check_feed_grouped(
             }
             let speed = deltas[i].abs() / minutes;
             let max = a.to_user(a.max_feed);
-            if speed > max * (1.0 + 1e-9) {
+            if speed > max * (1.0 + crate::tolerance::LIMIT_SLACK) {
                 return Err(MachineError::FeedExceeded {
                     point: p,
                     axis: a.name.clone(),

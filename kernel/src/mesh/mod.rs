@@ -230,7 +230,11 @@ impl TriMesh {
             let [a, b, c] = self.corners(t);
             let area2 = dot(cross(sub(b, a), sub(c, a)), cross(sub(b, a), sub(c, a))).sqrt();
             let scale = dot(sub(b, a), sub(b, a)).max(dot(sub(c, a), sub(c, a)));
-            if v[0] == v[1] || v[1] == v[2] || v[0] == v[2] || !(area2 > 1e-12 * scale) {
+            if v[0] == v[1]
+                || v[1] == v[2]
+                || v[0] == v[2]
+                || !(area2 > crate::tolerance::ROUNDING * scale)
+            {
                 return Err(MeshError::NotClosed(format!("triangle {t} is degenerate")));
             }
             for k in 0..3 {

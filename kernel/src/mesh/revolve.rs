@@ -111,7 +111,9 @@ pub fn revolve(section: &[[Real; 2]], tol: Real) -> Result<TriMesh, MeshError> {
         .iter()
         .map(|p| p[0].abs().max(p[1]))
         .fold(1.0, Real::max);
-    if (first[0] - last[0]).abs() > 1e-9 * scale || (first[1] - last[1]).abs() > 1e-9 * scale {
+    if (first[0] - last[0]).abs() > crate::tolerance::SAME_RATIO * scale
+        || (first[1] - last[1]).abs() > crate::tolerance::SAME_RATIO * scale
+    {
         return Err(MeshError::Open { first, last });
     }
     // Distinct points, cyclic.
@@ -145,7 +147,7 @@ pub fn revolve(section: &[[Real; 2]], tol: Real) -> Result<TriMesh, MeshError> {
         })
         .sum::<Real>()
         / 2.0;
-    if !(area.abs() > 1e-12 * scale * scale) {
+    if !(area.abs() > crate::tolerance::ROUNDING * scale * scale) {
         return Err(MeshError::Degenerate(format!(
             "the section's area is {area}"
         )));

@@ -96,9 +96,9 @@ pub fn frame_from_pose(tool: &ToolFrame, point: Point3, axis: Vec3) -> Mat4 {
     let a = tool.axis.normalize();
     let b = axis.normalize();
     let c = a.dot(&b);
-    let rot: Mat3 = if c > 1.0 - 1e-15 {
+    let rot: Mat3 = if c > 1.0 - crate::tolerance::ULP {
         Mat3::identity()
-    } else if c < -1.0 + 1e-15 {
+    } else if c < -1.0 + crate::tolerance::ULP {
         // Half a turn about any axis perpendicular to a.
         let p = if a.x.abs() < 0.9 {
             Vec3::x()

@@ -191,7 +191,8 @@ fn swept(rings: &[Vec<[Real; 3]>], holes: Option<&[Vec<[Real; 3]>]>) -> Result<T
             .sum();
         let want = area2 - hole_area2;
         let count = if h > 0 { m + h } else { m - 2 };
-        if tris.len() != 3 * count || (covered - want).abs() > 1e-9 * area2 {
+        if tris.len() != 3 * count || (covered - want).abs() > crate::tolerance::SAME_RATIO * area2
+        {
             return Err(MeshError::Degenerate(format!(
                 "section {j} is not a simple polygon: its cap cannot be made"
             )));

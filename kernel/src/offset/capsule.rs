@@ -120,7 +120,7 @@ pub fn flat_path(z: &[Real], x: &[Real], flat: Real, side: Side) -> Result<Polyl
     out_z.push(q[q.len() - 1]);
     let out_x: Vec<Real> = out_z.iter().map(|&v| s * value(v)).collect();
     // Drop points on straight runs: the path only needs its corners.
-    let keep = crate::profile::simplify_polyline(&out_z, &out_x, 1e-9);
+    let keep = crate::profile::simplify_polyline(&out_z, &out_x, crate::tolerance::SAME_LENGTH);
     Polyline::new(
         keep.iter().map(|&i| out_z[i]).collect(),
         keep.iter().map(|&i| out_x[i]).collect(),

@@ -81,7 +81,7 @@ impl Nodes {
         }
         let last = self.z.len() - 1;
         let (l1, r1) = (self.d1[last], other.d1[0]);
-        if (l1 - r1).abs() <= 1e-9 * (1.0 + l1.abs()) {
+        if (l1 - r1).abs() <= crate::tolerance::SAME_RATIO * (1.0 + l1.abs()) {
             let (l2, r2) = (self.d2[last], other.d2[0]);
             self.d2[last] = if r2.abs() > l2.abs() { r2 } else { l2 };
         } else {
@@ -185,7 +185,7 @@ impl ProfileBuilder {
                 } => arc(i, at, (z, x), radius, bulge, tol, max_step)?,
                 Segment::Law(law) => {
                     let x0 = law.x(0.0);
-                    if (x0 - at.1).abs() > 1e-9 * (1.0 + x0.abs()) {
+                    if (x0 - at.1).abs() > crate::tolerance::SAME_RATIO * (1.0 + x0.abs()) {
                         return Err(ProfileError::Discontinuous {
                             segment: i,
                             z: at.0,
@@ -279,7 +279,7 @@ fn arc(
     );
     // Upper half of the circle for Out, lower half for In; ends strictly inside.
     let side = -sign;
-    let margin = 1e-9 * r;
+    let margin = crate::tolerance::SAME_RATIO * r;
     if (a.1 - cx) * side <= margin || (b.1 - cx) * side <= margin {
         return Err(bad());
     }

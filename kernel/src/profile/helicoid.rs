@@ -38,6 +38,14 @@
 use crate::math::Real;
 use serde::{Deserialize, Serialize};
 
+/// Newton's step (mm) below which the half-width has converged to the
+/// rounding of the half-space it is solved from.
+const CONVERGED: Real = 1e-14;
+
+/// The step (mm) of the central difference of the flank's half-space over
+/// the radius: the curve is smooth, and the difference is exact to 1e-10.
+const CURVE_STEP: Real = 1e-4;
+
 /// How a thread's flanks are generated: see the module's docs.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(tag = "form", rename_all = "lowercase")]
@@ -92,11 +100,11 @@ impl FlankForm {
         let mut w = half_space * tilt.cos();
         for _ in 0..50 {
             let g = |w: Real| form(w).half_space(reference).unwrap_or(0.0) - half_space;
-            let (g0, dw) = (g(w), 1e-6);
+            let (g0, dw) = (g(w), crate::tolerance::DERIVATIVE_STEP);
             let slope = (g(w + dw) - g0) / dw;
             let step = g0 / slope;
             w -= step;
-            if step.abs() < 1e-14 {
+            if step.abs() < CONVERGED {
                 break;
             }
         }
@@ -151,7 +159,7 @@ impl FlankForm {
                     let df = 2.0 * u + 2.0 * s(u) * st * st * ta;
                     let step = f / df;
                     u -= step;
-                    if step.abs() < 1e-15 * r.abs().max(1.0) {
+                    if step.abs() < crate::tolerance::ULP * r.abs().max(1.0) {
                         break;
                     }
                 }
@@ -188,7 +196,7 @@ impl FlankForm {
             FlankForm::Normal { .. } => {
                 // The curve is smooth: a central difference over 1e-4 mm
                 // is exact to 1e-10.
-                let h = 1e-4;
+                let h = CURVE_STEP;
                 let (a, b) = (self.half_space(r + h)?, self.half_space(r - h)?);
                 Some(((a - b) / (2.0 * h)).atan())
             }

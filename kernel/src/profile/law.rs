@@ -137,7 +137,12 @@ pub fn uniform_grid(a: Real, b: Real, step: Real) -> Result<Vec<Real>, ProfileEr
     positive("grid step", step)?;
     // The small margin keeps a range that is a whole number of steps from
     // getting a sliver of a last step through rounding.
-    let count = super::check_node_count("grid step", ((b - a) / step - 1e-9).ceil(), step)?.max(2);
+    let count = super::check_node_count(
+        "grid step",
+        ((b - a) / step - crate::tolerance::COUNT_SLACK).ceil(),
+        step,
+    )?
+    .max(2);
     let h = if count == 2 && 2.0 * step > b - a {
         0.5 * (b - a)
     } else {

@@ -287,7 +287,7 @@ fn lint_apt(text: &str, program: &AxisProgram, d: &Dialect) -> Result<Linted, Li
         message,
     };
     let decimals = super::written_decimals(program.decimals, d.name);
-    let half = 0.5 * 10f64.powi(-(decimals as i32)) + 1e-9;
+    let half = 0.5 * 10f64.powi(-(decimals as i32)) + crate::tolerance::SAME_LENGTH;
     let Some(body) = text.strip_suffix('\n') else {
         return Err(fault(
             "the last line".into(),

@@ -25,6 +25,18 @@ use crate::math::Real;
 use crate::toolpath::{pass_ranges, Motion, Pass, Toolpath, ToolpathError};
 use std::ops::Range;
 
+/// How near (in the last written digit's units) a value may be to half a
+/// step and still be rounded by arithmetic: nearer, it is a tie the
+/// value's text decides (binary arithmetic cannot tell a tie from a value
+/// a rounding off it).
+const TIE: Real = 1e-6;
+
+/// How far (mm, deg) a block read from a program may be from the move of
+/// the cycle it stands for and still be that move: a nanometre, far below
+/// the program's written step and far above the arithmetic that expands
+/// the cycle.
+const CYCLE_MATCH: Real = 1e-6;
+
 /// The least feed of a cutting block on any machine (mm/min): below it a
 /// move would take longer than a report can say.
 pub const MIN_FEED: Real = 1e-3;
@@ -386,7 +398,7 @@ pub fn written_decimals(decimals: Option<usize>, control: &str) -> usize {
 pub fn written(v: Real, decimals: usize) -> Real {
     let scale = 10f64.powi(decimals.min(22) as i32);
     let t = v * scale;
-    if t.abs() < 4.5e15 && (t.fract().abs() - 0.5).abs() > 1e-6 {
+    if t.abs() < 4.5e15 && (t.fract().abs() - 0.5).abs() > TIE {
         t.round() / scale + 0.0
     } else {
         crate::math::fixed(v, decimals).parse().unwrap_or(v)
@@ -418,7 +430,7 @@ fn rotary_feeds(blocks: &mut [Block], axes: &[&Axis], toolpath: &Toolpath, info:
         let turns = axes
             .iter()
             .zip(&deltas)
-            .any(|(a, d)| a.kind == AxisKind::Rotary && d.abs() > 1e-12);
+            .any(|(a, d)| a.kind == AxisKind::Rotary && d.abs() > crate::tolerance::ROUNDING);
         let (p, q) = (points[k - 1].point, points[k].point);
         let chord = ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2) + (q[2] - p[2]).powi(2)).sqrt();
         if !turns || !(chord > 0.0) {
@@ -785,10 +797,10 @@ fn cycle_spans(
             let b = &blocks[i];
             let stands = (0..names.len())
                 .filter(|&k| k != x && k != z)
-                .all(|k| (b.values[k] - before.values[k]).abs() <= 1e-6);
+                .all(|k| (b.values[k] - before.values[k]).abs() <= CYCLE_MATCH);
             if b.motion != m.motion
-                || (b.values[x] - m.x).abs() > 1e-6
-                || (b.values[z] - m.z).abs() > 1e-6
+                || (b.values[x] - m.x).abs() > CYCLE_MATCH
+                || (b.values[z] - m.z).abs() > CYCLE_MATCH
                 || !stands
             {
                 return Err(bad(

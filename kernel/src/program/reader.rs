@@ -320,7 +320,7 @@ impl<'a> Reader<'a> {
             lines: lines.len(),
             framed,
             decimals,
-            half: 0.5 * 10f64.powi(-(decimals as i32)) + 1e-9,
+            half: 0.5 * 10f64.powi(-(decimals as i32)) + crate::tolerance::SAME_LENGTH,
             lead_letter: d.lead.chars().next().unwrap_or('K'),
             start_letter,
             start_scale,
@@ -1226,7 +1226,8 @@ impl<'a> Reader<'a> {
                 return Err(fault(place(k), "a thread block before any lead".into()));
             }
             if let Some(Motion::Thread { lead, start_deg }) = b.map(|b| b.motion) {
-                if !((read_lead - lead).abs() <= 0.5 * 10f64.powi(-(d.lead_decimals as i32)) + 1e-9)
+                if !((read_lead - lead).abs()
+                    <= 0.5 * 10f64.powi(-(d.lead_decimals as i32)) + crate::tolerance::SAME_LENGTH)
                 {
                     return Err(fault(
                         place(k),

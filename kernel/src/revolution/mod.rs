@@ -631,7 +631,7 @@ impl GroundStock {
                     check.passes[k - 1]
                         .along_z
                         .get(i)
-                        .filter(|q| (q[0] - b[0]).abs() < 1e-9)
+                        .filter(|q| (q[0] - b[0]).abs() < crate::tolerance::SAME_LENGTH)
                         .map(|q| q[1])
                 };
                 if let Some(before) = before {

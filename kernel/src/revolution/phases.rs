@@ -28,6 +28,10 @@ use crate::input::InputError;
 use crate::math::Real;
 use crate::profile::ProfileError;
 
+/// How far (mm) the wheel may move in the time left to a crossing and the
+/// crossing count as found: a nanometre.
+const SETTLED: Real = 1e-6;
+
 /// A wheel reference's path in time: points `(z, x)` and the time (minutes
 /// from the first point) it reaches each, moving along straight moves at
 /// their feeds.
@@ -283,7 +287,7 @@ fn crest_covered(
     let (mut lo, mut hi) = (t_in - period, t_out);
     for _ in 0..64 {
         let mid = 0.5 * (lo + hi);
-        if mid <= lo || mid >= hi || (hi - lo) * speed < 1e-6 {
+        if mid <= lo || mid >= hi || (hi - lo) * speed < SETTLED {
             break;
         }
         if h(mid) > h(mid + period) {

@@ -36,7 +36,7 @@ fn draw(
     if !(z0.is_finite() && y0.is_finite()) {
         return Err(format!("{title}: nothing to draw"));
     }
-    if z1 - z0 < 1e-9 {
+    if z1 - z0 < crate::tolerance::SAME_LENGTH {
         z1 = z0 + 1.0;
     }
     let pad = ((y1 - y0) * 0.06).max(0.05);
@@ -168,7 +168,7 @@ pub fn removed(passes: &[PassCheck], start: impl Fn(f64) -> Option<f64>) -> Vec<
                 start(z).map(|s| (s, s))
             } else {
                 let b = passes[k - 1].along_z.get(i)?;
-                ((b[0] - z).abs() < 1e-9).then_some((b[1], b[2]))
+                ((b[0] - z).abs() < crate::tolerance::SAME_LENGTH).then_some((b[1], b[2]))
             }
         };
         let along: Vec<[f64; 3]> = p

@@ -32,6 +32,10 @@ use super::phases::{Infeed, PhaseCrest, TimedPath};
 use crate::math::Real;
 use crate::profile::{Profile, ProfileError};
 
+/// The z (mm) where one part of the surface takes over from another is
+/// found to a nanometre.
+const TAKEOVER: Real = 1e-6;
+
 /// The fewest generatrices a pass is compared on: the replay simulates
 /// twice as many and doubles from there.
 pub const GENERATRICES: usize = 8;
@@ -343,7 +347,7 @@ impl GroundSurface {
                         let v = self.parts(&[z], extra);
                         v[q][0] - v[p][0]
                     };
-                    while r - l > 1e-6 {
+                    while r - l > TAKEOVER {
                         let m = 0.5 * (l + r);
                         if diff(m) < 0.0 {
                             r = m;

@@ -451,7 +451,8 @@ pub fn revolution_step(name: &str, section: &Section, pose: &Mat4) -> Result<Str
 /// Refuses a pose that is not a rigid motion.
 fn rigid(name: &str, pose: &Mat4) -> Result<(), StepError> {
     let rot = pose.fixed_view::<3, 3>(0, 0);
-    let rigid = (rot.transpose() * rot - nalgebra::Matrix3::identity()).amax() < 1e-9
+    let rigid = (rot.transpose() * rot - nalgebra::Matrix3::identity()).amax()
+        < crate::tolerance::SAME_RATIO
         && pose
             .row(3)
             .iter()

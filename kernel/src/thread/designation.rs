@@ -108,7 +108,9 @@ pub fn designated(text: &str, drawing: &Drawing) -> Result<ThreadProfile, InputE
             }
         };
         let starts = (lead / pitch).round();
-        if (lead / pitch - starts).abs() > 1e-9 || !(1.0..=12.0).contains(&starts) {
+        if (lead / pitch - starts).abs() > crate::tolerance::SAME_RATIO
+            || !(1.0..=12.0).contains(&starts)
+        {
             return Err(bad(&format!(
                 "the lead {lead} is not 1 to 12 times the pitch {pitch}"
             )));

@@ -299,7 +299,9 @@ impl ThreadSection {
     /// half-angle). Symmetric straight-flanked profiles only (`None`
     /// otherwise); the lead angle's small correction left out.
     pub fn over_wires(&self, wire: Real, pitch_diameter: Real) -> Option<Real> {
-        if (self.flanks[0] - self.flanks[1]).abs() > 1e-12 || !self.form.is_axial() {
+        if (self.flanks[0] - self.flanks[1]).abs() > crate::tolerance::ROUNDING
+            || !self.form.is_axial()
+        {
             return None;
         }
         let b = self.flanks[0];
@@ -310,7 +312,8 @@ impl ThreadSection {
     /// The best wire of a symmetric straight-flanked profile: the one that
     /// touches its flanks at the pitch diameter.
     pub fn best_wire(&self) -> Option<Real> {
-        ((self.flanks[0] - self.flanks[1]).abs() <= 1e-12 && self.form.is_axial())
-            .then(|| self.space_at_pitch / self.flanks[0].cos())
+        ((self.flanks[0] - self.flanks[1]).abs() <= crate::tolerance::ROUNDING
+            && self.form.is_axial())
+        .then(|| self.space_at_pitch / self.flanks[0].cos())
     }
 }

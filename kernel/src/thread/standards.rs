@@ -140,7 +140,10 @@ pub fn metric(
         .find(|g| g.0 == grade)
         .map(|g| g.1)
         .ok_or_else(bad_class)?;
-    let Some(&(_, dev)) = DEVIATIONS.iter().find(|(p, _)| (p - pitch).abs() < 1e-9) else {
+    let Some(&(_, dev)) = DEVIATIONS
+        .iter()
+        .find(|(p, _)| (p - pitch).abs() < crate::tolerance::SAME_LENGTH)
+    else {
         return Err(InputError::out_of_range(
             "pitch P",
             pitch,
@@ -214,7 +217,7 @@ pub fn metric(
             source: format!("ISO 965-1 {class}"),
         }
     };
-    let fine = if starts == 1 && (pitch - coarse_pitch(d)).abs() < 1e-9 {
+    let fine = if starts == 1 && (pitch - coarse_pitch(d)).abs() < crate::tolerance::SAME_LENGTH {
         format!("M{}", number(d))
     } else {
         format!("M{}x{}", number(d), lead_and_pitch(pitch, starts))
@@ -263,7 +266,7 @@ pub(crate) fn coarse_pitch(d: Real) -> Real {
     ];
     COARSE
         .iter()
-        .find(|(n, _)| (n - d).abs() < 1e-9)
+        .find(|(n, _)| (n - d).abs() < crate::tolerance::SAME_LENGTH)
         .map_or(0.0, |c| c.1)
 }
 

@@ -13,6 +13,14 @@ use crate::math::{Point3, Real, Vec3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
+/// The inverse kinematics' default tolerance on the tool's position (mm):
+/// 0.1 nm, a thousandth of the finest step a program is written in.
+const IK_POSITION: Real = 1e-7;
+
+/// The inverse kinematics' default tolerance on the tool's axis (the unit
+/// vectors' difference): 1e-9, a nanometre at a metre from the pivot.
+const IK_DIRECTION: Real = 1e-9;
+
 /// What inverse kinematics should reach.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Target {
@@ -58,8 +66,8 @@ pub struct IkOptions {
 impl Default for IkOptions {
     fn default() -> Self {
         Self {
-            tol_pos: 1e-7,
-            tol_dir: 1e-9,
+            tol_pos: IK_POSITION,
+            tol_dir: IK_DIRECTION,
             max_iter: 100,
             axis_weight: 100.0,
             restarts: true,
@@ -288,7 +296,7 @@ impl<'a> Solver<'a> {
                 if accepted {
                     q.copy_from_slice(&trial);
                     cost = self.eval(q, true);
-                    lambda = (lambda / 3.0).max(1e-12);
+                    lambda = (lambda / 3.0).max(crate::tolerance::ROUNDING);
                     if within {
                         return (true, it + 1);
                     }
@@ -320,7 +328,7 @@ impl<'a> Solver<'a> {
                 }
             }
             let max_diag = (0..m).map(|i| a[i * m + i]).fold(0.0, Real::max);
-            let floor = 1e-12 * max_diag.max(1e-300);
+            let floor = crate::tolerance::ROUNDING * max_diag.max(crate::tolerance::TINY);
             let mut improved = false;
             while lambda < 1e12 {
                 damped.copy_from_slice(&a);
@@ -339,7 +347,7 @@ impl<'a> Solver<'a> {
                     if c.is_finite() && c < cost {
                         q.copy_from_slice(&trial);
                         cost = self.eval(q, true);
-                        lambda = (lambda / 3.0).max(1e-12);
+                        lambda = (lambda / 3.0).max(crate::tolerance::ROUNDING);
                         improved = true;
                         break;
                     }
@@ -415,7 +423,7 @@ impl Solver<'_> {
                     .zip(&share)
                     .map(|(&i, w)| w * (seed[i] - q[i])),
             );
-            let Ok(alpha) = a.svd(true, true).solve(&d, 1e-12) else {
+            let Ok(alpha) = a.svd(true, true).solve(&d, crate::tolerance::ROUNDING) else {
                 break;
             };
             let mut moved = q.to_vec();
@@ -429,7 +437,7 @@ impl Solver<'_> {
                 .zip(q.iter())
                 .map(|(a, b)| (a - b).abs())
                 .fold(0.0, Real::max);
-            if !(change > 1e-12) {
+            if !(change > crate::tolerance::ROUNDING) {
                 break;
             }
             let (ok, it) = self.solve(&mut moved, opts, bounds);

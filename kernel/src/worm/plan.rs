@@ -54,7 +54,7 @@ pub fn roughing_depths(h_r: Real, n: Option<usize>, a_min: Real) -> Result<Vec<R
         let a = law(i).max(a_min);
         d = (d + a).min(h_r);
         // Within rounding of the depth: the depth.
-        if h_r - d < 1e-9 {
+        if h_r - d < crate::tolerance::SAME_LENGTH {
             d = h_r;
         }
         out.push(d);
@@ -282,7 +282,7 @@ pub fn plan(
         last = d;
     }
     let a1z = axial_offset(t, c);
-    let sides = if a1z > 1e-9 {
+    let sides = if a1z > crate::tolerance::SAME_LENGTH {
         crate::math::positive("axial step of the universal cutter", s.axial_step)?;
         let n = (a1z / s.axial_step).ceil();
         if n > MAX_PASSES as Real {

@@ -38,6 +38,10 @@ use crate::verdict::{Figure, Finding};
 use geo::{Area, BooleanOps, Coord, LineString, MultiPolygon, Polygon};
 use serde::{Deserialize, Serialize};
 
+/// How far (mm) inside its ends a radial band is read, where the flanks
+/// are defined on both sides: a nanometre.
+const INSIDE: Real = 1e-6;
+
 /// What the finished worm must hold.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct WormTolerances {
@@ -506,7 +510,7 @@ impl WormCheck {
             .filter(|z| *z > w0 && *z < w0 + lead)
             .collect();
         zs.sort_by(Real::total_cmp);
-        zs.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+        zs.dedup_by(|a, b| (*a - *b).abs() < crate::tolerance::SAME_LENGTH);
         zs.iter().map(|&z| [z, self.radius_at(z)]).collect()
     }
 }
@@ -711,7 +715,7 @@ pub fn simulate(
             let out_of_groove = matches!(written.blocks[i - 1].motion, Motion::Thread { .. })
                 && z0 == z1e
                 && r1 >= r0;
-            if low < r_a - 1e-9 && !out_of_groove {
+            if low < r_a - crate::tolerance::SAME_LENGTH && !out_of_groove {
                 // The cutter's profile reaches its height above the tip; what
                 // holds it is the collision check's.
                 let half = cutter.width_at((r_a - low).min(cutter.height)) / 2.0;
@@ -725,7 +729,7 @@ pub fn simulate(
             }
             continue;
         };
-        if (r1 - r0).abs() > 1e-9 {
+        if (r1 - r0).abs() > crate::tolerance::SAME_LENGTH {
             found(
                 i,
                 format!(
@@ -824,7 +828,7 @@ pub fn simulate(
         let beyond = chip.difference(&nominal);
         let mut gouge: Real = 0.0;
         let mut worst = [0.0; 2];
-        if beyond.unsigned_area() > 1e-12 {
+        if beyond.unsigned_area() > crate::tolerance::NO_AREA {
             for (p, _) in edges(&beyond) {
                 let q = [p.x, p.y];
                 let d = spaces
@@ -1075,7 +1079,7 @@ fn pitch_diameter(m: &MultiPolygon<Real>, t: &ThreadSection, c: Real, band: (Rea
     // depths rounded to the program's digit), the band starts at it.
     if width(lo).is_none() {
         if let Some(root) = vertical_top(m, c) {
-            lo = lo.max(root + 1e-6);
+            lo = lo.max(root + INSIDE);
         }
     }
     let (Some(w_lo), Some(w_hi)) = (width(lo), width(hi)) else {
@@ -1259,8 +1263,8 @@ fn measure(
                 (
                     aimed.root_diameter / 2.0
                         + cutter.nose_radius * (1.0 - w.flanks[0].min(w.flanks[1]).sin())
-                        + 1e-6,
-                    r_a - 1e-6,
+                        + INSIDE,
+                    r_a - INSIDE,
                 ),
             ),
             over_wires: req
