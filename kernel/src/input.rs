@@ -2,7 +2,7 @@
 //!
 //! A leaf: it depends on nothing in the kernel, and every module may use
 //! it. Each module has its own error enum naming the offending value and
-//! its place (index, row, axis, block); [`crate::Error`] gathers them all.
+//! its place (index, row, axis, block); [`crate::error::Error`] gathers them all.
 
 use std::fmt;
 

@@ -89,6 +89,7 @@ pub mod tool;
 pub mod toolpath;
 pub mod transform;
 pub mod verdict;
+pub mod version;
 pub mod worm;
 
 pub use catalog::{Catalog, OpenMachine};
@@ -120,5 +121,4 @@ pub use transform::{
 #[doc = include_str!("../../README.md")]
 pub struct ReadmeDoctests;
 
-/// The kernel's version, as in its `Cargo.toml`.
-pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+pub use version::VERSION;

@@ -57,7 +57,7 @@ const FAILED_RUN: &str = "of a FAILED run (no program)";
 fn marker_text(files: &[&str], failed: bool) -> String {
     let mut s = format!(
         "pilgrim {} output directory{}: the next run to it replaces it as a whole.\n",
-        crate::VERSION,
+        crate::version::VERSION,
         if failed {
             format!(" {FAILED_RUN}")
         } else {

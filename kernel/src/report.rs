@@ -210,7 +210,7 @@ impl Report {
         checks: Vec<Check>,
     ) -> Self {
         Self {
-            pilgrim: crate::VERSION.into(),
+            pilgrim: crate::version::VERSION.into(),
             script: family.name().to_owned(),
             machine: info.name.clone(),
             machine_spec: machine.spec.clone(),
@@ -383,7 +383,7 @@ pub struct SolidFile {
 /// What a failed run leaves to look at: its report marked FAILED (with
 /// the verdict: what failed, where, and every figure), `report.html`, the
 /// plots and the scene at the place it failed, the data files; no program
-/// a control could load. [`crate::Error::Failed`] carries it.
+/// a control could load. [`crate::error::Error::Failed`] carries it.
 #[derive(Clone, PartialEq)]
 pub struct FailedRun {
     /// The report.

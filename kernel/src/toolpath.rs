@@ -165,7 +165,7 @@ impl Toolpath {
     /// Checks the names and texts of [`Self::validate`].
     fn check_texts(&self) -> Result<(), ToolpathError> {
         use crate::names::{check_name, check_text};
-        let whole = |e: crate::InputError| ToolpathError::Whole(e.to_string());
+        let whole = |e: crate::input::InputError| ToolpathError::Whole(e.to_string());
         check_name("tool name", &self.tool.name).map_err(whole)?;
         check_name("part name", &self.part).map_err(whole)?;
         for (i, p) in self.passes.iter().enumerate() {

@@ -20,6 +20,7 @@ use crate::compensate::{
     Quantity, PREDICTED,
 };
 use crate::error::Error;
+use crate::family::PartFamily;
 use crate::math::Real;
 use crate::output::RunDir;
 use crate::params::ParamSource;
@@ -27,7 +28,6 @@ use crate::profile::Table;
 use crate::program::{pass_blocks, AxisProgram, ProgramPass};
 use crate::script::{Access, Limits, ScriptFamily};
 use crate::toolpath::Toolpath;
-use crate::PartFamily;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::PathBuf;

@@ -9,7 +9,7 @@
 use super::{Axis, AxisKind, BodyShape, BodySpec, FactorSpec, Machine, MachineError, MachineInfo};
 use crate::math::{Point3, Real, Vec3};
 use crate::transform::{Chain, FactorKind, ToolFrame};
-use pilgrim_plugin_abi::types::{FactorKind as SpecFactor, Radial};
+use pilgrim_plugin_abi::types::Radial;
 use std::collections::BTreeMap;
 
 /// How far a rotary axis's stated direction (a unit vector) may be from
@@ -80,17 +80,6 @@ fn invalid(place: Place, message: impl Into<String>) -> Invalid {
     }
 }
 
-fn kind_of(f: SpecFactor) -> FactorKind {
-    match f {
-        SpecFactor::Tx => FactorKind::Tx,
-        SpecFactor::Ty => FactorKind::Ty,
-        SpecFactor::Tz => FactorKind::Tz,
-        SpecFactor::Rx => FactorKind::Rx,
-        SpecFactor::Ry => FactorKind::Ry,
-        SpecFactor::Rz => FactorKind::Rz,
-    }
-}
-
 /// Compiles the factors of `body`'s chain (`None`: the tool's).
 fn compile_chain(
     info: &MachineInfo,
@@ -114,7 +103,7 @@ fn compile_chain(
     }
     for (i, f) in factors.iter().enumerate() {
         let at = |key| Place::Factor(owner.clone(), i, key);
-        let kind = kind_of(f.factor);
+        let kind = f.factor;
         let word = format!("{kind:?}").to_lowercase();
         let finite = |v: Real, key| {
             if v.is_finite() {

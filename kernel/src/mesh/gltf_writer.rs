@@ -26,7 +26,7 @@ fn build(scene: &Scene, uri: Option<String>) -> Result<(json::Root, Vec<u8>), Me
     let mut root = json::Root {
         asset: json::Asset {
             version: "2.0".into(),
-            generator: Some(format!("pilgrim {}", crate::VERSION)),
+            generator: Some(format!("pilgrim {}", crate::version::VERSION)),
             ..Default::default()
         },
         ..Default::default()

@@ -70,7 +70,7 @@ pub fn write_stl<W: Write>(
     match format {
         StlFormat::Binary => {
             let mut header = [b' '; 80];
-            let text = format!("pilgrim {} {} units=mm", crate::VERSION, name);
+            let text = format!("pilgrim {} {} units=mm", crate::version::VERSION, name);
             let n = text.len().min(80);
             header[..n].copy_from_slice(&text.as_bytes()[..n]);
             let mut w = Header {

@@ -298,7 +298,7 @@ fn lint_apt(text: &str, program: &AxisProgram, d: &Dialect) -> Result<Linted, Li
     let mut k = 0;
     let (mut rapid_next, mut coolant) = (false, false);
     let mut speed: Option<Real> = None;
-    let written_by = format!("written by pilgrim {}", crate::VERSION);
+    let written_by = format!("written by pilgrim {}", crate::version::VERSION);
     let mut ticker = crate::budget::Ticker::new("the CL file's lint", 1024);
     for (l, line) in lines.iter().enumerate() {
         let at = || format!("line {}", l + 1);

@@ -729,7 +729,7 @@ fn fill(template: &str, p: &AxisProgram, d: &Dialect) -> String {
         .replace("{TOOLNAME}", &tool_name)
         .replace("{TOOL}", &p.tool_number.to_string())
         .replace("{S}", &format!("{}", p.spindle_rpm.round() as i64))
-        .replace("{VERSION}", crate::VERSION)
+        .replace("{VERSION}", crate::version::VERSION)
 }
 
 /// The words of `setup` in `d`: work offset, plane, radius or diameter
@@ -1050,7 +1050,7 @@ mod tests {
         let expected = "%_N_DEMO_MPF\n;$PATH=/_N_MPF_DIR\n; DEMO for test-lathe, written by pilgrim VERSION\n\
 ; tool T3: thread insert 60\nN1 G90 G94 G71\nN2 T3 D1\nN3 S399 M3\n; pass 1\nN10 G0 X50.000 Z5.000\n\
 N20 G1 X40.000 F100.0\nN30 Z0.000\nN40 X40.000\nN50 G33 Z-60.000 K6.3500\nN60 G0 X50.000\nN70 M5\nN80 M30\n";
-        assert_eq!(text, expected.replace("VERSION", crate::VERSION));
+        assert_eq!(text, expected.replace("VERSION", crate::version::VERSION));
     }
 
     #[test]
@@ -1059,7 +1059,7 @@ N20 G1 X40.000 F100.0\nN30 Z0.000\nN40 X40.000\nN50 G33 Z-60.000 K6.3500\nN60 G0
         let expected = "%\nO0007 (DEMO)\n(TEST-LATHE, WRITTEN BY PILGRIM VERSION)\n(TOOL T03: THREAD INSERT 60)\n\
 G21 G40 G97 G98\nT0303\nS399 M03\n(PASS 1)\nG00 X50.000 Z5.000\nG01 X40.000 F100.0\nZ0.000\n\
 X40.000\nG32 Z-60.000 F6.3500\nG00 X50.000\nM05\nM30\n%\n";
-        assert_eq!(text, expected.replace("VERSION", crate::VERSION));
+        assert_eq!(text, expected.replace("VERSION", crate::version::VERSION));
     }
 
     #[test]
@@ -1069,7 +1069,7 @@ X40.000\nG32 Z-60.000 F6.3500\nG00 X50.000\nM05\nM30\n%\n";
 SPINDL/399,RPM,CLW\nPPRINT/pass 1\nRAPID\nGOTO/50.000,5.000\nFEDRAT/100.000,MMPM\nGOTO/40.000,5.000\n\
 GOTO/40.000,0.000\nGOTO/40.000,0.000\nFEDRAT/6.3500,MMPR\nGOTO/40.000,-60.000\nRAPID\nGOTO/50.000,-60.000\n\
 SPINDL/OFF\nFINI\n";
-        assert_eq!(text, expected.replace("VERSION", crate::VERSION));
+        assert_eq!(text, expected.replace("VERSION", crate::version::VERSION));
     }
 
     #[test]

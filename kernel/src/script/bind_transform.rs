@@ -4,6 +4,7 @@
 
 use super::floats::{err, kernel, numbers, Floats, Numbers};
 use crate::math::{Mat4, Real};
+use crate::transform::FactorGeometry;
 use crate::transform::{map_points, Chain, FactorKind};
 use rhai::plugin::*;
 use rhai::EvalAltResult;

@@ -504,7 +504,7 @@ fn write(
         "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION(('pilgrim: {name}, {what}'),'2;1');\n\
          FILE_NAME('{name}.step','',('pilgrim'),(''),'truck-stepio 0.3','pilgrim {}','');\n\
          FILE_SCHEMA(('{SCHEMA}'));\nENDSEC;\n{data}",
-        crate::VERSION
+        crate::version::VERSION
     ))
 }
 

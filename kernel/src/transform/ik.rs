@@ -7,6 +7,7 @@
 //! through the factors, one forward sweep accumulates the rotations, so an
 //! iteration costs about two chain evaluations.
 
+use super::FactorGeometry;
 use super::{Chain, FactorKind, FactorValue, Frame, ToolFrame, TransformError};
 use crate::input::InputError;
 use crate::math::{Point3, Real, Vec3};

@@ -26,51 +26,28 @@ use crate::input::InputError;
 use crate::math::{Mat3, Mat4, Point3, Real, Vec3};
 use serde::{Deserialize, Serialize};
 
-/// One of the six elementary factors of MATH §1.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum FactorKind {
-    /// Translation along X by the factor's value (mm).
-    Tx,
-    /// Translation along Y (mm).
-    Ty,
-    /// Translation along Z (mm).
-    Tz,
-    /// Rotation about X by the factor's value (rad), right-handed.
-    Rx,
-    /// Rotation about Y (rad), right-handed.
-    Ry,
-    /// Rotation about Z (rad), right-handed.
-    Rz,
+/// One of the six elementary factors of a chain: the plugin ABI's type,
+/// defined once there (a machine's description names its factors with
+/// it); [`FactorGeometry`] gives its direction and matrix in the kernel's
+/// types.
+pub use pilgrim_plugin_abi::types::FactorKind;
+
+/// A factor's geometry in the kernel's types.
+pub trait FactorGeometry {
+    /// The unit vector it moves along or about.
+    fn direction(self) -> Vec3;
+    /// The 4x4 matrix of the factor at `value`.
+    fn matrix(self, value: Real) -> Mat4;
 }
 
-impl FactorKind {
-    /// All six kinds, translations first.
-    pub const ALL: [FactorKind; 6] = [Self::Tx, Self::Ty, Self::Tz, Self::Rx, Self::Ry, Self::Rz];
-
-    /// Whether the factor is a rotation (its value in radians).
-    pub fn is_rotation(self) -> bool {
-        matches!(self, Self::Rx | Self::Ry | Self::Rz)
-    }
-
-    /// Index of the coordinate axis (0 = X, 1 = Y, 2 = Z) it moves along or about.
-    pub fn direction_index(self) -> usize {
-        match self {
-            Self::Tx | Self::Rx => 0,
-            Self::Ty | Self::Ry => 1,
-            Self::Tz | Self::Rz => 2,
-        }
-    }
-
-    /// The unit vector of [`Self::direction_index`].
-    pub fn direction(self) -> Vec3 {
+impl FactorGeometry for FactorKind {
+    fn direction(self) -> Vec3 {
         let mut v = Vec3::zeros();
         v[self.direction_index()] = 1.0;
         v
     }
 
-    /// The 4x4 matrix of the factor at `value`, as printed in MATH §1.
-    pub fn matrix(self, value: Real) -> Mat4 {
+    fn matrix(self, value: Real) -> Mat4 {
         let mut m = Mat4::identity();
         let (s, c) = crate::math::sin_cos(value);
         match self {

@@ -205,6 +205,26 @@ pub enum FactorKind {
     Rz,
 }
 
+impl FactorKind {
+    /// All six kinds, translations first.
+    pub const ALL: [FactorKind; 6] = [Self::Tx, Self::Ty, Self::Tz, Self::Rx, Self::Ry, Self::Rz];
+
+    /// Whether the factor is a rotation (its value in radians).
+    pub fn is_rotation(self) -> bool {
+        matches!(self, Self::Rx | Self::Ry | Self::Rz)
+    }
+
+    /// Index of the coordinate axis (0 = X, 1 = Y, 2 = Z) it moves along
+    /// or about.
+    pub fn direction_index(self) -> usize {
+        match self {
+            Self::Tx | Self::Rx => 0,
+            Self::Ty | Self::Ry => 1,
+            Self::Tz | Self::Rz => 2,
+        }
+    }
+}
+
 /// A number, or the name of a machine constant that gives it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(untagged)]
