@@ -12,8 +12,8 @@
 //!   replayed are printed, with points per second.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use pilgrim_kernel::caliber::check_groove;
 use pilgrim_kernel::catalog::{Catalog, CompiledPlugin};
+use pilgrim_kernel::families::caliber::check_groove;
 use pilgrim_kernel::job::{self, JobOptions};
 use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
 use pilgrim_kernel::PartFamily;
@@ -47,7 +47,7 @@ fn caliber_job(c: &mut Criterion) {
     };
     let out = run();
     assert!(
-        out.check::<pilgrim_kernel::caliber::GrooveOutcome>()
+        out.check::<pilgrim_kernel::families::caliber::GrooveOutcome>()
             .is_some()
             && out.files.len() >= 11,
         "{} files",
@@ -78,7 +78,7 @@ fn caliber_verify(c: &mut Criterion) {
     let family = family();
     let out = job::run(&family, &machine, &[], &JobOptions::default(), &mut |_| {}).unwrap();
     let Some(req) = family.verification(&out.params).unwrap().and_then(|v| {
-        v.request::<pilgrim_kernel::caliber::GrooveRequest>()
+        v.request::<pilgrim_kernel::families::caliber::GrooveRequest>()
             .cloned()
     }) else {
         panic!("the caliber asks for the groove's replay")
@@ -119,7 +119,7 @@ fn caliber_verify(c: &mut Criterion) {
     let allowance = req.stock.expect("the caliber states its stock");
     let limits = pilgrim_kernel::process::ProcessLimits::of(kin.info());
     let process = || {
-        let stock = pilgrim_kernel::caliber::GrooveStock::new(
+        let stock = pilgrim_kernel::families::caliber::GrooveStock::new(
             &req,
             allowance,
             &wheel,

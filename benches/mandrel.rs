@@ -12,11 +12,11 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pilgrim_kernel::catalog::{Catalog, CompiledPlugin};
+use pilgrim_kernel::families::revolution::phases::Infeed;
+use pilgrim_kernel::families::revolution::rest::{track, RestSetup};
+use pilgrim_kernel::families::revolution::surface::{GroundSurface, PassLayer, WheelSection};
 use pilgrim_kernel::job::{self, JobOptions};
 use pilgrim_kernel::offset::flat_path;
-use pilgrim_kernel::revolution::phases::Infeed;
-use pilgrim_kernel::revolution::rest::{track, RestSetup};
-use pilgrim_kernel::revolution::surface::{GroundSurface, PassLayer, WheelSection};
 use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
 use pilgrim_kernel::{
     drop_circle, equidistant, ClPoint, MandrelLaw, Motion, PartFamily, Pass, ProfileBuilder, Side,

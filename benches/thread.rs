@@ -78,7 +78,9 @@ fn thread_job(c: &mut Criterion) {
         };
         let out = run();
         assert!(
-            out.check::<pilgrim_kernel::worm::WormOutcome>().is_some() && out.files.len() >= 12,
+            out.check::<pilgrim_kernel::families::worm::WormOutcome>()
+                .is_some()
+                && out.files.len() >= 12,
             "{name}: {} files",
             out.files.len()
         );

@@ -10,9 +10,9 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pilgrim_kernel::catalog::{Catalog, CompiledPlugin};
+use pilgrim_kernel::families::worm::simulate;
 use pilgrim_kernel::job::{self, JobOptions};
 use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
-use pilgrim_kernel::worm::simulate;
 use pilgrim_kernel::{PartFamily, ToolShape};
 use std::hint::black_box;
 use std::path::Path;
@@ -44,7 +44,9 @@ fn worm_job(c: &mut Criterion) {
     };
     let out = run();
     assert!(
-        out.check::<pilgrim_kernel::worm::WormOutcome>().is_some() && out.files.len() >= 12,
+        out.check::<pilgrim_kernel::families::worm::WormOutcome>()
+            .is_some()
+            && out.files.len() >= 12,
         "{} files",
         out.files.len()
     );
@@ -59,11 +61,10 @@ fn worm_simulate(c: &mut Criterion) {
     let machine = catalog.open("fanuc-0i-tc").unwrap();
     let family = family();
     let out = job::run(&family, &machine, &[], &JobOptions::default(), &mut |_| {}).unwrap();
-    let Some(req) = family
-        .verification(&out.params)
-        .unwrap()
-        .and_then(|v| v.request::<pilgrim_kernel::worm::WormRequest>().cloned())
-    else {
+    let Some(req) = family.verification(&out.params).unwrap().and_then(|v| {
+        v.request::<pilgrim_kernel::families::worm::WormRequest>()
+            .cloned()
+    }) else {
         panic!("the worm asks for the simulation")
     };
     let ToolShape::ThreadCutter(cutter) = out.toolpath.tool.shape else {

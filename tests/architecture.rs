@@ -1,9 +1,8 @@
 //! The kernel's module graph as `docs/architecture.md` describes it: the
 //! top-level modules (a folder counts as one) and the arrows their code's
 //! `crate::<module>` paths draw (comments and unit tests left out). No
-//! circle; every arrow runs up the page's layer list; the generic modules
-//! that name a family are the registry and the ones the page lists, and no
-//! other.
+//! circle; every arrow runs up the page's layer list; a family is named
+//! only in its folder and the registry; the page's figures are the code's.
 
 use crate::common::root;
 use std::collections::{BTreeMap, BTreeSet};
@@ -81,17 +80,78 @@ fn the_kernels_modules_form_no_circle() {
     for m in g.keys() {
         visit(m, &g, &mut Vec::new(), &mut done);
     }
-    // The generic modules that name a family: the registry (by design),
-    // and each of the others in the page's list of arrows still to go.
-    let families = ["revolution", "caliber", "worm"];
-    let naming: Vec<&str> = g
-        .iter()
-        .filter(|(m, names)| {
-            !families.contains(&m.as_str()) && families.iter().any(|f| names.contains(*f))
-        })
-        .map(|(m, _)| m.as_str())
+}
+
+/// The families under `kernel/src/families/`, each its folder.
+fn families() -> Vec<String> {
+    let mut out: Vec<String> = std::fs::read_dir(root().join("kernel/src/families"))
+        .unwrap()
+        .flatten()
+        .filter(|e| e.path().is_dir())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
         .collect();
-    assert_eq!(naming, ["families", "job"]);
+    out.sort();
+    out
+}
+
+/// A family is its folder plus one registry line: no file outside
+/// `families/<f>/` names `<f>` by its path (`families::<f>`), the
+/// registry's (`families/mod.rs`) excepted; within the families, one
+/// names another only where it is built on it (the worm is a thread
+/// profile: `worm` uses `thread`).
+#[test]
+fn a_family_is_named_only_in_its_folder_and_the_registry() {
+    let families = families();
+    assert!(families.len() >= 4, "{families:?}");
+    let built_on = [("worm", "thread")];
+    let mut naming = vec![];
+    let src = root().join("kernel/src");
+    for file in rust_files(&src) {
+        let rel = file
+            .strip_prefix(&src)
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
+        if rel == "families/mod.rs" {
+            continue;
+        }
+        let own = rel
+            .strip_prefix("families/")
+            .and_then(|r| r.split('/').next())
+            .map(str::to_owned);
+        let text = std::fs::read_to_string(&file).unwrap();
+        for f in &families {
+            if own.as_deref() == Some(f.as_str())
+                || own
+                    .as_deref()
+                    .is_some_and(|o| built_on.contains(&(o, f.as_str())))
+            {
+                continue;
+            }
+            let path = format!("families::{f}");
+            let named = text.match_indices(&path).any(|(i, _)| {
+                !text[i + path.len()..].starts_with(|c: char| c.is_alphanumeric() || c == '_')
+            });
+            if named {
+                naming.push(format!("{rel} names {f}"));
+            }
+        }
+    }
+    assert!(naming.is_empty(), "{naming:#?}");
+}
+
+/// Every `.rs` file under `dir`.
+fn rust_files(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let mut out = vec![];
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            out.extend(rust_files(&p));
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+    out
 }
 
 /// The layers `docs/architecture.md` lists ("Dependencies go one way, down
@@ -147,5 +207,29 @@ fn the_kernels_modules_keep_the_pages_order() {
     assert!(
         down.is_empty(),
         "arrows down the page's list (move the module or the code): {down:?}"
+    );
+}
+
+/// The page says how many modules and arrows the graph has, as counted
+/// here: the figures are the code's, never a wish or an old count.
+#[test]
+fn the_pages_figures_are_the_codes() {
+    let g = graph();
+    let arrows: usize = g.values().map(BTreeSet::len).sum();
+    let said = format!("{} modules, {} arrows", g.len(), arrows);
+    let page = std::fs::read_to_string(root().join("docs/architecture.md")).unwrap();
+    let flat = page.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(
+        flat.contains(&said),
+        "docs/architecture.md must say '{said}' (run `cargo test --test pilgrim_e2e architecture::` for the figures)"
+    );
+    let abi = format!(
+        "{}.{} (`ABI_MINOR`)",
+        pilgrim_plugin_abi::ABI_MAJOR,
+        pilgrim_plugin_abi::ABI_MINOR
+    );
+    assert!(
+        flat.contains(&abi),
+        "docs/architecture.md must give the ABI as {abi}"
     );
 }

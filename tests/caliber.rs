@@ -7,7 +7,7 @@ use crate::common;
 
 use common::{pilgrim, pilgrim_in, root, s, scratch};
 use lz_250::CaliberKinematics;
-use pilgrim_kernel::caliber::{check_groove, Groove, GrooveRequest};
+use pilgrim_kernel::families::caliber::{check_groove, Groove, GrooveRequest};
 use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
 use pilgrim_kernel::PartFamily;
 use std::path::Path;
@@ -412,7 +412,7 @@ fn the_sizing_section_is_held_through_the_smoothing() {
 /// the script's one `smoothing(p)`).
 #[test]
 fn the_verification_measures_the_groove_asked_for() {
-    use pilgrim_kernel::caliber::EdgeKind;
+    use pilgrim_kernel::families::caliber::EdgeKind;
     use pilgrim_kernel::Interpolation;
     let fam =
         ScriptFamily::load(&root().join(SCRIPT), &Limits::default(), &Access::default()).unwrap();
@@ -666,7 +666,7 @@ fn edge_model(kind: &str, a: f64, b: f64, size: f64) -> EdgeModel {
 fn the_edge_from_the_table_is_ground_and_verified(
     name: &str,
     fixture: &str,
-    kind: pilgrim_kernel::caliber::EdgeKind,
+    kind: pilgrim_kernel::families::caliber::EdgeKind,
     column: &str,
     sizes: (f64, f64),
 ) {
@@ -685,8 +685,8 @@ fn the_edge_from_the_table_is_ground_and_verified(
     let r = report(&out);
     assert_eq!(r["verdict"]["status"], "passed", "{}", r["verdict"]);
     let word = match kind {
-        pilgrim_kernel::caliber::EdgeKind::Rounding => "rounding",
-        pilgrim_kernel::caliber::EdgeKind::Chamfer => "chamfer",
+        pilgrim_kernel::families::caliber::EdgeKind::Rounding => "rounding",
+        pilgrim_kernel::families::caliber::EdgeKind::Chamfer => "chamfer",
     };
     assert_eq!(r["notes"][format!("edge_{word}_min_mm")], sizes.0);
     assert_eq!(r["notes"][format!("edge_{word}_max_mm")], sizes.1);
@@ -817,7 +817,7 @@ fn the_edges_rounding_from_the_table_is_ground_and_verified() {
     the_edge_from_the_table_is_ground_and_verified(
         "rounded",
         fixture,
-        pilgrim_kernel::caliber::EdgeKind::Rounding,
+        pilgrim_kernel::families::caliber::EdgeKind::Rounding,
         "edge_r_mm",
         (2.0, 3.0),
     );
@@ -845,7 +845,7 @@ fn the_edges_chamfer_from_the_table_is_ground_and_verified() {
     the_edge_from_the_table_is_ground_and_verified(
         "chamfered",
         fixture,
-        pilgrim_kernel::caliber::EdgeKind::Chamfer,
+        pilgrim_kernel::families::caliber::EdgeKind::Chamfer,
         "edge_c_mm",
         (1.0, 1.5),
     );

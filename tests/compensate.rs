@@ -622,7 +622,7 @@ fn replayed_with(
 /// deviations from it.
 fn groove_at(
     report: &serde_json::Value,
-    g: &pilgrim_kernel::caliber::Groove,
+    g: &pilgrim_kernel::families::caliber::Groove,
     theta: f64,
 ) -> (f64, f64) {
     let t = &report["tables"]["predicted_deviation"];

@@ -1,7 +1,7 @@
 //! The mandrel family (seed 000) checked from the program text it writes.
 
+use pilgrim_kernel::families::revolution::GrindingCheck;
 use pilgrim_kernel::program::{block_label, build, AxisProgram, PostProcessor, SharedPost};
-use pilgrim_kernel::revolution::GrindingCheck;
 use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
 use pilgrim_kernel::{MandrelLaw, Params, PartFamily, Profile, Side, Toolpath};
 use std::collections::BTreeMap;
@@ -304,7 +304,7 @@ fn job(
         panic!("the mandrel's tool is a wheel")
     };
     let check = move |program: &AxisProgram| {
-        pilgrim_kernel::revolution::check_grinding(
+        pilgrim_kernel::families::revolution::check_grinding(
             program,
             &grinder,
             &reference,
@@ -375,7 +375,7 @@ fn verification_catches_a_corrupted_block() {
             "{}",
             p.name
         );
-        assert!(p.along_z.len() <= pilgrim_kernel::revolution::PROFILE_BUCKETS);
+        assert!(p.along_z.len() <= pilgrim_kernel::families::revolution::PROFILE_BUCKETS);
     }
     // Block 40 of the finishing pass goes 5 um too deep.
     let k = finish.first_block - 1 + 40;
@@ -740,7 +740,7 @@ fn process_errors(
     let pilgrim_kernel::ToolShape::Wheel(wheel) = tp.tool.shape else {
         panic!("the mandrel's tool is a wheel")
     };
-    let (_, stock) = pilgrim_kernel::revolution::replay_grinding(
+    let (_, stock) = pilgrim_kernel::families::revolution::replay_grinding(
         program,
         &grinder,
         &tp.tool.reference,

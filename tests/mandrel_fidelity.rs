@@ -527,7 +527,11 @@ fn the_rest_rides_the_large_mandrel() {
 fn verified(
     sets: &[(&str, &str)],
     tolerance: Option<f64>,
-) -> (pilgrim_kernel::revolution::GrindingCheck, String, Params) {
+) -> (
+    pilgrim_kernel::families::revolution::GrindingCheck,
+    String,
+    Params,
+) {
     verified_with(None, sets, tolerance)
 }
 
@@ -536,7 +540,11 @@ fn verified_with(
     file: Option<&str>,
     sets: &[(&str, &str)],
     tolerance: Option<f64>,
-) -> (pilgrim_kernel::revolution::GrindingCheck, String, Params) {
+) -> (
+    pilgrim_kernel::families::revolution::GrindingCheck,
+    String,
+    Params,
+) {
     let fam = family();
     let values = params(&fam, file, sets);
     let tp = fam.toolpath(&values).unwrap();
@@ -551,7 +559,7 @@ fn verified_with(
     let pilgrim_kernel::ToolShape::Wheel(wheel) = tp.tool.shape else {
         panic!("a wheel")
     };
-    let check = pilgrim_kernel::revolution::check_grinding(
+    let check = pilgrim_kernel::families::revolution::check_grinding(
         &program,
         &machine,
         &tp.tool.reference,

@@ -52,14 +52,14 @@
 //! ```
 
 mod binding;
+pub mod blade;
 pub mod budget;
-pub mod caliber;
 pub mod catalog;
 mod chart;
 pub mod collision;
 pub mod compensate;
 pub mod error;
-mod families;
+pub mod families;
 pub mod family;
 pub mod files;
 mod html;
@@ -79,10 +79,8 @@ pub mod profile;
 pub mod program;
 pub mod replay;
 mod report;
-pub mod revolution;
 pub mod script;
 pub mod step;
-pub mod thread;
 pub mod timing;
 pub mod tolerance;
 pub mod tool;
@@ -90,7 +88,6 @@ pub mod toolpath;
 pub mod transform;
 pub mod verdict;
 pub mod version;
-pub mod worm;
 
 pub use catalog::{Catalog, OpenMachine};
 pub use error::Error;

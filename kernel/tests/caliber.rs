@@ -2,7 +2,7 @@
 //! ellipse, distances along normals, circles intersected numerically, the
 //! torus against the groove's surface.
 
-use pilgrim_kernel::caliber::{
+use pilgrim_kernel::families::caliber::{
     exact_pose, scallop_height, seed_pose, step_for_scallop, Groove, GrooveError,
 };
 use pilgrim_kernel::math::Vec3;
@@ -375,7 +375,10 @@ fn passes_are_spread_across_the_groove() {
 #[test]
 fn passes_run_closer_on_the_edges_rounding() {
     let g = reduction_groove()
-        .with_edge(pilgrim_kernel::caliber::EdgeKind::Rounding, &[2.0; 81])
+        .with_edge(
+            pilgrim_kernel::families::caliber::EdgeKind::Rounding,
+            &[2.0; 81],
+        )
         .unwrap();
     let r_k = 10.0;
     let (psi, rz) = g.pass_angles(r_k, 1f64.to_radians(), FRAC_PI_2).unwrap();
@@ -412,7 +415,7 @@ fn passes_run_closer_on_the_edges_rounding() {
 /// periphery's.
 #[test]
 fn the_normal_turns_round_a_chamfers_corners() {
-    use pilgrim_kernel::caliber::EdgeKind;
+    use pilgrim_kernel::families::caliber::EdgeKind;
     let g = reduction_groove()
         .with_edge(EdgeKind::Chamfer, &[1.5; 81])
         .unwrap();
@@ -449,7 +452,10 @@ fn a_bad_edge_rounding_is_named() {
     radii[7] = -0.5;
     let e = g
         .clone()
-        .with_edge(pilgrim_kernel::caliber::EdgeKind::Rounding, &radii)
+        .with_edge(
+            pilgrim_kernel::families::caliber::EdgeKind::Rounding,
+            &radii,
+        )
         .unwrap_err()
         .to_string();
     assert!(
@@ -457,7 +463,10 @@ fn a_bad_edge_rounding_is_named() {
         "{e}"
     );
     let e = g
-        .with_edge(pilgrim_kernel::caliber::EdgeKind::Rounding, &[2.0; 80])
+        .with_edge(
+            pilgrim_kernel::families::caliber::EdgeKind::Rounding,
+            &[2.0; 80],
+        )
         .unwrap_err()
         .to_string();
     // The sizes are the edge's, not B's.
@@ -473,7 +482,7 @@ fn a_bad_edge_rounding_is_named() {
 /// rim is narrower than the groove; left in target/mesh-check for FreeCAD.
 #[test]
 fn the_caliber_solid_is_closed_and_holds_its_volume() {
-    use pilgrim_kernel::caliber::caliber_solid;
+    use pilgrim_kernel::families::caliber::caliber_solid;
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scripts/caliber-groove.csv");
     let t = pilgrim_kernel::read_table(&path).unwrap();

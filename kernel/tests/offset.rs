@@ -1,5 +1,5 @@
 //! Equidistants, envelopes and the steady rest, checked by geometry.
-use pilgrim_kernel::revolution::rest;
+use pilgrim_kernel::families::revolution::rest;
 
 use pilgrim_kernel::{
     assert_near, equidistant, Bulge, CircleEnvelope, MandrelLaw, Profile, ProfileBuilder,

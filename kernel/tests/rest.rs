@@ -1,8 +1,8 @@
 //! The steady rest's track on the current surface during a pass.
 
+use pilgrim_kernel::families::revolution::rest::{track, RestSetup, RestTrack};
+use pilgrim_kernel::families::revolution::surface::{GroundSurface, WheelSection};
 use pilgrim_kernel::profile::Polyline;
-use pilgrim_kernel::revolution::rest::{track, RestSetup, RestTrack};
-use pilgrim_kernel::revolution::surface::{GroundSurface, WheelSection};
 use pilgrim_kernel::{drop_circle, equidistant, MandrelLaw, Profile, ProfileError, Side};
 
 const R_S: f64 = 20.0;

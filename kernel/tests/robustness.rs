@@ -1,8 +1,8 @@
 //! Random input, including NaN, infinities and huge values, never makes the
 //! kernel panic: every bad value comes back as an error.
 
+use pilgrim_kernel::families::revolution::rest;
 use pilgrim_kernel::machine::{machine_file, BUILTIN_SOURCES};
-use pilgrim_kernel::revolution::rest;
 use pilgrim_kernel::{
     drop_circle, equidistant, read_table_str, Bulge, CircleEnvelope, EllipseSection, IkOptions,
     Machine, MandrelLaw, Point3, Profile, ProfileBuilder, Side, Target, ToolFrame, Vec3,

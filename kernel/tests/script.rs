@@ -252,9 +252,9 @@ fn transforms_in_scripts_follow_the_universal_chain() {
 /// script give what the same kernel calls give from Rust.
 #[test]
 fn mandrel_building_blocks_in_scripts() {
+    use pilgrim_kernel::families::revolution::rest::{track, RestSetup};
+    use pilgrim_kernel::families::revolution::surface::{GroundSurface, WheelSection};
     use pilgrim_kernel::profile::{simplify_polyline, Polyline};
-    use pilgrim_kernel::revolution::rest::{track, RestSetup};
-    use pilgrim_kernel::revolution::surface::{GroundSurface, WheelSection};
     use pilgrim_kernel::{equidistant, MandrelLaw, ProfileBuilder, Side};
     let src = format!(
         "{HEAD}fn toolpath(p) {{\n\

@@ -176,7 +176,7 @@ pub const NOT_VERIFIED: &str =
 impl JobOutput {
     /// The verification's outcome as its own type (`None` if the family
     /// asked for none, or for one of another kind): e.g.
-    /// `out.check::<crate::revolution::GrindingOutcome>()`.
+    /// `out.check::<GrindingOutcome>()` (the outcome type of the family's verification).
     pub fn check<T: 'static>(&self) -> Option<&T> {
         self.outcome.as_ref()?.as_any().downcast_ref()
     }

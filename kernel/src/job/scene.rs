@@ -76,7 +76,7 @@ pub fn bounds_of<'a>(meshes: impl Iterator<Item = &'a TriMesh>) -> Option<([f64;
 }
 
 /// The tool's solid in its own frame, standing `at` (a thread cutter's
-/// blade follows the thread it cuts there: [`crate::worm::ThreadBlade`]),
+/// blade follows the thread it cuts there: [`crate::blade::ThreadBlade`]),
 /// and the file name it is written as.
 ///
 /// # Failures
@@ -112,9 +112,9 @@ pub fn tool_mesh(
 }
 
 /// A thread cutter's blade standing `at`.
-pub fn thread_blade(c: &crate::worm::ThreadCutter, at: &ToolAt) -> crate::worm::ThreadBlade {
+pub fn thread_blade(c: &crate::tool::ThreadCutter, at: &ToolAt) -> crate::blade::ThreadBlade {
     let tip_radius = at.pose[(0, 3)].hypot(at.pose[(1, 3)]);
-    crate::worm::ThreadBlade::new(c, tip_radius, at.lead, at.pose)
+    crate::blade::ThreadBlade::new(c, tip_radius, at.lead, at.pose)
 }
 
 /// A body placed in the part frame: name, mesh in its own frame, pose.
@@ -378,7 +378,7 @@ pub struct ToolAt {
 /// kinematics of the axis values there; in a thread block, turned about the
 /// part's axis by the angle the spindle has turned the part since the
 /// thread's start (its start angle, then one turn a lead), as the worm's
-/// simulation places each cut ([`crate::worm::simulate`]): the tool stands
+/// simulation places each cut (the thread family's): the tool stands
 /// in the thread it cuts.
 ///
 /// # Failures

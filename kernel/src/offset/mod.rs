@@ -6,7 +6,7 @@
 //! ([`equidistant`]); the surface it leaves is the envelope of its positions
 //! ([`CircleEnvelope`]); the lowest position of a circle resting on a
 //! surface is its "drop" ([`drop_circle`]), which is also the exact model of
-//! the steady rest ([`crate::revolution::rest`]). The envelope and the drop are computed
+//! the steady rest (the revolution family's). The envelope and the drop are computed
 //! exactly on the sampled data and are the independent check of every
 //! offset.
 

@@ -3,9 +3,9 @@
 //! its control does (every value at the decimals written), [`replay`]
 //! moves the tool through the machine's forward kinematics block by block,
 //! [`passes_in`] finds the passes of a program read from its text; each
-//! family's replay ([`crate::revolution`] for bodies of revolution,
-//! [`crate::caliber`], [`crate::worm`]) builds on them and reports through
-//! [`VerifyError`].
+//! family's replay (in its folder under `families/`) builds on them and
+//! reports through [`VerifyError`]; [`polar`] replays the radius over angle
+//! of a part that is not round, for any family.
 
 pub mod polar;
 

@@ -249,7 +249,7 @@ fn register_types(e: &mut Engine) {
         .register_type_with_name::<Table>("Table")
         .register_type_with_name::<bind_toolpath::ToolpathHandle>("Toolpath")
         .register_type_with_name::<crate::family::Swept>("Solid");
-    for group in crate::families::SCRIPT_API {
+    for group in crate::families::script_api() {
         (group.types)(e);
     }
 }
@@ -262,7 +262,7 @@ fn no_types(_: &mut Engine) {}
 fn api() -> impl Iterator<Item = &'static ApiGroup> {
     BEFORE_FAMILIES
         .iter()
-        .chain(crate::families::SCRIPT_API)
+        .chain(crate::families::script_api())
         .chain(AFTER_FAMILIES.iter())
 }
 

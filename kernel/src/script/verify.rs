@@ -1,5 +1,5 @@
 //! What a script's `fn verify(p)` declares, read: a family's form (each
-//! family's folder reads its own map: `families::SCRIPT_API`), or a
+//! family's folder reads its own map: `families::FAMILIES`), or a
 //! verification of the script's own on a replay the kernel makes
 //! (`#{ replay: "radius_over_angle", ... , judge }`); either may name a
 //! `judge`, the script's function the kernel calls once with the replayed
@@ -33,8 +33,7 @@ const FINDING_KEYS: [&str; 3] = ["rule", "message", "block"];
 /// What a script's `fn verify(p)` declared, read; `Err(message)` says what
 /// is wrong, naming what is accepted.
 pub(super) fn read(script: &Script, params: Map, m: Map) -> Result<Verification, String> {
-    let forms: Vec<_> = crate::families::SCRIPT_API
-        .iter()
+    let forms: Vec<_> = crate::families::script_api()
         .filter_map(|g| g.verify.as_ref())
         .collect();
     let judge_of = |m: &mut Map| -> Result<Option<String>, String> {

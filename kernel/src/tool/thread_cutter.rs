@@ -289,7 +289,7 @@ mod tests {
             }
         }
         // The exact outline encloses the same area, less the chords'.
-        let exact = crate::worm::cutter_outline(&c, 10.0).area();
+        let exact = crate::blade::cutter_outline(&c, 10.0).area();
         assert!(
             exact >= area && (exact - (trapezoid - 2.0 * corner)).abs() < 1e-9,
             "{exact}"

@@ -53,3 +53,10 @@ pub(crate) use script::SCRIPT_API;
 pub use section::{Edge, EdgeKind, GrooveSection};
 pub use solid::{caliber_solid, Roll, SolidError};
 pub use stock::GrooveStock;
+
+/// The family, as the registry carries it.
+pub const FAMILY: super::Family = super::Family {
+    name: "caliber",
+    kind: Some(&KIND),
+    script: &[&SCRIPT_API],
+};

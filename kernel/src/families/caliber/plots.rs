@@ -3,8 +3,8 @@
 //! (theta, psi) as a heat map, and `section.svg`, the wheel's rounding at
 //! every pass in the groove's section where the most material is left.
 
-use crate::caliber::{GrooveCheck, GrooveRequest};
 use crate::chart::{tick_decimals, Marks, PassMark, PixelMap, PlaceMark};
+use crate::families::caliber::{GrooveCheck, GrooveRequest};
 use plotters::prelude::*;
 
 /// Colour levels of the heat map, an odd number: the middle one is zero.

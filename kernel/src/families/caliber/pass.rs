@@ -375,7 +375,7 @@ mod tests {
     #[test]
     fn stepping_over_the_rounding_keeps_off_it() {
         let g = lifting()
-            .with_edge(crate::caliber::EdgeKind::Rounding, &[2.0; 37])
+            .with_edge(crate::families::caliber::EdgeKind::Rounding, &[2.0; 37])
             .unwrap();
         let (r_k0, r_k) = (125.0, 8.0);
         let (psi, _) = g.pass_angles(r_k, 1f64.to_radians(), FRAC_PI_2).unwrap();

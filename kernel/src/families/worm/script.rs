@@ -4,10 +4,10 @@
 
 use crate::binding::floats::{kernel, number, Floats};
 use crate::binding::{ApiGroup, VerifyForm};
+use crate::families::worm::{self, FlankOrder, PlanSettings, ThreadCutter, WormSizes};
 use crate::family::Verification;
 use crate::math::Real;
 use crate::tool::{Tool, ToolShape};
-use crate::worm::{self, FlankOrder, PlanSettings, ThreadCutter, WormSizes};
 use rhai::plugin::*;
 use rhai::{Array, EvalAltResult, Map};
 
@@ -261,7 +261,7 @@ pub mod worm_api {
 /// The plan of passes over `section` for `tool` with a script's
 /// `settings` (the worm's `plan` and the thread's), as columns.
 pub(crate) fn plan_map(
-    section: &crate::thread::ThreadSection,
+    section: &crate::families::thread::ThreadSection,
     tool: &Tool,
     settings: &Map,
 ) -> Result<Map, Box<EvalAltResult>> {

@@ -5,7 +5,7 @@
 
 use crate::binding::floats::{kernel, number, numbers, Floats};
 use crate::binding::{ApiGroup, VerifyForm};
-use crate::caliber::{self, EdgeKind, Groove, SeedPose};
+use crate::families::caliber::{self, EdgeKind, Groove, SeedPose};
 use crate::family::Verification;
 // The Rhai `Solid`: a mesh and the exact body it was meshed from.
 use crate::family::Swept as Solid;

@@ -27,11 +27,11 @@
 //! the cutter in the axial plane), deflection and wear.
 
 use super::{ThreadCutter, WormSizes};
+use crate::families::thread::{Hand, ThreadSection};
 use crate::machine::MachineKinematics;
 use crate::math::Real;
 use crate::program::{block_name, AxisProgram};
 use crate::replay::{as_written, replay, VerifyError};
-use crate::thread::{Hand, ThreadSection};
 use crate::toolpath::Motion;
 use crate::transform::ToolFrame;
 use crate::verdict::{Figure, Finding};
@@ -84,7 +84,7 @@ pub struct WormRequest {
     /// A standard's limits the finished thread must hold besides: each
     /// start's pitch diameter within `pitch_diameter` (`None`: the
     /// tolerances alone).
-    pub limits: Option<crate::thread::ThreadLimits>,
+    pub limits: Option<crate::families::thread::ThreadLimits>,
     /// The finished part's name: its solid's files (`worm.stl`).
     pub part: &'static str,
     /// An internal thread's part, a nut: its outside diameter (mm). `None`
@@ -291,7 +291,7 @@ pub struct WormCheck {
     /// The standard's limits the thread was held to (none: the
     /// tolerances about the nominal alone).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub limits: Option<crate::thread::ThreadLimits>,
+    pub limits: Option<crate::families::thread::ThreadLimits>,
     /// The wire the over-wires measurement takes: the profile's best
     /// (mm).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -963,12 +963,14 @@ fn diameter(r: Real) -> Real {
 
 /// A thread's limits in rho = -r, or back (its own inverse): each band
 /// negated, least first.
-fn mirrored_limits(l: &crate::thread::ThreadLimits) -> crate::thread::ThreadLimits {
-    let band = |b: &crate::thread::Limits| crate::thread::Limits {
+fn mirrored_limits(
+    l: &crate::families::thread::ThreadLimits,
+) -> crate::families::thread::ThreadLimits {
+    let band = |b: &crate::families::thread::Limits| crate::families::thread::Limits {
         min: -b.max,
         max: -b.min,
     };
-    crate::thread::ThreadLimits {
+    crate::families::thread::ThreadLimits {
         pitch_diameter: band(&l.pitch_diameter),
         crest: band(&l.crest),
         root: band(&l.root),
@@ -1360,10 +1362,10 @@ fn measure(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::families::thread::{standards, Hand, ThreadProfile};
+    use crate::families::worm::{plan, FlankOrder, PlanSettings};
     use crate::machine::{ChainMachine, Machine};
     use crate::program::{Block, ProgramAxis};
-    use crate::thread::{standards, Hand, ThreadProfile};
-    use crate::worm::{plan, FlankOrder, PlanSettings};
 
     /// An external M20 6g cut with a 60 degree cutter to the plan's depths,
     /// the section aimed `aim` mm below the basic pitch diameter: the
@@ -1544,9 +1546,10 @@ mod tests {
         let wire = held.wire.unwrap();
         assert!((wire - 2.5 / 3f64.sqrt()).abs() < 1e-12, "{wire}");
         let m = held.starts[0].over_wires.unwrap();
-        let section = crate::thread::standards::metric(20.0, 2.5, false, "6g", 1, Hand::Right)
-            .unwrap()
-            .section;
+        let section =
+            crate::families::thread::standards::metric(20.0, 2.5, false, "6g", 1, Hand::Right)
+                .unwrap()
+                .section;
         let want = section.over_wires(wire, d2).unwrap();
         assert!((m - want).abs() < 1e-3, "M {m} vs {want}");
         let [lo, hi] = held.over_wires_limits.unwrap();
@@ -1597,7 +1600,7 @@ mod tests {
         let _ = check.clone().verified().unwrap();
         // Its part: a nut of 45 mm round the thread, closed, its volume
         // between the cylinders' at its root and at its crest.
-        let solid = crate::worm::worm_solid(&check, 30.0, 0.01, Some(45.0)).unwrap();
+        let solid = crate::families::worm::worm_solid(&check, 30.0, 0.01, Some(45.0)).unwrap();
         solid.check_closed().unwrap();
         let tube = |r: Real| std::f64::consts::PI * (22.5f64.powi(2) - r * r) * 30.0;
         let v = solid.volume();
@@ -1612,10 +1615,11 @@ mod tests {
             (hi[0] - 22.5).abs() < 1e-9 && (lo[2] + 30.0).abs() < 1e-9,
             "{lo:?} {hi:?}"
         );
-        assert!(crate::worm::worm_solid(&check, 30.0, 0.01, Some(28.0)).is_err());
+        assert!(crate::families::worm::worm_solid(&check, 30.0, 0.01, Some(28.0)).is_err());
         // Its STEP: the nut's faces close a solid of the mesh's volume
         // (the mesh's chords inside the helical surface by at most 0.01).
-        let sweep = crate::worm::WormSweep::new(&check, 30.0, 2.5e-4, Some(45.0)).unwrap();
+        let sweep =
+            crate::families::worm::WormSweep::new(&check, 30.0, 2.5e-4, Some(45.0)).unwrap();
         let fit = crate::step::swept_step("nut", "a nut", &sweep, 1e-3).unwrap();
         assert!(
             (fit.volume - v).abs() < 0.01 * 30.0 * 100.0,
@@ -1662,7 +1666,7 @@ mod tests {
         );
         // The solid: a vertex at angle phi lies on the section at 0
         // shifted by -lead phi / 2 pi (a right hand's, +).
-        let solid = crate::worm::worm_solid(&check, 30.0, 0.01, None).unwrap();
+        let solid = crate::families::worm::worm_solid(&check, 30.0, 0.01, None).unwrap();
         solid.check_closed().unwrap();
         let (w0, lead) = check.window;
         let mut worst: Real = 0.0;
@@ -1674,7 +1678,7 @@ mod tests {
             }
         }
         assert!(worst < 0.02, "{worst}");
-        let sweep = crate::worm::WormSweep::new(&check, 30.0, 2.5e-4, None).unwrap();
+        let sweep = crate::families::worm::WormSweep::new(&check, 30.0, 2.5e-4, None).unwrap();
         use crate::step::Sections;
         let q = sweep.point(0, 0.5, 0.5);
         let phi = q[1].atan2(q[0]);
@@ -1747,7 +1751,7 @@ mod tests {
     /// the ZI worm's curve as the straight one does.
     #[test]
     fn a_zi_worm_is_held_to_its_curved_flanks() {
-        use crate::worm::{WormProfile, WormSizes};
+        use crate::families::worm::{WormProfile, WormSizes};
         let worm = |profile| {
             WormSizes::with_profile(5.0, 2, 50.0, 0.2, 20f64.to_radians(), None, profile)
                 .unwrap()

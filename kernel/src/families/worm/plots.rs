@@ -4,7 +4,7 @@
 //! thread pass, written with the csv crate.
 
 use crate::chart::{Marks, PassMark, PixelMap};
-use crate::worm::WormCheck;
+use crate::families::worm::WormCheck;
 use plotters::prelude::*;
 use std::collections::BTreeMap;
 

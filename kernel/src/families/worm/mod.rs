@@ -19,7 +19,6 @@
 //! face towards the tailstock) to z = -b1, cut towards the chuck (-Z); X
 //! radial. The thread is right-handed.
 
-mod blade;
 mod outcome;
 mod plan;
 mod plots;
@@ -30,9 +29,9 @@ mod solid;
 mod thread_script;
 mod workbook;
 
-pub use crate::thread::{WormProfile, WormSizes};
+pub use crate::blade::{cutter_outline, ThreadBlade, BLADE_RELIEF_DEG, BLADE_THICKNESS};
+pub use crate::families::thread::{WormProfile, WormSizes};
 pub use crate::tool::{ThreadCutter, ARC_TOLERANCE};
-pub use blade::{cutter_outline, ThreadBlade, BLADE_RELIEF_DEG, BLADE_THICKNESS};
 pub use outcome::{WormOutcome, KIND};
 pub use plan::{
     axial_offset, plan, rational_passes, roughing_depths, Flank, FlankOrder, PassKind,
@@ -48,3 +47,10 @@ pub use simulate::{
 pub use solid::{worm_solid, WormSweep, MAX_AROUND};
 pub(crate) use thread_script::SCRIPT_API as THREAD_SCRIPT_API;
 pub use workbook::worm_pass_workbook;
+
+/// The family, as the registry carries it.
+pub const FAMILY: super::Family = super::Family {
+    name: "worm",
+    kind: Some(&KIND),
+    script: &[&SCRIPT_API, &THREAD_SCRIPT_API],
+};

@@ -408,7 +408,7 @@ fn nearest(list: &[Sample], q: &Vec3, theta: Real) -> (Real, usize) {
 /// Replays `program` on `machine` (the tool tracked at `tool`, a
 /// full-radius `wheel`: the toolpath's own) and measures the groove of `req` against the swept wheel; `passes` are the
 /// toolpath's, `req.psi` one per cutting pass. The check's `patch` is
-/// left for the caller ([`crate::caliber::contact_patch`], at the block it shows).
+/// left for the caller ([`crate::families::caliber::contact_patch`], at the block it shows).
 ///
 /// # Failures
 /// A tolerance finer than twice the program's resolution; the replay

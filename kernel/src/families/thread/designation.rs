@@ -251,7 +251,7 @@ pub fn designated(text: &str, drawing: &Drawing) -> Result<ThreadProfile, InputE
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::thread::ThreadSection;
+    use crate::families::thread::ThreadSection;
 
     const DRAWING: Drawing = Drawing {
         internal: None,

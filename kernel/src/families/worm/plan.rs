@@ -4,9 +4,9 @@
 //! steps, and the order of the starts.
 
 use super::ThreadCutter;
+use crate::families::thread::ThreadSection;
 use crate::input::InputError;
 use crate::math::Real;
-use crate::thread::ThreadSection;
 use serde::Serialize;
 
 /// The most passes a plan may have (all starts together): beyond it the
@@ -357,7 +357,7 @@ pub fn plan(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::worm::WormSizes;
+    use crate::families::worm::WormSizes;
 
     /// D_i = h sqrt(i / n) where no pass falls below a_min.
     #[test]
@@ -457,7 +457,7 @@ mod tests {
     /// order but radial is refused, naming it.
     #[test]
     fn a_form_cutter_plunges_straight_in() {
-        use crate::worm::{WormProfile, WormSizes};
+        use crate::families::worm::{WormProfile, WormSizes};
         let a = 20f64.to_radians();
         let w = WormSizes::with_profile(5.0, 2, 50.0, 0.2, a, None, WormProfile::ZI).unwrap();
         let t = w.section();

@@ -189,7 +189,7 @@ impl crate::process::Stock for GrooveStock {
 mod tests {
     use super::*;
     use crate::assert_near;
-    use crate::caliber::{pass_poses, SwivelPlane};
+    use crate::families::caliber::{pass_poses, SwivelPlane};
     use crate::process::Stock;
 
     /// Block after block along a pass, each search starting warm from the

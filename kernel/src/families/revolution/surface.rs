@@ -12,7 +12,7 @@
 //!   highest surface any spindle phase leaves ([`super::phases`]), what a
 //!   steady rest's support riding the turning part meets. The verification
 //!   cuts the same section at the same moments on each generatrix
-//!   ([`crate::revolution::check_grinding`]) and reports how far the crest
+//!   ([`crate::families::revolution::check_grinding`]) and reports how far the crest
 //!   stands above its own highest generatrix.
 //! - [`GroundSurface`] is the blank (a polyline: a step stays a step)
 //!   lowered by each pass's crest.
@@ -20,7 +20,7 @@
 //! # Generatrices
 //! The replay starts from 16 generatrices and doubles them until the
 //! finish's worst moves by less than 0.1 um from every other one to all
-//! ([`crate::revolution::replay_grinding`]); [`GENERATRICES`] = 8 is the
+//! ([`crate::families::revolution::replay_grinding`]); [`GENERATRICES`] = 8 is the
 //! half it first compares with. On a straight generatrix the ridge
 //! pattern is the same on every one, shifted by `f/m` along the part: the
 //! highest of `m` is within `h (1 - (1 - 1/m)^2) < 2 h / m` of the true

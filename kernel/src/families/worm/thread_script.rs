@@ -1,5 +1,5 @@
 //! Threads of any profile for scripts: a thread named as a drawing names
-//! it ([`crate::thread::designated`]), its sizes as the cut aims at them,
+//! it ([`crate::families::thread::designated`]), its sizes as the cut aims at them,
 //! the plan of passes over its section, and its verification (the worm's
 //! simulation, held to the standard's limits). Angles in degrees; lengths
 //! mm.
@@ -7,12 +7,12 @@
 use super::script::{cutter_of, plan_map, VerifyMap};
 use crate::binding::floats::{kernel, number};
 use crate::binding::{ApiGroup, VerifyForm};
+use crate::families::thread::standards::{LoadFlank, StatedLimits};
+use crate::families::thread::{Drawing, Hand, ThreadProfile};
+use crate::families::worm::{self, WormTolerances};
 use crate::family::Verification;
 use crate::math::Real;
-use crate::thread::standards::{LoadFlank, StatedLimits};
-use crate::thread::{Drawing, Hand, ThreadProfile};
 use crate::tool::Tool;
-use crate::worm::{self, WormTolerances};
 use rhai::plugin::*;
 use rhai::{EvalAltResult, Map};
 
@@ -109,7 +109,7 @@ pub mod thread_api {
         designation: &str,
         drawing: Map,
     ) -> Result<ThreadProfile, Box<EvalAltResult>> {
-        kernel(crate::thread::designated(
+        kernel(crate::families::thread::designated(
             designation,
             &super::drawing(&drawing)?,
         ))

@@ -14,10 +14,10 @@
 //! [`BLADE_RELIEF_DEG`] at the blade's faces: it touches the thread along
 //! its cutting edges only, as the cut it makes.
 
-use super::ThreadCutter;
 use crate::math::{Mat4, Point3, Real};
 use crate::mesh::{MeshError, TriMesh};
 use crate::step::Section;
+use crate::tool::ThreadCutter;
 
 /// The blade's thickness across the cutting plane (mm): the cutting
 /// profile is its edge; the thickness only shows it.
@@ -28,7 +28,7 @@ pub const BLADE_THICKNESS: Real = 6.0;
 pub const BLADE_RELIEF_DEG: Real = 3.0;
 
 /// A thread cutter's blade standing in a thread: see the module docs
-/// (`worm::blade`).
+/// (`blade`).
 #[derive(Debug, Clone)]
 pub struct ThreadBlade {
     outline: Section,

@@ -100,7 +100,7 @@ pub struct PassCheck {
     /// (blocks from 1): ridges included.
     pub deviation: Deviation,
     /// How far the highest surface any spindle phase leaves (what the
-    /// steady rest rides on: [`crate::revolution::phases`]) stands above the
+    /// steady rest rides on: [`crate::families::revolution::phases`]) stands above the
     /// highest generatrix simulated, after this pass (mm): the stand-off
     /// the spindle's unknown phase allows the rest.
     pub phase_stand_off_mm: Real,
@@ -845,6 +845,13 @@ impl GrindingCheck {
         (vec![figure], failure.into_iter().collect())
     }
 }
+
+/// The family, as the registry carries it.
+pub const FAMILY: super::Family = super::Family {
+    name: "revolution",
+    kind: Some(&KIND),
+    script: &[&SCRIPT_API],
+};
 
 #[cfg(test)]
 mod tests {

@@ -7,7 +7,7 @@
 //! first pass).
 
 use crate::chart::{tick_decimals, Marks, PassMark, PixelMap, PlaceMark, COLOURS};
-use crate::revolution::{GrindingCheck, PassCheck};
+use crate::families::revolution::{GrindingCheck, PassCheck};
 use plotters::prelude::*;
 
 /// One chart of `passes`' deviations (um) along z, with the tolerance
@@ -244,7 +244,7 @@ pub fn deviation_svgs(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::revolution::Deviation;
+    use crate::families::revolution::Deviation;
 
     fn pass(name: &str, along_z: Vec<[f64; 3]>) -> PassCheck {
         let d = Deviation {
