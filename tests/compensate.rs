@@ -6,7 +6,7 @@ use std::path::Path;
 
 /// The default mandrel's nominal diameter at z (mm): the law over the
 /// working part, the end cone after it (scripts/mandrel.rhai's defaults),
-/// written here from MATH §2.1, not taken from the kernel.
+/// written here from docs/math.md §2.1, not taken from the kernel.
 fn law(z: f64) -> f64 {
     let (d_min, d_max, l, k, n) = (38.0, 52.0, 400.0, 0.012, 2.3);
     if z <= l {

@@ -714,7 +714,7 @@ fn extent(c: &pilgrim_kernel::families::worm::ThreadCutter, h: f64, left: bool) 
 }
 
 /// The lead's error as a ratio after the carriage, a first-order servo of
-/// time constant `t` commanded to `v`, has travelled `s` (MATH §4.2):
+/// time constant `t` commanded to `v`, has travelled `s` (docs/math.md §4.2):
 /// `s = T V (-1 - ln a + a)`, solved for `a` by bisection.
 fn lead_error_after(t: f64, v: f64, s: f64) -> f64 {
     let (mut lo, mut hi) = (1e-300f64, 1.0f64);
@@ -729,7 +729,7 @@ fn lead_error_after(t: f64, v: f64, s: f64) -> f64 {
     (lo * hi).sqrt()
 }
 
-/// S1 and S2 are lengths of the thread (MATH §4.2): read back from
+/// S1 and S2 are lengths of the thread (docs/math.md §4.2): read back from
 /// `program.nc`, every thread block's leading cutting edge at the blank's
 /// radius meets the worm's face only after S1 of travel, and its trailing
 /// edge leaves the far end of the thread at least S2 before the block ends

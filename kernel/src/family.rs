@@ -1,4 +1,4 @@
-//! Part families (ARCHITECTURE §4): parameters to part geometry, toolpath
+//! Part families (docs/architecture.md, the extension points): parameters to part geometry, toolpath
 //! and checks. [`PartFamily`] is the extension point; the Rhai host
 //! implements it for scripts ([`crate::script::ScriptFamily`]) and a family
 //! may be written in Rust as well. [`crate::job`] runs any of them on a

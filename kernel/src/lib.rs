@@ -3,7 +3,7 @@
 //! The geometry kernel of pilgrim, a CAM system for special grinders and
 //! lathes: cold-pilger mandrels and calibers, worm threads.
 //!
-//! The modules, in the order data flows through them (ARCHITECTURE §1;
+//! The modules, in the order data flows through them (docs/architecture.md, the flow;
 //! `docs/architecture.md` says where each stage lives):
 //!
 //! - [`math`], [`InputError`], [`files`], [`names`]: the numbers, the one
@@ -34,7 +34,7 @@
 //! public through [`job`]), the families' registry and the input checks
 //! behind [`InputError`].
 //!
-//! Conventions (ARCHITECTURE §3): right-handed frames, millimetres and
+//! Conventions (docs/architecture.md, conventions): right-handed frames, millimetres and
 //! radians inside (degrees only in files, named `_deg`), the part frame's Z
 //! along the part's axis and X radial. Every approximate operation takes its
 //! tolerance as an argument. Every error names the value and its place.

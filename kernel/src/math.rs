@@ -1,6 +1,6 @@
 //! Numeric aliases and small helpers shared by every module.
 //!
-//! The kernel works in `f64` millimetres and radians (ARCHITECTURE §3).
+//! The kernel works in `f64` millimetres and radians (docs/architecture.md, conventions).
 //! There is no global epsilon: every approximate operation takes its
 //! tolerance as an argument and documents what it bounds.
 

@@ -10,7 +10,7 @@ mod thread_cutter;
 pub use thread_cutter::{GroundFlanks, ThreadCutter, ARC_TOLERANCE, FORM_STEP};
 
 /// A grinding wheel: a disk of `diameter` and `width` whose periphery is
-/// rounded with `rounding_radius` (a torus, MATH §2.2). Every other radius
+/// rounded with `rounding_radius` (a torus, docs/math.md §2.2). Every other radius
 /// is derived ([`Wheel::centre_radius`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Wheel {
@@ -60,7 +60,7 @@ impl Wheel {
     }
 
     /// The ridge this wheel leaves on a straight generatrix when its touches
-    /// are `f` mm apart (the feed per revolution, MATH §2.4): the
+    /// are `f` mm apart (the feed per revolution, docs/math.md §2.4): the
     /// rounding's, [`rounding_ridge`]. The flat is not counted: it covers
     /// the gap between touches only on a surface parallel to the wheel's
     /// axis; on a slope `s` it stands off the surface by `s` per mm and the
@@ -184,7 +184,7 @@ impl Tool {
     }
 
     /// A wheel whose programmed and tracked point is its centre, its axis
-    /// along +Z (the caliber grinders' tool frame, MATH §3.5).
+    /// along +Z (the caliber grinders' tool frame, docs/math.md §3.5).
     pub fn wheel_at_centre(name: &str, number: u32, wheel: Wheel) -> Self {
         Self {
             name: name.to_owned(),

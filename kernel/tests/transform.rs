@@ -1,6 +1,7 @@
 //! The universal chain against the product of its factors and the closed
 //! form of MATH §1; the mill example (S003-4); inverse kinematics round trips.
 
+use pilgrim_kernel::transform::FactorGeometry;
 use pilgrim_kernel::{
     assert_near, Chain, FactorKind, IkOptions, Machine, Mat4, Point3, Target, ToolFrame, Vec3,
 };

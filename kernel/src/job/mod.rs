@@ -1,4 +1,4 @@
-//! A run, as one kernel call (ARCHITECTURE §1): a part family on a machine
+//! A run, as one kernel call (docs/architecture.md, the flow): a part family on a machine
 //! with parameters, to every output.
 //!
 //! [`run`] resolves the parameters (the family's defaults, the machine's

@@ -7,7 +7,7 @@
 use super::{Machine, MachineError};
 
 /// `(name, TOML text)` of every built-in data machine: the vertical mill
-/// of MATH §1's example, the universal chain with only the mill's axes.
+/// of docs/math.md §1's example, the universal chain with only the mill's axes.
 pub const BUILTIN_SOURCES: [(&str, &str); 1] = [(
     "vertical-mill",
     include_str!("../../machines/vertical-mill.toml"),

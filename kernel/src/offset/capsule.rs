@@ -1,6 +1,6 @@
 //! A grinding wheel as it is: in the part's axial section its periphery is
 //! a flat of width `w = width - 2 R_s` between two roundings of radius
-//! `R_s` (MATH §2.4), a "capsule": the segment between the two rounding
+//! `R_s` (docs/math.md §2.4), a "capsule": the segment between the two rounding
 //! centres, thickened by `R_s`. With `w = 0` it is the one circle of the
 //! seed's model.
 //!

@@ -20,7 +20,7 @@ pub struct Drop {
 /// brought toward the profile from `side` until it touches: for
 /// [`Side::Outside`], the lowest centre x with no point of the profile inside
 /// the circle, `max over |z - zc| <= r of x(z) + sqrt(r^2 - (z - zc)^2)`
-/// (MATH §2.3's exact rest model).
+/// (docs/math.md §2.3's exact rest model).
 ///
 /// The profile is taken as the polyline through its nodes, and the result
 /// is exact for that polyline: vertices, contacts inside segments and the

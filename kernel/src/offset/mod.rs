@@ -1,5 +1,5 @@
 //! Equidistants of profiles and exact 2-D envelopes of tool circles
-//! (MATH §2.2, §2.3).
+//! (docs/math.md §2.2, §2.3).
 //!
 //! A grinding wheel's rounding (radius `R_s`) is a circle in the part's
 //! axial section. Its centre moves on the profile's equidistant
@@ -44,7 +44,7 @@ impl Side {
 }
 
 /// The centres of a tool circle of radius `radius` touching a profile at
-/// each of its nodes, and along an arc round each convex corner (MATH §2.2).
+/// each of its nodes, and along an arc round each convex corner (docs/math.md §2.2).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Equidistant {
     /// Centre z at each node (mm).
@@ -72,7 +72,7 @@ impl Equidistant {
 
 /// Every node where a tool of `radius` on `side` is rounder than the
 /// profile: the profile is concave seen from the tool and its radius of
-/// curvature is below `radius` (MATH §2.2's shaping condition).
+/// curvature is below `radius` (docs/math.md §2.2's shaping condition).
 pub fn curvature_violations(
     profile: &Profile,
     radius: Real,

@@ -1,4 +1,4 @@
-//! The plugin host: machine plugins (ARCHITECTURE §4, the ABI in the
+//! The plugin host: machine plugins (docs/architecture.md, the extension points, the ABI in the
 //! `pilgrim-plugin-abi` crate), loaded from shared libraries or compiled
 //! in. How to write one: `docs/plugins.md`.
 //!

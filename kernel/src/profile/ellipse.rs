@@ -1,4 +1,4 @@
-//! The caliber groove's elliptical section (MATH §3.1, S001-3, S001-4).
+//! The caliber groove's elliptical section (docs/math.md §3.1, S001-3, S001-4).
 
 use super::{Profile, ProfileError};
 use crate::input::InputError;

@@ -1,4 +1,4 @@
-//! The mandrel's working-part law (MATH §2.1, S000-1, corrected).
+//! The mandrel's working-part law (docs/math.md §2.1, S000-1, corrected).
 
 use super::{Profile, ProfileError};
 use crate::input::InputError;
@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 /// `d(z) = d_min + (d_max - d_min - k L_r) (z / L_r)^n + k z`, `x(z) = d(z) / 2`,
 ///
 /// for `0 <= z <= L_r`. The seed prints the last term as `k z^2`; the
-/// linear term is the one that gives `d(L_r) = d_max` (MATH §2.1).
+/// linear term is the one that gives `d(L_r) = d_max` (docs/math.md §2.1).
 ///
 /// ```
 /// use pilgrim_kernel::MandrelLaw;

@@ -1,4 +1,4 @@
-//! Profiles: the "digital array" `(z_i, x_i)` of a 2-D curve (MATH §2.1, §3.2).
+//! Profiles: the "digital array" `(z_i, x_i)` of a 2-D curve (docs/math.md §2.1, §3.2).
 //!
 //! A [`Profile`] is a curve `x(z)` sampled at strictly increasing `z`: the
 //! radius of a body of revolution along its axis, a groove's depth along the
@@ -70,7 +70,7 @@ pub enum ProfileError {
     Input(#[from] InputError),
     /// The tool is rounder than the profile: its radius exceeds the
     /// profile's radius of curvature where the profile is concave seen from
-    /// the tool (MATH §2.2). Every such place is listed.
+    /// the tool (docs/math.md §2.2). Every such place is listed.
     #[error("tool radius {tool_radius} mm exceeds the profile's radius of curvature at {} place(s): {}",
         violations.len(), list_violations(violations))]
     CurvatureBelowTool {

@@ -1,4 +1,4 @@
-//! Three-point smoothing of a table's derivative (MATH §3.2, S001-1).
+//! Three-point smoothing of a table's derivative (docs/math.md §3.2, S001-1).
 
 use super::{Profile, ProfileError};
 use crate::input::InputError;
@@ -58,7 +58,7 @@ impl Profile {
     /// rule blends into at the section's ends, so the smoothed slope meets
     /// the held one there; the anchor, inside the section, keeps its
     /// value, and so every node of the section does. A groove's sizing
-    /// section sets the tube's finished size and must not move (MATH §3.2).
+    /// section sets the tube's finished size and must not move (docs/math.md §3.2).
     ///
     /// ```
     /// use pilgrim_kernel::Profile;

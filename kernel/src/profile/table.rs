@@ -1,7 +1,7 @@
 //! Tables of numbers from CSV and spreadsheet files (XLSX, XLS, ODS).
 //!
 //! Engineers keep profiles and groove tables (`Hp = f1(theta)`,
-//! `B = f2(theta)`, MATH §3.1) in spreadsheets. A [`Table`] reads the first
+//! `B = f2(theta)`, docs/math.md §3.1) in spreadsheets. A [`Table`] reads the first
 //! sheet (or a CSV file), takes the first row as headers when any of its
 //! cells is not a number, and converts a column to numbers only when it is
 //! asked for, so a notes column does not get in the way. Every error names

@@ -126,7 +126,7 @@ pub mod offset_api {
     }
 
     /// The ridge (mm) the wheel leaves on a straight generatrix at a feed
-    /// of `feed_per_rev` mm per revolution of the part (MATH §2.4).
+    /// of `feed_per_rev` mm per revolution of the part (docs/math.md §2.4).
     #[rhai_fn(return_raw)]
     pub fn ridge_height(wheel: Tool, feed_per_rev: Real) -> Result<Real, Box<EvalAltResult>> {
         kernel(crate::math::finite("feed per revolution", feed_per_rev))?;

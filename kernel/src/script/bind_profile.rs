@@ -136,7 +136,7 @@ pub mod profile_api {
         s.max_change_z
     }
 
-    /// The mandrel's working-part law (MATH §2.1): diameters `d_min` at 0
+    /// The mandrel's working-part law (docs/math.md §2.1): diameters `d_min` at 0
     /// and `d_max` at `length`, initial taper (diameter change per mm at 0),
     /// exponent.
     #[rhai_fn(return_raw)]

@@ -1,4 +1,4 @@
-//! Transforms for scripts (MATH §1): the six elementary factors, the
+//! Transforms for scripts (docs/math.md §1): the six elementary factors, the
 //! universal chain of seed 003, and points mapped through them. Angles the
 //! script gives are degrees, in functions named `_deg`.
 
@@ -25,7 +25,7 @@ fn factor(kind: FactorKind, value: Real) -> Transform {
     Transform(kind.matrix(value))
 }
 
-/// Transforms (MATH §1): the elementary factors and the universal chain.
+/// Transforms (docs/math.md §1): the elementary factors and the universal chain.
 #[export_module]
 pub mod transform_api {
     use super::*;

@@ -1,4 +1,4 @@
-//! The Rhai host: part families written as scripts (ARCHITECTURE §4).
+//! The Rhai host: part families written as scripts (docs/architecture.md, the extension points).
 //!
 //! A family is a Rhai script that defines
 //!

@@ -3,7 +3,7 @@
 //! rounded by the nose radius, its flanks at their own angles from the
 //! radial direction. A full-profile cutter has the worm's half-angle on
 //! both flanks and the root's space as its tip; a narrower "universal"
-//! one reaches the flanks by the axial offset `a_1z` (MATH §4.4). A form
+//! one reaches the flanks by the axial offset `a_1z` (docs/math.md §4.4). A form
 //! cutter ground to a ZN or ZI worm's curved flanks ([`GroundFlanks`]) is
 //! the full-profile trapezoid whose flanks bend out on the curve of the
 //! space it was ground for.

@@ -1,4 +1,4 @@
-//! The universal 4x4 transform chain (MATH §1, seed 003).
+//! The universal 4x4 transform chain (docs/math.md §1, seed 003).
 //!
 //! A machine is a [`Chain`]: an ordered product of elementary factors
 //! ([`FactorKind`]: three translations, three rotations), each a constant of
@@ -277,7 +277,7 @@ impl Frame {
 }
 
 /// The points `(x[i], y[i], z[i])` mapped by the homogeneous matrix `m`
-/// (`r0 = m r1`, MATH §1), as three arrays.
+/// (`r0 = m r1`, docs/math.md §1), as three arrays.
 ///
 /// # Failures
 /// Arrays of different lengths.

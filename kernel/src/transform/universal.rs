@@ -9,7 +9,7 @@ pub const UNIVERSAL_PARAMETERS: [&str; 15] = [
 ];
 
 impl Chain {
-    /// The universal chain of MATH §1 (S003-3), every parameter an axis:
+    /// The universal chain of docs/math.md §1 (S003-3), every parameter an axis:
     ///
     /// `A = Tx(a3) Ty(b3) Tz(c3) Rx(psi) Tx(a2) Ty(b2) Tz(c2) Ry(theta)
     ///      Tx(a1) Ty(b1) Tz(c1) Rz(phi) Tx(a) Ty(b) Tz(c)`

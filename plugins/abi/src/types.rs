@@ -187,7 +187,7 @@ impl Axis {
     }
 }
 
-/// One of the six elementary factors of a transform chain (MATH §1).
+/// One of the six elementary factors of a transform chain (docs/math.md §1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum FactorKind {

@@ -1,4 +1,4 @@
-//! A two-axis CNC lathe with a Fanuc 0i-TC control (seed 004, MATH §4) as
+//! A two-axis CNC lathe with a Fanuc 0i-TC control (seed 004, docs/math.md §4) as
 //! a pilgrim machine plugin: cross slide X on diameter, carriage Z, main
 //! spindle; worm threads cut in many passes with single thread blocks
 //! (G32). The host's writer posts its programs in the `fanuc` dialect.
@@ -6,7 +6,7 @@
 //! Its description ([`describe`]) is the one definition of the machine
 //! (`pilgrim machines --toml fanuc-0i-tc` writes it as a machine file).
 //! Part frame: Z along the spindle's axis, X
-//! radial (ARCHITECTURE §3). Signs:
+//! radial (docs/architecture.md, conventions). Signs:
 //!
 //! - `X` on diameter: +1 mm moves the tool 0.5 mm away from the axis;
 //! - `Z` +1 mm moves the tool +1 mm along the axis, away from the chuck.
@@ -17,7 +17,7 @@
 //!
 //! Its constant `servo_time_constant` (s) is the carriage's servo time
 //! constant T, which sets a thread's acceleration and deceleration lengths
-//! (MATH §4.2); its Z axis's `max_feed` bounds lead x rpm of a thread.
+//! (docs/math.md §4.2); its Z axis's `max_feed` bounds lead x rpm of a thread.
 
 use pilgrim_plugin_abi::types::{
     Axis, AxisKind, BodyShape, BodySpec, FactorKind, FactorSpec, MachineInfo, Mount, Plane,

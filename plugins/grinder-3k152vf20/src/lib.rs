@@ -1,11 +1,11 @@
-//! The 3K152VF20 mandrel grinder (seed 000, MATH §2.3) as a pilgrim machine
+//! The 3K152VF20 mandrel grinder (seed 000, docs/math.md §2.3) as a pilgrim machine
 //! plugin: table Z, wheelhead X, CNC steady rest U, work spindle; a
 //! Sinumerik 840D control (the host's writer posts its programs).
 //!
 //! Its description ([`describe`]) is the one definition of the machine: its
 //! axes and their signs, the wheel's chain and the steady rest's, and the
 //! rest's constants. The part frame has Z along the mandrel's axis and X
-//! radial (ARCHITECTURE §3). Signs (the host checks them against the
+//! radial (docs/architecture.md, conventions). Signs (the host checks them against the
 //! chains whenever it loads the plugin):
 //!
 //! - `Z` +1 mm moves the wheel +1 mm along the part's axis relative to the
@@ -132,7 +132,7 @@ pub fn describe() -> MachineInfo {
             // z_r = z_k + B (mm): the rest stands 180 mm before the wheel along Z.
             ("rest_offset_b".to_owned(), -180.0),
             // Radius R_o of the rest's support in the axial section (mm).
-            // U programs the support's centre (the seed, MATH §2.3).
+            // U programs the support's centre (the seed, docs/math.md §2.3).
             ("rest_radius".to_owned(), 25.0),
             // The process (kernel/src/process.rs): the wheel moves into the
             // stock (a plunge, the infeed at a pass's reversal) at most at
@@ -203,7 +203,7 @@ fn bodies() -> Vec<BodySpec> {
                 .into(),
             label: "steady rest: support centre".into(),
             // The support's centre travels with the wheel along Z at the
-            // offset B (z_r = z_k + B, MATH §2.3), at 180 degrees round the
+            // offset B (z_r = z_k + B, docs/math.md §2.3), at 180 degrees round the
             // part.
             chain: vec![
                 FactorSpec::axis(FactorKind::Tz, "Z"),

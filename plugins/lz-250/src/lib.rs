@@ -1,4 +1,4 @@
-//! The LZ-250 caliber grinder (seed 001, MATH §3.5) as a pilgrim machine
+//! The LZ-250 caliber grinder (seed 001, docs/math.md §3.5) as a pilgrim machine
 //! plugin: the roll turns (A = theta) and moves along its axis (X) and
 //! radially (Z); the wheel swivels (B = epsilon) about the radial axis.
 //! Four controlled axes; a Sinumerik control (the host's writer posts its

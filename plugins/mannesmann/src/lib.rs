@@ -1,4 +1,4 @@
-//! The Mannesmann caliber grinder (seed 001, MATH §3.5) as a pilgrim
+//! The Mannesmann caliber grinder (seed 001, docs/math.md §3.5) as a pilgrim
 //! machine plugin: the LZ-250's axes (roll turn A, axial X, radial Z,
 //! wheel swivel B) and the cross axis Y, which lets it place the wheel
 //! exactly on profiles of large reduction. Its description and kinematics

@@ -1,4 +1,4 @@
-//! The roll and its groove in 3-D (MATH §3.1).
+//! The roll and its groove in 3-D (docs/math.md §3.1).
 
 use super::section::{Edge, EdgeKind, GrooveSection};
 use crate::input::InputError;
@@ -370,7 +370,7 @@ impl Groove {
     /// The pass angles `psi` (rad) of a wheel's rounding `r_k` across the
     /// groove, symmetric about its middle out to `psi_max`, `dpsi` apart at
     /// most (the passes spread evenly), with the scallop the step leaves in
-    /// the widest section (MATH §3.3: the section circle the groove's
+    /// the widest section (docs/math.md §3.3: the section circle the groove's
     /// largest profile radius, `max(B/2, Hp)` over the tables). On the
     /// edges' rounding or chamfer, where there is one, the passes run
     /// closer, evenly from where the edge begins in the section it begins
@@ -493,7 +493,7 @@ impl Groove {
 
     /// The node (row, from 0) in the middle of the sizing section: the
     /// longest run of rows of one depth (the groove that sizes the tube),
-    /// the smoothing's default anchor (MATH §3.2: its length shrinks
+    /// the smoothing's default anchor (docs/math.md §3.2: its length shrinks
     /// least); the middle row if no two rows have one depth.
     pub fn sizing_middle(&self) -> usize {
         match self.sizing_rows() {
@@ -552,7 +552,7 @@ impl Groove {
         }
     }
 
-    /// The groove with both tables smoothed (MATH §3.2,
+    /// The groove with both tables smoothed (docs/math.md §3.2,
     /// [`Profile::smooth_derivative_holding`]): `iterations` of the
     /// three-point rule on the first differences, the rows `held` (the
     /// sizing section, first and last) kept exactly, rebuilt from the row
@@ -586,7 +586,7 @@ impl Groove {
     }
 
     /// The groove with its tables interpolated between rows by
-    /// `interpolation` (MATH §3.2: a stated choice; the toolpath and the
+    /// `interpolation` (docs/math.md §3.2: a stated choice; the toolpath and the
     /// verification use the same groove).
     pub fn with_interpolation(self, interpolation: crate::profile::Interpolation) -> Self {
         Self {

@@ -1,4 +1,4 @@
-//! The caliber's geometry (seed 001, MATH §3): the groove of a cold-pilger
+//! The caliber's geometry (seed 001, docs/math.md §3): the groove of a cold-pilger
 //! roll as a surface in 3-D, the scallop between passes, and the wheel's
 //! pose on the groove, by the seed's model and exactly.
 //!
@@ -8,9 +8,9 @@
 //!   ([`GrooveSection`], [`Edge`]), its points and normals in the roll's
 //!   frame;
 //! - [`scallop_height`] and [`step_for_scallop`]: the cusp two neighbouring
-//!   passes leave, and its inverse (MATH §3.3); [`step_for_scallop_convex`]
+//!   passes leave, and its inverse (docs/math.md §3.3); [`step_for_scallop_convex`]
 //!   on an edge's rounding;
-//! - [`seed_pose`]: the seed's wheel centre and corrections (MATH §3.4);
+//! - [`seed_pose`]: the seed's wheel centre and corrections (docs/math.md §3.4);
 //!   [`TorusWheel`] and [`exact_pose`]: the torus touching the groove at a
 //!   point with its normal, and the distance of any point from it;
 //! - [`pass_poses`]: a pass's exact poses at a uniform step of the roll's
@@ -23,7 +23,7 @@
 //!   [`Roll`]: the same exactly, for STEP.
 //!
 //! The roll's frame: Z along the roll's axis, the section at `theta = 0` in
-//! the XZ plane, `theta` turning right-handed about +Z (ARCHITECTURE §3).
+//! the XZ plane, `theta` turning right-handed about +Z (docs/architecture.md, conventions).
 
 mod check;
 mod groove;

@@ -1,4 +1,4 @@
-//! A pass of the wheel along the groove (MATH §3.4, §3.5): the exact pose
+//! A pass of the wheel along the groove (docs/math.md §3.4, §3.5): the exact pose
 //! of the torus at each block, within what the machine reaches, at a
 //! uniform step of the roll's turn, and how far the seed's first-order
 //! model is from it.
@@ -22,7 +22,7 @@ pub enum SwivelPlane {
     /// which a machine with the cross axis Y carries (the Mannesmann).
     Contact,
     /// Square to the radius through the wheel's centre: what a machine
-    /// without a cross axis reaches (the LZ-250, MATH §3.5: its axis stays
+    /// without a cross axis reaches (the LZ-250, docs/math.md §3.5: its axis stays
     /// in the plane of the roll's axis and the circumferential direction
     /// at the wheel). Found by iterating the centre's angle.
     Wheel,
@@ -140,7 +140,7 @@ fn exact_at(
 fn with_seed(groove: &Groove, psi: Real, pose: PassPose) -> Result<PassPose, GrooveError> {
     let (theta, wheel) = (pose.theta, pose.wheel);
     let (r_k0, r_k) = (wheel.major + wheel.minor, wheel.minor);
-    // The seed's centre and axis (MATH §3.4): the rounding centre along
+    // The seed's centre and axis (docs/math.md §3.4): the rounding centre along
     // the roll's axis at x_k (swivelled), the wheel's centre on the
     // equidistant R_e at theta - dtheta + dtheta_1 (the centre lies on the
     // outward normal of the polar curve R_m, behind the contact where R_m
@@ -162,7 +162,7 @@ fn with_seed(groove: &Groove, psi: Real, pose: PassPose) -> Result<PassPose, Gro
 /// uniform step `step` (rad) of the roll's turn (the last step shorter if
 /// the range is not a whole number of steps): each the exact pose
 /// ([`pose_at`]) whose turn is the step's, found on the contact's theta by
-/// the secant method within a bracket (Illinois, to `TURN_TOLERANCE`), not interpolated (MATH §3.4's
+/// the secant method within a bracket (Illinois, to `TURN_TOLERANCE`), not interpolated (docs/math.md §3.4's
 /// re-interpolation, done exactly).
 ///
 /// # Failures

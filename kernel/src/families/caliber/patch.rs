@@ -1,4 +1,4 @@
-//! The contact patch at one block (MATH §3.6): the groove's points within
+//! The contact patch at one block (docs/math.md §3.6): the groove's points within
 //! a small distance of the wheel, what the seed reads off the CAD model.
 
 use super::check::{groove_middle, placed, wheel_distance, GrooveRequest};
@@ -12,7 +12,7 @@ use crate::transform::ToolFrame;
 use serde::{Deserialize, Serialize};
 
 /// The region of the groove within a small distance of the wheel at one
-/// block (MATH §3.6: what the seed reads off the CAD model).
+/// block (docs/math.md §3.6: what the seed reads off the CAD model).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ContactPatch {
     /// The block (from 1).

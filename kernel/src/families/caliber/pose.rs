@@ -1,5 +1,5 @@
-//! The wheel on the groove: the seed's model (MATH §3.4, S001-5..12) and
-//! the exact torus (MATH §3.5).
+//! The wheel on the groove: the seed's model (docs/math.md §3.4, S001-5..12) and
+//! the exact torus (docs/math.md §3.5).
 
 use super::groove::{Groove, GrooveError};
 use crate::input::InputError;
@@ -36,7 +36,7 @@ impl TorusWheel {
 /// surface at `p`, whose unit normal there is `n` (out of the material,
 /// toward the wheel), with its axis along `w` (any direction not along
 /// `n`; made unit): the rounding centre `C = p + r_k n`, the wheel's centre
-/// `O = C + (r_k0 - r_k) u`, `u` the part of `n` across the axis (MATH
+/// `O = C + (r_k0 - r_k) u`, `u` the part of `n` across the axis (docs/math.md
 /// §3.5). The wheel's surface passes through `p` with normal `-n`.
 ///
 /// # Failures
@@ -98,7 +98,7 @@ pub fn exact_pose_toward(
     })
 }
 
-/// The seed's wheel centre and corrections at `(theta, psi)` (MATH §3.4),
+/// The seed's wheel centre and corrections at `(theta, psi)` (docs/math.md §3.4),
 /// for a wheel of largest radius `R_k0` and rounding `r_k`. Angles in rad,
 /// lengths in mm.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -137,7 +137,7 @@ pub struct SeedPose {
 }
 
 /// The seed's pose of a wheel (largest radius `r_k0`, rounding `r_k`) on
-/// the pass at `psi` of `groove`, at `theta` (MATH §3.4 with its
+/// the pass at `psi` of `groove`, at `theta` (docs/math.md §3.4 with its
 /// corrections: `psi_1` in S001-8, the `+` of the law of cosines in
 /// S001-9). Derivatives along theta are central differences of 1e-6 rad
 /// (one-sided at the tables' ends), as the groove's normal's.

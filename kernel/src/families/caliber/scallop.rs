@@ -1,4 +1,4 @@
-//! The scallop between two passes (MATH §3.3, S001-2).
+//! The scallop between two passes (docs/math.md §3.3, S001-2).
 
 use crate::input::InputError;
 use crate::math::{positive, Real};

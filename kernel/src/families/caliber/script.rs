@@ -1,4 +1,4 @@
-//! The caliber's groove for scripts (MATH §3): the groove from its tables,
+//! The caliber's groove for scripts (docs/math.md §3): the groove from its tables,
 //! its points, normals and sections, the scallop between passes, the pass
 //! angles, and the seed's wheel pose. Angles are radians, as everywhere in
 //! the script API; the tables give theta in degrees.
@@ -41,7 +41,7 @@ pub mod caliber_api {
         g.sizing_middle() as i64
     }
 
-    /// The groove with both tables smoothed (MATH §3.2): `iterations` of
+    /// The groove with both tables smoothed (docs/math.md §3.2): `iterations` of
     /// the three-point rule (0: none, reported all the same), rebuilt from
     /// row `anchor` (from 0). `#{ groove, hp, b }`: `hp` and `b` are the
     /// smoothings (`.change`, `.max_change`, `.max_change_z`,
@@ -57,7 +57,7 @@ pub mod caliber_api {
 
     /// [`smoothed`] holding the rows `held`, `[first, last]` (from 0),
     /// exactly: the sizing section, which sets the tube's finished size
-    /// (MATH §3.2); `[]` holds none. The anchor must lie inside them.
+    /// (docs/math.md §3.2); `[]` holds none. The anchor must lie inside them.
     #[rhai_fn(name = "smoothed", pure, return_raw)]
     pub fn smoothed_holding(
         g: &mut Groove,
@@ -435,7 +435,7 @@ pub mod caliber_api {
     }
 
     /// The scallop (mm) two rounding circles of radius `r_k` leave `dpsi`
-    /// apart in a section circle of radius `section_radius` (MATH §3.3).
+    /// apart in a section circle of radius `section_radius` (docs/math.md §3.3).
     #[rhai_fn(return_raw)]
     pub fn scallop_height(
         section_radius: Real,
@@ -456,7 +456,7 @@ pub mod caliber_api {
     }
 
     /// The seed's pose of a wheel (largest radius `r_k0`, rounding `r_k`)
-    /// on the pass at `psi`, at `theta` (MATH §3.4): `.x_k`, `.z_k`,
+    /// on the pass at `psi`, at `theta` (docs/math.md §3.4): `.x_k`, `.z_k`,
     /// `.psi_1`, `.mu`, `.dtheta`, `.epsilon`, `.dtheta_1`, ...
     #[rhai_fn(pure, return_raw)]
     pub fn seed_pose(

@@ -1,5 +1,5 @@
 //! One section of the groove through the roll's axis: half an ellipse
-//! (MATH §3.1), its edges, where the table gives it, rounded or chamfered
+//! (docs/math.md §3.1), its edges, where the table gives it, rounded or chamfered
 //! into the roll's periphery.
 //!
 //! The section is a curve of one parameter `psi` from -90 to 90 deg. On

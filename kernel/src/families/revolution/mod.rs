@@ -166,7 +166,7 @@ pub struct GrindingCheck {
     pub passes: Vec<PassCheck>,
 }
 
-/// Replays a grinding program as the machine runs it (MATH §2.4): the
+/// Replays a grinding program as the machine runs it (docs/math.md §2.4): the
 /// values rounded as written, every axis moving in a straight line between
 /// blocks at the block's feed while the part turns at the program's
 /// spindle speed; on each generatrix (16, doubled while the finish's worst moves by

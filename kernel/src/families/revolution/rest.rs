@@ -1,4 +1,4 @@
-//! The CNC steady rest (axis U) riding the current surface (MATH §2.3).
+//! The CNC steady rest (axis U) riding the current surface (docs/math.md §2.3).
 //!
 //! The rest's support is a circle of radius `R_o` in the axial section,
 //! its centre at `z_r = z_k + B`. Two models give the centre's x:
@@ -19,7 +19,7 @@
 //! `|seed_u - exact_u| <= K (R_o S + h)(R_o S + 2h) / 2 + K h^2 / 8`
 //! ([`seed_error_bound`]),
 //!
-//! the O(R_o^2 s'') of MATH §2.3. On a ground surface with a cusp or a step
+//! the O(R_o^2 s'') of docs/math.md §2.3. On a ground surface with a cusp or a step
 //! (the edge of the current pass) the seed's model has no such bound: that
 //! is why the exact model is the default.
 
@@ -209,7 +209,7 @@ pub const KINK_WIDTH: Real = 1e-3;
 /// The largest number of rest points a pass may get.
 const MAX_REST_POINTS: usize = 200_000;
 
-/// The steady rest along a pass (MATH §2.3, §2.4): the wheel's reference
+/// The steady rest along a pass (docs/math.md §2.3, §2.4): the wheel's reference
 /// moves along `path` (one way along z) at `feed` (mm/min), having come to
 /// its first point by `infeed` (without one: it stood there a revolution),
 /// while the part turns at `rpm`, over a part whose surface before the

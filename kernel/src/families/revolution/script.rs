@@ -121,7 +121,7 @@ pub mod revolution_api {
         s.eval_many(&[z], None)[0]
     }
 
-    /// A steady rest (MATH §2.3): its support, a circle of
+    /// A steady rest (docs/math.md §2.3): its support, a circle of
     /// `support_radius` in the axial section, stands at `offset` along z
     /// from the wheel (z_r = z + offset). Its track samples the surface
     /// under the support every `sample` mm, and adds blocks until the
@@ -146,7 +146,7 @@ pub mod revolution_api {
         })
     }
 
-    /// The steady rest along a pass (MATH §2.3): the wheel moves along
+    /// The steady rest along a pass (docs/math.md §2.3): the wheel moves along
     /// `centres` (one way along z) at `feed` mm/min, the part turning at
     /// `spindle_rpm`, over `surface`. The result's `.path` is the pass with
     /// the blocks the rest needs added (on the wheel's line); per point of

@@ -1,4 +1,4 @@
-//! The surface of a part being ground, as the machine makes it (MATH §2.4):
+//! The surface of a part being ground, as the machine makes it (docs/math.md §2.4):
 //! the part turns at S rpm while the wheel moves along its path at F mm/min,
 //! so each generatrix of the part meets the wheel only at the moments it
 //! passes under it, `f = F / S` mm apart along the path; between those

@@ -1,4 +1,4 @@
-//! The worm's sizes (MATH §4.1): standard cylindrical-worm practice, not
+//! The worm's sizes (docs/math.md §4.1): standard cylindrical-worm practice, not
 //! the seed's words (the seed names the inputs only).
 
 use super::standards::StatedLimits;
@@ -310,8 +310,8 @@ impl WormSizes {
                 number(self.pitch_diameter)
             ),
             standard: match self.profile {
-                WormProfile::ZA => "MATH §4.1 (ZA worm)".into(),
-                _ => format!("MATH §4.1, DIN 3975 ({} worm)", self.profile.name()),
+                WormProfile::ZA => "docs/math.md §4.1 (ZA worm)".into(),
+                _ => format!("docs/math.md §4.1, DIN 3975 ({} worm)", self.profile.name()),
             },
             section,
             limits: ThreadLimits {

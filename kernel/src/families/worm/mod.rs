@@ -1,4 +1,4 @@
-//! Worm threads cut in many passes on a CNC lathe (seed 004, MATH §4, with
+//! Worm threads cut in many passes on a CNC lathe (seed 004, docs/math.md §4, with
 //! the corrections of issue 13).
 //!
 //! - [`WormSizes`] (the thread module's): the cylindrical worm, ZA, ZN or

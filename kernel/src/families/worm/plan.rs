@@ -1,4 +1,4 @@
-//! The passes (MATH §4.3, §4.4 with the corrections of issue 13): the
+//! The passes (docs/math.md §4.3, §4.4 with the corrections of issue 13): the
 //! roughing law of decreasing infeed with its minimum depth, the flank
 //! each pass cuts on, the finishing passes, the universal cutter's axial
 //! steps, and the order of the starts.
@@ -71,7 +71,7 @@ pub fn rational_passes(h_r: Real, a_min: Real) -> usize {
         .unwrap_or(MAX_PASSES)
 }
 
-/// The universal cutter's axial offset to each flank (MATH §4.4):
+/// The universal cutter's axial offset to each flank (docs/math.md §4.4):
 /// `a_1z = (P_z / z1 - S_a1 - S_a1r) / 2`, the space at the pitch line
 /// less `S_a1r`, the cutter's width at the pitch line when its tip is at
 /// the root.

@@ -1,4 +1,4 @@
-//! Worm threads for scripts (MATH §4): the worm's sizes, the thread
+//! Worm threads for scripts (docs/math.md §4): the worm's sizes, the thread
 //! cutter, the acceleration and deceleration lengths, the plan of passes.
 //! Angles are degrees here (as a process sheet gives them); lengths mm.
 

@@ -1,4 +1,4 @@
-//! Acceleration and deceleration lengths of a thread block (MATH §4.2):
+//! Acceleration and deceleration lengths of a thread block (docs/math.md §4.2):
 //! a CNC lathe has no rigid link between spindle and carriage, so the
 //! carriage, a first-order servo of time constant `T`, lags its command
 //! and the lead is wrong until it catches up.

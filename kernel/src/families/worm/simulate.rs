@@ -57,13 +57,13 @@ pub struct WormTolerances {
     /// Flank angles (rad).
     pub flank_angle: Real,
     /// The lead's error allowed where each pass's cutting edges meet the
-    /// worm's face and leave its far end, as a ratio of the lead (MATH
+    /// worm's face and leave its far end, as a ratio of the lead (docs/math.md
     /// §4.2's `a`).
     pub lead: Real,
 }
 
 /// The lead's usual allowed error at a thread's ends, as a ratio (Fanuc's
-/// practice, MATH §4.2): the default of [`WormTolerances::lead`].
+/// practice, docs/math.md §4.2): the default of [`WormTolerances::lead`].
 pub const LEAD_ERROR: Real = 0.01;
 
 /// What the family asks the simulation to check.
@@ -197,7 +197,7 @@ pub struct SimulatedPass {
     /// How far the carriage travels before the leading cutting edge, at
     /// the blank's radius, meets the worm's face (mm): the pass's S1.
     pub approach_mm: Real,
-    /// The lead's error there, as a ratio (the servo model of MATH §4.2).
+    /// The lead's error there, as a ratio (the servo model of docs/math.md §4.2).
     pub face_lead_error: Real,
     /// How far before the block's end the trailing cutting edge, at the
     /// blank's radius, leaves the thread's far end (mm): the pass's S2.
@@ -680,7 +680,7 @@ pub fn simulate(
     let mut chips = Vec::new();
     let mut lead_error: Real = 0.0;
     let x_axis = written.axes.iter().position(|a| a.name == "X");
-    // The carriage's servo (MATH §4.2): the machine's time constant and
+    // The carriage's servo (docs/math.md §4.2): the machine's time constant and
     // the spindle's speed as written.
     let servo = machine
         .info()
