@@ -2,7 +2,8 @@
 //! what a review would otherwise have to find by eye: every small
 //! tolerance named (a float literal below 1e-3 is a constant's value, in
 //! `kernel/src/tolerance.rs` or beside the code that gives its meaning,
-//! never a bare number in an expression).
+//! never a bare number in an expression); no public signature of the
+//! kernel with a `String` error.
 
 use proc_macro2::{TokenStream, TokenTree};
 use std::path::{Path, PathBuf};
@@ -158,5 +159,149 @@ fn the_literal_finder_finds_every_spelling() {
     assert_eq!(
         found,
         ["1e-9", "1E-9", "1e-9_f64", "0.000_001", "2e-7", "3e-8"]
+    );
+}
+
+/// The kernel's public items reachable from its root (every module on the
+/// way `pub`), parsed: each public function's (and trait method's, and
+/// public function type's) error type, where it is `String`.
+struct StringErrors {
+    path: Vec<String>,
+    found: Vec<String>,
+}
+
+/// Whether `ty` is `Result<_, String>` (or a `fn(..) -> Result<_, String>`).
+fn string_error(ty: &syn::Type) -> bool {
+    match ty {
+        syn::Type::Path(p) => {
+            let Some(last) = p.path.segments.last() else {
+                return false;
+            };
+            if last.ident != "Result" {
+                return false;
+            }
+            let syn::PathArguments::AngleBracketed(args) = &last.arguments else {
+                return false;
+            };
+            args.args.iter().nth(1).is_some_and(|a| {
+                matches!(a, syn::GenericArgument::Type(syn::Type::Path(e))
+                    if e.path.is_ident("String") || e.path.segments.last().is_some_and(|s| s.ident == "String"))
+            })
+        }
+        syn::Type::BareFn(f) => match &f.output {
+            syn::ReturnType::Type(_, t) => string_error(t),
+            syn::ReturnType::Default => false,
+        },
+        _ => false,
+    }
+}
+
+/// Whether a signature's output is a `String` error.
+fn returns_string_error(sig: &syn::Signature) -> bool {
+    matches!(&sig.output, syn::ReturnType::Type(_, t) if string_error(t))
+}
+
+fn is_pub(v: &syn::Visibility) -> bool {
+    matches!(v, syn::Visibility::Public(_))
+}
+
+impl StringErrors {
+    fn here(&self, name: &str) -> String {
+        format!("{}::{name}", self.path.join("::"))
+    }
+
+    /// The items of a module whose file is `file` (its folder `dir` for its
+    /// children).
+    fn items(&mut self, items: &[syn::Item], dir: &Path) {
+        for item in items {
+            match item {
+                syn::Item::Fn(f) if is_pub(&f.vis) && !is_test(&f.attrs) => {
+                    if returns_string_error(&f.sig) {
+                        self.found.push(self.here(&f.sig.ident.to_string()));
+                    }
+                }
+                syn::Item::Type(t) if is_pub(&t.vis) && string_error(&t.ty) => {
+                    self.found.push(self.here(&t.ident.to_string()));
+                }
+                syn::Item::Impl(i) if i.trait_.is_none() => {
+                    let ty = quote_type(&i.self_ty);
+                    for it in &i.items {
+                        if let syn::ImplItem::Fn(f) = it {
+                            if is_pub(&f.vis) && returns_string_error(&f.sig) {
+                                self.found.push(self.here(&format!("{ty}::{}", f.sig.ident)));
+                            }
+                        }
+                    }
+                }
+                syn::Item::Trait(t) if is_pub(&t.vis) => {
+                    for it in &t.items {
+                        if let syn::TraitItem::Fn(f) = it {
+                            if returns_string_error(&f.sig) {
+                                self.found.push(self.here(&format!("{}::{}", t.ident, f.sig.ident)));
+                            }
+                        }
+                    }
+                }
+                syn::Item::Struct(s) if is_pub(&s.vis) => {
+                    for f in &s.fields {
+                        if is_pub(&f.vis) && string_error(&f.ty) {
+                            let name = f.ident.as_ref().map(ToString::to_string).unwrap_or_default();
+                            self.found.push(self.here(&format!("{}.{name}", s.ident)));
+                        }
+                    }
+                }
+                syn::Item::Mod(m) if is_pub(&m.vis) && !is_test(&m.attrs) => {
+                    let name = m.ident.to_string();
+                    self.path.push(name.clone());
+                    match &m.content {
+                        Some((_, inner)) => self.items(inner, &dir.join(&name)),
+                        None => {
+                            let file = [dir.join(format!("{name}.rs")), dir.join(&name).join("mod.rs")]
+                                .into_iter()
+                                .find(|p| p.is_file())
+                                .unwrap_or_else(|| panic!("module {name} in {}", dir.display()));
+                            let text = std::fs::read_to_string(&file).unwrap();
+                            let parsed = syn::parse_file(&text).unwrap();
+                            self.items(&parsed.items, &dir.join(&name));
+                        }
+                    }
+                    self.path.pop();
+                }
+                _ => {}
+            }
+        }
+    }
+}
+
+/// A type as text (an impl's self type).
+fn quote_type(t: &syn::Type) -> String {
+    match t {
+        syn::Type::Path(p) => p
+            .path
+            .segments
+            .last()
+            .map(|s| s.ident.to_string())
+            .unwrap_or_default(),
+        _ => "_".into(),
+    }
+}
+
+/// No public function, method, trait method, function type or alias
+/// reachable from the kernel's root has `String` as its error: every
+/// failure a caller of the library meets is typed.
+#[test]
+fn no_public_signature_has_a_string_error() {
+    let src = crate::common::root().join("kernel/src");
+    let text = std::fs::read_to_string(src.join("lib.rs")).unwrap();
+    let mut v = StringErrors {
+        path: vec!["pilgrim_kernel".into()],
+        found: vec![],
+    };
+    v.items(&syn::parse_file(&text).unwrap().items, &src);
+    assert!(
+        v.found.is_empty(),
+        "{} public signatures with a String error: {:#?}",
+        v.found.len(),
+        v.found
     );
 }
