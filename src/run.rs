@@ -293,7 +293,7 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
             &Default::default(),
         )?;
         let label = format!("{}/report.json", args.target.display());
-        let first = vec![report.params_source(&label)?];
+        let first = vec![report.params_source(&label).map_err(|e| e.to_string())?];
         let spec = match kept.and_then(|k| k.1) {
             Some(spec) => spec,
             None => job::run_machine(&report, catalog, args.machine.as_deref(), &shown)
@@ -391,7 +391,8 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
             let o = pilgrim_kernel::program::offsets::Offsets::from_toml_str(
                 &text,
                 &pilgrim_kernel::files::shown_path(f),
-            )?;
+            )
+            .map_err(|e| e.to_string())?;
             let axes: Vec<char> = (machine.kinematics.info().axes.iter())
                 .filter_map(|a| a.name.chars().next())
                 .collect();

@@ -162,12 +162,21 @@ fn the_literal_finder_finds_every_spelling() {
     );
 }
 
-/// The kernel's public items reachable from its root (every module on the
-/// way `pub`), parsed: each public function's (and trait method's, and
-/// public function type's) error type, where it is `String`.
+/// The kernel's public items reachable from its root, parsed: each public
+/// function's (and method's, trait method's, public function type's and
+/// field's) error type, where it is `String`. An item is reachable where
+/// every module on its way is `pub`, or where a `pub use` names it (or
+/// globs its module).
+#[derive(Default)]
 struct StringErrors {
     path: Vec<String>,
-    found: Vec<String>,
+    /// Whether every module on the current path is `pub`.
+    open: Vec<bool>,
+    /// (item's name for reachability, the module it is in, its label,
+    /// reached through public modules).
+    found: Vec<(String, String, String, bool)>,
+    /// Names a `pub use` re-exports, and modules it globs.
+    reexported: std::collections::BTreeSet<String>,
 }
 
 /// Whether `ty` is `Result<_, String>` (or a `fn(..) -> Result<_, String>`).
@@ -185,7 +194,7 @@ fn string_error(ty: &syn::Type) -> bool {
             };
             args.args.iter().nth(1).is_some_and(|a| {
                 matches!(a, syn::GenericArgument::Type(syn::Type::Path(e))
-                    if e.path.is_ident("String") || e.path.segments.last().is_some_and(|s| s.ident == "String"))
+                    if e.path.segments.last().is_some_and(|s| s.ident == "String"))
             })
         }
         syn::Type::BareFn(f) => match &f.output {
@@ -205,30 +214,60 @@ fn is_pub(v: &syn::Visibility) -> bool {
     matches!(v, syn::Visibility::Public(_))
 }
 
+/// The names a `use` tree ends in (`*`: the module before it).
+fn use_leaves(tree: &syn::UseTree, last: &str, out: &mut std::collections::BTreeSet<String>) {
+    match tree {
+        syn::UseTree::Path(p) => use_leaves(&p.tree, &p.ident.to_string(), out),
+        syn::UseTree::Name(n) => {
+            out.insert(n.ident.to_string());
+        }
+        syn::UseTree::Rename(r) => {
+            out.insert(r.ident.to_string());
+        }
+        syn::UseTree::Glob(_) => {
+            out.insert(format!("{last}::*"));
+        }
+        syn::UseTree::Group(g) => {
+            for t in &g.items {
+                use_leaves(t, last, out);
+            }
+        }
+    }
+}
+
 impl StringErrors {
-    fn here(&self, name: &str) -> String {
-        format!("{}::{name}", self.path.join("::"))
+    fn note(&mut self, name: String, label: String) {
+        let module = self.path.last().cloned().unwrap_or_default();
+        let open = self.open.iter().all(|o| *o);
+        let label = format!("{}::{label}", self.path.join("::"));
+        self.found.push((name, module, label, open));
     }
 
-    /// The items of a module whose file is `file` (its folder `dir` for its
-    /// children).
+    /// The items of a module (its folder `dir` for its children).
     fn items(&mut self, items: &[syn::Item], dir: &Path) {
         for item in items {
             match item {
-                syn::Item::Fn(f) if is_pub(&f.vis) && !is_test(&f.attrs) => {
-                    if returns_string_error(&f.sig) {
-                        self.found.push(self.here(&f.sig.ident.to_string()));
-                    }
+                syn::Item::Use(u) if is_pub(&u.vis) => {
+                    let mut leaves = std::collections::BTreeSet::new();
+                    use_leaves(&u.tree, "", &mut leaves);
+                    self.reexported.extend(leaves);
+                }
+                syn::Item::Fn(f)
+                    if is_pub(&f.vis) && !is_test(&f.attrs) && returns_string_error(&f.sig) =>
+                {
+                    let n = f.sig.ident.to_string();
+                    self.note(n.clone(), n);
                 }
                 syn::Item::Type(t) if is_pub(&t.vis) && string_error(&t.ty) => {
-                    self.found.push(self.here(&t.ident.to_string()));
+                    let n = t.ident.to_string();
+                    self.note(n.clone(), n);
                 }
                 syn::Item::Impl(i) if i.trait_.is_none() => {
-                    let ty = quote_type(&i.self_ty);
+                    let ty = type_name(&i.self_ty);
                     for it in &i.items {
                         if let syn::ImplItem::Fn(f) = it {
                             if is_pub(&f.vis) && returns_string_error(&f.sig) {
-                                self.found.push(self.here(&format!("{ty}::{}", f.sig.ident)));
+                                self.note(ty.clone(), format!("{ty}::{}", f.sig.ident));
                             }
                         }
                     }
@@ -237,7 +276,10 @@ impl StringErrors {
                     for it in &t.items {
                         if let syn::TraitItem::Fn(f) = it {
                             if returns_string_error(&f.sig) {
-                                self.found.push(self.here(&format!("{}::{}", t.ident, f.sig.ident)));
+                                self.note(
+                                    t.ident.to_string(),
+                                    format!("{}::{}", t.ident, f.sig.ident),
+                                );
                             }
                         }
                     }
@@ -245,36 +287,58 @@ impl StringErrors {
                 syn::Item::Struct(s) if is_pub(&s.vis) => {
                     for f in &s.fields {
                         if is_pub(&f.vis) && string_error(&f.ty) {
-                            let name = f.ident.as_ref().map(ToString::to_string).unwrap_or_default();
-                            self.found.push(self.here(&format!("{}.{name}", s.ident)));
+                            let name = f
+                                .ident
+                                .as_ref()
+                                .map(ToString::to_string)
+                                .unwrap_or_default();
+                            self.note(s.ident.to_string(), format!("{}.{name}", s.ident));
                         }
                     }
                 }
-                syn::Item::Mod(m) if is_pub(&m.vis) && !is_test(&m.attrs) => {
+                syn::Item::Mod(m) if !is_test(&m.attrs) => {
                     let name = m.ident.to_string();
                     self.path.push(name.clone());
+                    self.open.push(is_pub(&m.vis));
                     match &m.content {
                         Some((_, inner)) => self.items(inner, &dir.join(&name)),
                         None => {
-                            let file = [dir.join(format!("{name}.rs")), dir.join(&name).join("mod.rs")]
-                                .into_iter()
-                                .find(|p| p.is_file())
-                                .unwrap_or_else(|| panic!("module {name} in {}", dir.display()));
+                            let file = [
+                                dir.join(format!("{name}.rs")),
+                                dir.join(&name).join("mod.rs"),
+                            ]
+                            .into_iter()
+                            .find(|p| p.is_file())
+                            .unwrap_or_else(|| panic!("module {name} in {}", dir.display()));
                             let text = std::fs::read_to_string(&file).unwrap();
                             let parsed = syn::parse_file(&text).unwrap();
                             self.items(&parsed.items, &dir.join(&name));
                         }
                     }
+                    self.open.pop();
                     self.path.pop();
                 }
                 _ => {}
             }
         }
     }
+
+    /// The labels of the items a caller outside the crate reaches.
+    fn reachable(&self) -> Vec<&str> {
+        self.found
+            .iter()
+            .filter(|(name, module, _, open)| {
+                *open
+                    || self.reexported.contains(name)
+                    || self.reexported.contains(&format!("{module}::*"))
+            })
+            .map(|(_, _, label, _)| label.as_str())
+            .collect()
+    }
 }
 
-/// A type as text (an impl's self type).
-fn quote_type(t: &syn::Type) -> String {
+/// A type's last name (an impl's self type).
+fn type_name(t: &syn::Type) -> String {
     match t {
         syn::Type::Path(p) => p
             .path
@@ -286,8 +350,8 @@ fn quote_type(t: &syn::Type) -> String {
     }
 }
 
-/// No public function, method, trait method, function type or alias
-/// reachable from the kernel's root has `String` as its error: every
+/// No public function, method, trait method, function type, field or
+/// alias reachable from the kernel's root has `String` as its error: every
 /// failure a caller of the library meets is typed.
 #[test]
 fn no_public_signature_has_a_string_error() {
@@ -295,13 +359,13 @@ fn no_public_signature_has_a_string_error() {
     let text = std::fs::read_to_string(src.join("lib.rs")).unwrap();
     let mut v = StringErrors {
         path: vec!["pilgrim_kernel".into()],
-        found: vec![],
+        ..Default::default()
     };
     v.items(&syn::parse_file(&text).unwrap().items, &src);
+    let found = v.reachable();
     assert!(
-        v.found.is_empty(),
-        "{} public signatures with a String error: {:#?}",
-        v.found.len(),
-        v.found
+        found.is_empty(),
+        "{} public signatures with a String error: {found:#?}",
+        found.len()
     );
 }

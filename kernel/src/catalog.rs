@@ -166,7 +166,7 @@ impl Catalog {
         let info = m.kinematics.info();
         crate::program::check_power_on(info).map_err(|message| MachineError::Description {
             machine: info.name.clone(),
-            message,
+            message: message.to_string(),
         })?;
         Ok(m)
     }

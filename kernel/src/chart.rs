@@ -52,6 +52,35 @@ pub(crate) fn legend<DB: DrawingBackend>(
     Ok(())
 }
 
+/// A picture, a table or a section of the page that could not be drawn
+/// or written: which, and the reason the drawing library or the data
+/// gives.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{what}: {message}")]
+pub struct DrawError {
+    /// What was being drawn (a file's name, a section of the page).
+    pub what: String,
+    /// Why it could not be.
+    pub message: String,
+}
+
+impl DrawError {
+    /// `what` could not be drawn, for `why`.
+    pub fn new(what: impl Into<String>, why: impl std::fmt::Display) -> Self {
+        Self {
+            what: what.into(),
+            message: why.to_string(),
+        }
+    }
+}
+
+impl From<serde_json::Error> for DrawError {
+    /// A report entry a section could not read.
+    fn from(e: serde_json::Error) -> Self {
+        Self::new("the report's entry", e)
+    }
+}
+
 /// The chart `spec` from `toolpath`'s tables as SVG text.
 ///
 /// # Failures

@@ -111,6 +111,10 @@ pub enum Error {
     /// An output that cannot be made.
     #[error("{0}")]
     Output(String),
+    /// A picture, a table or a report entry that cannot be drawn or
+    /// written, named.
+    #[error(transparent)]
+    Draw(#[from] crate::family::DrawError),
     /// The run failed a check, a rule of the process or its verification:
     /// what it found, to write where the user looks (no program).
     #[error("{}", .0.report.verdict.message())]

@@ -4,6 +4,7 @@
 //! may be written in Rust as well. [`crate::job`] runs any of them on a
 //! machine.
 
+pub use crate::chart::DrawError;
 use crate::mesh::TriMesh;
 use crate::params::{ParamSpec, Params};
 use crate::profile::{Profile, ProfileError};
@@ -200,7 +201,7 @@ pub trait Outcome: AnyOutcome + std::fmt::Debug + Send + Sync {
     ///
     /// # Failures
     /// The outcome not serialisable.
-    fn to_json(&self) -> Result<serde_json::Value, String>;
+    fn to_json(&self) -> Result<serde_json::Value, serde_json::Error>;
     /// The verdict's figures, and what failed, over `program` (as read).
     fn findings(
         &self,
@@ -257,7 +258,7 @@ pub trait Outcome: AnyOutcome + std::fmt::Debug + Send + Sync {
         &self,
         _ctx: &FilesContext<'_>,
         _tables: &std::collections::BTreeMap<String, std::collections::BTreeMap<String, Vec<f64>>>,
-    ) -> Result<Drawn, String> {
+    ) -> Result<Drawn, DrawError> {
         Ok(Drawn::default())
     }
 }
@@ -289,7 +290,7 @@ impl Clone for Box<dyn Outcome> {
 
 /// A kind's section of the report page: the HTML of its `report.json`
 /// entry, given each block's label (from its index from 0).
-pub type SectionFn = fn(&serde_json::Value, &dyn Fn(usize) -> String) -> Result<String, String>;
+pub type SectionFn = fn(&serde_json::Value, &dyn Fn(usize) -> String) -> Result<String, DrawError>;
 
 /// A kind of verification as the report page shows it: its key in
 /// `report.json` and the page's section drawn from that entry.

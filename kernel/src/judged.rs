@@ -195,8 +195,8 @@ impl Outcome for Judged {
         KIND.key
     }
 
-    fn to_json(&self) -> Result<serde_json::Value, String> {
-        serde_json::to_value(self).map_err(|e| e.to_string())
+    fn to_json(&self) -> Result<serde_json::Value, serde_json::Error> {
+        serde_json::to_value(self)
     }
 
     fn findings(&self, program: &AxisProgram) -> (Vec<Figure>, Vec<Finding>) {
@@ -220,8 +220,11 @@ pub const KIND: OutcomeKind = OutcomeKind {
 };
 
 /// The page's section of a judgement standing alone.
-fn section(entry: &serde_json::Value, label: &dyn Fn(usize) -> String) -> Result<String, String> {
-    let j: Judged = serde_json::from_value(entry.clone()).map_err(|e| e.to_string())?;
+fn section(
+    entry: &serde_json::Value,
+    label: &dyn Fn(usize) -> String,
+) -> Result<String, crate::family::DrawError> {
+    let j: Judged = serde_json::from_value(entry.clone())?;
     Ok(format!(
         "<h2>Verification: the program replayed, judged by its family</h2>\n{}",
         j.html(label)
@@ -248,7 +251,7 @@ impl Outcome for WithJudged {
         self.base.key()
     }
 
-    fn to_json(&self) -> Result<serde_json::Value, String> {
+    fn to_json(&self) -> Result<serde_json::Value, serde_json::Error> {
         let mut v = self.base.to_json()?;
         let judged = self.judged.to_json()?;
         match v.as_object_mut() {
@@ -256,10 +259,10 @@ impl Outcome for WithJudged {
                 m.insert(JUDGED_FIELD.into(), judged);
                 Ok(v)
             }
-            None => Err(format!(
+            None => Err(<serde_json::Error as serde::ser::Error>::custom(format!(
                 "{}'s entry is not a map to add the family's judgement to",
                 self.base.key()
-            )),
+            ))),
         }
     }
 
@@ -304,7 +307,7 @@ impl Outcome for WithJudged {
         &self,
         ctx: &FilesContext<'_>,
         tables: &Tables,
-    ) -> Result<crate::family::Drawn, String> {
+    ) -> Result<crate::family::Drawn, crate::family::DrawError> {
         self.base.files(ctx, tables)
     }
 }
@@ -314,11 +317,11 @@ impl Outcome for WithJudged {
 pub fn judged_section(
     entry: &serde_json::Value,
     label: &dyn Fn(usize) -> String,
-) -> Result<String, String> {
+) -> Result<String, crate::family::DrawError> {
     match entry.get(JUDGED_FIELD) {
         None => Ok(String::new()),
         Some(j) => {
-            let j: Judged = serde_json::from_value(j.clone()).map_err(|e| e.to_string())?;
+            let j: Judged = serde_json::from_value(j.clone())?;
             Ok(format!(
                 "<h3>The family's own figures</h3>\n{}",
                 j.html(label)

@@ -55,12 +55,15 @@ impl ParamValue {
     /// # Failures
     /// A kind a constant cannot give (text, a list), or a fractional value
     /// for a whole number.
-    pub fn from_constant(x: Real, like: &ParamValue) -> Result<Self, String> {
+    pub fn from_constant(x: Real, like: &ParamValue) -> Result<Self, NotOfKind> {
         match like {
             Self::Float(_) => Ok(Self::Float(x)),
             Self::Int(_) if x.fract() == 0.0 && x.abs() < 9e15 => Ok(Self::Int(x as i64)),
             Self::Bool(_) => Ok(Self::Bool(x != 0.0)),
-            _ => Err(format!("{x} is not {}", like.kind())),
+            _ => Err(NotOfKind {
+                value: x,
+                kind: like.kind(),
+            }),
         }
     }
 
@@ -282,6 +285,17 @@ pub enum ParamSource {
     },
 }
 
+/// A machine constant's value that a parameter of its kind cannot take
+/// (a fraction for a whole number, any number for a text).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{value} is not {kind}")]
+pub struct NotOfKind {
+    /// The constant's value.
+    pub value: Real,
+    /// The kind the parameter takes (`a whole number`).
+    pub kind: &'static str,
+}
+
 /// A parameter that cannot be resolved.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ParamError {
@@ -356,7 +370,7 @@ pub fn resolve_traced(
                 ParamValue::from_constant(x, &s.default).map_err(|message| ParamError::Bad {
                     name: s.name.clone(),
                     source_name: format!("the machine's constant {m}"),
-                    message,
+                    message: message.to_string(),
                 })?
             }
             None => {

@@ -225,7 +225,7 @@ pub fn check(
     let name = |k: usize| block_name(program, k);
     let n = written.blocks.len();
     let rows = crate::program::axis_rows(&written, info, &info.solved_axes, 0..n)
-        .map_err(crate::replay::VerifyError::Replay)?;
+        .map_err(|e| crate::replay::VerifyError::Replay(e.to_string()))?;
     let width = info.solved_axes.len();
     // The tool at `t` of the way through block k's move.
     let pose_at = |k: usize, t: Real| -> Result<Vec<Real>, crate::replay::VerifyError> {

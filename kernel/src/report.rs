@@ -185,13 +185,25 @@ impl Report {
     ///
     /// # Failures
     /// A value TOML cannot hold (not finite).
-    pub fn params_source(&self, label: &str) -> Result<crate::params::ParamSource, String> {
+    pub fn params_source(
+        &self,
+        label: &str,
+    ) -> Result<crate::params::ParamSource, crate::params::ParamError> {
+        self.params_source_text(label)
+            .map_err(|message| crate::params::ParamError::Source {
+                source_name: label.to_owned(),
+                message,
+            })
+    }
+
+    /// [`Self::params_source`], its failure as text.
+    fn params_source_text(&self, label: &str) -> Result<crate::params::ParamSource, String> {
         let values: BTreeMap<&str, &ParamValue> = self
             .parameters
             .iter()
             .map(|(k, p)| (k.as_str(), &p.value))
             .collect();
-        let text = toml::to_string(&values).map_err(|e| format!("{label}: {e}"))?;
+        let text = toml::to_string(&values).map_err(|e| e.to_string())?;
         Ok(crate::params::ParamSource::Toml {
             label: label.to_owned(),
             text,
@@ -297,7 +309,12 @@ pub fn axis_ranges(program: &AxisProgram) -> BTreeMap<String, [f64; 2]> {
 ///
 /// # Failures
 /// The writer failing (it writes to memory).
-pub fn block_table(program: &AxisProgram) -> Result<String, String> {
+pub fn block_table(program: &AxisProgram) -> Result<String, crate::family::DrawError> {
+    block_table_text(program).map_err(|e| crate::family::DrawError::new("report.csv", e))
+}
+
+/// [`block_table`], its failure as text.
+fn block_table_text(program: &AxisProgram) -> Result<String, String> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut header = vec![
         "block".to_owned(),

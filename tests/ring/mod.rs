@@ -121,7 +121,7 @@ impl Outcome for RingOutcome {
         }
     }
 
-    fn to_json(&self) -> Result<serde_json::Value, String> {
+    fn to_json(&self) -> Result<serde_json::Value, serde_json::Error> {
         Ok(serde_json::json!({
             "blocks": self.errors.len(),
             "worst_mm": self.worst().1,
@@ -159,7 +159,7 @@ impl Outcome for RingOutcome {
         &self,
         _ctx: &FilesContext<'_>,
         _tables: &BTreeMap<String, BTreeMap<String, Vec<f64>>>,
-    ) -> Result<pilgrim_kernel::family::Drawn, String> {
+    ) -> Result<pilgrim_kernel::family::Drawn, pilgrim_kernel::family::DrawError> {
         // The radius error round the contour, as a polyline.
         let points: Vec<String> = self
             .errors

@@ -435,7 +435,8 @@ pub fn check(
     let n = program.blocks.len();
     let names = placement.axes();
     let w = names.len();
-    let rows = axis_rows(program, info, names, 0..n).map_err(CollisionError::Program)?;
+    let rows = axis_rows(program, info, names, 0..n)
+        .map_err(|e| CollisionError::Program(e.to_string()))?;
     // Entity `e`'s frame at the axis values `q`, the tool's frame `tool`.
     let frame_of = |e: &Entity, q: &[Real], tool: &Mat4| -> Result<Mat4, CollisionError> {
         let f = match e.which {

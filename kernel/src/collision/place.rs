@@ -95,7 +95,8 @@ impl Placement {
             if !spec.reach.holds(inside) {
                 continue;
             }
-            let solid = Solid::of(shape, &info.constants).map_err(CollisionError::Machine)?;
+            let solid = Solid::of(shape, &info.constants)
+                .map_err(|e| CollisionError::Machine(e.to_string()))?;
             let own = || {
                 body.chain()
                     .matrix(&vec![0.0; body.chain().dof()])

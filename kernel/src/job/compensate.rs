@@ -387,7 +387,9 @@ pub fn compensate(
         )));
     }
     let label = format!("{shown}/report.json");
-    let base = report.params_source(&label).map_err(Error::Read)?;
+    let base = report
+        .params_source(&label)
+        .map_err(|e| Error::Read(e.to_string()))?;
     let spec = match kept.and_then(|k| k.1) {
         Some(spec) => spec,
         None => run_machine(&report, catalog, None, &shown)?,

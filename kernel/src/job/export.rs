@@ -92,7 +92,7 @@ pub fn export(
         .map_err(|e| bad("report.json", e.to_string()))?;
     let program: AxisProgram = serde_json::from_str(&read("program.json")?)
         .map_err(|e| bad("program.json", e.to_string()))?;
-    crate::program::check_shape(&program).map_err(|e| bad("program.json", e))?;
+    crate::program::check_shape(&program).map_err(|e| bad("program.json", e.to_string()))?;
     let toolpath: Toolpath = serde_json::from_str(&read("toolpath.json")?)
         .map_err(|e| bad("toolpath.json", e.to_string()))?;
     toolpath

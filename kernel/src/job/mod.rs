@@ -359,7 +359,7 @@ fn data_files(toolpath: &Toolpath, program: &AxisProgram) -> Result<[Vec<u8>; 3]
     Ok([
         json(toolpath)?,
         json(program)?,
-        block_table(program).map_err(Error::Output)?.into_bytes(),
+        block_table(program)?.into_bytes(),
     ])
 }
 
@@ -617,10 +617,7 @@ fn run_with(
             enter(stage, STAGES[3])?;
             let data = vec![
                 ("program.json".into(), json(&read)?),
-                (
-                    "report.csv".into(),
-                    block_table(&read).map_err(Error::Output)?.into_bytes(),
-                ),
+                ("report.csv".into(), block_table(&read)?.into_bytes()),
             ];
             (read, None, passes, Ok(Vec::new()), data, lines)
         }
@@ -849,7 +846,12 @@ fn run_with(
                         ),
                     }));
                 }
-                std::iter::once((key.to_owned(), o.to_json().map_err(Error::Output)?)).collect()
+                std::iter::once((
+                    key.to_owned(),
+                    o.to_json()
+                        .map_err(|e| crate::family::DrawError::new(key, e))?,
+                ))
+                .collect()
             }
             None => Default::default(),
         },
@@ -878,8 +880,7 @@ fn run_with(
             replay: replay_ctx,
             parts: &parts,
         };
-        let crate::family::Drawn { files: made, marks } =
-            o.files(&ctx, &report.tables).map_err(Error::Output)?;
+        let crate::family::Drawn { files: made, marks } = o.files(&ctx, &report.tables)?;
         // Marks over a plot it drew, by the plot's name.
         report.marks = marks
             .into_iter()

@@ -76,7 +76,7 @@ fn verification(out: &mut String, r: &Report) {
                         out,
                         "<p>The {} entry could not be read: {}</p>",
                         escape(key),
-                        escape(&e)
+                        escape(&e.to_string())
                     );
                 }
             }

@@ -168,8 +168,8 @@ fn machine_bodies(
     let program = &at_place(program, place)?;
     // In a thread the machine is shown turned with the tool.
     let turned = Mat4::from_axis_angle(&Vec3::z_axis(), at.turn);
-    let q =
-        axis_rows(program, machine.info(), placement.axes(), 0..1).map_err(SceneError::Place)?;
+    let q = axis_rows(program, machine.info(), placement.axes(), 0..1)
+        .map_err(|e| SceneError::Place(e.to_string()))?;
     let tool_frame = placement.tool_frame(&q).map_err(placing)?;
     placement
         .bodies
@@ -217,7 +217,8 @@ fn motion(
     if n == 0 {
         return Ok(None);
     }
-    let rows = axis_rows(program, info, placement.axes(), 0..n).map_err(SceneError::Place)?;
+    let rows = axis_rows(program, info, placement.axes(), 0..n)
+        .map_err(|e| SceneError::Place(e.to_string()))?;
     let w = placement.axes().len();
     let rotary: Vec<f64> = (0..n)
         .map(|k| placement.part_turn(&rows[k * w..(k + 1) * w]))

@@ -453,6 +453,12 @@ pub enum Solid {
     },
 }
 
+/// A body's shape whose sizes cannot be taken: the key and what is wrong
+/// with it (a constant the machine lacks, a size not above 0).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct BodyError(pub String);
+
 impl Solid {
     /// `shape` with its sizes taken from `constants` where it names them.
     ///
@@ -460,7 +466,12 @@ impl Solid {
     /// A constant the machine lacks, a size not above 0, a guard whose
     /// inner radius is not below its outer or whose cover is not within
     /// (0, 360) deg: the message names the key.
-    pub fn of(shape: &BodyShape, constants: &BTreeMap<String, Real>) -> Result<Solid, String> {
+    pub fn of(shape: &BodyShape, constants: &BTreeMap<String, Real>) -> Result<Solid, BodyError> {
+        Self::of_text(shape, constants).map_err(BodyError)
+    }
+
+    /// [`Self::of`], its failure as text.
+    fn of_text(shape: &BodyShape, constants: &BTreeMap<String, Real>) -> Result<Solid, String> {
         let size = |q: &super::Quantity, what: &str| -> Result<Real, String> {
             let v = q.resolve(constants).map_err(|m| format!("{what}: {m}"))?;
             if v.is_finite() && v > 0.0 {

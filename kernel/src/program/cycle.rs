@@ -93,6 +93,16 @@ pub fn expand(
     start: [Real; 2],
     diameter: bool,
     end_x: Option<Real>,
+) -> Result<Vec<CycleMove>, super::ProgramFault> {
+    expand_text(c, start, diameter, end_x).map_err(super::ProgramFault::new)
+}
+
+/// [`expand`], its failure as text.
+fn expand_text(
+    c: &ThreadCycle,
+    start: [Real; 2],
+    diameter: bool,
+    end_x: Option<Real>,
 ) -> Result<Vec<CycleMove>, String> {
     for (w, v) in [
         ('P', c.pitch),
@@ -260,7 +270,7 @@ mod tests {
 
     #[test]
     fn bad_words_are_refused() {
-        let e = |c: ThreadCycle| expand(&c, [24.0, 5.0], true, None).unwrap_err();
+        let e = |c: ThreadCycle| expand(&c, [24.0, 5.0], true, None).unwrap_err().message;
         assert!(e(ThreadCycle { i: 0.0, ..m20() }).contains("I must not be 0"));
         assert!(e(ThreadCycle { j: 0.0, ..m20() }).contains("J must be greater than 0"));
         assert!(e(ThreadCycle { k: 0.5, ..m20() }).contains("K0.5 must be greater than J0.6"));

@@ -41,6 +41,37 @@ const CYCLE_MATCH: Real = 1e-6;
 /// move would take longer than a report can say.
 pub const MIN_FEED: Real = 1e-3;
 
+/// A program that is not one a machine runs, or that cannot be read as
+/// asked (an axis it lacks, a block beyond it, words the control would not
+/// read): the block where it is, if at one, and what is wrong (the message
+/// names the block as the program numbers it).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{message}")]
+pub struct ProgramFault {
+    /// The block (from 0) where it is, if at one.
+    pub block: Option<usize>,
+    /// What is wrong, and where.
+    pub message: String,
+}
+
+impl ProgramFault {
+    /// A fault at no block.
+    pub fn new(message: impl Into<String>) -> Self {
+        Self {
+            block: None,
+            message: message.into(),
+        }
+    }
+
+    /// A fault at block `block` (from 0).
+    pub fn at(block: usize, message: impl Into<String>) -> Self {
+        Self {
+            block: Some(block),
+            message: message.into(),
+        }
+    }
+}
+
 /// Errors making a program from a toolpath. Blocks are named as the
 /// program names them ([`block_name`]: `N570 in "pass 1"`).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -271,62 +302,65 @@ pub fn pass_blocks(program: &AxisProgram, passes: &[Pass]) -> Vec<ProgramPass> {
 ///
 /// # Failures
 /// The first fault, naming the block as the program numbers it.
-pub fn check_shape(program: &AxisProgram) -> Result<(), String> {
+pub fn check_shape(program: &AxisProgram) -> Result<(), ProgramFault> {
     let width = program.axes.len();
     let letters = crate::machine::AXIS_LETTERS;
     if width == 0 || width > letters.len() {
-        return Err(format!(
+        return Err(ProgramFault::new(format!(
             "{width} axes (a program has 1 to {})",
             letters.len()
-        ));
+        )));
     }
     for (i, a) in program.axes.iter().enumerate() {
         if !(a.name.len() == 1 && letters.contains(a.name.as_str()))
             || program.axes[..i].iter().any(|b| b.name == a.name)
         {
-            return Err(format!(
+            return Err(ProgramFault::new(format!(
                 "axis {} is not one of the letters {letters}, once each",
                 crate::names::quoted(&a.name)
-            ));
+            )));
         }
     }
     let most = crate::toolpath::MAX_POINTS + 64;
     if program.blocks.len() > most {
-        return Err(format!(
+        return Err(ProgramFault::new(format!(
             "{} blocks, more than the {most} a run writes",
             program.blocks.len()
-        ));
+        )));
     }
     for (i, b) in program.blocks.iter().enumerate() {
         let at = || block_label(&program.control, i);
         if b.values.len() != width {
-            return Err(format!(
+            return Err(ProgramFault::new(format!(
                 "{}: {} values for the program's {width} axes",
                 at(),
                 b.values.len()
-            ));
+            )));
         }
         if let Some(v) = b.values.iter().find(|v| !v.is_finite()) {
-            return Err(format!("{}: the value {v} is not a finite number", at()));
+            return Err(ProgramFault::new(format!(
+                "{}: the value {v} is not a finite number",
+                at()
+            )));
         }
         if !(b.feed.is_finite() && b.feed >= 0.0)
             || b.spindle.is_some_and(|s| !(s.is_finite() && s >= 0.0))
         {
-            return Err(format!(
+            return Err(ProgramFault::new(format!(
                 "{}: a feed or spindle speed that is not a finite number of at least 0",
                 at()
-            ));
+            )));
         }
         if let Some(k) = b
             .keep
             .iter()
             .find(|k| !program.axes.iter().any(|a| &a.name == *k))
         {
-            return Err(format!(
+            return Err(ProgramFault::new(format!(
                 "{}: it keeps axis {}, which is not the program's",
                 at(),
                 crate::names::quoted(k)
-            ));
+            )));
         }
     }
     Ok(())
@@ -782,7 +816,7 @@ fn cycle_spans(
             diameter,
             None,
         )
-        .map_err(|m| bad(span.start, m))?;
+        .map_err(|m| bad(span.start, m.message))?;
         if moves.len() != span.len() {
             return Err(bad(
                 span.start,
@@ -948,13 +982,13 @@ pub fn axis_rows(
     info: &MachineInfo,
     names: &[String],
     blocks: std::ops::Range<usize>,
-) -> Result<Vec<Real>, String> {
+) -> Result<Vec<Real>, ProgramFault> {
     if blocks.end > program.blocks.len() {
-        return Err(format!(
+        return Err(ProgramFault::new(format!(
             "block {} is beyond the program's {} blocks",
             blocks.end,
             program.blocks.len()
-        ));
+        )));
     }
     let cols = names
         .iter()
@@ -963,13 +997,14 @@ pub fn axis_rows(
                 .axes
                 .iter()
                 .position(|a| &a.name == name)
-                .ok_or(format!("the program has no axis {name}"))?;
-            let axis = info
-                .axis(name)
-                .ok_or(format!("machine {} has no axis {name}", info.name))?;
+                .ok_or(ProgramFault::new(format!("the program has no axis {name}")))?;
+            let axis = info.axis(name).ok_or(ProgramFault::new(format!(
+                "machine {} has no axis {name}",
+                info.name
+            )))?;
             Ok((c, axis))
         })
-        .collect::<Result<Vec<(usize, &Axis)>, String>>()?;
+        .collect::<Result<Vec<(usize, &Axis)>, ProgramFault>>()?;
     Ok(program.blocks[blocks]
         .iter()
         .flat_map(|b| cols.iter().map(|&(c, a)| a.from_user(b.values[c])))
@@ -1033,49 +1068,49 @@ pub fn frame(info: &MachineInfo) -> AxisProgram {
 ///
 /// # Failures
 /// The first of these that does not hold, naming the key and the value.
-pub fn check_power_on(info: &MachineInfo) -> Result<(), String> {
+pub fn check_power_on(info: &MachineInfo) -> Result<(), ProgramFault> {
     let p = &info.setup.power_on;
     if p.is_unstated() {
         return Ok(());
     }
     let Some(d) = post::dialect(&info.control) else {
-        return Err(format!(
+        return Err(ProgramFault::new(format!(
             "setup: power_on is stated for the control '{}', whose modal groups pilgrim does not know",
             crate::files::excerpt(&info.control)
-        ));
+        )));
     };
     let mut seen: Vec<(usize, u32)> = Vec::new();
     for &c in &p.g {
         let Some(group) = d.reading.modal_groups.iter().position(|g| g.contains(&c)) else {
-            return Err(format!(
+            return Err(ProgramFault::new(format!(
                 "setup: power_on.g lists G{c}, which is in no modal group of {} pilgrim knows (groups: {})",
                 d.name,
                 groups_text(d.reading.modal_groups)
-            ));
+            )));
         };
         if let Some((_, other)) = seen.iter().find(|(g, _)| *g == group) {
-            return Err(format!(
+            return Err(ProgramFault::new(format!(
                 "setup: power_on.g lists G{other} and G{c}, two codes of one modal group"
-            ));
+            )));
         }
         seen.push((group, c));
     }
     if let Some(v) = p.no_point {
         if d.reading.least_input.is_none() {
-            return Err(format!(
+            return Err(ProgramFault::new(format!(
                 "setup: power_on.no_point = {v}: a number without its decimal point is millimetres on {}, which has no such parameter",
                 d.name
-            ));
+            )));
         }
         if !(v > 0.0 && v <= 1.0) {
-            return Err(format!(
+            return Err(ProgramFault::new(format!(
                 "setup: power_on.no_point = {v} must be above 0 and at most 1 (mm)"
-            ));
+            )));
         }
     }
     if let Some(sys) = &p.system {
         if !d.reading.systems.contains(&sys.as_str()) {
-            return Err(if d.reading.systems.is_empty() {
+            return Err(ProgramFault::new(if d.reading.systems.is_empty() {
                 format!(
                     "setup: power_on.system = \"{}\": {} has no G-code systems",
                     crate::files::excerpt(sys),
@@ -1088,7 +1123,7 @@ pub fn check_power_on(info: &MachineInfo) -> Result<(), String> {
                     d.name,
                     d.reading.systems.join(", ")
                 )
-            });
+            }));
         }
     }
     Ok(())

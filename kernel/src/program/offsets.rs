@@ -48,7 +48,12 @@ impl Offsets {
     /// not of the forms `D<n>`, `T<four digits>`, `G54`..`G59`; an axis
     /// name not a capital letter; a shift not finite or beyond
     /// [`MAX_SHIFT`]. Each names the file, the word and the axis.
-    pub fn from_toml_str(text: &str, source: &str) -> Result<Self, String> {
+    pub fn from_toml_str(text: &str, source: &str) -> Result<Self, super::ProgramFault> {
+        Self::from_toml_text(text, source).map_err(super::ProgramFault::new)
+    }
+
+    /// [`Self::from_toml_str`], its failure as text.
+    fn from_toml_text(text: &str, source: &str) -> Result<Self, String> {
         let shown = crate::files::excerpt(source);
         let table: toml::Table = text
             .parse()
@@ -188,7 +193,9 @@ mod tests {
             ("[tool]\nD2 = { X = 1e9 }\n", "must be finite and within"),
             ("[tool]\nD2 = 1.0\n", "must be a table of axes"),
         ] {
-            let e = Offsets::from_toml_str(text, "shop.toml").unwrap_err();
+            let e = Offsets::from_toml_str(text, "shop.toml")
+                .unwrap_err()
+                .message;
             assert!(
                 e.starts_with("shop.toml: ") && e.contains(says),
                 "{text}: {e}"

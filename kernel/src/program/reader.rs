@@ -524,7 +524,8 @@ impl<'a> Reader<'a> {
                 })
                 .map_or_else(|| at_line(line), str::to_owned)
         };
-        let mut tokens = super::words::words(code_text).map_err(|m| fault(at_block(), m))?;
+        let mut tokens =
+            super::words::words(code_text).map_err(|m| fault(at_block(), m.message))?;
         let line_number = match tokens.first() {
             Some(w) if w.letter == 'N' => {
                 let n = w.integer().ok_or_else(|| {
@@ -944,7 +945,7 @@ impl<'a> Reader<'a> {
                 ));
             };
             let moves = super::cycle::expand(&cycle, [x0, z0], st.radial == Some(true), end_x)
-                .map_err(|m| fault(place(k), m))?;
+                .map_err(|m| fault(place(k), m.message))?;
             let comment = at.pending.take();
             for (n, mv) in moves.iter().enumerate() {
                 let b = if reading { None } else { program.blocks.get(k) };

@@ -95,7 +95,12 @@ impl Word {
 /// # Failures
 /// The first character that does not begin or continue a word, named with
 /// what it is.
-pub fn words(code: &str) -> Result<Vec<Word>, String> {
+pub fn words(code: &str) -> Result<Vec<Word>, super::ProgramFault> {
+    words_text(code).map_err(super::ProgramFault::new)
+}
+
+/// [`words`], its failure as text.
+fn words_text(code: &str) -> Result<Vec<Word>, String> {
     let b = code.as_bytes();
     let mut out = Vec::new();
     let mut i = 0;
@@ -237,10 +242,10 @@ mod tests {
             ("X+", "without its number"),
             ("X1,5", "','"),
         ] {
-            let e = words(t).unwrap_err();
+            let e = words(t).unwrap_err().message;
             assert!(e.contains(says), "{t}: {e}");
         }
         let long = format!("X1.{}", "0".repeat(40));
-        assert!(words(&long).unwrap_err().contains("longer"));
+        assert!(words(&long).unwrap_err().message.contains("longer"));
     }
 }

@@ -102,8 +102,8 @@ pub fn replay_blocks(
     blocks: std::ops::Range<usize>,
 ) -> Result<Vec<Real>, VerifyError> {
     let info = machine.info();
-    let rows =
-        axis_rows(program, info, &info.solved_axes, blocks.clone()).map_err(VerifyError::Replay)?;
+    let rows = axis_rows(program, info, &info.solved_axes, blocks.clone())
+        .map_err(|e| VerifyError::Replay(e.to_string()))?;
     forward_rows(machine, &rows, tool, blocks)
 }
 

@@ -150,7 +150,8 @@ pub fn replay_polar(
     let (written, resolution) = as_written(program);
     let info = machine.info();
     let n = written.blocks.len();
-    let rows = axis_rows(&written, info, &info.solved_axes, 0..n).map_err(VerifyError::Replay)?;
+    let rows = axis_rows(&written, info, &info.solved_axes, 0..n)
+        .map_err(|e| VerifyError::Replay(e.to_string()))?;
     let rotary: Vec<bool> = info
         .solved_axes
         .iter()

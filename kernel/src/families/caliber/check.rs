@@ -285,7 +285,8 @@ fn samples(
 ) -> Result<(Vec<Vec<Sample>>, Real, usize), VerifyError> {
     let info = machine.info();
     let n = program.blocks.len();
-    let rows = axis_rows(program, info, &info.solved_axes, 0..n).map_err(VerifyError::Replay)?;
+    let rows = axis_rows(program, info, &info.solved_axes, 0..n)
+        .map_err(|e| VerifyError::Replay(e.to_string()))?;
     let width = info.solved_axes.len();
     let poses = crate::replay::replay(program, machine, tool)?;
     let at = |pose: &[Real]| placed(pose, wheel);

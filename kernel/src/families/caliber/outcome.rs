@@ -111,8 +111,8 @@ impl Outcome for GrooveOutcome {
         KIND.key
     }
 
-    fn to_json(&self) -> Result<serde_json::Value, String> {
-        serde_json::to_value(&self.check).map_err(|e| e.to_string())
+    fn to_json(&self) -> Result<serde_json::Value, serde_json::Error> {
+        serde_json::to_value(&self.check)
     }
 
     fn findings(&self, _program: &AxisProgram) -> (Vec<Figure>, Vec<Finding>) {
@@ -170,7 +170,7 @@ impl Outcome for GrooveOutcome {
         &self,
         ctx: &FilesContext<'_>,
         tables: &BTreeMap<String, BTreeMap<String, Vec<f64>>>,
-    ) -> Result<crate::family::Drawn, String> {
+    ) -> Result<crate::family::Drawn, crate::family::DrawError> {
         // Each grinding pass's psi, as the family's pass table gives it a
         // row per cutting pass in order; none where the rows do not match.
         let cutting: Vec<_> = ctx.replay.passes.iter().filter(|p| p.cuts).collect();
@@ -207,8 +207,11 @@ pub const KIND: OutcomeKind = OutcomeKind {
 };
 
 /// The page's section: the groove's extremes and where they are.
-fn section(entry: &serde_json::Value, _label: &dyn Fn(usize) -> String) -> Result<String, String> {
-    let g: GrooveCheck = serde_json::from_value(entry.clone()).map_err(|e| e.to_string())?;
+fn section(
+    entry: &serde_json::Value,
+    _label: &dyn Fn(usize) -> String,
+) -> Result<String, crate::family::DrawError> {
+    let g: GrooveCheck = serde_json::from_value(entry.clone())?;
     let mut out = String::new();
     let place = |p: &GroovePlace| {
         format!(

@@ -3,6 +3,7 @@
 //! (theta, psi) as a heat map, and `section.svg`, the wheel's rounding at
 //! every pass in the groove's section where the most material is left.
 
+use crate::chart::DrawError;
 use crate::chart::{tick_decimals, Marks, PassMark, PixelMap, PlaceMark};
 use crate::families::caliber::{GrooveCheck, GrooveRequest};
 use plotters::prelude::*;
@@ -47,17 +48,20 @@ fn level(v: f64, limit: f64) -> usize {
 pub fn deviation_map_svg(
     check: &GrooveCheck,
     passes: &[(std::ops::Range<usize>, f64)],
-) -> Result<(String, Marks), String> {
+) -> Result<(String, Marks), DrawError> {
     let m = &check.map;
     let (nt, np) = (
         m.theta_deg.len().saturating_sub(1),
         m.psi_deg.len().saturating_sub(1),
     );
     if nt == 0 || np == 0 || m.mm.len() != nt * np {
-        return Err("the groove's deviation map is empty".into());
+        return Err(DrawError::new(
+            "deviation_map.svg",
+            "the groove's deviation map is empty",
+        ));
     }
     let limit = check.tolerance.max(check.max_abs_mm);
-    let e = |e: DrawingAreaErrorKind<std::io::Error>| e.to_string();
+    let e = |e: DrawingAreaErrorKind<std::io::Error>| DrawError::new("deviation_map.svg", e);
     let mut svg = String::new();
     let mut marks = Marks {
         size: [1000, 560],
@@ -197,10 +201,12 @@ pub fn section_svg(
     check: &GrooveCheck,
     req: &GrooveRequest,
     rounding: f64,
-) -> Result<String, String> {
+) -> Result<String, DrawError> {
     let theta = check.max_left.theta_deg.to_radians();
     let g = &req.groove;
-    let section = g.section(theta).map_err(|e| e.to_string())?;
+    let section = g
+        .section(theta)
+        .map_err(|e| DrawError::new("section.svg", e))?;
     let er = crate::math::Vec3::new(theta.cos(), theta.sin(), 0.0);
     // In the section: x across the roll (mm), y the height above the
     // periphery (minus the depth).
@@ -214,7 +220,9 @@ pub fn section_svg(
     let mut circles = Vec::with_capacity(req.psi.len());
     for &psi in &req.psi {
         let (x, z) = section.point(psi);
-        let n = g.normal(theta, psi).map_err(|e| e.to_string())?;
+        let n = g
+            .normal(theta, psi)
+            .map_err(|e| DrawError::new("section.svg", e))?;
         // The normal points into the open groove: along the roll's axis
         // (section x) and outward (up in the section).
         circles.push((x + rounding * n.z, -z + rounding * n.dot(&er), (x, -z)));
@@ -234,7 +242,7 @@ pub fn section_svg(
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
     let (x0, x1) = (cx - 0.5 * w * scale, cx + 0.5 * w * scale);
     let (y0, y1) = (cy - 0.5 * h * scale, cy + 0.5 * h * scale);
-    let e = |e: DrawingAreaErrorKind<std::io::Error>| e.to_string();
+    let e = |e: DrawingAreaErrorKind<std::io::Error>| DrawError::new("section.svg", e);
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (1000, 680)).into_drawing_area();

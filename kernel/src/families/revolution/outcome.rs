@@ -135,8 +135,8 @@ impl Outcome for GrindingOutcome {
         KIND.key
     }
 
-    fn to_json(&self) -> Result<serde_json::Value, String> {
-        serde_json::to_value(&self.check).map_err(|e| e.to_string())
+    fn to_json(&self) -> Result<serde_json::Value, serde_json::Error> {
+        serde_json::to_value(&self.check)
     }
 
     fn findings(&self, program: &AxisProgram) -> (Vec<Figure>, Vec<Finding>) {
@@ -184,7 +184,7 @@ impl Outcome for GrindingOutcome {
         &self,
         ctx: &FilesContext<'_>,
         _tables: &std::collections::BTreeMap<String, std::collections::BTreeMap<String, Vec<f64>>>,
-    ) -> Result<crate::family::Drawn, String> {
+    ) -> Result<crate::family::Drawn, crate::family::DrawError> {
         let profiles: Vec<(String, crate::profile::Profile)> = ctx
             .parts
             .iter()
@@ -225,8 +225,11 @@ pub const KIND: OutcomeKind = OutcomeKind {
 };
 
 /// The page's section: the finish and every pass's figures.
-fn section(entry: &serde_json::Value, label: &dyn Fn(usize) -> String) -> Result<String, String> {
-    let v: GrindingCheck = serde_json::from_value(entry.clone()).map_err(|e| e.to_string())?;
+fn section(
+    entry: &serde_json::Value,
+    label: &dyn Fn(usize) -> String,
+) -> Result<String, crate::family::DrawError> {
+    let v: GrindingCheck = serde_json::from_value(entry.clone())?;
     let mut out = String::new();
     let _ = write!(
         out,

@@ -6,6 +6,7 @@
 //! (the surface before it minus the surface it left: the blank's for the
 //! first pass).
 
+use crate::chart::DrawError;
 use crate::chart::{tick_decimals, Marks, PassMark, PixelMap, PlaceMark, COLOURS};
 use crate::families::revolution::{GrindingCheck, PassCheck};
 use plotters::prelude::*;
@@ -17,7 +18,7 @@ fn draw(
     passes: &[&PassCheck],
     (title, y_desc): (&str, &str),
     band: Option<f64>,
-) -> Result<(String, Marks, PixelMap), String> {
+) -> Result<(String, Marks, PixelMap), DrawError> {
     let (mut z0, mut z1, mut y0, mut y1) = (
         f64::INFINITY,
         f64::NEG_INFINITY,
@@ -34,7 +35,7 @@ fn draw(
         (y0, y1) = (y0.min(-1e3 * t), y1.max(1e3 * t));
     }
     if !(z0.is_finite() && y0.is_finite()) {
-        return Err(format!("{title}: nothing to draw"));
+        return Err(DrawError::new(title, "nothing to draw"));
     }
     if z1 - z0 < crate::tolerance::SAME_LENGTH {
         z1 = z0 + 1.0;
@@ -47,7 +48,7 @@ fn draw(
     let map;
     {
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-        let e = |e: DrawingAreaErrorKind<_>| format!("{title}: {e:?}");
+        let e = |e: DrawingAreaErrorKind<_>| DrawError::new(title, format!("{e:?}"));
         root.fill(&WHITE).map_err(e)?;
         let (top, bottom) = root.split_vertically(600);
         let mut chart = ChartBuilder::on(&top)
@@ -201,9 +202,12 @@ pub fn deviation_svgs(
     check: &GrindingCheck,
     start: impl Fn(f64) -> Option<f64>,
     blocks: usize,
-) -> Result<[(String, String, Marks); 3], String> {
+) -> Result<[(String, String, Marks); 3], DrawError> {
     let all: Vec<&PassCheck> = check.passes.iter().collect();
-    let finish = all.last().copied().ok_or("the replay has no pass")?;
+    let finish = all
+        .last()
+        .copied()
+        .ok_or_else(|| DrawError::new("deviation.svg", "the replay has no pass"))?;
     let stock = removed(&check.passes, start);
     let at_worst = |(svg, mut marks, map): (String, Marks, PixelMap)| {
         marks.places.extend(worst_place(finish, &map));

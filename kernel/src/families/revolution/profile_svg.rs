@@ -3,6 +3,7 @@
 //! curvature, as panels of line plots drawn with plotters (the same job
 //! gives the same bytes).
 
+use crate::chart::DrawError;
 use crate::machine::{bodies_of, MachineKinematics};
 use crate::math::fixed;
 use crate::profile::Profile;
@@ -46,7 +47,7 @@ pub fn profile_svg(
     tool: &ToolFrame,
     nominal: &Profile,
     rounding: f64,
-) -> Result<String, String> {
+) -> Result<String, DrawError> {
     let cutting: Vec<&ProgramPass> = passes.iter().filter(|p| p.cuts).collect();
     let mut shape: Vec<Series> = profiles
         .iter()
@@ -62,7 +63,7 @@ pub fn profile_svg(
             name: format!("wheel centre, {}", last.name),
             color: COLORS[2],
             points: crate::replay::replay_blocks(program, machine, tool, last.blocks.clone())
-                .map_err(|e| e.to_string())?
+                .map_err(|e| DrawError::new("profile.svg", e))?
                 .chunks_exact(6)
                 .map(|p| (p[2], p[0].hypot(p[1])))
                 .collect(),
@@ -74,7 +75,7 @@ pub fn profile_svg(
         series: shape,
     }];
     let info = machine.info();
-    for body in bodies_of(info).map_err(|e| e.to_string())? {
+    for body in bodies_of(info).map_err(|e| DrawError::new("profile.svg", e))? {
         let Some(axis) = info
             .driven_axes
             .iter()
@@ -89,7 +90,8 @@ pub fn profile_svg(
         let mut series = Vec::new();
         for (i, p) in cutting.iter().enumerate() {
             let blocks = p.blocks.clone();
-            let rows = axis_rows(program, info, names, blocks.clone())?;
+            let rows = axis_rows(program, info, names, blocks.clone())
+                .map_err(|e| DrawError::new("profile.svg", e))?;
             let points = rows
                 .chunks_exact(names.len().max(1))
                 .zip(&program.blocks[blocks])
@@ -151,7 +153,7 @@ pub fn profile_svg(
 /// The panels as SVG, stacked, sharing the z range of all their points,
 /// each a plotters chart (axes with ticks and units, a grid, the legend
 /// below the data).
-fn render(panels: &[Panel]) -> Result<String, String> {
+fn render(panels: &[Panel]) -> Result<String, DrawError> {
     use plotters::prelude::*;
     let all = || {
         panels
@@ -163,7 +165,7 @@ fn render(panels: &[Panel]) -> Result<String, String> {
         (a.min(p.0), b.max(p.0))
     });
     if !z0.is_finite() {
-        return Err("profile.svg: nothing to draw".into());
+        return Err(DrawError::new("profile.svg", "nothing to draw"));
     }
     let z1 = if z1 > z0 { z1 } else { z0 + 1.0 };
     const CHART: u32 = 300;
@@ -175,7 +177,7 @@ fn render(panels: &[Panel]) -> Result<String, String> {
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (1100, height)).into_drawing_area();
-        let e = |e: DrawingAreaErrorKind<_>| format!("profile.svg: {e:?}");
+        let e = |e: DrawingAreaErrorKind<_>| DrawError::new("profile.svg", format!("{e:?}"));
         root.fill(&WHITE).map_err(e)?;
         let mut rest = root;
         for (panel, r) in panels.iter().zip(&rows) {

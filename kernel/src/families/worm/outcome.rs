@@ -105,8 +105,8 @@ impl Outcome for WormOutcome {
         KIND.key
     }
 
-    fn to_json(&self) -> Result<serde_json::Value, String> {
-        serde_json::to_value(&self.check).map_err(|e| e.to_string())
+    fn to_json(&self) -> Result<serde_json::Value, serde_json::Error> {
+        serde_json::to_value(&self.check)
     }
 
     fn findings(&self, _program: &AxisProgram) -> (Vec<Figure>, Vec<Finding>) {
@@ -211,7 +211,7 @@ impl Outcome for WormOutcome {
         &self,
         ctx: &FilesContext<'_>,
         tables: &BTreeMap<String, BTreeMap<String, Vec<f64>>>,
-    ) -> Result<crate::family::Drawn, String> {
+    ) -> Result<crate::family::Drawn, crate::family::DrawError> {
         let table = worm_pass_table(&self.check, tables.get("passes"))?;
         let workbook = super::worm_pass_workbook(&self.check, tables.get("passes"))?;
         let (svg, marks) = worm_passes_svg(&self.check, ctx.replay.program.blocks.len())?;
@@ -234,8 +234,11 @@ pub const KIND: OutcomeKind = OutcomeKind {
 };
 
 /// The page's section: chips, loads, leads and each start's figures.
-fn section(entry: &serde_json::Value, _label: &dyn Fn(usize) -> String) -> Result<String, String> {
-    let w: WormCheck = serde_json::from_value(entry.clone()).map_err(|e| e.to_string())?;
+fn section(
+    entry: &serde_json::Value,
+    _label: &dyn Fn(usize) -> String,
+) -> Result<String, crate::family::DrawError> {
+    let w: WormCheck = serde_json::from_value(entry.clone())?;
     let mut out = String::new();
     let _ = write!(
         out,

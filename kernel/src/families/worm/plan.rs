@@ -135,16 +135,18 @@ impl FlankOrder {
     ///
     /// # Failures
     /// Another name (the message names it).
-    pub fn parse(name: &str) -> Result<Self, String> {
+    pub fn parse(name: &str) -> Result<Self, crate::input::InputError> {
         Ok(match name {
             "alternating" => Self::Alternating,
             "left" => Self::Left,
             "right" => Self::Right,
             "radial" => Self::Radial,
             other => {
-                return Err(format!(
-                    "flank order '{other}' is not alternating, left, right or radial"
-                ))
+                return Err(crate::input::InputError::BadText {
+                    what: "flank order".into(),
+                    value: format!("'{other}'"),
+                    reason: "is not alternating, left, right or radial".into(),
+                })
             }
         })
     }

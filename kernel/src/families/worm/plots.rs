@@ -3,6 +3,7 @@
 //! "distribution" view), drawn with plotters; `passes.csv`, one row per
 //! thread pass, written with the csv crate.
 
+use crate::chart::DrawError;
 use crate::chart::{Marks, PassMark, PixelMap};
 use crate::families::worm::WormCheck;
 use plotters::prelude::*;
@@ -26,14 +27,14 @@ fn pass_colour(k: usize, n: usize) -> HSLColor {
 ///
 /// # Failures
 /// Drawing failing.
-pub fn worm_passes_svg(check: &WormCheck, blocks: usize) -> Result<(String, Marks), String> {
+pub fn worm_passes_svg(check: &WormCheck, blocks: usize) -> Result<(String, Marks), DrawError> {
     let (w0, lead) = check.window;
     let (mut r0, mut r1) = (f64::INFINITY, f64::NEG_INFINITY);
     for chip in check.chips.iter().flatten().flatten() {
         (r0, r1) = (r0.min(chip[1]), r1.max(chip[1]));
     }
     if !r0.is_finite() {
-        return Err("passes.svg: no chip to draw".into());
+        return Err(DrawError::new("passes.svg", "no chip to draw"));
     }
     let pad = 0.05 * (r1 - r0).max(1.0);
     let (r0, r1) = (r0 - 3.0 * pad, r1 + pad);
@@ -45,7 +46,7 @@ pub fn worm_passes_svg(check: &WormCheck, blocks: usize) -> Result<(String, Mark
     };
     {
         let root = SVGBackend::with_string(&mut svg, (1100, 700)).into_drawing_area();
-        let e = |e: DrawingAreaErrorKind<_>| format!("passes.svg: {e:?}");
+        let e = |e: DrawingAreaErrorKind<_>| DrawError::new("passes.svg", format!("{e:?}"));
         root.fill(&WHITE).map_err(e)?;
         let (top, bottom) = root.split_vertically(640);
         let mut chart = ChartBuilder::on(&top)
@@ -154,7 +155,7 @@ pub(super) fn plan_columns<'a>(
 pub fn worm_pass_table(
     check: &WormCheck,
     planned: Option<&BTreeMap<String, Vec<f64>>>,
-) -> Result<String, String> {
+) -> Result<String, DrawError> {
     let plan = plan_columns(check, planned);
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut head: Vec<String> = [
@@ -179,7 +180,8 @@ pub fn worm_pass_table(
         plan.iter()
             .map(|(k, _)| crate::names::spreadsheet_text(&format!("plan_{k}"))),
     );
-    w.write_record(&head).map_err(|e| e.to_string())?;
+    w.write_record(&head)
+        .map_err(|e| DrawError::new("passes.csv", e))?;
     for (i, p) in check.passes.iter().enumerate() {
         let mut row = vec![
             p.block.to_string(),
@@ -197,8 +199,11 @@ pub fn worm_pass_table(
             crate::math::fixed(p.end_lead_error, 6),
         ];
         row.extend(plan.iter().map(|(_, c)| crate::math::fixed(c[i], 5)));
-        w.write_record(&row).map_err(|e| e.to_string())?;
+        w.write_record(&row)
+            .map_err(|e| DrawError::new("passes.csv", e))?;
     }
-    let bytes = w.into_inner().map_err(|e| e.to_string())?;
-    String::from_utf8(bytes).map_err(|e| e.to_string())
+    let bytes = w
+        .into_inner()
+        .map_err(|e| DrawError::new("passes.csv", e))?;
+    String::from_utf8(bytes).map_err(|e| DrawError::new("passes.csv", e))
 }

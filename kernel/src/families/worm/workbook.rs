@@ -46,8 +46,8 @@ fn header(sheet: &mut Worksheet, columns: &[Column<'_>]) -> Result<(), XlsxError
 pub fn worm_pass_workbook(
     check: &WormCheck,
     planned: Option<&BTreeMap<String, Vec<f64>>>,
-) -> Result<Vec<u8>, String> {
-    build(check, planned).map_err(|e| format!("passes.xlsx: {e}"))
+) -> Result<Vec<u8>, crate::chart::DrawError> {
+    build(check, planned).map_err(|e| crate::chart::DrawError::new("passes.xlsx", e))
 }
 
 fn build(
