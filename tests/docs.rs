@@ -127,3 +127,57 @@ fn the_readme_is_short_and_the_docs_link_both_ways() {
     }
     assert!(checked > 30, "{checked} links");
 }
+
+/// The figures the docs quote of the default mandrel's passes are the
+/// default run's: its roughing feed, feed a revolution, the stock each
+/// roughing pass leaves and its ridge, as `docs/verification.md` and
+/// `docs/families.md` say them.
+#[test]
+fn the_docs_quote_the_default_mandrels_figures() {
+    let out = crate::common::default_run("docs", "mandrel", "figures");
+    let report = crate::common::report_of(&out);
+    let passes = report["verification"]["passes"].as_array().unwrap();
+    let (rough, finish) = passes.split_at(passes.len() - 1);
+    let num = |p: &serde_json::Value, k: &str| p[k].as_f64().unwrap();
+    let stock: Vec<String> = rough
+        .iter()
+        .map(|p| {
+            let name = p["name"].as_str().unwrap();
+            let um = name
+                .rsplit("stock ")
+                .next()
+                .unwrap()
+                .trim_end_matches(" um");
+            format!("{}", um.parse::<f64>().unwrap())
+        })
+        .collect();
+    let said = format!(
+        "the roughing passes at {} mm/min ({:.2} mm a revolution) leave {} um of stock under ridges of {:.0} um, and the finish at {} mm/min ({:.3} mm a revolution",
+        num(&rough[0], "feed_mm_min"),
+        num(&rough[0], "feed_per_rev_mm"),
+        stock.join(", "),
+        num(&rough[0], "ridge_mm") * 1e3,
+        num(&finish[0], "feed_mm_min"),
+        num(&finish[0], "feed_per_rev_mm"),
+    );
+    for page in ["docs/verification.md", "docs/families.md"] {
+        let text = std::fs::read_to_string(crate::common::root().join(page)).unwrap();
+        let flat = text.split_whitespace().collect::<Vec<_>>().join(" ");
+        assert!(flat.contains(&said), "{page} must say: {said}");
+    }
+}
+
+/// The script reference speaks the script's language: every function has
+/// its doc, and no type is shown by its Rust path.
+#[test]
+fn the_script_reference_documents_everything_in_script_terms() {
+    let text = std::fs::read_to_string(crate::common::root().join("docs/script-api.md")).unwrap();
+    let undocumented: Vec<&str> = text
+        .split("\n### ")
+        .filter(|s| s.contains("(undocumented)"))
+        .filter_map(|s| s.lines().next())
+        .collect();
+    assert!(undocumented.is_empty(), "{undocumented:#?}");
+    let rust: Vec<&str> = text.lines().filter(|l| l.contains("crate::")).collect();
+    assert!(rust.is_empty(), "{rust:#?}");
+}

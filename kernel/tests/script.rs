@@ -417,10 +417,11 @@ fn a_verify_map_names_what_is_wrong_with_it() {
     };
     let e = message("#{ depth: 1.0 }");
     assert!(
-        e.contains("must return #{ profile, from, to, tolerance }")
-            && e.contains(", #{ groove, psi,")
-            && e.contains(", #{ worm, length,")
-            && e.contains(" or #{ thread_profile, length,"),
+        e.contains("must return one of: #{ replay: \"radius_over_angle\"")
+            && e.contains("; #{ profile, from, to, tolerance }")
+            && e.contains("; #{ groove, psi,")
+            && e.contains("; #{ worm, length,")
+            && e.contains("; #{ thread_profile, length,"),
         "{e}"
     );
     let e = message(
@@ -431,5 +432,5 @@ fn a_verify_map_names_what_is_wrong_with_it() {
         "{e}"
     );
     let e = message("#{ worm: 1.0 }");
-    assert!(e.contains("must return #{ profile"), "{e}");
+    assert!(e.contains("must return one of: "), "{e}");
 }

@@ -18,6 +18,7 @@ pub use crate::binding::take_warnings;
 use crate::binding::{deprecated, gone};
 use crate::math::Real;
 use crate::profile::{MandrelLaw, Polyline, Profile};
+use crate::tool::Tool;
 use rhai::plugin::*;
 use rhai::{EvalAltResult, Map};
 
@@ -196,7 +197,7 @@ pub mod compat_api {
     pub fn cut_path(
         _previous: Profile,
         _centres: Polyline,
-        _wheel: crate::tool::Tool,
+        _wheel: Tool,
         _feed: Real,
     ) -> Result<Profile, Box<EvalAltResult>> {
         Err(gone(

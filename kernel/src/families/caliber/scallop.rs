@@ -10,7 +10,7 @@ use crate::math::{positive, Real};
 /// `Rz = r_section - (d cos(dpsi / 2) + r_k cos(beta))` (mm).
 ///
 /// ```
-/// let rz = pilgrim_kernel::caliber::scallop_height(20.0, 5.0, 1f64.to_radians()).unwrap();
+/// let rz = pilgrim_kernel::families::caliber::scallop_height(20.0, 5.0, 1f64.to_radians()).unwrap();
 /// assert!((rz - 2.28e-3).abs() < 1e-5); // 1 degree (the seed's finish): 2.3 um
 /// ```
 ///

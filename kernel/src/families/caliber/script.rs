@@ -10,7 +10,7 @@ use crate::family::Verification;
 // The Rhai `Solid`: a mesh and the exact body it was meshed from.
 use crate::family::Swept as Solid;
 use crate::math::Real;
-use crate::profile::{Smoothing, Table};
+use crate::profile::{Profile, Smoothing, Table};
 use crate::tool::{Tool, Wheel};
 use rhai::plugin::*;
 use rhai::{Array, EvalAltResult};
@@ -155,13 +155,13 @@ pub mod caliber_api {
 
     /// The depth table Hp(theta) as a profile (theta in rad, mm).
     #[rhai_fn(get = "depth", pure)]
-    pub fn depth(g: &mut Groove) -> crate::profile::Profile {
+    pub fn depth(g: &mut Groove) -> Profile {
         g.depth().clone()
     }
 
     /// The width table B(theta) as a profile (theta in rad, mm).
     #[rhai_fn(get = "width", pure)]
-    pub fn width(g: &mut Groove) -> crate::profile::Profile {
+    pub fn width(g: &mut Groove) -> Profile {
         g.width().clone()
     }
 

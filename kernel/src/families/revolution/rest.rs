@@ -60,7 +60,7 @@ impl RestModel {
 /// A non-positive `R_o`; `z_r` outside the surface's range.
 ///
 /// ```
-/// use pilgrim_kernel::revolution::rest;
+/// use pilgrim_kernel::families::revolution::rest;
 /// use pilgrim_kernel::Profile;
 /// let cone = Profile::new(vec![0.0, 10.0, 20.0], vec![10.0, 11.0, 12.0]).unwrap();
 /// let u = rest::seed_u(&cone, 5.0, 3.0).unwrap();

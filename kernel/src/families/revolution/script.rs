@@ -239,7 +239,6 @@ pub mod revolution_api {
         t.max_gap
     }
 
-    /// How far it presses into the surface at most (mm).
     /// `track.stand_off_on(grid)`: U's straight line between blocks
     /// minus the exact drop (mm; + off the surface, - into it) at each z
     /// of `grid` (increasing, evenly spaced; the support centre's z): the
@@ -255,6 +254,8 @@ pub mod revolution_api {
         Ok(Floats::new(t.stand_off_on(&grid)))
     }
 
+    /// How far U's straight line between blocks presses into the surface
+    /// at most (mm).
     #[rhai_fn(get = "max_press", pure)]
     pub fn track_press(t: &mut RestTrack) -> Real {
         t.max_press
