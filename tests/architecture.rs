@@ -106,7 +106,7 @@ fn a_family_is_named_only_in_its_folder_and_the_registry() {
     let built_on = [("worm", "thread")];
     let mut naming = vec![];
     let src = root().join("kernel/src");
-    for file in rust_files(&src) {
+    for file in crate::common::files_with_ext(&src, "rs") {
         let rel = file
             .strip_prefix(&src)
             .unwrap()
@@ -138,20 +138,6 @@ fn a_family_is_named_only_in_its_folder_and_the_registry() {
         }
     }
     assert!(naming.is_empty(), "{naming:#?}");
-}
-
-/// Every `.rs` file under `dir`.
-fn rust_files(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
-    let mut out = vec![];
-    for e in std::fs::read_dir(dir).unwrap().flatten() {
-        let p = e.path();
-        if p.is_dir() {
-            out.extend(rust_files(&p));
-        } else if p.extension().is_some_and(|x| x == "rs") {
-            out.push(p);
-        }
-    }
-    out
 }
 
 /// The layers `docs/architecture.md` lists ("Dependencies go one way, down

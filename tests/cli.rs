@@ -401,20 +401,9 @@ fn params_and_plugin_check() {
 /// Every script under scripts/ runs with its defaults.
 #[test]
 fn every_script_runs_with_its_defaults() {
-    fn scripts(dir: &Path, found: &mut Vec<PathBuf>) {
-        for e in std::fs::read_dir(dir).unwrap().flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                scripts(&p, found);
-            } else if p.extension().is_some_and(|x| x == "rhai") {
-                found.push(p);
-            }
-        }
-    }
-    let mut found = vec![];
-    scripts(
+    let found = crate::common::files_with_ext(
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts"),
-        &mut found,
+        "rhai",
     );
     assert!(!found.is_empty());
     let dir = scratch("scripts");

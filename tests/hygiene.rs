@@ -12,26 +12,14 @@ use syn::visit::Visit;
 /// The Rust sources that are not tests: the kernel's, the program's, the
 /// plugins' and the ABI's.
 fn sources() -> Vec<PathBuf> {
-    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
-        for e in std::fs::read_dir(dir).unwrap().flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                walk(&p, out);
-            } else if p.extension().is_some_and(|x| x == "rs") {
-                out.push(p);
-            }
-        }
-    }
     let root = crate::common::root();
-    let mut out = vec![];
-    walk(&root.join("kernel/src"), &mut out);
-    walk(&root.join("src"), &mut out);
+    let mut out = crate::common::files_with_ext(&root.join("kernel/src"), "rs");
+    out.extend(crate::common::files_with_ext(&root.join("src"), "rs"));
     for e in std::fs::read_dir(root.join("plugins")).unwrap().flatten() {
         if e.path().join("src").is_dir() {
-            walk(&e.path().join("src"), &mut out);
+            out.extend(crate::common::files_with_ext(&e.path().join("src"), "rs"));
         }
     }
-    out.sort();
     assert!(out.len() > 100, "{out:?}");
     out
 }

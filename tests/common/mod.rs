@@ -159,6 +159,25 @@ pub fn default_run(suite: &str, job: &str, name: &str) -> PathBuf {
     out
 }
 
+/// Every file under `dir` whose name ends in `.ext`, sorted.
+#[allow(dead_code)]
+pub fn files_with_ext(dir: &Path, ext: &str) -> Vec<PathBuf> {
+    fn walk(dir: &Path, ext: &str, out: &mut Vec<PathBuf>) {
+        for e in std::fs::read_dir(dir).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                walk(&p, ext, out);
+            } else if p.extension().is_some_and(|x| x == ext) {
+                out.push(p);
+            }
+        }
+    }
+    let mut out = vec![];
+    walk(dir, ext, &mut out);
+    out.sort();
+    out
+}
+
 /// A path as the text an argument takes.
 #[allow(dead_code)]
 pub fn s(p: &Path) -> &str {

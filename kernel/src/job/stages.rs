@@ -129,14 +129,14 @@ impl Run<'_> {
         })
     }
 
-    /// The report of a run that stopped before its program was checked:
-    /// every parameter, the checks, the program's file where it verifies
-    /// one, and `failed`.
+    /// The FAILED report of a run that stopped before its program was
+    /// checked: every parameter, the checks, the program's file where it
+    /// verifies one, and what `failed`.
     fn early_report(
         &self,
         plan_checks: Vec<Check>,
         info: &crate::machine::MachineInfo,
-        failed: Finding,
+        failed: Vec<Finding>,
         verified: bool,
     ) -> Error {
         let mut report = Report::of_run(
@@ -147,7 +147,7 @@ impl Run<'_> {
             plan_checks,
         );
         report.program_file = self.text.and(self.options.program_file.clone());
-        report.verdict = Verdict::of(verified, vec![failed], Vec::new(), Vec::new());
+        report.verdict = Verdict::of(verified, failed, Vec::new(), Vec::new());
         failed_run(report, Vec::new(), None)
     }
 
@@ -212,16 +212,7 @@ impl Run<'_> {
         if !failed.is_empty() {
             // Nothing to replay or draw: the report says which checks
             // failed, with every parameter.
-            let mut report = Report::of_run(
-                self.family,
-                self.machine,
-                info,
-                (self.values, self.origins),
-                checks,
-            );
-            report.program_file = self.text.and(self.options.program_file.clone());
-            report.verdict = Verdict::of(false, failed, Vec::new(), Vec::new());
-            return Err(failed_run(report, Vec::new(), None));
+            return Err(self.early_report(checks, info, failed, false));
         }
         enter(stage, STAGES[1])?;
         let mut toolpath = self.family.toolpath(self.values)?;
@@ -298,7 +289,7 @@ impl Run<'_> {
             self.early_report(
                 plan.checks.clone(),
                 info,
-                Finding::new("the program's text", message),
+                vec![Finding::new("the program's text", message)],
                 true,
             )
         };
@@ -438,10 +429,7 @@ impl<'a> Run<'a> {
 
     /// The part's bodies (the family's, with those its verification made:
     /// the finished worm) and their meshes.
-    fn bodies(
-        &self,
-        outcome: Option<&dyn Outcome>,
-    ) -> Result<Bodies, Error> {
+    fn bodies(&self, outcome: Option<&dyn Outcome>) -> Result<Bodies, Error> {
         let mut parts = self.family.part(self.values)?;
         if let Some(b) = parts.iter().find(|b| !crate::files::is_plain_name(&b.name)) {
             return Err(self.contract(format!(
