@@ -77,6 +77,7 @@ pub mod plugin;
 pub mod process;
 pub mod profile;
 pub mod program;
+pub mod render;
 pub mod replay;
 mod report;
 pub mod script;

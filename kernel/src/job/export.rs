@@ -1,12 +1,12 @@
 //! `pilgrim export DIR --block N`: a finished run's scene with the tool (and
 //! the machine's other bodies) placed at another block.
 
-use super::scene::{self, Formats};
 use super::Report;
 use crate::catalog::Catalog;
 use crate::error::Error;
 use crate::output::RunDir;
 use crate::program::AxisProgram;
+use crate::render::scene::{self, Formats};
 use crate::toolpath::Toolpath;
 
 /// The most part bodies an export places (a family's part is a few
@@ -98,7 +98,7 @@ pub fn export(
     toolpath
         .validate()
         .map_err(|e| bad("toolpath.json", e.to_string()))?;
-    let part_bodies: Vec<&super::scene::BodyFile> =
+    let part_bodies: Vec<&crate::render::scene::BodyFile> =
         report.bodies.iter().filter(|b| b.kind == "part").collect();
     if part_bodies.len() > MAX_PART_BODIES {
         return Err(bad(
@@ -208,7 +208,7 @@ pub fn export(
         .collect();
     // The tool's exact solid moves with it.
     let (tool_steps, tool_solids) =
-        super::solids::step_files(&[], &toolpath.tool, &pose, report.step_tolerance_mm)?;
+        crate::render::solids::step_files(&[], &toolpath.tool, &pose, report.step_tolerance_mm)?;
     report.solids.retain(|s| s.kind != "tool");
     report.solids.extend(tool_solids);
     all.extend(tool_steps);
@@ -229,9 +229,9 @@ pub fn export(
     let view = scene::bounds_of(parts.iter().map(|(_, m)| m))
         .map(|b| scene::contact_box(b, &toolpath.tool, &pose));
     // The listing's lines as the lint read the program.
-    let listed = super::page::written_program(&shown, control.extension);
+    let listed = crate::render::page::written_program(&shown, control.extension);
     report.program_lines = as_read.map(|r| r.lines).unwrap_or_default();
-    let html = super::page::page_of(&report, &shown, listed, view);
+    let html = crate::render::page::page_of(&report, &shown, listed, view);
     all.push(("report.html".into(), html.into_bytes()));
     all.push(("report.json".into(), super::report_json(&report)?));
     Ok(Exported {

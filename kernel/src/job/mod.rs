@@ -14,12 +14,11 @@
 mod compensate;
 mod export;
 pub mod kept;
-mod page;
-mod scene;
-mod solids;
-mod spin;
 mod stages;
 
+pub use crate::render::scene::{default_pose_block, BodyFile, Formats, PosePlace, SceneError};
+pub use crate::render::solids::SolidFile;
+use crate::render::{page, scene};
 pub use crate::report::{axis_ranges, block_table, FailedRun, Report, ReportParam};
 pub use compensate::{
     compensate, run_correction, CompensateOptions, Compensation, Place, ProgramChange, CORRECTION,
@@ -27,8 +26,6 @@ pub use compensate::{
 };
 pub use export::{export, run_machine, Exported};
 pub use kept::{Keep, KeptInput};
-pub use scene::{default_pose_block, BodyFile, Formats, PosePlace, SceneError};
-pub use solids::SolidFile;
 
 use crate::catalog::OpenMachine;
 use crate::error::Error;

@@ -8,8 +8,8 @@
 //! program's stage differs.
 
 use super::{
-    block_table, collisions, data_files, enter, failed_run, json, kept, page, post_all,
-    report_json, scene, solids, JobOptions, JobOutput, STAGES,
+    block_table, collisions, data_files, enter, failed_run, json, kept, post_all, report_json,
+    JobOptions, JobOutput, STAGES,
 };
 use crate::catalog::OpenMachine;
 use crate::error::Error;
@@ -21,6 +21,7 @@ use crate::mesh::TriMesh;
 use crate::params::{ParamValue, Params};
 use crate::program::post::Dialect;
 use crate::program::{build, AxisProgram, ProgramPass};
+use crate::render::{page, scene, solids};
 use crate::report::Report;
 use crate::toolpath::Toolpath;
 use crate::verdict::{Finding, Verdict};

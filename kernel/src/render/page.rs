@@ -16,8 +16,8 @@
 //! The HTML is written here by hand: a few tables and figures need no
 //! template engine, and [`escape`] is the one rule every text obeys.
 
-use super::Report;
 use crate::math::fixed;
+use crate::report::Report;
 use base64::Engine;
 use std::fmt::Write;
 
@@ -632,7 +632,7 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
 /// the program it lists (`program`: its name and text, none where the run
 /// wrote none) and `scene.glb`, the camera framing `part_box` (mm:
 /// [`super::scene::contact_box`]).
-pub(super) fn page_of(
+pub(crate) fn page_of(
     report: &Report,
     files: &[(String, Vec<u8>)],
     program: Option<(&str, &str)>,
@@ -657,7 +657,7 @@ pub(super) fn page_of(
 
 /// The control's program among a run's `files`, as the page lists it:
 /// `program.<extension>` and its text.
-pub(super) fn written_program<'a>(
+pub(crate) fn written_program<'a>(
     files: &'a [(String, Vec<u8>)],
     extension: &str,
 ) -> Option<(&'a str, &'a str)> {
