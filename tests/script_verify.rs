@@ -221,6 +221,11 @@ fn a_scripts_verification_is_read_strictly() {
             "unknown key 'table' in its result (keys: figures, findings, tables)",
         ),
         (
+            "name: \"cam: deepest cut of a pass\"",
+            "name: \"cam: deepest\x1b[2J cut\"",
+            "a figure's name",
+        ),
+        (
             "tolerance: p.tolerance, unit: \"mm\",",
             "tolerance: p.tolerance, units: \"mm\",",
             "unknown key 'units' in a figure (keys: name, value, tolerance, unit, place, block)",

@@ -319,11 +319,16 @@ fn entry_map(d: &Dynamic, what: &str, keys: &[&str]) -> Result<Map, String> {
     Ok(m)
 }
 
-/// The text under `k`.
+/// The text under `k`, checked as every text from outside is where it
+/// enters ([`crate::names::check_text`]): it reaches the terminal, the
+/// report and the page.
 fn text(m: &Map, k: &str, what: &str) -> Result<String, String> {
-    m.get(k)
+    let t = m
+        .get(k)
         .and_then(|v| v.clone().into_string().ok())
-        .ok_or_else(|| format!("a {what}'s {k} must be text"))
+        .ok_or_else(|| format!("a {what}'s {k} must be text"))?;
+    crate::names::check_text(&format!("a {what}'s {k}"), &t).map_err(|e| e.to_string())?;
+    Ok(t)
 }
 
 /// The block (from 0) under `block`, if any, within the program's
@@ -404,6 +409,8 @@ fn tables(d: Option<&Dynamic>) -> Result<Tables, String> {
             let cols = cols
                 .into_iter()
                 .map(|(c, v)| {
+                    crate::names::check_name("a table's column", &c)
+                        .map_err(|e| format!("table '{name}': {e}"))?;
                     crate::binding::floats::numbers(&v, &c)
                         .map(|v| (c.to_string(), v.to_vec()))
                         .map_err(|e| format!("table '{name}': {e}"))
