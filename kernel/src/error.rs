@@ -108,9 +108,6 @@ pub enum Error {
     /// A file of a finished run that cannot be read.
     #[error("{0}")]
     Read(String),
-    /// An output that cannot be made.
-    #[error("{0}")]
-    Output(String),
     /// A picture, a table or a report entry that cannot be drawn or
     /// written, named.
     #[error(transparent)]

@@ -729,7 +729,12 @@ pub fn compensate(
             .lock()
             .ok()
             .and_then(|mut s| s.take())
-            .ok_or_else(|| Error::Output("the corrected run did not finish its tables".into()))?;
+            .ok_or_else(|| {
+                crate::family::DrawError::new(
+                    CORRECTION_FILE,
+                    "the corrected run did not finish its tables",
+                )
+            })?;
         let moved = moved.map_err(Error::Read)?;
         let record = Compensation {
             run: shown.clone(),
@@ -760,7 +765,8 @@ pub fn compensate(
         out.files.push((CORRECTION_FILE.into(), csv.into_bytes()));
         out.files.push((
             "compensation.json".into(),
-            (serde_json::to_string_pretty(&record).map_err(|e| Error::Output(e.to_string()))?
+            (serde_json::to_string_pretty(&record)
+                .map_err(|e| crate::family::DrawError::new("compensation.json", e))?
                 + "\n")
                 .into_bytes(),
         ));

@@ -203,7 +203,7 @@ impl JobOutput {
 fn json<T: Serialize>(v: &T) -> Result<Vec<u8>, Error> {
     serde_json::to_string_pretty(v)
         .map(|s| (s + "\n").into_bytes())
-        .map_err(|e| Error::Output(e.to_string()))
+        .map_err(|e| crate::family::DrawError::new("a JSON file", e).into())
 }
 
 /// The first place in `v` holding null: where JSON has put a number that
@@ -225,11 +225,14 @@ fn null_at(v: &serde_json::Value, path: &str) -> Option<String> {
 
 /// The report as JSON, refused if any of its numbers is not finite.
 fn report_json(report: &Report) -> Result<Vec<u8>, Error> {
-    let value = serde_json::to_value(report).map_err(|e| Error::Output(e.to_string()))?;
+    let value = serde_json::to_value(report)
+        .map_err(|e| crate::family::DrawError::new("report.json", e))?;
     if let Some(at) = null_at(&value, "report") {
-        return Err(Error::Output(format!(
-            "{at} is not a finite number: the run's figures are out of range"
-        )));
+        return Err(crate::family::DrawError::new(
+            "report.json",
+            format!("{at} is not a finite number: the run's figures are out of range"),
+        )
+        .into());
     }
     json(report)
 }
