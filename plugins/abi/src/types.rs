@@ -206,9 +206,6 @@ pub enum FactorKind {
 }
 
 impl FactorKind {
-    /// All six kinds, translations first.
-    pub const ALL: [FactorKind; 6] = [Self::Tx, Self::Ty, Self::Tz, Self::Rx, Self::Ry, Self::Rz];
-
     /// Whether the factor is a rotation (its value in radians).
     pub fn is_rotation(self) -> bool {
         matches!(self, Self::Rx | Self::Ry | Self::Rz)
