@@ -38,6 +38,18 @@ pub struct JudgedFigure {
     pub block: Option<usize>,
 }
 
+impl JudgedFigure {
+    /// Where it is: its place in the family's words, then its block as
+    /// `label` names it.
+    fn where_(&self, label: &dyn Fn(usize) -> String) -> String {
+        match self.block {
+            Some(b) if self.place.is_empty() => label(b),
+            Some(b) => format!("{}, {}", self.place, label(b)),
+            None => self.place.clone(),
+        }
+    }
+}
+
 /// One finding a family's judgement returned: something wrong that is not
 /// a figure against a tolerance.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -78,11 +90,7 @@ impl Judged {
         let mut figures = Vec::new();
         let mut findings = Vec::new();
         for f in &self.figures {
-            let place = match (f.place.is_empty(), f.block) {
-                (_, Some(b)) if f.place.is_empty() => name(b),
-                (_, Some(b)) => format!("{}, {}", f.place, name(b)),
-                (_, None) => f.place.clone(),
-            };
+            let place = f.where_(&name);
             let mut figure = Figure::new(&f.name, f.value, f.tolerance, &f.unit, place.clone());
             if let Some(b) = f.block {
                 figure = figure.at_block(b);
@@ -146,11 +154,7 @@ impl Judged {
         );
         out.push_str("<table><tr><th>figure</th><th>value</th><th>tolerance</th><th>unit</th><th>where</th></tr>\n");
         for f in &self.figures {
-            let at = match f.block {
-                Some(b) if f.place.is_empty() => label(b),
-                Some(b) => format!("{}, {}", f.place, label(b)),
-                None => f.place.clone(),
-            };
+            let at = f.where_(label);
             row_at(
                 &mut out,
                 f.block,

@@ -294,7 +294,7 @@ impl Sweep<'_> {
                 return Err(VerifyError::Replay(format!(
                     "{}: the tool's axis leans {:.4} deg from the part's; the replay of radius over angle needs them parallel",
                     crate::program::block_name(self.program, k),
-                    lean.mul_add(-1.0, 1.0).clamp(-1.0, 1.0).acos().to_degrees()
+                    pose[5].abs().min(1.0).acos().to_degrees()
                 )));
             }
             let dz = (self.request.z - pose[2]) * pose[5].signum();

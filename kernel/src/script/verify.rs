@@ -155,7 +155,7 @@ impl Verifier for ScriptRequest {
             Replay::Polar(request) => {
                 let part = replay_polar(ctx.program, ctx.machine, ctx.tool, ctx.passes, request)?;
                 let part = polar_replayed(&part, request);
-                let judged = self.judge(&part)?;
+                let judged = self.judge(&part, ctx.program.blocks.len())?;
                 Ok(Verified {
                     outcome: Box::new(judged),
                     stock: None,
@@ -171,7 +171,7 @@ impl Verifier for ScriptRequest {
                         verified.outcome.key()
                     ))
                 })?;
-                let judged = self.judge(&part)?;
+                let judged = self.judge(&part, ctx.program.blocks.len())?;
                 verified.outcome = Box::new(WithJudged {
                     base: verified.outcome,
                     judged,
@@ -225,7 +225,7 @@ fn polar_replayed(part: &PolarPart, request: &PolarRequest) -> Replayed {
 
 impl ScriptRequest {
     /// The script's judgement of `part`: `fn judge(p, part)` called once.
-    fn judge(&self, part: &Replayed) -> Result<Judged, VerifyError> {
+    fn judge(&self, part: &Replayed, blocks: usize) -> Result<Judged, VerifyError> {
         let passes: Array = part
             .passes
             .iter()
@@ -269,7 +269,6 @@ impl ScriptRequest {
                 RESULT_KEYS.join(", ")
             )));
         }
-        let blocks = part.passes.iter().map(|p| p.blocks.end).max().unwrap_or(0);
         let figures: Vec<JudgedFigure> = entries(m.get("figures"), "figures")
             .and_then(|a| a.iter().map(|f| figure(f, blocks)).collect())
             .map_err(bad)?;
