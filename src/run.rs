@@ -102,7 +102,6 @@ fn run_within(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
         program_number: args.program_number,
         also_post: args.also_post.clone(),
         program_file: None,
-        annex: Default::default(),
         // The script, its tables and the machine file beside the run's
         // files, for `verify DIR` and `compensate`.
         keep: Some(job::Keep {

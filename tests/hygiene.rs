@@ -357,3 +357,82 @@ fn no_public_signature_has_a_string_error() {
         found.len()
     );
 }
+
+/// Functions (free, in impls and in traits, outside tests) longer than
+/// `limit` lines, as "file:line name (n lines)".
+fn long_functions(files: &[PathBuf], limit: usize) -> Vec<String> {
+    struct Long<'a> {
+        file: &'a Path,
+        limit: usize,
+        found: Vec<String>,
+    }
+    impl Long<'_> {
+        fn note(&mut self, name: &syn::Ident, block: &syn::Block) {
+            use syn::spanned::Spanned;
+            let span = block.span();
+            let lines = span.end().line - span.start().line + 1;
+            if lines > self.limit {
+                self.found.push(format!(
+                    "{}:{} {name} ({lines} lines)",
+                    self.file.display(),
+                    span.start().line
+                ));
+            }
+        }
+    }
+    impl<'ast> Visit<'ast> for Long<'_> {
+        fn visit_item_mod(&mut self, m: &'ast syn::ItemMod) {
+            if !is_test(&m.attrs) {
+                syn::visit::visit_item_mod(self, m);
+            }
+        }
+        fn visit_item_fn(&mut self, f: &'ast syn::ItemFn) {
+            if !is_test(&f.attrs) {
+                self.note(&f.sig.ident, &f.block);
+                syn::visit::visit_item_fn(self, f);
+            }
+        }
+        fn visit_impl_item_fn(&mut self, f: &'ast syn::ImplItemFn) {
+            self.note(&f.sig.ident, &f.block);
+            syn::visit::visit_impl_item_fn(self, f);
+        }
+        fn visit_trait_item_fn(&mut self, f: &'ast syn::TraitItemFn) {
+            if let Some(b) = &f.default {
+                self.note(&f.sig.ident, b);
+            }
+            syn::visit::visit_trait_item_fn(self, f);
+        }
+    }
+    let mut found = Vec::new();
+    for file in files {
+        let text = std::fs::read_to_string(file).unwrap();
+        let parsed = syn::parse_file(&text).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        let mut v = Long {
+            file,
+            limit,
+            found: Vec::new(),
+        };
+        v.visit_file(&parsed);
+        found.extend(v.found);
+    }
+    found
+}
+
+/// The run's stages, the page and each family read as a few screens of
+/// code at a time: no function there is longer than 80 lines.
+#[test]
+fn no_long_function_in_the_run_the_page_or_a_family() {
+    let src = crate::common::root().join("kernel/src");
+    let mut files = Vec::new();
+    for dir in ["job", "render", "families"] {
+        files.extend(crate::common::files_with_ext(&src.join(dir), "rs"));
+    }
+    assert!(files.len() > 30, "{files:?}");
+    let long = long_functions(&files, 80);
+    assert!(
+        long.is_empty(),
+        "{} functions over 80 lines:\n{}",
+        long.len(),
+        long.join("\n")
+    );
+}

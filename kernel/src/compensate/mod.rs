@@ -92,6 +92,14 @@ impl Nominal {
             },
         }
     }
+
+    /// The coordinate's name and unit, as its column spells them
+    /// (`z_mm`: `z`, `mm`).
+    pub fn names(&self) -> (&'static str, &'static str) {
+        self.coordinate
+            .rsplit_once('_')
+            .unwrap_or((self.coordinate, ""))
+    }
 }
 
 /// Errors reading a measurement and turning it into a correction; each

@@ -34,7 +34,6 @@ use crate::params::{ParamSource, ParamValue, Params};
 use crate::program::post::{dialect, CLD};
 use crate::program::AxisProgram;
 use crate::toolpath::Toolpath;
-use crate::verdict::{Finding, Verdict};
 use serde::Serialize;
 
 /// How a run makes its outputs.
@@ -62,10 +61,6 @@ pub struct JobOptions {
     /// The file the program [`verify`] reads came from, as messages show
     /// it: named in the report and on the page.
     pub program_file: Option<String>,
-    /// Tables and charts the caller adds to the family's (a compensated
-    /// run's measured error, its fit and the correction): in the report,
-    /// drawn and shown on the page as the family's own.
-    pub annex: Annex,
     /// What the run keeps of its inputs beside its files, if it keeps them
     /// (`pilgrim run` and `compensate` do; [`kept`]).
     pub keep: Option<Keep>,
@@ -74,52 +69,8 @@ pub struct JobOptions {
     pub offsets: Option<crate::program::offsets::Offsets>,
 }
 
-/// Tables and charts a run's caller adds ([`JobOptions::annex`]).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Annex {
-    /// Tables by name (columns of equal length).
-    pub tables: std::collections::BTreeMap<String, std::collections::BTreeMap<String, Vec<f64>>>,
-    /// Charts of them.
-    pub plots: Vec<crate::toolpath::PlotSpec>,
-    /// Called with the run's tables once its verification has added to
-    /// them, before anything is drawn: the caller's tables finished from
-    /// what the run found (a compensated run's part after, from its own
-    /// prediction; how far its program moved), and charts of them.
-    pub finish: Option<TablesHook>,
-}
-
 /// The tables a run keeps by name, each its columns by name.
-pub type Tables = std::collections::BTreeMap<String, std::collections::BTreeMap<String, Vec<f64>>>;
-
-/// A caller's function over a run's tables, given its program and its
-/// passes' blocks ([`Annex::finish`]): it may add to the tables and
-/// returns charts of them to draw besides. Copies share it, and are equal
-/// only to themselves.
-#[derive(Clone)]
-#[allow(clippy::type_complexity)]
-pub struct TablesHook(
-    pub  std::sync::Arc<
-        dyn Fn(
-                &mut Tables,
-                &AxisProgram,
-                &[crate::program::ProgramPass],
-            ) -> Vec<crate::toolpath::PlotSpec>
-            + Send
-            + Sync,
-    >,
-);
-
-impl std::fmt::Debug for TablesHook {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("TablesHook")
-    }
-}
-
-impl PartialEq for TablesHook {
-    fn eq(&self, other: &Self) -> bool {
-        std::sync::Arc::ptr_eq(&self.0, &other.0)
-    }
-}
+pub use crate::judged::Tables;
 
 impl Default for JobOptions {
     fn default() -> Self {
@@ -132,7 +83,6 @@ impl Default for JobOptions {
             also_post: Vec::new(),
             program_number: None,
             program_file: None,
-            annex: Annex::default(),
             keep: None,
             offsets: None,
         }
@@ -454,7 +404,7 @@ pub fn params_traced(
 }
 
 /// [`run`] of the program the run builds (`text` `None`), or [`verify`] of
-/// `text`.
+/// `text`: the stages ([`stages`]) one after the other.
 fn run_on(
     family: &dyn PartFamily,
     machine: &OpenMachine,
@@ -464,52 +414,24 @@ fn run_on(
     text: Option<&str>,
 ) -> Result<JobOutput, Error> {
     let (values, origins) = params_traced(family, machine, sources)?;
-    match run_with(family, machine, (&values, &origins), options, stage, text) {
-        // A run stopped by its time limit after its inputs were read
-        // leaves its report, FAILED, saying where it stopped.
-        // (A caller's cancel asked for nothing more: no report.)
-        Err(Error::OverTime(o)) if !o.cancelled => {
-            let info = machine.kinematics.info();
-            let mut report = Report::of_run(family, machine, info, (&values, &origins), Vec::new());
-            report.program_file = text.and(options.program_file.clone());
-            let message = format!("{o}; nothing was verified (give it more time: --run-seconds)");
-            report.verdict = Verdict::of(
-                true,
-                vec![Finding::new("the run's time limit", message)],
-                Vec::new(),
-                Vec::new(),
-            );
-            Err(failed_run(report, Vec::new(), None))
-        }
-        other => other,
-    }
-}
-
-/// [`run_on`] with the parameters' `values` and where each came from:
-/// the stages ([`stages`]) one after the other.
-fn run_with(
-    family: &dyn PartFamily,
-    machine: &OpenMachine,
-    (values, origins): (&Params, &std::collections::BTreeMap<String, String>),
-    options: &JobOptions,
-    stage: &mut dyn FnMut(&str),
-    text: Option<&str>,
-) -> Result<JobOutput, Error> {
     let run = stages::Run {
         family,
         machine,
-        values,
-        origins,
+        values: &values,
+        origins: &origins,
         options,
         text,
     };
-    let plan = run.plan(stage)?;
-    let mut made = match text {
-        None => run.build(&plan, stage)?,
-        Some(text) => run.read(&plan, text, stage)?,
-    };
-    let checked = run.check(&plan, &mut made)?;
-    run.render(plan, made, checked, stage)
+    let staged = (|| {
+        let plan = run.plan(stage)?;
+        let mut made = match text {
+            None => run.build(&plan, stage)?,
+            Some(text) => run.read(&plan, text, stage)?,
+        };
+        let checked = run.check(&plan, &mut made)?;
+        run.render(plan, made, checked, stage)
+    })();
+    run.stopped(staged)
 }
 
 /// Checks that the machine has every axis a parameter's value needs

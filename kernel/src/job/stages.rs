@@ -16,6 +16,7 @@ use crate::error::Error;
 use crate::family::{
     Check, FamilyError, FilesContext, Outcome, PartBody, PartFamily, ReplayContext,
 };
+use crate::judged::Tables;
 use crate::machine::MachineKinematics;
 use crate::mesh::TriMesh;
 use crate::params::{ParamValue, Params};
@@ -23,7 +24,7 @@ use crate::program::post::Dialect;
 use crate::program::{build, AxisProgram, ProgramPass};
 use crate::render::{page, scene, solids};
 use crate::report::Report;
-use crate::toolpath::Toolpath;
+use crate::toolpath::{PlotSpec, Toolpath};
 use crate::verdict::{Finding, Verdict};
 use std::collections::BTreeMap;
 
@@ -80,7 +81,9 @@ pub(super) struct Programmed {
 /// What the checks found: the verification's outcome, the verdict's
 /// figures, failures and warnings, the part's bodies and meshes, the
 /// machine's bodies placed, the collisions, the scene's block and what the
-/// verification shows there, and the files so far.
+/// verification shows there, the files so far, and the tables and charts
+/// the report will show (the family's and its verification's, with those a
+/// caller adds: [`Checked::add`]).
 pub(super) struct Checked {
     outcome: Option<Box<dyn Outcome>>,
     verified: bool,
@@ -94,6 +97,8 @@ pub(super) struct Checked {
     pose_place: scene::PosePlace,
     overlay: Option<TriMesh>,
     files: Files,
+    tables: Tables,
+    plots: Vec<PlotSpec>,
 }
 
 /// The scene's results for the report: the block it shows (from 1), the
@@ -119,9 +124,60 @@ impl Programmed {
     fn verified(&self) -> &AxisProgram {
         self.read_back.as_ref().unwrap_or(&self.program)
     }
+
+    /// The program as built or read.
+    pub(super) fn program(&self) -> &AxisProgram {
+        &self.program
+    }
+
+    /// Its passes' blocks.
+    pub(super) fn passes(&self) -> &[ProgramPass] {
+        &self.passes
+    }
+}
+
+impl Checked {
+    /// The tables the report will show, so far.
+    pub(super) fn tables(&self) -> &Tables {
+        &self.tables
+    }
+
+    /// A caller's tables and charts of them, shown as the family's own (a
+    /// compensated run's measured error, its fit and the correction): a
+    /// table of a name already there is replaced.
+    pub(super) fn add(&mut self, tables: Tables, plots: Vec<PlotSpec>) {
+        self.tables.extend(tables);
+        self.plots.extend(plots);
+    }
 }
 
 impl Run<'_> {
+    /// `result`, the stages' outcome, as the run gives it: a run stopped by
+    /// its time limit after its inputs were read leaves its report, FAILED,
+    /// saying where it stopped (a caller's cancel asked for nothing more:
+    /// no report).
+    pub(super) fn stopped(&self, result: Result<JobOutput, Error>) -> Result<JobOutput, Error> {
+        match result {
+            Err(Error::OverTime(o)) if !o.cancelled => {
+                let info = self.machine.kinematics.info();
+                let message =
+                    format!("{o}; nothing was verified (give it more time: --run-seconds)");
+                let failed = vec![Finding::new("the run's time limit", message)];
+                let mut report = Report::of_run(
+                    self.family,
+                    self.machine,
+                    info,
+                    (self.values, self.origins),
+                    Vec::new(),
+                );
+                report.program_file = self.text.and(self.options.program_file.clone());
+                report.verdict = Verdict::of(true, failed, Vec::new(), Vec::new());
+                Err(failed_run(report, Vec::new(), None))
+            }
+            other => other,
+        }
+    }
+
     /// The family's contract broken: `message`, naming it.
     fn contract(&self, message: String) -> Error {
         Error::Family(FamilyError::Contract {
@@ -216,11 +272,7 @@ impl Run<'_> {
             return Err(self.early_report(checks, info, failed, false));
         }
         enter(stage, STAGES[1])?;
-        let mut toolpath = self.family.toolpath(self.values)?;
-        toolpath.tables.extend(self.options.annex.tables.clone());
-        toolpath
-            .plots
-            .extend(self.options.annex.plots.iter().cloned());
+        let toolpath = self.family.toolpath(self.values)?;
         enter(stage, STAGES[2])?;
         let control =
             crate::program::post::dialect(&info.control).ok_or_else(|| Error::UnknownControl {
@@ -411,7 +463,6 @@ impl<'a> Run<'a> {
         }
         failures.extend(collisions.findings.iter().cloned());
         let mut checked = Checked {
-            outcome,
             verified: requested.is_some(),
             figures,
             failures,
@@ -423,9 +474,22 @@ impl<'a> Run<'a> {
             pose_place: scene::PosePlace::at_end(0),
             overlay: None,
             files: Vec::new(),
+            tables: Self::tables(plan, outcome.as_deref()),
+            plots: Vec::new(),
+            outcome,
         };
         self.pose_and_programs(plan, made, &mut checked)?;
         Ok(checked)
+    }
+
+    /// The tables the report will show: the toolpath's, then its
+    /// verification's.
+    fn tables(plan: &Plan, outcome: Option<&dyn Outcome>) -> Tables {
+        let mut tables = plan.toolpath.tables.clone();
+        if let Some(o) = outcome {
+            o.extend_tables(&mut tables);
+        }
+        tables
     }
 
     /// The part's bodies (the family's, with those its verification made:
@@ -500,7 +564,7 @@ impl<'a> Run<'a> {
 
 impl Run<'_> {
     /// The run's outputs from what the checks found: the scene and its
-    /// solids (beside the caller's hook over the tables), the report, the
+    /// solids, the report, the
     /// verification's files, the family's charts, the kept inputs, the
     /// page; a run that failed ends with its report and no program.
     pub(super) fn render(
@@ -515,31 +579,15 @@ impl Run<'_> {
         // The times of the program as its control reads it (feeds and
         // positions as written), as every other check takes it.
         let times = crate::timing::times(made.verified(), kin.info(), &made.passes);
-        // The verification's own tables, then the caller's hook over them,
-        // on a second thread while this one stages the scene and its solids
-        // (neither reads the other).
-        let mut tables = plan.toolpath.tables.clone();
-        if let Some(o) = &c.outcome {
-            o.extend_tables(&mut tables);
-        }
-        let (scene, (tables, finishing_plots)) = crate::budget::beside(
-            || self.scene(&plan, &made, &c, &times.block_s),
-            || {
-                let mut tables = tables;
-                let plots = match &self.options.annex.finish {
-                    Some(finish) => (finish.0)(&mut tables, &made.program, &made.passes),
-                    None => Vec::new(),
-                };
-                (tables, plots)
-            },
-        );
+        let scene = self.scene(&plan, &made, &c, &times.block_s);
         let (shown, scene_files, playback) = scene?;
         c.files.extend(scene_files);
         let part_box = shown.3;
-        let mut report = self.report(&plan, &made, &mut c, shown, tables, times)?;
+        let mut report = self.report(&plan, &made, &mut c, shown, times)?;
         report.playback = playback;
         let later = self.verification_files(&plan, &made, &mut c, &mut report)?;
-        self.charts(&plan, &finishing_plots, later, &mut c.files, &mut report)?;
+        let plots = std::mem::take(&mut c.plots);
+        self.charts(&plan, &plots, later, &mut c.files, &mut report)?;
         crate::budget::check("the report")?;
         self.keep(&mut c.files, &mut report)?;
         if report.verdict.failed() {
@@ -623,7 +671,6 @@ impl Run<'_> {
         made: &Programmed,
         c: &mut Checked,
         (pose_block, bodies, solids, _): Shown,
-        tables: crate::judged::Tables,
         times: crate::timing::Times,
     ) -> Result<Report, Error> {
         let toolpath = &plan.toolpath;
@@ -657,7 +704,7 @@ impl Run<'_> {
             },
             warnings: toolpath.warnings.clone(),
             notes: toolpath.notes.clone(),
-            tables,
+            tables: std::mem::take(&mut c.tables),
             verdict,
             collisions: Some(c.collisions.clone()),
             times: Some(times),
@@ -740,7 +787,7 @@ impl Run<'_> {
         Ok(Vec::new())
     }
 
-    /// The family's charts (its plots and those the caller's hook added),
+    /// The family's charts (its plots and those the caller added),
     /// between the verification's files that lead them (`c.files` has
     /// them) and those that follow (`later`).
     fn charts(
