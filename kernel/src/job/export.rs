@@ -76,68 +76,147 @@ pub fn export(
     block: Option<usize>,
     formats: Formats,
 ) -> Result<Exported, Error> {
-    let dir = run.path();
-    let shown = crate::files::shown_path(dir);
-    let read = |name: &str| {
-        run.read_text(name, crate::files::MAX_DATA_BYTES)
-            .map_err(|e| Error::Read(e.to_string()))
-    };
-    let bad = |name: &str, e: String| {
-        Error::Read(format!(
-            "{shown}/{name}: {} (not as the run wrote it)",
-            crate::files::excerpt(&e)
-        ))
-    };
-    let mut report: Report = serde_json::from_str(&read("report.json")?)
-        .map_err(|e| bad("report.json", e.to_string()))?;
-    let program: AxisProgram = serde_json::from_str(&read("program.json")?)
-        .map_err(|e| bad("program.json", e.to_string()))?;
-    crate::program::check_shape(&program).map_err(|e| bad("program.json", e.to_string()))?;
-    let toolpath: Toolpath = serde_json::from_str(&read("toolpath.json")?)
-        .map_err(|e| bad("toolpath.json", e.to_string()))?;
-    toolpath
-        .validate()
-        .map_err(|e| bad("toolpath.json", e.to_string()))?;
-    let part_bodies: Vec<&crate::render::scene::BodyFile> =
-        report.bodies.iter().filter(|b| b.kind == "part").collect();
-    if part_bodies.len() > MAX_PART_BODIES {
-        return Err(bad(
-            "report.json",
-            format!(
-                "{} part bodies, more than the {MAX_PART_BODIES} an export places",
-                part_bodies.len()
-            ),
-        ));
-    }
-    for (i, b) in part_bodies.iter().enumerate() {
-        if part_bodies[..i].iter().any(|o| o.name == b.name) {
-            return Err(bad(
-                "report.json",
-                format!("the body {} is listed twice", crate::names::quoted(&b.name)),
-            ));
-        }
-    }
-    if report.bodies.is_empty() {
-        return Err(Error::Read(format!(
-            "{shown}: the run has no 3-D models (its family has no fn part(p))"
-        )));
-    }
+    let shown = crate::files::shown_path(run.path());
+    let Finished {
+        mut report,
+        program,
+        toolpath,
+    } = Finished::read(run, &shown)?;
     let machine = catalog.open(&run_machine(&report, catalog, machine, &shown)?)?;
     let kin = machine.kinematics.as_ref();
+    let passes = crate::program::pass_blocks(&program, &toolpath.passes);
     let place = match block {
         Some(0) => return Err(Error::Options("--block counts blocks from 1".into())),
         Some(n) => scene::PosePlace::at_end(n - 1),
-        None => scene::default_pose_block(
-            &program,
-            &crate::program::pass_blocks(&program, &toolpath.passes),
-        ),
+        None => scene::default_pose_block(&program, &passes),
     };
-    let index = place.block;
+    let parts = part_meshes(run, &report, &shown)?;
+    let (text, as_read) = program_text(run, &report, &program, kin, &shown)?;
+    // The scene moves as the run's did: the same program, timed as read.
+    let times = crate::timing::times(
+        as_read.as_ref().map_or(&program, |r| &r.program),
+        kin.info(),
+        &passes,
+    );
+    let placement = scene::placement(kin, &program, &toolpath.tool, &parts)?;
+    let staged = scene::stage(
+        kin,
+        &program,
+        &toolpath.tool,
+        (&parts, &placement),
+        place,
+        &times.block_s,
+        vec![],
+        (report.mesh_tolerance_mm, formats),
+    )?;
+    report.playback = staged.playback;
+    report.pose_block = Some(place.block + 1);
+    report.pose_along = place.along;
+    report.bodies = staged.bodies;
+    let mut all: Vec<(String, Vec<u8>)> = (staged.files.into_iter())
+        .filter(|(n, _)| {
+            n == "scene.glb" || !(report.bodies.iter()).any(|b| b.kind == "part" && &b.file == n)
+        })
+        .collect();
+    // The tool's exact solid moves with it.
+    let pose = staged.pose;
+    let (tool_steps, tool_solids) =
+        crate::render::solids::step_files(&[], &toolpath.tool, &pose, report.step_tolerance_mm)?;
+    report.solids.retain(|s| s.kind != "tool");
+    report.solids.extend(tool_solids);
+    all.extend(tool_steps);
+    let view = scene::bounds_of(parts.iter().map(|(_, m)| m))
+        .map(|b| scene::contact_box(b, &toolpath.tool, &pose));
+    report.program_lines = as_read.map(|r| r.lines).unwrap_or_default();
+    let html = page(run, &report, &all, text, view)?;
+    all.push(("report.html".into(), html.into_bytes()));
+    all.push(("report.json".into(), super::report_json(&report)?));
+    Ok(Exported {
+        files: all,
+        block: place.block + 1,
+    })
+}
+
+/// A finished run's report, program and toolpath, read and checked.
+struct Finished {
+    report: Report,
+    program: AxisProgram,
+    toolpath: Toolpath,
+}
+
+impl Finished {
+    /// The run's files read as the run wrote them (`shown`: its directory,
+    /// for messages) and checked: the program's shape, the toolpath, the
+    /// part bodies (plain names, each once, at most [`MAX_PART_BODIES`]).
+    ///
+    /// # Failures
+    /// A file missing or not as the run wrote it; a run without 3-D models.
+    fn read(run: &RunDir, shown: &str) -> Result<Self, Error> {
+        let bad = |name: &str, e: String| {
+            Error::Read(format!(
+                "{shown}/{name}: {} (not as the run wrote it)",
+                crate::files::excerpt(&e)
+            ))
+        };
+        let report: Report = serde_json::from_str(&read(run, "report.json")?)
+            .map_err(|e| bad("report.json", e.to_string()))?;
+        let program: AxisProgram = serde_json::from_str(&read(run, "program.json")?)
+            .map_err(|e| bad("program.json", e.to_string()))?;
+        crate::program::check_shape(&program).map_err(|e| bad("program.json", e.to_string()))?;
+        let toolpath: Toolpath = serde_json::from_str(&read(run, "toolpath.json")?)
+            .map_err(|e| bad("toolpath.json", e.to_string()))?;
+        (toolpath.validate()).map_err(|e| bad("toolpath.json", e.to_string()))?;
+        let part_bodies: Vec<&scene::BodyFile> =
+            report.bodies.iter().filter(|b| b.kind == "part").collect();
+        if part_bodies.len() > MAX_PART_BODIES {
+            return Err(bad(
+                "report.json",
+                format!(
+                    "{} part bodies, more than the {MAX_PART_BODIES} an export places",
+                    part_bodies.len()
+                ),
+            ));
+        }
+        for (i, b) in part_bodies.iter().enumerate() {
+            if part_bodies[..i].iter().any(|o| o.name == b.name) {
+                return Err(bad(
+                    "report.json",
+                    format!("the body {} is listed twice", crate::names::quoted(&b.name)),
+                ));
+            }
+        }
+        if report.bodies.is_empty() {
+            return Err(Error::Read(format!(
+                "{shown}: the run has no 3-D models (its family has no fn part(p))"
+            )));
+        }
+        Ok(Self {
+            report,
+            program,
+            toolpath,
+        })
+    }
+}
+
+/// The text of the run's file `name`.
+fn read(run: &RunDir, name: &str) -> Result<String, Error> {
+    run.read_text(name, crate::files::MAX_DATA_BYTES)
+        .map_err(|e| Error::Read(e.to_string()))
+}
+
+/// The part's meshes, from the run's own STL files by the names the run
+/// gives them, together no larger than a data file.
+///
+/// # Failures
+/// A body's file not the run's, unreadable or not an STL.
+fn part_meshes(
+    run: &RunDir,
+    report: &Report,
+    shown: &str,
+) -> Result<Vec<(String, crate::mesh::TriMesh)>, Error> {
     let mut stl_bytes = 0u64;
-    let parts = part_bodies
-        .iter()
+    (report.bodies.iter().filter(|b| b.kind == "part"))
         .map(|b| {
-            // Only the run's own files, by the names the run gives them.
             if !crate::files::is_plain_name(&b.name) || b.file != format!("{}.stl", b.name) {
                 return Err(Error::Read(format!(
                     "{shown}: report.json names the file '{}' for body '{}', which is not a file of this run",
@@ -153,89 +232,75 @@ pub fn export(
                 .map(|m| (b.name.clone(), m))
                 .map_err(|e| Error::Read(e.to_string()))
         })
-        .collect::<Result<Vec<_>, _>>()?;
-    // The program's text as its control reads it, which the run timed: a
-    // text that does not read back as program.json is not the run's.
+        .collect()
+}
+
+/// The program's file (name and text) where the run wrote one, and the
+/// program as its control reads it, which the run timed: a text that does
+/// not read back as `program` is not the run's.
+///
+/// # Failures
+/// A control pilgrim does not know; the text unreadable or not the
+/// run's program.
+fn program_text(
+    run: &RunDir,
+    report: &Report,
+    program: &AxisProgram,
+    kin: &dyn crate::machine::MachineKinematics,
+    shown: &str,
+) -> Result<
+    (
+        Option<(String, String)>,
+        Option<crate::program::lint::TextProgram>,
+    ),
+    Error,
+> {
     let control = crate::program::post::dialect(&report.control).ok_or_else(|| {
         Error::Read(format!(
             "{shown}: report.json names the control '{}', which pilgrim does not know",
             crate::files::excerpt(&report.control)
         ))
     })?;
-    let program_file = format!("program.{}", control.extension);
-    let text = match report.files.contains(&program_file) {
-        true => Some(read(&program_file)?),
-        false => None,
-    };
-    let as_read = match &text {
-        Some(t) => Some(
-            crate::program::lint::lint_read(t, &program, control, &kin.info().axes)
-                .map_err(|e| bad(&program_file, e.to_string()))?,
-        ),
-        None => None,
-    };
-    // The scene moves as the run's did: the same program, timed as read.
-    let times = crate::timing::times(
-        as_read.as_ref().map_or(&program, |r| &r.program),
-        kin.info(),
-        &crate::program::pass_blocks(&program, &toolpath.passes),
-    );
-    let placement = scene::placement(kin, &program, &toolpath.tool, &parts)?;
-    let staged = scene::stage(
-        kin,
-        &program,
-        &toolpath.tool,
-        (&parts, &placement),
-        place,
-        &times.block_s,
-        vec![],
-        (report.mesh_tolerance_mm, formats),
-    )?;
-    let (files, bodies, pose) = (staged.files, staged.bodies, staged.pose);
-    report.playback = staged.playback;
-    report.pose_block = Some(index + 1);
-    report.pose_along = place.along;
-    report.bodies = bodies;
-    let mut all: Vec<(String, Vec<u8>)> = files
-        .into_iter()
-        .filter(|(n, _)| {
-            n == "scene.glb"
-                || !report
-                    .bodies
-                    .iter()
-                    .any(|b| b.kind == "part" && &b.file == n)
-        })
-        .collect();
-    // The tool's exact solid moves with it.
-    let (tool_steps, tool_solids) =
-        crate::render::solids::step_files(&[], &toolpath.tool, &pose, report.step_tolerance_mm)?;
-    report.solids.retain(|s| s.kind != "tool");
-    report.solids.extend(tool_solids);
-    all.extend(tool_steps);
-    // The page shows the new scene, with the run's plots and program.
-    let mut shown: Vec<(String, Vec<u8>)> = Vec::new();
-    // Only plots the run names by plain names, and its program.
+    let file = format!("program.{}", control.extension);
+    if !report.files.contains(&file) {
+        return Ok((None, None));
+    }
+    let text = read(run, &file)?;
+    let as_read = crate::program::lint::lint_read(&text, program, control, &kin.info().axes)
+        .map_err(|e| {
+            Error::Read(format!(
+                "{shown}/{file}: {} (not as the run wrote it)",
+                crate::files::excerpt(&e.to_string())
+            ))
+        })?;
+    Ok((Some((file, text)), Some(as_read)))
+}
+
+/// The page of `report` with the new scene (in `files`), the run's plots
+/// (those it names by plain names) and its program's `text`.
+///
+/// # Failures
+/// A plot unreadable.
+fn page(
+    run: &RunDir,
+    report: &Report,
+    files: &[(String, Vec<u8>)],
+    text: Option<(String, String)>,
+    view: Option<([f64; 3], [f64; 3])>,
+) -> Result<String, Error> {
     let plot = |n: &str| {
         n.strip_suffix(".svg")
             .is_some_and(crate::files::is_plain_name)
     };
+    let mut shown: Vec<(String, Vec<u8>)> = Vec::new();
     for name in report.files.iter().filter(|n| plot(n)) {
-        shown.push((name.clone(), read(name)?.into_bytes()));
+        shown.push((name.clone(), read(run, name)?.into_bytes()));
     }
-    if let Some(t) = &text {
-        shown.push((program_file.clone(), t.clone().into_bytes()));
-    }
-    shown.extend(all.iter().filter(|f| f.0 == "scene.glb").cloned());
-    let view = scene::bounds_of(parts.iter().map(|(_, m)| m))
-        .map(|b| scene::contact_box(b, &toolpath.tool, &pose));
-    // The listing's lines as the lint read the program.
-    let listed = crate::render::page::written_program(&shown, control.extension);
-    report.program_lines = as_read.map(|r| r.lines).unwrap_or_default();
-    let html = crate::render::page::page_of(&report, &shown, listed, view);
-    all.push(("report.html".into(), html.into_bytes()));
-    all.push(("report.json".into(), super::report_json(&report)?));
-    Ok(Exported {
-        files: all,
-        block: index + 1,
-    })
+    let listed = text.map(|(file, text)| {
+        shown.push((file.clone(), text.clone().into_bytes()));
+        (file, text)
+    });
+    shown.extend(files.iter().filter(|f| f.0 == "scene.glb").cloned());
+    let listed = listed.as_ref().map(|(f, t)| (f.as_str(), t.as_str()));
+    Ok(crate::render::page::page_of(report, &shown, listed, view))
 }
