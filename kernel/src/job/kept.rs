@@ -128,48 +128,12 @@ pub fn kept(
     for k in &report.inputs {
         if k.role == "plugin" {
             machine_kept = true;
-            let Some(given) = machine else {
-                return Err(Error::Read(format!(
-                    "{shown}: the run's machine is the plugin library {} (sha256 {}): name it with --machine (pilgrim loads a library only when the command line names it)",
-                    crate::files::excerpt(&k.file),
-                    k.sha256
-                )));
-            };
-            let bytes = crate::files::read_bytes(Path::new(given), 1 << 30)
-                .map_err(|e| Error::Read(e.to_string()))?;
-            if sha256_hex(&bytes) != k.sha256 {
-                return Err(Error::Read(format!(
-                    "{}: not the plugin library the run was made with ({}, sha256 {}): verify with that library, or run again",
-                    crate::files::excerpt(given),
-                    crate::files::excerpt(&k.file),
-                    k.sha256
-                )));
-            }
-            spec = Some(given.to_owned());
+            spec = Some(kept_plugin(k, machine, shown)?);
             continue;
         }
-        let bytes = run
-            .read(&k.file, crate::files::MAX_DATA_BYTES)
-            .map_err(|e| Error::Read(e.to_string()))?;
-        if sha256_hex(&bytes) != k.sha256 {
-            return Err(Error::Read(format!(
-                "{shown}/{}: changed since the run kept it (its SHA-256 is not the one report.json records): a run's inputs stay as they were; run again to change them",
-                crate::files::excerpt(&k.file)
-            )));
-        }
+        let bytes = kept_file(run, k, shown)?;
         let path = run.path().join(&k.file);
-        let same_as = |given: &Path, what: &str| -> Result<(), Error> {
-            let theirs = crate::files::read_bytes(given, crate::files::MAX_DATA_BYTES)
-                .map_err(|e| Error::Read(e.to_string()))?;
-            if theirs != bytes {
-                return Err(Error::Read(format!(
-                    "{}: not the {what} the run was made with (kept as {shown}/{}): verify against the kept one (leave the option out), or run again",
-                    crate::files::excerpt(&given.display().to_string()),
-                    crate::files::excerpt(&k.file)
-                )));
-            }
-            Ok(())
-        };
+        let same_as = |given: &Path, what: &str| same_as(&bytes, given, what, k, shown);
         match k.role.as_str() {
             "family" => {
                 if let Some(given) = family {
@@ -205,4 +169,71 @@ pub fn kept(
         ))
     })?;
     Ok(Some((script, spec)))
+}
+
+/// The plugin library the run was made with: the one the command line
+/// names (`machine`), checked by its digest.
+///
+/// # Failures
+/// None named, or another library.
+fn kept_plugin(k: &KeptInput, machine: Option<&str>, shown: &str) -> Result<String, Error> {
+    let Some(given) = machine else {
+        return Err(Error::Read(format!(
+            "{shown}: the run's machine is the plugin library {} (sha256 {}): name it with --machine (pilgrim loads a library only when the command line names it)",
+            crate::files::excerpt(&k.file),
+            k.sha256
+        )));
+    };
+    let bytes = crate::files::read_bytes(Path::new(given), 1 << 30)
+        .map_err(|e| Error::Read(e.to_string()))?;
+    if sha256_hex(&bytes) != k.sha256 {
+        return Err(Error::Read(format!(
+            "{}: not the plugin library the run was made with ({}, sha256 {}): verify with that library, or run again",
+            crate::files::excerpt(given),
+            crate::files::excerpt(&k.file),
+            k.sha256
+        )));
+    }
+    Ok(given.to_owned())
+}
+
+/// The bytes of the file the run kept as `k`, checked by its digest.
+///
+/// # Failures
+/// The file unreadable or changed since the run.
+fn kept_file(run: &RunDir, k: &KeptInput, shown: &str) -> Result<Vec<u8>, Error> {
+    let bytes = run
+        .read(&k.file, crate::files::MAX_DATA_BYTES)
+        .map_err(|e| Error::Read(e.to_string()))?;
+    if sha256_hex(&bytes) != k.sha256 {
+        return Err(Error::Read(format!(
+            "{shown}/{}: changed since the run kept it (its SHA-256 is not the one report.json records): a run's inputs stay as they were; run again to change them",
+            crate::files::excerpt(&k.file)
+        )));
+    }
+    Ok(bytes)
+}
+
+/// Checks the file `given` (the `what` the command line names) is the one
+/// the run kept as `k` (its `bytes`).
+///
+/// # Failures
+/// It is unreadable or differs, naming both.
+fn same_as(
+    bytes: &[u8],
+    given: &Path,
+    what: &str,
+    k: &KeptInput,
+    shown: &str,
+) -> Result<(), Error> {
+    let theirs = crate::files::read_bytes(given, crate::files::MAX_DATA_BYTES)
+        .map_err(|e| Error::Read(e.to_string()))?;
+    if theirs != bytes {
+        return Err(Error::Read(format!(
+            "{}: not the {what} the run was made with (kept as {shown}/{}): verify against the kept one (leave the option out), or run again",
+            crate::files::excerpt(&given.display().to_string()),
+            crate::files::excerpt(&k.file)
+        )));
+    }
+    Ok(())
 }

@@ -488,7 +488,6 @@ fn marks(m: &crate::chart::Marks) -> String {
 /// The page's text.
 pub fn report_html(inputs: &PageInputs<'_>) -> String {
     let r = inputs.report;
-    let b64 = base64::engine::general_purpose::STANDARD;
     let mut out = String::with_capacity(
         MODEL_VIEWER.len() + inputs.embedded_scene().map_or(0, |s| s.0.len() * 4 / 3) + 200_000,
     );
@@ -517,6 +516,20 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
     );
     banner(&mut out, r);
     twin(&mut out, inputs);
+    summary(&mut out, r);
+    verification(&mut out, r);
+    warnings_and_checks(&mut out, r);
+    clearances(&mut out, r);
+    pass_times(&mut out, r);
+    plots_and_parameters(&mut out, inputs);
+    scripts(&mut out, inputs);
+    out.push_str("</body>\n</html>\n");
+    out
+}
+
+/// The summary's table: passes, points, blocks, the cycle time, the 3-D
+/// pose and the files.
+fn summary(out: &mut String, r: &Report) {
     out.push_str("<h2>Summary</h2>\n<table>\n");
     for (k, v) in [
         (
@@ -557,10 +570,13 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
         ),
         ("files", r.files.join(", ")),
     ] {
-        row(&mut out, &[k.into(), escape(&v)]);
+        row(out, &[k.into(), escape(&v)]);
     }
     out.push_str("</table>\n");
-    verification(&mut out, r);
+}
+
+/// The family's warnings and its checks.
+fn warnings_and_checks(out: &mut String, r: &Report) {
     if !r.warnings.is_empty() {
         out.push_str("<h2>Warnings</h2>\n<ul class=\"warn\">\n");
         for w in &r.warnings {
@@ -571,7 +587,7 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
     out.push_str("<h2>Checks</h2>\n<table><tr><th>check</th><th></th><th>detail</th></tr>\n");
     for c in &r.checks {
         row(
-            &mut out,
+            out,
             &[
                 escape(&c.name),
                 if c.ok { "ok" } else { "FAILED" }.into(),
@@ -580,8 +596,13 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
         );
     }
     out.push_str("</table>\n");
-    clearances(&mut out, r);
-    pass_times(&mut out, r);
+}
+
+/// The plots with their marks, the parameters and the figures the family
+/// noted.
+fn plots_and_parameters(out: &mut String, inputs: &PageInputs<'_>) {
+    let r = inputs.report;
+    let b64 = base64::engine::general_purpose::STANDARD;
     if !inputs.plots.is_empty() {
         out.push_str("<h2>Plots</h2>\n");
         for (name, svg) in &inputs.plots {
@@ -597,16 +618,21 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
     out.push_str("<h2>Parameters</h2>\n<table><tr><th>name</th><th>value</th><th>unit</th></tr>\n");
     for (name, p) in &r.parameters {
         let value = serde_json::to_string(&p.value).unwrap_or_default();
-        row(&mut out, &[escape(name), escape(&value), escape(&p.unit)]);
+        row(out, &[escape(name), escape(&value), escape(&p.unit)]);
     }
     out.push_str("</table>\n");
     if !r.notes.is_empty() {
         out.push_str("<h2>Figures the family noted</h2>\n<table>\n");
         for (k, v) in &r.notes {
-            row(&mut out, &[escape(k), format!("{v}")]);
+            row(out, &[escape(k), format!("{v}")]);
         }
         out.push_str("</table>\n");
     }
+}
+
+/// The page's scripts: whatever names a block takes the player there; the
+/// 3-D viewer where the page embeds a scene.
+fn scripts(out: &mut String, inputs: &PageInputs<'_>) {
     // Whatever names a block (a table's row, a plot's mark) takes the
     // player there, and the view to the machine.
     out.push_str("<script>\ndocument.querySelectorAll('[data-block]').forEach(el => el.addEventListener('click', () => {\n  document.dispatchEvent(new CustomEvent('pilgrim-go', {detail: +el.dataset.block}));\n  document.querySelector('.twin').scrollIntoView({block: 'start'});\n}));\n// The pass the player is in, lit on the plots that mark passes.\nconst passMarks = [...document.querySelectorAll('.marks .pass')];\ndocument.addEventListener('pilgrim-block', e => passMarks.forEach(m => m.classList.toggle('now', +m.dataset.first <= e.detail && e.detail < +m.dataset.end)));\n</script>\n");
@@ -624,8 +650,6 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
         out.push_str(&MODEL_VIEWER.replace("</script", "<\\/script"));
         out.push_str("\n</script>\n");
     }
-    out.push_str("</body>\n</html>\n");
-    out
 }
 
 /// The page of a run from its files (name, bytes): the plots (`.svg`),

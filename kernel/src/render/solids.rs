@@ -21,7 +21,6 @@ pub fn step_files(
     at: &super::scene::ToolAt,
     tol: Real,
 ) -> Result<(Files, Vec<SolidFile>), StepError> {
-    let tool_pose = &at.pose;
     let mut files = Vec::new();
     let mut solids = Vec::new();
     // Each solid: its file's text and its volume from its own outline.
@@ -70,6 +69,37 @@ pub fn step_files(
             }
         }
     }
+    let (text, volume, fit) = match tool_step(tool, at, tol)? {
+        Some(t) => t,
+        None => return Ok((files, solids)),
+    };
+    let name = if matches!(tool.shape, ToolShape::Wheel(_)) {
+        "wheel"
+    } else {
+        "cutter"
+    };
+    add(name, "tool", (Ok(text), volume), fit)?;
+    Ok((files, solids))
+}
+
+/// The tool's exact solid placed at `at` as its STL is: its STEP text,
+/// volume, and deviation and faces where it is fitted (a thread cutter's
+/// blade); none for an insert.
+///
+/// # Failures
+/// The blade's fit.
+fn tool_step(
+    tool: &Tool,
+    at: &super::scene::ToolAt,
+    tol: Real,
+) -> Result<Option<(String, Real, (Real, usize))>, StepError> {
+    let revolution = |name: &str, s: &step::Section, pose: &Mat4| {
+        Ok::<_, StepError>(Some((
+            step::revolution_step(name, s, pose)?,
+            s.volume(),
+            (0.0, 0),
+        )))
+    };
     match tool.shape {
         ToolShape::Wheel(w) => {
             // The wheel's section turns about its own axis, which runs
@@ -79,31 +109,19 @@ pub fn step_files(
                 WheelOrigin::Periphery => 0.0,
                 WheelOrigin::Centre => -r,
             };
-            let pose = tool_pose * Mat4::new_translation(&Vec3::new(r + origin, 0.0, 0.0));
-            let solid = revolution("wheel", &step::wheel_section(&w), &pose);
-            add("wheel", "tool", solid, (0.0, 0))?;
+            let pose = at.pose * Mat4::new_translation(&Vec3::new(r + origin, 0.0, 0.0));
+            revolution("wheel", &step::wheel_section(&w), &pose)
         }
         ToolShape::EndMill { diameter, length } => {
             let s = step::cylinder_section(diameter / 2.0, length);
-            add(
-                "cutter",
-                "tool",
-                revolution("cutter", &s, tool_pose),
-                (0.0, 0),
-            )?;
+            revolution("cutter", &s, &at.pose)
         }
         ToolShape::ThreadCutter(c) => {
             // The blade as the STL shows it, following the thread it cuts.
             let blade = super::scene::thread_blade(&c, at);
             let fit = step::swept_step("cutter", "a thread cutter's blade", &blade, tol)?;
-            add(
-                "cutter",
-                "tool",
-                (Ok(fit.text), fit.volume),
-                (fit.deviation, fit.faces),
-            )?;
+            Ok(Some((fit.text, fit.volume, (fit.deviation, fit.faces))))
         }
-        ToolShape::Insert { .. } => {}
+        ToolShape::Insert { .. } => Ok(None),
     }
-    Ok((files, solids))
 }

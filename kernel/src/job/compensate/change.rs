@@ -81,7 +81,6 @@ pub(super) fn path_moved(
     let mut by_pass: Vec<Vec<f64>> = Vec::with_capacity(after_passes.len());
     let mut blocks = 0;
     for (p, q) in before_passes.iter().zip(after_passes) {
-        let mut moved: Vec<f64> = vec![0.0; n];
         let mut line: Vec<&[f64]> = before
             .blocks
             .get(p.blocks.clone())?
@@ -91,64 +90,8 @@ pub(super) fn path_moved(
         if line.len() == 1 {
             line.push(line[0]);
         }
-        // Each segment's direction and squared length, once per pass.
-        let dirs: Vec<(Vec<f64>, f64)> = line
-            .windows(2)
-            .map(|w| {
-                let d: Vec<f64> = w[1].iter().zip(w[0]).map(|(b, a)| b - a).collect();
-                let l2 = d.iter().map(|x| x * x).sum();
-                (d, l2)
-            })
-            .collect();
-        let mut near: usize = 0;
-        for b in after.blocks.get(q.blocks.clone())? {
-            let v = &b.values;
-            // Where on segment k the block's nearest point lies (0 to 1),
-            // and the squared distance to it; no allocation per segment.
-            let nearest = |k: usize| {
-                let (a, (d, l2)) = (line[k], &dirs[k]);
-                let t = if *l2 > 0.0 {
-                    let dot: f64 = v.iter().zip(a).zip(d).map(|((v, a), d)| (v - a) * d).sum();
-                    (dot / l2).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                let dist2: f64 = v
-                    .iter()
-                    .zip(a)
-                    .zip(d)
-                    .map(|((v, a), d)| (v - a - d * t).powi(2))
-                    .sum();
-                (t, dist2)
-            };
-            let (lo, hi) = (
-                near.saturating_sub(WINDOW),
-                (near + WINDOW + 1).min(dirs.len()),
-            );
-            // The last block's segment first; a segment whose start lies
-            // farther than its length beyond the best so far cannot be
-            // nearer (nor tie), and is passed over. The same segment as a
-            // search of every one in the window.
-            let first = near.clamp(lo, hi.saturating_sub(1));
-            let mut best = (first, nearest(first));
-            for k in lo..hi {
-                let from: f64 = v.iter().zip(line[k]).map(|(v, a)| (v - a).powi(2)).sum();
-                let reach = best.1 .1.sqrt() + dirs[k].1.sqrt();
-                if from > reach * reach * (1.0 + crate::tolerance::LIMIT_SLACK) {
-                    continue;
-                }
-                let got = nearest(k);
-                if got.1 < best.1 .1 || (got.1 == best.1 .1 && k < best.0) {
-                    best = (k, got);
-                }
-            }
-            let (k, (t, dist2)) = best;
-            near = k;
-            blocks += usize::from(dist2.sqrt() > MOVED);
-            for (i, m) in moved.iter_mut().enumerate() {
-                *m = m.max((v[i] - line[k][i] - dirs[k].0[i] * t).abs());
-            }
-        }
+        let (moved, n_moved) = pass_moved(&line, after.blocks.get(q.blocks.clone())?, n);
+        blocks += n_moved;
         by_pass.push(moved);
     }
     let names: Vec<String> = after.axes.iter().map(|a| a.name.clone()).collect();
@@ -161,6 +104,73 @@ pub(super) fn path_moved(
         axes: names,
         by_pass,
     })
+}
+
+/// How far each axis of `blocks` stands from the polyline `line` (a pass of
+/// the first program, `n` axes), the largest per axis, and how many
+/// blocks stand more than [`MOVED`] off it.
+fn pass_moved(line: &[&[f64]], blocks: &[crate::program::Block], n: usize) -> (Vec<f64>, usize) {
+    let mut moved: Vec<f64> = vec![0.0; n];
+    let mut count = 0;
+    // Each segment's direction and squared length, once per pass.
+    let dirs: Vec<(Vec<f64>, f64)> = line
+        .windows(2)
+        .map(|w| {
+            let d: Vec<f64> = w[1].iter().zip(w[0]).map(|(b, a)| b - a).collect();
+            let l2 = d.iter().map(|x| x * x).sum();
+            (d, l2)
+        })
+        .collect();
+    let mut near: usize = 0;
+    for b in blocks {
+        let v = &b.values;
+        // Where on segment k the block's nearest point lies (0 to 1),
+        // and the squared distance to it; no allocation per segment.
+        let nearest = |k: usize| {
+            let (a, (d, l2)) = (line[k], &dirs[k]);
+            let t = if *l2 > 0.0 {
+                let dot: f64 = v.iter().zip(a).zip(d).map(|((v, a), d)| (v - a) * d).sum();
+                (dot / l2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let dist2: f64 = v
+                .iter()
+                .zip(a)
+                .zip(d)
+                .map(|((v, a), d)| (v - a - d * t).powi(2))
+                .sum();
+            (t, dist2)
+        };
+        let (lo, hi) = (
+            near.saturating_sub(WINDOW),
+            (near + WINDOW + 1).min(dirs.len()),
+        );
+        // The last block's segment first; a segment whose start lies
+        // farther than its length beyond the best so far cannot be
+        // nearer (nor tie), and is passed over. The same segment as a
+        // search of every one in the window.
+        let first = near.clamp(lo, hi.saturating_sub(1));
+        let mut best = (first, nearest(first));
+        for k in lo..hi {
+            let from: f64 = v.iter().zip(line[k]).map(|(v, a)| (v - a).powi(2)).sum();
+            let reach = best.1 .1.sqrt() + dirs[k].1.sqrt();
+            if from > reach * reach * (1.0 + crate::tolerance::LIMIT_SLACK) {
+                continue;
+            }
+            let got = nearest(k);
+            if got.1 < best.1 .1 || (got.1 == best.1 .1 && k < best.0) {
+                best = (k, got);
+            }
+        }
+        let (k, (t, dist2)) = best;
+        near = k;
+        count += usize::from(dist2.sqrt() > MOVED);
+        for (i, m) in moved.iter_mut().enumerate() {
+            *m = m.max((v[i] - line[k][i] - dirs[k].0[i] * t).abs());
+        }
+    }
+    (moved, count)
 }
 
 /// How far a corrected program's path moved from the first's
