@@ -78,7 +78,7 @@ fn thread_job(c: &mut Criterion) {
         };
         let out = run();
         assert!(
-            out.check::<pilgrim_kernel::families::worm::WormOutcome>()
+            out.check::<pilgrim_kernel::families::thread::ThreadOutcome>()
                 .is_some()
                 && out.files.len() >= 12,
             "{name}: {} files",

@@ -10,7 +10,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pilgrim_kernel::catalog::{Catalog, CompiledPlugin};
-use pilgrim_kernel::families::worm::simulate;
+use pilgrim_kernel::families::thread::simulate;
 use pilgrim_kernel::job::{self, JobOptions};
 use pilgrim_kernel::script::{Access, Limits, ScriptFamily};
 use pilgrim_kernel::{PartFamily, ToolShape};
@@ -44,7 +44,7 @@ fn worm_job(c: &mut Criterion) {
     };
     let out = run();
     assert!(
-        out.check::<pilgrim_kernel::families::worm::WormOutcome>()
+        out.check::<pilgrim_kernel::families::thread::ThreadOutcome>()
             .is_some()
             && out.files.len() >= 12,
         "{} files",
@@ -62,7 +62,7 @@ fn worm_simulate(c: &mut Criterion) {
     let family = family();
     let out = job::run(&family, &machine, &[], &JobOptions::default(), &mut |_| {}).unwrap();
     let Some(req) = family.verification(&out.params).unwrap().and_then(|v| {
-        v.request::<pilgrim_kernel::families::worm::WormRequest>()
+        v.request::<pilgrim_kernel::families::thread::ThreadRequest>()
             .cloned()
     }) else {
         panic!("the worm asks for the simulation")

@@ -7,7 +7,9 @@
 use crate::common;
 
 use common::{pilgrim, s, scratch, word};
-use pilgrim_kernel::families::worm::{simulate, WormCheck, WormRequest, WormSizes, WormTolerances};
+use pilgrim_kernel::families::thread::{
+    simulate, ThreadCheck, ThreadRequest, ThreadTolerances, WormSizes,
+};
 use pilgrim_kernel::plugin::PluginMachine;
 use pilgrim_kernel::program::{AxisProgram, Block, ProgramAxis};
 use pilgrim_kernel::step::Sections;
@@ -118,7 +120,7 @@ fn read_nc(nc: &str, rpm: f64) -> AxisProgram {
 }
 
 /// The run's cutter, as its toolpath.json says.
-fn cutter(dir: &Path) -> pilgrim_kernel::families::worm::ThreadCutter {
+fn cutter(dir: &Path) -> pilgrim_kernel::families::thread::ThreadCutter {
     let tp: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("toolpath.json")).unwrap()).unwrap();
     let tool: Tool = serde_json::from_value(tp["tool"].clone()).unwrap();
@@ -131,12 +133,12 @@ fn cutter(dir: &Path) -> pilgrim_kernel::families::worm::ThreadCutter {
 /// What the family asks the simulation to hold for a worm of module `m`,
 /// `z1` starts, pitch diameter `d1`, `b1` long, placed as the run's report
 /// `r` says: the family's default tolerances.
-fn request(r: &serde_json::Value, m: f64, z1: i64, d1: f64, b1: f64) -> WormRequest {
-    WormRequest::worm(
+fn request(r: &serde_json::Value, m: f64, z1: i64, d1: f64, b1: f64) -> ThreadRequest {
+    ThreadRequest::worm(
         &WormSizes::new(m, z1, d1, 0.2, 20f64.to_radians(), None).unwrap(),
         b1,
         r["notes"]["space_centre_mm"].as_f64().unwrap(),
-        WormTolerances {
+        ThreadTolerances {
             form: 0.01,
             thickness: 0.02,
             diameter: 0.02,
@@ -155,7 +157,7 @@ fn simulate_nc(
     z1: i64,
     d1: f64,
     b1: f64,
-) -> Result<WormCheck, String> {
+) -> Result<ThreadCheck, String> {
     let r = report(dir);
     let rpm = r["parameters"]["spindle"]["value"].as_f64().unwrap();
     let program = read_nc(nc, rpm);
@@ -169,7 +171,7 @@ fn simulate_nc(
 /// thread spaces' area (less the root's fillets the nose radius leaves);
 /// the profile within its tolerances at every start; alternating flanks
 /// share the load.
-fn holds(check: &WormCheck, z1: usize, m: f64, nose: f64) {
+fn holds(check: &ThreadCheck, z1: usize, m: f64, nose: f64) {
     // Each space keeps at most two fillets of r^2 (tan(phi/2) - phi/2),
     // phi = 70 deg, where the nose radius turns the root's corners (the
     // last roughing passes on the flanks take part of them).
@@ -224,7 +226,7 @@ fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
     // The finished worm's solid: closed, and its volume the section's swept
     // along the helix, pi b1 / L * integral of r(u)^2 over a lead (for any
     // length: every section across the axis meets a whole lead of it).
-    let solid = pilgrim_kernel::families::worm::worm_solid(&check, 60.0, 0.01, None).unwrap();
+    let solid = pilgrim_kernel::families::thread::thread_solid(&check, 60.0, 0.01, None).unwrap();
     solid.check_closed().unwrap();
     // Every vertex between the root's and the tip's circles (the axis's
     // points of the flat ends aside).
@@ -254,7 +256,8 @@ fn the_default_two_start_worm_holds_its_profile_read_back_from_the_program() {
         worst_mesh < 1e-3,
         "worm.stl strays {worst_mesh} mm from the helix"
     );
-    let sweep = pilgrim_kernel::families::worm::WormSweep::new(&check, 60.0, 2.5e-4, None).unwrap();
+    let sweep =
+        pilgrim_kernel::families::thread::ThreadSweep::new(&check, 60.0, 2.5e-4, None).unwrap();
     let mut worst_sweep: f64 = 0.0;
     for k in 0..sweep.pieces() {
         for (u, v) in [(0.0, 0.0), (0.37, 0.5), (0.81, 0.93)] {
@@ -702,7 +705,7 @@ fn bad_input_is_refused_with_no_output() {
 /// or right side: the flank's line, or the nose's arc below the point where
 /// the flank touches it (this test's own geometry of the rounded
 /// trapezoid).
-fn extent(c: &pilgrim_kernel::families::worm::ThreadCutter, h: f64, left: bool) -> f64 {
+fn extent(c: &pilgrim_kernel::families::thread::ThreadCutter, h: f64, left: bool) -> f64 {
     let a = if left { c.left_angle } else { c.right_angle };
     let (w, r) = (c.tip_width / 2.0, c.nose_radius);
     if h >= r * (1.0 - a.sin()) {
@@ -851,7 +854,7 @@ fn a_rapid_through_the_stock_is_refused() {
     use pilgrim_kernel::MachineKinematics;
     let errors = |p: &AxisProgram| {
         let check = simulate(p, &lathe(), &Default::default(), &c, &req).unwrap();
-        let stock = pilgrim_kernel::families::worm::WormStock::new(&check, &req, &c);
+        let stock = pilgrim_kernel::families::thread::ThreadStock::new(&check, &req, &c);
         let limits = pilgrim_kernel::process::ProcessLimits::of(lathe().info());
         pilgrim_kernel::process::check(p, &lathe(), &Default::default(), Some(&stock), &limits)
             .unwrap()

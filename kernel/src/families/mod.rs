@@ -32,7 +32,12 @@ pub struct Family {
 }
 
 /// Every family the kernel carries, one line each.
-pub const FAMILIES: [&Family; 3] = [&revolution::FAMILY, &caliber::FAMILY, &worm::FAMILY];
+pub const FAMILIES: [&Family; 4] = [
+    &revolution::FAMILY,
+    &caliber::FAMILY,
+    &worm::FAMILY,
+    &thread::FAMILY,
+];
 
 /// Every kind of verification the kernel carries: the families' own, and
 /// a family's judgement of its replayed part ([`crate::judged`]).

@@ -235,6 +235,12 @@ fn part_meshes(
         .collect()
 }
 
+/// A run's program file (name and text) and the program as read of it.
+type ProgramText = (
+    Option<(String, String)>,
+    Option<crate::program::lint::TextProgram>,
+);
+
 /// The program's file (name and text) where the run wrote one, and the
 /// program as its control reads it, which the run timed: a text that does
 /// not read back as `program` is not the run's.
@@ -248,13 +254,7 @@ fn program_text(
     program: &AxisProgram,
     kin: &dyn crate::machine::MachineKinematics,
     shown: &str,
-) -> Result<
-    (
-        Option<(String, String)>,
-        Option<crate::program::lint::TextProgram>,
-    ),
-    Error,
-> {
+) -> Result<ProgramText, Error> {
     let control = crate::program::post::dialect(&report.control).ok_or_else(|| {
         Error::Read(format!(
             "{shown}: report.json names the control '{}', which pilgrim does not know",

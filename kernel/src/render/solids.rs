@@ -82,6 +82,9 @@ pub fn step_files(
     Ok((files, solids))
 }
 
+/// A tool's STEP text, its volume, and its fit's deviation and faces.
+type ToolStep = (String, Real, (Real, usize));
+
 /// The tool's exact solid placed at `at` as its STL is: its STEP text,
 /// volume, and deviation and faces where it is fitted (a thread cutter's
 /// blade); none for an insert.
@@ -92,7 +95,7 @@ fn tool_step(
     tool: &Tool,
     at: &super::scene::ToolAt,
     tol: Real,
-) -> Result<Option<(String, Real, (Real, usize))>, StepError> {
+) -> Result<Option<ToolStep>, StepError> {
     let revolution = |name: &str, s: &step::Section, pose: &Mat4| {
         Ok::<_, StepError>(Some((
             step::revolution_step(name, s, pose)?,

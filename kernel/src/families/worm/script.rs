@@ -2,21 +2,15 @@
 //! cutter, the acceleration and deceleration lengths, the plan of passes.
 //! Angles are degrees here (as a process sheet gives them); lengths mm.
 
-use crate::binding::floats::{kernel, number, Floats};
+use crate::binding::floats::kernel;
 use crate::binding::{ApiGroup, VerifyForm};
-use crate::families::worm::{self, FlankOrder, PlanSettings, ThreadCutter, WormSizes};
+use crate::families::thread::script::{cutter_of, plan_map, VerifyMap};
+use crate::families::thread::{self, ThreadCutter, WormSizes};
 use crate::family::Verification;
 use crate::math::Real;
 use crate::tool::{Tool, ToolShape};
 use rhai::plugin::*;
-use rhai::{Array, EvalAltResult, Map};
-
-pub(crate) fn cutter_of(tool: &Tool) -> Result<ThreadCutter, Box<EvalAltResult>> {
-    match tool.shape {
-        ToolShape::ThreadCutter(c) => Ok(c),
-        _ => Err(format!("tool '{}' is not a thread cutter", tool.name).into()),
-    }
-}
+use rhai::{EvalAltResult, Map};
 
 /// The worm's sizes, the cutter, S1 and S2, the plan.
 #[export_module]
@@ -65,7 +59,7 @@ pub mod worm_api {
             c,
             alpha_deg.to_radians(),
             (s_a1 != 0.0).then_some(s_a1),
-            kernel(worm::WormProfile::parse(profile))?,
+            kernel(thread::WormProfile::parse(profile))?,
         ))
     }
 
@@ -222,27 +216,27 @@ pub mod worm_api {
     /// The universal cutter's axial offset to each flank, `a_1z` (mm).
     #[rhai_fn(pure, return_raw)]
     pub fn axial_offset(w: &mut WormSizes, tool: Tool) -> Result<Real, Box<EvalAltResult>> {
-        Ok(worm::axial_offset(&w.section(), &cutter_of(&tool)?))
+        Ok(thread::axial_offset(&w.section(), &cutter_of(&tool)?))
     }
 
     /// The approach S1 = T V (-1 - ln a + a) (mm): servo time constant
     /// `t` (s), feed velocity `v` (mm/s), lead error ratio `a`.
     pub fn approach_length(t: Real, v: Real, a: Real) -> Real {
-        worm::approach_length(t, v, a)
+        thread::approach_length(t, v, a)
     }
     /// The run-out S2 = T V (mm).
     pub fn runout_length(t: Real, v: Real) -> Real {
-        worm::runout_length(t, v)
+        thread::runout_length(t, v)
     }
     /// The lead error ratio at the thread's start with an approach of
     /// `length` mm.
     pub fn approach_error(t: Real, v: Real, length: Real) -> Real {
-        worm::approach_error(t, v, length)
+        thread::approach_error(t, v, length)
     }
     /// The lead error ratio at the thread's end with a run-out of
     /// `length` mm.
     pub fn runout_error(t: Real, v: Real, length: Real) -> Real {
-        worm::runout_error(t, v, length)
+        thread::runout_error(t, v, length)
     }
 
     /// The passes, in the order cut, for `tool` (a thread cutter), with
@@ -256,100 +250,6 @@ pub mod worm_api {
     pub fn plan(w: &mut WormSizes, tool: Tool, settings: Map) -> Result<Map, Box<EvalAltResult>> {
         plan_map(&w.section(), &tool, &settings)
     }
-}
-
-/// The plan of passes over `section` for `tool` with a script's
-/// `settings` (the worm's `plan` and the thread's), as columns.
-pub(crate) fn plan_map(
-    section: &crate::families::thread::ThreadSection,
-    tool: &Tool,
-    settings: &Map,
-) -> Result<Map, Box<EvalAltResult>> {
-    const KEYS: [&str; 7] = [
-        "roughing_passes",
-        "min_depth",
-        "finish_depth",
-        "finish_passes",
-        "order",
-        "axial_step",
-        "by_depth",
-    ];
-    if let Some(k) = settings.keys().find(|k| !KEYS.contains(&k.as_str())) {
-        return Err(format!(
-            "plan: unknown setting '{k}' (settings: {})",
-            KEYS.join(", ")
-        )
-        .into());
-    }
-    let num = |k: &str| -> Result<Real, Box<EvalAltResult>> {
-        settings
-            .get(k)
-            .and_then(number)
-            .ok_or_else(|| format!("plan: '{k}' must be a number").into())
-    };
-    let count = |k: &str| -> Result<usize, Box<EvalAltResult>> {
-        let v = num(k)?;
-        if !(0.0..=worm::MAX_PASSES as Real).contains(&v) || v.fract() != 0.0 {
-            return Err(format!(
-                "plan: {k} = {v} must be a whole number from 0 to {}",
-                worm::MAX_PASSES
-            )
-            .into());
-        }
-        Ok(v as usize)
-    };
-    let order = settings
-        .get("order")
-        .and_then(|d| d.clone().into_string().ok())
-        .ok_or("plan: 'order' must be a string")?;
-    let by_depth = settings
-        .get("by_depth")
-        .and_then(|d| d.as_bool().ok())
-        .ok_or("plan: 'by_depth' must be true or false")?;
-    let n = count("roughing_passes")?;
-    let s = PlanSettings {
-        roughing_passes: (n > 0).then_some(n),
-        min_depth: num("min_depth")?,
-        finish_depth: num("finish_depth")?,
-        finish_passes: count("finish_passes")?,
-        order: FlankOrder::parse(&order).map_err(|e| format!("plan: {e}"))?,
-        axial_step: num("axial_step")?,
-        starts_by_depth: by_depth,
-    };
-    let passes = kernel(worm::plan(section, &cutter_of(tool)?, &s))?;
-    let col = |f: &dyn Fn(&worm::PlannedPass) -> Real| {
-        Dynamic::from(Floats::new(passes.iter().map(f).collect()))
-    };
-    let mut m = Map::new();
-    m.insert(
-        "kind".into(),
-        Dynamic::from(
-            passes
-                .iter()
-                .map(|p| {
-                    Dynamic::from(match p.kind {
-                        worm::PassKind::Rough => "rough",
-                        worm::PassKind::Finish => "finish",
-                        worm::PassKind::Side => "side",
-                    })
-                })
-                .collect::<Array>(),
-        ),
-    );
-    m.insert("start".into(), col(&|p| Real::from(p.start)));
-    m.insert("depth".into(), col(&|p| p.depth));
-    m.insert("cumulative".into(), col(&|p| p.cumulative));
-    m.insert("offset".into(), col(&|p| p.offset));
-    m.insert(
-        "flank".into(),
-        col(&|p| match p.flank {
-            worm::Flank::Left => -1.0,
-            worm::Flank::Radial => 0.0,
-            worm::Flank::Right => 1.0,
-        }),
-    );
-    m.insert("planned_area".into(), col(&|p| p.planned_area));
-    Ok(m)
 }
 
 /// The worm's part of the script API, as the reference lists it.
@@ -369,60 +269,6 @@ pub(crate) const SCRIPT_API: ApiGroup = ApiGroup {
     }),
 };
 
-/// What the worm's and the thread's `fn verify(p)` maps share: the object
-/// under their key, `length`, `space_centre` and the `tolerance` map.
-pub(crate) struct VerifyMap<T> {
-    /// The object under the family's key (`worm`, `thread_profile`).
-    pub part: T,
-    /// The thread's length (mm).
-    pub length: Real,
-    /// Where start 0's space is centred (mm).
-    pub space_centre: Real,
-    tolerance: Map,
-    keys: &'static str,
-}
-
-impl<T: Clone + 'static> VerifyMap<T> {
-    /// The map `m` read: `Err(None)` where it is not of the form (no
-    /// object of type `T` under `key`, no numbers, no tolerance map);
-    /// `keys` lists the tolerance's keys in messages.
-    pub(crate) fn read(m: &Map, key: &str, keys: &'static str) -> Result<Self, Option<String>> {
-        let num = |k: &str| m.get(k).and_then(number).ok_or(None);
-        Ok(Self {
-            part: m
-                .get(key)
-                .and_then(|w| w.clone().try_cast::<T>())
-                .ok_or(None)?,
-            length: num("length")?,
-            space_centre: num("space_centre")?,
-            tolerance: m
-                .get("tolerance")
-                .and_then(|t| t.clone().try_cast::<Map>())
-                .ok_or(None)?,
-            keys,
-        })
-    }
-
-    /// The tolerance `k`, a number.
-    pub(crate) fn tolerance(&self, k: &str) -> Result<Real, Option<String>> {
-        self.tolerance.get(k).and_then(number).ok_or_else(|| {
-            Some(format!(
-                "fn verify(p): tolerance.{k} must be a number (tolerance: {})",
-                self.keys
-            ))
-        })
-    }
-
-    /// The lead's error allowed at the thread's ends: `tolerance.lead`,
-    /// [`worm::LEAD_ERROR`] where it is left out.
-    pub(crate) fn lead(&self) -> Result<Real, Option<String>> {
-        match self.tolerance.get("lead") {
-            None => Ok(worm::LEAD_ERROR),
-            Some(_) => self.tolerance("lead"),
-        }
-    }
-}
-
 /// The worm's request from the map of a script's `fn verify(p)`.
 fn verification(m: &Map) -> Result<Verification, Option<String>> {
     let v = VerifyMap::<WormSizes>::read(
@@ -430,11 +276,11 @@ fn verification(m: &Map) -> Result<Verification, Option<String>> {
         "worm",
         "form, thickness, diameter, position, flank_angle_deg",
     )?;
-    Ok(Verification::new(worm::WormRequest::worm(
+    Ok(Verification::new(thread::ThreadRequest::worm(
         &v.part,
         v.length,
         v.space_centre,
-        worm::WormTolerances {
+        thread::ThreadTolerances {
             form: v.tolerance("form")?,
             thickness: v.tolerance("thickness")?,
             diameter: v.tolerance("diameter")?,

@@ -359,7 +359,7 @@ pub fn plan(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::families::worm::WormSizes;
+    use crate::families::thread::WormSizes;
 
     /// D_i = h sqrt(i / n) where no pass falls below a_min.
     #[test]
@@ -459,7 +459,7 @@ mod tests {
     /// order but radial is refused, naming it.
     #[test]
     fn a_form_cutter_plunges_straight_in() {
-        use crate::families::worm::{WormProfile, WormSizes};
+        use crate::families::thread::{WormProfile, WormSizes};
         let a = 20f64.to_radians();
         let w = WormSizes::with_profile(5.0, 2, 50.0, 0.2, a, None, WormProfile::ZI).unwrap();
         let t = w.section();

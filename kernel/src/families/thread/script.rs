@@ -4,16 +4,18 @@
 //! simulation, held to the standard's limits). Angles in degrees; lengths
 //! mm.
 
-use super::script::{cutter_of, plan_map, VerifyMap};
+use crate::binding::floats::Floats;
 use crate::binding::floats::{kernel, number};
 use crate::binding::{ApiGroup, VerifyForm};
 use crate::families::thread::standards::{LoadFlank, StatedLimits};
+use crate::families::thread::{self, FlankOrder, PlanSettings, ThreadCutter, ThreadTolerances};
 use crate::families::thread::{Drawing, Hand, ThreadProfile};
-use crate::families::worm::{self, WormTolerances};
 use crate::family::Verification;
 use crate::math::Real;
 use crate::tool::Tool;
+use crate::tool::ToolShape;
 use rhai::plugin::*;
+use rhai::Array;
 use rhai::{EvalAltResult, Map};
 
 /// The keys of a drawing's map, in the order the docs give them.
@@ -250,7 +252,7 @@ pub mod thread_api {
         t: &mut ThreadProfile,
         tool: Tool,
     ) -> Result<Real, Box<EvalAltResult>> {
-        Ok(worm::axial_offset(&t.aimed(), &cutter_of(&tool)?))
+        Ok(thread::axial_offset(&t.aimed(), &cutter_of(&tool)?))
     }
 
     /// The passes over the section the cut aims at, as the worm's `plan`
@@ -299,13 +301,13 @@ fn verification(m: &Map) -> Result<Verification, Option<String>> {
         "form, position, flank_angle_deg, lead",
     )?;
     let (profile, section) = (&v.part, v.part.aimed());
-    Ok(Verification::new(worm::WormRequest {
+    Ok(Verification::new(thread::ThreadRequest {
         // The flanks are measured a twentieth of the depth inside the root
         // and the crest.
         flank_margin: 0.05 * section.depth(),
         length: v.length,
         space_centre: v.space_centre,
-        tolerances: WormTolerances {
+        tolerances: ThreadTolerances {
             form: v.tolerance("form")?,
             // The standard's limits hold the thickness (by the pitch
             // diameter) and the diameters: these are the halves of their
@@ -353,5 +355,161 @@ fn per_start(m: &Map, key: &str, what: &str, starts: u32) -> Result<Vec<Real>, O
                 "fn verify(p): {key} must be {starts} numbers, each start's {what} (mm), not {d}"
             ))),
         },
+    }
+}
+
+/// The thread cutter `tool` is, or why not.
+pub(crate) fn cutter_of(tool: &Tool) -> Result<ThreadCutter, Box<EvalAltResult>> {
+    match tool.shape {
+        ToolShape::ThreadCutter(c) => Ok(c),
+        _ => Err(format!("tool '{}' is not a thread cutter", tool.name).into()),
+    }
+}
+
+/// The plan of passes over `section` for `tool` with a script's
+/// `settings` (the worm's `plan` and the thread's), as columns.
+pub(crate) fn plan_map(
+    section: &crate::families::thread::ThreadSection,
+    tool: &Tool,
+    settings: &Map,
+) -> Result<Map, Box<EvalAltResult>> {
+    const KEYS: [&str; 7] = [
+        "roughing_passes",
+        "min_depth",
+        "finish_depth",
+        "finish_passes",
+        "order",
+        "axial_step",
+        "by_depth",
+    ];
+    if let Some(k) = settings.keys().find(|k| !KEYS.contains(&k.as_str())) {
+        return Err(format!(
+            "plan: unknown setting '{k}' (settings: {})",
+            KEYS.join(", ")
+        )
+        .into());
+    }
+    let num = |k: &str| -> Result<Real, Box<EvalAltResult>> {
+        settings
+            .get(k)
+            .and_then(number)
+            .ok_or_else(|| format!("plan: '{k}' must be a number").into())
+    };
+    let count = |k: &str| -> Result<usize, Box<EvalAltResult>> {
+        let v = num(k)?;
+        if !(0.0..=thread::MAX_PASSES as Real).contains(&v) || v.fract() != 0.0 {
+            return Err(format!(
+                "plan: {k} = {v} must be a whole number from 0 to {}",
+                thread::MAX_PASSES
+            )
+            .into());
+        }
+        Ok(v as usize)
+    };
+    let order = settings
+        .get("order")
+        .and_then(|d| d.clone().into_string().ok())
+        .ok_or("plan: 'order' must be a string")?;
+    let by_depth = settings
+        .get("by_depth")
+        .and_then(|d| d.as_bool().ok())
+        .ok_or("plan: 'by_depth' must be true or false")?;
+    let n = count("roughing_passes")?;
+    let s = PlanSettings {
+        roughing_passes: (n > 0).then_some(n),
+        min_depth: num("min_depth")?,
+        finish_depth: num("finish_depth")?,
+        finish_passes: count("finish_passes")?,
+        order: FlankOrder::parse(&order).map_err(|e| format!("plan: {e}"))?,
+        axial_step: num("axial_step")?,
+        starts_by_depth: by_depth,
+    };
+    let passes = kernel(thread::plan(section, &cutter_of(tool)?, &s))?;
+    let col = |f: &dyn Fn(&thread::PlannedPass) -> Real| {
+        Dynamic::from(Floats::new(passes.iter().map(f).collect()))
+    };
+    let mut m = Map::new();
+    m.insert(
+        "kind".into(),
+        Dynamic::from(
+            passes
+                .iter()
+                .map(|p| {
+                    Dynamic::from(match p.kind {
+                        thread::PassKind::Rough => "rough",
+                        thread::PassKind::Finish => "finish",
+                        thread::PassKind::Side => "side",
+                    })
+                })
+                .collect::<Array>(),
+        ),
+    );
+    m.insert("start".into(), col(&|p| Real::from(p.start)));
+    m.insert("depth".into(), col(&|p| p.depth));
+    m.insert("cumulative".into(), col(&|p| p.cumulative));
+    m.insert("offset".into(), col(&|p| p.offset));
+    m.insert(
+        "flank".into(),
+        col(&|p| match p.flank {
+            thread::Flank::Left => -1.0,
+            thread::Flank::Radial => 0.0,
+            thread::Flank::Right => 1.0,
+        }),
+    );
+    m.insert("planned_area".into(), col(&|p| p.planned_area));
+    Ok(m)
+}
+
+/// What the worm's and the thread's `fn verify(p)` maps share: the object
+/// under their key, `length`, `space_centre` and the `tolerance` map.
+pub(crate) struct VerifyMap<T> {
+    /// The object under the family's key (`worm`, `thread_profile`).
+    pub part: T,
+    /// The thread's length (mm).
+    pub length: Real,
+    /// Where start 0's space is centred (mm).
+    pub space_centre: Real,
+    tolerance: Map,
+    keys: &'static str,
+}
+
+impl<T: Clone + 'static> VerifyMap<T> {
+    /// The map `m` read: `Err(None)` where it is not of the form (no
+    /// object of type `T` under `key`, no numbers, no tolerance map);
+    /// `keys` lists the tolerance's keys in messages.
+    pub(crate) fn read(m: &Map, key: &str, keys: &'static str) -> Result<Self, Option<String>> {
+        let num = |k: &str| m.get(k).and_then(number).ok_or(None);
+        Ok(Self {
+            part: m
+                .get(key)
+                .and_then(|w| w.clone().try_cast::<T>())
+                .ok_or(None)?,
+            length: num("length")?,
+            space_centre: num("space_centre")?,
+            tolerance: m
+                .get("tolerance")
+                .and_then(|t| t.clone().try_cast::<Map>())
+                .ok_or(None)?,
+            keys,
+        })
+    }
+
+    /// The tolerance `k`, a number.
+    pub(crate) fn tolerance(&self, k: &str) -> Result<Real, Option<String>> {
+        self.tolerance.get(k).and_then(number).ok_or_else(|| {
+            Some(format!(
+                "fn verify(p): tolerance.{k} must be a number (tolerance: {})",
+                self.keys
+            ))
+        })
+    }
+
+    /// The lead's error allowed at the thread's ends: `tolerance.lead`,
+    /// [`thread::LEAD_ERROR`] where it is left out.
+    pub(crate) fn lead(&self) -> Result<Real, Option<String>> {
+        match self.tolerance.get("lead") {
+            None => Ok(thread::LEAD_ERROR),
+            Some(_) => self.tolerance("lead"),
+        }
     }
 }

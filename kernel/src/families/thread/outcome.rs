@@ -1,12 +1,12 @@
-//! A worm's verification as the run uses it: the request ([`WormRequest`])
+//! A worm's verification as the run uses it: the request ([`ThreadRequest`])
 //! simulates a program's cut pass by pass with [`simulate`]; the outcome
 //! gives the verdict's figures, the report's `thread_verification`, the
 //! finished worm's solid, the simulated areas in the family's `passes`
 //! table, `passes.csv`, `passes.xlsx`, `passes.svg` and the page's section.
 
 use super::{
-    simulate, worm_pass_table, worm_passes_svg, worm_solid, SimulatedPass, WormCheck, WormRequest,
-    WormStock, WormSweep,
+    pass_table, passes_svg, simulate, thread_solid, SimulatedPass, ThreadCheck, ThreadRequest,
+    ThreadStock, ThreadSweep,
 };
 use crate::family::{
     FilesContext, Outcome, OutcomeKind, PartBody, PartGeometry, ReplayContext, Swept, SweptBody,
@@ -22,7 +22,7 @@ use crate::verdict::{Figure, Finding};
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
-impl Verifier for WormRequest {
+impl Verifier for ThreadRequest {
     fn verify(&self, ctx: &ReplayContext<'_>) -> Result<Verified, VerifyError> {
         let ToolShape::ThreadCutter(c) = ctx.tool.shape else {
             return Err(VerifyError::Contract(
@@ -30,9 +30,9 @@ impl Verifier for WormRequest {
             ));
         };
         let check = simulate(ctx.program, ctx.machine, &ctx.tool.reference, &c, self)?;
-        let stock = WormStock::new(&check, self, &c);
+        let stock = ThreadStock::new(&check, self, &c);
         Ok(Verified {
-            outcome: Box::new(WormOutcome {
+            outcome: Box::new(ThreadOutcome {
                 check,
                 request: self.clone(),
             }),
@@ -93,14 +93,14 @@ impl Verifier for WormRequest {
 
 /// A worm's cut simulated against its thread.
 #[derive(Debug, Clone, PartialEq)]
-pub struct WormOutcome {
+pub struct ThreadOutcome {
     /// What the simulation found.
-    pub check: WormCheck,
+    pub check: ThreadCheck,
     /// What it was held to.
-    pub request: WormRequest,
+    pub request: ThreadRequest,
 }
 
-impl Outcome for WormOutcome {
+impl Outcome for ThreadOutcome {
     fn key(&self) -> &'static str {
         KIND.key
     }
@@ -139,11 +139,11 @@ impl Outcome for WormOutcome {
             source,
         };
         let (w, length) = (&self.check, self.request.length);
-        let mesh = worm_solid(w, length, mesh_tolerance, self.request.outside_diameter)
+        let mesh = thread_solid(w, length, mesh_tolerance, self.request.outside_diameter)
             .map_err(mesh_error)?;
         // A quarter of the STEP tolerance for merging the outline's points,
         // the rest for the fit.
-        let body = WormSweep::new(
+        let body = ThreadSweep::new(
             w,
             length,
             step_tolerance / 4.0,
@@ -212,9 +212,9 @@ impl Outcome for WormOutcome {
         ctx: &FilesContext<'_>,
         tables: &BTreeMap<String, BTreeMap<String, Vec<f64>>>,
     ) -> Result<crate::family::Drawn, crate::family::DrawError> {
-        let table = worm_pass_table(&self.check, tables.get("passes"))?;
-        let workbook = super::worm_pass_workbook(&self.check, tables.get("passes"))?;
-        let (svg, marks) = worm_passes_svg(&self.check, ctx.replay.program.blocks.len())?;
+        let table = pass_table(&self.check, tables.get("passes"))?;
+        let workbook = super::pass_workbook(&self.check, tables.get("passes"))?;
+        let (svg, marks) = passes_svg(&self.check, ctx.replay.program.blocks.len())?;
         Ok(crate::family::Drawn {
             files: vec![
                 ("passes.csv".into(), table.into_bytes()),
@@ -238,7 +238,7 @@ fn section(
     entry: &serde_json::Value,
     _label: &dyn Fn(usize) -> String,
 ) -> Result<String, crate::family::DrawError> {
-    let w: WormCheck = serde_json::from_value(entry.clone())?;
+    let w: ThreadCheck = serde_json::from_value(entry.clone())?;
     let mut out = String::new();
     let _ = write!(
         out,

@@ -12,7 +12,7 @@
 //! root and tip diameters, each start's position.
 //!
 //! An internal thread is cut as its external twin in rho = -r
-//! ([`WormRequest::mirrored`]): its space opens towards the axis, so in
+//! ([`ThreadRequest::mirrored`]): its space opens towards the axis, so in
 //! rho it opens outwards as an external thread's, and the results are
 //! turned back (diameters positive, the measurement over wires one between
 //! balls).
@@ -44,7 +44,7 @@ const INSIDE: Real = 1e-6;
 
 /// What the finished worm must hold.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct WormTolerances {
+pub struct ThreadTolerances {
     /// Flank form and any cut beyond the nominal (mm, normal to the flank).
     pub form: Real,
     /// Axial thickness at the pitch line (mm).
@@ -63,12 +63,12 @@ pub struct WormTolerances {
 }
 
 /// The lead's usual allowed error at a thread's ends, as a ratio (Fanuc's
-/// practice, docs/math.md §4.2): the default of [`WormTolerances::lead`].
+/// practice, docs/math.md §4.2): the default of [`ThreadTolerances::lead`].
 pub const LEAD_ERROR: Real = 0.01;
 
 /// What the family asks the simulation to check.
 #[derive(Debug, Clone, PartialEq)]
-pub struct WormRequest {
+pub struct ThreadRequest {
     /// The thread's section, external or internal.
     pub section: ThreadSection,
     /// How far inside the root and the crest the flanks are measured (mm,
@@ -80,7 +80,7 @@ pub struct WormRequest {
     /// (z, mm; any z the same modulo the lead).
     pub space_centre: Real,
     /// The tolerances.
-    pub tolerances: WormTolerances,
+    pub tolerances: ThreadTolerances,
     /// A standard's limits the finished thread must hold besides: each
     /// start's pitch diameter within `pitch_diameter` (`None`: the
     /// tolerances alone).
@@ -100,14 +100,14 @@ pub struct WormRequest {
     pub place_shift: Vec<Real>,
 }
 
-impl WormRequest {
+impl ThreadRequest {
     /// The request for the worm `sizes`: its section, the flanks measured
     /// a tenth of the module inside the root and the tip.
     pub fn worm(
         sizes: &WormSizes,
         length: Real,
         space_centre: Real,
-        tolerances: WormTolerances,
+        tolerances: ThreadTolerances,
     ) -> Self {
         Self {
             section: sizes.section(),
@@ -124,7 +124,7 @@ impl WormRequest {
     }
 }
 
-impl WormRequest {
+impl ThreadRequest {
     /// An internal thread's external twin in rho = -r: the section's
     /// diameters and the limits negated. An internal thread's space opens
     /// inwards from its root (the major) to its crest (the bore); in rho
@@ -248,7 +248,7 @@ pub struct StartProfile {
 /// The simulation's result (`report.json`'s `thread_verification`; the
 /// section and chips, for drawing, are not in it).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct WormCheck {
+pub struct ThreadCheck {
     /// Every thread block, in order.
     pub passes: Vec<SimulatedPass>,
     /// The finished profile at each start.
@@ -262,7 +262,7 @@ pub struct WormCheck {
     /// The loads summed over all passes: left edge, right edge (mm^2).
     pub flank_loads: [Real; 2],
     /// The tolerances checked.
-    pub tolerances: WormTolerances,
+    pub tolerances: ThreadTolerances,
     /// Each pass's chip as polygons `(z, r)` (for the pass-by-pass view).
     #[serde(skip)]
     pub chips: Vec<Vec<Vec<[Real; 2]>>>,
@@ -309,7 +309,7 @@ pub struct WormCheck {
     pub hand: Hand,
 }
 
-impl WormCheck {
+impl ThreadCheck {
     /// The check, or its first failure as an error.
     ///
     /// # Failures
@@ -471,7 +471,7 @@ impl WormCheck {
     }
 
     /// The check of an internal thread's external twin (simulated in rho =
-    /// -r, [`WormRequest::mirrored`]) turned back: radii and diameters
+    /// -r, [`ThreadRequest::mirrored`]) turned back: radii and diameters
     /// positive, the limits its own.
     fn mirrored(mut self) -> Self {
         for s in &mut self.starts {
@@ -598,8 +598,8 @@ fn thread_middle(t: &ThreadSection) -> [Real; 2] {
 /// The nominal spaces of one lead's window (and one either side), each an
 /// outline from the root to above the crest: a trapezoid, or curved
 /// flanks in chords of [`NOMINAL_CHORDS`] along the depth; each start's
-/// moved radially by its correction ([`WormRequest::pitch_shift`]).
-fn nominal_spaces(req: &WormRequest, c0: Real) -> Vec<Vec<[Real; 2]>> {
+/// moved radially by its correction ([`ThreadRequest::pitch_shift`]).
+fn nominal_spaces(req: &ThreadRequest, c0: Real) -> Vec<Vec<[Real; 2]>> {
     let t = &req.section;
     let n = if t.form.is_axial() { 1 } else { NOMINAL_CHORDS };
     (-1..=i64::from(t.starts))
@@ -646,8 +646,8 @@ pub fn simulate(
     machine: &dyn MachineKinematics,
     tool: &ToolFrame,
     cutter: &ThreadCutter,
-    req: &WormRequest,
-) -> Result<WormCheck, VerifyError> {
+    req: &ThreadRequest,
+) -> Result<ThreadCheck, VerifyError> {
     // An internal thread is simulated as its external twin in rho = -r
     // (see `mirrored`), and its results turned back.
     let inside = req.section.internal;
@@ -919,7 +919,7 @@ pub fn simulate(
     let (starts, unmeasured) = measure(&material, req, cutter);
     let nominal_flanks = nominal_flanks_deg(w, &flank_radii(w, req.flank_margin, cutter));
     failures.extend(unmeasured);
-    let check = WormCheck {
+    let check = ThreadCheck {
         failures,
         nominal: (
             w.pitch - w.space_at_pitch,
@@ -984,7 +984,7 @@ fn mirrored_limits(
 /// under it (the envelope of the section over a turn); and each thread
 /// block's chip, the last at each start finishing it.
 #[derive(Debug, Clone)]
-pub struct WormStock {
+pub struct ThreadStock {
     /// +1, or -1 for an internal thread: radii are taken as rho = -r, so
     /// that the material lies below the crest as an external thread's.
     rho: Real,
@@ -998,10 +998,10 @@ pub struct WormStock {
     passes: Vec<crate::process::PassStock>,
 }
 
-impl WormStock {
+impl ThreadStock {
     /// The material of the worm of `req` that `check` simulated, cut by
     /// `cutter`.
-    pub fn new(check: &WormCheck, req: &WormRequest, cutter: &ThreadCutter) -> Self {
+    pub fn new(check: &ThreadCheck, req: &ThreadRequest, cutter: &ThreadCutter) -> Self {
         let section = cutter.section(cutter.height);
         let mut outline = Vec::new();
         for j in 0..section.len() {
@@ -1044,7 +1044,7 @@ impl WormStock {
     }
 }
 
-impl crate::process::Stock for WormStock {
+impl crate::process::Stock for ThreadStock {
     fn tool_depth(&self, _: usize, pose: &[Real]) -> Real {
         let (z, r) = (pose[2], self.rho * pose[0].hypot(pose[1]));
         // Into the blank, the outline's points over it; off it, the
@@ -1167,7 +1167,7 @@ fn nominal_flanks_deg(w: &ThreadSection, radii: &[Real]) -> [Real; 2] {
 /// nominal (a start whose space is not there is not measured further).
 fn measure(
     m: &MultiPolygon<Real>,
-    req: &WormRequest,
+    req: &ThreadRequest,
     cutter: &ThreadCutter,
 ) -> (Vec<StartProfile>, Vec<Finding>) {
     let (w, tol) = (&req.section, &req.tolerances);
@@ -1362,15 +1362,15 @@ fn measure(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::families::thread::{plan, FlankOrder, PlanSettings};
     use crate::families::thread::{standards, Hand, ThreadProfile};
-    use crate::families::worm::{plan, FlankOrder, PlanSettings};
     use crate::machine::{ChainMachine, Machine};
     use crate::program::{Block, ProgramAxis};
 
     /// An external M20 6g cut with a 60 degree cutter to the plan's depths,
     /// the section aimed `aim` mm below the basic pitch diameter: the
     /// lathe's program of plain thread blocks.
-    fn cut_m20(aim: Real) -> Result<WormCheck, VerifyError> {
+    fn cut_m20(aim: Real) -> Result<ThreadCheck, VerifyError> {
         let profile = standards::metric(20.0, 2.5, false, "6g", 1, Hand::Right).unwrap();
         cut(&profile, aim, FlankOrder::Alternating)
     }
@@ -1384,7 +1384,7 @@ mod tests {
         profile: &ThreadProfile,
         aim: Real,
         order: FlankOrder,
-    ) -> Result<WormCheck, VerifyError> {
+    ) -> Result<ThreadCheck, VerifyError> {
         cut_towards(profile, aim, order, -1.0)
     }
 
@@ -1396,7 +1396,7 @@ mod tests {
         aim: Real,
         order: FlankOrder,
         towards: Real,
-    ) -> Result<WormCheck, VerifyError> {
+    ) -> Result<ThreadCheck, VerifyError> {
         cut_by(profile, aim, order, towards, |t| {
             ThreadCutter::new(t.root_space(), 0.15, t.flanks[0], t.flanks[1], 3.0).unwrap()
         })
@@ -1409,7 +1409,7 @@ mod tests {
         order: FlankOrder,
         towards: Real,
         make: fn(&ThreadSection) -> ThreadCutter,
-    ) -> Result<WormCheck, VerifyError> {
+    ) -> Result<ThreadCheck, VerifyError> {
         // The blank turned to the middle of the crest's band.
         let s = profile.section.opening();
         let t = &ThreadSection {
@@ -1493,12 +1493,12 @@ mod tests {
             cycles: Vec::new(),
         };
         let lathe = ChainMachine::new(Machine::from_info(fanuc_0i_tc::describe()).unwrap());
-        let req = WormRequest {
+        let req = ThreadRequest {
             section: t.clone(),
             flank_margin: 0.1,
             length,
             space_centre: c0,
-            tolerances: WormTolerances {
+            tolerances: ThreadTolerances {
                 form: 0.01,
                 thickness: 1.0,
                 diameter: 1.0,
@@ -1600,7 +1600,7 @@ mod tests {
         let _ = check.clone().verified().unwrap();
         // Its part: a nut of 45 mm round the thread, closed, its volume
         // between the cylinders' at its root and at its crest.
-        let solid = crate::families::worm::worm_solid(&check, 30.0, 0.01, Some(45.0)).unwrap();
+        let solid = crate::families::thread::thread_solid(&check, 30.0, 0.01, Some(45.0)).unwrap();
         solid.check_closed().unwrap();
         let tube = |r: Real| std::f64::consts::PI * (22.5f64.powi(2) - r * r) * 30.0;
         let v = solid.volume();
@@ -1615,11 +1615,11 @@ mod tests {
             (hi[0] - 22.5).abs() < 1e-9 && (lo[2] + 30.0).abs() < 1e-9,
             "{lo:?} {hi:?}"
         );
-        assert!(crate::families::worm::worm_solid(&check, 30.0, 0.01, Some(28.0)).is_err());
+        assert!(crate::families::thread::thread_solid(&check, 30.0, 0.01, Some(28.0)).is_err());
         // Its STEP: the nut's faces close a solid of the mesh's volume
         // (the mesh's chords inside the helical surface by at most 0.01).
         let sweep =
-            crate::families::worm::WormSweep::new(&check, 30.0, 2.5e-4, Some(45.0)).unwrap();
+            crate::families::thread::ThreadSweep::new(&check, 30.0, 2.5e-4, Some(45.0)).unwrap();
         let fit = crate::step::swept_step("nut", "a nut", &sweep, 1e-3).unwrap();
         assert!(
             (fit.volume - v).abs() < 0.01 * 30.0 * 100.0,
@@ -1666,7 +1666,7 @@ mod tests {
         );
         // The solid: a vertex at angle phi lies on the section at 0
         // shifted by -lead phi / 2 pi (a right hand's, +).
-        let solid = crate::families::worm::worm_solid(&check, 30.0, 0.01, None).unwrap();
+        let solid = crate::families::thread::thread_solid(&check, 30.0, 0.01, None).unwrap();
         solid.check_closed().unwrap();
         let (w0, lead) = check.window;
         let mut worst: Real = 0.0;
@@ -1678,7 +1678,7 @@ mod tests {
             }
         }
         assert!(worst < 0.02, "{worst}");
-        let sweep = crate::families::worm::WormSweep::new(&check, 30.0, 2.5e-4, None).unwrap();
+        let sweep = crate::families::thread::ThreadSweep::new(&check, 30.0, 2.5e-4, None).unwrap();
         use crate::step::Sections;
         let q = sweep.point(0, 0.5, 0.5);
         let phi = q[1].atan2(q[0]);
@@ -1751,7 +1751,7 @@ mod tests {
     /// the ZI worm's curve as the straight one does.
     #[test]
     fn a_zi_worm_is_held_to_its_curved_flanks() {
-        use crate::families::worm::{WormProfile, WormSizes};
+        use crate::families::thread::{WormProfile, WormSizes};
         let worm = |profile| {
             WormSizes::with_profile(5.0, 2, 50.0, 0.2, 20f64.to_radians(), None, profile)
                 .unwrap()

@@ -5,7 +5,7 @@
 
 use crate::chart::DrawError;
 use crate::chart::{Marks, PassMark, PixelMap};
-use crate::families::worm::WormCheck;
+use crate::families::thread::ThreadCheck;
 use plotters::prelude::*;
 use std::collections::BTreeMap;
 
@@ -27,7 +27,7 @@ fn pass_colour(k: usize, n: usize) -> HSLColor {
 ///
 /// # Failures
 /// Drawing failing.
-pub fn worm_passes_svg(check: &WormCheck, blocks: usize) -> Result<(String, Marks), DrawError> {
+pub fn passes_svg(check: &ThreadCheck, blocks: usize) -> Result<(String, Marks), DrawError> {
     let (w0, lead) = check.window;
     let (mut r0, mut r1) = (f64::INFINITY, f64::NEG_INFINITY);
     for chip in check.chips.iter().flatten().flatten() {
@@ -127,7 +127,7 @@ pub fn worm_passes_svg(check: &WormCheck, blocks: usize) -> Result<(String, Mark
 /// value per simulated pass, less those the simulation's own columns
 /// repeat.
 pub(super) fn plan_columns<'a>(
-    check: &WormCheck,
+    check: &ThreadCheck,
     planned: Option<&'a BTreeMap<String, Vec<f64>>>,
 ) -> Vec<(&'a String, &'a Vec<f64>)> {
     planned
@@ -152,8 +152,8 @@ pub(super) fn plan_columns<'a>(
 ///
 /// # Failures
 /// The writer failing.
-pub fn worm_pass_table(
-    check: &WormCheck,
+pub fn pass_table(
+    check: &ThreadCheck,
     planned: Option<&BTreeMap<String, Vec<f64>>>,
 ) -> Result<String, DrawError> {
     let plan = plan_columns(check, planned);

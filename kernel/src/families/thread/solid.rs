@@ -16,7 +16,7 @@
 //! An internal thread's part is a nut: the same helical surface as the
 //! hole through a cylinder of its outside diameter.
 
-use super::WormCheck;
+use super::ThreadCheck;
 use crate::math::Real;
 use crate::mesh::{sweep, MeshError, TriMesh};
 use std::f64::consts::TAU;
@@ -31,8 +31,8 @@ pub const MAX_AROUND: usize = 2048;
 /// # Failures
 /// A length or tolerance not positive; an internal thread without an
 /// outside diameter beyond its thread; a mesh that cannot be closed.
-pub fn worm_solid(
-    check: &WormCheck,
+pub fn thread_solid(
+    check: &ThreadCheck,
     length: Real,
     tol: Real,
     outside: Option<Real>,
@@ -119,7 +119,7 @@ fn points_round(r: Real, tol: Real) -> usize {
 /// beyond the thread's largest radius `r_thread`; `None` for an external
 /// thread.
 fn nut_radius(
-    check: &WormCheck,
+    check: &ThreadCheck,
     outside: Option<Real>,
     r_thread: Real,
 ) -> Result<Option<Real>, MeshError> {
@@ -136,13 +136,13 @@ fn nut_radius(
 
 /// The finished worm exactly, for STEP: the section `outline` (`(z, r)`
 /// over one lead from `window`'s start, straight between its points,
-/// repeated with the lead) swept helically as [`worm_solid`] meshes it,
+/// repeated with the lead) swept helically as [`thread_solid`] meshes it,
 /// from z = -length to 0. Its cross-sections are the pieces: piece `k` is
 /// the outline's stretch `k` wound round the axis (at the part's angle
 /// `phi`, the radius is the outline's at `z - lead phi / 2 pi`), and `v`
 /// runs along the axis; the end faces are square to it.
 #[derive(Debug, Clone, PartialEq)]
-pub struct WormSweep {
+pub struct ThreadSweep {
     /// The outline's points kept (within the simplification's tolerance),
     /// the first repeated a lead on at the end.
     points: Vec<[Real; 2]>,
@@ -157,7 +157,7 @@ pub struct WormSweep {
     outside: Option<Real>,
 }
 
-impl WormSweep {
+impl ThreadSweep {
     /// The worm of `check`'s finished section, `length` long (for an
     /// internal thread the nut round it, `outside` its outside diameter);
     /// points of the outline within `merge` (mm, radially) of the line
@@ -168,7 +168,7 @@ impl WormSweep {
     /// A length or merge distance not positive, an empty section; an
     /// internal thread without an outside diameter beyond its thread.
     pub fn new(
-        check: &WormCheck,
+        check: &ThreadCheck,
         length: Real,
         merge: Real,
         outside: Option<Real>,
@@ -217,7 +217,7 @@ impl WormSweep {
             points.push(all[to]);
             from = to;
         }
-        Ok(WormSweep {
+        Ok(ThreadSweep {
             points,
             lead,
             length,
@@ -234,7 +234,7 @@ impl WormSweep {
     }
 }
 
-impl crate::step::Sections for WormSweep {
+impl crate::step::Sections for ThreadSweep {
     fn pieces(&self) -> usize {
         self.points.len() - 1
     }
@@ -261,12 +261,12 @@ impl crate::step::Sections for WormSweep {
     }
 }
 
-impl crate::family::SweptSolid for WormSweep {
+impl crate::family::SweptSolid for ThreadSweep {
     fn sections(&self) -> &dyn crate::step::Sections {
         self
     }
 
     fn simplified(&self) -> crate::math::Real {
-        WormSweep::simplified(self)
+        ThreadSweep::simplified(self)
     }
 }

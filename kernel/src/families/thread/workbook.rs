@@ -5,12 +5,12 @@
 //! run writes the same bytes.
 //!
 //! - `passes`: one row per simulated thread pass, the columns of
-//!   [`super::worm_pass_table`] and the plan's;
+//!   [`super::pass_table`] and the plan's;
 //! - `starts`: each start's finished profile beside its nominal;
 //! - `figures`: the verification's figures and the tolerances held, with
 //!   units.
 
-use super::WormCheck;
+use super::ThreadCheck;
 use rust_xlsxwriter::{DocProperties, ExcelDateTime, Format, Workbook, Worksheet, XlsxError};
 use std::collections::BTreeMap;
 
@@ -43,15 +43,15 @@ fn header(sheet: &mut Worksheet, columns: &[Column<'_>]) -> Result<(), XlsxError
 ///
 /// # Failures
 /// The writer failing.
-pub fn worm_pass_workbook(
-    check: &WormCheck,
+pub fn pass_workbook(
+    check: &ThreadCheck,
     planned: Option<&BTreeMap<String, Vec<f64>>>,
 ) -> Result<Vec<u8>, crate::chart::DrawError> {
     build(check, planned).map_err(|e| crate::chart::DrawError::new("passes.xlsx", e))
 }
 
 fn build(
-    check: &WormCheck,
+    check: &ThreadCheck,
     planned: Option<&BTreeMap<String, Vec<f64>>>,
 ) -> Result<Vec<u8>, XlsxError> {
     let mut book = Workbook::new();
