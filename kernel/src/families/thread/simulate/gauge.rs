@@ -1,0 +1,326 @@
+//! The gauges of the finished section: the pitch diameter, the
+//! measurement over wires, the flanks' angles and form, the root and crest.
+
+use super::{space_edges, thread_middle, vertical_top, StartProfile, ThreadRequest, INSIDE};
+use crate::families::thread::{ThreadCutter, ThreadSection};
+use crate::math::Real;
+use crate::replay::VerifyError;
+use crate::verdict::Finding;
+use geo::MultiPolygon;
+
+/// A diameter of the section from a radius of the simulation's, which is
+/// negative for an internal thread's twin.
+pub(super) fn diameter(r: Real) -> Real {
+    2.0 * r.abs()
+}
+
+/// A thread's limits in rho = -r, or back (its own inverse): each band
+/// negated, least first.
+pub(super) fn mirrored_limits(
+    l: &crate::families::thread::ThreadLimits,
+) -> crate::families::thread::ThreadLimits {
+    let band = |b: &crate::families::thread::Limits| crate::families::thread::Limits {
+        min: -b.max,
+        max: -b.min,
+    };
+    crate::families::thread::ThreadLimits {
+        pitch_diameter: band(&l.pitch_diameter),
+        crest: band(&l.crest),
+        root: band(&l.root),
+        source: l.source.clone(),
+    }
+}
+
+/// The diameter where the space round `c` is as wide as the basic
+/// section's at its pitch diameter, between the radii `band` (from the cut
+/// root, where it stands above the band's start; bisection on the space's
+/// width, which grows towards the crest; 0 if it is not within the band).
+pub(super) fn pitch_diameter(
+    m: &MultiPolygon<Real>,
+    t: &ThreadSection,
+    c: Real,
+    band: (Real, Real),
+) -> Real {
+    let width = |r: Real| space_edges(m, r, c).map(|(a, b)| b - a);
+    let (mut lo, mut hi) = band;
+    // Where the cut's root stands above the band's start (the passes'
+    // depths rounded to the program's digit), the band starts at it.
+    if width(lo).is_none() {
+        if let Some(root) = vertical_top(m, c) {
+            lo = lo.max(root + INSIDE);
+        }
+    }
+    let (Some(w_lo), Some(w_hi)) = (width(lo), width(hi)) else {
+        return 0.0;
+    };
+    let want = t.space_at_pitch;
+    if !(w_lo <= want && want <= w_hi) {
+        return 0.0;
+    }
+    // 50 halvings take a band of millimetres below 1e-12 mm.
+    for _ in 0..50 {
+        let mid = 0.5 * (lo + hi);
+        match width(mid) {
+            Some(w) if w < want => lo = mid,
+            Some(_) => hi = mid,
+            None => return 0.0,
+        }
+    }
+    lo + hi
+}
+
+/// The measurement over two wires of diameter `wire` laid in spaces whose
+/// flanks are the lines `left` and `right` (`z = a + b r`), opposite each
+/// other: each wire's centre where the space is as wide as the wire
+/// reaches across it, touching both flanks.
+pub(super) fn over_wires(t: &ThreadSection, wire: Real, left: [Real; 2], right: [Real; 2]) -> Real {
+    // A wire touching a flank at `a` from the radial has its centre
+    // wire / 2 / cos(a) from it along the axis.
+    let (a_l, a_r) = ((-left[1]).atan(), right[1].atan());
+    let across = 0.5 * wire * (1.0 / a_l.cos() + 1.0 / a_r.cos());
+    let r_centre = (across - (right[0] - left[0])) / (right[1] - left[1]);
+    2.0 * r_centre + t.opening() * wire
+}
+
+/// The least-squares slope `b` of `z = a + b r`.
+pub(super) fn slope(samples: &[(Real, Real)]) -> Real {
+    line(samples)[1]
+}
+
+/// The least-squares line `z = a + b r`: `[a, b]`.
+pub(super) fn line(samples: &[(Real, Real)]) -> [Real; 2] {
+    let n = samples.len() as Real;
+    let (mr, mz) = samples
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (r, z)| (a + r / n, b + z / n));
+    let (mut sxy, mut sxx) = (0.0, 0.0);
+    for (r, z) in samples {
+        sxy += (r - mr) * (z - mz);
+        sxx += (r - mr) * (r - mr);
+    }
+    let b = sxy / sxx;
+    [mz - b * mr, b]
+}
+
+/// The radii the flanks of section `w` are measured at: 21, `margin`
+/// clear of the root's fillet and the tip's edge.
+pub(super) fn flank_radii(w: &ThreadSection, margin: Real, cutter: &ThreadCutter) -> Vec<Real> {
+    let r_lo = w.root_diameter / 2.0 + 2.0 * cutter.nose_radius + margin;
+    let r_hi = w.crest_diameter / 2.0 - margin;
+    (0..21)
+        .map(|j| r_lo + (r_hi - r_lo) * j as Real / 20.0)
+        .collect()
+}
+
+/// The nominal flanks' angles the measured ones are held to (deg, the
+/// flank towards -Z first): straight flanks' own; curved flanks' (ZN, ZI)
+/// least-squares lines over the `radii` they are measured at, as the
+/// measured angles are taken.
+pub(super) fn nominal_flanks_deg(w: &ThreadSection, radii: &[Real]) -> [Real; 2] {
+    if w.form.is_axial() {
+        return w.flanks.map(Real::to_degrees);
+    }
+    let side = |k: usize, sign: Real| -> Vec<(Real, Real)> {
+        radii.iter().map(|&r| (r, sign * w.reach(r)[k])).collect()
+    };
+    [
+        (-slope(&side(0, -1.0))).atan().to_degrees(),
+        slope(&side(1, 1.0)).atan().to_degrees(),
+    ]
+}
+
+/// The finished profile at every start, and what of it fails against the
+/// nominal (a start whose space is not there is not measured further).
+pub(super) fn measure(
+    m: &MultiPolygon<Real>,
+    req: &ThreadRequest,
+    cutter: &ThreadCutter,
+) -> (Vec<StartProfile>, Vec<Finding>) {
+    let (w, tol) = (&req.section, &req.tolerances);
+    let mut failures = Vec::new();
+    let fail = |m: String| Finding::new("verification", VerifyError::Failed(m).to_string());
+    let (px, r_a, r1) = (w.pitch, w.crest_diameter / 2.0, w.pitch_diameter / 2.0);
+    let c0 = req.space_centre;
+    let mut out = Vec::new();
+    'starts: for k in 0..w.starts {
+        // The start's place in the window (modulo the lead).
+        let c =
+            c0 + Real::from(w.hand.start_place(i64::from(k), w.starts)) * px + req.start_shift(k);
+        // The start's aimed space, moved by its correction, and the radii
+        // its flanks are measured at.
+        let aimed = req.start_section(k);
+        let radii = flank_radii(&aimed, req.flank_margin, cutter);
+        let nominal_angles = nominal_flanks_deg(&aimed, &radii);
+        let space = |r: Real| {
+            space_edges(m, r, c).ok_or_else(|| {
+                fail(format!(
+                    "start {}: no space cut at diameter {:.3} (the thread's space is not there)",
+                    k + 1,
+                    diameter(r)
+                ))
+            })
+        };
+        let (mut left, mut right) = (Vec::new(), Vec::new());
+        let (mut left_form, mut right_form): (Real, Real) = (0.0, 0.0);
+        let mut worst_at = [0.0; 2];
+        for &r in &radii {
+            let (zl, zr) = match space(r) {
+                Ok(s) => s,
+                Err(e) => {
+                    failures.push(e);
+                    continue 'starts;
+                }
+            };
+            left.push((r, zl));
+            right.push((r, zr));
+            let reach = aimed.reach(r);
+            let dl = (zl - (c - reach[0])) * w.flanks[0].cos();
+            let dr = ((c + reach[1]) - zr) * w.flanks[1].cos();
+            if dl.abs() > left_form.abs() {
+                left_form = dl;
+                worst_at[0] = r;
+            }
+            if dr.abs() > right_form.abs() {
+                right_form = dr;
+                worst_at[1] = r;
+            }
+        }
+        let (zl, zr) = match space(r1) {
+            Ok(s) => s,
+            Err(e) => {
+                failures.push(e);
+                continue 'starts;
+            }
+        };
+        // The space after the last start's is start 0's, one lead on.
+        let next = if k + 1 == w.starts {
+            space_edges(m, r1, c0).map(|(a, _)| a + w.lead())
+        } else {
+            space_edges(m, r1, c + px).map(|(a, _)| a)
+        };
+        let Some(next) = next else {
+            failures.push(fail(format!(
+                "start {}: no space after it at the pitch line",
+                k + 1
+            )));
+            continue 'starts;
+        };
+        let p = StartProfile {
+            start: k,
+            // The pitch line's middle stands off the root's by half the
+            // flanks' difference over the depth between them.
+            position_error: 0.5 * (zl + zr) - c - {
+                let reach = aimed.reach(r1);
+                0.5 * (reach[1] - reach[0])
+            },
+            thickness: next - zr,
+            left_angle_deg: (-slope(&left)).atan().to_degrees(),
+            right_angle_deg: slope(&right).atan().to_degrees(),
+            left_form,
+            right_form,
+            root_diameter: 2.0 * vertical_top(m, c).unwrap_or(0.0),
+            // The thread's middle (the last start's at the window's end:
+            // 1 um inside it).
+            tip_diameter: 2.0 * vertical_top(m, c + thread_middle(w)[1] - 1e-3).unwrap_or(0.0),
+            // Searched over the straight flanks: from where the nose's
+            // arc meets them to the crest.
+            pitch_diameter: pitch_diameter(
+                m,
+                w,
+                c,
+                (
+                    aimed.root_diameter / 2.0
+                        + cutter.nose_radius * (1.0 - w.flanks[0].min(w.flanks[1]).sin())
+                        + INSIDE,
+                    r_a - INSIDE,
+                ),
+            ),
+            over_wires: req
+                .limits
+                .as_ref()
+                .and(w.best_wire())
+                .map(|wire| over_wires(w, wire, line(&left), line(&right))),
+        };
+        let s = k + 1;
+        for (flank, form, r) in [
+            ("left", p.left_form, worst_at[0]),
+            ("right", p.right_form, worst_at[1]),
+        ] {
+            if form.abs() > tol.form {
+                failures.push(fail(format!(
+                    "start {s}, {flank} flank: {} {:.4} mm from the nominal flank at diameter {:.3} (tolerance {} mm)",
+                    if form > 0.0 { "material left" } else { "cut too deep" },
+                    form.abs(), diameter(r), tol.form
+                )));
+            }
+        }
+        for (flank, a, alpha) in [
+            ("left", p.left_angle_deg, nominal_angles[0]),
+            ("right", p.right_angle_deg, nominal_angles[1]),
+        ] {
+            if (a - alpha).abs() > tol.flank_angle.to_degrees() {
+                failures.push(fail(format!(
+                    "start {s}, {flank} flank: angle {a:.4} deg, nominal {alpha:.4} deg (tolerance {:.4} deg)",
+                    tol.flank_angle.to_degrees()
+                )));
+            }
+        }
+        let thickness = w.pitch - w.space_at_pitch;
+        if req.limits.is_none() && (p.thickness - thickness).abs() > tol.thickness {
+            failures.push(fail(format!(
+                "start {s}: axial thickness at the pitch line {:.4} mm, nominal {:.4} mm (tolerance {} mm)",
+                p.thickness, thickness, tol.thickness
+            )));
+        }
+        for (what, d, nominal) in [
+            ("root diameter", p.root_diameter, w.root_diameter),
+            ("tip diameter", p.tip_diameter, w.crest_diameter),
+        ] {
+            if req.limits.is_none() && (d - nominal).abs() > tol.diameter {
+                failures.push(fail(format!(
+                    "start {s}: {what} {:.4} mm, nominal {:.4} mm (tolerance {} mm)",
+                    d.abs(),
+                    nominal.abs(),
+                    tol.diameter
+                )));
+            }
+        }
+        if let Some(l) = &req.limits {
+            // A corrected start's pitch and root diameters are held to the
+            // standard's band moved by its correction: the part is to come
+            // out in the band when the measured error repeats.
+            let by = aimed.pitch_diameter - w.pitch_diameter;
+            for (what, v, d, by) in [
+                ("pitch diameter", p.pitch_diameter, &l.pitch_diameter, by),
+                ("root diameter", p.root_diameter, &l.root, by),
+                ("crest diameter", p.tip_diameter, &l.crest, 0.0),
+            ] {
+                if !d.holds(v - by, 0.0) {
+                    let (lo, hi) = (d.min + by, d.max + by);
+                    let (lo, hi) = (lo.abs().min(hi.abs()), lo.abs().max(hi.abs()));
+                    let corrected = if by == 0.0 {
+                        String::new()
+                    } else {
+                        format!(
+                            ", moved by {:+.4} mm for the correction",
+                            by * w.pitch_diameter.signum()
+                        )
+                    };
+                    failures.push(fail(format!(
+                        "start {s}: {what} {:.4} mm, outside {lo:.4} to {hi:.4} mm ({}{corrected})",
+                        v.abs(),
+                        l.source
+                    )));
+                }
+            }
+        }
+        if p.position_error.abs() > tol.position {
+            failures.push(fail(format!(
+                "start {s}: its space is {:.4} mm from its place (tolerance {} mm)",
+                p.position_error, tol.position
+            )));
+        }
+        out.push(p);
+    }
+    (out, failures)
+}
