@@ -171,10 +171,26 @@ impl ThreadCheck {
     /// Each figure the simulation holds to its tolerance, the worst over
     /// the starts and passes, and what failed.
     pub fn findings(&self) -> (Vec<Figure>, Vec<Finding>) {
+        let mut figures = self.start_figures();
+        figures.push(Figure::new(
+            "the lead over the thread",
+            self.lead_error,
+            self.tolerances.position,
+            "mm",
+            String::new(),
+        ));
+        figures.extend(self.pass_figures());
+        (figures, self.failures.clone())
+    }
+
+    /// The figures of the starts, each the worst start's: the flanks' form
+    /// and angles, the diameters (a standard thread's from the middle of
+    /// each band, within half the band; a worm's from the nominal), each
+    /// start's place.
+    fn start_figures(&self) -> Vec<Figure> {
         let t = &self.tolerances;
         let worst = |f: &dyn Fn(&StartProfile) -> Real| {
-            self.starts
-                .iter()
+            (self.starts.iter())
                 .map(|s| (f(s), s.start))
                 .max_by(|a, b| a.0.abs().total_cmp(&b.0.abs()))
         };
@@ -184,68 +200,65 @@ impl ThreadCheck {
                 figures.push(Figure::new(name, v, tol, unit, format!("start {}", s + 1)));
             }
         };
+        // The larger of two sides in size.
+        let larger = |l: Real, r: Real| if l.abs() >= r.abs() { l } else { r };
         start_figure(
             "flank form",
-            &|s| {
-                if s.left_form.abs() >= s.right_form.abs() {
-                    s.left_form
-                } else {
-                    s.right_form
-                }
-            },
+            &|s| larger(s.left_form, s.right_form),
             t.form,
             "mm",
         );
         let [alpha_l, alpha_r] = self.nominal_flanks_deg;
         start_figure(
             "flank angle",
-            &|s| {
-                let (l, r) = (s.left_angle_deg - alpha_l, s.right_angle_deg - alpha_r);
-                if l.abs() >= r.abs() {
-                    l
-                } else {
-                    r
-                }
-            },
+            &|s| larger(s.left_angle_deg - alpha_l, s.right_angle_deg - alpha_r),
             t.flank_angle.to_degrees(),
             "deg",
         );
-        match &self.limits {
-            // A standard thread: each diameter from the middle of its band,
-            // within half the band.
-            Some(l) => {
-                for (name, f, band) in [
-                    (
-                        "pitch diameter",
-                        &(|s: &StartProfile| s.pitch_diameter) as &dyn Fn(&StartProfile) -> Real,
-                        l.pitch_diameter,
-                    ),
-                    ("root diameter", &|s| s.root_diameter, l.root),
-                    ("crest diameter", &|s| s.tip_diameter, l.crest),
-                ] {
-                    start_figure(name, &|s| f(s) - band.middle(), 0.5 * band.width(), "mm");
-                }
-            }
-            None => {
-                start_figure(
-                    "thickness at the pitch line",
-                    &|s| s.thickness - self.nominal.0,
-                    t.thickness,
-                    "mm",
-                );
-                start_figure(
+        let diameters: [(&str, Of<'_, StartProfile>, Real, Real); 3] = match &self.limits {
+            Some(l) => [
+                (
+                    "pitch diameter",
+                    &|s| s.pitch_diameter,
+                    l.pitch_diameter.middle(),
+                    0.5 * l.pitch_diameter.width(),
+                ),
+                (
                     "root diameter",
-                    &|s| s.root_diameter - self.nominal.1,
+                    &|s| s.root_diameter,
+                    l.root.middle(),
+                    0.5 * l.root.width(),
+                ),
+                (
+                    "crest diameter",
+                    &|s| s.tip_diameter,
+                    l.crest.middle(),
+                    0.5 * l.crest.width(),
+                ),
+            ],
+            None => [
+                (
+                    "thickness at the pitch line",
+                    &|s| s.thickness,
+                    self.nominal.0,
+                    t.thickness,
+                ),
+                (
+                    "root diameter",
+                    &|s| s.root_diameter,
+                    self.nominal.1,
                     t.diameter,
-                    "mm",
-                );
-                start_figure(
+                ),
+                (
                     "tip diameter",
-                    &|s| s.tip_diameter - self.nominal.2,
+                    &|s| s.tip_diameter,
+                    self.nominal.2,
                     t.diameter,
-                    "mm",
-                );
-            }
+                ),
+            ],
+        };
+        for (name, f, from, tol) in diameters {
+            start_figure(name, &|s| f(s) - from, tol, "mm");
         }
         start_figure(
             "each start's place",
@@ -253,39 +266,36 @@ impl ThreadCheck {
             t.position,
             "mm",
         );
-        figures.push(Figure::new(
-            "the lead over the thread",
-            self.lead_error,
-            t.position,
-            "mm",
-            String::new(),
-        ));
+        figures
+    }
+
+    /// The figures of the passes, each the worst pass's, at its block: the
+    /// cut beyond the nominal space, the lead where an edge meets the face
+    /// and leaves the far end.
+    fn pass_figures(&self) -> Vec<Figure> {
+        let t = &self.tolerances;
         let pass = |f: &dyn Fn(&SimulatedPass) -> Real| {
-            self.passes
-                .iter()
+            (self.passes.iter())
                 .max_by(|a, b| f(a).total_cmp(&f(b)))
                 .map(|p| (f(p), p.name.clone(), p.block))
         };
-        for (name, f, tol, unit) in [
-            (
-                "cut beyond the nominal space",
-                &(|p: &SimulatedPass| p.gouge) as &dyn Fn(&SimulatedPass) -> Real,
-                t.form,
-                "mm",
-            ),
+        let rows: [(&str, Of<'_, SimulatedPass>, Real, &str); 3] = [
+            ("cut beyond the nominal space", &|p| p.gouge, t.form, "mm"),
             (
                 "the lead where a pass's edge meets the face",
-                &|p: &SimulatedPass| 100.0 * p.face_lead_error,
+                &|p| 100.0 * p.face_lead_error,
                 100.0 * t.lead,
                 "%",
             ),
             (
                 "the lead where a pass's edge leaves the far end",
-                &|p: &SimulatedPass| 100.0 * p.end_lead_error,
+                &|p| 100.0 * p.end_lead_error,
                 100.0 * t.lead,
                 "%",
             ),
-        ] {
+        ];
+        let mut figures = Vec::new();
+        for (name, f, tol, unit) in rows {
             if let Some((v, place, block)) = pass(f) {
                 let figure = Figure::new(name, v, tol, unit, place);
                 figures.push(match block.checked_sub(1) {
@@ -294,7 +304,7 @@ impl ThreadCheck {
                 });
             }
         }
-        (figures, self.failures.clone())
+        figures
     }
 
     /// The finished thread's radius at `z` in the section at part angle 0
@@ -355,3 +365,6 @@ impl ThreadCheck {
         zs.iter().map(|&z| [z, self.radius_at(z)]).collect()
     }
 }
+
+/// A figure's value of a start or a pass.
+type Of<'a, T> = &'a dyn Fn(&T) -> Real;

@@ -136,191 +136,236 @@ pub(super) fn measure(
     req: &ThreadRequest,
     cutter: &ThreadCutter,
 ) -> (Vec<StartProfile>, Vec<Finding>) {
-    let (w, tol) = (&req.section, &req.tolerances);
-    let mut failures = Vec::new();
     let fail = |m: String| Finding::new("verification", VerifyError::Failed(m).to_string());
-    let (px, r_a, r1) = (w.pitch, w.crest_diameter / 2.0, w.pitch_diameter / 2.0);
-    let c0 = req.space_centre;
+    let mut failures = Vec::new();
     let mut out = Vec::new();
-    'starts: for k in 0..w.starts {
-        // The start's place in the window (modulo the lead).
-        let c =
-            c0 + Real::from(w.hand.start_place(i64::from(k), w.starts)) * px + req.start_shift(k);
-        // The start's aimed space, moved by its correction, and the radii
-        // its flanks are measured at.
-        let aimed = req.start_section(k);
-        let radii = flank_radii(&aimed, req.flank_margin, cutter);
-        let nominal_angles = nominal_flanks_deg(&aimed, &radii);
-        let space = |r: Real| {
-            space_edges(m, r, c).ok_or_else(|| {
-                fail(format!(
-                    "start {}: no space cut at diameter {:.3} (the thread's space is not there)",
-                    k + 1,
-                    diameter(r)
-                ))
-            })
-        };
-        let (mut left, mut right) = (Vec::new(), Vec::new());
-        let (mut left_form, mut right_form): (Real, Real) = (0.0, 0.0);
-        let mut worst_at = [0.0; 2];
-        for &r in &radii {
-            let (zl, zr) = match space(r) {
-                Ok(s) => s,
-                Err(e) => {
-                    failures.push(e);
-                    continue 'starts;
-                }
-            };
-            left.push((r, zl));
-            right.push((r, zr));
-            let reach = aimed.reach(r);
-            let dl = (zl - (c - reach[0])) * w.flanks[0].cos();
-            let dr = ((c + reach[1]) - zr) * w.flanks[1].cos();
-            if dl.abs() > left_form.abs() {
-                left_form = dl;
-                worst_at[0] = r;
+    for k in 0..req.section.starts {
+        match measure_start(m, req, cutter, k) {
+            Ok((p, worst_at)) => {
+                failures.extend(
+                    start_faults(req, cutter, &p, worst_at)
+                        .into_iter()
+                        .map(fail),
+                );
+                out.push(p);
             }
-            if dr.abs() > right_form.abs() {
-                right_form = dr;
-                worst_at[1] = r;
-            }
+            Err(e) => failures.push(fail(e)),
         }
-        let (zl, zr) = match space(r1) {
-            Ok(s) => s,
-            Err(e) => {
-                failures.push(e);
-                continue 'starts;
-            }
-        };
-        // The space after the last start's is start 0's, one lead on.
-        let next = if k + 1 == w.starts {
-            space_edges(m, r1, c0).map(|(a, _)| a + w.lead())
-        } else {
-            space_edges(m, r1, c + px).map(|(a, _)| a)
-        };
-        let Some(next) = next else {
-            failures.push(fail(format!(
-                "start {}: no space after it at the pitch line",
-                k + 1
-            )));
-            continue 'starts;
-        };
-        let p = StartProfile {
-            start: k,
-            // The pitch line's middle stands off the root's by half the
-            // flanks' difference over the depth between them.
-            position_error: 0.5 * (zl + zr) - c - {
-                let reach = aimed.reach(r1);
-                0.5 * (reach[1] - reach[0])
-            },
-            thickness: next - zr,
-            left_angle_deg: (-slope(&left)).atan().to_degrees(),
-            right_angle_deg: slope(&right).atan().to_degrees(),
-            left_form,
-            right_form,
-            root_diameter: 2.0 * vertical_top(m, c).unwrap_or(0.0),
-            // The thread's middle (the last start's at the window's end:
-            // 1 um inside it).
-            tip_diameter: 2.0 * vertical_top(m, c + thread_middle(w)[1] - 1e-3).unwrap_or(0.0),
-            // Searched over the straight flanks: from where the nose's
-            // arc meets them to the crest.
-            pitch_diameter: pitch_diameter(
-                m,
-                w,
-                c,
-                (
-                    aimed.root_diameter / 2.0
-                        + cutter.nose_radius * (1.0 - w.flanks[0].min(w.flanks[1]).sin())
-                        + INSIDE,
-                    r_a - INSIDE,
-                ),
-            ),
-            over_wires: req
-                .limits
-                .as_ref()
-                .and(w.best_wire())
-                .map(|wire| over_wires(w, wire, line(&left), line(&right))),
-        };
-        let s = k + 1;
-        for (flank, form, r) in [
-            ("left", p.left_form, worst_at[0]),
-            ("right", p.right_form, worst_at[1]),
-        ] {
-            if form.abs() > tol.form {
-                failures.push(fail(format!(
-                    "start {s}, {flank} flank: {} {:.4} mm from the nominal flank at diameter {:.3} (tolerance {} mm)",
-                    if form > 0.0 { "material left" } else { "cut too deep" },
-                    form.abs(), diameter(r), tol.form
-                )));
-            }
-        }
-        for (flank, a, alpha) in [
-            ("left", p.left_angle_deg, nominal_angles[0]),
-            ("right", p.right_angle_deg, nominal_angles[1]),
-        ] {
-            if (a - alpha).abs() > tol.flank_angle.to_degrees() {
-                failures.push(fail(format!(
-                    "start {s}, {flank} flank: angle {a:.4} deg, nominal {alpha:.4} deg (tolerance {:.4} deg)",
-                    tol.flank_angle.to_degrees()
-                )));
-            }
-        }
-        let thickness = w.pitch - w.space_at_pitch;
-        if req.limits.is_none() && (p.thickness - thickness).abs() > tol.thickness {
-            failures.push(fail(format!(
-                "start {s}: axial thickness at the pitch line {:.4} mm, nominal {:.4} mm (tolerance {} mm)",
-                p.thickness, thickness, tol.thickness
-            )));
-        }
-        for (what, d, nominal) in [
-            ("root diameter", p.root_diameter, w.root_diameter),
-            ("tip diameter", p.tip_diameter, w.crest_diameter),
-        ] {
-            if req.limits.is_none() && (d - nominal).abs() > tol.diameter {
-                failures.push(fail(format!(
-                    "start {s}: {what} {:.4} mm, nominal {:.4} mm (tolerance {} mm)",
-                    d.abs(),
-                    nominal.abs(),
-                    tol.diameter
-                )));
-            }
-        }
-        if let Some(l) = &req.limits {
-            // A corrected start's pitch and root diameters are held to the
-            // standard's band moved by its correction: the part is to come
-            // out in the band when the measured error repeats.
-            let by = aimed.pitch_diameter - w.pitch_diameter;
-            for (what, v, d, by) in [
-                ("pitch diameter", p.pitch_diameter, &l.pitch_diameter, by),
-                ("root diameter", p.root_diameter, &l.root, by),
-                ("crest diameter", p.tip_diameter, &l.crest, 0.0),
-            ] {
-                if !d.holds(v - by, 0.0) {
-                    let (lo, hi) = (d.min + by, d.max + by);
-                    let (lo, hi) = (lo.abs().min(hi.abs()), lo.abs().max(hi.abs()));
-                    let corrected = if by == 0.0 {
-                        String::new()
-                    } else {
-                        format!(
-                            ", moved by {:+.4} mm for the correction",
-                            by * w.pitch_diameter.signum()
-                        )
-                    };
-                    failures.push(fail(format!(
-                        "start {s}: {what} {:.4} mm, outside {lo:.4} to {hi:.4} mm ({}{corrected})",
-                        v.abs(),
-                        l.source
-                    )));
-                }
-            }
-        }
-        if p.position_error.abs() > tol.position {
-            failures.push(fail(format!(
-                "start {s}: its space is {:.4} mm from its place (tolerance {} mm)",
-                p.position_error, tol.position
-            )));
-        }
-        out.push(p);
     }
     (out, failures)
+}
+
+/// Start `k`'s place in the window (modulo the lead).
+fn start_centre(req: &ThreadRequest, k: u32) -> Real {
+    let w = &req.section;
+    let place = w.hand.start_place(i64::from(k), w.starts);
+    req.space_centre + Real::from(place) * w.pitch + req.start_shift(k)
+}
+
+/// Start `k`'s space in `m` at radius `r`, or why not.
+fn space_of(m: &MultiPolygon<Real>, k: u32, c: Real, r: Real) -> Result<(Real, Real), String> {
+    space_edges(m, r, c).ok_or_else(|| {
+        format!(
+            "start {}: no space cut at diameter {:.3} (the thread's space is not there)",
+            k + 1,
+            diameter(r)
+        )
+    })
+}
+
+/// Start `k`'s finished profile, and the radii where its flanks' form is
+/// worst (left, right).
+///
+/// # Failures
+/// Its space, or the next start's at the pitch line, not there.
+fn measure_start(
+    m: &MultiPolygon<Real>,
+    req: &ThreadRequest,
+    cutter: &ThreadCutter,
+    k: u32,
+) -> Result<(StartProfile, [Real; 2]), String> {
+    let w = &req.section;
+    let (r_a, r1) = (w.crest_diameter / 2.0, w.pitch_diameter / 2.0);
+    let c = start_centre(req, k);
+    // The start's aimed space, moved by its correction, and the radii
+    // its flanks are measured at.
+    let aimed = req.start_section(k);
+    let radii = flank_radii(&aimed, req.flank_margin, cutter);
+    let (mut left, mut right) = (Vec::new(), Vec::new());
+    let (mut form, mut worst_at) = ([0.0 as Real; 2], [0.0; 2]);
+    for &r in &radii {
+        let (zl, zr) = space_of(m, k, c, r)?;
+        left.push((r, zl));
+        right.push((r, zr));
+        let reach = aimed.reach(r);
+        let d = [
+            (zl - (c - reach[0])) * w.flanks[0].cos(),
+            ((c + reach[1]) - zr) * w.flanks[1].cos(),
+        ];
+        for side in 0..2 {
+            if d[side].abs() > form[side].abs() {
+                form[side] = d[side];
+                worst_at[side] = r;
+            }
+        }
+    }
+    let (zl, zr) = space_of(m, k, c, r1)?;
+    // The space after the last start's is start 0's, one lead on.
+    let next = if k + 1 == w.starts {
+        space_edges(m, r1, req.space_centre).map(|(a, _)| a + w.lead())
+    } else {
+        space_edges(m, r1, c + w.pitch).map(|(a, _)| a)
+    };
+    let next =
+        next.ok_or_else(|| format!("start {}: no space after it at the pitch line", k + 1))?;
+    let reach = aimed.reach(r1);
+    let p = StartProfile {
+        start: k,
+        // The pitch line's middle stands off the root's by half the
+        // flanks' difference over the depth between them.
+        position_error: 0.5 * (zl + zr) - c - 0.5 * (reach[1] - reach[0]),
+        thickness: next - zr,
+        left_angle_deg: (-slope(&left)).atan().to_degrees(),
+        right_angle_deg: slope(&right).atan().to_degrees(),
+        left_form: form[0],
+        right_form: form[1],
+        root_diameter: 2.0 * vertical_top(m, c).unwrap_or(0.0),
+        // The thread's middle (the last start's at the window's end:
+        // 1 um inside it).
+        tip_diameter: 2.0 * vertical_top(m, c + thread_middle(w)[1] - 1e-3).unwrap_or(0.0),
+        // Searched over the straight flanks: from where the nose's
+        // arc meets them to the crest.
+        pitch_diameter: pitch_diameter(
+            m,
+            w,
+            c,
+            (
+                aimed.root_diameter / 2.0
+                    + cutter.nose_radius * (1.0 - w.flanks[0].min(w.flanks[1]).sin())
+                    + INSIDE,
+                r_a - INSIDE,
+            ),
+        ),
+        over_wires: (req.limits.as_ref())
+            .and(w.best_wire())
+            .map(|wire| over_wires(w, wire, line(&left), line(&right))),
+    };
+    Ok((p, worst_at))
+}
+
+/// What of start `p` fails against the nominal: its flanks' form (worst
+/// at the radii `worst_at`) and angles, and its thickness and diameters (a
+/// worm's against the nominal, a standard thread's against its limits),
+/// its place.
+fn start_faults(
+    req: &ThreadRequest,
+    cutter: &ThreadCutter,
+    p: &StartProfile,
+    worst_at: [Real; 2],
+) -> Vec<String> {
+    let (w, tol) = (&req.section, &req.tolerances);
+    let aimed = req.start_section(p.start);
+    let nominal_angles = nominal_flanks_deg(&aimed, &flank_radii(&aimed, req.flank_margin, cutter));
+    let s = p.start + 1;
+    let mut faults = Vec::new();
+    for (flank, form, r) in [
+        ("left", p.left_form, worst_at[0]),
+        ("right", p.right_form, worst_at[1]),
+    ] {
+        if form.abs() > tol.form {
+            faults.push(format!(
+                "start {s}, {flank} flank: {} {:.4} mm from the nominal flank at diameter {:.3} (tolerance {} mm)",
+                if form > 0.0 { "material left" } else { "cut too deep" },
+                form.abs(), diameter(r), tol.form
+            ));
+        }
+    }
+    for (flank, a, alpha) in [
+        ("left", p.left_angle_deg, nominal_angles[0]),
+        ("right", p.right_angle_deg, nominal_angles[1]),
+    ] {
+        if (a - alpha).abs() > tol.flank_angle.to_degrees() {
+            faults.push(format!(
+                "start {s}, {flank} flank: angle {a:.4} deg, nominal {alpha:.4} deg (tolerance {:.4} deg)",
+                tol.flank_angle.to_degrees()
+            ));
+        }
+    }
+    match &req.limits {
+        None => faults.extend(nominal_faults(req, p)),
+        Some(l) => faults.extend(limit_faults(w, l, &aimed, p)),
+    }
+    if p.position_error.abs() > tol.position {
+        faults.push(format!(
+            "start {s}: its space is {:.4} mm from its place (tolerance {} mm)",
+            p.position_error, tol.position
+        ));
+    }
+    faults
+}
+
+/// A worm's start `p` against its nominal thickness and diameters.
+fn nominal_faults(req: &ThreadRequest, p: &StartProfile) -> Vec<String> {
+    let (w, tol, s) = (&req.section, &req.tolerances, p.start + 1);
+    let mut faults = Vec::new();
+    let thickness = w.pitch - w.space_at_pitch;
+    if (p.thickness - thickness).abs() > tol.thickness {
+        faults.push(format!(
+            "start {s}: axial thickness at the pitch line {:.4} mm, nominal {:.4} mm (tolerance {} mm)",
+            p.thickness, thickness, tol.thickness
+        ));
+    }
+    for (what, d, nominal) in [
+        ("root diameter", p.root_diameter, w.root_diameter),
+        ("tip diameter", p.tip_diameter, w.crest_diameter),
+    ] {
+        if (d - nominal).abs() > tol.diameter {
+            faults.push(format!(
+                "start {s}: {what} {:.4} mm, nominal {:.4} mm (tolerance {} mm)",
+                d.abs(),
+                nominal.abs(),
+                tol.diameter
+            ));
+        }
+    }
+    faults
+}
+
+/// A standard thread's start `p` against its limits `l`. A corrected
+/// start's pitch and root diameters are held to the standard's band moved
+/// by its correction (its `aimed` section's): the part is to come out in
+/// the band when the measured error repeats.
+fn limit_faults(
+    w: &ThreadSection,
+    l: &crate::families::thread::ThreadLimits,
+    aimed: &ThreadSection,
+    p: &StartProfile,
+) -> Vec<String> {
+    let s = p.start + 1;
+    let by = aimed.pitch_diameter - w.pitch_diameter;
+    let mut faults = Vec::new();
+    for (what, v, d, by) in [
+        ("pitch diameter", p.pitch_diameter, &l.pitch_diameter, by),
+        ("root diameter", p.root_diameter, &l.root, by),
+        ("crest diameter", p.tip_diameter, &l.crest, 0.0),
+    ] {
+        if !d.holds(v - by, 0.0) {
+            let (lo, hi) = (d.min + by, d.max + by);
+            let (lo, hi) = (lo.abs().min(hi.abs()), lo.abs().max(hi.abs()));
+            let corrected = if by == 0.0 {
+                String::new()
+            } else {
+                format!(
+                    ", moved by {:+.4} mm for the correction",
+                    by * w.pitch_diameter.signum()
+                )
+            };
+            faults.push(format!(
+                "start {s}: {what} {:.4} mm, outside {lo:.4} to {hi:.4} mm ({}{corrected})",
+                v.abs(),
+                l.source
+            ));
+        }
+    }
+    faults
 }
