@@ -59,13 +59,9 @@ const MAX_LEN: usize = 64;
 /// number of pitches; an internal thread asked of an external class (or
 /// the reverse).
 pub fn designated(text: &str, drawing: &Drawing) -> Result<ThreadProfile, InputError> {
-    let bad = |why: &str| InputError::BadText {
-        what: "thread designation".into(),
-        value: format!("'{}':", crate::files::excerpt(text)),
-        reason: why.into(),
-    };
+    let r = Reader { text, drawing };
     if text.len() > MAX_LEN || text.chars().any(|c| c.is_control()) {
-        return Err(bad(&format!(
+        return Err(r.bad(&format!(
             "not a designation (at most {MAX_LEN} printable characters)"
         )));
     }
@@ -81,114 +77,24 @@ pub fn designated(text: &str, drawing: &Drawing) -> Result<ThreadProfile, InputE
         }
         _ => Hand::Right,
     };
-    let num = |s: &str, what: &str| -> Result<Real, InputError> {
-        let v = match s.split_once('/') {
-            Some((a, b)) => a
-                .parse::<Real>()
-                .ok()
-                .zip(b.parse::<Real>().ok())
-                .map(|(a, b)| a / b),
-            None => s.parse::<Real>().ok(),
-        };
-        v.filter(|v| v.is_finite() && *v > 0.0)
-            .ok_or_else(|| bad(&format!("{what} '{s}' is not a positive number")))
-    };
-    // `<lead>[(P<pitch>)]`: the pitch and the number of starts.
-    let lead_pitch = |s: &str| -> Result<(Real, u32), InputError> {
-        let (lead, pitch) = match s.split_once("(P") {
-            Some((l, p)) => {
-                let p = p
-                    .strip_suffix(')')
-                    .ok_or_else(|| bad("'(P' without its ')'"))?;
-                (num(l, "lead")?, num(p, "pitch")?)
-            }
-            None => {
-                let l = num(s, "pitch")?;
-                (l, l)
-            }
-        };
-        let starts = (lead / pitch).round();
-        if (lead / pitch - starts).abs() > crate::tolerance::SAME_RATIO
-            || !(1.0..=12.0).contains(&starts)
-        {
-            return Err(bad(&format!(
-                "the lead {lead} is not 1 to 12 times the pitch {pitch}"
-            )));
-        }
-        Ok((pitch, starts as u32))
-    };
-    let external_unless = |asked: bool| -> Result<bool, InputError> {
-        match drawing.internal {
-            Some(i) if i != asked => Err(bad(&format!(
-                "its class is an {} thread's, and the drawing says {}",
-                if asked { "internal" } else { "external" },
-                if i { "internal" } else { "external" }
-            ))),
-            _ => Ok(asked),
-        }
-    };
     let internal = drawing.internal.unwrap_or(false);
     match words.as_slice() {
-        [m, rest @ ..] if m.starts_with('M') && rest.len() <= 1 => {
-            let size = &m[1..];
-            let (d, pitch, starts) = match size.split_once('x') {
-                Some((d, lp)) => {
-                    let (p, z) = lead_pitch(lp)?;
-                    (num(d, "diameter")?, p, z)
-                }
-                None => {
-                    let d = num(size, "diameter")?;
-                    let p = standards::coarse_pitch(d);
-                    if p == 0.0 {
-                        return Err(bad(&format!(
-                            "M{size} has no coarse pitch in ISO 261's table: give it, as M{size}x1.5"
-                        )));
-                    }
-                    (d, p, 1)
-                }
-            };
-            let (class, internal) = match rest {
-                [c] => {
-                    let upper = c.chars().last().is_some_and(|l| l.is_ascii_uppercase());
-                    (*c, external_unless(upper)?)
-                }
-                _ => (if internal { "6H" } else { "6g" }, internal),
-            };
-            standards::metric(d, pitch, internal, class, starts, hand)
-        }
+        [m, rest @ ..] if m.starts_with('M') && rest.len() <= 1 => r.metric(&m[1..], rest, hand),
         [t] if t.starts_with("Tr") => {
             let (d, lp) = t[2..]
                 .split_once('x')
-                .ok_or_else(|| bad("a trapezoidal thread is Tr<d>x<pitch>, as Tr40x7"))?;
-            let (pitch, starts) = lead_pitch(lp)?;
-            standards::trapezoidal(num(d, "diameter")?, pitch, internal, starts, hand, drawing.stated)
+                .ok_or_else(|| r.bad("a trapezoidal thread is Tr<d>x<pitch>, as Tr40x7"))?;
+            let (pitch, starts) = r.lead_pitch(lp)?;
+            let d = r.num(d, "diameter")?;
+            standards::trapezoidal(d, pitch, internal, starts, hand, drawing.stated)
         }
         [d, size @ .., acme, class] if *acme == "ACME" && (1..=2).contains(&size.len()) => {
-            let grade = class
-                .strip_suffix('G')
-                .and_then(|g| g.parse::<u32>().ok())
-                .ok_or_else(|| bad(&format!("ACME class '{class}' is not <n>G, as 2G")))?;
-            // `<tpi>`, or ASME's multiple-start `<pitch>P-<lead>L` (inches).
-            let (tpi, starts) = match size {
-                [tpi] => (num(tpi, "threads per inch")?, 1),
-                [p, l] => {
-                    let inches = |w: &str, end: char, what: &str| {
-                        w.strip_suffix(end)
-                            .ok_or_else(|| bad(&format!("'{w}' is not the {what} as <inches>{end}")))
-                            .and_then(|v| num(v, what))
-                    };
-                    let (pitch, lead) = (inches(p, 'P', "pitch")?, inches(l, 'L', "lead")?);
-                    let (_, starts) = lead_pitch(&format!("{lead}(P{pitch})"))?;
-                    (1.0 / pitch, starts)
-                }
-                _ => return Err(bad("an ACME size is <tpi> or <pitch>P-<lead>L")),
-            };
-            standards::acme(num(d, "diameter")?, tpi, internal, grade, starts, hand)
+            r.acme(d, size, class, hand)
         }
         [d, tpi, butt, form @ ..] if *butt == "BUTT" && (form.is_empty() || form == ["7/45"]) => {
             standards::buttress(
-                num(d, "diameter")?,
-                num(tpi, "threads per inch")?,
+                r.num(d, "diameter")?,
+                r.num(tpi, "threads per inch")?,
                 internal,
                 drawing.load,
                 1,
@@ -196,56 +102,194 @@ pub fn designated(text: &str, drawing: &Drawing) -> Result<ThreadProfile, InputE
                 drawing.stated,
             )
         }
-        [kind, sizes @ ..] if kind.len() == 2 && kind.starts_with('Z') => {
-            let profile = super::WormProfile::parse(kind).map_err(|e| bad(&e.to_string()))?;
-            let form = "a worm is Z<A|N|I> m<module> z<starts> d<pitch diameter> [a<angle>], as ZI m5 z2 d50";
-            let (mut m, mut z, mut d, mut a) = (None, None, None, 20.0);
-            for w in sizes {
-                let Some((k, v)) = w.char_indices().nth(1).map(|(i, _)| w.split_at(i)) else {
-                    return Err(bad(form));
-                };
-                match k {
-                    "m" => m = Some(num(v, "module")?),
-                    "z" => z = Some(num(v, "number of starts")?),
-                    "d" => d = Some(num(v, "pitch diameter")?),
-                    "a" => a = num(v, "profile angle")?,
-                    _ => return Err(bad(form)),
-                }
-            }
-            let (Some(m), Some(z), Some(d)) = (m, z, d) else {
-                return Err(bad(form));
-            };
-            if z.fract() != 0.0 || z > 12.0 {
-                return Err(bad(&format!("the number of starts z{z} is not a whole number from 1 to 12")));
-            }
-            external_unless(false)?;
-            let sizes =
-                super::WormSizes::with_profile(m, z as i64, d, 0.2, a.to_radians(), None, profile)
-                    .map_err(|e| bad(&e.to_string()))?;
-            Ok(sizes.drawn(hand, &drawing.stated))
-        }
-        [g, ..] if g.starts_with('G') => {
-            // ISO 228-1: `G<size>` internal, `G<size>A` or `B` external.
-            let all = words.join(" ");
-            let body = all[1..].trim();
-            let (size, class) = match body.chars().last() {
-                Some(c @ ('A' | 'B')) => (body[..body.len() - 1].trim(), Some(c)),
-                _ => (body, None),
-            };
-            let internal = match class {
-                Some(_) => external_unless(false)?,
-                None => drawing.internal.unwrap_or(true),
-            };
-            standards::pipe(size, internal, class, 1, hand)
-        }
-        _ => Err(bad(
+        [kind, sizes @ ..] if kind.len() == 2 && kind.starts_with('Z') => r.worm(kind, sizes, hand),
+        [g, ..] if g.starts_with('G') => r.pipe(&words.join(" ")[1..], hand),
+        _ => Err(r.bad(
             "not a form pilgrim reads: M20x2.5-6g, M30x2-6H, Tr40x7, Tr40x14(P7), 1-5 ACME-2G, 1-0.2P-0.4L ACME-2G, 2-8 BUTT 7/45, G1/2A, G1 1/2, ZI m5 z2 d50 (LH at the end for a left hand)",
         )),
     }
     .map_err(|e| match e {
         InputError::BadText { ref what, .. } if what == "thread designation" => e,
-        other => bad(&other.to_string()),
+        other => r.bad(&other.to_string()),
     })
+}
+
+/// A designation being read: its text and the drawing's other notes.
+struct Reader<'a> {
+    text: &'a str,
+    drawing: &'a Drawing,
+}
+
+impl Reader<'_> {
+    /// The designation refused: `why`.
+    fn bad(&self, why: &str) -> InputError {
+        InputError::BadText {
+            what: "thread designation".into(),
+            value: format!("'{}':", crate::files::excerpt(self.text)),
+            reason: why.into(),
+        }
+    }
+
+    /// The positive number `s` (a fraction `a/b` too), the designation's
+    /// `what`.
+    fn num(&self, s: &str, what: &str) -> Result<Real, InputError> {
+        let v = match s.split_once('/') {
+            Some((a, b)) => (a.parse::<Real>().ok())
+                .zip(b.parse::<Real>().ok())
+                .map(|(a, b)| a / b),
+            None => s.parse::<Real>().ok(),
+        };
+        v.filter(|v| v.is_finite() && *v > 0.0)
+            .ok_or_else(|| self.bad(&format!("{what} '{s}' is not a positive number")))
+    }
+
+    /// `<lead>[(P<pitch>)]`: the pitch and the number of starts.
+    fn lead_pitch(&self, s: &str) -> Result<(Real, u32), InputError> {
+        let (lead, pitch) = match s.split_once("(P") {
+            Some((l, p)) => {
+                let p = p
+                    .strip_suffix(')')
+                    .ok_or_else(|| self.bad("'(P' without its ')'"))?;
+                (self.num(l, "lead")?, self.num(p, "pitch")?)
+            }
+            None => {
+                let l = self.num(s, "pitch")?;
+                (l, l)
+            }
+        };
+        let starts = (lead / pitch).round();
+        if (lead / pitch - starts).abs() > crate::tolerance::SAME_RATIO
+            || !(1.0..=12.0).contains(&starts)
+        {
+            return Err(self.bad(&format!(
+                "the lead {lead} is not 1 to 12 times the pitch {pitch}"
+            )));
+        }
+        Ok((pitch, starts as u32))
+    }
+
+    /// Whether the thread is internal, as its class says (`asked`): the
+    /// drawing must not say otherwise.
+    fn external_unless(&self, asked: bool) -> Result<bool, InputError> {
+        match self.drawing.internal {
+            Some(i) if i != asked => Err(self.bad(&format!(
+                "its class is an {} thread's, and the drawing says {}",
+                if asked { "internal" } else { "external" },
+                if i { "internal" } else { "external" }
+            ))),
+            _ => Ok(asked),
+        }
+    }
+
+    /// ISO metric: `M<d>[x<lead>[(P<pitch>)]]` and its class, if any.
+    fn metric(&self, size: &str, rest: &[&str], hand: Hand) -> Result<ThreadProfile, InputError> {
+        let (d, pitch, starts) = match size.split_once('x') {
+            Some((d, lp)) => {
+                let (p, z) = self.lead_pitch(lp)?;
+                (self.num(d, "diameter")?, p, z)
+            }
+            None => {
+                let d = self.num(size, "diameter")?;
+                let p = standards::coarse_pitch(d);
+                if p == 0.0 {
+                    return Err(self.bad(&format!(
+                        "M{size} has no coarse pitch in ISO 261's table: give it, as M{size}x1.5"
+                    )));
+                }
+                (d, p, 1)
+            }
+        };
+        let internal = self.drawing.internal.unwrap_or(false);
+        let (class, internal) = match rest {
+            [c] => {
+                let upper = c.chars().last().is_some_and(|l| l.is_ascii_uppercase());
+                (*c, self.external_unless(upper)?)
+            }
+            _ => (if internal { "6H" } else { "6g" }, internal),
+        };
+        standards::metric(d, pitch, internal, class, starts, hand)
+    }
+
+    /// ACME: `<d>-<tpi> ACME-<n>G`, or ASME's multiple-start
+    /// `<d>-<pitch>P-<lead>L ACME-<n>G` (inches).
+    fn acme(
+        &self,
+        d: &str,
+        size: &[&str],
+        class: &str,
+        hand: Hand,
+    ) -> Result<ThreadProfile, InputError> {
+        let grade = (class.strip_suffix('G'))
+            .and_then(|g| g.parse::<u32>().ok())
+            .ok_or_else(|| self.bad(&format!("ACME class '{class}' is not <n>G, as 2G")))?;
+        let (tpi, starts) = match size {
+            [tpi] => (self.num(tpi, "threads per inch")?, 1),
+            [p, l] => {
+                let inches = |w: &str, end: char, what: &str| {
+                    w.strip_suffix(end)
+                        .ok_or_else(|| {
+                            self.bad(&format!("'{w}' is not the {what} as <inches>{end}"))
+                        })
+                        .and_then(|v| self.num(v, what))
+                };
+                let (pitch, lead) = (inches(p, 'P', "pitch")?, inches(l, 'L', "lead")?);
+                let (_, starts) = self.lead_pitch(&format!("{lead}(P{pitch})"))?;
+                (1.0 / pitch, starts)
+            }
+            _ => return Err(self.bad("an ACME size is <tpi> or <pitch>P-<lead>L")),
+        };
+        let internal = self.drawing.internal.unwrap_or(false);
+        standards::acme(self.num(d, "diameter")?, tpi, internal, grade, starts, hand)
+    }
+
+    /// A cylindrical worm: `Z<A|N|I> m<module> z<starts> d<pitch diameter>
+    /// [a<angle>]`.
+    fn worm(&self, kind: &str, sizes: &[&str], hand: Hand) -> Result<ThreadProfile, InputError> {
+        let profile = super::WormProfile::parse(kind).map_err(|e| self.bad(&e.to_string()))?;
+        let form =
+            "a worm is Z<A|N|I> m<module> z<starts> d<pitch diameter> [a<angle>], as ZI m5 z2 d50";
+        let (mut m, mut z, mut d, mut a) = (None, None, None, 20.0);
+        for w in sizes {
+            let Some((k, v)) = w.char_indices().nth(1).map(|(i, _)| w.split_at(i)) else {
+                return Err(self.bad(form));
+            };
+            match k {
+                "m" => m = Some(self.num(v, "module")?),
+                "z" => z = Some(self.num(v, "number of starts")?),
+                "d" => d = Some(self.num(v, "pitch diameter")?),
+                "a" => a = self.num(v, "profile angle")?,
+                _ => return Err(self.bad(form)),
+            }
+        }
+        let (Some(m), Some(z), Some(d)) = (m, z, d) else {
+            return Err(self.bad(form));
+        };
+        if z.fract() != 0.0 || z > 12.0 {
+            return Err(self.bad(&format!(
+                "the number of starts z{z} is not a whole number from 1 to 12"
+            )));
+        }
+        self.external_unless(false)?;
+        let sizes =
+            super::WormSizes::with_profile(m, z as i64, d, 0.2, a.to_radians(), None, profile)
+                .map_err(|e| self.bad(&e.to_string()))?;
+        Ok(sizes.drawn(hand, &self.drawing.stated))
+    }
+
+    /// ISO 228-1: `G<size>` internal, `G<size>A` or `B` external (`body`:
+    /// what follows the `G`).
+    fn pipe(&self, body: &str, hand: Hand) -> Result<ThreadProfile, InputError> {
+        let body = body.trim();
+        let (size, class) = match body.chars().last() {
+            Some(c @ ('A' | 'B')) => (body[..body.len() - 1].trim(), Some(c)),
+            _ => (body, None),
+        };
+        let internal = match class {
+            Some(_) => self.external_unless(false)?,
+            None => self.drawing.internal.unwrap_or(true),
+        };
+        standards::pipe(size, internal, class, 1, hand)
+    }
 }
 
 #[cfg(test)]

@@ -101,26 +101,36 @@ pub fn passes_svg(check: &ThreadCheck, blocks: usize) -> Result<(String, Marks),
                     .map_err(e)?;
             }
         }
-        // The colour strip: pass 1 on the left to pass n on the right.
-        let width = 700.0;
-        for k in 0..n {
-            let x = 200 + (width * k as f64 / n as f64) as i32;
-            let x1 = 200 + (width * (k + 1) as f64 / n as f64).ceil() as i32;
-            bottom
-                .draw(&Rectangle::new(
-                    [(x, 18), (x1, 38)],
-                    pass_colour(k, n).filled(),
-                ))
-                .map_err(e)?;
-        }
-        for (text, x) in [("pass 1".to_owned(), 130), (format!("pass {n}"), 910)] {
-            bottom
-                .draw(&Text::new(text, (x, 20), ("sans-serif", 16)))
-                .map_err(e)?;
-        }
+        colour_strip(&bottom, n)?;
         root.present().map_err(e)?;
     }
     Ok((svg, marks))
+}
+
+/// The colour strip under the chart: pass 1 on the left to pass `n` on the
+/// right.
+fn colour_strip(
+    bottom: &plotters::drawing::DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+    n: usize,
+) -> Result<(), DrawError> {
+    let e = |e: DrawingAreaErrorKind<_>| DrawError::new("passes.svg", format!("{e:?}"));
+    let width = 700.0;
+    for k in 0..n {
+        let x = 200 + (width * k as f64 / n as f64) as i32;
+        let x1 = 200 + (width * (k + 1) as f64 / n as f64).ceil() as i32;
+        bottom
+            .draw(&Rectangle::new(
+                [(x, 18), (x1, 38)],
+                pass_colour(k, n).filled(),
+            ))
+            .map_err(e)?;
+    }
+    for (text, x) in [("pass 1".to_owned(), 130), (format!("pass {n}"), 910)] {
+        bottom
+            .draw(&Text::new(text, (x, 20), ("sans-serif", 16)))
+            .map_err(e)?;
+    }
+    Ok(())
 }
 
 /// The plan's columns of the family's pass table `planned` that hold one

@@ -373,6 +373,45 @@ pub(crate) fn plan_map(
     tool: &Tool,
     settings: &Map,
 ) -> Result<Map, Box<EvalAltResult>> {
+    let s = plan_settings(settings)?;
+    let passes = kernel(thread::plan(section, &cutter_of(tool)?, &s))?;
+    let col = |f: &dyn Fn(&thread::PlannedPass) -> Real| {
+        Dynamic::from(Floats::new(passes.iter().map(f).collect()))
+    };
+    let mut m = Map::new();
+    m.insert(
+        "kind".into(),
+        Dynamic::from(
+            passes
+                .iter()
+                .map(|p| {
+                    Dynamic::from(match p.kind {
+                        thread::PassKind::Rough => "rough",
+                        thread::PassKind::Finish => "finish",
+                        thread::PassKind::Side => "side",
+                    })
+                })
+                .collect::<Array>(),
+        ),
+    );
+    m.insert("start".into(), col(&|p| Real::from(p.start)));
+    m.insert("depth".into(), col(&|p| p.depth));
+    m.insert("cumulative".into(), col(&|p| p.cumulative));
+    m.insert("offset".into(), col(&|p| p.offset));
+    m.insert(
+        "flank".into(),
+        col(&|p| match p.flank {
+            thread::Flank::Left => -1.0,
+            thread::Flank::Radial => 0.0,
+            thread::Flank::Right => 1.0,
+        }),
+    );
+    m.insert("planned_area".into(), col(&|p| p.planned_area));
+    Ok(m)
+}
+
+/// The plan's settings of a script's map, each key checked.
+fn plan_settings(settings: &Map) -> Result<PlanSettings, Box<EvalAltResult>> {
     const KEYS: [&str; 7] = [
         "roughing_passes",
         "min_depth",
@@ -415,7 +454,7 @@ pub(crate) fn plan_map(
         .and_then(|d| d.as_bool().ok())
         .ok_or("plan: 'by_depth' must be true or false")?;
     let n = count("roughing_passes")?;
-    let s = PlanSettings {
+    Ok(PlanSettings {
         roughing_passes: (n > 0).then_some(n),
         min_depth: num("min_depth")?,
         finish_depth: num("finish_depth")?,
@@ -423,41 +462,7 @@ pub(crate) fn plan_map(
         order: FlankOrder::parse(&order).map_err(|e| format!("plan: {e}"))?,
         axial_step: num("axial_step")?,
         starts_by_depth: by_depth,
-    };
-    let passes = kernel(thread::plan(section, &cutter_of(tool)?, &s))?;
-    let col = |f: &dyn Fn(&thread::PlannedPass) -> Real| {
-        Dynamic::from(Floats::new(passes.iter().map(f).collect()))
-    };
-    let mut m = Map::new();
-    m.insert(
-        "kind".into(),
-        Dynamic::from(
-            passes
-                .iter()
-                .map(|p| {
-                    Dynamic::from(match p.kind {
-                        thread::PassKind::Rough => "rough",
-                        thread::PassKind::Finish => "finish",
-                        thread::PassKind::Side => "side",
-                    })
-                })
-                .collect::<Array>(),
-        ),
-    );
-    m.insert("start".into(), col(&|p| Real::from(p.start)));
-    m.insert("depth".into(), col(&|p| p.depth));
-    m.insert("cumulative".into(), col(&|p| p.cumulative));
-    m.insert("offset".into(), col(&|p| p.offset));
-    m.insert(
-        "flank".into(),
-        col(&|p| match p.flank {
-            thread::Flank::Left => -1.0,
-            thread::Flank::Radial => 0.0,
-            thread::Flank::Right => 1.0,
-        }),
-    );
-    m.insert("planned_area".into(), col(&|p| p.planned_area));
-    Ok(m)
+    })
 }
 
 /// What the worm's and the thread's `fn verify(p)` maps share: the object

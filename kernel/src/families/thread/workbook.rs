@@ -50,6 +50,7 @@ pub fn pass_workbook(
     build(check, planned).map_err(|e| crate::chart::DrawError::new("passes.xlsx", e))
 }
 
+/// The workbook: the passes, the starts and the figures, each a sheet.
 fn build(
     check: &ThreadCheck,
     planned: Option<&BTreeMap<String, Vec<f64>>>,
@@ -61,6 +62,19 @@ fn build(
             .set_title("pilgrim: the thread's passes, simulated")
             .set_creation_datetime(&ExcelDateTime::from_ymd(2000, 1, 1)?),
     );
+    passes_sheet(&mut book, check, planned)?;
+    starts_sheet(&mut book, check)?;
+    figures_sheet(&mut book, check)?;
+    book.save_to_buffer()
+}
+
+/// The sheet `passes`: a row per thread block simulated, with the plan's
+/// columns where it has one row per pass.
+fn passes_sheet(
+    book: &mut Workbook,
+    check: &ThreadCheck,
+    planned: Option<&BTreeMap<String, Vec<f64>>>,
+) -> Result<(), XlsxError> {
     let plan = super::plots::plan_columns(check, planned);
     let plan_names: Vec<String> = plan.iter().map(|(k, _)| format!("plan: {k}")).collect();
     let mut columns: Vec<Column<'_>> = vec![
@@ -110,7 +124,11 @@ fn build(
             sheet.write_number_with_format(r, j as u16, c[i], &formats[j])?;
         }
     }
+    Ok(())
+}
 
+/// The sheet `starts`: each start's finished profile beside the nominal.
+fn starts_sheet(book: &mut Workbook, check: &ThreadCheck) -> Result<(), XlsxError> {
     let (thickness, root, tip) = check.nominal;
     let columns: [Column<'_>; 13] = [
         ("start", None),
@@ -150,7 +168,12 @@ fn build(
             sheet.write_number_with_format(i as u32 + 1, j as u16, v, &formats[j])?;
         }
     }
+    Ok(())
+}
 
+/// The sheet `figures`: the areas, the loads, the lead's error and the
+/// tolerances.
+fn figures_sheet(book: &mut Workbook, check: &ThreadCheck) -> Result<(), XlsxError> {
     let t = &check.tolerances;
     let rows: [(&str, f64, &str); 12] = [
         ("area of the spaces (one lead)", check.space_area, "mm²"),
@@ -176,5 +199,5 @@ fn build(
         sheet.write_number_with_format(r, 1, *v, &value)?;
         sheet.write_string(r, 2, *unit)?;
     }
-    book.save_to_buffer()
+    Ok(())
 }
