@@ -158,17 +158,87 @@ pub fn metric(
         ));
     };
     let mean = (range[0] * range[1]).sqrt();
+    let basic = MetricBasic::of(d, pitch);
+    let limits = metric_limits(&basic, internal, class, (position, factor, dev, mean))
+        .ok_or_else(bad_class)?;
+    let (h, d1, d2) = (basic.h, basic.d1, basic.d2);
+    let fine = if starts == 1 && (pitch - coarse_pitch(d)).abs() < crate::tolerance::SAME_LENGTH {
+        format!("M{}", number(d))
+    } else {
+        format!("M{}x{}", number(d), lead_and_pitch(pitch, starts))
+    };
+    Ok(ThreadProfile {
+        designation: format!("{fine}-{class}{}", hand_suffix(hand)),
+        standard: "ISO 68-1, ISO 965-1".into(),
+        section: ThreadSection {
+            internal,
+            pitch,
+            starts,
+            hand,
+            major: d,
+            pitch_diameter: d2,
+            root_diameter: if internal { d } else { d1 - h / 6.0 },
+            crest_diameter: if internal { d1 } else { d },
+            flanks: [30.0_f64.to_radians(); 2],
+            space_at_pitch: pitch / 2.0,
+            root_radius: if internal { 0.0 } else { h / 6.0 },
+            form: FlankForm::Axial,
+        },
+        limits,
+    })
+}
+
+/// ISO 68-1's basic sizes of a metric thread: the major diameter, the
+/// pitch, the fundamental triangle's height H, the minor and pitch
+/// diameters.
+#[derive(Debug, Clone, Copy)]
+struct MetricBasic {
+    d: Real,
+    pitch: Real,
+    h: Real,
+    d1: Real,
+    d2: Real,
+}
+
+impl MetricBasic {
+    /// The basic sizes of `M<d>x<pitch>`.
+    fn of(d: Real, pitch: Real) -> Self {
+        let h = 3.0_f64.sqrt() / 2.0 * pitch;
+        // 3/8 and 5/8 of the fundamental triangle's height H from the major.
+        Self {
+            d,
+            pitch,
+            h,
+            d1: d - 1.25 * h,
+            d2: d - 0.75 * h,
+        }
+    }
+}
+
+/// The limits of `basic` in `class` (its tolerance position, its grade's
+/// factor, the pitch's fundamental deviations of e, f, g (um) and the
+/// diameter range's geometric mean); none for a position the thread
+/// cannot have.
+fn metric_limits(
+    basic: &MetricBasic,
+    internal: bool,
+    class: &str,
+    (position, factor, dev, mean): (&str, Real, [Real; 3], Real),
+) -> Option<ThreadLimits> {
+    let MetricBasic {
+        d,
+        pitch,
+        h,
+        d1,
+        d2,
+    } = *basic;
     let um = 1e-3;
     let td2 = r40(factor * 90.0 * pitch.powf(0.4) * mean.powf(0.1));
-    let h = 3.0_f64.sqrt() / 2.0 * pitch;
-    // 3/8 and 5/8 of the fundamental triangle's height H from the major.
-    let d2 = d - 0.75 * h;
-    let d1 = d - 1.25 * h;
-    let limits = if internal {
+    Some(if internal {
         let ei = match position {
             "H" => 0.0,
             "G" => dev[2],
-            _ => return Err(bad_class()),
+            _ => return None,
         } * um;
         let td2 = r40(1.32 * factor * 90.0 * pitch.powf(0.4) * mean.powf(0.1)) * um;
         let td1 = r40(factor * 230.0 * pitch.powf(0.7)) * um;
@@ -194,7 +264,7 @@ pub fn metric(
             "g" => dev[2],
             "f" => dev[1],
             "e" => dev[0],
-            _ => return Err(bad_class()),
+            _ => return None,
         } * um;
         let td = r40(factor * (180.0 * pitch.powf(2.0 / 3.0) - 3.15 / pitch.sqrt())) * um;
         let d3 = d1 - h / 6.0;
@@ -216,30 +286,6 @@ pub fn metric(
             },
             source: format!("ISO 965-1 {class}"),
         }
-    };
-    let fine = if starts == 1 && (pitch - coarse_pitch(d)).abs() < crate::tolerance::SAME_LENGTH {
-        format!("M{}", number(d))
-    } else {
-        format!("M{}x{}", number(d), lead_and_pitch(pitch, starts))
-    };
-    Ok(ThreadProfile {
-        designation: format!("{fine}-{class}{}", hand_suffix(hand)),
-        standard: "ISO 68-1, ISO 965-1".into(),
-        section: ThreadSection {
-            internal,
-            pitch,
-            starts,
-            hand,
-            major: d,
-            pitch_diameter: d2,
-            root_diameter: if internal { d } else { d1 - h / 6.0 },
-            crest_diameter: if internal { d1 } else { d },
-            flanks: [30.0_f64.to_radians(); 2],
-            space_at_pitch: pitch / 2.0,
-            root_radius: if internal { 0.0 } else { h / 6.0 },
-            form: FlankForm::Axial,
-        },
-        limits,
     })
 }
 
@@ -642,7 +688,48 @@ pub fn pipe(
             ),
         });
     };
-    let class = match (internal, class) {
+    let class = pipe_class(internal, class)?;
+    let p = INCH / tpi;
+    let (h, r) = (0.640327 * p, 0.137329 * p);
+    let (d2, d1) = (d - h, d - 2.0 * h);
+    let limits = pipe_limits(internal, class, tpi, (d, d1, d2), p);
+    let starts_text = if starts == 1 {
+        String::new()
+    } else {
+        format!(" ({starts} starts)")
+    };
+    Ok(ThreadProfile {
+        designation: format!(
+            "G{name}{}{starts_text}{}",
+            class.map_or(String::new(), String::from),
+            hand_suffix(hand)
+        ),
+        standard: "ISO 228-1".into(),
+        section: ThreadSection {
+            internal,
+            pitch: p,
+            starts,
+            hand,
+            major: d,
+            pitch_diameter: d2,
+            root_diameter: if internal { d } else { d1 },
+            crest_diameter: if internal { d1 } else { d },
+            flanks: [27.5_f64.to_radians(); 2],
+            space_at_pitch: p / 2.0,
+            root_radius: r,
+            form: FlankForm::Axial,
+        },
+        limits,
+    })
+}
+
+/// ISO 228-1's class of a pipe thread: A or B on an external thread,
+/// none on an internal one.
+///
+/// # Failures
+/// Any other.
+fn pipe_class(internal: bool, class: Option<char>) -> Result<Option<char>, InputError> {
+    Ok(match (internal, class) {
         (false, Some(c @ ('A' | 'B'))) => Some(c),
         (true, None) => None,
         (false, c) => {
@@ -662,10 +749,18 @@ pub fn pipe(
                 "none on an internal thread (its pitch diameter has one tolerance)",
             ))
         }
-    };
-    let p = INCH / tpi;
-    let (h, r) = (0.640327 * p, 0.137329 * p);
-    let (d2, d1) = (d - h, d - 2.0 * h);
+    })
+}
+
+/// ISO 228-1's limits of a pipe thread of `tpi` threads per inch (pitch
+/// `p`) and major, minor and pitch diameters `d`, `d1`, `d2`.
+fn pipe_limits(
+    internal: bool,
+    class: Option<char>,
+    tpi: Real,
+    (d, d1, d2): (Real, Real, Real),
+    p: Real,
+) -> ThreadLimits {
     // ISO 228-1's tolerances (mm) by threads per inch: TD2, and the
     // internal minor's.
     let (td2, td1) = match tpi as u32 {
@@ -676,7 +771,7 @@ pub fn pipe(
         _ => (0.217, 0.640),
     };
     let big_h = 0.960491 * p;
-    let limits = if internal {
+    if internal {
         ThreadLimits {
             pitch_diameter: Limits {
                 min: d2,
@@ -713,35 +808,7 @@ pub fn pipe(
             },
             source: format!("ISO 228-1 class {}", class.unwrap_or('A')),
         }
-    };
-    let starts_text = if starts == 1 {
-        String::new()
-    } else {
-        format!(" ({starts} starts)")
-    };
-    Ok(ThreadProfile {
-        designation: format!(
-            "G{name}{}{starts_text}{}",
-            class.map_or(String::new(), String::from),
-            hand_suffix(hand)
-        ),
-        standard: "ISO 228-1".into(),
-        section: ThreadSection {
-            internal,
-            pitch: p,
-            starts,
-            hand,
-            major: d,
-            pitch_diameter: d2,
-            root_diameter: if internal { d } else { d1 },
-            crest_diameter: if internal { d1 } else { d },
-            flanks: [27.5_f64.to_radians(); 2],
-            space_at_pitch: p / 2.0,
-            root_radius: r,
-            form: FlankForm::Axial,
-        },
-        limits,
-    })
+    }
 }
 
 #[cfg(test)]
