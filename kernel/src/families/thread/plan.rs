@@ -248,92 +248,10 @@ pub fn plan(
         });
     }
     let rough = roughing_depths(h - stock, s.roughing_passes, s.min_depth)?;
-    // On a flank the cutter's edge stands on that flank's final line.
-    let tan = |flank: Flank| match flank {
-        Flank::Left => t.flanks[0].tan(),
-        Flank::Right | Flank::Radial => t.flanks[1].tan(),
-    };
-    let area = |d0: Real, d1: Real| {
-        c.tip_width * (d1 - d0)
-            + 0.5 * (c.left_angle.tan() + c.right_angle.tan()) * (d1 * d1 - d0 * d0)
-    };
-    // The positions at one start: (kind, depth, cumulative, offset, flank).
-    let mut steps: Vec<PlannedPass> = Vec::new();
-    let mut last = 0.0;
-    for (i, &d) in rough.iter().enumerate() {
-        let flank = match s.order {
-            FlankOrder::Alternating if i % 2 == 0 => Flank::Left,
-            FlankOrder::Alternating | FlankOrder::Right => Flank::Right,
-            FlankOrder::Left => Flank::Left,
-            FlankOrder::Radial => Flank::Radial,
-        };
-        let e = (h - d) * tan(flank);
-        steps.push(PlannedPass {
-            kind: PassKind::Rough,
-            start: 0,
-            depth: d - last,
-            cumulative: d,
-            offset: match flank {
-                Flank::Left => -e,
-                Flank::Right => e,
-                Flank::Radial => 0.0,
-            },
-            flank,
-            planned_area: area(last, d),
-        });
-        last = d;
-    }
-    let a1z = axial_offset(t, c);
-    let sides = if a1z > crate::tolerance::SAME_LENGTH {
-        crate::math::positive("axial step of the universal cutter", s.axial_step)?;
-        let n = (a1z / s.axial_step).ceil();
-        if n > MAX_PASSES as Real {
-            return Err(InputError::out_of_range(
-                "axial step of the universal cutter",
-                s.axial_step,
-                format!(
-                    "at least a_1z / {MAX_PASSES} = {:.6} mm",
-                    a1z / MAX_PASSES as Real
-                ),
-            ));
-        }
-        n as usize
-    } else {
-        0
-    };
-    let side_steps = |steps: &mut Vec<PlannedPass>, d: Real| {
-        for (sign, flank) in [(-1.0, Flank::Left), (1.0, Flank::Right)] {
-            for k in 1..=sides {
-                steps.push(PlannedPass {
-                    kind: PassKind::Side,
-                    start: 0,
-                    depth: 0.0,
-                    cumulative: d,
-                    offset: sign * a1z * k as Real / sides as Real,
-                    flank,
-                    planned_area: a1z / sides as Real * d,
-                });
-            }
-        }
-    };
-    for j in 1..=s.finish_passes {
-        let d = last + s.finish_depth;
-        steps.push(PlannedPass {
-            kind: PassKind::Finish,
-            start: 0,
-            depth: s.finish_depth,
-            cumulative: d,
-            offset: 0.0,
-            flank: Flank::Radial,
-            planned_area: area(last, d),
-        });
-        last = d;
-        let _ = j;
-        side_steps(&mut steps, d);
-    }
-    if s.finish_passes == 0 {
-        side_steps(&mut steps, last);
-    }
+    let mut steps = rough_steps(t, c, s.order, &rough);
+    let last = rough.last().copied().unwrap_or(0.0);
+    let sides = side_count(t, c, s.axial_step)?;
+    finish_steps(t, c, s, (last, sides), &mut steps);
     side_step_areas(t, c, &mut steps);
     let z1 = t.starts;
     if steps.len() * z1 as usize > MAX_PASSES {
@@ -354,6 +272,125 @@ pub fn plan(
         }
     }
     Ok(out)
+}
+
+/// The chip's area between the depths `d0` and `d1` of cutter `c`'s
+/// section.
+fn area(c: &ThreadCutter, d0: Real, d1: Real) -> Real {
+    c.tip_width * (d1 - d0) + 0.5 * (c.left_angle.tan() + c.right_angle.tan()) * (d1 * d1 - d0 * d0)
+}
+
+/// The roughing passes at one start to the depths `rough`, on the flanks
+/// `order` gives: on a flank the cutter's edge stands on that flank's
+/// final line.
+fn rough_steps(
+    t: &ThreadSection,
+    c: &ThreadCutter,
+    order: FlankOrder,
+    rough: &[Real],
+) -> Vec<PlannedPass> {
+    let h = t.depth();
+    let tan = |flank: Flank| match flank {
+        Flank::Left => t.flanks[0].tan(),
+        Flank::Right | Flank::Radial => t.flanks[1].tan(),
+    };
+    let mut steps: Vec<PlannedPass> = Vec::new();
+    let mut last = 0.0;
+    for (i, &d) in rough.iter().enumerate() {
+        let flank = match order {
+            FlankOrder::Alternating if i % 2 == 0 => Flank::Left,
+            FlankOrder::Alternating | FlankOrder::Right => Flank::Right,
+            FlankOrder::Left => Flank::Left,
+            FlankOrder::Radial => Flank::Radial,
+        };
+        let e = (h - d) * tan(flank);
+        steps.push(PlannedPass {
+            kind: PassKind::Rough,
+            start: 0,
+            depth: d - last,
+            cumulative: d,
+            offset: match flank {
+                Flank::Left => -e,
+                Flank::Right => e,
+                Flank::Radial => 0.0,
+            },
+            flank,
+            planned_area: area(c, last, d),
+        });
+        last = d;
+    }
+    steps
+}
+
+/// How many side steps a universal cutter takes to each flank (its axial
+/// offset over `axial_step`); none for a full-profile cutter.
+///
+/// # Failures
+/// A step not positive, or so small it would make more than
+/// [`MAX_PASSES`].
+fn side_count(t: &ThreadSection, c: &ThreadCutter, axial_step: Real) -> Result<usize, InputError> {
+    let a1z = axial_offset(t, c);
+    if a1z <= crate::tolerance::SAME_LENGTH {
+        return Ok(0);
+    }
+    crate::math::positive("axial step of the universal cutter", axial_step)?;
+    let n = (a1z / axial_step).ceil();
+    if n > MAX_PASSES as Real {
+        return Err(InputError::out_of_range(
+            "axial step of the universal cutter",
+            axial_step,
+            format!(
+                "at least a_1z / {MAX_PASSES} = {:.6} mm",
+                a1z / MAX_PASSES as Real
+            ),
+        ));
+    }
+    Ok(n as usize)
+}
+
+/// The finishing passes after the roughing's `last` depth, each followed
+/// by `sides` side steps to each flank (after the roughing where there is
+/// no finishing pass), added to `steps`.
+fn finish_steps(
+    t: &ThreadSection,
+    c: &ThreadCutter,
+    s: &PlanSettings,
+    (mut last, sides): (Real, usize),
+    steps: &mut Vec<PlannedPass>,
+) {
+    let a1z = axial_offset(t, c);
+    let side_steps = |steps: &mut Vec<PlannedPass>, d: Real| {
+        for (sign, flank) in [(-1.0, Flank::Left), (1.0, Flank::Right)] {
+            for k in 1..=sides {
+                steps.push(PlannedPass {
+                    kind: PassKind::Side,
+                    start: 0,
+                    depth: 0.0,
+                    cumulative: d,
+                    offset: sign * a1z * k as Real / sides as Real,
+                    flank,
+                    planned_area: a1z / sides as Real * d,
+                });
+            }
+        }
+    };
+    for _ in 1..=s.finish_passes {
+        let d = last + s.finish_depth;
+        steps.push(PlannedPass {
+            kind: PassKind::Finish,
+            start: 0,
+            depth: s.finish_depth,
+            cumulative: d,
+            offset: 0.0,
+            flank: Flank::Radial,
+            planned_area: area(c, last, d),
+        });
+        last = d;
+        side_steps(steps, d);
+    }
+    if s.finish_passes == 0 {
+        side_steps(steps, last);
+    }
 }
 
 #[cfg(test)]
