@@ -19,29 +19,7 @@ fn draw(
     (title, y_desc): (&str, &str),
     band: Option<f64>,
 ) -> Result<(String, Marks, PixelMap), DrawError> {
-    let (mut z0, mut z1, mut y0, mut y1) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for p in passes {
-        for b in &p.along_z {
-            (z0, z1) = (z0.min(b[0]), z1.max(b[0]));
-            (y0, y1) = (y0.min(1e3 * b[1].min(b[2])), y1.max(1e3 * b[1].max(b[2])));
-        }
-    }
-    if let Some(t) = band {
-        (y0, y1) = (y0.min(-1e3 * t), y1.max(1e3 * t));
-    }
-    if !(z0.is_finite() && y0.is_finite()) {
-        return Err(DrawError::new(title, "nothing to draw"));
-    }
-    if z1 - z0 < crate::tolerance::SAME_LENGTH {
-        z1 = z0 + 1.0;
-    }
-    let pad = ((y1 - y0) * 0.06).max(0.05);
-    let (y0, y1) = (y0 - pad, y1 + pad);
+    let (z0, z1, y0, y1) = extent(passes, title, band)?;
     let rows = (passes.len() + usize::from(band.is_some())).div_ceil(2) as u32;
     let mut svg = String::new();
     let size = (1100, 600 + 24 * rows);
@@ -107,6 +85,42 @@ fn draw(
         ..Marks::default()
     };
     Ok((svg, marks, map))
+}
+
+/// The chart's extent: z over the passes, and their deviations (um) with
+/// the band's lines, padded.
+///
+/// # Failures
+/// Nothing to draw.
+fn extent(
+    passes: &[&PassCheck],
+    title: &str,
+    band: Option<f64>,
+) -> Result<(f64, f64, f64, f64), DrawError> {
+    let (mut z0, mut z1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for p in passes {
+        for b in &p.along_z {
+            (z0, z1) = (z0.min(b[0]), z1.max(b[0]));
+            (y0, y1) = (y0.min(1e3 * b[1].min(b[2])), y1.max(1e3 * b[1].max(b[2])));
+        }
+    }
+    if let Some(t) = band {
+        (y0, y1) = (y0.min(-1e3 * t), y1.max(1e3 * t));
+    }
+    if !(z0.is_finite() && y0.is_finite()) {
+        return Err(DrawError::new(title, "nothing to draw"));
+    }
+    if z1 - z0 < crate::tolerance::SAME_LENGTH {
+        z1 = z0 + 1.0;
+    }
+    let pad = ((y1 - y0) * 0.06).max(0.05);
+    let (y0, y1) = (y0 - pad, y1 + pad);
+    Ok((z0, z1, y0, y1))
 }
 
 /// The most points a pass's mark over a plot keeps (every k-th beyond).

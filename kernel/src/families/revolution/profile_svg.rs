@@ -74,6 +74,22 @@ pub fn profile_svg(
         y_label: "radius x".into(),
         series: shape,
     }];
+    panels.extend(body_panels(program, machine, &cutting)?);
+    panels.push(curvature_panel(nominal, rounding));
+    render(&panels)
+}
+
+/// A panel for each machine body an axis of the program drives (the
+/// steady rest's U), its axis over z at every cutting pass.
+///
+/// # Failures
+/// The machine's bodies or the program's axes not matching.
+fn body_panels(
+    program: &AxisProgram,
+    machine: &dyn MachineKinematics,
+    cutting: &[&ProgramPass],
+) -> Result<Vec<Panel>, DrawError> {
+    let mut panels = Vec::new();
     let info = machine.info();
     for body in bodies_of(info).map_err(|e| DrawError::new("profile.svg", e))? {
         let Some(axis) = info
@@ -114,6 +130,11 @@ pub fn profile_svg(
             series,
         });
     }
+    Ok(panels)
+}
+
+/// The nominal's curvature as a share of the wheel's limit.
+fn curvature_panel(nominal: &Profile, rounding: f64) -> Panel {
     // Curvature as a share of the wheel's limit (1 = as round as the wheel):
     // the margin reads directly, and the curve keeps its shape however far
     // below the limit it is (the limit's line is drawn when it is near).
@@ -139,15 +160,33 @@ pub fn profile_svg(
             points: vec![(z[0], 1.0), (z[z.len() - 1], 1.0)],
         });
     }
-    panels.push(Panel {
+    Panel {
         title: format!(
             "curvature of the nominal against the wheel's limit 1/R_s (R_s = {rounding} mm): largest {}",
             fixed(top, 4)
         ),
         y_label: "R_s x curvature".into(),
         series,
-    });
-    render(&panels)
+    }
+}
+
+impl Panel {
+    /// The range of its finite values, padded by 5 % (1 either side of a
+    /// single value).
+    fn y_range(&self) -> (f64, f64) {
+        let (y0, y1) = (self.series.iter())
+            .flat_map(|s| s.points.iter())
+            .filter(|p| p.1.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                (a.min(p.1), b.max(p.1))
+            });
+        if y1 > y0 {
+            let pad = 0.05 * (y1 - y0);
+            (y0 - pad, y1 + pad)
+        } else {
+            (y0 - 1.0, y0 + 1.0)
+        }
+    }
 }
 
 /// The panels as SVG, stacked, sharing the z range of all their points,
@@ -184,22 +223,7 @@ fn render(panels: &[Panel]) -> Result<String, DrawError> {
             let (area, below) = rest.split_vertically(CHART + 24 * r + 8);
             rest = below;
             let (top, legend_area) = area.split_vertically(CHART);
-            let pts = || {
-                panel
-                    .series
-                    .iter()
-                    .flat_map(|s| s.points.iter())
-                    .filter(|p| p.1.is_finite())
-            };
-            let (y0, y1) = pts().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
-                (a.min(p.1), b.max(p.1))
-            });
-            let (y0, y1) = if y1 > y0 {
-                let pad = 0.05 * (y1 - y0);
-                (y0 - pad, y1 + pad)
-            } else {
-                (y0 - 1.0, y0 + 1.0)
-            };
+            let (y0, y1) = panel.y_range();
             let mut chart = ChartBuilder::on(&top)
                 .caption(&panel.title, ("sans-serif", 18))
                 .margin(12)

@@ -200,7 +200,6 @@ impl ThreadCheck {
                 figures.push(Figure::new(name, v, tol, unit, format!("start {}", s + 1)));
             }
         };
-        // The larger of two sides in size.
         let larger = |l: Real, r: Real| if l.abs() >= r.abs() { l } else { r };
         start_figure(
             "flank form",
