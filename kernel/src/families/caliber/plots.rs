@@ -87,28 +87,7 @@ pub fn deviation_map_svg(
             .build_cartesian_2d(t0..t1, p0..p1)
             .map_err(e)?;
         let map = PixelMap::of(&chart, t0..t1, p0..p1);
-        // Each pass's line across the map at its psi, and the extremes'
-        // places.
-        marks.passes = passes
-            .iter()
-            .map(|(blocks, psi)| PassMark {
-                blocks: [blocks.start, blocks.end],
-                points: vec![map.at(t0, *psi), map.at(t1, *psi)],
-                closed: false,
-            })
-            .collect();
-        for (place, name) in [
-            (&check.max_left, "most material left"),
-            (&check.max_gouge, "deepest gouge"),
-        ] {
-            if let Some(block) = place.block_from_0().filter(|_| place.mm != 0.0) {
-                marks.places.push(PlaceMark {
-                    at: map.at(place.theta_deg, place.psi_deg),
-                    block,
-                    label: name.into(),
-                });
-            }
-        }
+        map_marks(&mut marks, check, passes, &map);
         let (dt, dp) = (tick_decimals(t1 - t0), tick_decimals(p1 - p0));
         chart
             .configure_mesh()
@@ -120,26 +99,7 @@ pub fn deviation_map_svg(
             .label_style(("sans-serif", 13))
             .draw()
             .map_err(e)?;
-        // Runs of one colour along theta, per row of psi.
-        let mut rects = Vec::new();
-        for j in 0..np {
-            let mut i = 0;
-            while i < nt {
-                let k = level(m.mm[i * np + j], limit);
-                let mut end = i + 1;
-                while end < nt && level(m.mm[end * np + j], limit) == k {
-                    end += 1;
-                }
-                rects.push(Rectangle::new(
-                    [
-                        (m.theta_deg[i], m.psi_deg[j]),
-                        (m.theta_deg[end], m.psi_deg[j + 1]),
-                    ],
-                    level_colour(k).filled(),
-                ));
-                i = end;
-            }
-        }
+        let rects = colour_runs(check, limit);
         chart.draw_series(rects).map_err(e)?;
         for (place, name) in [
             (&check.max_left, "most left"),
@@ -158,36 +118,105 @@ pub fn deviation_map_svg(
                     .map_err(e)?;
             }
         }
-        // The colour bar: the levels from -limit to +limit.
-        let um = limit * 1e3;
-        let mut scale = ChartBuilder::on(&bar)
-            .margin_top(40)
-            .margin_bottom(56)
-            .margin_right(50)
-            .y_label_area_size(0)
-            .right_y_label_area_size(44)
-            .build_cartesian_2d(0.0..1.0, -um..um)
-            .map_err(e)?;
-        let d = tick_decimals(2.0 * um);
-        scale
-            .configure_mesh()
-            .disable_mesh()
-            .disable_x_axis()
-            .y_desc("um")
-            .y_label_formatter(&|v| format!("{v:.d$}"))
-            .label_style(("sans-serif", 12))
-            .draw()
-            .map_err(e)?;
-        let step = 2.0 * um / LEVELS as f64;
-        scale
-            .draw_series((0..LEVELS).map(|k| {
-                let y = -um + step * k as f64;
-                Rectangle::new([(0.0, y), (1.0, y + step)], level_colour(k).filled())
-            }))
-            .map_err(e)?;
+        colour_bar(&bar, limit)?;
         root.present().map_err(e)?;
     }
     Ok((svg, marks))
+}
+
+/// The colour bar beside the map: the levels from -`limit` to +`limit`
+/// (mm), in um.
+fn colour_bar(
+    bar: &plotters::drawing::DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+    limit: f64,
+) -> Result<(), DrawError> {
+    let e = |e: DrawingAreaErrorKind<std::io::Error>| DrawError::new("deviation_map.svg", e);
+    let um = limit * 1e3;
+    let mut scale = ChartBuilder::on(bar)
+        .margin_top(40)
+        .margin_bottom(56)
+        .margin_right(50)
+        .y_label_area_size(0)
+        .right_y_label_area_size(44)
+        .build_cartesian_2d(0.0..1.0, -um..um)
+        .map_err(e)?;
+    let d = tick_decimals(2.0 * um);
+    scale
+        .configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_desc("um")
+        .y_label_formatter(&|v| format!("{v:.d$}"))
+        .label_style(("sans-serif", 12))
+        .draw()
+        .map_err(e)?;
+    let step = 2.0 * um / LEVELS as f64;
+    scale
+        .draw_series((0..LEVELS).map(|k| {
+            let y = -um + step * k as f64;
+            Rectangle::new([(0.0, y), (1.0, y + step)], level_colour(k).filled())
+        }))
+        .map_err(e)?;
+    Ok(())
+}
+
+/// The map's cells as rectangles: runs of one colour along theta, per row
+/// of psi, on a scale of +-`limit`.
+fn colour_runs(check: &GrooveCheck, limit: f64) -> Vec<Rectangle<(f64, f64)>> {
+    let m = &check.map;
+    let (nt, np) = (m.theta_deg.len() - 1, m.psi_deg.len() - 1);
+    let mut rects = Vec::new();
+    for j in 0..np {
+        let mut i = 0;
+        while i < nt {
+            let k = level(m.mm[i * np + j], limit);
+            let mut end = i + 1;
+            while end < nt && level(m.mm[end * np + j], limit) == k {
+                end += 1;
+            }
+            rects.push(Rectangle::new(
+                [
+                    (m.theta_deg[i], m.psi_deg[j]),
+                    (m.theta_deg[end], m.psi_deg[j + 1]),
+                ],
+                level_colour(k).filled(),
+            ));
+            i = end;
+        }
+    }
+    rects
+}
+
+/// Each pass's line across the map at its psi, and the extremes' places,
+/// into `marks` (`map`: the chart's pixels).
+fn map_marks(
+    marks: &mut Marks,
+    check: &GrooveCheck,
+    passes: &[(std::ops::Range<usize>, f64)],
+    map: &PixelMap,
+) {
+    let m = &check.map;
+    let (t0, t1) = (m.theta_deg[0], m.theta_deg[m.theta_deg.len() - 1]);
+    marks.passes = passes
+        .iter()
+        .map(|(blocks, psi)| PassMark {
+            blocks: [blocks.start, blocks.end],
+            points: vec![map.at(t0, *psi), map.at(t1, *psi)],
+            closed: false,
+        })
+        .collect();
+    for (place, name) in [
+        (&check.max_left, "most material left"),
+        (&check.max_gouge, "deepest gouge"),
+    ] {
+        if let Some(block) = place.block_from_0().filter(|_| place.mm != 0.0) {
+            marks.places.push(PlaceMark {
+                at: map.at(place.theta_deg, place.psi_deg),
+                block,
+                label: name.into(),
+            });
+        }
+    }
 }
 
 /// `section.svg`: the groove's section at the theta where the most material
@@ -207,41 +236,8 @@ pub fn section_svg(
     let section = g
         .section(theta)
         .map_err(|e| DrawError::new("section.svg", e))?;
-    let er = crate::math::Vec3::new(theta.cos(), theta.sin(), 0.0);
-    // In the section: x across the roll (mm), y the height above the
-    // periphery (minus the depth).
-    let curve: Vec<(f64, f64)> = (0..=360)
-        .map(|k| {
-            let psi = (-90.0 + 0.5 * k as f64).to_radians();
-            let (x, z) = section.point(psi);
-            (x, -z)
-        })
-        .collect();
-    let mut circles = Vec::with_capacity(req.psi.len());
-    for &psi in &req.psi {
-        let (x, z) = section.point(psi);
-        let n = g
-            .normal(theta, psi)
-            .map_err(|e| DrawError::new("section.svg", e))?;
-        // The normal points into the open groove: along the roll's axis
-        // (section x) and outward (up in the section).
-        circles.push((x + rounding * n.z, -z + rounding * n.dot(&er), (x, -z)));
-    }
-    let (mut x0, mut x1) = (f64::INFINITY, f64::NEG_INFINITY);
-    let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
-    for &(x, y) in &curve {
-        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
-    }
-    for &(cx, cy, _) in &circles {
-        (x0, x1) = (x0.min(cx - rounding), x1.max(cx + rounding));
-        (y0, y1) = (y0.min(cy - rounding), y1.max(cy + rounding));
-    }
-    // Equal scales on both axes, so that circles are round.
-    let (w, h) = (900.0, 520.0);
-    let scale = ((x1 - x0) / w).max((y1 - y0) / h) * 1.08;
-    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-    let (x0, x1) = (cx - 0.5 * w * scale, cx + 0.5 * w * scale);
-    let (y0, y1) = (cy - 0.5 * h * scale, cy + 0.5 * h * scale);
+    let (curve, circles) = section_curves(g, &section, theta, &req.psi, rounding)?;
+    let ((x0, x1), (y0, y1)) = equal_scales(&curve, &circles, rounding);
     let e = |e: DrawingAreaErrorKind<std::io::Error>| DrawError::new("section.svg", e);
     let mut svg = String::new();
     {
@@ -317,4 +313,71 @@ pub fn section_svg(
         root.present().map_err(e)?;
     }
     Ok(svg)
+}
+
+/// Points in the section's plane (mm).
+type Polyline = Vec<(f64, f64)>;
+
+/// A wheel's rounding at a pass in the section: its centre and its contact
+/// point.
+type Rounding = (f64, f64, (f64, f64));
+
+/// The groove's `section` at `theta` as a curve (x across the roll, y the
+/// height above the periphery) and the wheel's rounding at each pass
+/// angle of `psis`.
+///
+/// # Failures
+/// The groove's normal not given there.
+fn section_curves(
+    g: &super::Groove,
+    section: &super::section::GrooveSection,
+    theta: f64,
+    psis: &[f64],
+    rounding: f64,
+) -> Result<(Polyline, Vec<Rounding>), DrawError> {
+    let er = crate::math::Vec3::new(theta.cos(), theta.sin(), 0.0);
+    // In the section: x across the roll (mm), y the height above the
+    // periphery (minus the depth).
+    let curve: Vec<(f64, f64)> = (0..=360)
+        .map(|k| {
+            let psi = (-90.0 + 0.5 * k as f64).to_radians();
+            let (x, z) = section.point(psi);
+            (x, -z)
+        })
+        .collect();
+    let mut circles = Vec::with_capacity(psis.len());
+    for &psi in psis {
+        let (x, z) = section.point(psi);
+        let n = g
+            .normal(theta, psi)
+            .map_err(|e| DrawError::new("section.svg", e))?;
+        // The normal points into the open groove: along the roll's axis
+        // (section x) and outward (up in the section).
+        circles.push((x + rounding * n.z, -z + rounding * n.dot(&er), (x, -z)));
+    }
+    Ok((curve, circles))
+}
+
+/// The picture's x and y ranges holding the `curve` and the `circles` of
+/// radius `rounding`, on equal scales so that circles are round.
+fn equal_scales(
+    curve: &[(f64, f64)],
+    circles: &[Rounding],
+    rounding: f64,
+) -> ((f64, f64), (f64, f64)) {
+    let (mut x0, mut x1) = (f64::INFINITY, f64::NEG_INFINITY);
+    let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &(x, y) in curve {
+        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+    }
+    for &(cx, cy, _) in circles {
+        (x0, x1) = (x0.min(cx - rounding), x1.max(cx + rounding));
+        (y0, y1) = (y0.min(cy - rounding), y1.max(cy + rounding));
+    }
+    let (w, h) = (900.0, 520.0);
+    let scale = ((x1 - x0) / w).max((y1 - y0) / h) * 1.08;
+    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    let (x0, x1) = (cx - 0.5 * w * scale, cx + 0.5 * w * scale);
+    let (y0, y1) = (cy - 0.5 * h * scale, cy + 0.5 * h * scale);
+    ((x0, x1), (y0, y1))
 }
