@@ -152,12 +152,7 @@ impl Finished {
     /// # Failures
     /// A file missing or not as the run wrote it; a run without 3-D models.
     fn read(run: &RunDir, shown: &str) -> Result<Self, Error> {
-        let bad = |name: &str, e: String| {
-            Error::Read(format!(
-                "{shown}/{name}: {} (not as the run wrote it)",
-                crate::files::excerpt(&e)
-            ))
-        };
+        let bad = |name: &str, e: String| not_as_written(shown, name, &e);
         let report: Report = serde_json::from_str(&read(run, "report.json")?)
             .map_err(|e| bad("report.json", e.to_string()))?;
         let program: AxisProgram = serde_json::from_str(&read(run, "program.json")?)
@@ -196,6 +191,14 @@ impl Finished {
             toolpath,
         })
     }
+}
+
+/// The run's file `name` (in `shown`) is not what the run wrote: `e`.
+fn not_as_written(shown: &str, name: &str, e: &str) -> Error {
+    Error::Read(format!(
+        "{shown}/{name}: {} (not as the run wrote it)",
+        crate::files::excerpt(e)
+    ))
 }
 
 /// The text of the run's file `name`.
@@ -267,12 +270,7 @@ fn program_text(
     }
     let text = read(run, &file)?;
     let as_read = crate::program::lint::lint_read(&text, program, control, &kin.info().axes)
-        .map_err(|e| {
-            Error::Read(format!(
-                "{shown}/{file}: {} (not as the run wrote it)",
-                crate::files::excerpt(&e.to_string())
-            ))
-        })?;
+        .map_err(|e| not_as_written(shown, &file, &e.to_string()))?;
     Ok((Some((file, text)), Some(as_read)))
 }
 

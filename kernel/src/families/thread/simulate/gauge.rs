@@ -141,9 +141,9 @@ pub(super) fn measure(
     let mut out = Vec::new();
     for k in 0..req.section.starts {
         match measure_start(m, req, cutter, k) {
-            Ok((p, worst_at)) => {
+            Ok((p, worst_at, angles)) => {
                 failures.extend(
-                    start_faults(req, cutter, &p, worst_at)
+                    start_faults(req, &p, worst_at, angles)
                         .into_iter()
                         .map(fail),
                 );
@@ -173,8 +173,8 @@ fn space_of(m: &MultiPolygon<Real>, k: u32, c: Real, r: Real) -> Result<(Real, R
     })
 }
 
-/// Start `k`'s finished profile, and the radii where its flanks' form is
-/// worst (left, right).
+/// Start `k`'s finished profile, the radii where its flanks' form is
+/// worst (left, right), and its aimed flanks' angles there (deg).
 ///
 /// # Failures
 /// Its space, or the next start's at the pitch line, not there.
@@ -183,7 +183,7 @@ fn measure_start(
     req: &ThreadRequest,
     cutter: &ThreadCutter,
     k: u32,
-) -> Result<(StartProfile, [Real; 2]), String> {
+) -> Result<(StartProfile, [Real; 2], [Real; 2]), String> {
     let w = &req.section;
     let (r_a, r1) = (w.crest_diameter / 2.0, w.pitch_diameter / 2.0);
     let c = start_centre(req, k);
@@ -250,22 +250,21 @@ fn measure_start(
             .and(w.best_wire())
             .map(|wire| over_wires(w, wire, line(&left), line(&right))),
     };
-    Ok((p, worst_at))
+    Ok((p, worst_at, nominal_flanks_deg(&aimed, &radii)))
 }
 
 /// What of start `p` fails against the nominal: its flanks' form (worst
-/// at the radii `worst_at`) and angles, and its thickness and diameters (a
+/// at the radii `worst_at`) and angles (against `nominal_angles`), and its thickness and diameters (a
 /// worm's against the nominal, a standard thread's against its limits),
 /// its place.
 fn start_faults(
     req: &ThreadRequest,
-    cutter: &ThreadCutter,
     p: &StartProfile,
     worst_at: [Real; 2],
+    nominal_angles: [Real; 2],
 ) -> Vec<String> {
     let (w, tol) = (&req.section, &req.tolerances);
     let aimed = req.start_section(p.start);
-    let nominal_angles = nominal_flanks_deg(&aimed, &flank_radii(&aimed, req.flank_margin, cutter));
     let s = p.start + 1;
     let mut faults = Vec::new();
     for (flank, form, r) in [
