@@ -433,9 +433,7 @@ fn no_long_function_in_the_run_the_page_or_a_family() {
     assert!(files.len() > 30, "{files:?}");
     // Not yet split (the next step's work): each named here may only
     // shrink out of this list; any other function over 80 lines fails.
-    const NOT_YET: [(&str, &str); 7] = [
-        ("caliber/check.rs", "samples"),
-        ("caliber/check.rs", "check_groove"),
+    const NOT_YET: [(&str, &str); 5] = [
         ("caliber/pass.rs", "pass_poses"),
         ("caliber/patch.rs", "contact_patch"),
         ("caliber/plots.rs", "section_svg"),

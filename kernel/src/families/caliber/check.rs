@@ -27,13 +27,14 @@
 //! a strip [`PERIPHERY_REACH`] rounding radii wide, for cuts only (it is
 //! turned, not ground): a wheel whose side reaches past the edge cuts it.
 
+use super::grid::Grid;
 use super::groove::Groove;
 use super::patch::ContactPatch;
 use super::pose::TorusWheel;
 use crate::budget::OverTime;
 use crate::machine::MachineKinematics;
 use crate::math::{Real, Vec3};
-use crate::program::{axis_rows, block_name, AxisProgram, ProgramPass};
+use crate::program::{axis_rows, AxisProgram, ProgramPass};
 use crate::replay::{as_written, VerifyError};
 use crate::tool::Wheel;
 use crate::transform::ToolFrame;
@@ -56,7 +57,7 @@ pub const MAX_SAMPLES: usize = 20_000_000;
 
 /// The coarsest step of the grid across the groove beyond the outermost
 /// passes (rad): 1 deg, when there is one pass and no spacing to follow.
-const EDGE_GRID_STEP: Real = std::f64::consts::PI / 180.0;
+pub(super) const EDGE_GRID_STEP: Real = std::f64::consts::PI / 180.0;
 
 /// How far the periphery strip beside each edge runs, in rounding radii:
 /// the rounding, touching the edge, reaches no farther along the axis.
@@ -287,82 +288,40 @@ fn samples(
     let n = program.blocks.len();
     let rows = axis_rows(program, info, &info.solved_axes, 0..n)
         .map_err(|e| VerifyError::Replay(e.to_string()))?;
-    let width = info.solved_axes.len();
     let poses = crate::replay::replay(program, machine, tool)?;
-    let at = |pose: &[Real]| placed(pose, wheel);
-    let (r_k0, r_k) = (0.5 * wheel.diameter, wheel.rounding_radius);
     // Between samples no point of the wheel moves more than `step`.
     let target = req.tolerance / SAMPLING_SHARE;
-    let step = (8.0 * r_k * target).sqrt();
-    // A pass's wheel positions from its poses, unwrapped from the first
-    // (taken within half a turn of the groove's middle), then in order of
-    // turn: made on a second thread while this one replays the next pass
-    // (the machine's kinematics stay on this one).
-    let mid = groove_middle(&req.groove);
-    let finish = |sub_poses: Vec<Real>, owner: Vec<usize>| -> Vec<Sample> {
-        let mut list: Vec<Sample> = sub_poses
-            .chunks_exact(6)
-            .zip(owner)
-            .map(|(p, block)| Sample {
-                wheel: at(p),
-                block,
-                turn: p[1].atan2(p[0]),
-            })
-            .collect();
-        let mut prev = list
-            .first()
-            .map_or(0.0, |s| mid + crate::math::wrap_angle(s.turn - mid));
-        for s in &mut list {
-            s.turn = prev + crate::math::wrap_angle(s.turn - prev);
-            prev = s.turn;
-        }
-        list.sort_by(|a, b| a.turn.total_cmp(&b.turn));
-        list
+    let mut sub = Substeps {
+        wheel,
+        poses: &poses,
+        rows: &rows,
+        width: info.solved_axes.len(),
+        step: (8.0 * wheel.rounding_radius * target).sqrt(),
+        worst: 0.0,
+        count: 0,
     };
-    let mut worst: Real = 0.0;
-    let mut count = 0;
+    // A pass's samples are ordered on a second thread while this one
+    // replays the next pass (the machine's kinematics stay on this one).
+    let mid = groove_middle(&req.groove);
     let out = std::thread::scope(|s| {
         let (send, receive) = std::sync::mpsc::channel::<(Vec<Real>, Vec<usize>)>();
         let lists = s.spawn(move || {
             receive
                 .into_iter()
-                .map(|(p, o)| finish(p, o))
+                .map(|(p, o)| ordered(p, o, wheel, mid))
                 .collect::<Vec<_>>()
         });
         let replayed = (|| {
             for blocks in passes.iter().filter(|p| p.cuts).map(|p| p.blocks.clone()) {
                 crate::budget::check("the groove's replay")?;
-                let mut rows_sub: Vec<Real> = Vec::new();
-                let mut owner = Vec::new();
-                for k in blocks.start.max(1)..blocks.end {
-                    let (a, b) = (at(&poses[6 * (k - 1)..6 * k]), at(&poses[6 * k..6 * k + 6]));
-                    let turned = a.axis.dot(&b.axis).clamp(-1.0, 1.0).acos();
-                    let moved = (b.centre - a.centre).norm() + r_k0 * turned;
-                    let subs = ((moved / step).ceil() as usize).max(1);
-                    worst = worst.max(moved / subs as Real);
-                    count += subs;
-                    if count > MAX_SAMPLES {
-                        return Err(VerifyError::Replay(format!(
-                            "more than {MAX_SAMPLES} wheel positions to replay: a coarser tolerance or fewer blocks"
-                        )));
-                    }
-                    let (ra, rb) = (
-                        &rows[(k - 1) * width..k * width],
-                        &rows[k * width..(k + 1) * width],
-                    );
-                    for s in 1..=subs {
-                        let t = s as Real / subs as Real;
-                        rows_sub.extend(ra.iter().zip(rb).map(|(x, y)| x + (y - x) * t));
-                        owner.push(k);
-                    }
-                }
+                let (rows_sub, owner) = sub.of_pass(blocks.clone())?;
                 let sub_poses =
                     crate::replay::forward_rows(machine, &rows_sub, tool, blocks.clone())?;
                 // A send fails only where the second thread panicked, and
                 // its join passes that on.
                 let _ = send.send((sub_poses, owner));
             }
-            Ok(())
+            Ok::<(), VerifyError>(())
         })();
         drop(send);
         let lists = lists
@@ -370,7 +329,83 @@ fn samples(
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
         replayed.map(|()| lists)
     })?;
-    Ok((out, worst * worst / (8.0 * r_k), count))
+    let r_k = wheel.rounding_radius;
+    Ok((out, sub.worst * sub.worst / (8.0 * r_k), sub.count))
+}
+
+/// The sub-steps of the cutting moves: each move cut so that no point of
+/// the wheel moves more than `step` between two of them.
+struct Substeps<'a> {
+    wheel: &'a Wheel,
+    /// The replayed poses, 6 per block.
+    poses: &'a [Real],
+    /// The solved axes' values, `width` per block.
+    rows: &'a [Real],
+    width: usize,
+    step: Real,
+    /// The largest motion of a wheel point between two sub-steps (mm).
+    worst: Real,
+    /// The sub-steps so far, bounded by [`MAX_SAMPLES`].
+    count: usize,
+}
+
+impl Substeps<'_> {
+    /// The axes' values at every sub-step of the moves of `blocks`, and
+    /// the block (from 0) each is on.
+    fn of_pass(
+        &mut self,
+        blocks: std::ops::Range<usize>,
+    ) -> Result<(Vec<Real>, Vec<usize>), VerifyError> {
+        let (w, at) = (self.width, |pose: &[Real]| placed(pose, self.wheel));
+        let r_k0 = 0.5 * self.wheel.diameter;
+        let mut rows_sub: Vec<Real> = Vec::new();
+        let mut owner = Vec::new();
+        for k in blocks.start.max(1)..blocks.end {
+            let a = at(&self.poses[6 * (k - 1)..6 * k]);
+            let b = at(&self.poses[6 * k..6 * k + 6]);
+            let turned = a.axis.dot(&b.axis).clamp(-1.0, 1.0).acos();
+            let moved = (b.centre - a.centre).norm() + r_k0 * turned;
+            let subs = ((moved / self.step).ceil() as usize).max(1);
+            self.worst = self.worst.max(moved / subs as Real);
+            self.count += subs;
+            if self.count > MAX_SAMPLES {
+                return Err(VerifyError::Replay(format!(
+                    "more than {MAX_SAMPLES} wheel positions to replay: a coarser tolerance or fewer blocks"
+                )));
+            }
+            let (ra, rb) = (&self.rows[(k - 1) * w..k * w], &self.rows[k * w..(k + 1) * w]);
+            for s in 1..=subs {
+                let t = s as Real / subs as Real;
+                rows_sub.extend(ra.iter().zip(rb).map(|(x, y)| x + (y - x) * t));
+                owner.push(k);
+            }
+        }
+        Ok((rows_sub, owner))
+    }
+}
+
+/// A pass's wheel positions from its poses (6 per sub-step, `owner` the
+/// block of each), their turns unwrapped from the first (taken within half
+/// a turn of the groove's middle `mid`), then in order of turn.
+fn ordered(sub_poses: Vec<Real>, owner: Vec<usize>, wheel: &Wheel, mid: Real) -> Vec<Sample> {
+    let mut list: Vec<Sample> = sub_poses
+        .chunks_exact(6)
+        .zip(owner)
+        .map(|(p, block)| Sample {
+            wheel: placed(p, wheel),
+            block,
+            turn: p[1].atan2(p[0]),
+        })
+        .collect();
+    let mut prev = list
+        .first()
+        .map_or(0.0, |s| mid + crate::math::wrap_angle(s.turn - mid));
+    for s in &mut list {
+        s.turn = prev + crate::math::wrap_angle(s.turn - prev);
+        prev = s.turn;
+    }
+    list.sort_by(|a, b| a.turn.total_cmp(&b.turn));
+    list
 }
 
 /// The least distance from `q` over `list` (sorted by turn), searched
@@ -441,167 +476,145 @@ pub fn check_groove(
             req.psi.len()
         )));
     }
-    // The grid: theta over the tables, psi over the passes (sorted), each
-    // pass step divided.
-    let (lo, hi) = req.groove.theta_range();
-    let n_theta = ((hi - lo) / req.grid_theta).ceil() as usize + 1;
-    let mut order: Vec<usize> = (0..req.psi.len()).collect();
-    order.sort_by(|&a, &b| req.psi[a].total_cmp(&req.psi[b]));
-    let per = req.grid_per_step.max(1);
-    let mut psi_grid: Vec<(Real, usize)> = Vec::new(); // (psi, index in `order`)
-    for (k, w) in order.windows(2).enumerate() {
-        let (a, b) = (req.psi[w[0]], req.psi[w[1]]);
-        for s in 0..per {
-            psi_grid.push((a + (b - a) * s as Real / per as Real, k));
-        }
-    }
-    let last = order.len() - 1;
-    psi_grid.push((req.psi[order[last]], last));
-    let pass_range = [psi_grid[0].0, psi_grid[psi_grid.len() - 1].0];
-    // On to the edges beyond the outermost passes, no coarser than between
-    // them, against the outermost passes.
-    let h = psi_grid
-        .windows(2)
-        .map(|w| w[1].0 - w[0].0)
-        .fold(EDGE_GRID_STEP, Real::min);
-    let edge = std::f64::consts::FRAC_PI_2;
-    let spans = |from: Real, to: Real| {
-        ((to - from) / h - crate::tolerance::COUNT_SLACK)
-            .ceil()
-            .max(0.0) as usize
+    let grid = Grid::new(req, wheel)?;
+    let points = grid.points(&req.groove)?;
+    let dist = measured(&grid, &points, &lists, req.grid_theta)?;
+    let (max_left, max_gouge, periphery_cut) = extremes(&grid, &dist, program);
+    let max_abs = max_left.mm.max(-max_gouge.mm);
+    let worst = if max_left.mm >= -max_gouge.mm {
+        &max_left
+    } else {
+        &max_gouge
     };
-    let below = spans(-edge, pass_range[0]);
-    let above = spans(pass_range[1], edge);
-    let mut grid: Vec<(Real, usize)> = (0..below)
-        .map(|i| {
-            (
-                -edge + (pass_range[0] + edge) * i as Real / below as Real,
-                0,
-            )
-        })
-        .collect();
-    grid.extend(psi_grid);
-    grid.extend((1..=above).map(|i| {
-        let psi = pass_range[1] + (edge - pass_range[1]) * i as Real / above as Real;
-        (psi, last)
-    }));
-    let psi_grid = grid;
-    // The periphery beside each edge: (side, distance beyond the edge,
-    // pass), from the tolerance out, doubling, to the rounding's reach.
-    let reach = PERIPHERY_REACH * wheel.rounding_radius;
-    let mut offsets = Vec::new();
-    let mut d = req.tolerance;
-    while d < reach {
-        offsets.push(d);
-        d *= 2.0;
-    }
-    offsets.push(reach);
-    let rim: Vec<(Real, Real, usize)> = [(-1.0, 0), (1.0, last)]
-        .into_iter()
-        .flat_map(|(side, k)| offsets.iter().map(move |&d| (side, d, k)))
-        .collect();
-    let np = psi_grid.len();
-    let nc = np + rim.len();
-    if n_theta.saturating_mul(nc) > MAX_GRID_POINTS {
-        return Err(VerifyError::Replay(format!(
-            "a grid of {n_theta} x {nc} points is more than {MAX_GRID_POINTS}: a coarser grid"
-        )));
-    }
-    let thetas: Vec<Real> = (0..n_theta)
-        .map(|i| (lo + req.grid_theta * i as Real).min(hi))
-        .collect();
-    // The points, row by row of theta: the groove's, then the periphery's.
-    let r_d = req.groove.roll_radius();
-    let mut points = Vec::with_capacity(n_theta * nc);
-    for &t in &thetas {
-        let section = req.groove.section(t)?;
-        for &(psi, _) in &psi_grid {
-            points.push(req.groove.point_of(&section, t, psi));
-        }
-        let half = section.edge_x();
-        for &(side, d, _) in &rim {
-            points.push(Vec3::new(r_d * t.cos(), r_d * t.sin(), side * (half + d)));
-        }
-    }
-    let pass_of = |j: usize| {
-        if j < np {
-            psi_grid[j].1
-        } else {
-            rim[j - np].2
-        }
+    let why = if max_abs > req.tolerance {
+        explain(&req.groove, worst, grid.pass_range)?
+    } else {
+        String::new()
     };
-    // Each point against the passes around it; two threads share rows.
-    let measure = |rows: std::ops::Range<usize>| -> Result<Vec<(Real, usize)>, OverTime> {
-        let mut out = Vec::with_capacity(rows.len() * nc);
-        for i in rows {
-            crate::budget::check("the groove's measurement")?;
-            for j in 0..nc {
-                let k = pass_of(j);
-                let q = &points[i * nc + j];
-                let from = k.saturating_sub(NEIGHBOUR_PASSES);
-                let to = (k + NEIGHBOUR_PASSES + 1).min(order.len() - 1);
-                let mut best = (Real::INFINITY, 0);
-                for &pass in &order[from..=to] {
-                    let got = nearest(&lists[pass], q, thetas[i]);
-                    if got.0 < best.0 {
-                        best = got;
-                    }
-                }
-                out.push(best);
-            }
-        }
-        Ok(out)
-    };
+    let (np, nc) = (grid.np(), grid.nc());
+    Ok(GrooveCheck {
+        along_theta: along_theta(&grid, &dist),
+        tolerance: req.tolerance,
+        resolution_mm: resolution,
+        sampling_resolution_mm: sampling,
+        samples: count,
+        grid_theta: grid.thetas.len(),
+        grid_psi: np,
+        grid_theta_step_deg: req.grid_theta.to_degrees(),
+        psi_range_deg: [grid.psi[0].0.to_degrees(), grid.psi[np - 1].0.to_degrees()],
+        pass_range_deg: grid.pass_range.map(Real::to_degrees),
+        max_left,
+        max_gouge,
+        max_abs_mm: max_abs,
+        periphery_cut,
+        why,
+        patch: None,
+        map: DeviationMap::of(
+            &grid.thetas,
+            &grid.psi.iter().map(|p| p.0).collect::<Vec<_>>(),
+            &dist
+                .chunks_exact(nc)
+                .flat_map(|row| row[..np].iter().map(|d| d.0))
+                .collect::<Vec<_>>(),
+        ),
+    })
+}
+
+/// The distance from each of the grid's `points` to the swept wheel, and
+/// the block (from 0) whose wheel is nearest: against the passes around
+/// the point, then every block's wheel across the whole section at its own
+/// theta (`step` the grid's along theta); two threads share the rows.
+fn measured(
+    grid: &Grid,
+    points: &[Vec3],
+    lists: &[Vec<Sample>],
+    step: Real,
+) -> Result<Vec<(Real, usize)>, OverTime> {
+    let n_theta = grid.thetas.len();
     let half = n_theta / 2;
-    let (a, b) = crate::budget::beside(|| measure(0..half), || measure(half..n_theta));
+    let near = |rows| near_passes(grid, points, lists, rows);
+    let (a, b) = crate::budget::beside(|| near(0..half), || near(half..n_theta));
     let mut dist = a?;
     dist.extend(b?);
-    // Each block's wheel across the whole section at its own theta; the
-    // two threads take the two halves of the rows again.
-    let across = |rows: std::ops::Range<usize>, dist: &mut [(Real, usize)]| {
-        for list in &lists {
-            crate::budget::check("the groove's measurement")?;
-            for (idx, s) in list.iter().enumerate() {
-                if idx + 1 < list.len() && list[idx + 1].block == s.block {
-                    continue; // one sample per block: its last, at the block
+    let (first, second) = dist.split_at_mut(half * grid.nc());
+    let across = |rows, dist: &mut [(Real, usize)]| across(grid, points, lists, step, rows, dist);
+    let (a, b) = crate::budget::beside(|| across(0..half, first), || across(half..n_theta, second));
+    a.and(b)?;
+    Ok(dist)
+}
+
+/// The distance and block at the grid's points in `rows`, each against
+/// the passes within [`NEIGHBOUR_PASSES`] of its own.
+fn near_passes(
+    grid: &Grid,
+    points: &[Vec3],
+    lists: &[Vec<Sample>],
+    rows: std::ops::Range<usize>,
+) -> Result<Vec<(Real, usize)>, OverTime> {
+    let (nc, order) = (grid.nc(), &grid.order);
+    let mut out = Vec::with_capacity(rows.len() * nc);
+    for i in rows {
+        crate::budget::check("the groove's measurement")?;
+        for j in 0..nc {
+            let k = grid.pass_of(j);
+            let q = &points[i * nc + j];
+            let from = k.saturating_sub(NEIGHBOUR_PASSES);
+            let to = (k + NEIGHBOUR_PASSES + 1).min(order.len() - 1);
+            let mut best = (Real::INFINITY, 0);
+            for &pass in &order[from..=to] {
+                let got = nearest(&lists[pass], q, grid.thetas[i]);
+                if got.0 < best.0 {
+                    best = got;
                 }
-                let i = ((s.turn - lo) / req.grid_theta).round();
-                if !(i >= rows.start as Real && i < rows.end as Real) {
-                    continue;
-                }
-                let i = i as usize;
-                for j in 0..nc {
-                    let d = wheel_distance(&s.wheel, &points[i * nc + j]);
-                    let at = &mut dist[(i - rows.start) * nc + j];
-                    if d < at.0 {
-                        *at = (d, s.block);
-                    }
+            }
+            out.push(best);
+        }
+    }
+    Ok(out)
+}
+
+/// Each block's wheel (its last sample) across the whole section at its
+/// own theta, for the rows in `rows` (`dist` holds those rows only).
+fn across(
+    grid: &Grid,
+    points: &[Vec3],
+    lists: &[Vec<Sample>],
+    step: Real,
+    rows: std::ops::Range<usize>,
+    dist: &mut [(Real, usize)],
+) -> Result<(), OverTime> {
+    let (nc, lo) = (grid.nc(), grid.thetas[0]);
+    for list in lists {
+        crate::budget::check("the groove's measurement")?;
+        for (idx, s) in list.iter().enumerate() {
+            if idx + 1 < list.len() && list[idx + 1].block == s.block {
+                continue; // one sample per block: its last, at the block
+            }
+            let i = ((s.turn - lo) / step).round();
+            if !(i >= rows.start as Real && i < rows.end as Real) {
+                continue;
+            }
+            let i = i as usize;
+            for j in 0..nc {
+                let d = wheel_distance(&s.wheel, &points[i * nc + j]);
+                let at = &mut dist[(i - rows.start) * nc + j];
+                if d < at.0 {
+                    *at = (d, s.block);
                 }
             }
         }
-        Ok::<_, OverTime>(())
-    };
-    {
-        let (first, second) = dist.split_at_mut(half * nc);
-        let (a, b) =
-            crate::budget::beside(|| across(0..half, first), || across(half..n_theta, second));
-        a.and(b)?;
     }
-    let place = |idx: usize| {
-        let (i, j) = (idx / nc, idx % nc);
-        let (psi, beyond) = match j.checked_sub(np) {
-            None => (psi_grid[j].0, 0.0),
-            Some(r) => (rim[r].0 * edge, rim[r].1),
-        };
-        GroovePlace {
-            mm: dist[idx].0,
-            theta_deg: thetas[i].to_degrees(),
-            psi_deg: psi.to_degrees(),
-            block: block_name(program, dist[idx].1),
-            block_index: dist[idx].1 + 1,
-            beyond_edge_mm: beyond,
-        }
-    };
+    Ok(())
+}
+
+/// The most material left and the deepest gouge on the groove, and the
+/// deepest cut into the periphery (0 where none), with their places.
+fn extremes(
+    grid: &Grid,
+    dist: &[(Real, usize)],
+    program: &AxisProgram,
+) -> (GroovePlace, GroovePlace, GroovePlace) {
+    let (np, nc) = (grid.np(), grid.nc());
     let (mut left, mut gouge, mut cut) = (0, 0, np);
     for (idx, d) in dist.iter().enumerate() {
         if idx % nc >= np {
@@ -617,66 +630,31 @@ pub fn check_groove(
             gouge = idx;
         }
     }
-    let max_left = place(left);
-    let mut max_gouge = place(gouge);
-    if max_gouge.mm > 0.0 {
-        max_gouge.mm = 0.0;
-    }
-    let mut periphery_cut = place(cut);
+    let mut max_gouge = grid.place(gouge, dist, program);
+    max_gouge.mm = max_gouge.mm.min(0.0);
+    let mut periphery_cut = grid.place(cut, dist, program);
     periphery_cut.mm = periphery_cut.mm.min(0.0);
-    let max_abs = max_left.mm.max(-max_gouge.mm);
-    let worst = if max_left.mm >= -max_gouge.mm {
-        &max_left
+    (grid.place(left, dist, program), max_gouge, periphery_cut)
+}
+
+/// Along theta: `[theta (deg), depth, width]`, as
+/// [`GrooveCheck::along_theta`] says.
+fn along_theta(grid: &Grid, dist: &[(Real, usize)]) -> Vec<[Real; 3]> {
+    let (np, nc) = (grid.np(), grid.nc());
+    let bottom = grid.psi.partition_point(|p| p.0 < 0.0).clamp(1, np - 1);
+    let (a, b) = (grid.psi[bottom - 1].0, grid.psi[bottom].0);
+    let s = if b > a {
+        (-a / (b - a)).clamp(0.0, 1.0)
     } else {
-        &max_gouge
+        0.0
     };
-    let why = if max_abs > req.tolerance {
-        explain(&req.groove, worst, pass_range)?
-    } else {
-        String::new()
-    };
-    let bottom = psi_grid.partition_point(|p| p.0 < 0.0).clamp(1, np - 1);
-    let along_theta = dist
-        .chunks_exact(nc)
-        .zip(&thetas)
+    dist.chunks_exact(nc)
+        .zip(&grid.thetas)
         .map(|(row, t)| {
-            let (a, b) = (psi_grid[bottom - 1].0, psi_grid[bottom].0);
-            let s = if b > a {
-                (-a / (b - a)).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
             let at_bottom = row[bottom - 1].0 + s * (row[bottom].0 - row[bottom - 1].0);
             [t.to_degrees(), -at_bottom, -(row[0].0 + row[np - 1].0)]
         })
-        .collect();
-    let check = GrooveCheck {
-        along_theta,
-        tolerance: req.tolerance,
-        resolution_mm: resolution,
-        sampling_resolution_mm: sampling,
-        samples: count,
-        grid_theta: n_theta,
-        grid_psi: np,
-        grid_theta_step_deg: req.grid_theta.to_degrees(),
-        psi_range_deg: [psi_grid[0].0.to_degrees(), psi_grid[np - 1].0.to_degrees()],
-        pass_range_deg: pass_range.map(Real::to_degrees),
-        max_left,
-        max_gouge,
-        max_abs_mm: max_abs,
-        periphery_cut,
-        why,
-        patch: None,
-        map: DeviationMap::of(
-            &thetas,
-            &psi_grid.iter().map(|p| p.0).collect::<Vec<_>>(),
-            &dist
-                .chunks_exact(nc)
-                .flat_map(|row| row[..np].iter().map(|d| d.0))
-                .collect::<Vec<_>>(),
-        ),
-    };
-    Ok(check)
+        .collect()
 }
 
 /// Why `worst` strays, where the geometry tells: material left beyond

@@ -26,6 +26,7 @@
 //! the XZ plane, `theta` turning right-handed about +Z (docs/architecture.md, conventions).
 
 mod check;
+mod grid;
 mod groove;
 mod outcome;
 mod pass;
