@@ -373,7 +373,10 @@ impl Substeps<'_> {
                     "more than {MAX_SAMPLES} wheel positions to replay: a coarser tolerance or fewer blocks"
                 )));
             }
-            let (ra, rb) = (&self.rows[(k - 1) * w..k * w], &self.rows[k * w..(k + 1) * w]);
+            let (ra, rb) = (
+                &self.rows[(k - 1) * w..k * w],
+                &self.rows[k * w..(k + 1) * w],
+            );
             for s in 1..=subs {
                 let t = s as Real / subs as Real;
                 rows_sub.extend(ra.iter().zip(rb).map(|(x, y)| x + (y - x) * t));

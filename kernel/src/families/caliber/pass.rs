@@ -198,83 +198,107 @@ pub fn pass_poses(
     for k in 1..steps {
         let target = first.turn + step * k as Real;
         let prev: PassPose = *poses.last().expect("the first pose is in");
-        // The turn runs ahead of theta by a nearly constant amount: start
-        // from the last pose's offset, bracket the target, then the secant
-        // method kept inside the bracket.
-        let guess = (target - (prev.turn - prev.theta)).clamp(lo, hi);
-        let mut a = (prev.theta, prev);
-        let mut b = (guess.max(prev.theta), at(guess.max(prev.theta))?);
-        let mut widen = step;
-        while b.1.turn < target && b.0 < hi {
-            a = b;
-            let t = (b.0 + widen).min(hi);
-            b = (t, at(t)?);
-            widen *= 2.0;
-        }
-        if !(b.1.turn >= target - crate::tolerance::ROUNDING) {
-            return Err(InputError::out_of_range(
+        let out_of_reach = |why: &str| -> GrooveError {
+            InputError::out_of_range(
                 "the roll's turn a pass reaches (deg)",
                 target.to_degrees(),
-                format!(
-                    "within the turns the groove's tables give the wheel at psi = {:.3} deg",
-                    psi.to_degrees()
-                ),
+                format!("{why} at psi = {:.3} deg", psi.to_degrees()),
             )
-            .into());
-        }
-        let mut best = if (a.1.turn - target).abs() < (b.1.turn - target).abs() {
-            a.1
-        } else {
-            b.1
+            .into()
         };
-        let mut side = 0;
-        for _ in 0..200 {
-            if (best.turn - target).abs() < TURN_TOLERANCE || b.0 - a.0 < TURN_STALL {
-                break;
-            }
-            let span = b.1.turn - a.1.turn;
-            let mut t = if span > 0.0 {
-                a.0 + (target - a.1.turn) / span * (b.0 - a.0)
-            } else {
-                0.5 * (a.0 + b.0)
-            };
-            if !(t > a.0 && t < b.0) {
-                t = 0.5 * (a.0 + b.0);
-            }
-            let c = at(t)?;
-            best = c;
-            // Illinois: an end kept twice has its value halved, so that the
-            // bracket shrinks from both sides.
-            if c.turn < target {
-                if side == -1 {
-                    b.1.turn = target + 0.5 * (b.1.turn - target);
-                }
-                a = (t, c);
-                side = -1;
-            } else {
-                if side == 1 {
-                    a.1.turn = target + 0.5 * (a.1.turn - target);
-                }
-                b = (t, c);
-                side = 1;
-            }
+        // The turn runs ahead of theta by a nearly constant amount: start
+        // from the last pose's offset.
+        let guess = (target - (prev.turn - prev.theta)).clamp(lo, hi);
+        let (a, b) = bracket(&at, prev, guess, target, step, hi)?;
+        if !(b.1.turn >= target - crate::tolerance::ROUNDING) {
+            return Err(out_of_reach(
+                "within the turns the groove's tables give the wheel",
+            ));
         }
+        let best = illinois(&at, a, b, target)?;
         if !((best.turn - target).abs() < 10.0 * TURN_TOLERANCE) {
-            return Err(InputError::out_of_range(
-                "the roll's turn a pass reaches (deg)",
-                target.to_degrees(),
-                format!(
-                    "a turn the wheel reaches at psi = {:.3} deg (the turn is not monotone in theta there)",
-                    psi.to_degrees()
-                ),
-            )
-            .into());
+            return Err(out_of_reach(
+                "a turn the wheel reaches (the turn is not monotone in theta there)",
+            ));
         }
-        let p_b = with_seed(groove, psi, best)?;
-        poses.push(p_b);
+        poses.push(with_seed(groove, psi, best)?);
     }
     poses.push(with_seed(groove, psi, last)?);
     Ok(poses)
+}
+
+/// A pose at theta with theta itself, an end of a bracket.
+type End = (Real, PassPose);
+
+/// A bracket of theta round the `target` turn: from the previous pose and
+/// the `guess`, widened from `step` doubling, up to `hi`; where the turn
+/// never reaches the target the upper end is `hi`'s, short of it.
+fn bracket(
+    at: &impl Fn(Real) -> Result<PassPose, GrooveError>,
+    prev: PassPose,
+    guess: Real,
+    target: Real,
+    step: Real,
+    hi: Real,
+) -> Result<(End, End), GrooveError> {
+    let mut a = (prev.theta, prev);
+    let mut b = (guess.max(prev.theta), at(guess.max(prev.theta))?);
+    let mut widen = step;
+    while b.1.turn < target && b.0 < hi {
+        a = b;
+        let t = (b.0 + widen).min(hi);
+        b = (t, at(t)?);
+        widen *= 2.0;
+    }
+    Ok((a, b))
+}
+
+/// The pose whose turn is `target` within [`TURN_TOLERANCE`], by the
+/// secant method kept inside the bracket `a`..`b` (Illinois: an end kept
+/// twice has its value halved, so that the bracket shrinks from both
+/// sides); the last pose tried where it stalls.
+fn illinois(
+    at: &impl Fn(Real) -> Result<PassPose, GrooveError>,
+    mut a: End,
+    mut b: End,
+    target: Real,
+) -> Result<PassPose, GrooveError> {
+    let mut best = if (a.1.turn - target).abs() < (b.1.turn - target).abs() {
+        a.1
+    } else {
+        b.1
+    };
+    let mut side = 0;
+    for _ in 0..200 {
+        if (best.turn - target).abs() < TURN_TOLERANCE || b.0 - a.0 < TURN_STALL {
+            break;
+        }
+        let span = b.1.turn - a.1.turn;
+        let mut t = if span > 0.0 {
+            a.0 + (target - a.1.turn) / span * (b.0 - a.0)
+        } else {
+            0.5 * (a.0 + b.0)
+        };
+        if !(t > a.0 && t < b.0) {
+            t = 0.5 * (a.0 + b.0);
+        }
+        let c = at(t)?;
+        best = c;
+        if c.turn < target {
+            if side == -1 {
+                b.1.turn = target + 0.5 * (b.1.turn - target);
+            }
+            a = (t, c);
+            side = -1;
+        } else {
+            if side == 1 {
+                a.1.turn = target + 0.5 * (a.1.turn - target);
+            }
+            b = (t, c);
+            side = 1;
+        }
+    }
+    Ok(best)
 }
 
 /// The deepest a step-over is split: `2^20` poses at most between two

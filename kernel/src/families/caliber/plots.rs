@@ -245,15 +245,7 @@ pub fn section_svg(
         root.fill(&WHITE).map_err(e)?;
         let (area, below) = root.split_vertically(640);
         let mut chart = ChartBuilder::on(&area)
-            .caption(
-                format!(
-                    "{} passes in the section at theta = {} deg (where the most material is left), wheel rounding r_k = {} mm",
-                    req.psi.len(),
-                    crate::math::fixed(check.max_left.theta_deg, 2),
-                    crate::math::fixed(rounding, 2)
-                ),
-                ("sans-serif", 16),
-            )
+            .caption(section_caption(check, req, rounding), ("sans-serif", 16))
             .margin(12)
             .x_label_area_size(44)
             .y_label_area_size(60)
@@ -298,21 +290,30 @@ pub fn section_svg(
                     .map(|&(_, _, p)| Circle::new(p, 3, RGBColor(214, 39, 40).filled())),
             )
             .map_err(e)?;
-        crate::chart::legend(
-            &below,
-            &[
-                ("the groove's section".into(), BLACK),
-                ("the wheel's rounding at each pass".into(), wheel),
-                ("its contact point".into(), RGBColor(214, 39, 40)),
-                ("the roll's periphery".into(), RGBColor(120, 120, 120)),
-            ],
-            (72, 230, 4),
-            13,
-        )
-        .map_err(e)?;
+        crate::chart::legend(&below, &section_legend(wheel), (72, 230, 4), 13).map_err(e)?;
         root.present().map_err(e)?;
     }
     Ok(svg)
+}
+
+/// The section's caption: its passes, its theta and the wheel's rounding.
+fn section_caption(check: &GrooveCheck, req: &GrooveRequest, rounding: f64) -> String {
+    format!(
+        "{} passes in the section at theta = {} deg (where the most material is left), wheel rounding r_k = {} mm",
+        req.psi.len(),
+        crate::math::fixed(check.max_left.theta_deg, 2),
+        crate::math::fixed(rounding, 2)
+    )
+}
+
+/// The section's legend, the wheel's rounding drawn in `wheel`.
+fn section_legend(wheel: RGBColor) -> [(String, RGBColor); 4] {
+    [
+        ("the groove's section".into(), BLACK),
+        ("the wheel's rounding at each pass".into(), wheel),
+        ("its contact point".into(), RGBColor(214, 39, 40)),
+        ("the roll's periphery".into(), RGBColor(120, 120, 120)),
+    ]
 }
 
 /// Points in the section's plane (mm).
