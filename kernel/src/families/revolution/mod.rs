@@ -7,7 +7,7 @@
 //!   over every spindle phase the program leaves open;
 //! - [`rest`]: the steady rest riding that surface (U at every block and
 //!   between blocks), the seed's formula beside it;
-//! - the replay (this module): [`check_grinding`] reads a grinding program
+//! - the replay (this module, each pass in `grinding`): [`check_grinding`] reads a grinding program
 //!   as a control does (its values as written, [`as_written`]), replays
 //!   every block through the machine's forward kinematics, and simulates
 //!   what the machine makes of it: the part turning while the wheel moves
@@ -25,16 +25,15 @@
 //! here.
 
 use crate::machine::MachineKinematics;
-use crate::math::{positive, Real};
-use crate::offset::{CapsuleEnvelope, Side};
-use crate::profile::{Profile, ProfileError};
+use crate::math::Real;
+use crate::offset::CapsuleEnvelope;
+use crate::profile::Profile;
 use crate::program::{AxisProgram, ProgramPass};
 use crate::tool::Wheel;
 use crate::transform::ToolFrame;
 use crate::verdict::{Figure, Finding};
-use phases::{Infeed, TimedPath};
 use serde::{Deserialize, Serialize};
-use surface::{touches, GroundSurface, PartLayer, PassLayer, WheelSection, GENERATRICES};
+use surface::{GroundSurface, PartLayer, GENERATRICES};
 
 /// The most the finish's worst may move when the generatrices double for
 /// the sampling to stand (mm): 0.1 um.
@@ -48,6 +47,7 @@ pub use crate::replay::{as_written, passes_in, replay, replay_blocks, VerifyErro
 pub use plots::deviation_svgs;
 pub use profile_svg::profile_svg;
 
+mod grinding;
 mod outcome;
 pub mod phases;
 mod plots;
@@ -225,7 +225,7 @@ pub fn replay_grinding(
     // says how far doubling from `m / 2` moved the finish's worst.
     let mut m = 2 * GENERATRICES;
     loop {
-        let (mut check, stock, half) = replay_on(
+        let (mut check, stock, half) = grinding::replay_on(
             program, machine, tool, wheel, passes, nominal, blank, range, tolerance, m,
         )?;
         let worst = check.passes.last().map_or(0.0, |p| p.deviation.max_abs);
@@ -235,316 +235,6 @@ pub fn replay_grinding(
         }
         m *= 2;
     }
-}
-
-/// [`replay_grinding`] on `m` generatrices (even), with the finish's worst
-/// over every other one.
-#[allow(clippy::too_many_arguments)]
-fn replay_on(
-    program: &AxisProgram,
-    machine: &dyn MachineKinematics,
-    tool: &ToolFrame,
-    wheel: &Wheel,
-    passes: &[ProgramPass],
-    nominal: &Profile,
-    blank: Option<&Profile>,
-    range: (Real, Real),
-    tolerance: Real,
-    m: usize,
-) -> Result<(GrindingCheck, Option<GroundStock>, Real), VerifyError> {
-    positive("verification tolerance", tolerance)?;
-    let (written, resolution) = as_written(program);
-    if tolerance < 2.0 * resolution {
-        return Err(VerifyError::Resolution {
-            tolerance,
-            resolution,
-        });
-    }
-    let poses = replay(&written, machine, tool)?;
-    let info = machine.info();
-    let axes: Vec<Option<&crate::machine::Axis>> =
-        written.axes.iter().map(|a| info.axis(&a.name)).collect();
-    let known: Vec<&crate::machine::Axis> = axes.iter().flatten().copied().collect();
-    // A rapid moves the wheel as fast as the slowest linear axis may.
-    let rapid = info
-        .axes
-        .iter()
-        .filter(|a| a.kind == crate::machine::AxisKind::Linear)
-        .map(|a| a.max_feed)
-        .fold(Real::INFINITY, Real::min);
-    let mut out = GrindingCheck {
-        tolerance,
-        generatrices: m,
-        sampling_change_mm: 0.0,
-        resolution_mm: resolution,
-        passes: Vec::new(),
-    };
-    let mut rpm = written.spindle_rpm;
-    // Each generatrix's earlier sweeps, with the block (from 1) of each of
-    // their touches: the surface a pass cuts into is their lowest.
-    let mut earlier: Vec<Vec<(CapsuleEnvelope, Vec<usize>)>> = (0..m).map(|_| Vec::new()).collect();
-    // Each generatrix's sweeps' cutting passes (from 0), and each cutting
-    // pass's blocks (from 0).
-    let mut ordinals: Vec<Vec<usize>> = vec![Vec::new(); m];
-    // The last pass's worst over every other generatrix.
-    let mut half_worst = 0.0;
-    let mut cut_blocks: Vec<std::ops::Range<usize>> = Vec::new();
-    // The surface over every spindle phase: before each cutting pass, and
-    // the time of each of its blocks (the cutting pass, from 0, and
-    // minutes from its start).
-    let mut phases = GroundSurface::new(match blank {
-        Some(b) => b.clone(),
-        None => nominal.clone(),
-    });
-    let mut phase_states = Vec::new();
-    let mut block_time = std::collections::BTreeMap::new();
-    for pass in passes {
-        let blocks = pass.blocks.clone();
-        crate::budget::check("the grinding replay")?;
-        for b in &written.blocks[blocks.clone()] {
-            if let Some(s) = b.spindle {
-                rpm = s;
-            }
-        }
-        if !pass.cuts {
-            continue;
-        }
-        let z: Vec<Real> = blocks.clone().map(|b| poses[6 * b + 2]).collect();
-        let x: Vec<Real> = blocks
-            .clone()
-            .map(|b| poses[6 * b].hypot(poses[6 * b + 1]))
-            .collect();
-        // The wheel's speed along its (z, x) line on block k (from block
-        // k - 1, `line` mm): the block's feed over the control's path
-        // (every linear axis of the block).
-        let line_feed = |k: usize, line: Real| {
-            let (a, b) = (&written.blocks[k - 1], &written.blocks[k]);
-            let deltas: Vec<Real> = a
-                .values
-                .iter()
-                .zip(&b.values)
-                .zip(&axes)
-                .filter(|(_, ax)| ax.is_some())
-                .map(|((p, q), _)| q - p)
-                .collect();
-            let path = crate::machine::feed_length(&known, &deltas, &info.setup.feed_group);
-            let f = if b.motion == crate::toolpath::Motion::Rapid {
-                rapid
-            } else {
-                b.feed
-            };
-            // A move that leaves the wheel standing (only the rest's U
-            // moves) adds no length to the wheel's path and no time to it:
-            // the part's turn meanwhile shifts every later touch alike,
-            // which the phases, free over every spindle phase, already
-            // cover.
-            if path > 0.0 && line > 0.0 {
-                f * line / path
-            } else {
-                f
-            }
-        };
-        let mut feeds = vec![0.0; z.len()];
-        let mut cutting_feed: Real = 0.0;
-        for (i, k) in blocks.clone().enumerate().skip(1) {
-            let b = &written.blocks[k];
-            if b.motion != crate::toolpath::Motion::Rapid {
-                cutting_feed = cutting_feed.max(b.feed);
-            }
-            feeds[i] = line_feed(k, (z[i] - z[i - 1]).hypot(x[i] - x[i - 1]));
-        }
-        // The wheel came to the pass's first point by the block before it
-        // (the infeed at its feed, the part turning all the while).
-        let infeed = match blocks.start {
-            k if k > 0 && !blocks.is_empty() => {
-                let (iz, ix) = (
-                    poses[6 * (k - 1) + 2],
-                    poses[6 * (k - 1)].hypot(poses[6 * (k - 1) + 1]),
-                );
-                Some(Infeed {
-                    z: iz,
-                    x: ix,
-                    feed: line_feed(k, (z[0] - iz).hypot(x[0] - ix)),
-                })
-            }
-            _ => None,
-        };
-        let timed = TimedPath::entered(infeed, &z, &x, &feeds)?;
-        let t = touches(&timed, rpm, m)?;
-        phase_states.push(phases.clone());
-        // The same section at the same moments, over every spindle phase.
-        let section = WheelSection {
-            radius: wheel.rounding_radius,
-            flat: wheel.flat(),
-        };
-        let layer = PassLayer::timed(timed, section, rpm)?;
-        block_time.extend(
-            blocks
-                .clone()
-                .zip(layer.path().times())
-                .map(|(k, &tm)| (k, (cut_blocks.len(), tm))),
-        );
-        phases = phases.with(layer);
-        // Each generatrix met: the wheel's section at its touches.
-        let met: Vec<usize> = (0..t.z.len()).filter(|&g| !t.z[g].is_empty()).collect();
-        let envs = met
-            .iter()
-            .map(|&g| {
-                CapsuleEnvelope::new(
-                    &t.z[g],
-                    &t.x[g],
-                    wheel.rounding_radius,
-                    wheel.flat(),
-                    Side::Outside,
-                )
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        let mut zs =
-            crate::profile::uniform_grid(range.0, range.1, (tolerance * 20.0).clamp(0.005, 0.05))?;
-        zs.extend(
-            nominal
-                .z()
-                .iter()
-                .copied()
-                .filter(|z| (range.0..=range.1).contains(z)),
-        );
-        // Where this pass's ridges and the earlier ones' peak.
-        for env in envs.iter().chain(earlier.iter().flatten().map(|(e, _)| e)) {
-            zs.extend(env.kinks(range.0, range.1));
-        }
-        zs.sort_by(Real::total_cmp);
-        zs.dedup();
-        let profile = nominal.eval_many(&zs)?;
-        let before = match blank {
-            Some(b) => b.eval_many(&zs)?,
-            None => vec![Real::INFINITY; zs.len()],
-        };
-        let mut d = Deviation {
-            max_above: Real::NEG_INFINITY,
-            above_z: range.0,
-            max_below: Real::INFINITY,
-            below_z: range.0,
-            max_abs: 0.0,
-            at_z: range.0,
-            block: None,
-        };
-        // The generatrix of the largest value above and below.
-        let (mut g_above, mut g_below) = (0, 0);
-        let (mut half_above, mut half_below) = (Real::NEG_INFINITY, Real::INFINITY);
-        let mut lo = vec![Real::INFINITY; zs.len()];
-        let mut hi = vec![Real::NEG_INFINITY; zs.len()];
-        for (g, env) in envs.iter().enumerate() {
-            crate::budget::check("the grinding replay")?;
-            let surface = env.eval_many(&zs);
-            // The surface the pass cut into (not finite where an earlier
-            // sweep never reached: there it does not bound).
-            let mut under = before.clone();
-            for (e, _) in &earlier[met[g]] {
-                for (u, s) in under.iter_mut().zip(e.eval_many(&zs)) {
-                    if s.is_finite() {
-                        *u = u.min(s);
-                    }
-                }
-            }
-            for (i, ((&z, &s), &p)) in zs.iter().zip(&surface).zip(&profile).enumerate() {
-                if !s.is_finite() {
-                    return Err(VerifyError::Pass {
-                        pass: pass.name.clone(),
-                        source: ProfileError::OutsideProfile {
-                            what: format!(
-                                "generatrix {} of {m}: the wheel never reached the profile",
-                                met[g] + 1
-                            ),
-                            z,
-                            z_min: range.0,
-                            z_max: range.1,
-                        },
-                    });
-                }
-                let e = s.min(under[i]) - p;
-                (lo[i], hi[i]) = (lo[i].min(e), hi[i].max(e));
-                if e > d.max_above {
-                    (d.max_above, d.above_z, g_above) = (e, z, g);
-                }
-                if e < d.max_below {
-                    (d.max_below, d.below_z, g_below) = (e, z, g);
-                }
-                if met[g].is_multiple_of(2) {
-                    (half_above, half_below) = (half_above.max(e), half_below.min(e));
-                }
-            }
-        }
-        // The phases' surface against the highest generatrix.
-        let envelope = phases.cut_many(&zs);
-        let (mut stand_off, mut stand_off_z) = (0.0, range.0);
-        for i in 0..zs.len() {
-            let s = envelope[i].min(before[i]) - (hi[i] + profile[i]);
-            if s.is_finite() && s > stand_off {
-                (stand_off, stand_off_z) = (s, zs[i]);
-            }
-        }
-        half_worst = if half_above >= -half_below {
-            half_above.abs()
-        } else {
-            half_below.abs()
-        };
-        let gen_at = if d.max_above >= -d.max_below {
-            (d.max_abs, d.at_z) = (d.max_above.abs(), d.above_z);
-            g_above
-        } else {
-            (d.max_abs, d.at_z) = (d.max_below.abs(), d.below_z);
-            g_below
-        };
-        // The touch forming the worst place: of this pass's sweep or of the
-        // earlier one lowest there (none where the blank is lowest).
-        for (env, g) in envs.into_iter().zip(&met) {
-            let touched: Vec<usize> = t.block[*g].iter().map(|&k| blocks.start + k + 1).collect();
-            earlier[*g].push((env, touched));
-            ordinals[*g].push(cut_blocks.len());
-        }
-        cut_blocks.push(blocks.clone());
-        let (this, before) = earlier[met[gen_at]]
-            .split_last()
-            .expect("this pass's sweep was just kept");
-        let at = [d.at_z];
-        let lowest = std::iter::once(this)
-            .chain(before)
-            .map(|(e, b)| (e.eval_many(&at)[0], e, b))
-            .filter(|(s, _, _)| s.is_finite())
-            .min_by(|a, b| a.0.total_cmp(&b.0));
-        let blank_at = blank.map_or(Ok(Real::INFINITY), |b| b.eval(d.at_z))?;
-        d.block = lowest
-            .filter(|(s, _, _)| *s <= blank_at)
-            .and_then(|(_, e, b)| e.source_at(d.at_z).and_then(|i| b.get(i)).copied());
-        let f = if rpm > 0.0 { cutting_feed / rpm } else { 0.0 };
-        out.passes.push(PassCheck {
-            name: pass.name.clone(),
-            first_block: blocks.start + 1,
-            feed_mm_min: cutting_feed,
-            spindle_rpm: rpm,
-            feed_per_rev_mm: f,
-            ridge_mm: wheel.ridge(f),
-            deviation: d,
-            phase_stand_off_mm: stand_off,
-            phase_stand_off_z: stand_off_z,
-            along_z: bucketed(&zs, &lo, &hi, PROFILE_BUCKETS),
-        });
-    }
-    if out.passes.is_empty() {
-        return Err(VerifyError::NoCuttingPass);
-    }
-    let stock = match blank {
-        Some(b) => {
-            phase_states.push(phases);
-            let mut stock =
-                GroundStock::new(&out, b, nominal, wheel, &earlier, &ordinals, cut_blocks)?;
-            stock.phases = phase_states;
-            stock.block_time = block_time;
-            Some(stock)
-        }
-        None => None,
-    };
-    Ok((out, stock, half_worst))
 }
 
 /// The spacing of [`GroundStock`]'s grid along z (mm): the wheel's and the

@@ -1,0 +1,477 @@
+//! The grinding passes replayed one after another on `m` generatrices:
+//! each pass's wheel path timed as the control runs it, the wheel's
+//! section where each generatrix meets it, the surface it leaves (the
+//! lowest of its sweep, the earlier sweeps' and the blank) against the
+//! nominal profile, the surface over every spindle phase, and the block
+//! whose touch forms the worst place.
+
+use super::phases::{Infeed, TimedPath};
+use super::surface::{touches, GroundSurface, PassLayer, Touches, WheelSection};
+use super::{bucketed, Deviation, GrindingCheck, GroundStock, PassCheck, PROFILE_BUCKETS};
+use crate::machine::{Axis, AxisKind, MachineInfo, MachineKinematics};
+use crate::math::{positive, Real};
+use crate::offset::{CapsuleEnvelope, Side};
+use crate::profile::{Profile, ProfileError};
+use crate::program::{AxisProgram, ProgramPass};
+use crate::replay::{as_written, replay, VerifyError};
+use crate::tool::Wheel;
+use crate::toolpath::Motion;
+use crate::transform::ToolFrame;
+use std::collections::BTreeMap;
+use std::ops::Range;
+
+/// A generatrix's sweeps so far, each with the block (from 1) of each of
+/// its touches.
+type Sweeps = Vec<(CapsuleEnvelope, Vec<usize>)>;
+
+/// [`super::replay_grinding`] on `m` generatrices (even), with the
+/// finish's worst over every other one.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn replay_on(
+    program: &AxisProgram,
+    machine: &dyn MachineKinematics,
+    tool: &ToolFrame,
+    wheel: &Wheel,
+    passes: &[ProgramPass],
+    nominal: &Profile,
+    blank: Option<&Profile>,
+    range: (Real, Real),
+    tolerance: Real,
+    m: usize,
+) -> Result<(GrindingCheck, Option<GroundStock>, Real), VerifyError> {
+    positive("verification tolerance", tolerance)?;
+    let (written, resolution) = as_written(program);
+    if tolerance < 2.0 * resolution {
+        return Err(VerifyError::Resolution {
+            tolerance,
+            resolution,
+        });
+    }
+    let info = machine.info();
+    let on = Setting {
+        written: &written,
+        poses: replay(&written, machine, tool)?,
+        axes: written.axes.iter().map(|a| info.axis(&a.name)).collect(),
+        info,
+        rapid: rapid(info),
+        wheel,
+        nominal,
+        blank,
+        range,
+        tolerance,
+        m,
+    };
+    let mut out = GrindingCheck {
+        tolerance,
+        generatrices: m,
+        sampling_change_mm: 0.0,
+        resolution_mm: resolution,
+        passes: Vec::new(),
+    };
+    let mut run = Run {
+        earlier: (0..m).map(|_| Vec::new()).collect(),
+        ordinals: vec![Vec::new(); m],
+        cut_blocks: Vec::new(),
+        phases: GroundSurface::new(blank.unwrap_or(nominal).clone()),
+        phase_states: Vec::new(),
+        block_time: BTreeMap::new(),
+    };
+    let (mut rpm, mut half_worst) = (written.spindle_rpm, 0.0);
+    for pass in passes {
+        crate::budget::check("the grinding replay")?;
+        for b in &written.blocks[pass.blocks.clone()] {
+            if let Some(s) = b.spindle {
+                rpm = s;
+            }
+        }
+        if pass.cuts {
+            let (check, half) = on.pass(pass, rpm, &mut run)?;
+            out.passes.push(check);
+            half_worst = half;
+        }
+    }
+    if out.passes.is_empty() {
+        return Err(VerifyError::NoCuttingPass);
+    }
+    let stock = match blank {
+        Some(b) => {
+            run.phase_states.push(run.phases);
+            let mut stock = GroundStock::new(
+                &out,
+                b,
+                nominal,
+                wheel,
+                &run.earlier,
+                &run.ordinals,
+                run.cut_blocks,
+            )?;
+            stock.phases = run.phase_states;
+            stock.block_time = run.block_time;
+            Some(stock)
+        }
+        None => None,
+    };
+    Ok((out, stock, half_worst))
+}
+
+/// A rapid moves the wheel as fast as the slowest linear axis may (mm/min).
+fn rapid(info: &MachineInfo) -> Real {
+    info.axes
+        .iter()
+        .filter(|a| a.kind == AxisKind::Linear)
+        .map(|a| a.max_feed)
+        .fold(Real::INFINITY, Real::min)
+}
+
+/// What every pass is replayed on: the program as written, its poses, the
+/// machine, the wheel, the profiles and the range checked.
+struct Setting<'a> {
+    written: &'a AxisProgram,
+    /// The replayed poses, 6 per block.
+    poses: Vec<Real>,
+    /// The machine's axis of each of the program's axes, where it has it.
+    axes: Vec<Option<&'a Axis>>,
+    info: &'a MachineInfo,
+    /// The wheel's speed on a rapid (mm/min).
+    rapid: Real,
+    wheel: &'a Wheel,
+    nominal: &'a Profile,
+    blank: Option<&'a Profile>,
+    range: (Real, Real),
+    tolerance: Real,
+    /// The generatrices.
+    m: usize,
+}
+
+/// What the passes replayed so far leave for the next.
+struct Run {
+    /// Each generatrix's earlier sweeps: the surface a pass cuts into is
+    /// their lowest.
+    earlier: Vec<Sweeps>,
+    /// Each generatrix's sweeps' cutting passes (from 0).
+    ordinals: Vec<Vec<usize>>,
+    /// Each cutting pass's blocks (from 0).
+    cut_blocks: Vec<Range<usize>>,
+    /// The surface over every spindle phase so far.
+    phases: GroundSurface,
+    /// That surface before each cutting pass.
+    phase_states: Vec<GroundSurface>,
+    /// Each cutting block's pass (from 0) and minutes from its start.
+    block_time: BTreeMap<usize, (usize, Real)>,
+}
+
+/// How a pass's surface strays from the nominal over its generatrices.
+struct Spread {
+    /// The pass's deviation (its block not yet found).
+    deviation: Deviation,
+    /// The generatrix met (an index into the pass's sweeps) forming the
+    /// largest of it.
+    worst: usize,
+    /// The largest over every other generatrix (mm).
+    half_worst: Real,
+    /// The least and the greatest over the generatrices at each z (mm).
+    lo: Vec<Real>,
+    hi: Vec<Real>,
+}
+
+impl Setting<'_> {
+    /// One cutting pass replayed at `rpm` on the surface `run` holds,
+    /// which it then holds too: its check, and its worst over every other
+    /// generatrix.
+    fn pass(
+        &self,
+        pass: &ProgramPass,
+        rpm: Real,
+        run: &mut Run,
+    ) -> Result<(PassCheck, Real), VerifyError> {
+        let blocks = pass.blocks.clone();
+        let (timed, cutting_feed) = self.timed(blocks.clone())?;
+        let t = touches(&timed, rpm, self.m)?;
+        run.phase_states.push(run.phases.clone());
+        // The same section at the same moments, over every spindle phase.
+        let section = WheelSection {
+            radius: self.wheel.rounding_radius,
+            flat: self.wheel.flat(),
+        };
+        let layer = PassLayer::timed(timed, section, rpm)?;
+        let pass_index = run.cut_blocks.len();
+        run.block_time.extend(
+            blocks
+                .clone()
+                .zip(layer.path().times())
+                .map(|(k, &tm)| (k, (pass_index, tm))),
+        );
+        run.phases = run.phases.with(layer);
+        // Each generatrix met: the wheel's section at its touches.
+        let met: Vec<usize> = (0..t.z.len()).filter(|&g| !t.z[g].is_empty()).collect();
+        let envs = met
+            .iter()
+            .map(|&g| {
+                let (w, flat) = (self.wheel.rounding_radius, self.wheel.flat());
+                CapsuleEnvelope::new(&t.z[g], &t.x[g], w, flat, Side::Outside)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let zs = self.grid(&envs, &run.earlier)?;
+        let profile = self.nominal.eval_many(&zs)?;
+        let before = match self.blank {
+            Some(b) => b.eval_many(&zs)?,
+            None => vec![Real::INFINITY; zs.len()],
+        };
+        let mut spread = self.spread(pass, &zs, &profile, &before, &envs, &met, &run.earlier)?;
+        // The phases' surface against the highest generatrix.
+        let envelope = run.phases.cut_many(&zs);
+        let (mut stand_off, mut stand_off_z) = (0.0, self.range.0);
+        for i in 0..zs.len() {
+            let s = envelope[i].min(before[i]) - (spread.hi[i] + profile[i]);
+            if s.is_finite() && s > stand_off {
+                (stand_off, stand_off_z) = (s, zs[i]);
+            }
+        }
+        let worst_generatrix = met[spread.worst];
+        keep(run, envs, &met, &t, blocks.clone());
+        spread.deviation.block =
+            self.forming_block(&run.earlier[worst_generatrix], spread.deviation.at_z)?;
+        let f = if rpm > 0.0 { cutting_feed / rpm } else { 0.0 };
+        let check = PassCheck {
+            name: pass.name.clone(),
+            first_block: blocks.start + 1,
+            feed_mm_min: cutting_feed,
+            spindle_rpm: rpm,
+            feed_per_rev_mm: f,
+            ridge_mm: self.wheel.ridge(f),
+            deviation: spread.deviation,
+            phase_stand_off_mm: stand_off,
+            phase_stand_off_z: stand_off_z,
+            along_z: bucketed(&zs, &spread.lo, &spread.hi, PROFILE_BUCKETS),
+        };
+        Ok((check, spread.half_worst))
+    }
+
+    /// The wheel's path over `blocks` in the (z, x) plane, each point
+    /// with the time it is reached, from the infeed of the block before;
+    /// and the pass's cutting feed (mm/min, the largest of its moves).
+    fn timed(&self, blocks: Range<usize>) -> Result<(TimedPath, Real), VerifyError> {
+        let p = &self.poses;
+        let z: Vec<Real> = blocks.clone().map(|b| p[6 * b + 2]).collect();
+        let x: Vec<Real> = blocks
+            .clone()
+            .map(|b| p[6 * b].hypot(p[6 * b + 1]))
+            .collect();
+        let mut feeds = vec![0.0; z.len()];
+        let mut cutting_feed: Real = 0.0;
+        for (i, k) in blocks.clone().enumerate().skip(1) {
+            let b = &self.written.blocks[k];
+            if b.motion != Motion::Rapid {
+                cutting_feed = cutting_feed.max(b.feed);
+            }
+            feeds[i] = self.line_feed(k, (z[i] - z[i - 1]).hypot(x[i] - x[i - 1]));
+        }
+        // The wheel came to the pass's first point by the block before it
+        // (the infeed at its feed, the part turning all the while).
+        let infeed = match blocks.start {
+            k if k > 0 && !blocks.is_empty() => {
+                let (iz, ix) = (p[6 * (k - 1) + 2], p[6 * (k - 1)].hypot(p[6 * (k - 1) + 1]));
+                Some(Infeed {
+                    z: iz,
+                    x: ix,
+                    feed: self.line_feed(k, (z[0] - iz).hypot(x[0] - ix)),
+                })
+            }
+            _ => None,
+        };
+        Ok((TimedPath::entered(infeed, &z, &x, &feeds)?, cutting_feed))
+    }
+
+    /// The wheel's speed along its (z, x) line on block `k` (from block
+    /// `k - 1`, `line` mm): the block's feed over the control's path
+    /// (every linear axis of the block).
+    fn line_feed(&self, k: usize, line: Real) -> Real {
+        let (a, b) = (&self.written.blocks[k - 1], &self.written.blocks[k]);
+        let deltas: Vec<Real> = a
+            .values
+            .iter()
+            .zip(&b.values)
+            .zip(&self.axes)
+            .filter(|(_, ax)| ax.is_some())
+            .map(|((p, q), _)| q - p)
+            .collect();
+        let known: Vec<&Axis> = self.axes.iter().flatten().copied().collect();
+        let path = crate::machine::feed_length(&known, &deltas, &self.info.setup.feed_group);
+        let f = if b.motion == Motion::Rapid {
+            self.rapid
+        } else {
+            b.feed
+        };
+        // A move that leaves the wheel standing (only the rest's U moves)
+        // adds no length to the wheel's path and no time to it: the part's
+        // turn meanwhile shifts every later touch alike, which the phases,
+        // free over every spindle phase, already cover.
+        if path > 0.0 && line > 0.0 {
+            f * line / path
+        } else {
+            f
+        }
+    }
+
+    /// Where a pass's surface is measured: a grid over the range (20
+    /// times finer than the tolerance, within 5 to 50 um), the nominal's
+    /// nodes, and where this pass's ridges and the earlier ones' peak.
+    fn grid(&self, envs: &[CapsuleEnvelope], earlier: &[Sweeps]) -> Result<Vec<Real>, VerifyError> {
+        let (z0, z1) = self.range;
+        let step = (self.tolerance * 20.0).clamp(0.005, 0.05);
+        let mut zs = crate::profile::uniform_grid(z0, z1, step)?;
+        zs.extend(
+            self.nominal
+                .z()
+                .iter()
+                .copied()
+                .filter(|z| (z0..=z1).contains(z)),
+        );
+        for env in envs.iter().chain(earlier.iter().flatten().map(|(e, _)| e)) {
+            zs.extend(env.kinks(z0, z1));
+        }
+        zs.sort_by(Real::total_cmp);
+        zs.dedup();
+        Ok(zs)
+    }
+
+    /// The pass's surface on each generatrix met (`envs`, the generatrices
+    /// `met`) at `zs` against the nominal `profile`: the lowest of its
+    /// sweep, the earlier sweeps and the blank (`before`).
+    #[allow(clippy::too_many_arguments)]
+    fn spread(
+        &self,
+        pass: &ProgramPass,
+        zs: &[Real],
+        profile: &[Real],
+        before: &[Real],
+        envs: &[CapsuleEnvelope],
+        met: &[usize],
+        earlier: &[Sweeps],
+    ) -> Result<Spread, VerifyError> {
+        let z0 = self.range.0;
+        let mut d = Deviation {
+            max_above: Real::NEG_INFINITY,
+            above_z: z0,
+            max_below: Real::INFINITY,
+            below_z: z0,
+            max_abs: 0.0,
+            at_z: z0,
+            block: None,
+        };
+        // The generatrix of the largest value above and below.
+        let (mut g_above, mut g_below) = (0, 0);
+        let (mut half_above, mut half_below) = (Real::NEG_INFINITY, Real::INFINITY);
+        let mut lo = vec![Real::INFINITY; zs.len()];
+        let mut hi = vec![Real::NEG_INFINITY; zs.len()];
+        for (g, env) in envs.iter().enumerate() {
+            crate::budget::check("the grinding replay")?;
+            let surface = env.eval_many(zs);
+            let under = cut_into(before, &earlier[met[g]], zs);
+            for (i, ((&z, &s), &p)) in zs.iter().zip(&surface).zip(profile).enumerate() {
+                if !s.is_finite() {
+                    return Err(self.never_reached(pass, met[g], z));
+                }
+                let e = s.min(under[i]) - p;
+                (lo[i], hi[i]) = (lo[i].min(e), hi[i].max(e));
+                if e > d.max_above {
+                    (d.max_above, d.above_z, g_above) = (e, z, g);
+                }
+                if e < d.max_below {
+                    (d.max_below, d.below_z, g_below) = (e, z, g);
+                }
+                if met[g].is_multiple_of(2) {
+                    (half_above, half_below) = (half_above.max(e), half_below.min(e));
+                }
+            }
+        }
+        let half_worst = if half_above >= -half_below {
+            half_above.abs()
+        } else {
+            half_below.abs()
+        };
+        let worst = if d.max_above >= -d.max_below {
+            (d.max_abs, d.at_z) = (d.max_above.abs(), d.above_z);
+            g_above
+        } else {
+            (d.max_abs, d.at_z) = (d.max_below.abs(), d.below_z);
+            g_below
+        };
+        Ok(Spread {
+            deviation: d,
+            worst,
+            half_worst,
+            lo,
+            hi,
+        })
+    }
+
+    /// The refusal of a pass that leaves generatrix `g` (from 0) unmet at
+    /// `z`: the wheel never reached the profile there.
+    fn never_reached(&self, pass: &ProgramPass, g: usize, z: Real) -> VerifyError {
+        VerifyError::Pass {
+            pass: pass.name.clone(),
+            source: ProfileError::OutsideProfile {
+                what: format!(
+                    "generatrix {} of {}: the wheel never reached the profile",
+                    g + 1,
+                    self.m
+                ),
+                z,
+                z_min: self.range.0,
+                z_max: self.range.1,
+            },
+        }
+    }
+
+    /// The block whose touch forms the surface at `z` on a generatrix
+    /// with `sweeps` (this pass's last): of this pass's sweep or of the
+    /// earlier one lowest there; none where the blank is lowest.
+    fn forming_block(&self, sweeps: &Sweeps, z: Real) -> Result<Option<usize>, VerifyError> {
+        let (this, before) = sweeps
+            .split_last()
+            .expect("this pass's sweep was just kept");
+        let at = [z];
+        let lowest = std::iter::once(this)
+            .chain(before)
+            .map(|(e, b)| (e.eval_many(&at)[0], e, b))
+            .filter(|(s, _, _)| s.is_finite())
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        let blank_at = self.blank.map_or(Ok(Real::INFINITY), |b| b.eval(z))?;
+        Ok(lowest
+            .filter(|(s, _, _)| *s <= blank_at)
+            .and_then(|(_, e, b)| e.source_at(z).and_then(|i| b.get(i)).copied()))
+    }
+}
+
+/// The surface a sweep cuts into at `zs`: the lowest of the blank
+/// (`before`) and the generatrix's `earlier` sweeps (those not finite where
+/// they never reached: there they do not bound).
+fn cut_into(before: &[Real], earlier: &Sweeps, zs: &[Real]) -> Vec<Real> {
+    let mut under = before.to_vec();
+    for (e, _) in earlier {
+        for (u, s) in under.iter_mut().zip(e.eval_many(zs)) {
+            if s.is_finite() {
+                *u = u.min(s);
+            }
+        }
+    }
+    under
+}
+
+/// A pass's sweeps (`envs`, on the generatrices `met`, touched as `t`
+/// says) kept in `run` for the passes after it.
+fn keep(
+    run: &mut Run,
+    envs: Vec<CapsuleEnvelope>,
+    met: &[usize],
+    t: &Touches,
+    blocks: Range<usize>,
+) {
+    for (env, &g) in envs.into_iter().zip(met) {
+        let touched: Vec<usize> = t.block[g].iter().map(|&k| blocks.start + k + 1).collect();
+        run.earlier[g].push((env, touched));
+        run.ordinals[g].push(run.cut_blocks.len());
+    }
+    run.cut_blocks.push(blocks);
+}
