@@ -431,27 +431,10 @@ fn no_long_function_in_the_run_the_page_or_a_family() {
     }
     files.retain(|f| f.file_name().is_none_or(|n| n != "tests.rs"));
     assert!(files.len() > 30, "{files:?}");
-    // Not yet split (the next step's work): each named here may only
-    // shrink out of this list; any other function over 80 lines fails.
-    const NOT_YET: [(&str, &str); 1] = [
-        ("revolution/rest.rs", "track"),
-    ];
     let long = long_functions(&files, 80);
-    let listed = |l: &String, (file, name): (&str, &str)| {
-        l.contains(&format!("families/{file}:")) && l.contains(&format!(" {name} ("))
-    };
-    let new: Vec<&String> = (long.iter())
-        .filter(|l| !NOT_YET.iter().any(|n| listed(l, *n)))
-        .collect();
     assert!(
-        new.is_empty(),
-        "{} functions over 80 lines:\n{new:#?}",
-        new.len()
+        long.is_empty(),
+        "{} functions over 80 lines:\n{long:#?}",
+        long.len()
     );
-    for n in NOT_YET {
-        assert!(
-            long.iter().any(|l| listed(l, n)),
-            "{n:?} is no longer over 80 lines: take it off the list"
-        );
-    }
 }

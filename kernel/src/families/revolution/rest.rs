@@ -253,37 +253,14 @@ pub fn track(
     }
     let layer = PassLayer::new(&path.z, &path.x, wheel, feed, infeed, rpm)?;
     let time = layer.path().times();
-    let (lo, hi) = before.z_range();
-    // The exact drop with the wheel at `(z, time)`, and the seed's formula
-    // there if asked.
-    let at = |z: Real, time: Real, k: usize, seed: bool| -> Result<(Drop, Real), ProfileError> {
-        let z_r = z + setup.offset_b;
-        let part = Some(layer.by_time(time));
-        let Some(d) = before.support(z_r, setup.radius, setup.sample, part.as_ref())? else {
-            return Err(ProfileError::OutsideProfile {
-                what: format!(
-                    "the steady rest's support at point {} of the pass (z_r = z + B, B = {} mm) has nothing under it: its centre",
-                    k + 1,
-                    crate::math::fixed(setup.offset_b, 4)
-                ),
-                z: z_r,
-                z_min: lo,
-                z_max: hi,
-            });
-        };
-        if !seed {
-            return Ok((d, Real::NAN));
-        }
-        // The seed's formula reads the surface as an array at an even step.
-        let (a, b) = ((z_r - setup.radius).max(lo), (z_r + setup.radius).min(hi));
-        let grid = crate::profile::uniform_grid(a, b, setup.sample)?;
-        let even = Profile::new(grid.clone(), before.eval_many(&grid, part.as_ref()))?;
-        let seed = seed_u(&even, z_r.clamp(a, b), setup.radius)?;
-        Ok((d, seed))
+    let rider = Rider {
+        before,
+        layer: &layer,
+        setup,
     };
     // Exact U at every point, then at samples along each move, adding the
     // worst sample as a point where the straight line strays.
-    let mut pts: Vec<(Real, Real, Real)> = path
+    let mut pts: Vec<Point> = path
         .z
         .iter()
         .zip(&path.x)
@@ -293,7 +270,7 @@ pub fn track(
     let mut drops: Vec<(Drop, Real)> = pts
         .iter()
         .enumerate()
-        .map(|(k, p)| at(p.0, p.2, k, true))
+        .map(|(k, p)| rider.drop_at(p.0, p.2, k, true))
         .collect::<Result<_, _>>()?;
     let (mut max_gap, mut max_press) = (0.0 as Real, 0.0 as Real);
     let mut stand_off = vec![[pts[0].0 + setup.offset_b, 0.0]];
@@ -302,68 +279,12 @@ pub fn track(
     while k < pts.len() {
         crate::budget::check("the steady rest's track")?;
         let (a, b) = (pts[k - 1], pts[k]);
-        let (ua, ub) = (drops[k - 1].0.centre_x, drops[k].0.centre_x);
-        let n = ((b.0 - a.0).abs() / REST_CHECK_STEP)
-            .ceil()
-            .max(MIN_REST_CHECKS as Real) as usize;
-        let mut worst: Option<(Real, Real)> = None;
-        let (mut gap, mut press) = (0.0 as Real, 0.0 as Real);
-        let mut checked = Vec::with_capacity(n);
-        let mut contact = drops[k - 1].0.contact_z;
-        let mut kink: Option<(Real, Real)> = None;
-        let at_s = |s: Real| at(a.0 + s * (b.0 - a.0), a.2 + s * (b.2 - a.2), k, false);
-        for i in 1..=n {
-            crate::budget::check("the steady rest's track")?;
-            let s = i as Real / n as Real;
-            let d = if i == n { drops[k].0 } else { at_s(s)?.0 };
-            // The support's contact jumping from one feature of the
-            // surface to another (a corner, a step, where a pass's cut
-            // begins) is a kink in U: found to within KINK_WIDTH and made
-            // a block, so the straight lines either side follow smooth arcs.
-            let dz = (b.0 - a.0).abs() / n as Real;
-            if kink.is_none() && dz > KINK_WIDTH && (d.contact_z - contact).abs() > 2.0 * dz + 1e-3
-            {
-                let (mut lo, mut hi) = ((i - 1) as Real / n as Real, s);
-                let from = contact;
-                while (hi - lo) * (b.0 - a.0).abs() > KINK_WIDTH {
-                    let m = 0.5 * (lo + hi);
-                    if (at_s(m)?.0.contact_z - from).abs()
-                        > 2.0 * (m - lo) * (b.0 - a.0).abs() + 1e-3
-                    {
-                        hi = m;
-                    } else {
-                        lo = m;
-                    }
-                }
-                kink = Some((lo, hi));
-            }
-            contact = d.contact_z;
-            if i == n {
-                break;
-            }
-            let (exact, line) = (d.centre_x, ua + s * (ub - ua));
-            checked.push([a.0 + s * (b.0 - a.0) + setup.offset_b, line - exact]);
-            gap = gap.max(line - exact);
-            press = press.max(exact - line);
-            let dev = (line - exact).abs();
-            if dev > setup.tolerance && worst.is_none_or(|w| dev > w.0) {
-                worst = Some((dev, s));
-            }
-        }
-        // Where the line strays: a kink in the move gets a block either
-        // side of it (the short move between them has no room to stray),
-        // else a block goes at the worst place.
-        let add: Vec<Real> = match (kink, worst) {
-            (Some((lo, hi)), Some(_)) => [lo, hi]
-                .into_iter()
-                .filter(|s| *s > 0.0 && *s < 1.0)
-                .collect(),
-            (_, w) => w.map(|w| w.1).into_iter().collect(),
-        };
+        let along = rider.along(a, b, k, [drops[k - 1].0, drops[k].0])?;
+        let add = along.added();
         if add.is_empty() {
-            max_gap = max_gap.max(gap);
-            max_press = max_press.max(press);
-            stand_off.extend(checked);
+            max_gap = max_gap.max(along.gap);
+            max_press = max_press.max(along.press);
+            stand_off.extend(along.checked);
             stand_off.push([b.0 + setup.offset_b, 0.0]);
             k += 1;
             continue;
@@ -382,38 +303,204 @@ pub fn track(
                 a.1 + s * (b.1 - a.1),
                 a.2 + s * (b.2 - a.2),
             );
-            let d = at(p.0, p.2, k + j, true)?;
+            let d = rider.drop_at(p.0, p.2, k + j, true)?;
             pts.insert(k + j, p);
             drops.insert(k + j, d);
         }
     }
-    let mut out = RestTrack {
-        path: Polyline {
-            z: pts.iter().map(|p| p.0).collect(),
-            x: pts.iter().map(|p| p.1).collect(),
-        },
-        centre_x: Vec::with_capacity(pts.len()),
-        contact_z: Vec::with_capacity(pts.len()),
-        contact_x: Vec::with_capacity(pts.len()),
-        seed_centre_x: Vec::with_capacity(pts.len()),
-        max_model_difference: 0.0,
-        max_difference_block: 0,
-        max_gap,
-        max_press,
-        added: pts.len() - original,
+    let added = pts.len() - original;
+    Ok(RestTrack::of(
+        &pts,
+        &drops,
+        [max_gap, max_press],
+        added,
         stand_off,
-    };
-    for (k, (d, seed)) in drops.iter().enumerate() {
-        if (seed - d.centre_x).abs() > out.max_model_difference {
-            out.max_model_difference = (seed - d.centre_x).abs();
-            out.max_difference_block = k;
+    ))
+}
+
+impl RestTrack {
+    /// The track through `pts` with the rest's `drops` there (each with
+    /// the seed's formula's U beside it), the straight lines' largest
+    /// `[gap, press]`, the points `added` and the stand-off samples.
+    fn of(
+        pts: &[Point],
+        drops: &[(Drop, Real)],
+        [max_gap, max_press]: [Real; 2],
+        added: usize,
+        stand_off: Vec<[Real; 2]>,
+    ) -> Self {
+        let mut out = RestTrack {
+            path: Polyline {
+                z: pts.iter().map(|p| p.0).collect(),
+                x: pts.iter().map(|p| p.1).collect(),
+            },
+            centre_x: Vec::with_capacity(pts.len()),
+            contact_z: Vec::with_capacity(pts.len()),
+            contact_x: Vec::with_capacity(pts.len()),
+            seed_centre_x: Vec::with_capacity(pts.len()),
+            max_model_difference: 0.0,
+            max_difference_block: 0,
+            max_gap,
+            max_press,
+            added,
+            stand_off,
+        };
+        for (k, (d, seed)) in drops.iter().enumerate() {
+            if (seed - d.centre_x).abs() > out.max_model_difference {
+                out.max_model_difference = (seed - d.centre_x).abs();
+                out.max_difference_block = k;
+            }
+            out.centre_x.push(d.centre_x);
+            out.contact_z.push(d.contact_z);
+            out.contact_x.push(d.contact_x);
+            out.seed_centre_x.push(*seed);
         }
-        out.centre_x.push(d.centre_x);
-        out.contact_z.push(d.contact_z);
-        out.contact_x.push(d.contact_x);
-        out.seed_centre_x.push(*seed);
+        out
     }
-    Ok(out)
+}
+
+/// A point of the wheel's path: (z, x (mm), time from the pass's start
+/// (min)).
+type Point = (Real, Real, Real);
+
+/// The rest riding the surface before a pass while the pass cuts it.
+struct Rider<'a> {
+    before: &'a GroundSurface,
+    layer: &'a PassLayer,
+    setup: &'a RestSetup,
+}
+
+/// What a straight move of U between two points does against the rest's
+/// exact drops along it.
+struct Along {
+    /// The line's largest gap above the exact U, and its largest press
+    /// below it (mm).
+    gap: Real,
+    press: Real,
+    /// The samples between the points: [z_r, line - exact] (mm).
+    checked: Vec<[Real; 2]>,
+    /// The largest deviation over the tolerance and its place along the
+    /// move (0..1).
+    worst: Option<(Real, Real)>,
+    /// Where the support's contact jumps (0..1, narrowed to
+    /// [`KINK_WIDTH`]).
+    kink: Option<(Real, Real)>,
+}
+
+impl Along {
+    /// Where the line strays, the places (0..1) a block goes: a kink in
+    /// the move gets one either side of it (the short move between them
+    /// has no room to stray), else one goes at the worst place.
+    fn added(&self) -> Vec<Real> {
+        match (self.kink, self.worst) {
+            (Some((lo, hi)), Some(_)) => [lo, hi]
+                .into_iter()
+                .filter(|s| *s > 0.0 && *s < 1.0)
+                .collect(),
+            (_, w) => w.map(|w| w.1).into_iter().collect(),
+        }
+    }
+}
+
+impl Rider<'_> {
+    /// The exact drop with the wheel at `(z, time)` (point `k` of the
+    /// pass, from 0), and the seed's formula there where `seed` (else NaN).
+    fn drop_at(
+        &self,
+        z: Real,
+        time: Real,
+        k: usize,
+        seed: bool,
+    ) -> Result<(Drop, Real), ProfileError> {
+        let setup = self.setup;
+        let (lo, hi) = self.before.z_range();
+        let z_r = z + setup.offset_b;
+        let part = Some(self.layer.by_time(time));
+        let Some(d) = self
+            .before
+            .support(z_r, setup.radius, setup.sample, part.as_ref())?
+        else {
+            return Err(ProfileError::OutsideProfile {
+                what: format!(
+                    "the steady rest's support at point {} of the pass (z_r = z + B, B = {} mm) has nothing under it: its centre",
+                    k + 1,
+                    crate::math::fixed(setup.offset_b, 4)
+                ),
+                z: z_r,
+                z_min: lo,
+                z_max: hi,
+            });
+        };
+        if !seed {
+            return Ok((d, Real::NAN));
+        }
+        // The seed's formula reads the surface as an array at an even step.
+        let (a, b) = ((z_r - setup.radius).max(lo), (z_r + setup.radius).min(hi));
+        let grid = crate::profile::uniform_grid(a, b, setup.sample)?;
+        let even = Profile::new(grid.clone(), self.before.eval_many(&grid, part.as_ref()))?;
+        let seed = seed_u(&even, z_r.clamp(a, b), setup.radius)?;
+        Ok((d, seed))
+    }
+
+    /// The move from `a` to `b` (point `k`, from 0, is `b`; `ends` the
+    /// exact drops there) sampled at [`REST_CHECK_STEP`], at least
+    /// [`MIN_REST_CHECKS`] times.
+    fn along(&self, a: Point, b: Point, k: usize, ends: [Drop; 2]) -> Result<Along, ProfileError> {
+        let (ua, ub) = (ends[0].centre_x, ends[1].centre_x);
+        let n = ((b.0 - a.0).abs() / REST_CHECK_STEP)
+            .ceil()
+            .max(MIN_REST_CHECKS as Real) as usize;
+        let mut out = Along {
+            gap: 0.0,
+            press: 0.0,
+            checked: Vec::with_capacity(n),
+            worst: None,
+            kink: None,
+        };
+        let mut contact = ends[0].contact_z;
+        let at_s = |s: Real| self.drop_at(a.0 + s * (b.0 - a.0), a.2 + s * (b.2 - a.2), k, false);
+        let dz = (b.0 - a.0).abs() / n as Real;
+        for i in 1..=n {
+            crate::budget::check("the steady rest's track")?;
+            let s = i as Real / n as Real;
+            let d = if i == n { ends[1] } else { at_s(s)?.0 };
+            // The support's contact jumping from one feature of the
+            // surface to another (a corner, a step, where a pass's cut
+            // begins) is a kink in U: found to within KINK_WIDTH and made
+            // a block, so the straight lines either side follow smooth arcs.
+            if out.kink.is_none()
+                && dz > KINK_WIDTH
+                && (d.contact_z - contact).abs() > 2.0 * dz + 1e-3
+            {
+                let (mut lo, mut hi) = ((i - 1) as Real / n as Real, s);
+                while (hi - lo) * (b.0 - a.0).abs() > KINK_WIDTH {
+                    let m = 0.5 * (lo + hi);
+                    if (at_s(m)?.0.contact_z - contact).abs()
+                        > 2.0 * (m - lo) * (b.0 - a.0).abs() + 1e-3
+                    {
+                        hi = m;
+                    } else {
+                        lo = m;
+                    }
+                }
+                out.kink = Some((lo, hi));
+            }
+            contact = d.contact_z;
+            if i == n {
+                break;
+            }
+            let (exact, line) = (d.centre_x, ua + s * (ub - ua));
+            out.checked
+                .push([a.0 + s * (b.0 - a.0) + self.setup.offset_b, line - exact]);
+            out.gap = out.gap.max(line - exact);
+            out.press = out.press.max(exact - line);
+            let dev = (line - exact).abs();
+            if dev > self.setup.tolerance && out.worst.is_none_or(|w| dev > w.0) {
+                out.worst = Some((dev, s));
+            }
+        }
+        Ok(out)
+    }
 }
 
 #[cfg(test)]
