@@ -360,6 +360,35 @@ fn no_public_signature_has_a_string_error() {
     );
 }
 
+/// The kernel's [`Error`] carries its stages' typed errors: none of its
+/// variants is a bare message (a single `String`).
+#[test]
+fn no_variant_of_the_kernels_error_is_a_bare_message() {
+    let path = crate::common::root().join("kernel/src/error.rs");
+    let file = syn::parse_file(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let error = (file.items.iter())
+        .find_map(|i| match i {
+            syn::Item::Enum(e) if e.ident == "Error" => Some(e),
+            _ => None,
+        })
+        .expect("error.rs defines Error");
+    let bare: Vec<String> = (error.variants.iter())
+        .filter(|v| match &v.fields {
+            syn::Fields::Unnamed(f) => {
+                f.unnamed.len() == 1
+                    && matches!(&f.unnamed[0].ty, syn::Type::Path(p) if p.path.is_ident("String"))
+            }
+            _ => false,
+        })
+        .map(|v| v.ident.to_string())
+        .collect();
+    assert!(error.variants.len() > 10, "{}", error.variants.len());
+    assert!(
+        bare.is_empty(),
+        "Error's variants with a bare message: {bare:?}"
+    );
+}
+
 /// Functions (free, in impls and in traits, outside tests) longer than
 /// `limit` lines, as "file:line name (n lines)".
 fn long_functions(files: &[PathBuf], limit: usize) -> Vec<String> {

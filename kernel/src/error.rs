@@ -100,14 +100,17 @@ pub enum Error {
     },
     /// The collision check could not run (a chain or a program it cannot
     /// place the bodies by).
-    #[error("{0}")]
-    Collision(String),
-    /// An option of the run that cannot be used.
-    #[error("{0}")]
-    Options(String),
-    /// A file of a finished run that cannot be read.
-    #[error("{0}")]
-    Read(String),
+    #[error(transparent)]
+    Collision(crate::collision::CollisionError),
+    /// A block number of 0 given to an option that counts blocks from 1.
+    #[error("{option} counts blocks from 1")]
+    BlockFromOne {
+        /// The option, by its flag.
+        option: &'static str,
+    },
+    /// A finished run whose files cannot be used as the run left them.
+    #[error(transparent)]
+    Run(#[from] crate::output::RunError),
     /// A picture, a table or a report entry that cannot be drawn or
     /// written, named.
     #[error(transparent)]
@@ -116,6 +119,18 @@ pub enum Error {
     /// what it found, to write where the user looks (no program).
     #[error("{}", .0.report.verdict.message())]
     Failed(Box<crate::report::FailedRun>),
+}
+
+impl From<crate::output::OutputError> for Error {
+    fn from(e: crate::output::OutputError) -> Self {
+        Self::Run(e.into())
+    }
+}
+
+impl From<crate::files::FileError> for Error {
+    fn from(e: crate::files::FileError) -> Self {
+        Self::Run(e.into())
+    }
 }
 
 /// What the program says of a panic (a defect of pilgrim, never the user's

@@ -42,6 +42,154 @@ pub struct OutputError {
     pub message: String,
 }
 
+/// A finished run whose files cannot be used as the run left them (to
+/// verify, export or correct it): each names the run's file or the input
+/// given beside it, and what to do. Outside text in it is quoted short
+/// ([`crate::files::excerpt`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RunError {
+    /// The run's directory or one of its files that cannot be read.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// An input named beside the run that cannot be read.
+    #[error(transparent)]
+    File(#[from] crate::files::FileError),
+    /// A file of the run that is not as the run wrote it.
+    #[error("{file}: {what} (not as the run wrote it)")]
+    NotAsWritten {
+        /// The file, with its run's directory.
+        file: String,
+        /// What is wrong with it.
+        what: String,
+    },
+    /// A body whose file `report.json` names is not one of the run's.
+    #[error("{run}: report.json names the file '{file}' for body '{body}', which is not a file of this run")]
+    NotTheRunsFile {
+        /// The run's directory.
+        run: String,
+        /// The file named.
+        file: String,
+        /// The body.
+        body: String,
+    },
+    /// A run with no 3-D models to export.
+    #[error("{run}: the run has no 3-D models (its family has no fn part(p))")]
+    NoModels {
+        /// The run's directory.
+        run: String,
+    },
+    /// A control in the report that is not a dialect pilgrim reads.
+    #[error("{file}: names the control '{control}', which is not a dialect pilgrim reads")]
+    UnknownControl {
+        /// The report, with its run's directory.
+        file: String,
+        /// The control named.
+        control: String,
+    },
+    /// An input the run kept beside its files, changed since.
+    #[error("{file}: changed since the run kept it (its SHA-256 is not the one report.json records): a run's inputs stay as they were; run again to change them")]
+    KeptChanged {
+        /// The kept file, with its run's directory.
+        file: String,
+    },
+    /// A file the command line names that is not the one the run kept.
+    #[error("{given}: not the {what} the run was made with (kept as {kept}): verify against the kept one (leave the option out), or run again")]
+    NotTheKept {
+        /// The file given.
+        given: String,
+        /// What it is (`family`, `machine file`).
+        what: String,
+        /// The kept file, with its run's directory.
+        kept: String,
+    },
+    /// A run made with a plugin library, which the command line does not
+    /// name.
+    #[error("{run}: the run's machine is the plugin library {file} (sha256 {sha256}): name it with --machine (pilgrim loads a library only when the command line names it)")]
+    PluginNotNamed {
+        /// The run's directory.
+        run: String,
+        /// The library's file name, as kept.
+        file: String,
+        /// Its digest.
+        sha256: String,
+    },
+    /// A plugin library named that is not the one the run was made with.
+    #[error("{given}: not the plugin library the run was made with ({file}, sha256 {sha256}): verify with that library, or run again")]
+    OtherPlugin {
+        /// The library given.
+        given: String,
+        /// The run's library's file name.
+        file: String,
+        /// Its digest.
+        sha256: String,
+    },
+    /// A run made on a machine that is not built in, which the command
+    /// line does not name.
+    #[error("{run}: the run's machine '{machine}' is not a built-in: name it with --machine (pilgrim loads a plugin or machine file only when the command line names it)")]
+    MachineNotNamed {
+        /// The run's directory.
+        run: String,
+        /// The machine the report names.
+        machine: String,
+    },
+    /// A machine named that is not the built-in one the run was made on.
+    #[error("{given}: not the machine the run was made on (the built-in {machine}): leave --machine out, or run again")]
+    OtherMachine {
+        /// The machine given.
+        given: String,
+        /// The run's.
+        machine: String,
+    },
+    /// A report whose kept inputs name no family's script.
+    #[error("{run}/report.json: its inputs name no family's script")]
+    NoFamily {
+        /// The run's directory.
+        run: String,
+    },
+    /// An older run's family, no longer where its report names it.
+    #[error("{run}: the run's family '{script}' is not there (its report names it from where the run was made)")]
+    FamilyGone {
+        /// The run's directory.
+        run: String,
+        /// The script its report names.
+        script: String,
+    },
+    /// An input whose name the run cannot keep beside its files.
+    #[error("{path}: an input whose name the run cannot keep beside its files")]
+    UnkeepableName {
+        /// The input.
+        path: String,
+    },
+    /// An input whose name is another of the run's files'.
+    #[error("{path}: the run keeps its inputs beside its files, and '{name}' is the name of another of them; rename it")]
+    NameTaken {
+        /// The input.
+        path: String,
+        /// Its file name.
+        name: String,
+    },
+    /// A prediction the report records that its program, verified again,
+    /// does not give.
+    #[error("{file}: its table {table} {what}: the report or the program was changed since the run (run the job again, and measure the part its program makes)")]
+    PredictionChanged {
+        /// The report, with its run's directory.
+        file: String,
+        /// The table.
+        table: String,
+        /// What differs, where, both values.
+        what: String,
+    },
+    /// A run's program that, verified again to predict its part, is
+    /// refused.
+    #[error("{file}: the run's program, verified again to predict its part, is refused: {why}")]
+    PredictionRefused {
+        /// The program, with its run's directory.
+        file: String,
+        /// The refusal, as the verification gives it.
+        why: String,
+    },
+}
+
 fn err(path: &Path, message: impl Into<String>) -> OutputError {
     OutputError {
         path: crate::files::shown_path(path),

@@ -159,14 +159,20 @@ pub struct Collisions {
 }
 
 /// Why the check could not run.
-#[derive(Debug, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CollisionError {
     /// The machine's description failed to compile (it did when loaded).
     #[error("the collision check: {0}")]
-    Machine(String),
+    Machine(#[from] crate::machine::MachineError),
+    /// A body's shape whose sizes its machine's constants do not give.
+    #[error("the collision check: {0}")]
+    Body(#[from] crate::machine::BodyError),
+    /// A chain that cannot be placed at a block's axis values.
+    #[error("the collision check: {0}")]
+    Chain(#[from] crate::transform::TransformError),
     /// The program lacks an axis a chain needs.
     #[error("the collision check: {0}")]
-    Program(String),
+    Program(#[from] crate::program::ProgramFault),
     /// The check ran past the run's time budget.
     #[error(transparent)]
     OverTime(#[from] crate::budget::OverTime),
@@ -435,8 +441,7 @@ pub fn check(
     let n = program.blocks.len();
     let names = placement.axes();
     let w = names.len();
-    let rows = axis_rows(program, info, names, 0..n)
-        .map_err(|e| CollisionError::Program(e.to_string()))?;
+    let rows = axis_rows(program, info, names, 0..n)?;
     // Entity `e`'s frame at the axis values `q`, the tool's frame `tool`.
     let frame_of = |e: &Entity, q: &[Real], tool: &Mat4| -> Result<Mat4, CollisionError> {
         let f = match e.which {

@@ -69,16 +69,10 @@ impl Placement {
         part_z: Option<(Real, Real)>,
         inside: bool,
     ) -> Result<Self, CollisionError> {
-        let machine = |e: crate::machine::MachineError| CollisionError::Machine(e.to_string());
         let tool_chain = if info.chain.is_empty() {
             None
         } else {
-            Some(
-                Machine::from_info(info.clone())
-                    .map_err(machine)?
-                    .chain()
-                    .clone(),
-            )
+            Some(Machine::from_info(info.clone())?.chain().clone())
         };
         let tool_axes: Vec<String> = tool_chain
             .as_ref()
@@ -87,7 +81,7 @@ impl Placement {
         let mut used = tool_axes.clone();
         let mut bodies = Vec::new();
         let mut notes = Vec::new();
-        for body in bodies_of(info).map_err(machine)? {
+        for body in bodies_of(info)? {
             let spec = body.spec();
             let Some(shape) = &spec.shape else {
                 continue;
@@ -95,12 +89,11 @@ impl Placement {
             if !spec.reach.holds(inside) {
                 continue;
             }
-            let solid = Solid::of(shape, &info.constants)
-                .map_err(|e| CollisionError::Machine(e.to_string()))?;
+            let solid = Solid::of(shape, &info.constants)?;
             let own = || {
                 body.chain()
                     .matrix(&vec![0.0; body.chain().dof()])
-                    .map_err(|e| CollisionError::Machine(e.to_string()))
+                    .map_err(CollisionError::from)
             };
             let (carrier, moved_by) = match spec.mount {
                 Mount::Part => {
@@ -208,8 +201,7 @@ impl Placement {
         match &self.tool {
             Some((c, cols)) => {
                 let tq: Vec<Real> = cols.iter().map(|&i| q[i]).collect();
-                c.matrix(&tq)
-                    .map_err(|e| CollisionError::Program(e.to_string()))
+                Ok(c.matrix(&tq)?)
             }
             None => Ok(Mat4::identity()),
         }
@@ -246,9 +238,7 @@ impl Placement {
             Carrier::Tool(m) => tool * m,
             Carrier::Chain(chain, cols) => {
                 let bq: Vec<Real> = cols.iter().map(|&c| q[c]).collect();
-                chain
-                    .matrix(&bq)
-                    .map_err(|e| CollisionError::Program(e.to_string()))?
+                chain.matrix(&bq)?
             }
             Carrier::Fixed(m) => *m,
         })

@@ -185,6 +185,28 @@ pub enum CompensateError {
         /// What it must be.
         range: String,
     },
+    /// A family that takes no correction: its script declares no
+    /// `correction` parameter.
+    #[error("{script}: the family takes no correction: its script declares no `correction` parameter (a table's name)")]
+    NoCorrection {
+        /// The family's script.
+        script: String,
+    },
+    /// A family whose verification takes no measurement of its part.
+    #[error("{script}: the family's verification takes no measurement of its part")]
+    NotMeasured {
+        /// The family's script.
+        script: String,
+    },
+    /// A measurement applied already in the line of corrections that made
+    /// the run.
+    #[error("{file}: this measurement was applied already, in the line of corrections that made {run} (its compensation.json): measure the part its corrected program made, and correct by that")]
+    AppliedAlready {
+        /// The measurement.
+        file: String,
+        /// The run corrected.
+        run: String,
+    },
     /// The fit could not be made.
     #[error("the measured error could not be fitted: {0}")]
     Fit(String),

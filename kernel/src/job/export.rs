@@ -4,7 +4,7 @@
 use super::Report;
 use crate::catalog::Catalog;
 use crate::error::Error;
-use crate::output::RunDir;
+use crate::output::{RunDir, RunError};
 use crate::program::AxisProgram;
 use crate::render::scene::{self, Formats};
 use crate::toolpath::Toolpath;
@@ -46,10 +46,11 @@ pub fn run_machine(
         {
             Ok(report.machine_spec.clone())
         }
-        None => Err(Error::Read(format!(
-            "{shown}: the run's machine '{}' is not a built-in: name it with --machine (pilgrim loads a plugin or machine file only when the command line names it)",
-            crate::files::excerpt(&report.machine_spec)
-        ))),
+        None => Err(RunError::MachineNotNamed {
+            run: shown.to_owned(),
+            machine: crate::files::excerpt(&report.machine_spec),
+        }
+        .into()),
     }
 }
 
@@ -86,7 +87,7 @@ pub fn export(
     let kin = machine.kinematics.as_ref();
     let passes = crate::program::pass_blocks(&program, &toolpath.passes);
     let place = match block {
-        Some(0) => return Err(Error::Options("--block counts blocks from 1".into())),
+        Some(0) => return Err(Error::BlockFromOne { option: "--block" }),
         Some(n) => scene::PosePlace::at_end(n - 1),
         None => scene::default_pose_block(&program, &passes),
     };
@@ -181,9 +182,10 @@ impl Finished {
             }
         }
         if report.bodies.is_empty() {
-            return Err(Error::Read(format!(
-                "{shown}: the run has no 3-D models (its family has no fn part(p))"
-            )));
+            return Err(RunError::NoModels {
+                run: shown.to_owned(),
+            }
+            .into());
         }
         Ok(Self {
             report,
@@ -195,16 +197,17 @@ impl Finished {
 
 /// The run's file `name` (in `shown`) is not what the run wrote: `e`.
 fn not_as_written(shown: &str, name: &str, e: &str) -> Error {
-    Error::Read(format!(
-        "{shown}/{name}: {} (not as the run wrote it)",
-        crate::files::excerpt(e)
-    ))
+    RunError::NotAsWritten {
+        file: format!("{shown}/{name}"),
+        what: crate::files::excerpt(e),
+    }
+    .into()
 }
 
 /// The text of the run's file `name`.
 fn read(run: &RunDir, name: &str) -> Result<String, Error> {
     run.read_text(name, crate::files::MAX_DATA_BYTES)
-        .map_err(|e| Error::Read(e.to_string()))
+        .map_err(Error::from)
 }
 
 /// The part's meshes, from the run's own STL files by the names the run
@@ -221,19 +224,20 @@ fn part_meshes(
     (report.bodies.iter().filter(|b| b.kind == "part"))
         .map(|b| {
             if !crate::files::is_plain_name(&b.name) || b.file != format!("{}.stl", b.name) {
-                return Err(Error::Read(format!(
-                    "{shown}: report.json names the file '{}' for body '{}', which is not a file of this run",
-                    crate::files::excerpt(&b.file),
-                    crate::files::excerpt(&b.name)
-                )));
+                return Err(RunError::NotTheRunsFile {
+                    run: shown.to_owned(),
+                    file: crate::files::excerpt(&b.file),
+                    body: crate::files::excerpt(&b.name),
+                }
+                .into());
             }
             let bytes = run
                 .read(&b.file, crate::files::MAX_DATA_BYTES - stl_bytes)
-                .map_err(|e| Error::Read(e.to_string()))?;
+                .map_err(Error::from)?;
             stl_bytes += bytes.len() as u64;
             crate::mesh::read_stl_bytes(&bytes, &format!("{shown}/{}", b.file))
                 .map(|m| (b.name.clone(), m))
-                .map_err(|e| Error::Read(e.to_string()))
+                .map_err(Error::from)
         })
         .collect()
 }
@@ -258,12 +262,11 @@ fn program_text(
     kin: &dyn crate::machine::MachineKinematics,
     shown: &str,
 ) -> Result<ProgramText, Error> {
-    let control = crate::program::post::dialect(&report.control).ok_or_else(|| {
-        Error::Read(format!(
-            "{shown}: report.json names the control '{}', which pilgrim does not know",
-            crate::files::excerpt(&report.control)
-        ))
-    })?;
+    let control =
+        crate::program::post::dialect(&report.control).ok_or_else(|| RunError::UnknownControl {
+            file: format!("{shown}/report.json"),
+            control: crate::files::excerpt(&report.control),
+        })?;
     let file = format!("program.{}", control.extension);
     if !report.files.contains(&file) {
         return Ok((None, None));

@@ -11,7 +11,7 @@
 
 use super::Error;
 use crate::catalog::Origin;
-use crate::output::RunDir;
+use crate::output::{RunDir, RunError};
 pub use crate::report::KeptInput;
 use crate::report::Report;
 use crate::script::ReadLog;
@@ -43,10 +43,10 @@ fn name_of(path: &Path) -> Result<String, Error> {
         .filter(|n| crate::output::is_plain_file_name(n))
         .map(str::to_owned)
         .ok_or_else(|| {
-            Error::Read(format!(
-                "{}: an input whose name the run cannot keep beside its files",
-                crate::files::excerpt(&path.display().to_string())
-            ))
+            RunError::UnkeepableName {
+                path: crate::files::excerpt(&path.display().to_string()),
+            }
+            .into()
         })
 }
 
@@ -64,9 +64,7 @@ pub fn inputs(
     origin: &Origin,
     taken: &[String],
 ) -> Result<Vec<(KeptInput, Vec<u8>)>, Error> {
-    let read = |p: &Path, limit: u64| {
-        crate::files::read_bytes(p, limit).map_err(|e| Error::Read(e.to_string()))
-    };
+    let read = |p: &Path, limit: u64| crate::files::read_bytes(p, limit).map_err(Error::from);
     let mut out: Vec<(KeptInput, Vec<u8>)> = Vec::new();
     let mut add = |role: &str, path: &Path, bytes: Vec<u8>, file: bool| -> Result<(), Error> {
         let name = name_of(path)?;
@@ -76,10 +74,11 @@ pub fn inputs(
                     .iter()
                     .any(|(k, _)| k.file == name && k.role != "plugin"))
         {
-            return Err(Error::Read(format!(
-                "{}: the run keeps its inputs beside its files, and '{name}' is the name of another of them; rename it",
-                crate::files::excerpt(&path.display().to_string())
-            )));
+            return Err(RunError::NameTaken {
+                path: crate::files::excerpt(&path.display().to_string()),
+                name,
+            }
+            .into());
         }
         let kept = KeptInput {
             role: role.into(),
@@ -155,18 +154,16 @@ pub fn kept(
     if !machine_kept {
         if let Some(given) = machine {
             if !given.eq_ignore_ascii_case(&report.machine_spec) {
-                return Err(Error::Read(format!(
-                    "{}: not the machine the run was made on (the built-in {}): leave --machine out, or run again",
-                    crate::files::excerpt(given),
-                    crate::files::excerpt(&report.machine_spec)
-                )));
+                return Err(RunError::OtherMachine {
+                    given: crate::files::excerpt(given),
+                    machine: crate::files::excerpt(&report.machine_spec),
+                }
+                .into());
             }
         }
     }
-    let script = script.ok_or_else(|| {
-        Error::Read(format!(
-            "{shown}/report.json: its inputs name no family's script"
-        ))
+    let script = script.ok_or_else(|| RunError::NoFamily {
+        run: shown.to_owned(),
     })?;
     Ok(Some((script, spec)))
 }
@@ -178,21 +175,21 @@ pub fn kept(
 /// None named, or another library.
 fn kept_plugin(k: &KeptInput, machine: Option<&str>, shown: &str) -> Result<String, Error> {
     let Some(given) = machine else {
-        return Err(Error::Read(format!(
-            "{shown}: the run's machine is the plugin library {} (sha256 {}): name it with --machine (pilgrim loads a library only when the command line names it)",
-            crate::files::excerpt(&k.file),
-            k.sha256
-        )));
+        return Err(RunError::PluginNotNamed {
+            run: shown.to_owned(),
+            file: crate::files::excerpt(&k.file),
+            sha256: k.sha256.clone(),
+        }
+        .into());
     };
-    let bytes = crate::files::read_bytes(Path::new(given), 1 << 30)
-        .map_err(|e| Error::Read(e.to_string()))?;
+    let bytes = crate::files::read_bytes(Path::new(given), 1 << 30).map_err(Error::from)?;
     if sha256_hex(&bytes) != k.sha256 {
-        return Err(Error::Read(format!(
-            "{}: not the plugin library the run was made with ({}, sha256 {}): verify with that library, or run again",
-            crate::files::excerpt(given),
-            crate::files::excerpt(&k.file),
-            k.sha256
-        )));
+        return Err(RunError::OtherPlugin {
+            given: crate::files::excerpt(given),
+            file: crate::files::excerpt(&k.file),
+            sha256: k.sha256.clone(),
+        }
+        .into());
     }
     Ok(given.to_owned())
 }
@@ -204,12 +201,12 @@ fn kept_plugin(k: &KeptInput, machine: Option<&str>, shown: &str) -> Result<Stri
 fn kept_file(run: &RunDir, k: &KeptInput, shown: &str) -> Result<Vec<u8>, Error> {
     let bytes = run
         .read(&k.file, crate::files::MAX_DATA_BYTES)
-        .map_err(|e| Error::Read(e.to_string()))?;
+        .map_err(Error::from)?;
     if sha256_hex(&bytes) != k.sha256 {
-        return Err(Error::Read(format!(
-            "{shown}/{}: changed since the run kept it (its SHA-256 is not the one report.json records): a run's inputs stay as they were; run again to change them",
-            crate::files::excerpt(&k.file)
-        )));
+        return Err(RunError::KeptChanged {
+            file: format!("{shown}/{}", crate::files::excerpt(&k.file)),
+        }
+        .into());
     }
     Ok(bytes)
 }
@@ -226,14 +223,15 @@ fn same_as(
     k: &KeptInput,
     shown: &str,
 ) -> Result<(), Error> {
-    let theirs = crate::files::read_bytes(given, crate::files::MAX_DATA_BYTES)
-        .map_err(|e| Error::Read(e.to_string()))?;
+    let theirs =
+        crate::files::read_bytes(given, crate::files::MAX_DATA_BYTES).map_err(Error::from)?;
     if theirs != bytes {
-        return Err(Error::Read(format!(
-            "{}: not the {what} the run was made with (kept as {shown}/{}): verify against the kept one (leave the option out), or run again",
-            crate::files::excerpt(&given.display().to_string()),
-            crate::files::excerpt(&k.file)
-        )));
+        return Err(RunError::NotTheKept {
+            given: crate::files::excerpt(&given.display().to_string()),
+            what: what.to_owned(),
+            kept: format!("{shown}/{}", crate::files::excerpt(&k.file)),
+        }
+        .into());
     }
     Ok(())
 }

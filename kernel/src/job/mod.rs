@@ -300,7 +300,7 @@ fn collisions(
     )
     .map_err(|e| match e {
         crate::collision::CollisionError::OverTime(o) => Error::OverTime(o),
-        e => Error::Collision(e.to_string()),
+        e => Error::Collision(e),
     })
 }
 

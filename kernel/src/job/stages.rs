@@ -407,7 +407,9 @@ impl<'a> Run<'a> {
     /// (none where anything failed).
     pub(super) fn check(&self, plan: &Plan, made: &mut Programmed) -> Result<Checked, Error> {
         if self.options.pose_block == Some(0) {
-            return Err(Error::Options("--pose-block counts blocks from 1".into()));
+            return Err(Error::BlockFromOne {
+                option: "--pose-block",
+            });
         }
         let requested = self.family.verification(self.values)?;
         let ctx = self.replay_ctx(plan, made);

@@ -27,7 +27,8 @@ mod write;
 
 pub use builtin::{BUILTIN_MACHINES, BUILTIN_SOURCES};
 pub use info::{
-    bodies_of, body_offset, check_description, part_turn_factors, Body, Solid, AXIS_LETTERS,
+    bodies_of, body_offset, check_description, part_turn_factors, Body, BodyError, Solid,
+    AXIS_LETTERS,
 };
 pub(crate) use kinematics::overridden as kinematics_overridden;
 pub use kinematics::{batch_rows, ChainMachine, KinematicsError, MachineKinematics};

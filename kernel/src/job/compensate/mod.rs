@@ -25,6 +25,7 @@ use crate::catalog::Catalog;
 use crate::compensate::{CompensateError, Quantity};
 use crate::error::Error;
 use crate::math::Real;
+use crate::output::RunError;
 use crate::params::ParamSource;
 use crate::profile::Table;
 use crate::script::{Limits, ScriptFamily};
@@ -167,7 +168,9 @@ fn correct(
                 .into(),
             },
         )?;
-    let moved = moved.map_err(Error::Read)?;
+    // None where the run stopped at its time limit before its program was
+    // checked (its report says so).
+    let moved = moved.transpose()?.flatten();
     let after = (out.files.iter())
         .find(|(n, _)| *n == prior.program_file)
         .map(|(_, b)| String::from_utf8_lossy(b).into_owned())
@@ -199,8 +202,12 @@ fn correct(
 
 /// What the corrected run found besides its output: the records with the
 /// part after, and how far its program's path moved from the first's
-/// (why not, where the first could not be read).
-type Found = (Vec<QuantityRecord>, Result<Option<change::Moved>, String>);
+/// (why not, where the first could not be read; none where the run
+/// stopped before its program was checked).
+type Found = (
+    Vec<QuantityRecord>,
+    Option<Result<Option<change::Moved>, RunError>>,
+);
 
 /// The corrected run, in the run's stages: once its verification has
 /// predicted its part, the correction's tables made with the part after,
@@ -245,7 +252,7 @@ fn corrected_run(
         text: None,
     };
     let nominal = &prior.nominal;
-    let mut moved = Err("the corrected run stopped before its program was checked".to_owned());
+    let mut moved = None;
     let staged = (|| {
         let stage = &mut |_: &str| {};
         let plan = run.plan(stage)?;
@@ -260,20 +267,14 @@ fn corrected_run(
         let (tables, mut plots) =
             annex::annex(nominal.coordinate, quantities, &records, nominal.names());
         checked.add(tables, Vec::new());
-        moved = match first
+        let first = first
             .join()
-            .unwrap_or_else(|p| std::panic::resume_unwind(p))
-        {
-            Ok((program, passes)) => Ok(change::path_moved(
-                &program,
-                &passes,
-                made.program(),
-                made.passes(),
-            )),
-            Err(e) => Err(e),
-        };
+            .unwrap_or_else(|p| std::panic::resume_unwind(p));
+        moved = Some(first.map(|(program, passes)| {
+            change::path_moved(&program, &passes, made.program(), made.passes())
+        }));
         let mut moves = Tables::new();
-        if let Ok(Some(m)) = &moved {
+        if let Some(Ok(Some(m))) = &moved {
             plots.push(change::moves_chart(m, &mut moves));
         }
         checked.add(moves, plots);

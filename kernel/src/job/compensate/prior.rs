@@ -5,11 +5,11 @@
 
 use super::{CompensateOptions, Lineage, Tables, CORRECTION, SAME_PREDICTION};
 use crate::catalog::Catalog;
-use crate::compensate::{Nominal, Quantity, PREDICTED};
+use crate::compensate::{CompensateError, Nominal, Quantity, PREDICTED};
 use crate::error::Error;
 use crate::family::PartFamily;
 use crate::job::{params_on, run_machine, JobOptions, Report};
-use crate::output::RunDir;
+use crate::output::{RunDir, RunError};
 use crate::params::ParamSource;
 use crate::profile::Table;
 use crate::program::{pass_blocks, AxisProgram, ProgramPass};
@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 /// The first run's program and its passes' blocks, as read on a thread of
 /// their own.
 pub(super) type FirstProgram =
-    std::thread::JoinHandle<Result<(AxisProgram, Vec<ProgramPass>), String>>;
+    std::thread::JoinHandle<Result<(AxisProgram, Vec<ProgramPass>), RunError>>;
 
 /// The run corrected: see the module's docs.
 pub(super) struct Prior {
@@ -65,9 +65,13 @@ impl Prior {
         options: &CompensateOptions,
     ) -> Result<Self, Error> {
         let shown = dir.display().to_string();
-        let run = RunDir::open(dir).map_err(|e| Error::Read(e.to_string()))?;
-        let report: Report = serde_json::from_str(&read(&run, "report.json")?)
-            .map_err(|e| Error::Read(format!("{shown}/report.json: {e}")))?;
+        let run = RunDir::open(dir).map_err(Error::from)?;
+        let report: Report = serde_json::from_str(&read(&run, "report.json")?).map_err(|e| {
+            RunError::NotAsWritten {
+                file: format!("{shown}/report.json"),
+                what: crate::files::excerpt(&e.to_string()),
+            }
+        })?;
         let lineage = lineage(&run, &shown, measured, options)?;
         // The script and machine the run kept beside its files (an older
         // run's: the paths its report names).
@@ -77,26 +81,23 @@ impl Prior {
             None => PathBuf::from(&report.script),
         };
         if !script.is_file() {
-            return Err(Error::Read(format!(
-                "{shown}: the run's family '{}' is not there (its report names it from where the run was made)",
-                report.script
-            )));
+            return Err(RunError::FamilyGone {
+                run: shown.clone(),
+                script: crate::files::excerpt(&report.script),
+            }
+            .into());
         }
         let label = format!("{shown}/report.json");
-        let base = report
-            .params_source(&label)
-            .map_err(|e| Error::Read(e.to_string()))?;
+        let base = report.params_source(&label).map_err(Error::from)?;
         let spec = match kept.and_then(|k| k.1) {
             Some(spec) => spec,
             None => run_machine(&report, catalog, None, &shown)?,
         };
         let program_file = crate::program::post::dialect(&report.control)
             .map(|d| format!("program.{}", d.extension))
-            .ok_or_else(|| {
-                Error::Read(format!(
-                    "{label}: the control '{}' is not a dialect pilgrim reads",
-                    report.control
-                ))
+            .ok_or_else(|| RunError::UnknownControl {
+                file: label.clone(),
+                control: crate::files::excerpt(&report.control),
             })?;
         let tables_read = ReadLog::default();
         let nominal = nominal_of(&script, &tables_read, catalog, (&spec, &base), options)?;
@@ -170,11 +171,9 @@ impl Prior {
             },
             &mut |_| {},
         )
-        .map_err(|e| {
-            Error::Read(format!(
-                "{}/{}: the run's program, verified again to predict its part, is refused: {e}",
-                self.shown, self.program_file
-            ))
+        .map_err(|e| RunError::PredictionRefused {
+            file: format!("{}/{}", self.shown, self.program_file),
+            why: e.to_string(),
         })?;
         Ok(again.report.tables)
     }
@@ -184,14 +183,15 @@ impl Prior {
     pub fn first_program(&self) -> FirstProgram {
         let (run, shown) = (self.run.clone(), self.shown.clone());
         std::thread::spawn(move || {
-            let parse = |name: &str| {
-                run.read_text(name, crate::files::MAX_DATA_BYTES)
-                    .map_err(|e| e.to_string())
+            let parse = |name: &str| run.read_text(name, crate::files::MAX_DATA_BYTES);
+            let bad = |name: &str, e: serde_json::Error| RunError::NotAsWritten {
+                file: format!("{shown}/{name}"),
+                what: crate::files::excerpt(&e.to_string()),
             };
             let program: AxisProgram = serde_json::from_str(&parse("program.json")?)
-                .map_err(|e| format!("{shown}/program.json: {e}"))?;
+                .map_err(|e| bad("program.json", e))?;
             let toolpath: Toolpath = serde_json::from_str(&parse("toolpath.json")?)
-                .map_err(|e| format!("{shown}/toolpath.json: {e}"))?;
+                .map_err(|e| bad("toolpath.json", e))?;
             let passes = pass_blocks(&program, &toolpath.passes);
             Ok((program, passes))
         })
@@ -267,10 +267,10 @@ fn nominal_of(
 ) -> Result<Nominal, Error> {
     let family = load(script, log, options, Vec::new())?;
     if !family.params().iter().any(|p| p.name == CORRECTION) {
-        return Err(Error::Options(format!(
-            "{}: the family takes no correction: its script declares no `{CORRECTION}` parameter (a table's name)",
-            script.display()
-        )));
+        return Err(CompensateError::NoCorrection {
+            script: script.display().to_string(),
+        }
+        .into());
     }
     let machine = catalog.open(spec)?;
     let sources = vec![
@@ -285,17 +285,17 @@ fn nominal_of(
         .verification(&params)?
         .and_then(|v| v.nominal())
         .ok_or_else(|| {
-            Error::Options(format!(
-                "{}: the family's verification takes no measurement of its part",
-                script.display()
-            ))
+            CompensateError::NotMeasured {
+                script: script.display().to_string(),
+            }
+            .into()
         })
 }
 
 /// The text of the run's file `name`.
 fn read(run: &RunDir, name: &str) -> Result<String, Error> {
     run.read_text(name, crate::files::MAX_DATA_BYTES)
-        .map_err(|e| Error::Read(e.to_string()))
+        .map_err(Error::from)
 }
 
 /// The corrected run's lineage: the run's own, one generation on, with
@@ -313,10 +313,11 @@ fn lineage(
     let digest = measured.digest();
     let (generation, mut applied) = lineage_of(run, shown)?.unwrap_or_default();
     if applied.contains(&digest) {
-        return Err(Error::Options(format!(
-            "{}: this measurement was applied already, in the line of corrections that made {shown} (its compensation.json): measure the part its corrected program made, and correct by that",
-            measured.source()
-        )));
+        return Err(CompensateError::AppliedAlready {
+            file: measured.source().to_string(),
+            run: shown.to_owned(),
+        }
+        .into());
     }
     applied.push(digest.clone());
     Ok(Lineage {
@@ -340,8 +341,11 @@ fn lineage_of(run: &RunDir, shown: &str) -> Result<Option<(u32, Vec<String>)>, E
     }
     let text = run
         .read_text("compensation.json", crate::files::MAX_DATA_BYTES)
-        .map_err(|e| Error::Read(e.to_string()))?;
-    let bad = |what: &str| Error::Read(format!("{shown}/compensation.json: {what}"));
+        .map_err(Error::from)?;
+    let bad = |what: &str| RunError::NotAsWritten {
+        file: format!("{shown}/compensation.json"),
+        what: crate::files::excerpt(what),
+    };
     let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| bad(&e.to_string()))?;
     let l = &v["lineage"];
     let generation = l["generation"]
@@ -373,7 +377,7 @@ pub fn run_correction(run: &RunDir, report: &Report) -> Result<Option<(String, S
         Some(crate::params::ParamValue::Text(name)) if !name.is_empty() => {
             let text = run
                 .read_text(name, crate::files::MAX_DATA_BYTES)
-                .map_err(|e| Error::Read(e.to_string()))?;
+                .map_err(Error::from)?;
             Ok(Some((name.clone(), text)))
         }
         _ => Ok(None),
@@ -400,7 +404,10 @@ pub(super) fn predicted(
         return Ok(None);
     };
     let p = crate::profile::Profile::new(s.clone(), values.clone())
-        .map_err(|e| Error::Read(format!("the run's table {PREDICTED}: {e}")))?
+        .map_err(|e| RunError::NotAsWritten {
+            file: format!("the run's table {PREDICTED}"),
+            what: e.to_string(),
+        })?
         .with_interpolation(crate::profile::Interpolation::Linear);
     let (lo, hi) = p.z_range();
     let at: Vec<f64> = at.iter().map(|z| z.clamp(lo, hi)).collect();
@@ -421,9 +428,12 @@ fn same_prediction(file: &Tables, again: &Tables, label: &str) -> Result<(), Err
         again.get(PREDICTED).unwrap_or(&empty),
     );
     let changed = |what: String| {
-        Err(Error::Read(format!(
-            "{label}: its table {PREDICTED} {what}: the report or the program was changed since the run (run the job again, and measure the part its program makes)"
-        )))
+        Err(RunError::PredictionChanged {
+            file: label.to_owned(),
+            table: PREDICTED.to_owned(),
+            what,
+        }
+        .into())
     };
     for (column, want) in ours {
         let Some(have) = theirs.get(column) else {
