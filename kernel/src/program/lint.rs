@@ -31,7 +31,10 @@ use super::reader::{Mode, ReadMove, Reader};
 use super::AxisProgram;
 use crate::machine::Axis;
 use crate::math::Real;
-use crate::toolpath::Motion;
+
+mod cl;
+
+use cl::lint_apt;
 
 /// A program that fails its lint: which program, where, what.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -273,174 +276,12 @@ fn lint_gcode(
     })
 }
 
-/// The APT CL file: each record one the writer makes, in the form it
-/// makes it (the part's, machine's and tool's names and numbers, text of
-/// names' characters in `PPRINT/`), no character pilgrim never writes;
-/// the spindle turning (at a speed that is not 0) and the coolant on where
-/// the setup says before a cutting `GOTO/`, `RAPID` before exactly the
-/// rapid ones; one `GOTO/` a block with the axis program's values,
-/// `FINI` last.
-fn lint_apt(text: &str, program: &AxisProgram, d: &Dialect) -> Result<Linted, LintError> {
-    let fault = |place: String, message: String| LintError {
-        dialect: d.name.to_owned(),
-        place,
-        message,
-    };
-    let decimals = super::written_decimals(program.decimals, d.name);
-    let half = 0.5 * 10f64.powi(-(decimals as i32)) + crate::tolerance::SAME_LENGTH;
-    let Some(body) = text.strip_suffix('\n') else {
-        return Err(fault(
-            "the last line".into(),
-            "the CL file's last line does not end with a line feed".into(),
-        ));
-    };
-    let lines: Vec<&str> = body.split('\n').collect();
-    let mut k = 0;
-    let (mut rapid_next, mut coolant) = (false, false);
-    let mut speed: Option<Real> = None;
-    let written_by = format!("written by pilgrim {}", crate::version::VERSION);
-    let mut ticker = crate::budget::Ticker::new("the CL file's lint", 1024);
-    for (l, line) in lines.iter().enumerate() {
-        let at = || format!("line {}", l + 1);
-        ticker.tick().map_err(|e| fault(at(), e.to_string()))?;
-        if let Some(c) = line.chars().find(|c| c.is_control() || !c.is_ascii()) {
-            return Err(fault(
-                at(),
-                format!(
-                    "the character U+{:04X}, which pilgrim never writes",
-                    u32::from(c)
-                ),
-            ));
-        }
-        let not_record = || {
-            fault(
-                at(),
-                format!(
-                    "'{}' is not a CL record pilgrim writes",
-                    crate::files::excerpt(line)
-                ),
-            )
-        };
-        let (word, arg) = line.split_once('/').unwrap_or((line, ""));
-        match (word, arg) {
-            ("PARTNO", a) if a == program.name => {}
-            ("MACHIN", a) if a == super::post::comment_text(d, &program.machine) => {}
-            ("UNITS", "MM") | ("FINI", "") => {}
-            ("LOADTL", a) if a == program.tool_number.to_string() => {}
-            ("PPRINT", a) => {
-                if a != written_by && !a.chars().all(crate::names::is_name_char) {
-                    return Err(fault(
-                        at(),
-                        format!(
-                            "PPRINT/{}: text no comment of pilgrim's holds",
-                            crate::files::excerpt(a)
-                        ),
-                    ));
-                }
-            }
-            ("COOLNT", "ON") => coolant = true,
-            ("COOLNT", "OFF") => coolant = false,
-            ("SPINDL", "OFF") => speed = None,
-            ("SPINDL", a) => {
-                let v: Real = a
-                    .strip_suffix(",RPM,CLW")
-                    .and_then(|v| v.parse().ok())
-                    .ok_or_else(not_record)?;
-                if !(v >= 1.0) {
-                    return Err(fault(
-                        at(),
-                        format!("SPINDL/{v}: the spindle would stand while the program cuts"),
-                    ));
-                }
-                speed = Some(v);
-            }
-            ("RAPID", "") => rapid_next = true,
-            ("FEDRAT", a) if a.ends_with(",MMPM") || a.ends_with(",MMPR") => {}
-            ("GOTO", _) => {}
-            _ => return Err(not_record()),
-        }
-        if *line == "FINI" && l + 1 != lines.len() {
-            return Err(fault(at(), "records after FINI".into()));
-        }
-        let Some(values) = line.strip_prefix("GOTO/") else {
-            continue;
-        };
-        // Named only when a fault is told: finding the pass of a block
-        // walks back through the blocks before it.
-        let place = || super::name_in(d.name, &program.blocks, k);
-        let Some(b) = program.blocks.get(k) else {
-            return Err(fault(at(), "a GOTO beyond the axis program".into()));
-        };
-        let rapid = std::mem::take(&mut rapid_next);
-        if rapid != (b.motion == Motion::Rapid) {
-            return Err(fault(
-                place(),
-                format!(
-                    "{}, where the axis program has a {:?} move",
-                    if rapid { "RAPID" } else { "a feed move" },
-                    b.motion
-                ),
-            ));
-        }
-        if !rapid && speed.is_none() {
-            return Err(fault(place(), "a cutting move with the spindle off".into()));
-        }
-        if !rapid && program.setup.coolant && !coolant {
-            return Err(fault(
-                place(),
-                "a cutting move with the coolant off (no COOLNT/ON), which the machine's setup turns on".into(),
-            ));
-        }
-        let read: Vec<Real> = values
-            .split(',')
-            .map(|v| v.parse())
-            .collect::<Result<_, _>>()
-            .map_err(|_| fault(place(), format!("'{values}' are not numbers")))?;
-        if read.len() != b.values.len() {
-            return Err(fault(
-                place(),
-                format!("{} values for {} axes", read.len(), b.values.len()),
-            ));
-        }
-        for (i, (r, w)) in read.iter().zip(&b.values).enumerate() {
-            if !((r - w).abs() <= half) {
-                return Err(fault(
-                    place(),
-                    format!(
-                        "{} = {r} read back, the axis program's {w}",
-                        program.axes[i].name
-                    ),
-                ));
-            }
-        }
-        k += 1;
-    }
-    if lines.last() != Some(&"FINI") {
-        return Err(fault(
-            format!("line {}", lines.len()),
-            "the CL file does not end with FINI".into(),
-        ));
-    }
-    if k != program.blocks.len() {
-        return Err(fault(
-            format!("line {}", lines.len()),
-            format!(
-                "{k} GOTO records, the axis program has {} blocks",
-                program.blocks.len()
-            ),
-        ));
-    }
-    Ok(Linted {
-        moves: k,
-        lines: lines.len(),
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::program::post::{post, CLD, FANUC, LINUXCNC, SINUMERIK};
     use crate::program::{ProgramSetup, Radial};
+    use crate::toolpath::Motion;
 
     fn program() -> AxisProgram {
         crate::program::test_program()

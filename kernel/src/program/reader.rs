@@ -20,6 +20,12 @@ use crate::math::Real;
 use crate::toolpath::Motion;
 use pilgrim_plugin_abi::types::Radial;
 
+mod codes;
+mod cycles;
+mod line;
+mod moves;
+mod setup;
+
 /// A move as the reader took it: each axis's value where the text has
 /// given one so far.
 #[derive(Debug, Clone, PartialEq)]
@@ -183,94 +189,39 @@ enum OwnWord {
     StartAngle(Real),
 }
 
-/// Line `i` of a G-code program in `d` as its control reads it: the code
-/// with its comments blanked in place (the same length, so the words'
-/// spans index the line), after checking that every comment is one the
-/// dialect's comment writer makes ([`super::post::comment_text`]): closed
-/// on its line, nothing but names' characters, nothing LinuxCNC acts on;
-/// and that the line holds no character pilgrim never writes (a control
-/// character such as a lone carriage return, which ends a line on some
-/// controls; anything beyond ASCII). With it, the text of the line's last
-/// comment.
-fn read_line(d: &Dialect, i: usize, line: &str) -> Result<(String, Option<String>), String> {
-    if let Some(c) = line.chars().find(|c| c.is_control() || !c.is_ascii()) {
-        return Err(format!(
-            "the character U+{:04X}, which pilgrim never writes (a carriage return or another control character ends or changes a line on some controls)",
-            u32::from(c)
-        ));
-    }
-    let check = |comment: &str| -> Result<(), String> {
-        // A header line with nothing filled in is the dialect's own at its
-        // place (Sinumerik's `;$PATH=/_N_MPF_DIR`), whatever it holds.
-        if d.header
-            .get(i)
-            .is_some_and(|h| !h.contains('{') && *h == line)
-        {
-            return Ok(());
-        }
-        let text = comment.strip_prefix(' ').unwrap_or(comment);
-        if let Some(c) = text.chars().find(|c| !crate::names::is_name_char(*c)) {
-            return Err(format!(
-                "'{c}' in the comment '{}', which pilgrim's comments never hold",
-                crate::files::excerpt(comment)
-            ));
-        }
-        if d.upper_comments && text.chars().any(|c| c.is_ascii_lowercase()) {
-            return Err(format!(
-                "lower case in the comment '{}', which the control may refuse",
-                crate::files::excerpt(comment)
-            ));
-        }
-        if super::post::is_active_comment(d, text) {
-            return Err(format!(
-                "the comment '({})' makes LinuxCNC act (a message, a file, a script)",
-                crate::files::excerpt(comment)
-            ));
-        }
-        Ok(())
-    };
-    let mut code = String::with_capacity(line.len());
-    let mut said = None;
-    if d.comment.1.is_empty() {
-        // A comment runs from its opening (`;`) to the line's end.
-        let open = d.comment.0.trim_end();
-        let (c, comment) = match line.find(open) {
-            Some(p) => (&line[..p], Some(&line[p + open.len()..])),
-            None => (line, None),
-        };
-        if let Some(comment) = comment {
-            check(comment)?;
-            said = Some(comment.strip_prefix(' ').unwrap_or(comment).to_owned());
-        }
-        code.push_str(c);
-        code.push_str(&" ".repeat(line.len() - c.len()));
-        return Ok((code, said));
-    }
-    // Parenthesised comments, closed on their line, none inside another.
-    let mut rest = line;
-    while let Some(p) = rest.find(['(', ')', ';']) {
-        code.push_str(&rest[..p]);
-        match rest.as_bytes()[p] {
-            b'(' => {
-                let inner = &rest[p + 1..];
-                let Some(q) = inner.find(')') else {
-                    return Err("a comment '(' that its line does not close".into());
-                };
-                let comment = &inner[..q];
-                if comment.contains('(') {
-                    return Err("a comment inside a comment".into());
-                }
-                check(comment)?;
-                said = Some(comment.strip_prefix(' ').unwrap_or(comment).to_owned());
-                code.push_str(&" ".repeat(q + 2));
-                rest = &inner[q + 1..];
-            }
-            b')' => return Err("')' outside a comment".into()),
-            _ => return Err("';', which pilgrim never writes in this dialect".into()),
-        }
-    }
-    code.push_str(rest);
-    Ok((code, said))
+/// One block being read: where it is and what it holds.
+struct Block {
+    /// Its line (from 0).
+    line: usize,
+    /// Its number N, where it has one.
+    number: Option<u32>,
+    /// Its code as the control reads it (comments blanked in place).
+    code: String,
+    /// Its ISO words after the number.
+    tokens: Vec<super::words::Word>,
+    /// Sinumerik's own words in it.
+    own: Vec<OwnWord>,
+}
+
+/// What a block's words say before its move is read: its motion code,
+/// its addresses with their values, the setup's words, a start angle.
+#[derive(Debug, Default)]
+struct Said {
+    /// The motion code (G0, G1, G32, G33, G76), where it has one.
+    motion: Option<u32>,
+    /// Each address with its value and text (`@`: Sinumerik's `SF=`).
+    read: Vec<(char, Real, String)>,
+    /// Diameter (true) or radius programming, with the word that says it.
+    radial: Vec<(bool, String)>,
+    /// `FGROUP(..)`'s lists.
+    feed_group: Vec<String>,
+    /// The word giving a thread's start angle, where one does.
+    start_word: Option<String>,
+}
+
+/// "line N" for line `l` (from 0).
+fn at_line(l: usize) -> String {
+    format!("line {}", l + 1)
 }
 
 impl<'a> Reader<'a> {
@@ -411,6 +362,11 @@ impl<'a> Reader<'a> {
     /// which becomes the standing after it; its moves are pushed to `out`.
     /// After a failure `at` is not a standing of the text.
     ///
+    /// The line's code ([`line`]: comments, the header's lines, Sinumerik's
+    /// own words), its block and number, its words ([`codes`]), the
+    /// machine's setup words ([`setup`]), then a threading cycle's moves
+    /// ([`cycles`]) or the block's move ([`moves`]).
+    ///
     /// # Failures
     /// The first word or rule of the line the reader cannot account for,
     /// named by the block's `N` or the line; the run's deadline.
@@ -421,900 +377,42 @@ impl<'a> Reader<'a> {
         text: &str,
         out: &mut Vec<ReadMove>,
     ) -> Result<(), LintError> {
-        let fault = |place: String, message: String| LintError {
+        self.ticker
+            .tick()
+            .map_err(|e| self.fault(i, e.to_string()))?;
+        let (code, own) = self.code_of(at, i, text)?;
+        let Some(block) = self.block_of(at, i, text, code, own)? else {
+            return Ok(());
+        };
+        let said = self.words_of(at, &block)?;
+        self.setup_words(&mut at.st, &block, at.k, &said)?;
+        if said.motion == Some(76) {
+            return self.cycle(at, &block, &said, out);
+        }
+        self.moves(at, &block, said, out)
+    }
+
+    /// A fault at `place` (`N20`, `line 3`).
+    fn err(&self, place: String, message: String) -> LintError {
+        LintError {
             dialect: self.d.name.to_owned(),
             place,
             message,
-        };
-        let at_line = |l: usize| format!("line {}", l + 1);
-        self.ticker
-            .tick()
-            .map_err(|e| fault(at_line(i), e.to_string()))?;
-        let Self {
-            d,
-            program,
-            axes,
-            reading,
-            decimals,
-            half,
-            lead_letter,
-            start_letter,
-            start_scale,
-            ref names,
-            ref program_number,
-            ref header_name,
-            radial,
-            start,
-            spindle,
-            framed,
-            lines: n_lines,
-            ..
-        } = *self;
-        let (g_ok, m_ok) = (d.reading.g_codes, d.reading.m_codes);
-        let name_line = d.reading.name_line;
-        let line = i;
-        // The line as its control reads it: comments out of the way of the
-        // word reader (blanked in place) and checked, the header's own
-        // lines recognised where they stand, Sinumerik's own words read.
-        let mut own: Vec<OwnWord> = Vec::new();
-        let (mut l, said) = read_line(d, i, text).map_err(|m| fault(at_line(i), m))?;
-        if l.trim().is_empty() {
-            if let Some(s) = &said {
-                at.pending = Some(s.clone());
-            }
         }
-        // A program read as it stands names itself.
-        let own_name = name_line
-            .and_then(|(before, after)| text.strip_prefix(before)?.strip_suffix(after))
-            .filter(|n| {
-                reading && !n.is_empty() && n.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
-            });
-        let own_number = first_code(&l)
-            .and_then(|w| w.strip_prefix('O'))
-            .filter(|n| reading && n.len() == 4)
-            .and_then(|n| n.parse::<u32>().ok());
-        if i == 0 && (header_name.as_deref() == Some(text) || own_name.is_some()) {
-            at.name = own_name.map(str::to_owned);
-            l = " ".repeat(text.len());
-        } else if framed && text == "%" && (i == 0 || i + 1 == n_lines) {
-            l = " ".into();
-        } else if d.reading.number_line
-            && framed
-            && i == 1
-            && (first_code(&l).is_some_and(|w| w == program_number) || own_number.is_some())
-        {
-            at.number = own_number;
-            // Fanuc's program number, `O0001`, is not an ISO word.
-            let n = l.find('O').unwrap_or(0);
-            l.replace_range(n..n + 5, "     ");
+    }
+
+    /// Where block `b` is, for a message, with `k` moves read before it: its
+    /// number where the text is read as it stands, the axis program's
+    /// block `k` where it is held to one, else its line.
+    fn place(&self, b: &Block, k: usize) -> String {
+        if self.reading {
+            b.number
+                .map_or_else(|| at_line(b.line), |n| format!("N{n}"))
+        } else if k < self.program.blocks.len() {
+            name_in(self.d.name, &self.program.blocks, k)
         } else {
-            let code_part = l.clone();
-            for word in code_part.split_whitespace() {
-                let w =
-                    if let Some((_, diameter)) = radial.filter(|(r, dm)| word == *r || word == *dm)
-                    {
-                        OwnWord::Radial(word == diameter)
-                    } else if let Some(list) = d
-                        .feed_group
-                        .and_then(|g| word.strip_prefix(g)?.strip_prefix('(')?.strip_suffix(')'))
-                    {
-                        OwnWord::FeedGroup(list.to_owned())
-                    } else if let Some(v) = start.and_then(|a| word.strip_prefix(a)) {
-                        OwnWord::StartAngle(v.parse().map_err(|_| {
-                            fault(at_line(i), format!("'{word}' is not a start angle"))
-                        })?)
-                    } else {
-                        continue;
-                    };
-                own.push(w);
-                l = l.replacen(word, &" ".repeat(word.len()), 1);
-            }
+            at_line(b.line)
         }
-        let has_code = !l.trim().is_empty() || !own.is_empty();
-        let code_text = &l;
-        let st = &mut at.st;
-        let mut k = at.k;
-        // The block's words, every character accounted for.
-        let at_block = || {
-            code_text
-                .split_whitespace()
-                .next()
-                .filter(|w| {
-                    w.len() > 1 && w.starts_with('N') && w[1..].bytes().all(|b| b.is_ascii_digit())
-                })
-                .map_or_else(|| at_line(line), str::to_owned)
-        };
-        let mut tokens =
-            super::words::words(code_text).map_err(|m| fault(at_block(), m.message))?;
-        let line_number = match tokens.first() {
-            Some(w) if w.letter == 'N' => {
-                let n = w.integer().ok_or_else(|| {
-                    fault(
-                        at_line(line),
-                        format!("{}: a block number is a whole number", w.text()),
-                    )
-                })?;
-                tokens.remove(0);
-                Some(n)
-            }
-            _ => None,
-        };
-        if let Some(w) = tokens.iter().find(|w| w.letter == 'N') {
-            return Err(fault(
-                at_block(),
-                format!("{}: a block number that does not open its block", w.text()),
-            ));
-        }
-        let own_here = own;
-        if tokens.is_empty() && line_number.is_none() && own_here.is_empty() {
-            if has_code {
-                return Err(fault(
-                    at_line(line),
-                    format!(
-                        "'{}' is not a block the {} can account for",
-                        crate::files::excerpt(text),
-                        if reading { "reader" } else { "lint" }
-                    ),
-                ));
-            }
-            return Ok(());
-        }
-        let place = |k: usize| {
-            if reading {
-                line_number.map_or_else(|| at_line(line), |n| format!("N{n}"))
-            } else if k < program.blocks.len() {
-                name_in(d.name, &program.blocks, k)
-            } else {
-                at_line(line)
-            }
-        };
-        if st.ended {
-            return Err(fault(
-                place(k),
-                format!(
-                    "a block after the program's end ({})",
-                    st.ended_by.as_deref().unwrap_or("")
-                ),
-            ));
-        }
-        match (d.numbering, line_number) {
-            (Some(_), None) => {
-                return Err(fault(
-                    at_line(line),
-                    format!(
-                        "a block without its number ('{}' opens it)",
-                        code_text.split_whitespace().next().unwrap_or_default()
-                    ),
-                ))
-            }
-            (Some(_), Some(n)) => {
-                if at.last_n.is_some_and(|m| n <= m) {
-                    return Err(fault(
-                        format!("N{n}"),
-                        format!("numbered out of order, after N{}", at.last_n.unwrap_or(0)),
-                    ));
-                }
-                at.last_n = Some(n);
-            }
-            (None, Some(n)) => {
-                return Err(fault(
-                    at_line(line),
-                    format!("N{n}: the dialect numbers no blocks"),
-                ))
-            }
-            (None, None) => {}
-        }
-        // The block's words: codes, the tool call, addresses with values.
-        let mut radial_here: Vec<(bool, String)> = Vec::new();
-        let mut feed_group_here: Vec<&str> = Vec::new();
-        let mut sf_here = None;
-        for w in &own_here {
-            match w {
-                OwnWord::Radial(diameter) => {
-                    let (radius, on_diameter) = d.radial_words.unwrap_or_default();
-                    radial_here.push((
-                        *diameter,
-                        if *diameter { on_diameter } else { radius }.into(),
-                    ))
-                }
-                OwnWord::FeedGroup(list) => feed_group_here.push(list),
-                OwnWord::StartAngle(v) => sf_here = Some(*v),
-            }
-        }
-        let mut motion_here = None;
-        let mut read = Vec::new();
-        let mut letters_here: Vec<char> = Vec::new();
-        let mut start_word: Option<String> = sf_here.map(|v| format!("SF={v}"));
-        for w in &tokens {
-            match w.letter {
-                'G' | 'M' => {
-                    let listed = if w.letter == 'G' { g_ok } else { m_ok };
-                    // A code as the dialect reads it: to a tenth where it
-                    // does (LinuxCNC's G1.0 is G1), else a whole number.
-                    let code = if d.reading.code_tenths {
-                        w.whole()
-                    } else {
-                        w.integer()
-                    };
-                    let Some(n) = code.filter(|n| listed.contains(n)) else {
-                        // What the code means on this control, where the
-                        // dialect's table says: never another dialect's.
-                        let named = w
-                            .code()
-                            .map(|c| format!("{}{c}", w.letter))
-                            .and_then(|c| d.reading.meanings.iter().find(|m| m.0 == c))
-                            .map_or_else(String::new, |m| format!(" ({} on {})", m.1, d.name));
-                        return Err(fault(
-                            place(k),
-                            format!("{}{named}{}", w.text(), self.not_read),
-                        ));
-                    };
-                    let by = || Some(format!("{} at {}", w.text(), place(k)));
-                    if w.letter == 'M' {
-                        match n {
-                            3 | 5 if st.spindle_on != (n == 3) => {
-                                st.spindle_on = n == 3;
-                                st.spindle_by = by();
-                            }
-                            8 | 9 if st.coolant != (n == 8) => {
-                                st.coolant = n == 8;
-                                st.coolant_by = by();
-                            }
-                            n if n == d.reading.end_code => {
-                                st.ended = true;
-                                st.ended_by = by();
-                            }
-                            _ => {}
-                        }
-                        continue;
-                    }
-                    match n {
-                        0 | 1 | 32 | 33 | 76 => {
-                            if let Some(m) = motion_here {
-                                return Err(fault(
-                                    place(k),
-                                    format!("G{m} and {} in one block: two motions", w.text()),
-                                ));
-                            }
-                            motion_here = Some(n)
-                        }
-                        97 => st.constant_speed = true,
-                        // LinuxCNC's diameter (G7) and radius (G8) modes.
-                        7 | 8 => radial_here.push((n == 7, w.text())),
-                        n if d.reading.work_offsets.contains(&n) => {
-                            // The part zero is the work offset the program
-                            // selects first (before its moves: the one in
-                            // force at power-on, the first listed, if none).
-                            let power_on = (k > 0).then(|| {
-                                (
-                                    power_on_code(d, program, d.reading.work_offsets)
-                                        .unwrap_or(d.reading.work_offsets[0]),
-                                    "power-on, before the moves".into(),
-                                )
-                            });
-                            // A switch the offsets table gives: its shift
-                            // (back to the first: none).
-                            let first = st.work_offset.as_ref().map(|(c, _)| *c);
-                            let table = first
-                                .filter(|c| *c != n)
-                                .and_then(|_| self.work_shift(&format!("G{n}")));
-                            if first == Some(n) {
-                                st.work_shift = Vec::new();
-                                continue;
-                            }
-                            if let Some(shift) = table {
-                                st.work_shift = shift;
-                                continue;
-                            }
-                            keep_first(&mut st.work_offset, power_on, n, || place(k)).map_err(
-                                |(c, at)| {
-                                    fault(
-                                        place(k),
-                                        format!(
-                                            "{}: a switch of the work offset from G{c} ({at}), the part zero the verification places the part at (another part zero moves every later block); verify a program that keeps one, or give the offset's shift in an --offsets file",
-                                            w.text()
-                                        ),
-                                    )
-                                },
-                            )?;
-                        }
-                        17..=19 => {
-                            // The plane the machine's setup states (the
-                            // tool's length offsets and arcs follow it), or
-                            // the first selected: another is refused.
-                            let setup = match program.setup.plane {
-                                Some(p) => {
-                                    Some((super::post::plane_code(p), "the machine's setup".into()))
-                                }
-                                None => power_on_code(d, program, &[17, 18, 19])
-                                    .map(|c| (c, "the machine's power-on state".into())),
-                            };
-                            keep_first(&mut st.plane, setup, n, || {
-                                format!("{} at {}", w.text(), place(k))
-                            })
-                            .map_err(|(c, at)| {
-                                fault(
-                                    place(k),
-                                    format!(
-                                        "{}: another plane than G{c} ({at}); the tool's length offsets and arcs follow the plane, which the verification keeps",
-                                        w.text()
-                                    ),
-                                )
-                            })?;
-                        }
-                        _ => {}
-                    }
-                    // The setup's codes stated (a code restated, or one
-                    // the setup does not need, changes nothing kept).
-                    if d.reading.setup_codes.contains(&n) && !st.stated.contains(&n) {
-                        st.stated.push(n);
-                    }
-                }
-                'T' => {
-                    if letters_here.contains(&'T') {
-                        return Err(fault(
-                            place(k),
-                            format!("{}: T twice in one block", w.text()),
-                        ));
-                    }
-                    letters_here.push('T');
-                    if k > 0 {
-                        return Err(fault(
-                            place(k),
-                            format!("a tool call {} among the moves", w.text()),
-                        ));
-                    }
-                    let n = w.integer().ok_or_else(|| {
-                        fault(
-                            place(k),
-                            format!("{}: a tool call is a whole number", w.text()),
-                        )
-                    })?;
-                    // A lathe's T names the tool and its offset (`T0303`):
-                    // the model's tool is the tool with its own offset.
-                    at.tool = Some(if d.reading.tool_and_offset {
-                        let (tool, offset) = (n / 100, n % 100);
-                        let table = (n >= 100 && offset != tool)
-                            .then(|| self.tool_shift(&format!("T{n:04}")))
-                            .flatten();
-                        if let Some(shift) = table {
-                            st.tool_shift = shift;
-                        } else if n < 100 || offset != tool {
-                            return Err(fault(
-                                place(k),
-                                format!(
-                                    "{}: tool {tool:02} with offset {offset:02}; the verification's tool is a tool with its own offset (T{tool:02}{tool:02}: 00 cancels the offset, another number is another tool's), or one an --offsets file gives",
-                                    w.text()
-                                ),
-                            ));
-                        }
-                        tool
-                    } else {
-                        n
-                    });
-                    // Another tool has its own shape and offsets: the
-                    // verification models the family's.
-                    if at.tool != Some(program.tool_number) {
-                        return Err(fault(
-                            place(k),
-                            format!(
-                                "{}: another tool than T{}, the family's, whose shape the verification models",
-                                w.text(),
-                                program.tool_number
-                            ),
-                        ));
-                    }
-                }
-                letter => {
-                    if letters_here.contains(&letter) {
-                        return Err(fault(
-                            place(k),
-                            format!("{}: {letter} twice in one block", w.text()),
-                        ));
-                    }
-                    letters_here.push(letter);
-                    if d.reading.point_needed.contains(letter) && !w.has_point() {
-                        return Err(fault(
-                            place(k),
-                            format!(
-                                "{}: a number without its decimal point, which {} reads by a parameter of the control; write {}.",
-                                w.text(),
-                                d.name,
-                                w.text()
-                            ),
-                        ));
-                    }
-                    if d.reading.no_point.contains(letter) && w.has_point() {
-                        return Err(fault(
-                            place(k),
-                            format!(
-                                "{}: a decimal point in a word {} reads as a whole number",
-                                w.text(),
-                                d.name
-                            ),
-                        ));
-                    }
-                    // An axis value without a decimal point is in the
-                    // control's least input unit where it says so.
-                    let v = match self.least_input {
-                        Some(unit) if !w.has_point() && names.contains(&letter) => w.value() * unit,
-                        _ => w.value(),
-                    };
-                    if start_letter == Some(letter) {
-                        start_word = Some(w.text());
-                    }
-                    if d.reading.offset_word == Some(letter) {
-                        st.tool_shift = match w.integer() {
-                            Some(1) => Vec::new(),
-                            Some(n) => self.tool_shift(&format!("{letter}{n}")).ok_or_else(|| {
-                                fault(
-                                    place(k),
-                                    format!(
-                                        "{}: another tool offset than {letter}1, the tool call's, which is the verification's tool ({letter}0 cancels it, another number is another edge's); an --offsets file that gives {letter}{n} says where it moves the tool",
-                                        w.text()
-                                    ),
-                                )
-                            })?,
-                            None => {
-                                return Err(fault(
-                                    place(k),
-                                    format!(
-                                        "{}: another tool offset than {letter}1, the tool call's, which is the verification's tool ({letter}0 cancels it, another number is another edge's)",
-                                        w.text()
-                                    ),
-                                ))
-                            }
-                        };
-                    }
-                    read.push((letter, v, w.text()));
-                }
-            }
-        }
-        if let Some(s) = sf_here {
-            read.push(('@', s, format!("SF={s}")));
-        }
-        let mut axis_here = vec![None; names.len()];
-        // The machine's setup words, once, before the first move, and as
-        // the setup says.
-        for (diameter, word) in radial_here {
-            let want = program.setup.radial.map(|r| r == Radial::Diameter);
-            if k > 0 || st.radial.is_some() || want != Some(diameter) {
-                return Err(fault(
-                    place(k),
-                    format!(
-                        "{word}: {} where the machine's setup {}",
-                        if diameter {
-                            "diameter programming"
-                        } else {
-                            "radius programming"
-                        },
-                        match (want, k > 0 || st.radial.is_some()) {
-                            (_, true) => "sets it once, before the moves".to_owned(),
-                            (Some(true), _) => "programs the radial axis on diameter".to_owned(),
-                            (Some(false), _) => "programs the radial axis on radius".to_owned(),
-                            (None, _) => "says nothing of it".to_owned(),
-                        }
-                    ),
-                ));
-            }
-            st.radial = Some(diameter);
-        }
-        for list in feed_group_here {
-            if k > 0 || st.feed_group || list != program.setup.feed_group.join(",") {
-                return Err(fault(
-                    place(k),
-                    format!(
-                        "FGROUP({list}) where the machine's setup groups the feed over ({}), once, before the moves",
-                        program.setup.feed_group.join(",")
-                    ),
-                ));
-            }
-            st.feed_group = true;
-        }
-        // A threading cycle (LinuxCNC's G76): the moves it makes, each
-        // held and read as a block of its own.
-        if motion_here == Some(76) {
-            let values: Vec<(char, Real)> = read.iter().map(|(c, v, _)| (*c, *v)).collect();
-            let (cycle, end_x) = cycle_words(&values, d).map_err(|m| fault(place(k), m))?;
-            let what = "a threading cycle";
-            let needs_g97 = (d.reading.thread_needs_constant_speed && !st.constant_speed)
-                .then(|| format!("{what} before constant spindle speed (G97)"));
-            if let Some(m) = cutting_fault(st, d, &program.setup, what)
-                .or(needs_g97)
-                .or_else(|| setup_fault(st, d, program, what))
-            {
-                return Err(fault(place(k), m));
-            }
-            let (Some(xi), Some(zi)) = (
-                names.iter().position(|n| *n == 'X'),
-                names.iter().position(|n| *n == 'Z'),
-            ) else {
-                return Err(fault(
-                    place(k),
-                    format!(
-                        "a threading cycle on {}, which programs no X and Z",
-                        program.machine
-                    ),
-                ));
-            };
-            let (Some(x0), Some(z0)) = (st.values[xi], st.values[zi]) else {
-                return Err(fault(
-                    place(k),
-                    "a threading cycle before X and Z are written (the drive line it starts from)"
-                        .into(),
-                ));
-            };
-            let moves = super::cycle::expand(&cycle, [x0, z0], st.radial == Some(true), end_x)
-                .map_err(|m| fault(place(k), m.message))?;
-            let comment = at.pending.take();
-            for (n, mv) in moves.iter().enumerate() {
-                let b = if reading { None } else { program.blocks.get(k) };
-                if !reading && b.is_none() {
-                    return Err(fault(
-                        at_line(line),
-                        format!(
-                            "the threading cycle's move {} is beyond the axis program's {} blocks",
-                            n + 1,
-                            program.blocks.len()
-                        ),
-                    ));
-                }
-                let mut values = st.values.clone();
-                values[xi] = Some(mv.x);
-                values[zi] = Some(mv.z);
-                if let Some(b) = b {
-                    let off = (0..names.len())
-                        .find(|&i| values[i].is_some_and(|v| !((v - b.values[i]).abs() <= half)));
-                    if b.motion != mv.motion || off.is_some() {
-                        return Err(fault(
-                            place(k),
-                            format!(
-                                "the threading cycle's move {} is {:?} to X{} Z{}, the axis program's {:?} to X{} Z{}",
-                                n + 1,
-                                mv.motion,
-                                crate::math::fixed(mv.x, decimals + 2),
-                                crate::math::fixed(mv.z, decimals + 2),
-                                b.motion,
-                                crate::math::fixed(b.values[xi], decimals + 2),
-                                crate::math::fixed(b.values[zi], decimals + 2)
-                            ),
-                        ));
-                    }
-                }
-                for (i, v) in [(xi, mv.x), (zi, mv.z)] {
-                    if let Some(a) = axes.iter().find(|a| a.name == program.axes[i].name) {
-                        let (lo, hi) = (a.to_user(a.min), a.to_user(a.max));
-                        if v < lo - half || v > hi + half {
-                            return Err(fault(
-                                place(k),
-                                format!(
-                                    "the threading cycle's move {} takes {} to {v}, outside the axis's travel [{lo}, {hi}]",
-                                    n + 1,
-                                    program.axes[i].name
-                                ),
-                            ));
-                        }
-                    }
-                }
-                st.values = values;
-                out.push(ReadMove {
-                    motion: mv.motion,
-                    values: placed(st),
-                    feed: match mv.motion {
-                        Motion::Thread { lead, .. } => lead * st.speed.unwrap_or_default(),
-                        _ => 0.0,
-                    },
-                    spindle: if n == 0 { at.speed_next.take() } else { None },
-                    comment: if n == 0 { comment.clone() } else { None },
-                    number: line_number,
-                    line,
-                });
-                k += 1;
-                at.k = k;
-            }
-            at.st.motion = Some(76);
-            return Ok(());
-        }
-        let mut lead_here = None;
-        // A lead by its own address (K), which only a thread block reads.
-        let mut lead_word: Option<String> = None;
-        let mut s_here = None;
-        for (letter, v, text) in read {
-            if let Some(i) = names.iter().position(|n| *n == letter) {
-                axis_here[i] = Some(v);
-                continue;
-            }
-            if letter == 'F' && !(v > 0.0) {
-                return Err(fault(
-                    place(k),
-                    format!("{text}: a feed is a positive number"),
-                ));
-            }
-            match letter {
-                // One modal F where the lead's address is the feed's
-                // (Fanuc): a feed written on a G01 is the next thread's
-                // lead, and a lead the next G01's feed.
-                'F' if lead_letter == 'F' => {
-                    st.feed = true;
-                    st.f = Some(v);
-                    lead_here = Some(v);
-                }
-                'F' => {
-                    st.feed = true;
-                    st.f = Some(v);
-                }
-                'S' => s_here = Some(v),
-                c if d.reading.offset_word == Some(c) => {}
-                c if start_letter == Some(c) => st.start_deg = v / start_scale,
-                '@' => st.start_deg = v,
-                c if c == lead_letter => {
-                    lead_here = Some(v);
-                    lead_word = Some(text);
-                }
-                c if reading => {
-                    // What the address means on this control, where its
-                    // table says (Fanuc system A's U and W).
-                    let named = (d.reading.meanings.iter())
-                        .find(|m| m.0.len() == 1 && m.0.starts_with(c))
-                        .map_or_else(String::new, |m| format!(" ({} on {})", m.1, d.name));
-                    return Err(fault(
-                        place(k),
-                        format!(
-                            "{text}{named}: a word the verification cannot simulate ({} on {} reads the axes {}, F, S, T{})",
-                            d.name,
-                            program.machine,
-                            names.iter().collect::<String>(),
-                            start_letter.map(|c| format!(", {c}")).unwrap_or_default()
-                        ),
-                    ));
-                }
-                _ => {
-                    return Err(fault(
-                        place(k),
-                        format!("{text}: not a word of {} on {}", d.name, program.machine),
-                    ))
-                }
-            }
-        }
-        if let Some(m) = motion_here {
-            st.motion = Some(m);
-        }
-        if let Some(l) = lead_here {
-            st.lead = Some(l);
-        }
-        let moves = axis_here.iter().any(Option::is_some);
-        if let Some(v) = s_here {
-            // The speed the axis program sets here: a move's own where it
-            // changes, the program's before the moves.
-            let want = if moves {
-                program.blocks.get(k).and_then(|b| b.spindle)
-            } else {
-                Some(program.spindle_rpm)
-            }
-            .map(Real::round);
-            if k == 0 && !moves {
-                at.rpm = Some(v);
-            } else {
-                at.speed_next = Some(v);
-            }
-            if !reading && want != Some(v) {
-                return Err(fault(
-                    place(k),
-                    format!(
-                        "S{v} read back, where the axis program sets {}",
-                        want.map_or("no speed".to_owned(), |w| format!("S{w}"))
-                    ),
-                ));
-            }
-            if !(v >= 1.0) {
-                return Err(fault(
-                    place(k),
-                    format!("S{v}: the spindle would stand while the program cuts"),
-                ));
-            }
-            if let Some(a) = spindle.filter(|a| !(v >= a.min && v <= a.max)) {
-                return Err(fault(
-                    place(k),
-                    format!(
-                        "S{v} is outside spindle {}'s range [{}, {}] rpm",
-                        a.name, a.min, a.max
-                    ),
-                ));
-            }
-            st.speed = Some(v);
-        }
-        let lead_outside = |w: &str| {
-            format!(
-                "{w}: a thread's lead outside a thread block ({} reads {lead_letter} as the lead of {} only)",
-                d.name, d.thread
-            )
-        };
-        if !moves {
-            if motion_here.is_some() {
-                return Err(fault(place(k), "a motion word with no axis".into()));
-            }
-            if let Some(w) = &lead_word {
-                return Err(fault(place(k), lead_outside(w)));
-            }
-            if let Some(w) = &start_word {
-                return Err(fault(place(k), outside_thread(w, d)));
-            }
-            return Ok(());
-        }
-        // A move: the modal values carried, held to the axis program.
-        let b = if reading { None } else { program.blocks.get(k) };
-        if !reading && b.is_none() {
-            return Err(fault(
-                at_line(line),
-                format!(
-                    "a move beyond the axis program's {} blocks",
-                    program.blocks.len()
-                ),
-            ));
-        };
-        for (i, v) in axis_here.iter().enumerate() {
-            if let Some(v) = v {
-                st.values[i] = Some(*v);
-            }
-        }
-        let Some(m) = st.motion else {
-            return Err(fault(
-                place(k),
-                "a move before any motion word (G0, G1)".into(),
-            ));
-        };
-        if m == 76 {
-            return Err(fault(
-                place(k),
-                "a move under a threading cycle's modal G76 without its words: write G0 or G1 first".into(),
-            ));
-        }
-        let is_thread = m == 32 || m == 33;
-        if let Some(w) = lead_word.as_ref().filter(|_| !is_thread) {
-            return Err(fault(place(k), lead_outside(w)));
-        }
-        if let Some(b) = b {
-            let want = match b.motion {
-                Motion::Rapid => m == 0,
-                Motion::Linear => m == 1,
-                Motion::Thread { .. } => is_thread,
-            };
-            if !want {
-                return Err(fault(
-                    place(k),
-                    format!("G{m}, where the axis program has a {:?} move", b.motion),
-                ));
-            }
-        }
-        if m == 1 && !st.feed {
-            return Err(fault(place(k), "G1 before any feed F".into()));
-        }
-        if let Some(m) = (m != 0)
-            .then(|| cutting_fault(st, d, &program.setup, "a cutting move"))
-            .flatten()
-        {
-            return Err(fault(place(k), m));
-        }
-        if let Some(w) = start_word.as_ref().filter(|_| !is_thread) {
-            return Err(fault(place(k), outside_thread(w, d)));
-        }
-        if let Some(m) = setup_fault(st, d, program, "a move") {
-            return Err(fault(place(k), m));
-        }
-        let read_lead = st.lead.unwrap_or(Real::NAN);
-        let motion = match m {
-            0 => Motion::Rapid,
-            1 => Motion::Linear,
-            _ => Motion::Thread {
-                lead: read_lead,
-                start_deg: st.start_deg,
-            },
-        };
-        if is_thread {
-            if d.lead_every_block && lead_here.is_none() {
-                return Err(fault(
-                    place(k),
-                    format!("a thread block without its lead {}", d.lead),
-                ));
-            }
-            if d.reading.thread_needs_constant_speed && !st.constant_speed {
-                return Err(fault(
-                    place(k),
-                    "a thread before constant spindle speed (G97)".into(),
-                ));
-            }
-            if !(read_lead > 0.0) {
-                return Err(fault(place(k), "a thread block before any lead".into()));
-            }
-            if let Some(Motion::Thread { lead, start_deg }) = b.map(|b| b.motion) {
-                if !((read_lead - lead).abs()
-                    <= 0.5 * 10f64.powi(-(d.lead_decimals as i32)) + crate::tolerance::SAME_LENGTH)
-                {
-                    return Err(fault(
-                        place(k),
-                        format!("lead {read_lead}, the axis program's {lead}"),
-                    ));
-                }
-                if (st.start_deg - start_deg).abs() > 1e-3 {
-                    return Err(fault(
-                        place(k),
-                        format!(
-                            "thread start {} deg, the axis program's {start_deg} deg",
-                            st.start_deg
-                        ),
-                    ));
-                }
-            }
-            if d.thread_start.is_some_and(|t| !t.modal) {
-                st.start_deg = 0.0; // Fanuc's Q holds for its block only
-            }
-        }
-        // Where each axis goes: its value with the offsets' shifts.
-        let going = placed(st);
-        for (i, name) in program.axes.iter().enumerate() {
-            if b.is_some_and(|b| b.keep.contains(&name.name)) {
-                continue;
-            }
-            let v = match (st.values[i], b) {
-                (Some(v), _) => v,
-                // Read: an axis not yet written stands where it stands.
-                (None, None) => continue,
-                (None, Some(_)) => {
-                    return Err(fault(
-                        place(k),
-                        format!("axis {} has no value yet", name.name),
-                    ))
-                }
-            };
-            if let Some(b) = b.filter(|b| !((v - b.values[i]).abs() <= half)) {
-                return Err(fault(
-                    place(k),
-                    format!(
-                        "{}{v} read back, the axis program's {}",
-                        name.name,
-                        crate::math::fixed(b.values[i], decimals + 2)
-                    ),
-                ));
-            }
-            if let Some(a) = axes.iter().find(|a| a.name == name.name) {
-                let (lo, hi) = (a.to_user(a.min), a.to_user(a.max));
-                let shifted = going[i].unwrap_or(v);
-                if shifted < lo - half || shifted > hi + half {
-                    let by = if shifted == v {
-                        String::new()
-                    } else {
-                        format!(" (at {shifted} with the offsets' shift)")
-                    };
-                    return Err(fault(
-                        place(k),
-                        format!(
-                            "{}{v}{by} is outside the axis's travel [{lo}, {hi}]",
-                            name.name
-                        ),
-                    ));
-                }
-            }
-        }
-        // The move as read (a lint reads it too: what a run verifies).
-        {
-            let comment = at.pending.take();
-            out.push(ReadMove {
-                motion,
-                values: going,
-                feed: match motion {
-                    Motion::Rapid => 0.0,
-                    Motion::Linear => st.f.unwrap_or_default(),
-                    Motion::Thread { lead, .. } => lead * st.speed.unwrap_or_default(),
-                },
-                spindle: at.speed_next.take(),
-                comment,
-                number: line_number,
-                line,
-            });
-        }
-        k += 1;
-        at.k = k;
-        Ok(())
     }
 
     /// The checks at the text's end, from `at`, the standing after its
@@ -1487,62 +585,6 @@ fn setup_fault(st: &State, d: &Dialect, program: &AxisProgram, what: &str) -> Op
     } else {
         None
     }
-}
-
-/// A threading cycle's words as read (`read`, its block's letters and
-/// values): the cycle and the block's X, where it writes one (where the
-/// cycle leaves the tool). LinuxCNC's defaults: `R` 1, `Q` not given
-/// (-1, no compound), `H` 0.
-///
-/// # Failures
-/// A word missing (the block's reader refuses one given twice), `H` not a whole number, the tapered
-/// ends (`E`, `L`), which are not simulated, or a word the cycle has not.
-fn cycle_words(
-    read: &[(char, Real)],
-    d: &Dialect,
-) -> Result<(super::cycle::ThreadCycle, Option<Real>), String> {
-    let mut seen: Vec<char> = Vec::new();
-    // The block's reader refuses an address given twice: the first is it.
-    let mut get = |c: char| -> Option<Real> {
-        seen.push(c);
-        read.iter().find(|(l, _)| *l == c).map(|(_, v)| *v)
-    };
-    let need = |c: char, v: Option<Real>| v.ok_or_else(|| format!("G76 without its {c} word"));
-    let pitch = need('P', get('P'))?;
-    let z = need('Z', get('Z'))?;
-    let i = need('I', get('I'))?;
-    let j = need('J', get('J'))?;
-    let k = need('K', get('K'))?;
-    let r = get('R').unwrap_or(1.0);
-    let q = get('Q').unwrap_or(-1.0);
-    let h = get('H').unwrap_or(0.0);
-    let end_x = get('X');
-    if !(h >= 0.0 && h.fract() == 0.0 && h <= 1000.0) {
-        return Err(format!(
-            "G76 H{h}: the spring passes must be a whole number from 0 to 1000"
-        ));
-    }
-    if let Some((c, v)) = read.iter().find(|(l, _)| !seen.contains(l)) {
-        return Err(match c {
-            'E' | 'L' => format!(
-                "G76 {c}{v}: the cycle's tapered ends, which the verification does not simulate; verify a program without them"
-            ),
-            _ => format!("G76 {c}{v}: not a word of {}'s threading cycle", d.name),
-        });
-    }
-    Ok((
-        super::cycle::ThreadCycle {
-            pitch,
-            z,
-            i,
-            j,
-            r,
-            k,
-            q,
-            h: h as u32,
-        },
-        end_x,
-    ))
 }
 
 /// Why the reader refuses a code: in a program pilgrim wrote, a word its
