@@ -192,6 +192,97 @@ fn an_edited_cam_program_is_refused_by_the_scripts_figure() {
     );
 }
 
+/// The cam corrected as a built-in family is: its script names its
+/// nominal radius over angle, the kernel predicts the finish's, and a
+/// measurement with a wheel's wear the replay does not know (1.5 um at
+/// 180 deg to 4.5 um at 0), exact here (its uncertainty stated as 0.2
+/// um), is fitted by `compensate` and moved against: the correction is the
+/// wear's opposite within 0.5 um everywhere (0.32 um at the range's
+/// ends and beside the rise's foot), and
+/// the corrected program, replayed here from its file's words, leaves the
+/// section higher than the first program's by the wear, within 0.3 um on
+/// average over the turn (at an angle within the two programs' rounding
+/// of X to 1 um).
+#[test]
+fn a_cam_in_script_alone_is_corrected_by_its_measurement() {
+    let dir = scratch("script-verify", "cam-corrected");
+    let out = cam_run(&dir, &["--set", "tolerance=0.01"]);
+    let report = report_of(&out);
+    let predicted = &report["tables"]["predicted_deviation"];
+    let col = |k: &str| -> Vec<f64> {
+        (predicted[k]
+            .as_array()
+            .unwrap_or_else(|| panic!("{k}: {predicted}"))
+            .iter())
+        .map(|v| v.as_f64().unwrap())
+        .collect()
+    };
+    let (angle, dr) = (col("angle_deg"), col("dr_mm"));
+    assert_eq!((angle.len(), angle[1800]), (1801, 360.0));
+    let wear = |a: f64| 0.0015 + 0.0015 * (1.0 + a.to_radians().cos());
+    // Measured every 5 deg: the part as predicted, less the wear.
+    let mut csv = String::from("angle_deg,r_mm\n");
+    for i in 0..72 {
+        let k = i * 25;
+        let a = angle[k];
+        let r = cam_radius(a.to_radians()) + dr[k] - wear(a);
+        csv += &format!("{a},{r:.6}\n");
+    }
+    let measured = dir.join("measured.csv");
+    std::fs::write(&measured, csv).unwrap();
+    let corrected = dir.join("corrected");
+    let (code, _, err) = pilgrim(&[
+        "compensate",
+        s(&out),
+        "--measured",
+        s(&measured),
+        "--out",
+        s(&corrected),
+        "--uncertainty",
+        "0.0002",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let table = std::fs::read_to_string(corrected.join("correction.csv")).unwrap();
+    let mut rows = table.lines();
+    assert_eq!(rows.next(), Some("angle_deg,dr_mm"));
+    let mut n = 0;
+    for l in rows {
+        let (a, d) = l.split_once(',').unwrap();
+        let (a, d): (f64, f64) = (a.parse().unwrap(), d.parse().unwrap());
+        assert!(
+            (d - wear(a)).abs() < 5e-4,
+            "at {a} deg: dr {d}, wear {}",
+            wear(a)
+        );
+        n += 1;
+    }
+    assert!(n > 10, "{table}");
+    let corrected_report = report_of(&corrected);
+    assert_eq!(corrected_report["verdict"]["status"], "passed");
+    let text = |d: &Path| std::fs::read_to_string(d.join("program.mpf")).unwrap();
+    let picked: Vec<f64> = angle[..1800].iter().step_by(45).copied().collect();
+    let before = replayed_finish(&text(&out), 200.0, &picked);
+    let after = replayed_finish(&text(&corrected), 200.0, &picked);
+    // Each program's X is written to 1 um: at an angle the two differ by
+    // the correction and up to two roundings, over the turn by the
+    // correction alone.
+    let mut off = Vec::new();
+    for ((a, b), c) in picked.iter().zip(&before).zip(&after) {
+        let o = c - b - wear(*a);
+        assert!(
+            o.abs() < 1.5e-3,
+            "at {a} deg: {b} before, {c} after, the wear {}",
+            wear(*a)
+        );
+        off.push(o);
+    }
+    let mean = off.iter().sum::<f64>() / off.len() as f64;
+    assert!(
+        mean.abs() < 3e-4,
+        "the corrected section off the wear by {mean} on average"
+    );
+}
+
 /// What a script declares is read strictly: an unknown key, a replay the
 /// kernel does not make, a judge that is not a function, a judge's result
 /// with an unknown key: each refused naming what is accepted.
@@ -214,6 +305,16 @@ fn a_scripts_verification_is_read_strictly() {
             "judge: \"judge\",",
             "judge: \"jugde\",",
             "judge 'jugde' names no fn jugde(p, part)",
+        ),
+        (
+            "nominal: \"nominal_radii\",",
+            "nominal: \"nominal_radiii\",",
+            "nominal 'nominal_radiii' names no fn nominal_radiii(p, angle_deg)",
+        ),
+        (
+            "    floats(out)\n}",
+            "    out.push(1.0);\n    floats(out)\n}",
+            "must return a radius above 0 (mm) at each of the 1801 angles",
         ),
         (
             "        tables: #{",

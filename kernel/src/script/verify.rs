@@ -4,22 +4,34 @@
 //! (`#{ replay: "radius_over_angle", ... , judge }`); either may name a
 //! `judge`, the script's function the kernel calls once with the replayed
 //! part, pass by pass, in whole arrays, whose figures and findings the
-//! run treats as a built-in verification's ([`crate::judged`]). The host
+//! run treats as a built-in verification's ([`crate::judged`]). On the
+//! radius-over-angle replay, `nominal` names the script's function giving
+//! the nominal radius over angle: the part is then measured and corrected
+//! as a built-in family's (`pilgrim compensate`: `r_mm` at `angle_deg`,
+//! the correction `dr_mm`), the finish's predicted radius made by the
+//! kernel. The host
 //! knows no family's form: it matches the map's keys against them.
 
 use super::Script;
 use crate::binding::floats::{number, Floats};
+use crate::compensate::{Nominal, Quantity, PREDICTED};
 use crate::family::{ReplayContext, Replayed, ReplayedPass, Verification, Verified, Verifier};
 use crate::judged::{Judged, JudgedFigure, JudgedFinding, Tables, WithJudged};
+use crate::profile::Profile;
 use crate::replay::polar::{replay_polar, PolarPart, PolarRequest};
 use crate::replay::VerifyError;
 use rhai::{Array, Dynamic, Map};
+use std::collections::BTreeMap;
 
 /// The replays a script's own verification may ask for (`replay:`).
 pub const REPLAYS: [&str; 1] = ["radius_over_angle"];
 
 /// The keys of a script's own verification on the radius-over-angle replay.
-const POLAR_KEYS: [&str; 5] = ["replay", "z", "angles", "blank", "judge"];
+const POLAR_KEYS: [&str; 6] = ["replay", "z", "angles", "blank", "judge", "nominal"];
+
+/// The quantity a measurement of a part replayed as radius over angle
+/// holds: its radius (`r_mm`) at `angle_deg`, its correction `dr_mm`.
+const POLAR_RADIUS: [(&str, f64); 1] = [("r_mm", 1.0)];
 
 /// The keys a judge's result may hold.
 const RESULT_KEYS: [&str; 3] = ["figures", "findings", "tables"];
@@ -54,7 +66,7 @@ pub(super) fn read(script: &Script, params: Map, m: Map) -> Result<Verification,
     };
     let every_form = || {
         let mut all = vec![format!(
-            "#{{ replay: \"{}\", z, angles, blank, judge }}",
+            "#{{ replay: \"{}\", z, angles, blank, judge, nominal }}",
             REPLAYS.join("\" | \"")
         )];
         all.extend(forms.iter().map(|f| f.form.to_owned()));
@@ -107,11 +119,16 @@ pub(super) fn read(script: &Script, params: Map, m: Map) -> Result<Verification,
             angles: angles as usize,
             blank: num("blank", None)?,
         };
+        let nominal = match m.get("nominal") {
+            None => None,
+            Some(n) => Some(polar_nominal(script, &params, n, request.angles)?),
+        };
         return Ok(Verification::new(ScriptRequest {
             script: script.clone(),
             params,
             judge,
             replay: Replay::Polar(request),
+            nominal,
         }));
     }
     let Some(form) = forms.iter().find(|f| m.contains_key(f.key)) else {
@@ -127,6 +144,7 @@ pub(super) fn read(script: &Script, params: Map, m: Map) -> Result<Verification,
             params,
             judge,
             replay: Replay::Base(base),
+            nominal: None,
         }),
     })
 }
@@ -138,6 +156,10 @@ struct ScriptRequest {
     params: Map,
     judge: String,
     replay: Replay,
+    /// On the radius-over-angle replay, the nominal radius over angle
+    /// (0 to 360 deg) the script names, which a measurement is held
+    /// against; none: the part is not measured.
+    nominal: Option<Profile>,
 }
 
 /// The replay a script's judgement reads.
@@ -153,9 +175,13 @@ impl Verifier for ScriptRequest {
     fn verify(&self, ctx: &ReplayContext<'_>) -> Result<Verified, VerifyError> {
         match &self.replay {
             Replay::Polar(request) => {
-                let part = replay_polar(ctx.program, ctx.machine, ctx.tool, ctx.passes, request)?;
-                let part = polar_replayed(&part, request);
-                let judged = self.judge(&part, ctx.program.blocks.len())?;
+                let polar = replay_polar(ctx.program, ctx.machine, ctx.tool, ctx.passes, request)?;
+                let part = polar_replayed(&polar, request);
+                let mut judged = self.judge(&part, ctx.program.blocks.len())?;
+                if let Some(nominal) = &self.nominal {
+                    let table = polar_predicted(&polar, nominal)?;
+                    judged.tables.insert(PREDICTED.into(), table);
+                }
                 Ok(Verified {
                     outcome: Box::new(judged),
                     stock: None,
@@ -183,10 +209,84 @@ impl Verifier for ScriptRequest {
 
     fn nominal(&self) -> Option<crate::compensate::Nominal> {
         match &self.replay {
-            Replay::Polar(_) => None,
+            Replay::Polar(_) => self.nominal.as_ref().map(|n| Nominal {
+                coordinate: "angle_deg",
+                range: (0.0, 360.0),
+                quantities: vec![Quantity {
+                    name: "radius".into(),
+                    values: &POLAR_RADIUS,
+                    select: None,
+                    nominal: n.clone(),
+                    along: true,
+                    key: "dr_mm".into(),
+                }],
+            }),
             Replay::Base(base) => base.nominal(),
         }
     }
+}
+
+/// The nominal radius over angle a script's own verification on the
+/// radius-over-angle replay names (`nominal: "name"`): its `fn name(p,
+/// angle_deg)` called once with the replay's angles and 360 deg closing
+/// the turn, which gives the radius at each (mm).
+fn polar_nominal(
+    script: &Script,
+    params: &Map,
+    d: &Dynamic,
+    angles: usize,
+) -> Result<Profile, String> {
+    let name = d.clone().into_string().map_err(|t| {
+        format!("fn verify(p): nominal must be the name of the script's function giving the nominal radius at the angles it is given, fn name(p, angle_deg), not {t}")
+    })?;
+    if !script.has_fn(&name, 2) {
+        return Err(format!(
+            "fn verify(p): nominal '{name}' names no fn {name}(p, angle_deg) in the script"
+        ));
+    }
+    let at: Vec<f64> = (0..=angles)
+        .map(|i| 360.0 * i as f64 / angles as f64)
+        .collect();
+    let by = format!("{}: fn {name}(p, angle_deg)", script.file);
+    let got = script
+        .call(
+            &name,
+            (params.clone(), Dynamic::from(Floats::new(at.clone()))),
+        )
+        .map_err(|e| e.to_string())?;
+    let radius = crate::binding::floats::numbers(&got, &by).map_err(|e| e.to_string())?;
+    if radius.len() != at.len() || radius.iter().any(|r| !(r.is_finite() && *r > 0.0)) {
+        return Err(format!(
+            "{by}: must return a radius above 0 (mm) at each of the {} angles it is given, not {} values",
+            at.len(),
+            radius.len()
+        ));
+    }
+    Profile::new(at, radius.to_vec()).map_err(|e| format!("{by}: {e}"))
+}
+
+/// The part the finish leaves ([`PREDICTED`]): the last cutting pass's
+/// radius less the `nominal` at each of the replay's angles (`angle_deg`,
+/// `dr_mm`), and at 360 deg the turn closed.
+fn polar_predicted(
+    part: &PolarPart,
+    nominal: &Profile,
+) -> Result<BTreeMap<String, Vec<f64>>, VerifyError> {
+    let Some(finish) = part.passes.iter().rev().find(|p| p.cuts) else {
+        return Ok(BTreeMap::new());
+    };
+    let mut at = part.angle_deg.clone();
+    let mut radius = finish.radius.clone();
+    if let Some(&first) = radius.first() {
+        at.push(360.0);
+        radius.push(first);
+    }
+    let want = nominal.eval_many(&at)?;
+    let dr = radius.iter().zip(&want).map(|(r, w)| r - w).collect();
+    Ok(BTreeMap::from([
+        ("angle_deg".to_owned(), at),
+        ("dr_mm".to_owned(), dr),
+    ]))
 }
 
 /// The radius-over-angle replay as whole columns: `angle_deg`,
