@@ -23,8 +23,10 @@
 //! every move read back, the modal values carried, equal to the axis
 //! program's block within half the output's last decimal.
 //!
-//! Sinumerik's own words (`DIAMON`, `DIAMOF`, `FGROUP(..)`, `SF=`) and the
-//! `%_N_.._MPF` header are read here, before the ISO words.
+//! The G-code is read by [`super::reader`] (the line and its comments,
+//! Sinumerik's own words `DIAMON`, `DIAMOF`, `FGROUP(..)`, `SF=` and the
+//! `%_N_.._MPF` header before the ISO words, the codes, the setup's words,
+//! the threading cycle, the moves); the CL file by its records in `cl`.
 
 use super::post::{Dialect, Style};
 use super::reader::{Mode, ReadMove, Reader};
