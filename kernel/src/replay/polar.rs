@@ -64,6 +64,16 @@ pub struct PolarRequest {
     pub blank: Real,
 }
 
+impl PolarRequest {
+    /// The angles (deg) the radius is read at: `angles` equally spaced
+    /// from 0, 360 not among them.
+    pub fn angles_deg(&self) -> Vec<Real> {
+        (0..self.angles)
+            .map(|i| 360.0 * i as Real / self.angles as Real)
+            .collect()
+    }
+}
+
 /// The section one pass left.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PolarPass {
@@ -186,9 +196,7 @@ pub fn replay_polar(
         }
     }
     Ok(PolarPart {
-        angle_deg: (0..request.angles)
-            .map(|i| 360.0 * i as Real / request.angles as Real)
-            .collect(),
+        angle_deg: request.angles_deg(),
         passes: last,
         sampling_change: change,
         resolution,

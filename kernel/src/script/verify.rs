@@ -121,7 +121,7 @@ pub(super) fn read(script: &Script, params: Map, m: Map) -> Result<Verification,
         };
         let nominal = match m.get("nominal") {
             None => None,
-            Some(n) => Some(polar_nominal(script, &params, n, request.angles)?),
+            Some(n) => Some(polar_nominal(script, &params, n, &request)?),
         };
         return Ok(Verification::new(ScriptRequest {
             script: script.clone(),
@@ -234,7 +234,7 @@ fn polar_nominal(
     script: &Script,
     params: &Map,
     d: &Dynamic,
-    angles: usize,
+    request: &PolarRequest,
 ) -> Result<Profile, String> {
     let name = d.clone().into_string().map_err(|t| {
         format!("fn verify(p): nominal must be the name of the script's function giving the nominal radius at the angles it is given, fn name(p, angle_deg), not {t}")
@@ -244,9 +244,8 @@ fn polar_nominal(
             "fn verify(p): nominal '{name}' names no fn {name}(p, angle_deg) in the script"
         ));
     }
-    let at: Vec<f64> = (0..=angles)
-        .map(|i| 360.0 * i as f64 / angles as f64)
-        .collect();
+    let mut at = request.angles_deg();
+    at.push(360.0);
     let by = format!("{}: fn {name}(p, angle_deg)", script.file);
     let got = script
         .call(
