@@ -48,10 +48,12 @@ pub(super) fn replay_on(
         });
     }
     let info = machine.info();
+    let axes: Vec<Option<&Axis>> = written.axes.iter().map(|a| info.axis(&a.name)).collect();
     let on = Setting {
         written: &written,
         poses: replay(&written, machine, tool)?,
-        axes: written.axes.iter().map(|a| info.axis(&a.name)).collect(),
+        known: axes.iter().flatten().copied().collect(),
+        axes,
         info,
         rapid: rapid(info),
         wheel,
@@ -131,6 +133,8 @@ struct Setting<'a> {
     poses: Vec<Real>,
     /// The machine's axis of each of the program's axes, where it has it.
     axes: Vec<Option<&'a Axis>>,
+    /// Those the machine has.
+    known: Vec<&'a Axis>,
     info: &'a MachineInfo,
     /// The wheel's speed on a rapid (mm/min).
     rapid: Real,
@@ -295,8 +299,7 @@ impl Setting<'_> {
             .filter(|(_, ax)| ax.is_some())
             .map(|((p, q), _)| q - p)
             .collect();
-        let known: Vec<&Axis> = self.axes.iter().flatten().copied().collect();
-        let path = crate::machine::feed_length(&known, &deltas, &self.info.setup.feed_group);
+        let path = crate::machine::feed_length(&self.known, &deltas, &self.info.setup.feed_group);
         let f = if b.motion == Motion::Rapid {
             self.rapid
         } else {
