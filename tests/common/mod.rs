@@ -30,19 +30,8 @@ pub fn shared_lib(name: &str) -> PathBuf {
         let mut cmd = std::process::Command::new(env!("CARGO"));
         // The workspace's libraries, programs and tests, as `cargo test
         // --workspace` selects them: the same features, so nothing is
-        // built a second time with others (only the cdylibs are new). The
-        // kernel's own tests are left out: they build in the `test`
-        // profile's settings (Cargo.toml), which `cargo build` would not
-        // use, and no other crate's features depend on them.
-        cmd.args([
-            "build",
-            "--workspace",
-            "--exclude",
-            "pilgrim-kernel",
-            "--lib",
-            "--bins",
-            "--tests",
-        ])
+        // built a second time with others (only the cdylibs are new).
+        cmd.args(["build", "--workspace", "--lib", "--bins", "--tests"])
             .current_dir(env!("CARGO_MANIFEST_DIR"));
         if dir.file_name().is_some_and(|n| n == "release") {
             cmd.arg("--release");
