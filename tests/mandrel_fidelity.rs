@@ -153,18 +153,27 @@ impl Pass {
             .t
             .partition_point(|&v| v < t)
             .clamp(1, self.t.len() - 1);
+        (k, self.along(k, t))
+    }
+
+    /// How far along move `k` the pass is at time `t` (0 to 1).
+    fn along(&self, k: usize, t: f64) -> f64 {
         let (t0, t1) = (self.t[k - 1], self.t[k]);
-        let s = if t1 > t0 {
+        if t1 > t0 {
             ((t - t0) / (t1 - t0)).clamp(0.0, 1.0)
         } else {
             1.0
-        };
-        (k, s)
+        }
     }
 
     /// The wheel's reference at time `t` (clamped to the pass).
     pub(crate) fn at(&self, t: f64) -> (f64, f64) {
         let (k, s) = self.segment_at(t);
+        self.point(k, s)
+    }
+
+    /// The wheel's reference a fraction `s` along move `k`.
+    fn point(&self, k: usize, s: f64) -> (f64, f64) {
         (
             self.z[k - 1] + s * (self.z[k] - self.z[k - 1]),
             self.x[k - 1] + s * (self.x[k] - self.x[k - 1]),
@@ -223,11 +232,19 @@ impl Pass {
             return (f64::INFINITY, f64::INFINITY);
         }
         let mut low = vec![f64::INFINITY; phases];
+        // The touches in time order: the move under way is walked on to
+        // (the move `segment_at` would find) and the generatrix counted
+        // round, not searched and divided for afresh at each touch.
+        let mut k = self.segment_at(first as f64 * dt).0;
+        let mut i = first.rem_euclid(phases as i64) as usize;
         for m in first..=last {
             let t = m as f64 * dt;
-            let (cz, cx) = self.at(t);
-            let i = m.rem_euclid(phases as i64) as usize;
+            while k < self.t.len() - 1 && self.t[k] < t {
+                k += 1;
+            }
+            let (cz, cx) = self.point(k, self.along(k, t));
             low[i] = low[i].min(s.lower(cz, cx + wear(t), z));
+            i = if i + 1 == phases { 0 } else { i + 1 };
         }
         let crest = low.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         let valley = low.iter().copied().fold(f64::INFINITY, f64::min);
