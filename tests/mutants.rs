@@ -28,6 +28,7 @@ use pilgrim_kernel::program::post::{self, Dialect};
 use pilgrim_kernel::program::reader::{Mode, ReadMove, Reader, Standing};
 use pilgrim_kernel::program::{AxisProgram, PowerOn, Radial};
 use pilgrim_kernel::toolpath::Motion;
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
 /// A program under test: its lines, its dialect, the frame and axes its
@@ -267,29 +268,40 @@ fn chosen_lines(subject: &Subject, base: &Baseline) -> Vec<usize> {
     chosen
 }
 
-/// The changes of a word: every G and M code 0..199 bare, `.0`..`.9` and
-/// a long decimal; every letter as its address; its number with and
-/// without a decimal point.
-fn variants(word: &str) -> Vec<String> {
-    let mut out = Vec::with_capacity(4900);
-    for c in ['G', 'M'] {
-        for n in 0..200 {
-            out.push(format!("{c}{n}"));
-            for d in 0..10 {
-                out.push(format!("{c}{n}.{d}"));
+/// Every G and M code 0..199 bare, `.0`..`.9` and a long decimal: the
+/// changes any word is put through, made once for all the words.
+fn codes() -> &'static [String] {
+    static CODES: std::sync::OnceLock<Vec<String>> = std::sync::OnceLock::new();
+    CODES.get_or_init(|| {
+        let mut out = Vec::with_capacity(4800);
+        for c in ['G', 'M'] {
+            for n in 0..200 {
+                out.push(format!("{c}{n}"));
+                for d in 0..10 {
+                    out.push(format!("{c}{n}.{d}"));
+                }
+                out.push(format!("{c}{n}.000010"));
             }
-            out.push(format!("{c}{n}.000010"));
         }
-    }
+        out
+    })
+}
+
+/// The changes of a word: the [`codes`]; every letter as its address; its
+/// number with and without a decimal point. The word itself is not among
+/// them.
+fn variants(word: &str) -> Vec<Cow<'static, str>> {
+    let mut out: Vec<Cow<'static, str>> =
+        codes().iter().map(|c| Cow::Borrowed(c.as_str())).collect();
     if iso(word) {
         let number = &word[1..];
         for l in 'A'..='Z' {
-            out.push(format!("{l}{number}"));
+            out.push(format!("{l}{number}").into());
         }
         let letter = &word[..1];
         match number.split_once('.') {
-            Some((a, b)) => out.push(format!("{letter}{a}{b}")),
-            None => out.push(format!("{letter}{number}.")),
+            Some((a, b)) => out.push(format!("{letter}{a}{b}").into()),
+            None => out.push(format!("{letter}{number}.").into()),
         }
     }
     out.retain(|v| v != word);
@@ -1040,6 +1052,8 @@ fn mutate(subject: &Subject) -> (Tally, Vec<String>) {
     let mut fail = |key: String, what: String| {
         failures.entry(key).or_insert((0, what)).0 += 1;
     };
+    // One buffer for every mutant's text.
+    let mut mutant = String::new();
     for line in chosen_lines(subject, &base) {
         let text = &subject.lines[line];
         // The block as a refusal names it.
@@ -1077,13 +1091,19 @@ fn mutate(subject: &Subject) -> (Tally, Vec<String>) {
         }
         for t in tokens(text, subject.dialect) {
             for v in variants(&t.text) {
-                let mutant = format!("{}{v}{}", &text[..t.start], &text[t.end..]);
+                mutant.clear();
+                mutant.push_str(&text[..t.start]);
+                mutant.push_str(&v);
+                mutant.push_str(&text[t.end..]);
                 tally.mutants += 1;
-                let class = format!(
-                    "{}->{}",
-                    t.text.chars().next().unwrap(),
-                    v.chars().next().unwrap()
-                );
+                // Named only where an edit fails or is sampled.
+                let class = || {
+                    format!(
+                        "{}->{}",
+                        t.text.chars().next().unwrap(),
+                        v.chars().next().unwrap()
+                    )
+                };
                 // Every 64th edit whose effect lasts is read to the end.
                 let mut outcome = read_mutant(&mut reader, subject, &base, line, &mutant, BOUND);
                 if let Outcome::Read { lasting: true, .. } = outcome {
@@ -1099,7 +1119,8 @@ fn mutate(subject: &Subject) -> (Tally, Vec<String>) {
                         if !names_edit(&e, &v, &block) && !names_edit(&e, &t.text, &block) {
                             fail(
                                 format!(
-                                    "unnamed {class} {}",
+                                    "unnamed {} {}",
+                                    class(),
                                     e.message.split(':').next().unwrap_or("")
                                 ),
                                 format!(
@@ -1124,7 +1145,8 @@ fn mutate(subject: &Subject) -> (Tally, Vec<String>) {
                         if let Err(why) = ruled {
                             fail(
                                 format!(
-                                    "accepted {class} {}",
+                                    "accepted {} {}",
+                                    class(),
                                     why.split(':').next_back().unwrap_or("")
                                 ),
                                 format!(
@@ -1134,12 +1156,12 @@ fn mutate(subject: &Subject) -> (Tally, Vec<String>) {
                             );
                         } else if got != want {
                             fail(
-                                format!("misread {class}"),
+                                format!("misread {}", class()),
                                 format!("'{mutant}' ({} for {v}): read as {got:?}, the rules read {want:?}", t.text),
                             );
                         } else if !lasting && to < subject.lines.len() && at != rules_before[to] {
                             fail(
-                                format!("unfollowed {class}"),
+                                format!("unfollowed {}", class()),
                                 format!("'{mutant}' ({} for {v}): the reader stands as the program does after line {to}, the control does not: {at:?}", t.text),
                             );
                         } else if got.iter().eq(base.moves[line..to]
@@ -1152,8 +1174,11 @@ fn mutate(subject: &Subject) -> (Tally, Vec<String>) {
                             tally.same += 1;
                         } else {
                             tally.changed += 1;
-                            if sampled.len() < 40 && !sampled.iter().any(|(c, _, _)| *c == class) {
-                                sampled.push((class.clone(), line, mutant.clone()));
+                            if sampled.len() < 40 {
+                                let class = class();
+                                if !sampled.iter().any(|(c, _, _)| *c == class) {
+                                    sampled.push((class, line, mutant.clone()));
+                                }
                             }
                         }
                     }
