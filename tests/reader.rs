@@ -7,8 +7,10 @@
 
 use crate::common::{pilgrim, s, scratch};
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 /// A program pilgrim wrote, and how `verify` is asked about its edits.
+#[derive(Clone)]
 struct Written {
     dir: PathBuf,
     text: String,
@@ -81,19 +83,30 @@ fn refused(said: (i32, String, String), word: &str, case: &str) {
 }
 
 /// The mandrel's Sinumerik program, the same on LinuxCNC, the worm's whole
-/// Fanuc program.
+/// Fanuc program: run once for all the tests here (the runs are the
+/// defaults', the same for each), their edits verified in a folder of the
+/// test's own (`name`).
 fn three(name: &str) -> (Written, Written, Written) {
+    static RUNS: OnceLock<(Written, Written, Written)> = OnceLock::new();
+    let (mpf, ngc, nc) = RUNS.get_or_init(|| {
+        let dir = scratch("reader", "runs");
+        let machine = linuxcnc_grinder(&dir);
+        let mpf = written(&dir, "scripts/mandrel.rhai", "mpf", &[]);
+        let ngc = written(
+            &dir,
+            "scripts/mandrel.rhai",
+            "ngc",
+            &["--machine", s(&machine)],
+        );
+        let nc = written(&dir, "scripts/worm.rhai", "nc", &["--program-number", "1"]);
+        (mpf, ngc, nc)
+    });
     let dir = scratch("reader", name);
-    let machine = linuxcnc_grinder(&dir);
-    let mpf = written(&dir, "scripts/mandrel.rhai", "mpf", &[]);
-    let ngc = written(
-        &dir,
-        "scripts/mandrel.rhai",
-        "ngc",
-        &["--machine", s(&machine)],
-    );
-    let nc = written(&dir, "scripts/worm.rhai", "nc", &["--program-number", "1"]);
-    (mpf, ngc, nc)
+    let here = |w: &Written| Written {
+        dir: dir.clone(),
+        ..w.clone()
+    };
+    (here(mpf), here(ngc), here(nc))
 }
 
 /// A code whose decimals the control reads (`G91.000010` is G91 on
