@@ -102,6 +102,7 @@ fn run_within(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
         program_number: args.program_number,
         also_post: args.also_post.clone(),
         program_file: None,
+        program_dir: None,
         // The script, its tables and the machine file beside the run's
         // files, for `verify DIR` and `compensate`.
         keep: Some(job::Keep {
@@ -410,6 +411,7 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
         program_name: "verify".into(),
         program_file: Some(pilgrim_kernel::files::shown_path(&file)),
         offsets,
+        program_dir: file.parent().map(std::path::Path::to_path_buf),
         ..JobOptions::default()
     };
     let what = args.target.display();

@@ -105,6 +105,33 @@ pub fn read_text(path: &Path, limit: u64) -> Result<String, FileError> {
         .map_err(|e| error(path, format!("not UTF-8 text: {}", e.utf8_error())))
 }
 
+/// The text of file `name` in folder `dir` (a subprogram a program calls
+/// by name), `None` where there is no such file or no folder. `name` is a
+/// file's name only (letters, digits, `_`, `-`, one `.`): never a path, so
+/// nothing outside the folder is read.
+///
+/// # Failures
+/// A name that is not a plain file name; a file that cannot be read or is
+/// larger than [`MAX_TEXT_BYTES`].
+pub fn beside(dir: Option<&Path>, name: &str) -> Result<Option<String>, String> {
+    let plain =
+        name.split('.').count() <= 2 && name.split('.').all(|p| !p.is_empty() && is_plain_name(p));
+    if !plain {
+        return Err(format!(
+            "'{}': not a file's name a call may open (letters, digits, '_', '-' and one '.')",
+            excerpt(name)
+        ));
+    }
+    let Some(dir) = dir else { return Ok(None) };
+    let path = dir.join(name);
+    if !path.is_file() {
+        return Ok(None);
+    }
+    read_text(&path, MAX_TEXT_BYTES)
+        .map(Some)
+        .map_err(|e| e.to_string())
+}
+
 /// Whether `name` is a plain name (letters, digits, `_`, `-`): what a body
 /// or part name must be before it becomes a file name.
 pub fn is_plain_name(name: &str) -> bool {

@@ -67,6 +67,11 @@ pub struct JobOptions {
     /// The shop's offset table a verified program's tool and work offsets
     /// are read by (`--offsets`), if given.
     pub offsets: Option<crate::program::offsets::Offsets>,
+    /// The folder a verified program's subprogram calls read their files
+    /// from (the program file's own), if any: a file is named by the
+    /// dialect's rule (`O1234.nc`, `KONTUR.SPF`, `name.ngc`), never by a
+    /// path.
+    pub program_dir: Option<std::path::PathBuf>,
 }
 
 /// The tables a run keeps by name, each its columns by name.
@@ -85,6 +90,7 @@ impl Default for JobOptions {
             program_file: None,
             keep: None,
             offsets: None,
+            program_dir: None,
         }
     }
 }

@@ -347,15 +347,19 @@ impl Run<'_> {
             )
         };
         let frame = crate::program::frame(info);
+        let dir = self.options.program_dir.clone();
+        let beside = move |name: &str| crate::files::beside(dir.as_deref(), name);
         let crate::program::lint::TextProgram {
             program: read,
             lines,
+            ..
         } = crate::program::lint::read_with(
             text,
             &frame,
             plan.control,
             &info.axes,
             self.options.offsets.as_ref(),
+            Some(&beside),
         )
         .map_err(|e| refused(e.to_string()))?;
         // No more blocks than a run writes: the replays' work is bounded.

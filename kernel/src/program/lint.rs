@@ -73,7 +73,9 @@ pub fn lint(
 ) -> Result<Linted, LintError> {
     match d.style {
         Style::Apt => lint_apt(text, program, d),
-        Style::GCode => lint_gcode(text, program, d, axes, Mode::Lint, None).map(|r| r.linted),
+        Style::GCode => {
+            lint_gcode(text, program, d, axes, Mode::Lint, None, None).map(|r| r.linted)
+        }
     }
 }
 
@@ -84,8 +86,14 @@ pub fn lint(
 pub struct TextProgram {
     /// The program read.
     pub program: AxisProgram,
-    /// The line (from 1) of each block's move, in the blocks' order.
+    /// The line (from 1) of each block's move in the program's own text,
+    /// in the blocks' order (a subprogram's move: the line of its call).
     pub lines: Vec<usize>,
+    /// Where each block's move was read: its file (0: the program's own,
+    /// else `files[n - 1]`) and its line there (from 1).
+    pub sources: Vec<(usize, usize)>,
+    /// The subprograms' files the text called.
+    pub files: Vec<String>,
 }
 
 /// Reads `text`, a program in `d` for the machine whose axes (their
@@ -111,12 +119,14 @@ pub fn read(
     d: &Dialect,
     axes: &[Axis],
 ) -> Result<TextProgram, LintError> {
-    read_with(text, frame, d, axes, None)
+    read_with(text, frame, d, axes, None, None)
 }
 
 /// [`read`] with the shop's offset table: a tool or work offset it gives
 /// is followed, each later position shifted by it
-/// ([`super::offsets`]), where [`read`] refuses it.
+/// ([`super::offsets`]), where [`read`] refuses it; and with `beside`,
+/// where a subprogram the text calls is read by its file's name (the
+/// program's folder).
 ///
 /// # Failures
 /// As [`read`].
@@ -126,12 +136,13 @@ pub fn read_with(
     d: &Dialect,
     axes: &[Axis],
     offsets: Option<&super::offsets::Offsets>,
+    beside: Option<super::reader::Beside<'_>>,
 ) -> Result<TextProgram, LintError> {
     if d.style != Style::GCode {
         return Err(not_a_control_program(d));
     }
     Ok(assemble(
-        lint_gcode(text, frame, d, axes, Mode::Read, offsets)?,
+        lint_gcode(text, frame, d, axes, Mode::Read, offsets, beside)?,
         frame,
     ))
 }
@@ -154,7 +165,7 @@ pub fn lint_read(
         return Err(not_a_control_program(d));
     }
     let mut read = assemble(
-        lint_gcode(text, program, d, axes, Mode::Lint, None)?,
+        lint_gcode(text, program, d, axes, Mode::Lint, None, None)?,
         program,
     );
     for (r, b) in read.program.blocks.iter_mut().zip(&program.blocks) {
@@ -177,7 +188,12 @@ fn not_a_control_program(d: &Dialect) -> LintError {
 /// Axes the text never writes are left out; an axis not yet written is
 /// kept where it stands until its first value.
 fn assemble(read: ReadText, frame: &AxisProgram) -> TextProgram {
-    let lines = read.blocks.iter().map(|b| b.line + 1).collect();
+    let lines = read
+        .blocks
+        .iter()
+        .map(|b| b.via.unwrap_or(b.line) + 1)
+        .collect();
+    let sources = read.blocks.iter().map(|b| (b.file, b.line + 1)).collect();
     let written: Vec<usize> = (0..frame.axes.len())
         .filter(|&i| read.blocks.iter().any(|b| b.values[i].is_some()))
         .collect();
@@ -229,7 +245,12 @@ fn assemble(read: ReadText, frame: &AxisProgram) -> TextProgram {
         setup: frame.setup.clone(),
         cycles: Vec::new(),
     };
-    TextProgram { program, lines }
+    TextProgram {
+        program,
+        lines,
+        sources,
+        files: read.files,
+    }
 }
 
 /// What a G-code text read as: the lint's count, the moves and what the
@@ -241,10 +262,13 @@ struct ReadText {
     number: Option<u32>,
     tool: Option<u32>,
     rpm: Option<Real>,
+    /// The subprograms' files read.
+    files: Vec<String>,
 }
 
 /// A G-code text read line by line by the [`Reader`], held to `program`
-/// or read as it stands (`mode`).
+/// or read as it stands (`mode`), following its statements through the
+/// files `beside` gives (a program read as it stands).
 fn lint_gcode(
     text: &str,
     program: &AxisProgram,
@@ -252,8 +276,9 @@ fn lint_gcode(
     axes: &[Axis],
     mode: Mode,
     offsets: Option<&super::offsets::Offsets>,
+    beside: Option<super::reader::Beside<'_>>,
 ) -> Result<ReadText, LintError> {
-    let lines: Vec<&str> = text.split('\n').collect();
+    let mut lines: Vec<&str> = text.split('\n').collect();
     if lines.last() != Some(&"") {
         return Err(LintError {
             dialect: d.name.to_owned(),
@@ -261,12 +286,22 @@ fn lint_gcode(
             message: "the program's last line does not end with a line feed".into(),
         });
     }
-    let lines = &lines[..lines.len() - 1];
-    let (reader, mut at) = Reader::new(lines, program, d, axes, mode)?;
-    let mut reader = reader.with_offsets(offsets);
+    lines.pop();
+    if mode == Mode::Read {
+        // A line ended by a carriage return and a line feed (a file kept on
+        // Windows) is a line.
+        for l in &mut lines {
+            *l = l.strip_suffix('\r').unwrap_or(l);
+        }
+    }
+    let (reader, mut at) = Reader::new(&lines, program, d, axes, mode)?;
+    let mut reader = reader.with_offsets(offsets).with_beside(beside);
     let mut blocks = Vec::new();
-    for (i, line) in lines.iter().enumerate() {
-        reader.line(&mut at, i, line, &mut blocks)?;
+    let mut line = String::new();
+    while let Some((f, i)) = reader.next_line(&mut at)? {
+        line.clear();
+        line.push_str(reader.text(f, i));
+        reader.line(&mut at, i, &line, &mut blocks)?;
     }
     Ok(ReadText {
         linted: reader.end(&at)?,
@@ -275,6 +310,7 @@ fn lint_gcode(
         number: at.number(),
         tool: at.tool(),
         rpm: at.rpm(),
+        files: reader.called_files(),
     })
 }
 

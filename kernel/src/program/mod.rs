@@ -10,6 +10,7 @@
 
 pub mod cycle;
 pub mod lint;
+pub mod macros;
 pub mod offsets;
 pub mod post;
 pub mod reader;

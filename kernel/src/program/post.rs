@@ -190,6 +190,29 @@ pub struct Reading {
     /// dimensions elsewhere; its `U` an incremental X), for the refusal to
     /// say: never another dialect's meaning.
     pub meanings: &'static [(&'static str, &'static str)],
+    /// The language a program read as it stands may be written in beyond
+    /// plain blocks (variables, jumps, loops, subprograms), or `None`. A
+    /// lint (a program pilgrim wrote) reads plain blocks only.
+    pub macros: Option<MacroReading>,
+}
+
+/// How a dialect's macro language is read ([`super::macros`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MacroReading {
+    /// The language.
+    pub language: super::macros::Language,
+    /// The files a call opens beside the program, tried in order: `{O}`
+    /// is a called program's number in four digits (`M98 P12`: `0012`),
+    /// `{N}` its number as written, `{NAME}` its name as the call writes
+    /// it, `{name}` in lower case.
+    pub files: &'static [&'static str],
+    /// Whether a subprogram call's repetitions stand before the program's
+    /// four digits in P (the 0i's `M98 P0041234`: O1234 four times);
+    /// otherwise P is the program's number and L the repetitions.
+    pub repeats_in_p: bool,
+    /// The first line of a subprogram's file that names it, before and
+    /// after the name (Sinumerik's `%_N_KONTUR_SPF`), if any.
+    pub sub_name_line: Option<(&'static str, &'static str)>,
 }
 
 /// The word of a thread block's spindle start angle.
@@ -292,6 +315,18 @@ pub const SINUMERIK: Dialect = Dialect {
             ("M4", "the spindle counter-clockwise"),
             ("M17", "the end of a subprogram"),
         ],
+        macros: Some(MacroReading {
+            language: super::macros::Language::Sinumerik,
+            files: &[
+                "{NAME}.SPF",
+                "{NAME}.spf",
+                "{name}.spf",
+                "{NAME}.MPF",
+                "{NAME}.mpf",
+            ],
+            repeats_in_p: false,
+            sub_name_line: Some(("%_N_", "_SPF")),
+        }),
     },
 };
 
@@ -398,6 +433,12 @@ pub const FANUC: Dialect = Dialect {
             ("U", "X incremental, in G-code system A"),
             ("W", "Z incremental, in G-code system A"),
         ],
+        macros: Some(MacroReading {
+            language: super::macros::Language::Fanuc,
+            files: &["O{O}", "O{O}.nc", "O{O}.NC", "{O}.nc", "{N}.nc"],
+            repeats_in_p: true,
+            sub_name_line: None,
+        }),
     },
 };
 
@@ -481,6 +522,12 @@ pub const LINUXCNC: Dialect = Dialect {
             ("G98", "the canned cycles' return to the initial level"),
             ("G99", "the canned cycles' return to the R level"),
         ],
+        macros: Some(MacroReading {
+            language: super::macros::Language::Rs274,
+            files: &["{name}.ngc", "{NAME}.ngc", "{name}.NGC"],
+            repeats_in_p: false,
+            sub_name_line: None,
+        }),
     },
 };
 
@@ -536,6 +583,7 @@ pub const CLD: Dialect = Dialect {
         modal_groups: &[],
         systems: &[],
         meanings: &[],
+        macros: None,
     },
 };
 

@@ -22,9 +22,12 @@ use pilgrim_plugin_abi::types::Radial;
 
 mod codes;
 mod cycles;
+mod flow;
 mod line;
 mod moves;
 mod setup;
+
+pub use flow::{Beside, SourceFile, MAX_SUB_BYTES};
 
 /// A move as the reader took it: each axis's value where the text has
 /// given one so far.
@@ -43,8 +46,14 @@ pub struct ReadMove {
     pub comment: Option<String>,
     /// Its block number, where the text numbers blocks.
     pub number: Option<u32>,
-    /// The line it stands on (from 0).
+    /// The line it stands on (from 0), in its file.
     pub line: usize,
+    /// Its file: 0 the program's own, else a subprogram's file
+    /// ([`Reader::file_name`]).
+    pub file: usize,
+    /// The line of the program's own text (from 0) whose call made it,
+    /// where a subprogram's line did.
+    pub via: Option<usize>,
 }
 
 /// Where a reading stands between two lines: the control's modal state
@@ -66,6 +75,13 @@ pub struct Standing {
     number: Option<u32>,
     tool: Option<u32>,
     rpm: Option<Real>,
+    /// What the text's statements have set: variables, calls, turns.
+    mac: crate::program::macros::State,
+    /// The next line to read in the file being read.
+    next: usize,
+    /// Whether the reading has ended before the text's last line (the
+    /// program's end reached in a subprogram, or other programs after it).
+    stopped: bool,
 }
 
 impl Standing {
@@ -125,6 +141,14 @@ pub struct Reader<'a> {
     least_input: Option<Real>,
     /// The shop's offset table, where the caller gives one (read only).
     offsets: Option<&'a super::offsets::Offsets>,
+    /// The dialect's macro language, where the text is read as it stands.
+    macros: Option<super::post::MacroReading>,
+    /// The files of the reading: the program's own text first.
+    files: Vec<SourceFile<'a>>,
+    /// Where a called subprogram's file is read, if anywhere.
+    beside: Option<Beside<'a>>,
+    /// The file the line being read is in.
+    current: usize,
 }
 
 /// Whether a G-code text is held to an axis program (the lint of a
@@ -224,6 +248,14 @@ fn at_line(l: usize) -> String {
     format!("line {}", l + 1)
 }
 
+/// Where line `i` (from 0) whose code is `code` is, for a message: its
+/// `N` where it opens with one, else its line.
+fn code_place(code: &str, i: usize) -> String {
+    (code.split_whitespace().next())
+        .filter(|w| w.len() > 1 && w.starts_with('N') && w[1..].bytes().all(|b| b.is_ascii_digit()))
+        .map_or_else(|| at_line(i), str::to_owned)
+}
+
 impl<'a> Reader<'a> {
     /// A reader of `lines` (the text split at its line feeds, the empty
     /// piece after the last taken off), a program in `d` held to
@@ -293,6 +325,10 @@ impl<'a> Reader<'a> {
             },
             offsets: None,
             names,
+            macros: d.reading.macros.filter(|_| reading),
+            files: vec![SourceFile::new(String::new(), lines, d)],
+            beside: None,
+            current: 0,
         };
         // The framing: % first and last where the dialect frames.
         if framed {
@@ -327,6 +363,9 @@ impl<'a> Reader<'a> {
             number: None,
             tool: None,
             rpm: None,
+            mac: Default::default(),
+            next: 0,
+            stopped: false,
         };
         Ok((reader, standing))
     }
@@ -339,6 +378,24 @@ impl<'a> Reader<'a> {
         self
     }
 
+    /// The reader with `beside`, where a called subprogram's file is read
+    /// by its name (the program's folder).
+    pub fn with_beside(mut self, beside: Option<Beside<'a>>) -> Self {
+        self.beside = beside;
+        self
+    }
+
+    /// The name of file `f` of the reading (empty: the program's own).
+    pub fn file_name(&self, f: usize) -> &str {
+        &self.files[f].name
+    }
+
+    /// The files the reading opened besides the program's own, in the
+    /// order of their numbers from 1.
+    pub fn called_files(&self) -> Vec<String> {
+        self.files[1..].iter().map(|f| f.name.clone()).collect()
+    }
+
     /// The shifts of tool word `word` by the offsets table, if it gives it.
     fn tool_shift(&self, word: &str) -> Option<Vec<Real>> {
         self.offsets?.tool_shift(word, &self.names)
@@ -349,12 +406,21 @@ impl<'a> Reader<'a> {
         self.offsets?.work_shift(word, &self.names)
     }
 
-    /// A fault at line `i` (from 0).
+    /// A fault at line `i` (from 0) of the file being read.
     fn fault(&self, i: usize, message: String) -> LintError {
         LintError {
             dialect: self.d.name.to_owned(),
-            place: format!("line {}", i + 1),
+            place: self.in_file(format!("line {}", i + 1)),
             message,
+        }
+    }
+
+    /// `place` in the file being read: as it is in the program's own, with
+    /// the file's name in a subprogram's.
+    fn in_file(&self, place: String) -> String {
+        match self.current {
+            0 => place,
+            f => format!("{place} of {}", self.files[f].name),
         }
     }
 
@@ -380,7 +446,67 @@ impl<'a> Reader<'a> {
         self.ticker
             .tick()
             .map_err(|e| self.fault(i, e.to_string()))?;
-        let (code, own) = self.code_of(at, i, text)?;
+        self.current = at.mac.file();
+        at.next = i + 1;
+        let mut code = self.code_of(at, i, text)?;
+        let mut evaluated = None;
+        if let Some(m) = self.macros.filter(|_| !code.trim().is_empty()) {
+            if at.st.ended && at.mac.frames.is_empty() {
+                // After the program's end: only other programs (Fanuc's
+                // O sections) follow, never read unless called.
+                if crate::program::macros::scan::is_program_line(m.language, &code) {
+                    at.stopped = true;
+                    return Ok(());
+                }
+            } else {
+                let env = crate::program::macros::Env {
+                    lang: m.language,
+                    file: &self.files[self.current],
+                    line: i,
+                    round_axes: self.least_input.or(self.d.reading.least_input),
+                    axes: &self.names,
+                    repeats_in_p: m.repeats_in_p,
+                };
+                let step = crate::program::macros::step(&env, &mut at.mac, &code)
+                    .map_err(|e| self.err(self.in_file(code_place(&code, i)), e))?;
+                self.follow(at, i, step.flow)
+                    .map_err(|e| self.err(self.in_file(code_place(&code, i)), e))?;
+                match step.left {
+                    crate::program::macros::Left::Nothing => return Ok(()),
+                    crate::program::macros::Left::Same => {}
+                    crate::program::macros::Left::Code(c) => {
+                        evaluated = Some(c.clone());
+                        code = c;
+                    }
+                }
+            }
+        }
+        let read = self.block_line(at, i, text, code, out);
+        match (read, evaluated) {
+            (Err(mut e), Some(c)) => {
+                e.message = format!(
+                    "{} (the block as the control evaluates it: {})",
+                    e.message,
+                    crate::files::excerpt(c.trim())
+                );
+                Err(e)
+            }
+            (r, _) => r,
+        }
+    }
+
+    /// Line `i`'s block, `code` (its statements carried out), read: its
+    /// own words, its number and ISO words, the setup's words, then a
+    /// threading cycle's moves or the block's move.
+    fn block_line(
+        &mut self,
+        at: &mut Standing,
+        i: usize,
+        text: &str,
+        mut code: String,
+        out: &mut Vec<ReadMove>,
+    ) -> Result<(), LintError> {
+        let own = self.own_words(&mut code, i)?;
         let Some(block) = self.block_of(at, i, text, code, own)? else {
             return Ok(());
         };
@@ -406,8 +532,10 @@ impl<'a> Reader<'a> {
     /// block `k` where it is held to one, else its line.
     fn place(&self, b: &Block, k: usize) -> String {
         if self.reading {
-            b.number
-                .map_or_else(|| at_line(b.line), |n| format!("N{n}"))
+            self.in_file(
+                b.number
+                    .map_or_else(|| at_line(b.line), |n| format!("N{n}")),
+            )
         } else if k < self.program.blocks.len() {
             name_in(self.d.name, &self.program.blocks, k)
         } else {
@@ -446,6 +574,17 @@ impl<'a> Reader<'a> {
             moves: at.k,
             lines: self.lines,
         })
+    }
+}
+
+impl Reader<'_> {
+    /// Where a move read now comes from: the file being read, and the
+    /// program's own line whose call made it (where a subprogram's did).
+    fn origin(&self, at: &Standing) -> (usize, Option<usize>) {
+        (
+            self.current,
+            at.mac.frames.first().map(|f| f.back.1.saturating_sub(1)),
+        )
     }
 }
 

@@ -60,6 +60,7 @@ impl Reader<'_> {
         let moves = crate::program::cycle::expand(&cycle, [x0, z0], st.radial == Some(true), end_x)
             .map_err(|m| fail(m.message))?;
         let comment = at.pending.take();
+        let (file, via) = self.origin(at);
         for (n, mv) in moves.iter().enumerate() {
             at.st.values = self.cycle_move(&at.st, b, at.k, n, mv, [xi, zi])?;
             out.push(ReadMove {
@@ -73,6 +74,8 @@ impl Reader<'_> {
                 comment: if n == 0 { comment.clone() } else { None },
                 number: b.number,
                 line: b.line,
+                file,
+                via,
             });
             at.k += 1;
         }

@@ -10,19 +10,30 @@ impl Reader<'_> {
     /// Line `i`'s code (`text` as its control reads it, [`read_line`]): a
     /// comment alone noted for the next move, the header's own lines
     /// blanked where they stand (the name and number the text gives
-    /// itself noted), Sinumerik's own words taken out.
+    /// itself noted; a subprogram file's name line and its `%` framing).
     pub(super) fn code_of(
         &self,
         at: &mut Standing,
         i: usize,
         text: &str,
-    ) -> Result<(String, Vec<OwnWord>), LintError> {
+    ) -> Result<String, LintError> {
         let (d, reading) = (self.d, self.reading);
-        let (mut l, said) = read_line(d, i, text).map_err(|m| self.fault(i, m))?;
+        let (mut l, said) = read_line(d, i, text, reading).map_err(|m| self.fault(i, m))?;
         if l.trim().is_empty() {
             if let Some(s) = &said {
                 at.pending = Some(s.clone());
             }
+        }
+        if self.current > 0 {
+            // A subprogram's file: its name line and its framing.
+            let named =
+                (self.macros.and_then(|m| m.sub_name_line)).is_some_and(|(before, after)| {
+                    i == 0 && text.starts_with(before) && text.ends_with(after)
+                });
+            if named || text == "%" {
+                l = " ".repeat(text.len());
+            }
+            return Ok(l);
         }
         // A program read as it stands names itself.
         let own_name = (d.reading.name_line)
@@ -48,16 +59,13 @@ impl Reader<'_> {
             // Fanuc's program number, `O0001`, is not an ISO word.
             let n = l.find('O').unwrap_or(0);
             l.replace_range(n..n + 5, "     ");
-        } else {
-            let own = self.own_words(&mut l, i)?;
-            return Ok((l, own));
         }
-        Ok((l, Vec::new()))
+        Ok(l)
     }
 
     /// Sinumerik's own words in line `i`'s code `l`, taken out of it
     /// (blanked in place).
-    fn own_words(&self, l: &mut String, i: usize) -> Result<Vec<OwnWord>, LintError> {
+    pub(super) fn own_words(&self, l: &mut String, i: usize) -> Result<Vec<OwnWord>, LintError> {
         let mut own = Vec::new();
         let code = l.clone();
         for word in code.split_whitespace() {
@@ -156,6 +164,13 @@ impl Reader<'_> {
 
     /// Block `b`'s number against the dialect's numbering and the last.
     fn numbered(&self, at: &mut Standing, b: &Block) -> Result<(), LintError> {
+        // A program read as it stands numbers its blocks as its author
+        // likes (the control needs no number, nor any order; a jump's
+        // target is found by the statements' index, which refuses one
+        // standing twice).
+        if self.reading {
+            return Ok(());
+        }
         match (self.d.numbering, b.number) {
             (Some(_), None) => Err(self.fault(
                 b.line,
@@ -195,11 +210,22 @@ pub(super) fn read_line(
     d: &Dialect,
     i: usize,
     line: &str,
+    reading: bool,
 ) -> Result<(String, Option<String>), String> {
-    if let Some(c) = line.chars().find(|c| c.is_control() || !c.is_ascii()) {
+    // A shop's program may hold tabs, and anything in its comments; never
+    // a control character that ends or changes a line on some controls.
+    let bad = |c: char| {
+        if reading {
+            c.is_control() && c != '\t'
+        } else {
+            c.is_control() || !c.is_ascii()
+        }
+    };
+    if let Some(c) = line.chars().find(|c| bad(*c)) {
         return Err(format!(
-            "the character U+{:04X}, which pilgrim never writes (a carriage return or another control character ends or changes a line on some controls)",
-            u32::from(c)
+            "the character U+{:04X}, which {} (a carriage return or another control character ends or changes a line on some controls)",
+            u32::from(c),
+            if reading { "a control may read otherwise than the verification" } else { "pilgrim never writes" }
         ));
     }
     let check = |comment: &str| -> Result<(), String> {
@@ -212,6 +238,20 @@ pub(super) fn read_line(
             return Ok(());
         }
         let text = comment.strip_prefix(' ').unwrap_or(comment);
+        if reading {
+            // A shop's program: its comments say what they like; only one
+            // the control acts on is refused (a message is only shown).
+            let shown = ["MSG", "DEBUG", "PRINT"].iter().any(|k| {
+                (text.trim_start().get(..k.len())).is_some_and(|p| p.eq_ignore_ascii_case(k))
+            });
+            if crate::program::post::is_active_comment(d, text) && !shown {
+                return Err(format!(
+                    "the comment '({})' makes LinuxCNC act (a file, a probe, a script), which the verification does not follow",
+                    crate::files::excerpt(comment)
+                ));
+            }
+            return Ok(());
+        }
         if let Some(c) = text.chars().find(|c| !crate::names::is_name_char(*c)) {
             return Err(format!(
                 "'{c}' in the comment '{}', which pilgrim's comments never hold",
@@ -247,6 +287,7 @@ pub(super) fn read_line(
         }
         code.push_str(c);
         code.push_str(&" ".repeat(line.len() - c.len()));
+        ascii_code(&code)?;
         return Ok((code, said));
     }
     // Parenthesised comments, closed on their line, none inside another.
@@ -269,9 +310,34 @@ pub(super) fn read_line(
                 rest = &inner[q + 1..];
             }
             b')' => return Err("')' outside a comment".into()),
+            // rs274ngc reads `;` as a comment to the line's end.
+            _ if reading
+                && d.reading
+                    .macros
+                    .is_some_and(|m| m.language == crate::program::macros::Language::Rs274) =>
+            {
+                let comment = &rest[p + 1..];
+                check(comment)?;
+                said = Some(comment.trim().to_owned());
+                code.push_str(&" ".repeat(rest.len() - p));
+                return Ok((code, said));
+            }
             _ => return Err("';', which pilgrim never writes in this dialect".into()),
         }
     }
     code.push_str(rest);
+    ascii_code(&code)?;
     Ok((code, said))
+}
+
+/// A block's code (its comments blanked) holds ASCII only: a control reads
+/// no other character as a word's.
+fn ascii_code(code: &str) -> Result<(), String> {
+    match code.chars().find(|c| !c.is_ascii()) {
+        Some(c) => Err(format!(
+            "the character U+{:04X} outside a comment, which no control reads in a block",
+            u32::from(c)
+        )),
+        None => Ok(()),
+    }
 }

@@ -86,6 +86,7 @@ impl Reader<'_> {
         let motion = self.motion(&mut at.st, b, k, &given, &said.start_word, block)?;
         let going = self.going(&at.st, b, k, block)?;
         // The move as read (a lint reads it too: what a run verifies).
+        let (file, via) = self.origin(at);
         let st = &at.st;
         out.push(ReadMove {
             motion,
@@ -99,6 +100,8 @@ impl Reader<'_> {
             comment: at.pending.take(),
             number: b.number,
             line: b.line,
+            file,
+            via,
         });
         at.k += 1;
         Ok(())
