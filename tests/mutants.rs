@@ -1023,6 +1023,8 @@ fn names_edit(e: &LintError, word: &str, block: &str) -> bool {
             Some((i, f)) if f.chars().all(|c| c == '0') => i,
             _ => n,
         };
+        // `N00` is block N0.
+        let n = if n.is_empty() && !word[1..].is_empty() { "0" } else { n };
         !n.is_empty() && said.contains(&format!("{l}{n}"))
     }
 }
@@ -1116,7 +1118,15 @@ fn mutate(subject: &Subject) -> (Tally, Vec<String>) {
                 match outcome {
                     Outcome::Refused(e) => {
                         tally.refused += 1;
-                        if !names_edit(&e, &v, &block) && !names_edit(&e, &t.text, &block) {
+                        // A block whose N the edit took away is named by
+                        // its line (a program read as it stands numbers its
+                        // blocks as it likes).
+                        let line_name = format!("line {}", line + 1);
+                        let named = |w: &str| {
+                            names_edit(&e, w, &block)
+                                || (t.text.starts_with('N') && e.place == line_name)
+                        };
+                        if !named(&v) && !named(&t.text) {
                             fail(
                                 format!(
                                     "unnamed {} {}",

@@ -150,6 +150,9 @@ pub fn key(lang: Language, code: &str) -> Key {
             }
         }
         Language::Rs274 => {
+            if !p.rest.starts_with(['O', 'o']) {
+                return Key::Plain;
+            }
             let sq = squeezed(p.rest).to_ascii_uppercase();
             let Some(name_and_rest) = sq.strip_prefix('O') else {
                 return Key::Plain;

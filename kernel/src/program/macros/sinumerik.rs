@@ -24,6 +24,9 @@ const INSTRUCTIONS: [&str; 14] = [
 
 /// Line `code`'s statements carried out (see [`super::step`]).
 pub fn step(env: &Env<'_>, st: &mut State, code: &str) -> Result<Step, String> {
+    if plain(code) {
+        return Ok(Step::block(None));
+    }
     let p = scan::parts(LANG, code);
     let rest = p.rest;
     if rest.is_empty() {
@@ -140,6 +143,26 @@ pub fn step(env: &Env<'_>, st: &mut State, code: &str) -> Result<Step, String> {
         Some(c) => Some(c),
         None => changed.then_some(block),
     }))
+}
+
+/// Whether `code` is a plain block: ISO words (a letter and a number)
+/// and the reader's own setup words only, no `=`, no label, no name.
+fn plain(code: &str) -> bool {
+    // `M17` returns, `L10` calls: statements, not plain words.
+    let word = |t: &str| {
+        let b = t.as_bytes();
+        b.len() > 1
+            && b[0].is_ascii_uppercase()
+            && b[0] != b'L'
+            && b[1..]
+                .iter()
+                .all(|c| c.is_ascii_digit() || matches!(c, b'.' | b'-' | b'+'))
+    };
+    !code.contains(['=', ':', '"'])
+        && !code.contains("M17")
+        && code.split_whitespace().all(|t| {
+            word(t) || matches!(t, "DIAMON" | "DIAMOF") || t.starts_with("FGROUP(")
+        })
 }
 
 /// A setting `R1=..` or `NAME=..` where `NAME` is not an address the

@@ -287,7 +287,9 @@ pub(super) fn read_line(
         }
         code.push_str(c);
         code.push_str(&" ".repeat(line.len() - c.len()));
-        ascii_code(&code)?;
+        if !line.is_ascii() {
+            ascii_code(&code)?;
+        }
         return Ok((code, said));
     }
     // Parenthesised comments, closed on their line, none inside another.
@@ -326,7 +328,9 @@ pub(super) fn read_line(
         }
     }
     code.push_str(rest);
-    ascii_code(&code)?;
+    if !line.is_ascii() {
+        ascii_code(&code)?;
+    }
     Ok((code, said))
 }
 
