@@ -1024,7 +1024,11 @@ fn names_edit(e: &LintError, word: &str, block: &str) -> bool {
             _ => n,
         };
         // `N00` is block N0.
-        let n = if n.is_empty() && !word[1..].is_empty() { "0" } else { n };
+        let n = if n.is_empty() && !word[1..].is_empty() {
+            "0"
+        } else {
+            n
+        };
         !n.is_empty() && said.contains(&format!("{l}{n}"))
     }
 }

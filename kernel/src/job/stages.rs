@@ -809,6 +809,23 @@ impl Run<'_> {
             ..plan.toolpath.clone()
         };
         for plot in plan.toolpath.plots.iter().chain(finishing) {
+            // A program read from a file draws what its own tables hold:
+            // the plan's columns do not describe it.
+            let mut plot = plot.clone();
+            if self.text.is_some() {
+                let table = charted.tables.get(&plot.table);
+                let has = |c: &str| table.is_some_and(|t| t.contains_key(c));
+                plot.y.retain(|c| has(c));
+                if !has(&plot.x) || plot.y.is_empty() {
+                    report.checks.push(crate::family::Check {
+                        name: format!("plot {}", plot.file),
+                        ok: true,
+                        detail: "not drawn: its columns are the plan's, which a program read from a file does not follow".into(),
+                    });
+                    continue;
+                }
+            }
+            let plot = &plot;
             let text = crate::chart::chart_svg(&charted, plot)
                 .map_err(|message| self.contract(message))?;
             let name = format!("{}.svg", plot.file);

@@ -199,6 +199,236 @@ fn expand_text(
     Ok(moves)
 }
 
+/// Fanuc's two-block threading cycle (`G76 P(m)(r)(a) Q(dd_min) R(d)`,
+/// then `G76 X Z R(i) P(k) Q(dd) F(L)`) as its words give it, every length
+/// a radius in mm (the words' least input units converted) but `x`, the
+/// thread's end as the program writes X.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FanucCycle {
+    /// m: the finishing passes at the full height.
+    pub finishes: u32,
+    /// r: the chamfer at the end, in tenths of the lead (0 to 99).
+    pub chamfer_tenths: u32,
+    /// a: the tool's angle (deg): 80, 60, 55, 30, 29 or 0.
+    pub angle_deg: Real,
+    /// dd_min: the least depth a roughing pass adds.
+    pub min_cut: Real,
+    /// d: the finishing allowance.
+    pub allowance: Real,
+    /// X: the thread's end at its full height (as the program writes X).
+    pub x: Real,
+    /// Z: the thread's end.
+    pub z: Real,
+    /// i: the taper, the radius at the start minus at the end.
+    pub taper: Real,
+    /// k: the thread's height.
+    pub height: Real,
+    /// dd: the first pass's depth.
+    pub first: Real,
+    /// L: the lead.
+    pub lead: Real,
+}
+
+/// How a control of Fanuc's kind moves where its manual leaves room: the
+/// chamfer's pull-out angle (deg from the axis; 45 on the 0i).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FanucRules {
+    /// The pull-out's angle.
+    pub chamfer_deg: Real,
+}
+
+/// The passes of Fanuc's two-block G76: each pass's depth below the crest
+/// and its shift along Z towards the cycle's start (radius, mm).
+/// `D_1 = dd`, `D_n = dd sqrt(n)`, raised to `D_(n-1) + dd_min` where the
+/// step is smaller, capped at `k - d`, where roughing ends; then `m`
+/// passes at `k`. Pass `n` is shifted towards the start by `(k - D_n)
+/// tan(a/2)`: the tool's leading edge cuts, its trailing edge follows the
+/// flank on the start's side; the finishing passes are not shifted
+/// (docs/math.md, "Threading cycles").
+///
+/// # Failures
+/// A word the control refuses (a height or first depth not above 0, the
+/// allowance not below the height, an angle not of the list, no finishing
+/// pass) or more than [`MAX_CYCLE_PASSES`] passes.
+pub fn fanuc_passes(c: &FanucCycle) -> Result<Vec<(Real, Real)>, super::ProgramFault> {
+    fanuc_passes_text(c).map_err(super::ProgramFault::new)
+}
+
+fn fanuc_passes_text(c: &FanucCycle) -> Result<Vec<(Real, Real)>, String> {
+    for (w, v) in [
+        ("P(k)", c.height),
+        ("Q(dd)", c.first),
+        ("Q(dd_min)", c.min_cut),
+        ("R(d)", c.allowance),
+        ("R(i)", c.taper),
+        ("F", c.lead),
+        ("X", c.x),
+        ("Z", c.z),
+    ] {
+        if !v.is_finite() {
+            return Err(format!("G76 {w} {v} is not a finite number"));
+        }
+    }
+    if !(c.height > 0.0) {
+        return Err(format!(
+            "G76 P(k) {}: the thread's height must be above 0",
+            c.height
+        ));
+    }
+    if !(c.first > 0.0) {
+        return Err(format!(
+            "G76 Q(dd) {}: the first depth must be above 0",
+            c.first
+        ));
+    }
+    if !(c.allowance >= 0.0 && c.allowance < c.height) {
+        return Err(format!(
+            "G76 R(d) {}: the finishing allowance must be from 0 to below the height {}",
+            c.allowance, c.height
+        ));
+    }
+    if !(c.min_cut >= 0.0) {
+        return Err(format!("G76 Q(dd_min) {}: below 0", c.min_cut));
+    }
+    if ![80.0, 60.0, 55.0, 30.0, 29.0, 0.0].contains(&c.angle_deg) {
+        return Err(format!(
+            "G76 P..{:02}: the tool's angle must be 80, 60, 55, 30, 29 or 00",
+            c.angle_deg
+        ));
+    }
+    if c.finishes == 0 || c.finishes > 99 {
+        return Err(format!(
+            "G76 P{:02}....: the finishing passes must be 1 to 99",
+            c.finishes
+        ));
+    }
+    if !(c.lead > 0.0) {
+        return Err(format!("G76 F{}: the lead must be above 0", c.lead));
+    }
+    let tan = (0.5 * c.angle_deg).to_radians().tan();
+    let rough = c.height - c.allowance;
+    let mut out = Vec::new();
+    let mut last: Real = 0.0;
+    let mut n: Real = 1.0;
+    loop {
+        let d = (c.first * n.sqrt()).max(last + c.min_cut).min(rough);
+        out.push((d, (c.height - d) * tan));
+        if out.len() > MAX_CYCLE_PASSES {
+            return Err(format!(
+                "G76 Q(dd) {} P(k) {}: more than {MAX_CYCLE_PASSES} passes",
+                c.first, c.height
+            ));
+        }
+        if d >= rough {
+            break;
+        }
+        last = d;
+        n += 1.0;
+    }
+    out.extend((0..c.finishes).map(|_| (c.height, 0.0)));
+    Ok(out)
+}
+
+/// The moves Fanuc's two-block G76 `c` makes from its start `start` (`[X,
+/// Z]` as the program writes them, X on diameter where `diameter`), by
+/// `rules`: each pass a rapid to its depth and shift, the cut to Z (the
+/// chamfer's pull-out over `0.1 r L` before it, at `rules`' angle, where r
+/// is above 0), a rapid out to the start's X and one back to its Z.
+///
+/// # Failures
+/// As [`fanuc_passes`].
+pub fn expand_fanuc(
+    c: &FanucCycle,
+    start: [Real; 2],
+    diameter: bool,
+    rules: &FanucRules,
+) -> Result<Vec<CycleMove>, super::ProgramFault> {
+    let passes = fanuc_passes(c)?;
+    let s = if diameter { 0.5 } else { 1.0 };
+    let (x0, z0) = (start[0] * s, start[1]);
+    let root = c.x * s;
+    // Outside (the thread's end below the start) the passes go inwards.
+    let outside = root < x0;
+    let inward = if outside { -1.0 } else { 1.0 };
+    let crest = root - inward * c.height;
+    // Towards the start along Z.
+    let back = if z0 >= c.z { 1.0 } else { -1.0 };
+    let chamfer = 0.1 * Real::from(c.chamfer_tenths) * c.lead;
+    let rise = chamfer * rules.chamfer_deg.to_radians().tan();
+    let thread = Motion::Thread {
+        lead: c.lead,
+        start_deg: 0.0,
+    };
+    let mut moves = Vec::with_capacity(5 * passes.len());
+    let mut push = |motion, x: Real, z: Real| {
+        moves.push(CycleMove {
+            motion,
+            x: x / s,
+            z,
+        })
+    };
+    for (depth, shift) in passes {
+        let end = crest + inward * depth;
+        let begin = end + c.taper;
+        let dz = back * shift;
+        push(Motion::Rapid, begin, z0 + dz);
+        if chamfer > 0.0 {
+            push(thread, end, c.z + dz + back * chamfer);
+            // The pull-out rises away from the axis's side the cut is on,
+            // no further than the start's X.
+            let out = end - inward * rise;
+            let out = if outside { out.min(x0) } else { out.max(x0) };
+            push(thread, out, c.z + dz);
+        } else {
+            push(thread, end, c.z + dz);
+        }
+        push(Motion::Rapid, x0, c.z + dz);
+        push(Motion::Rapid, x0, z0);
+    }
+    Ok(moves)
+}
+
+/// The moves of one pass of Fanuc's simple threading cycle (`G92 X Z F
+/// R`, system A) from its start `start` (`[X, Z]` as written): a rapid to
+/// X (with the taper `taper`, radius, at the start), the cut to `[x, z]`,
+/// a rapid out to the start's X and one back to its Z.
+pub fn fanuc_g92(
+    start: [Real; 2],
+    x: Real,
+    z: Real,
+    taper: Real,
+    lead: Real,
+    diameter: bool,
+) -> Vec<CycleMove> {
+    let s = if diameter { 0.5 } else { 1.0 };
+    let thread = Motion::Thread {
+        lead,
+        start_deg: 0.0,
+    };
+    vec![
+        CycleMove {
+            motion: Motion::Rapid,
+            x: (x * s + taper) / s,
+            z: start[1],
+        },
+        CycleMove {
+            motion: thread,
+            x,
+            z,
+        },
+        CycleMove {
+            motion: Motion::Rapid,
+            x: start[0],
+            z,
+        },
+        CycleMove {
+            motion: Motion::Rapid,
+            x: start[0],
+            z: start[1],
+        },
+    ]
+}
+
 /// An external M20's cycle on diameter (the tests' example): P2.5,
 /// from the drive line 4 mm over the crest, J0.6, R2, K3, Q29.5, H1, to
 /// Z-35.
@@ -266,6 +496,82 @@ mod tests {
         let first = moves[2];
         assert!((first.x - 28.6).abs() < 1e-12, "{}", first.x);
         assert!(moves[1].z > -35.0);
+    }
+
+    /// The two worked examples of docs/math.md ("Threading cycles"): the
+    /// depths, the shifts towards the start, the clamp and the chamfer.
+    #[test]
+    fn fanuc_g76_worked_examples() {
+        let first = FanucCycle {
+            finishes: 2,
+            chamfer_tenths: 0,
+            angle_deg: 60.0,
+            min_cut: 0.050,
+            allowance: 0.020,
+            x: 18.052,
+            z: -30.0,
+            taper: 0.0,
+            height: 0.974,
+            first: 0.400,
+            lead: 1.5,
+        };
+        let round = |v: Real| (v * 1000.0).round() / 1000.0;
+        let got: Vec<(Real, Real)> = fanuc_passes(&first)
+            .unwrap()
+            .into_iter()
+            .map(|(d, s)| (round(d), round(s)))
+            .collect();
+        let want = [
+            (0.400, 0.331),
+            (0.566, 0.236),
+            (0.693, 0.162),
+            (0.800, 0.100),
+            (0.894, 0.046),
+            (0.954, 0.012),
+            (0.974, 0.0),
+            (0.974, 0.0),
+        ];
+        assert_eq!(got, want);
+        let clamped = FanucCycle {
+            min_cut: 0.100,
+            chamfer_tenths: 10,
+            ..first
+        };
+        let got: Vec<(Real, Real)> = fanuc_passes(&clamped)
+            .unwrap()
+            .into_iter()
+            .map(|(d, s)| (round(d), round(s)))
+            .collect();
+        let want = [
+            (0.400, 0.331),
+            (0.566, 0.236),
+            (0.693, 0.162),
+            (0.800, 0.100),
+            (0.900, 0.043),
+            (0.954, 0.012),
+            (0.974, 0.0),
+            (0.974, 0.0),
+        ];
+        assert_eq!(got, want);
+        // From X24 Z5 on diameter: the crest at 18.052 / 2 + 0.974; each
+        // pass pulls out over L = 1.5 before Z at 45 degrees.
+        let rules = FanucRules { chamfer_deg: 45.0 };
+        let moves = expand_fanuc(&clamped, [24.0, 5.0], true, &rules).unwrap();
+        assert_eq!(moves.len(), 5 * 8);
+        let crest = 9.026 + 0.974;
+        let (cut, pull) = (moves[1], moves[2]);
+        assert!((moves[0].z - (5.0 + (0.974 - 0.4) * 30f64.to_radians().tan())).abs() < 1e-12);
+        assert!((cut.x / 2.0 - (crest - 0.4)).abs() < 1e-12, "{}", cut.x);
+        assert!((cut.z - (-30.0 + moves[0].z - 5.0 + 1.5)).abs() < 1e-12);
+        assert!(
+            (pull.x / 2.0 - (crest - 0.4 + 1.5)).abs() < 1e-12,
+            "{}",
+            pull.x
+        );
+        assert!((pull.z - (moves[0].z - 5.0 - 30.0)).abs() < 1e-12);
+        assert_eq!((moves[3].x, moves[4].x, moves[4].z), (24.0, 24.0, 5.0));
+        let last = &moves[35..40];
+        assert!((last[1].x - 18.052).abs() < 1e-12 && (last[2].z + 30.0).abs() < 1e-12);
     }
 
     #[test]

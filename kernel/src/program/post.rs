@@ -190,10 +190,28 @@ pub struct Reading {
     /// dimensions elsewhere; its `U` an incremental X), for the refusal to
     /// say: never another dialect's meaning.
     pub meanings: &'static [(&'static str, &'static str)],
+    /// The G codes read in a program read as it stands beyond
+    /// [`Reading::g_codes`] (a shop's cycles and arcs, which pilgrim does
+    /// not write): a lint refuses them.
+    pub read_g_codes: &'static [u32],
+    /// How the dialect's `G76` threading cycle is read, if it has one.
+    pub g76: Option<G76Form>,
+    /// Whether `G92` is the simple threading cycle (Fanuc's system A).
+    pub g92_thread: bool,
     /// The language a program read as it stands may be written in beyond
     /// plain blocks (variables, jumps, loops, subprograms), or `None`. A
     /// lint (a program pilgrim wrote) reads plain blocks only.
     pub macros: Option<MacroReading>,
+}
+
+/// The form of a dialect's `G76` threading cycle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum G76Form {
+    /// LinuxCNC's one block `G76 P Z I J R K Q H` ([`super::cycle::expand`]).
+    LinuxCnc,
+    /// Fanuc's two blocks `G76 P(m)(r)(a) Q R` then `G76 X Z R P Q F`
+    /// ([`super::cycle::expand_fanuc`]), by the control's rules.
+    FanucTwoBlock(super::cycle::FanucRules),
 }
 
 /// How a dialect's macro language is read ([`super::macros`]).
@@ -285,6 +303,9 @@ pub const SINUMERIK: Dialect = Dialect {
         point_needed: "",
         no_point: "",
         code_tenths: false,
+        read_g_codes: &[],
+        g76: None,
+        g92_thread: false,
         // Programming Manual, Fundamentals, "List of G functions": group 6
         // (plane), 7 (cutter radius compensation), 8 (settable work
         // offset, G500 none), 13 (inch/metric), 14 (absolute/incremental),
@@ -390,6 +411,13 @@ pub const FANUC: Dialect = Dialect {
         point_needed: "F",
         no_point: "Q",
         code_tenths: false,
+        // Read in a shop's program: the threading cycles (0i-TC Operator's
+        // Manual, "Multiple threading cycle (G76)", "Threading cycle (G92)").
+        read_g_codes: &[76, 92],
+        g76: Some(G76Form::FanucTwoBlock(super::cycle::FanucRules {
+            chamfer_deg: 45.0,
+        })),
+        g92_thread: true,
         // 0i-TC Operator's Manual, "G code list" (system A): group 16
         // (plane), 06 (inch/metric), 07 (tool nose radius compensation),
         // 14 (work coordinate system), 02 (constant surface speed), 05
@@ -491,6 +519,9 @@ pub const LINUXCNC: Dialect = Dialect {
         point_needed: "",
         no_point: "",
         code_tenths: true,
+        read_g_codes: &[],
+        g76: Some(G76Form::LinuxCnc),
+        g92_thread: false,
         // G-code reference, "Modal groups": 2 (plane), 6 (units), 7
         // (cutter compensation), 12 (coordinate system), 3 (distance), 5
         // (feed rate mode), lathe diameter/radius and spindle speed modes.
@@ -580,6 +611,9 @@ pub const CLD: Dialect = Dialect {
         point_needed: "",
         no_point: "",
         code_tenths: false,
+        read_g_codes: &[],
+        g76: None,
+        g92_thread: false,
         modal_groups: &[],
         systems: &[],
         meanings: &[],

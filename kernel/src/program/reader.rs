@@ -22,6 +22,7 @@ use pilgrim_plugin_abi::types::Radial;
 
 mod codes;
 mod cycles;
+mod fanuc_cycles;
 mod flow;
 mod line;
 mod moves;
@@ -200,6 +201,25 @@ struct State {
     /// Each axis's shift by the work offset in force, against the first
     /// (empty: none).
     work_shift: Vec<Real>,
+    /// Fanuc's first G76 block's words, once written: the control keeps
+    /// them for the next cycle.
+    fanuc_g76: Option<FanucFirst>,
+    /// Where a run of cycle blocks (Fanuc's modal G92) started: each pass
+    /// returns there.
+    cycle_start: Option<[Real; 2]>,
+    /// The last G92 pass's X and Z (a block may write one of them).
+    g92_x: Option<Real>,
+    g92_z: Option<Real>,
+}
+
+/// Fanuc's first G76 block: m, r, a, dd_min (mm), d (mm).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct FanucFirst {
+    finishes: u32,
+    chamfer_tenths: u32,
+    angle_deg: Real,
+    min_cut: Real,
+    allowance: Real,
 }
 
 /// A word of Sinumerik's own, outside the ISO words [`super::words`] reads.
@@ -514,6 +534,14 @@ impl<'a> Reader<'a> {
         self.setup_words(&mut at.st, &block, at.k, &said)?;
         if said.motion == Some(76) {
             return self.cycle(at, &block, &said, out);
+        }
+        // Fanuc's G92 is modal: a block of X (and Z) under it is a pass.
+        let moves = said.read.iter().any(|(c, ..)| self.names.contains(c));
+        if said.motion == Some(92) || (said.motion.is_none() && at.st.motion == Some(92) && moves) {
+            return self.g92(at, &block, &said, out);
+        }
+        if said.motion.is_some() {
+            at.st.cycle_start = None;
         }
         self.moves(at, &block, said, out)
     }

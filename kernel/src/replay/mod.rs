@@ -15,6 +15,7 @@ use crate::math::Real;
 use crate::profile::ProfileError;
 use crate::program::{axis_rows, AxisProgram, ProgramPass};
 use crate::transform::ToolFrame;
+use nalgebra::Vector3;
 
 /// Why a program could not be verified, or failed verification.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -165,19 +166,24 @@ pub fn as_written(program: &AxisProgram) -> (AxisProgram, Real) {
     (p, 10f64.powi(-(decimals as i32)))
 }
 
-/// The passes of a program read from its text: a pass begins at each block
-/// with a comment (the line before it, as pilgrim writes a pass's name)
-/// and runs to the next; blocks before the first comment are one pass,
-/// `start`. A pass cuts ([`crate::toolpath::Pass::cuts`]) when one of its
-/// moves other than a rapid moves the tool: its first block, or a block
-/// that puts the tool (replayed on `machine` with `tool`) elsewhere than
-/// the block before.
+/// The passes of a program read from its text, as its motion makes them
+/// (never its comments, which only name them): the tool's moves replayed
+/// on `machine` with `tool`, in the part's frame (Z its axis). A cutting
+/// pass is a run of cutting moves (a move other than a rapid that moves
+/// the tool); it ends where a rapid takes the tool away, or where the feed
+/// reverses along the part: the moves' travel along the part's surface
+/// (along Z and round it: the radial part left out) turns back by more
+/// than [`REVERSAL_COS`] against the pass's travel. Moves that are mostly
+/// radial (an infeed) or that step across the travel (a caliber's step to
+/// its next section) between two runs begin the later pass; so do the
+/// rapids between two passes. A thread's pass is its spindle-synchronised
+/// move (rapids part the passes). Blocks before the first cut are the
+/// pass `start`, after the last `end`, neither cutting; a pass is named by
+/// the first comment among its blocks (as pilgrim writes `; pass 1`), else
+/// by its order among the cutting passes (`pass 3`).
 ///
 /// # Failures
-/// The replay failing (a solved axis the program lacks); a program whose
-/// blocks are all one pass that cuts (no comment between its blocks): the
-/// surface each pass leaves, the rest rides and the finish's stock need
-/// its passes, which a comment before each names.
+/// The replay failing (a solved axis the program lacks).
 pub fn passes_in(
     program: &AxisProgram,
     machine: &dyn MachineKinematics,
@@ -185,30 +191,126 @@ pub fn passes_in(
 ) -> Result<Vec<ProgramPass>, VerifyError> {
     let (written, _) = as_written(program);
     let poses = replay(&written, machine, tool)?;
-    let mut out: Vec<ProgramPass> = Vec::new();
-    for (k, b) in written.blocks.iter().enumerate() {
-        match (&b.comment, out.last_mut()) {
-            (None, Some(p)) => p.blocks.end = k + 1,
-            (name, _) => out.push(ProgramPass {
-                name: name.clone().unwrap_or_else(|| "start".into()),
-                blocks: k..k + 1,
-                cuts: false,
-            }),
+    let n = written.blocks.len();
+    let at = |k: usize| Vector3::new(poses[6 * k], poses[6 * k + 1], poses[6 * k + 2]);
+    // (start, cuts) of each run; the first is the start.
+    let mut runs: Vec<(usize, bool)> = vec![(0, false)];
+    // The travel along the surface of the pass so far, and where a run of
+    // infeeds and steps since its last travel began.
+    let mut travel: Option<Vector3<Real>> = None;
+    let mut stepping: Option<usize> = None;
+    for k in 1..n {
+        let (p, q) = (at(k - 1), at(k));
+        let d = q - p;
+        if d.norm() <= crate::tolerance::SAME_LENGTH {
+            continue;
         }
-        let moved = k == 0
-            || out.last().is_some_and(|p| p.blocks.start == k)
-            || poses[6 * k..6 * k + 6] != poses[6 * (k - 1)..6 * k];
-        if b.motion != crate::toolpath::Motion::Rapid && moved {
-            if let Some(p) = out.last_mut() {
-                p.cuts = true;
+        let rapid = written.blocks[k].motion == crate::toolpath::Motion::Rapid;
+        let last = runs.len() - 1;
+        if rapid {
+            travel = None;
+            stepping = None;
+            // Rapids after a cut begin the next pass (its approach).
+            if runs[last].1 {
+                runs.push((k, false));
             }
+            continue;
+        }
+        if !runs[last].1 {
+            if last == 0 {
+                runs.push((k, true));
+            } else {
+                runs[last].1 = true;
+            }
+            travel = along_surface(p, q);
+            stepping = None;
+            if travel.is_none() {
+                stepping = Some(k);
+            }
+            continue;
+        }
+        let Some(v) = along_surface(p, q) else {
+            stepping.get_or_insert(k);
+            continue;
+        };
+        let Some(t) = travel else {
+            travel = Some(v);
+            continue;
+        };
+        let cos = v.dot(&t) / (v.norm() * t.norm());
+        if cos < REVERSAL_COS {
+            let from = stepping.unwrap_or(k);
+            runs.push((from, true));
+            travel = Some(v);
+            stepping = None;
+        } else if cos > -REVERSAL_COS {
+            travel = Some(v);
+            stepping = None;
+        } else if v.norm() > t.norm() {
+            // Across a shorter first move (an infeed along the axis): this
+            // is the pass's travel.
+            travel = Some(v);
+        } else {
+            // A step across the travel: the pass's travel stays.
+            stepping.get_or_insert(k);
         }
     }
-    if out.len() == 1 && out[0].cuts {
-        return Err(VerifyError::Replay(format!(
-            "the program's {} blocks are one pass: the verification reads a pass as the blocks after a comment line (as pilgrim writes `; pass 1` or `(PASS 1)`); put a comment before the first block of each pass",
-            program.blocks.len()
-        )));
+    // The trailing rapids after the last cut are the end.
+    let mut out: Vec<ProgramPass> = Vec::with_capacity(runs.len());
+    let mut cutting = 0;
+    for (i, &(start, cuts)) in runs.iter().enumerate() {
+        let end = runs.get(i + 1).map_or(n, |r| r.0);
+        if start >= end {
+            continue;
+        }
+        let named = written.blocks[start..end]
+            .iter()
+            .find_map(|b| b.comment.clone());
+        let name = match (named, cuts) {
+            (Some(c), _) => c,
+            (None, true) => format!("pass {}", cutting + 1),
+            (None, false) if i == 0 => "start".into(),
+            (None, false) => "end".into(),
+        };
+        cutting += usize::from(cuts);
+        out.push(ProgramPass {
+            name,
+            blocks: start..end,
+            cuts,
+        });
+    }
+    if n > 0 && out.is_empty() {
+        out.push(ProgramPass {
+            name: "start".into(),
+            blocks: 0..n,
+            cuts: false,
+        });
     }
     Ok(out)
+}
+
+/// How far a cutting move may turn back against its pass's travel before
+/// it begins another pass (the cosine of the angle between them, 120
+/// degrees): a feed that reverses turns by 180 degrees; one that follows
+/// a profile or goes round a part turns by a few; a step across the
+/// travel by 90.
+pub const REVERSAL_COS: Real = -0.5;
+
+/// The travel of a move from `p` to `q` (part frame, Z the part's axis)
+/// along the part's surface: along Z and round it (the arc at the mean
+/// radius), the radial part left out; `None` where the move is an infeed:
+/// its radial part more than half its travel (steeper than 27 degrees
+/// to the surface), or no travel.
+fn along_surface(p: Vector3<Real>, q: Vector3<Real>) -> Option<Vector3<Real>> {
+    let (rp, rq) = (p.xy().norm(), q.xy().norm());
+    let turn = if rp > crate::tolerance::SAME_LENGTH && rq > crate::tolerance::SAME_LENGTH {
+        let a = q.y.atan2(q.x) - p.y.atan2(p.x);
+        // The shorter way round.
+        (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
+    } else {
+        0.0
+    };
+    let v = Vector3::new(q.z - p.z, 0.5 * (rp + rq) * turn, 0.0);
+    let travel = v.norm();
+    (travel > crate::tolerance::SAME_LENGTH && (rq - rp).abs() <= 0.5 * travel).then_some(v)
 }

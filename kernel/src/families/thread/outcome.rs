@@ -181,6 +181,18 @@ impl Outcome for ThreadOutcome {
         }
         // The simulated areas beside the plan's, row for row, where the
         // family's "passes" table has one row per thread block.
+        // A program whose thread blocks are not the plan's rows (one read
+        // from a file: a shop's G76) has its own table, the program's.
+        let planned = tables
+            .get("passes")
+            .is_some_and(|t| !t.is_empty() && t.values().all(|c| c.len() == w.passes.len()));
+        if !planned && !w.passes.is_empty() {
+            let n = w.passes.len();
+            tables.insert(
+                "passes".into(),
+                BTreeMap::from([("pass".to_owned(), (1..=n).map(|k| k as f64).collect())]),
+            );
+        }
         if let Some(t) = tables.get_mut("passes") {
             if t.values().all(|c| c.len() == w.passes.len()) && !t.is_empty() {
                 t.insert(

@@ -160,9 +160,9 @@ fn plain(code: &str) -> bool {
     };
     !code.contains(['=', ':', '"'])
         && !code.contains("M17")
-        && code.split_whitespace().all(|t| {
-            word(t) || matches!(t, "DIAMON" | "DIAMOF") || t.starts_with("FGROUP(")
-        })
+        && code
+            .split_whitespace()
+            .all(|t| word(t) || matches!(t, "DIAMON" | "DIAMOF") || t.starts_with("FGROUP("))
 }
 
 /// A setting `R1=..` or `NAME=..` where `NAME` is not an address the

@@ -77,7 +77,13 @@ impl Reader<'_> {
         } else {
             w.integer()
         };
-        let Some(n) = code.filter(|n| listed.contains(n)) else {
+        // A shop's program may hold what pilgrim never writes (its cycles).
+        let read_too = if self.reading && w.letter == 'G' {
+            d.reading.read_g_codes
+        } else {
+            &[]
+        };
+        let Some(n) = code.filter(|n| listed.contains(n) || read_too.contains(n)) else {
             // What the code means on this control, where the dialect's
             // table says: never another dialect's.
             let named = (w.code().map(|c| format!("{}{c}", w.letter)))
@@ -108,7 +114,7 @@ impl Reader<'_> {
             return Ok(());
         }
         match n {
-            0 | 1 | 32 | 33 | 76 => {
+            0 | 1 | 32 | 33 | 76 | 92 => {
                 if let Some(m) = said.motion {
                     return Err(self.err(
                         self.place(b, k),

@@ -28,10 +28,33 @@ impl Reader<'_> {
         said: &Said,
         out: &mut Vec<ReadMove>,
     ) -> Result<(), LintError> {
-        let (d, program) = (self.d, self.program);
+        let d = self.d;
         let fail = |m: String| self.err(self.place(b, at.k), m);
+        if let Some(crate::program::post::G76Form::FanucTwoBlock(rules)) = d.reading.g76 {
+            return self.fanuc_g76(at, b, said, &rules, out);
+        }
         let values: Vec<(char, Real)> = said.read.iter().map(|(c, v, _)| (*c, *v)).collect();
         let (cycle, end_x) = cycle_words(&values, d).map_err(fail)?;
+        let ([x0, z0], xz) = self.cycle_ready(at, b)?;
+        let moves =
+            crate::program::cycle::expand(&cycle, [x0, z0], at.st.radial == Some(true), end_x)
+                .map_err(|m| fail(m.message))?;
+        self.cycle_moves(at, b, &moves, xz, out)?;
+        at.st.motion = Some(76);
+        Ok(())
+    }
+
+    /// What a threading cycle at block `b` needs of the modal state: the
+    /// spindle, constant speed where the dialect wants it, the setup, X
+    /// and Z written; where it starts (`[X, Z]` as written) and the two
+    /// axes' places among the program's.
+    pub(super) fn cycle_ready(
+        &self,
+        at: &Standing,
+        b: &Block,
+    ) -> Result<([Real; 2], [usize; 2]), LintError> {
+        let (d, program) = (self.d, self.program);
+        let fail = |m: String| self.err(self.place(b, at.k), m);
         let st = &at.st;
         let what = "a threading cycle";
         let needs_g97 = (d.reading.thread_needs_constant_speed && !st.constant_speed)
@@ -57,12 +80,23 @@ impl Reader<'_> {
                     .into(),
             ));
         };
-        let moves = crate::program::cycle::expand(&cycle, [x0, z0], st.radial == Some(true), end_x)
-            .map_err(|m| fail(m.message))?;
+        Ok(([x0, z0], [xi, zi]))
+    }
+
+    /// The moves a cycle at block `b` makes, each held and pushed to `out`
+    /// as a block of its own.
+    pub(super) fn cycle_moves(
+        &self,
+        at: &mut Standing,
+        b: &Block,
+        moves: &[CycleMove],
+        xz: [usize; 2],
+        out: &mut Vec<ReadMove>,
+    ) -> Result<(), LintError> {
         let comment = at.pending.take();
         let (file, via) = self.origin(at);
         for (n, mv) in moves.iter().enumerate() {
-            at.st.values = self.cycle_move(&at.st, b, at.k, n, mv, [xi, zi])?;
+            at.st.values = self.cycle_move(&at.st, b, at.k, n, mv, xz)?;
             out.push(ReadMove {
                 motion: mv.motion,
                 values: placed(&at.st),
@@ -79,7 +113,6 @@ impl Reader<'_> {
             });
             at.k += 1;
         }
-        at.st.motion = Some(76);
         Ok(())
     }
 

@@ -1,0 +1,190 @@
+//! Fanuc's threading cycles in a shop's program (system A): the two-block
+//! `G76` (its first block's words kept by the control for the next
+//! cycle) and the modal `G92`, each expanded as the control runs it
+//! ([`crate::program::cycle::expand_fanuc`], [`crate::program::cycle::fanuc_g92`])
+//! and its moves read as blocks of their own.
+
+use super::{Block, FanucFirst, ReadMove, Reader, Said, Standing};
+use crate::math::Real;
+use crate::program::cycle::{FanucCycle, FanucRules};
+use crate::program::lint::LintError;
+
+impl Reader<'_> {
+    /// The unit of a cycle's whole-number words (P, Q; R without its
+    /// point): the control's least input increment.
+    fn increment(&self) -> Real {
+        self.d.reading.least_input.unwrap_or(0.001)
+    }
+
+    /// Word `c` of block `b`'s words `said`: its value and whether it is
+    /// written with a decimal point.
+    fn cycle_word(said: &Said, c: char) -> Option<(Real, bool)> {
+        said.read
+            .iter()
+            .find(|(l, ..)| *l == c)
+            .map(|(_, v, t)| (*v, t.contains('.')))
+    }
+
+    /// A length word `c` of a cycle: in mm with its point, else in the
+    /// least input increment.
+    fn cycle_length(&self, said: &Said, c: char) -> Option<Real> {
+        Self::cycle_word(said, c).map(|(v, point)| if point { v } else { v * self.increment() })
+    }
+
+    /// Fanuc's `G76` at block `b`: the first block's words kept, or the
+    /// second block's cycle expanded from where the tool stands.
+    ///
+    /// # Failures
+    /// A word the cycle has not, one written with a point where the
+    /// control takes a whole number, the second block before any first
+    /// (its values would be the control's parameters, which the machine
+    /// does not state), a cycle the control refuses.
+    pub(super) fn fanuc_g76(
+        &self,
+        at: &mut Standing,
+        b: &Block,
+        said: &Said,
+        rules: &FanucRules,
+        out: &mut Vec<ReadMove>,
+    ) -> Result<(), LintError> {
+        let fail = |m: String| self.err(self.place(b, at.k), m);
+        let second = said.read.iter().any(|(c, ..)| *c == 'X' || *c == 'Z');
+        let allowed: &[char] = if second {
+            &['X', 'Z', 'R', 'P', 'Q', 'F']
+        } else {
+            &['P', 'Q', 'R']
+        };
+        if let Some((c, _, t)) = said.read.iter().find(|(c, ..)| !allowed.contains(c)) {
+            return Err(fail(format!(
+                "{t}: not a word of G76's {} block ({}); {c} is {}",
+                if second { "second" } else { "first" },
+                allowed.iter().collect::<String>(),
+                if *c == 'U' || *c == 'W' {
+                    "incremental, which the verification does not read"
+                } else {
+                    "another word"
+                }
+            )));
+        }
+        let whole = |c: char| -> Result<Option<Real>, LintError> {
+            match Self::cycle_word(said, c) {
+                Some((_, true)) => Err(fail(format!(
+                    "G76 {c} with a decimal point: the control takes {c} as a whole number in its least input increment"
+                ))),
+                Some((v, false)) => Ok(Some(v)),
+                None => Ok(None),
+            }
+        };
+        if !second {
+            let p = whole('P')?.ok_or_else(|| fail("G76 without P(m)(r)(a)".into()))?;
+            let p = p as u64;
+            let first = FanucFirst {
+                finishes: (p / 10_000) as u32,
+                chamfer_tenths: ((p / 100) % 100) as u32,
+                angle_deg: (p % 100) as Real,
+                min_cut: whole('Q')?.map_or(0.0, |q| q * self.increment()),
+                allowance: self.cycle_length(said, 'R').unwrap_or(0.0),
+            };
+            if whole('Q')?.is_none() || said.read.iter().all(|(c, ..)| *c != 'R') {
+                return Err(fail(
+                    "G76's first block without Q(dd_min) or R(d): the control would take them from its parameters, which the machine does not state; write both".into(),
+                ));
+            }
+            at.st.fanuc_g76 = Some(first);
+            return Ok(());
+        }
+        let Some(f) = at.st.fanuc_g76 else {
+            return Err(fail(
+                "G76's second block before its first (G76 P(m)(r)(a) Q(dd_min) R(d)): the control would take m, r, a, dd_min and d from its parameters, which the machine does not state".into(),
+            ));
+        };
+        let need = |c: char, what: &str| fail(format!("G76 without {c}, {what}"));
+        let (start, xz) = self.cycle_ready(at, b)?;
+        let x = Self::cycle_word(said, 'X').map_or(start[0], |(v, _)| v);
+        let z = Self::cycle_word(said, 'Z')
+            .map(|(v, _)| v)
+            .ok_or_else(|| need('Z', "the thread's end"))?;
+        let lead = match Self::cycle_word(said, 'F') {
+            Some((v, _)) => v,
+            None => at.st.lead.ok_or_else(|| need('F', "the lead"))?,
+        };
+        let cycle = FanucCycle {
+            finishes: f.finishes,
+            chamfer_tenths: f.chamfer_tenths,
+            angle_deg: f.angle_deg,
+            min_cut: f.min_cut,
+            allowance: f.allowance,
+            x,
+            z,
+            taper: self.cycle_length(said, 'R').unwrap_or(0.0),
+            height: whole('P')?.ok_or_else(|| need('P', "the thread's height"))? * self.increment(),
+            first: whole('Q')?.ok_or_else(|| need('Q', "the first cut's depth"))?
+                * self.increment(),
+            lead,
+        };
+        let diameter = self.program.setup.radial == Some(super::Radial::Diameter);
+        let moves = crate::program::cycle::expand_fanuc(&cycle, start, diameter, rules)
+            .map_err(|e| fail(e.message))?;
+        at.st.f = Some(lead);
+        at.st.lead = Some(lead);
+        self.cycle_moves(at, b, &moves, xz, out)
+    }
+
+    /// Fanuc's modal `G92` at block `b`: one pass from where the run of
+    /// G92 blocks started, to the block's X (its Z, F and R, or the last
+    /// block's).
+    ///
+    /// # Failures
+    /// A word the cycle has not, no lead, the modal state a cut needs.
+    pub(super) fn g92(
+        &self,
+        at: &mut Standing,
+        b: &Block,
+        said: &Said,
+        out: &mut Vec<ReadMove>,
+    ) -> Result<(), LintError> {
+        let fail = |m: String| self.err(self.place(b, at.k), m);
+        if !self.d.reading.g92_thread {
+            return Err(fail("G92: not a threading cycle of this dialect".into()));
+        }
+        if let Some((c, _, t)) = said
+            .read
+            .iter()
+            .find(|(c, ..)| !['X', 'Z', 'F', 'R'].contains(c))
+        {
+            return Err(fail(format!(
+                "{t}: not a word of G92 (X, Z, F, R); {c} {}",
+                if *c == 'U' || *c == 'W' {
+                    "is incremental, which the verification does not read"
+                } else {
+                    "is another word"
+                }
+            )));
+        }
+        let (here, xz) = self.cycle_ready(at, b)?;
+        let start = *at.st.cycle_start.get_or_insert(here);
+        if let Some(f) = Self::cycle_word(said, 'F').map(|(v, _)| v) {
+            at.st.f = Some(f);
+            at.st.lead = Some(f);
+        }
+        let lead = at
+            .st
+            .lead
+            .ok_or_else(|| fail("G92 before any lead F".into()))?;
+        let x = Self::cycle_word(said, 'X')
+            .map(|(v, _)| v)
+            .or(at.st.g92_x)
+            .ok_or_else(|| fail("G92 without X".into()))?;
+        let z = Self::cycle_word(said, 'Z')
+            .map(|(v, _)| v)
+            .or(at.st.g92_z)
+            .ok_or_else(|| fail("G92 without Z".into()))?;
+        let taper = self.cycle_length(said, 'R').unwrap_or(0.0);
+        at.st.g92_x = Some(x);
+        at.st.g92_z = Some(z);
+        let diameter = self.program.setup.radial == Some(super::Radial::Diameter);
+        let moves = crate::program::cycle::fanuc_g92(start, x, z, taper, lead, diameter);
+        at.st.motion = Some(92);
+        self.cycle_moves(at, b, &moves, xz, out)
+    }
+}
