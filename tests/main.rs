@@ -14,6 +14,7 @@ mod bodies;
 mod caliber;
 mod cli;
 mod collisions;
+mod corpus;
 mod compensate;
 mod containment;
 mod docs;

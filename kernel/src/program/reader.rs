@@ -767,9 +767,11 @@ fn not_read(reading: bool, d: &Dialect) -> String {
                 .collect::<Vec<_>>()
                 .join(" ")
         };
+        let mut g = g.to_vec();
+        g.extend(d.reading.read_g_codes);
         format!(
             ": a word the verification cannot simulate (it reads {} and {} in {} programs); verify a program without it",
-            list('G', g),
+            list('G', &g),
             list('M', m),
             d.name
         )

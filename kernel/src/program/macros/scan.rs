@@ -261,6 +261,11 @@ impl Index {
                 ix.labels.entry(l.to_ascii_uppercase()).or_default().push(i);
             }
             let k = key(lang, code);
+            if let Key::Program(n) = k {
+                if ix.programs.insert(n, i).is_some() {
+                    return Err((i, format!("program O{n:04} stands twice in the file")));
+                }
+            }
             if k != Key::Plain {
                 ix.texts.insert(i, code.to_owned());
             }

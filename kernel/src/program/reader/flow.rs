@@ -157,15 +157,18 @@ impl<'a> Reader<'a> {
         let Some(m) = self.macros else {
             return Err("the dialect calls no subprograms".into());
         };
-        let names: Vec<String> = (m.files.iter())
-            .map(|p| {
+        let mut names: Vec<String> = Vec::new();
+        for file in (m.files.iter()).map(|p| {
                 let o = number.map_or(String::new(), |n| format!("{n:04}"));
                 p.replace("{O}", &o)
                     .replace("{N}", name)
                     .replace("{NAME}", &name.to_ascii_uppercase())
                     .replace("{name}", &name.to_ascii_lowercase())
-            })
-            .collect();
+        }) {
+            if !names.contains(&file) {
+                names.push(file);
+            }
+        }
         if let Some(k) = self.files.iter().position(|f| names.contains(&f.name)) {
             return Ok(k);
         }

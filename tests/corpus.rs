@@ -1,0 +1,220 @@
+//! A corpus of programs written by hand as shops write them, from the
+//! controls' documented examples (`tests/corpus/`), each beside its plain
+//! twin (the same motion as plain blocks, written out from the rules the
+//! control follows): Fanuc's two-block G76 (its depths by docs/math.md's
+//! law, "Threading cycles"), G92's modal passes, a macro B loop, M98 into
+//! the same file and into a file beside it. Every program verifies, with
+//! the twin's figures exactly; what the reader refuses is refused naming
+//! the construct, in the control's words.
+
+use crate::common::{pilgrim, s, scratch};
+use std::path::{Path, PathBuf};
+
+/// The corpus's folder.
+fn corpus() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/corpus")
+}
+
+/// `file` of the corpus verified on `machine` against `family` into a
+/// folder of `dir`: the exit code, the message, the report.
+fn verified(
+    dir: &Path,
+    file: &str,
+    machine: &str,
+    family: &str,
+) -> (i32, String, serde_json::Value) {
+    let out = dir.join(file.replace('/', "-"));
+    let (code, _, err) = pilgrim(&[
+        "verify",
+        s(&corpus().join(file)),
+        "--machine",
+        machine,
+        "--family",
+        family,
+        "--out",
+        s(&out),
+        "-q",
+    ]);
+    let report = std::fs::read_to_string(out.join("report.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or(serde_json::Value::Null);
+    (code, err, report)
+}
+
+/// The figures of a verification: its family's section and the verdict,
+/// without the names of passes and blocks (a comment names them, and a
+/// twin's comments are its own) and the program's file.
+fn figures(report: &serde_json::Value) -> serde_json::Value {
+    fn strip(v: &mut serde_json::Value) {
+        match v {
+            serde_json::Value::Object(m) => {
+                m.retain(|k, _| !matches!(k.as_str(), "name" | "block_name" | "program_file"));
+                m.values_mut().for_each(strip);
+            }
+            serde_json::Value::Array(a) => a.iter_mut().for_each(strip),
+            serde_json::Value::String(t) => {
+                // A message names blocks by the program's own lines.
+                *t = String::new();
+            }
+            _ => {}
+        }
+    }
+    let mut v = serde_json::json!({
+        "thread": report["thread_verification"],
+        "verification": report["verification"],
+        "status": report["verdict"]["status"],
+    });
+    strip(&mut v);
+    v
+}
+
+/// The Fanuc corpus on the 0i-TC lathe against the thread family's
+/// default (M20x2.5-6g): each program and its twin verify, alike.
+#[test]
+fn fanuc_programs_verify_as_their_plain_twins() {
+    let dir = scratch("corpus", "fanuc");
+    for name in [
+        "g76_m20",
+        "g92_m20",
+        "macro_while",
+        "m98_same_file",
+        "m98_beside",
+    ] {
+        let program = format!("fanuc/{name}.nc");
+        let twin = format!("fanuc/{name}.plain.nc");
+        let (code, err, report) = verified(&dir, &program, "fanuc-0i-tc", "scripts/thread.rhai");
+        assert_eq!(code, 0, "{program}: {err}");
+        let (tcode, terr, treport) = verified(&dir, &twin, "fanuc-0i-tc", "scripts/thread.rhai");
+        assert_eq!(tcode, 0, "{twin}: {terr}");
+        assert!(report["thread_verification"].is_object(), "{program}");
+        assert_eq!(figures(&report), figures(&treport), "{program} and its twin");
+        assert_eq!(
+            report["blocks"], treport["blocks"],
+            "{program}: the moves the control makes"
+        );
+    }
+}
+
+/// What the reader refuses, it refuses by name: the construct, its line
+/// or block, why; never a Rust type or debug text.
+#[test]
+fn what_is_not_read_is_refused_by_name() {
+    let dir = scratch("corpus", "refused");
+    for (file, says) in [
+        ("fanuc/refused/g76_second_alone.nc", "G76's second block before its first"),
+        ("fanuc/refused/endless.nc", "loop turns"),
+        ("fanuc/refused/system_variable.nc", "#5001: a system variable"),
+        ("fanuc/refused/m99_main.nc", "M99 in the main program"),
+        ("fanuc/refused/common_unset.nc", "#100 is read before the program sets it"),
+        ("fanuc/refused/goto_twice.nc", "stands on 2 lines"),
+        ("fanuc/refused/recursion.nc", "calls nested deeper than 16"),
+        ("fanuc/refused/nose_radius.nc", "G42 (tool nose radius compensation right"),
+    ] {
+        let (code, err, _) = verified(&dir, file, "fanuc-0i-tc", "scripts/thread.rhai");
+        assert_eq!(code, 1, "{file}: {err}");
+        assert!(err.contains(says), "{file}: {err}");
+        for rust in ["Some(", "Unexpected {", "::", "None", "Err("] {
+            assert!(!err.contains(rust), "{file}: Rust's text in '{err}'");
+        }
+    }
+}
+
+/// `text` (a program in the dialect whose comments open with `open`)
+/// without its comments: a comment line goes, a comment after a block's
+/// words is cut off.
+fn uncommented(text: &str, open: &str, close: &str) -> String {
+    let mut out = String::new();
+    for line in text.lines() {
+        let code = match (line.find(open), close.is_empty()) {
+            (Some(p), true) => &line[..p],
+            (Some(p), false) => {
+                let end = line[p..].find(close).map_or(line.len(), |q| p + q + 1);
+                // Fanuc's `O0001 (NAME)`: the number stays.
+                let (a, b) = (&line[..p], &line[end..]);
+                if a.trim().is_empty() && b.trim().is_empty() {
+                    ""
+                } else {
+                    out.push_str(a.trim_end());
+                    out.push_str(b);
+                    out.push('\n');
+                    continue;
+                }
+            }
+            (None, _) => line,
+        };
+        if !code.trim().is_empty() || line.starts_with('%') {
+            out.push_str(code.trim_end());
+            out.push('\n');
+        }
+    }
+    out
+}
+
+/// The default jobs' programs with every comment taken out verify with
+/// the program's own figures and the same passes: the passes are the
+/// motion's, the comments only name them.
+#[test]
+fn the_default_programs_without_comments_verify_alike() {
+    for (job, file, machine, open, close) in [
+        ("mandrel", "program.mpf", "3K152VF20", ";", ""),
+        ("caliber", "program.mpf", "Mannesmann", ";", ""),
+        ("worm", "program.nc", "fanuc-0i-tc", "(", ")"),
+        ("thread", "program.nc", "fanuc-0i-tc", "(", ")"),
+    ] {
+        let run = crate::common::default_run("corpus", job, &format!("bare-{job}"));
+        let text = std::fs::read_to_string(run.join(file)).unwrap();
+        let bare = uncommented(&text, open, close);
+        assert!(!bare.contains(open), "{job}: {bare}");
+        let dir = run.parent().unwrap();
+        let verify = |name: &str, text: &str| {
+            let path = dir.join(name);
+            std::fs::write(&path, text).unwrap();
+            let out = dir.join(format!("{name}.verify"));
+            let family = format!("scripts/{job}.rhai");
+            let (code, _, err) = pilgrim(&[
+                "verify",
+                s(&path),
+                "--machine",
+                machine,
+                "--family",
+                &family,
+                "--out",
+                s(&out),
+                "-q",
+            ]);
+            assert_eq!(code, 0, "{job} {name}: {err}");
+            let report: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap())
+                    .unwrap();
+            report
+        };
+        let ext = file.rsplit('.').next().unwrap();
+        let own = verify(&format!("OWN.{ext}"), &text);
+        let stripped = verify(&format!("BARE.{ext}"), &bare);
+        let section = ["verification", "groove_verification", "thread_verification"]
+            .into_iter()
+            .find(|k| own.get(k).is_some())
+            .unwrap();
+        let strip = |r: &serde_json::Value| {
+            let mut r = serde_json::json!({ "v": r[section], "verdict": r["verdict"]["status"] });
+            fn names_out(v: &mut serde_json::Value) {
+                match v {
+                    serde_json::Value::Object(m) => {
+                        m.remove("name");
+                        m.values_mut().for_each(names_out);
+                    }
+                    serde_json::Value::Array(a) => a.iter_mut().for_each(names_out),
+                    serde_json::Value::String(t) => t.clear(),
+                    _ => {}
+                }
+            }
+            names_out(&mut r);
+            r
+        };
+        assert_eq!(strip(&own), strip(&stripped), "{job}: the figures");
+        for key in ["cutting_passes", "blocks"] {
+            assert_eq!(own[key], stripped[key], "{job}: {key}");
+        }
+    }
+}
