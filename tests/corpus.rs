@@ -88,7 +88,11 @@ fn fanuc_programs_verify_as_their_plain_twins() {
         let (tcode, terr, treport) = verified(&dir, &twin, "fanuc-0i-tc", "scripts/thread.rhai");
         assert_eq!(tcode, 0, "{twin}: {terr}");
         assert!(report["thread_verification"].is_object(), "{program}");
-        assert_eq!(figures(&report), figures(&treport), "{program} and its twin");
+        assert_eq!(
+            figures(&report),
+            figures(&treport),
+            "{program} and its twin"
+        );
         assert_eq!(
             report["blocks"], treport["blocks"],
             "{program}: the moves the control makes"
@@ -102,14 +106,26 @@ fn fanuc_programs_verify_as_their_plain_twins() {
 fn what_is_not_read_is_refused_by_name() {
     let dir = scratch("corpus", "refused");
     for (file, says) in [
-        ("fanuc/refused/g76_second_alone.nc", "G76's second block before its first"),
+        (
+            "fanuc/refused/g76_second_alone.nc",
+            "G76's second block before its first",
+        ),
         ("fanuc/refused/endless.nc", "loop turns"),
-        ("fanuc/refused/system_variable.nc", "#5001: a system variable"),
+        (
+            "fanuc/refused/system_variable.nc",
+            "#5001: a system variable",
+        ),
         ("fanuc/refused/m99_main.nc", "M99 in the main program"),
-        ("fanuc/refused/common_unset.nc", "#100 is read before the program sets it"),
+        (
+            "fanuc/refused/common_unset.nc",
+            "#100 is read before the program sets it",
+        ),
         ("fanuc/refused/goto_twice.nc", "stands on 2 lines"),
         ("fanuc/refused/recursion.nc", "calls nested deeper than 16"),
-        ("fanuc/refused/nose_radius.nc", "G42 (tool nose radius compensation right"),
+        (
+            "fanuc/refused/nose_radius.nc",
+            "G42 (tool nose radius compensation right",
+        ),
     ] {
         let (code, err, _) = verified(&dir, file, "fanuc-0i-tc", "scripts/thread.rhai");
         assert_eq!(code, 1, "{file}: {err}");
@@ -216,5 +232,41 @@ fn the_default_programs_without_comments_verify_alike() {
         for key in ["cutting_passes", "blocks"] {
             assert_eq!(own[key], stripped[key], "{job}: {key}");
         }
+    }
+}
+
+/// The LinuxCNC corpus on the lathe with a LinuxCNC control: o-word
+/// subroutines, `while`, `if`, `do`/`while`, `repeat`, numbered and named
+/// parameters (`##30`, `#<depth>`), each verified as its plain twin; each
+/// left for CI, where LinuxCNC's own `rs274` must make the moves the
+/// reader read (`.ci/rs274_check.py`).
+#[test]
+fn linuxcnc_programs_verify_as_their_plain_twins_and_as_rs274_reads_them() {
+    let dir = scratch("corpus", "linuxcnc");
+    let lathe = pilgrim_kernel::machine::machine_file(&fanuc_0i_tc::describe(), "its crate");
+    let machine = dir.join("linuxcnc-lathe.toml");
+    std::fs::write(&machine, crate::common::with_control(&lathe, "linuxcnc")).unwrap();
+    let exe = std::env::current_exe().unwrap();
+    let check = exe.ancestors().nth(3).unwrap().join("linuxcnc-check");
+    for name in ["osub_while", "repeat_params"] {
+        let program = format!("linuxcnc/{name}.ngc");
+        let twin = format!("linuxcnc/{name}.plain.ngc");
+        let (code, err, report) = verified(&dir, &program, s(&machine), "scripts/thread.rhai");
+        assert_eq!(code, 0, "{program}: {err}");
+        let (tcode, terr, treport) = verified(&dir, &twin, s(&machine), "scripts/thread.rhai");
+        assert_eq!(tcode, 0, "{twin}: {terr}");
+        assert_eq!(
+            figures(&report),
+            figures(&treport),
+            "{program} and its twin"
+        );
+        let left = check.join(format!("corpus-{name}"));
+        std::fs::create_dir_all(&left).unwrap();
+        std::fs::copy(corpus().join(&program), left.join("program.ngc")).unwrap();
+        std::fs::copy(
+            dir.join(program.replace('/', "-")).join("program.json"),
+            left.join("program.json"),
+        )
+        .unwrap();
     }
 }

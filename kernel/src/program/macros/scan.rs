@@ -364,6 +364,7 @@ impl Index {
                     }
                 }
             }
+            Key::O(_, "CALL") => return Ok(()),
             Key::O(_, s) => s,
             _ => return Ok(()),
         };

@@ -82,7 +82,7 @@ impl Landmarks for SourceFile<'_> {
                 } else {
                     format!(" of {}", self.name)
                 };
-                format!("line {}{file}: {m}", l + 1)
+                format!("the structure of the program{file} (line {}): {m}", l + 1)
             })
         });
         built.as_ref().map_err(Clone::clone)
@@ -159,11 +159,11 @@ impl<'a> Reader<'a> {
         };
         let mut names: Vec<String> = Vec::new();
         for file in (m.files.iter()).map(|p| {
-                let o = number.map_or(String::new(), |n| format!("{n:04}"));
-                p.replace("{O}", &o)
-                    .replace("{N}", name)
-                    .replace("{NAME}", &name.to_ascii_uppercase())
-                    .replace("{name}", &name.to_ascii_lowercase())
+            let o = number.map_or(String::new(), |n| format!("{n:04}"));
+            p.replace("{O}", &o)
+                .replace("{N}", name)
+                .replace("{NAME}", &name.to_ascii_uppercase())
+                .replace("{name}", &name.to_ascii_lowercase())
         }) {
             if !names.contains(&file) {
                 names.push(file);
