@@ -100,6 +100,46 @@ fn fanuc_programs_verify_as_their_plain_twins() {
     }
 }
 
+/// The Sinumerik corpus on the mandrel grinder: the default mandrel's
+/// motion with its feeds in a `DEF REAL` local and an R parameter's
+/// place, a jump over a block never run (`GOTOF` to a label), a counting
+/// `WHILE` loop, the finishing pass a subprogram called by its name
+/// (`FINISH.SPF` beside it, ended by `M17`): verified as its plain twin.
+#[test]
+fn sinumerik_programs_verify_as_their_plain_twins() {
+    let dir = scratch("corpus", "sinumerik");
+    let (code, err, report) = verified(
+        &dir,
+        "sinumerik/mandrel_r.mpf",
+        "3K152VF20",
+        "scripts/mandrel.rhai",
+    );
+    assert_eq!(code, 0, "{err}");
+    let (tcode, terr, treport) = verified(
+        &dir,
+        "sinumerik/mandrel.plain.mpf",
+        "3K152VF20",
+        "scripts/mandrel.rhai",
+    );
+    assert_eq!(tcode, 0, "{terr}");
+    assert!(report["verification"].is_object());
+    assert_eq!(figures(&report), figures(&treport));
+    assert_eq!(report["blocks"], treport["blocks"]);
+    for (file, says) in [
+        ("sinumerik/refused/cycle97.mpf", "CYCLE97: a Siemens cycle"),
+        ("sinumerik/refused/system_variable.mpf", "a system variable"),
+        (
+            "sinumerik/refused/r_unset.mpf",
+            "R7 is read before the program sets it",
+        ),
+        ("sinumerik/refused/no_subprogram.mpf", "no file CONTOUR.SPF"),
+    ] {
+        let (code, err, _) = verified(&dir, file, "3K152VF20", "scripts/mandrel.rhai");
+        assert_eq!(code, 1, "{file}: {err}");
+        assert!(err.contains(says), "{file}: {err}");
+    }
+}
+
 /// What the reader refuses, it refuses by name: the construct, its line
 /// or block, why; never a Rust type or debug text.
 #[test]
