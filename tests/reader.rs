@@ -503,12 +503,6 @@ fn a_refused_code_is_named_with_its_dialects_meaning() {
         (
             &nc,
             "T0101\n",
-            "G92",
-            "the threading cycle (system A) on fanuc",
-        ),
-        (
-            &nc,
-            "T0101\n",
             "G94",
             "end face turning cycle (system A) on fanuc",
         ),

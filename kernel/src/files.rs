@@ -113,23 +113,22 @@ pub fn read_text(path: &Path, limit: u64) -> Result<String, FileError> {
 /// # Failures
 /// A name that is not a plain file name; a file that cannot be read or is
 /// larger than [`MAX_TEXT_BYTES`].
-pub fn beside(dir: Option<&Path>, name: &str) -> Result<Option<String>, String> {
+pub fn beside(dir: Option<&Path>, name: &str) -> Result<Option<String>, FileError> {
     let plain =
         name.split('.').count() <= 2 && name.split('.').all(|p| !p.is_empty() && is_plain_name(p));
     if !plain {
-        return Err(format!(
-            "'{}': not a file's name a call may open (letters, digits, '_', '-' and one '.')",
-            excerpt(name)
-        ));
+        return Err(FileError {
+            file: excerpt(name),
+            message: "not a file's name a call may open (letters, digits, '_', '-' and one '.')"
+                .into(),
+        });
     }
     let Some(dir) = dir else { return Ok(None) };
     let path = dir.join(name);
     if !path.is_file() {
         return Ok(None);
     }
-    read_text(&path, MAX_TEXT_BYTES)
-        .map(Some)
-        .map_err(|e| e.to_string())
+    read_text(&path, MAX_TEXT_BYTES).map(Some)
 }
 
 /// Whether `name` is a plain name (letters, digits, `_`, `-`): what a body

@@ -10,7 +10,7 @@
 
 pub mod cycle;
 pub mod lint;
-pub mod macros;
+pub(crate) mod macros;
 pub mod offsets;
 pub mod post;
 pub mod reader;

@@ -214,11 +214,33 @@ pub enum G76Form {
     FanucTwoBlock(super::cycle::FanucRules),
 }
 
+/// A control's macro language ([`super::macros`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MacroLanguage {
+    /// Fanuc's custom macro B.
+    Fanuc,
+    /// LinuxCNC's rs274ngc.
+    Rs274,
+    /// Sinumerik's NC language.
+    Sinumerik,
+}
+
+impl MacroLanguage {
+    /// Its name in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Fanuc => "Fanuc macro B",
+            Self::Rs274 => "rs274ngc (LinuxCNC)",
+            Self::Sinumerik => "Sinumerik",
+        }
+    }
+}
+
 /// How a dialect's macro language is read ([`super::macros`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MacroReading {
     /// The language.
-    pub language: super::macros::Language,
+    pub language: MacroLanguage,
     /// The files a call opens beside the program, tried in order: `{O}`
     /// is a called program's number in four digits (`M98 P12`: `0012`),
     /// `{N}` its number as written, `{NAME}` its name as the call writes
@@ -337,7 +359,7 @@ pub const SINUMERIK: Dialect = Dialect {
             ("M17", "the end of a subprogram"),
         ],
         macros: Some(MacroReading {
-            language: super::macros::Language::Sinumerik,
+            language: MacroLanguage::Sinumerik,
             files: &[
                 "{NAME}.SPF",
                 "{NAME}.spf",
@@ -462,7 +484,7 @@ pub const FANUC: Dialect = Dialect {
             ("W", "Z incremental, in G-code system A"),
         ],
         macros: Some(MacroReading {
-            language: super::macros::Language::Fanuc,
+            language: MacroLanguage::Fanuc,
             files: &["O{O}", "O{O}.nc", "O{O}.NC", "{O}.nc", "{N}.nc"],
             repeats_in_p: true,
             sub_name_line: None,
@@ -554,7 +576,7 @@ pub const LINUXCNC: Dialect = Dialect {
             ("G99", "the canned cycles' return to the R level"),
         ],
         macros: Some(MacroReading {
-            language: super::macros::Language::Rs274,
+            language: MacroLanguage::Rs274,
             files: &["{name}.ngc", "{NAME}.ngc", "{name}.NGC"],
             repeats_in_p: false,
             sub_name_line: None,

@@ -28,7 +28,8 @@ mod line;
 mod moves;
 mod setup;
 
-pub use flow::{Beside, SourceFile, MAX_SUB_BYTES};
+use flow::SourceFile;
+pub use flow::{Beside, MAX_SUB_BYTES};
 
 /// A move as the reader took it: each axis's value where the text has
 /// given one so far.

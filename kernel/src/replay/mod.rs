@@ -230,7 +230,15 @@ pub fn passes_in(
             continue;
         }
         let Some(v) = along_surface(p, q) else {
-            stepping.get_or_insert(k);
+            // A plunge straight into the part after the pass's travel (a
+            // cam's next turn, a mandrel's next pass) begins the next.
+            if travel.is_some() && is_plunge(p, q) {
+                runs.push((k, true));
+                travel = None;
+                stepping = None;
+            } else {
+                stepping.get_or_insert(k);
+            }
             continue;
         };
         let Some(t) = travel else {
@@ -240,7 +248,9 @@ pub fn passes_in(
         let cos = v.dot(&t) / (v.norm() * t.norm());
         if cos < REVERSAL_COS {
             let from = stepping.unwrap_or(k);
-            runs.push((from, true));
+            if from > runs[runs.len() - 1].0 {
+                runs.push((from, true));
+            }
             travel = Some(v);
             stepping = None;
         } else if cos > -REVERSAL_COS {
@@ -296,12 +306,18 @@ pub fn passes_in(
 /// travel by 90.
 pub const REVERSAL_COS: Real = -0.5;
 
-/// The travel of a move from `p` to `q` (part frame, Z the part's axis)
-/// along the part's surface: along Z and round it (the arc at the mean
-/// radius), the radial part left out; `None` where the move is an infeed:
-/// its radial part more than half its travel (steeper than 27 degrees
-/// to the surface), or no travel.
-fn along_surface(p: Vector3<Real>, q: Vector3<Real>) -> Option<Vector3<Real>> {
+/// Whether the move from `p` to `q` plunges straight into the part (or
+/// out of it): its travel along the surface a tenth of its radial part
+/// at most.
+fn is_plunge(p: Vector3<Real>, q: Vector3<Real>) -> bool {
+    let dr = (q.xy().norm() - p.xy().norm()).abs();
+    let travel = along_any(p, q).norm();
+    dr > crate::tolerance::SAME_LENGTH && travel <= 0.1 * dr
+}
+
+/// The travel of a move from `p` to `q` along the surface (see
+/// [`along_surface`]), whatever its radial part.
+fn along_any(p: Vector3<Real>, q: Vector3<Real>) -> Vector3<Real> {
     let (rp, rq) = (p.xy().norm(), q.xy().norm());
     let turn = if rp > crate::tolerance::SAME_LENGTH && rq > crate::tolerance::SAME_LENGTH {
         let a = q.y.atan2(q.x) - p.y.atan2(p.x);
@@ -310,7 +326,17 @@ fn along_surface(p: Vector3<Real>, q: Vector3<Real>) -> Option<Vector3<Real>> {
     } else {
         0.0
     };
-    let v = Vector3::new(q.z - p.z, 0.5 * (rp + rq) * turn, 0.0);
+    Vector3::new(q.z - p.z, 0.5 * (rp + rq) * turn, 0.0)
+}
+
+/// The travel of a move from `p` to `q` (part frame, Z the part's axis)
+/// along the part's surface: along Z and round it (the arc at the mean
+/// radius), the radial part left out; `None` where the move is an infeed:
+/// its radial part more than half its travel (steeper than 27 degrees
+/// to the surface), or no travel.
+fn along_surface(p: Vector3<Real>, q: Vector3<Real>) -> Option<Vector3<Real>> {
+    let v = along_any(p, q);
     let travel = v.norm();
-    (travel > crate::tolerance::SAME_LENGTH && (rq - rp).abs() <= 0.5 * travel).then_some(v)
+    let dr = (q.xy().norm() - p.xy().norm()).abs();
+    (travel > crate::tolerance::SAME_LENGTH && dr <= 0.5 * travel).then_some(v)
 }

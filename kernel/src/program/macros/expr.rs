@@ -298,165 +298,95 @@ impl<'t, 'l> Parser<'t, 'l> {
         Ok(v)
     }
 
-    fn fanuc_sum(&mut self) -> Result<Value, String> {
-        let mut v = self.fanuc_product()?;
-        loop {
-            let op = if self.symbol("+") {
-                Op::Add
-            } else if self.symbol("-") {
-                Op::Sub
-            } else if self.keyword("OR") {
-                Op::Or
-            } else if self.keyword("XOR") {
-                Op::Xor
-            } else {
-                return Ok(v);
-            };
-            let w = self.fanuc_product()?;
-            v = self.apply(op, v, w)?;
+    /// Operands `next` reads, joined left to right by the operators `ops`
+    /// (a symbol, or a keyword where it is letters).
+    fn level(
+        &mut self,
+        ops: &[(&str, Op)],
+        next: fn(&mut Self) -> Result<Value, String>,
+    ) -> Result<Value, String> {
+        let mut v = next(self)?;
+        'more: loop {
+            self.skip_spaces();
+            for (s, op) in ops {
+                let hit = if s.as_bytes()[0].is_ascii_alphabetic() {
+                    self.keyword(s)
+                } else {
+                    // rs274ngc's `**` is a power, never a product's `*`.
+                    !(*s == "*" && self.text[self.at..].starts_with(b"**")) && self.symbol(s)
+                };
+                if hit {
+                    let w = next(self)?;
+                    v = self.apply(*op, v, w)?;
+                    continue 'more;
+                }
+            }
+            return Ok(v);
         }
+    }
+
+    fn fanuc_sum(&mut self) -> Result<Value, String> {
+        const OPS: [(&str, Op); 4] = [
+            ("+", Op::Add),
+            ("-", Op::Sub),
+            ("OR", Op::Or),
+            ("XOR", Op::Xor),
+        ];
+        self.level(&OPS, Self::fanuc_product)
     }
 
     fn fanuc_product(&mut self) -> Result<Value, String> {
-        let mut v = self.unary()?;
-        loop {
-            let op = if self.symbol("*") {
-                Op::Mul
-            } else if self.symbol("/") {
-                Op::Div
-            } else if self.keyword("AND") {
-                Op::And
-            } else if self.keyword("MOD") {
-                Op::Mod
-            } else {
-                return Ok(v);
-            };
-            let w = self.unary()?;
-            v = self.apply(op, v, w)?;
-        }
+        const OPS: [(&str, Op); 4] = [
+            ("*", Op::Mul),
+            ("/", Op::Div),
+            ("AND", Op::And),
+            ("MOD", Op::Mod),
+        ];
+        self.level(&OPS, Self::unary)
     }
 
     fn rs274_logic(&mut self) -> Result<Value, String> {
-        let mut v = self.comparison(Self::rs274_sum)?;
-        loop {
-            let op = if self.keyword("AND") {
-                Op::And
-            } else if self.keyword("XOR") {
-                Op::Xor
-            } else if self.keyword("OR") {
-                Op::Or
-            } else {
-                return Ok(v);
-            };
-            let w = self.comparison(Self::rs274_sum)?;
-            v = self.apply(op, v, w)?;
-        }
+        const OPS: [(&str, Op); 3] = [("AND", Op::And), ("XOR", Op::Xor), ("OR", Op::Or)];
+        self.level(&OPS, |p| p.comparison(Self::rs274_sum))
     }
 
     fn rs274_sum(&mut self) -> Result<Value, String> {
-        let mut v = self.rs274_product()?;
-        loop {
-            let op = if self.symbol("+") {
-                Op::Add
-            } else if self.symbol("-") {
-                Op::Sub
-            } else {
-                return Ok(v);
-            };
-            let w = self.rs274_product()?;
-            v = self.apply(op, v, w)?;
-        }
+        self.level(&[("+", Op::Add), ("-", Op::Sub)], Self::rs274_product)
     }
 
     fn rs274_product(&mut self) -> Result<Value, String> {
-        let mut v = self.rs274_power()?;
-        loop {
-            // `**` is the power's, read below: never a product's `*`.
-            self.skip_spaces();
-            let op = if self.text[self.at..].starts_with(b"**") {
-                return Ok(v);
-            } else if self.symbol("*") {
-                Op::Mul
-            } else if self.symbol("/") {
-                Op::Div
-            } else if self.keyword("MOD") {
-                Op::Mod
-            } else {
-                return Ok(v);
-            };
-            let w = self.rs274_power()?;
-            v = self.apply(op, v, w)?;
-        }
+        const OPS: [(&str, Op); 3] = [("*", Op::Mul), ("/", Op::Div), ("MOD", Op::Mod)];
+        self.level(&OPS, Self::rs274_power)
     }
 
     fn rs274_power(&mut self) -> Result<Value, String> {
-        let mut v = self.unary()?;
-        while self.symbol("**") {
-            let w = self.unary()?;
-            v = self.apply(Op::Pow, v, w)?;
-        }
-        Ok(v)
+        self.level(&[("**", Op::Pow)], Self::unary)
     }
 
     fn sinumerik_or(&mut self) -> Result<Value, String> {
-        let mut v = self.sinumerik_xor()?;
-        while self.keyword("OR") {
-            let w = self.sinumerik_xor()?;
-            v = self.apply(Op::Or, v, w)?;
-        }
-        Ok(v)
+        self.level(&[("OR", Op::Or)], Self::sinumerik_xor)
     }
 
     fn sinumerik_xor(&mut self) -> Result<Value, String> {
-        let mut v = self.sinumerik_and()?;
-        while self.keyword("XOR") {
-            let w = self.sinumerik_and()?;
-            v = self.apply(Op::Xor, v, w)?;
-        }
-        Ok(v)
+        self.level(&[("XOR", Op::Xor)], Self::sinumerik_and)
     }
 
     fn sinumerik_and(&mut self) -> Result<Value, String> {
-        let mut v = self.sinumerik_sum()?;
-        while self.keyword("AND") {
-            let w = self.sinumerik_sum()?;
-            v = self.apply(Op::And, v, w)?;
-        }
-        Ok(v)
+        self.level(&[("AND", Op::And)], Self::sinumerik_sum)
     }
 
     fn sinumerik_sum(&mut self) -> Result<Value, String> {
-        let mut v = self.sinumerik_product()?;
-        loop {
-            let op = if self.symbol("+") {
-                Op::Add
-            } else if self.symbol("-") {
-                Op::Sub
-            } else {
-                return Ok(v);
-            };
-            let w = self.sinumerik_product()?;
-            v = self.apply(op, v, w)?;
-        }
+        self.level(&[("+", Op::Add), ("-", Op::Sub)], Self::sinumerik_product)
     }
 
     fn sinumerik_product(&mut self) -> Result<Value, String> {
-        let mut v = self.unary()?;
-        loop {
-            let op = if self.symbol("*") {
-                Op::Mul
-            } else if self.symbol("/") {
-                Op::Div
-            } else if self.keyword("DIV") {
-                Op::IntDiv
-            } else if self.keyword("MOD") {
-                Op::Mod
-            } else {
-                return Ok(v);
-            };
-            let w = self.unary()?;
-            v = self.apply(op, v, w)?;
-        }
+        const OPS: [(&str, Op); 4] = [
+            ("*", Op::Mul),
+            ("/", Op::Div),
+            ("DIV", Op::IntDiv),
+            ("MOD", Op::Mod),
+        ];
+        self.level(&OPS, Self::unary)
     }
 
     /// A sign, Sinumerik's `NOT`, then an operand.

@@ -29,27 +29,7 @@ use crate::math::Real;
 use expr::{Lookup, Value};
 use std::collections::BTreeMap;
 
-/// A control's macro language.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Language {
-    /// Fanuc's custom macro B.
-    Fanuc,
-    /// LinuxCNC's rs274ngc.
-    Rs274,
-    /// Sinumerik's NC language.
-    Sinumerik,
-}
-
-impl Language {
-    /// Its name in messages.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Fanuc => "Fanuc macro B",
-            Self::Rs274 => "rs274ngc (LinuxCNC)",
-            Self::Sinumerik => "Sinumerik",
-        }
-    }
-}
+pub use crate::program::post::MacroLanguage as Language;
 
 /// Loop turns and repetitions of a subprogram in one reading, in all: a
 /// program that turns more is refused (a loop that never ends would

@@ -425,7 +425,7 @@ impl Index {
     /// None there, or more than one (the control would take the first it
     /// meets: the verification refuses to guess which the programmer
     /// meant).
-    pub fn number(
+    pub(crate) fn number(
         &self,
         n: u32,
         within: std::ops::Range<usize>,
@@ -440,7 +440,7 @@ impl Index {
     ///
     /// # Failures
     /// As [`Self::number`].
-    pub fn label(&self, name: &str, from: usize, way: Way) -> Result<usize, String> {
+    pub(crate) fn label(&self, name: &str, from: usize, way: Way) -> Result<usize, String> {
         let upper = name.to_ascii_uppercase();
         let lines = self.labels.get(&upper).map_or(&[][..], Vec::as_slice);
         found(

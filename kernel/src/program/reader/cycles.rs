@@ -35,7 +35,7 @@ impl Reader<'_> {
         }
         let values: Vec<(char, Real)> = said.read.iter().map(|(c, v, _)| (*c, *v)).collect();
         let (cycle, end_x) = cycle_words(&values, d).map_err(fail)?;
-        let ([x0, z0], xz) = self.cycle_ready(at, b)?;
+        let ([x0, z0], xz) = self.cycle_ready(at, b, 76)?;
         let moves =
             crate::program::cycle::expand(&cycle, [x0, z0], at.st.radial == Some(true), end_x)
                 .map_err(|m| fail(m.message))?;
@@ -46,17 +46,18 @@ impl Reader<'_> {
 
     /// What a threading cycle at block `b` needs of the modal state: the
     /// spindle, constant speed where the dialect wants it, the setup, X
-    /// and Z written; where it starts (`[X, Z]` as written) and the two
+    /// and Z written (`code` the cycle's G code, for a message); where it starts (`[X, Z]` as written) and the two
     /// axes' places among the program's.
     pub(super) fn cycle_ready(
         &self,
         at: &Standing,
         b: &Block,
+        code: u32,
     ) -> Result<([Real; 2], [usize; 2]), LintError> {
         let (d, program) = (self.d, self.program);
         let fail = |m: String| self.err(self.place(b, at.k), m);
         let st = &at.st;
-        let what = "a threading cycle";
+        let what = &format!("a threading cycle (G{code})");
         let needs_g97 = (d.reading.thread_needs_constant_speed && !st.constant_speed)
             .then(|| format!("{what} before constant spindle speed (G97)"));
         if let Some(m) = cutting_fault(st, d, &program.setup, what)

@@ -99,7 +99,7 @@ impl Reader<'_> {
             ));
         };
         let need = |c: char, what: &str| fail(format!("G76 without {c}, {what}"));
-        let (start, xz) = self.cycle_ready(at, b)?;
+        let (start, xz) = self.cycle_ready(at, b, 76)?;
         let x = Self::cycle_word(said, 'X').map_or(start[0], |(v, _)| v);
         let z = Self::cycle_word(said, 'Z')
             .map(|(v, _)| v)
@@ -161,7 +161,7 @@ impl Reader<'_> {
                 }
             )));
         }
-        let (here, xz) = self.cycle_ready(at, b)?;
+        let (here, xz) = self.cycle_ready(at, b, 92)?;
         let start = *at.st.cycle_start.get_or_insert(here);
         if let Some(f) = Self::cycle_word(said, 'F').map(|(v, _)| v) {
             at.st.f = Some(f);

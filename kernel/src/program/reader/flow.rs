@@ -13,13 +13,13 @@ use std::cell::OnceCell;
 /// Reads a file beside the program by its name: its text, `None` where
 /// there is no such file (a path is never given: names only, so nothing
 /// outside the program's folder is read).
-pub type Beside<'a> = &'a dyn Fn(&str) -> Result<Option<String>, String>;
+pub type Beside<'a> = &'a dyn Fn(&str) -> Result<Option<String>, crate::files::FileError>;
 
 /// The largest subprogram file read (bytes), as a program file.
 pub const MAX_SUB_BYTES: usize = crate::files::MAX_TEXT_BYTES as usize;
 
 /// One file of the reading: its name, its text by lines, its landmarks.
-pub struct SourceFile<'a> {
+pub(crate) struct SourceFile<'a> {
     /// Its name (the program's own: empty).
     pub name: String,
     text: String,
@@ -180,7 +180,7 @@ impl<'a> Reader<'a> {
             ));
         };
         for file in &names {
-            if let Some(text) = beside(file)? {
+            if let Some(text) = beside(file).map_err(|e| e.to_string())? {
                 if self.files.len() > macros::MAX_FILES {
                     return Err(format!(
                         "more than {} subprogram files called",
