@@ -1063,6 +1063,7 @@ fn mutate(subject: &Subject) -> (Tally, Vec<String>) {
     for line in chosen_lines(subject, &base) {
         let text = &subject.lines[line];
         // The block as a refusal names it.
+        let line_name = format!("line {}", line + 1);
         let block = match text.split_whitespace().next() {
             Some(n) if n.starts_with('N') && n.len() > 1 => n.to_owned(),
             _ => format!("line {}", line + 1),
@@ -1125,7 +1126,6 @@ fn mutate(subject: &Subject) -> (Tally, Vec<String>) {
                         // A block whose N the edit took away is named by
                         // its line (a program read as it stands numbers its
                         // blocks as it likes).
-                        let line_name = format!("line {}", line + 1);
                         let named = |w: &str| {
                             names_edit(&e, w, &block)
                                 || (t.text.starts_with('N') && e.place == line_name)

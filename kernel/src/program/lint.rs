@@ -817,7 +817,7 @@ mod tests {
             (
                 "S399 M3",
                 "S399 M5",
-                "a threading cycle with the spindle stopped (no M3)",
+                "a threading cycle (G76) with the spindle stopped (no M3)",
             ),
         ] {
             let bad = text.replacen(from, to, 1);
