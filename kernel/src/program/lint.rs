@@ -40,8 +40,11 @@ use cl::lint_apt;
 
 /// A program that fails its lint: which program, where, what.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("lint of the {dialect} program: {place}: {message}")]
+#[error("{what} of the {dialect} program: {place}: {message}")]
 pub struct LintError {
+    /// What read the program: "lint" (a program pilgrim wrote, read back)
+    /// or "reading" (a program read as it stands).
+    pub what: &'static str,
     /// The dialect.
     pub dialect: String,
     /// The block as the program numbers it (`N570`, `block 57 in "pass
@@ -177,6 +180,7 @@ pub fn lint_read(
 /// The refusal of a CL file where a control's program is wanted.
 fn not_a_control_program(d: &Dialect) -> LintError {
     LintError {
+        what: "lint",
         dialect: d.name.to_owned(),
         place: "line 1".into(),
         message: "a CL file is not a program a control runs: read the control's program".into(),
@@ -281,6 +285,11 @@ fn lint_gcode(
     let mut lines: Vec<&str> = text.split('\n').collect();
     if lines.last() != Some(&"") {
         return Err(LintError {
+            what: if mode == Mode::Read {
+                "reading"
+            } else {
+                "lint"
+            },
             dialect: d.name.to_owned(),
             place: format!("line {}", lines.len()),
             message: "the program's last line does not end with a line feed".into(),
@@ -444,7 +453,7 @@ mod tests {
         frame.blocks.clear();
         let text = post(&p, &SINUMERIK).unwrap();
         for (from, to, word) in [
-            ("G1 X40.000", "G2 X40.000 I5.0", "G2"),
+            ("G1 X40.000", "G96 G1 X40.000", "G96"),
             ("G1 X40.000", "G1 X40.000 R5", "R5"),
             ("M3", "M98", "M98"),
         ] {

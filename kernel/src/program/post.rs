@@ -202,6 +202,22 @@ pub struct Reading {
     /// plain blocks (variables, jumps, loops, subprograms), or `None`. A
     /// lint (a program pilgrim wrote) reads plain blocks only.
     pub macros: Option<MacroReading>,
+    /// How a program read as it stands may give a circular move (G2, G3
+    /// among [`Reading::read_g_codes`]), or `None`: the reader refuses arcs.
+    pub arcs: Option<ArcReading>,
+}
+
+/// How a dialect's circular interpolation (G2 clockwise, G3
+/// counter-clockwise, in the lathe's plane G18 of Z and X) is read: the
+/// centre by I (along X, on radius) and K (along Z), each from the arc's
+/// start, or by the words below ([`super::reader`]'s `arcs`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ArcReading {
+    /// The word giving the arc's radius (Sinumerik's `CR=`: negative for
+    /// an arc of more than a half turn), if the control reads one.
+    pub radius: Option<&'static str>,
+    /// The word giving the arc's opening angle in degrees (`AR=`), if any.
+    pub angle: Option<&'static str>,
 }
 
 /// The form of a dialect's `G76` threading cycle.
@@ -325,7 +341,7 @@ pub const SINUMERIK: Dialect = Dialect {
         point_needed: "",
         no_point: "",
         code_tenths: false,
-        read_g_codes: &[],
+        read_g_codes: &[2, 3],
         g76: None,
         g92_thread: false,
         // Programming Manual, Fundamentals, "List of G functions": group 6
@@ -369,6 +385,12 @@ pub const SINUMERIK: Dialect = Dialect {
             ],
             repeats_in_p: false,
             sub_name_line: Some(("%_N_", "_SPF")),
+        }),
+        // Programming Manual, Fundamentals, "Circular interpolation": the
+        // centre by I and K, the radius by CR=, the opening angle by AR=.
+        arcs: Some(ArcReading {
+            radius: Some("CR="),
+            angle: Some("AR="),
         }),
     },
 };
@@ -489,6 +511,7 @@ pub const FANUC: Dialect = Dialect {
             repeats_in_p: true,
             sub_name_line: None,
         }),
+        arcs: None,
     },
 };
 
@@ -581,6 +604,7 @@ pub const LINUXCNC: Dialect = Dialect {
             repeats_in_p: false,
             sub_name_line: None,
         }),
+        arcs: None,
     },
 };
 
@@ -640,6 +664,7 @@ pub const CLD: Dialect = Dialect {
         systems: &[],
         meanings: &[],
         macros: None,
+        arcs: None,
     },
 };
 

@@ -20,6 +20,7 @@ use crate::math::Real;
 use crate::toolpath::Motion;
 use pilgrim_plugin_abi::types::Radial;
 
+mod arcs;
 mod codes;
 mod cycles;
 mod fanuc_cycles;
@@ -232,6 +233,10 @@ enum OwnWord {
     FeedGroup(String),
     /// `SF=`, the thread's start angle (deg).
     StartAngle(Real),
+    /// `CR=`, an arc's radius, with the word.
+    ArcRadius(Real, String),
+    /// `AR=`, an arc's opening angle (deg), with the word.
+    ArcAngle(Real, String),
 }
 
 /// One block being read: where it is and what it holds.
@@ -262,6 +267,8 @@ struct Said {
     feed_group: Vec<String>,
     /// The word giving a thread's start angle, where one does.
     start_word: Option<String>,
+    /// An arc's own words (its radius, its angle).
+    arc: arcs::ArcWords,
 }
 
 /// "line N" for line `l` (from 0).
@@ -427,9 +434,20 @@ impl<'a> Reader<'a> {
         self.offsets?.work_shift(word, &self.names)
     }
 
+    /// What reads the text, for a message: "reading" as it stands, else
+    /// "lint".
+    fn what(&self) -> &'static str {
+        if self.reading {
+            "reading"
+        } else {
+            "lint"
+        }
+    }
+
     /// A fault at line `i` (from 0) of the file being read.
     fn fault(&self, i: usize, message: String) -> LintError {
         LintError {
+            what: self.what(),
             dialect: self.d.name.to_owned(),
             place: self.in_file(format!("line {}", i + 1)),
             message,
@@ -550,6 +568,7 @@ impl<'a> Reader<'a> {
     /// A fault at `place` (`N20`, `line 3`).
     fn err(&self, place: String, message: String) -> LintError {
         LintError {
+            what: self.what(),
             dialect: self.d.name.to_owned(),
             place,
             message,

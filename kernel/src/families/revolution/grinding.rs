@@ -372,10 +372,18 @@ impl Setting<'_> {
             let surface = env.eval_many(zs);
             let under = cut_into(before, &earlier[met[g]], zs);
             for (i, ((&z, &s), &p)) in zs.iter().zip(&surface).zip(profile).enumerate() {
-                if !s.is_finite() {
+                // Where the sweep never reaches, the pass leaves what was
+                // there (a pass may cover a stretch only); where nothing
+                // was, no surface is known.
+                let left = if s.is_finite() {
+                    s.min(under[i])
+                } else {
+                    under[i]
+                };
+                if !left.is_finite() {
                     return Err(self.never_reached(pass, met[g], z));
                 }
-                let e = s.min(under[i]) - p;
+                let e = left - p;
                 (lo[i], hi[i]) = (lo[i].min(e), hi[i].max(e));
                 if e > d.max_above {
                     (d.max_above, d.above_z, g_above) = (e, z, g);
@@ -410,7 +418,8 @@ impl Setting<'_> {
     }
 
     /// The refusal of a pass that leaves generatrix `g` (from 0) unmet at
-    /// `z`: the wheel never reached the profile there.
+    /// `z` where neither the blank nor an earlier pass gives a surface:
+    /// the wheel never reached the profile there.
     fn never_reached(&self, pass: &ProgramPass, g: usize, z: Real) -> VerifyError {
         VerifyError::Pass {
             pass: pass.name.clone(),

@@ -34,6 +34,7 @@ pub(super) fn lint_apt(
     d: &Dialect,
 ) -> Result<Linted, LintError> {
     let fault = |place: String, message: String| LintError {
+        what: "lint",
         dialect: d.name.to_owned(),
         place,
         message,

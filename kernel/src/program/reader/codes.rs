@@ -25,6 +25,8 @@ impl Reader<'_> {
                     start_angle = Some(*v);
                     said.start_word = Some(format!("SF={v}"));
                 }
+                OwnWord::ArcRadius(v, text) => said.arc.radius = Some((*v, text.clone())),
+                OwnWord::ArcAngle(v, text) => said.arc.angle = Some((*v, text.clone())),
             }
         }
         let mut letters: Vec<char> = Vec::new();
@@ -114,7 +116,7 @@ impl Reader<'_> {
             return Ok(());
         }
         match n {
-            0 | 1 | 32 | 33 | 76 | 92 => {
+            0 | 1 | 2 | 3 | 32 | 33 | 76 | 92 => {
                 if let Some(m) = said.motion {
                     return Err(self.err(
                         self.place(b, k),

@@ -82,6 +82,25 @@ impl Reader<'_> {
                     v.parse()
                         .map_err(|_| self.fault(i, format!("'{word}' is not a start angle")))?,
                 )
+            } else if let Some(v) = (self.d.reading.arcs)
+                .and_then(|a| a.radius)
+                .and_then(|a| word.strip_prefix(a))
+            {
+                let r = v.parse().map_err(|_| {
+                    self.fault(i, format!("'{word}' is not an arc's radius (a number)"))
+                })?;
+                OwnWord::ArcRadius(r, word.to_owned())
+            } else if let Some(v) = (self.d.reading.arcs)
+                .and_then(|a| a.angle)
+                .and_then(|a| word.strip_prefix(a))
+            {
+                let a = v.parse().map_err(|_| {
+                    self.fault(
+                        i,
+                        format!("'{word}' is not an arc's opening angle (a number of degrees)"),
+                    )
+                })?;
+                OwnWord::ArcAngle(a, word.to_owned())
             } else {
                 continue;
             };

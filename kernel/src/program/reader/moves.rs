@@ -21,6 +21,9 @@ struct Given {
     lead_word: Option<String>,
     /// The spindle's speed S, where the block writes it.
     speed: Option<Real>,
+    /// An arc's centre from its start, I (along X) and K (along Z), where
+    /// the block is an arc's and gives them.
+    centre: [Option<Real>; 2],
 }
 
 impl Reader<'_> {
@@ -35,12 +38,25 @@ impl Reader<'_> {
         &self,
         at: &mut Standing,
         b: &Block,
-        said: Said,
+        mut said: Said,
         out: &mut Vec<ReadMove>,
     ) -> Result<(), LintError> {
         let k = at.k;
         let fail = |m: String| self.err(self.place(b, k), m);
-        let given = self.addresses(&mut at.st, b, k, said.read)?;
+        let arc = match said.motion.or(at.st.motion) {
+            Some(2) => Some(true),
+            Some(3) => Some(false),
+            _ => None,
+        };
+        if let Some((_, w)) =
+            (said.arc.radius.as_ref().or(said.arc.angle.as_ref())).filter(|_| arc.is_none())
+        {
+            return Err(fail(format!(
+                "{w}: an arc's word outside an arc block (G2, G3)"
+            )));
+        }
+        let read = std::mem::take(&mut said.read);
+        let given = self.addresses(&mut at.st, b, k, read, arc.is_some())?;
         if let Some(m) = said.motion {
             at.st.motion = Some(m);
         }
@@ -78,6 +94,7 @@ impl Reader<'_> {
                 ),
             ));
         };
+        let before = arc.map(|_| placed(&at.st));
         for (i, v) in given.axes.iter().enumerate() {
             if let Some(v) = v {
                 at.st.values[i] = Some(*v);
@@ -85,6 +102,9 @@ impl Reader<'_> {
         }
         let motion = self.motion(&mut at.st, b, k, &given, &said.start_word, block)?;
         let going = self.going(&at.st, b, k, block)?;
+        if let (Some(clockwise), Some(before)) = (arc, before) {
+            return self.arc(at, b, clockwise, &said, given.centre, &before, going, out);
+        }
         // The move as read (a lint reads it too: what a run verifies).
         let (file, via) = self.origin(at);
         let st = &at.st;
@@ -124,6 +144,7 @@ impl Reader<'_> {
         b: &Block,
         k: usize,
         read: Vec<(char, Real, String)>,
+        arc: bool,
     ) -> Result<Given, LintError> {
         let (d, program) = (self.d, self.program);
         let fail = |m: String| self.err(self.place(b, k), m);
@@ -132,11 +153,23 @@ impl Reader<'_> {
             lead: None,
             lead_word: None,
             speed: None,
+            centre: [None, None],
         };
         for (letter, v, text) in read {
             if let Some(i) = self.names.iter().position(|n| *n == letter) {
-                given.axes[i] = Some(v);
+                given.axes[i] = Some(v * self.radial_scale(st, letter));
                 continue;
+            }
+            match letter {
+                'I' if arc => {
+                    given.centre[0] = Some(v);
+                    continue;
+                }
+                'K' if arc => {
+                    given.centre[1] = Some(v);
+                    continue;
+                }
+                _ => {}
             }
             if letter == 'F' && !(v > 0.0) {
                 return Err(fail(format!("{text}: a feed is a positive number")));
@@ -268,8 +301,8 @@ impl Reader<'_> {
                 )));
             }
         }
-        if m == 1 && !st.feed {
-            return Err(fail("G1 before any feed F".into()));
+        if matches!(m, 1..=3) && !st.feed {
+            return Err(fail(format!("G{m} before any feed F")));
         }
         if let Some(m) = (m != 0)
             .then(|| cutting_fault(st, d, &program.setup, "a cutting move"))
@@ -286,7 +319,8 @@ impl Reader<'_> {
         let read_lead = st.lead.unwrap_or(Real::NAN);
         let motion = match m {
             0 => Motion::Rapid,
-            1 => Motion::Linear,
+            // An arc is followed by chords (`arcs`).
+            1..=3 => Motion::Linear,
             _ => Motion::Thread {
                 lead: read_lead,
                 start_deg: st.start_deg,
@@ -372,22 +406,57 @@ impl Reader<'_> {
                     crate::math::fixed(bl.values[i], self.decimals + 2)
                 )));
             }
-            if let Some(a) = self.axes.iter().find(|a| a.name == name.name) {
-                let (lo, hi) = (a.to_user(a.min), a.to_user(a.max));
-                let shifted = going[i].unwrap_or(v);
-                if shifted < lo - half || shifted > hi + half {
-                    let by = if shifted == v {
-                        String::new()
-                    } else {
-                        format!(" (at {shifted} with the offsets' shift)")
-                    };
-                    return Err(fail(format!(
-                        "{}{v}{by} is outside the axis's travel [{lo}, {hi}]",
-                        name.name
-                    )));
-                }
-            }
+            self.within_travel(b, k, i, v, going[i].unwrap_or(v))?;
         }
         Ok(going)
+    }
+
+    /// Axis `i`'s value `v` (`shifted` with the offsets' shifts) on block
+    /// `b`'s move (`k` moves before it) held to the axis's travel.
+    pub(super) fn within_travel(
+        &self,
+        b: &Block,
+        k: usize,
+        i: usize,
+        v: Real,
+        shifted: Real,
+    ) -> Result<(), LintError> {
+        let (name, half) = (&self.program.axes[i].name, self.half);
+        if let Some(a) = self.axes.iter().find(|a| a.name == *name) {
+            let (lo, hi) = (a.to_user(a.min), a.to_user(a.max));
+            if shifted < lo - half || shifted > hi + half {
+                let by = if shifted == v {
+                    String::new()
+                } else {
+                    format!(" (at {shifted} with the offsets' shift)")
+                };
+                return Err(self.err(
+                    self.place(b, k),
+                    format!("{name}{v}{by} is outside the axis's travel [{lo}, {hi}]"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// What an axis value of `letter` is multiplied by to be in the
+    /// machine's setup's programming: 1, but for the radial axis of a
+    /// program read as it stands that switched to the other programming
+    /// by the dialect's own word (Sinumerik's `DIAMON` on a machine
+    /// programmed on radius: a half).
+    fn radial_scale(&self, st: &State, letter: char) -> Real {
+        let setup = &self.program.setup;
+        let radial = setup.radial_axis.chars().next().unwrap_or('X');
+        let (Some(now), Some(want)) = (st.radial, setup.radial) else {
+            return 1.0;
+        };
+        if !self.reading || self.radial.is_none() || letter != radial {
+            return 1.0;
+        }
+        match (now, want == pilgrim_plugin_abi::types::Radial::Diameter) {
+            (true, false) => 0.5,
+            (false, true) => 2.0,
+            _ => 1.0,
+        }
     }
 }

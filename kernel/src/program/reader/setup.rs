@@ -1,6 +1,7 @@
 //! The machine's setup words a block may hold: diameter or radius
 //! programming and the feed's group, each once, before the first move,
-//! and as the machine's setup says.
+//! and as the machine's setup says (a program read as it stands may
+//! switch between diameter and radius by Sinumerik's words anywhere).
 
 use super::{Block, Reader, Said, State};
 use crate::program::lint::LintError;
@@ -23,8 +24,12 @@ impl Reader<'_> {
         for (diameter, word) in &said.radial {
             let diameter = *diameter;
             let want = program.setup.radial.map(|r| r == Radial::Diameter);
-            let once = k > 0 || st.radial.is_some();
-            if once || want != Some(diameter) {
+            // A program read as it stands may switch by the dialect's own
+            // words among its moves: its radial axis's values are taken
+            // into the setup's programming (`Reader::radial_scale`).
+            let switch = self.reading && self.radial.is_some() && want.is_some();
+            let once = !switch && (k > 0 || st.radial.is_some());
+            if once || (!switch && want != Some(diameter)) {
                 return Err(self.err(
                     self.place(b, k),
                     format!(
