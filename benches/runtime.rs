@@ -7,7 +7,11 @@
 //!   (target: <= 5% slower);
 //! - `verify_deadline`: the demo family's program of 1M blocks verified
 //!   under `--run-seconds 1` (the whole verification takes several): how
-//!   long until the run's deadline stops it (target: within 2x the limit).
+//!   long until the run's deadline stops it (target: within 2x the limit);
+//! - `verify_loop`: the demo family's contour written by hand as a
+//!   Sinumerik `WHILE` loop of one block (`C=R1*360/N`), 10k and 100k
+//!   turns, read and verified as the program's (target: linear in the
+//!   blocks: the 100k loop within 12x the 10k's).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pilgrim_kernel::params::{resolve, ParamSource};
@@ -225,5 +229,81 @@ fn verify_deadline(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(runtime, rhai_overhead, plugin_batch, verify_deadline);
+/// The demo family's program for `n` points with its contour written as a
+/// Sinumerik loop of one block: what the shop writes by hand.
+fn loop_program(plain: &str, n: usize) -> String {
+    let mut out = String::new();
+    let mut lines = plain.lines();
+    for l in lines.by_ref() {
+        if l.starts_with("N70 ") {
+            out.push_str(&format!("{l}\nR1=2\nWHILE R1<={n}\nC=R1*360/{n}\nR1=R1+1\nENDWHILE\n"));
+            break;
+        }
+        out.push_str(l);
+        out.push('\n');
+    }
+    // After the contour's blocks (`N.. C..`): the retract and the end.
+    for l in lines.skip_while(|l| l.starts_with('N') && l.contains(" C")) {
+        out.push_str(l);
+        out.push('\n');
+    }
+    out
+}
+
+fn verify_loop(c: &mut Criterion) {
+    use pilgrim_kernel::job::{self, JobOptions};
+    let family = ScriptFamily::load(
+        Path::new("scripts/examples/mill_circle.rhai"),
+        &Limits::default(),
+        &Access::default(),
+    )
+    .unwrap();
+    let catalog = pilgrim_kernel::catalog::Catalog::new(&[]).unwrap();
+    let machine = catalog.open("vertical-mill").unwrap();
+    let options = JobOptions::default();
+    let mut g = c.benchmark_group("verify_loop");
+    g.sample_size(10).measurement_time(Duration::from_secs(20));
+    let mut per_block = Vec::new();
+    for n in [10_000usize, 100_000] {
+        let sources = vec![ParamSource::Pairs {
+            label: "the bench".into(),
+            pairs: vec![("points".into(), n.to_string())],
+        }];
+        let out = job::run(&family, &machine, &sources, &options, &mut |_| {}).unwrap();
+        let plain = out
+            .files
+            .iter()
+            .find(|f| f.0 == "program.mpf")
+            .map(|f| String::from_utf8(f.1.clone()).unwrap())
+            .unwrap();
+        let text = loop_program(&plain, n);
+        assert!(text.lines().count() < 40, "{text}");
+        let verify = || job::verify(&family, &machine, &sources, &text, &options, &mut |_| {});
+        // The loop is read as the control runs it: the plain program's moves.
+        let verified = verify().unwrap();
+        assert_eq!(verified.program.blocks.len(), out.program.blocks.len());
+        let c = |p: &pilgrim_kernel::program::AxisProgram| p.blocks.last().unwrap().values[3];
+        assert!((c(&verified.program) - c(&out.program)).abs() < 1e-9);
+        let started = std::time::Instant::now();
+        verify().unwrap();
+        per_block.push(started.elapsed().as_secs_f64() / n as f64);
+        g.bench_function(format!("verify_{}k_turns", n / 1000), |b| {
+            b.iter(|| black_box(verify().is_ok()))
+        });
+    }
+    eprintln!(
+        "verify_loop: {:.2} us per block at 10k, {:.2} us at 100k",
+        per_block[0] * 1e6,
+        per_block[1] * 1e6
+    );
+    g.finish();
+}
+
+criterion_group!(
+    runtime,
+    rhai_overhead,
+    plugin_batch,
+    verify_deadline,
+    verify_loop
+);
 criterion_main!(runtime);
