@@ -444,6 +444,61 @@ mod tests {
             .contains("CL file"));
     }
 
+    /// Fanuc's text of the test program with `before_end` before its M30
+    /// and `after` (other programs) after it.
+    fn fanuc_with(before_end: &str, after: &str) -> String {
+        let text = post(&program(), &FANUC).unwrap();
+        let at = text.find("M30").unwrap();
+        let line = text[..at].rfind('\n').unwrap() + 1;
+        let end = text.rfind("%\n").unwrap();
+        format!(
+            "{}{before_end}{}{after}%\n",
+            &text[..line],
+            &text[line..end]
+        )
+    }
+
+    /// The bounds of a reading are exact: a loop of MAX_TURNS turns is
+    /// read, one turn more is refused; calls MAX_CALL_DEPTH deep are
+    /// followed, one deeper is refused.
+    #[test]
+    fn the_reading_bounds_are_exact() {
+        use crate::program::macros::{MAX_CALL_DEPTH, MAX_TURNS};
+        let mut frame = program();
+        frame.blocks.clear();
+        let turns = |n: u64| {
+            let text = fanuc_with(&format!("#1=0\nWHILE[#1LT{n}]DO1\n#1=#1+1\nEND1\n"), "");
+            read(&text, &frame, &FANUC, &axes())
+        };
+        let moves = read(&fanuc_with("", ""), &frame, &FANUC, &axes())
+            .unwrap()
+            .program
+            .blocks;
+        assert_eq!(turns(MAX_TURNS).unwrap().program.blocks, moves);
+        let e = turns(MAX_TURNS + 1).unwrap_err().to_string();
+        assert!(e.contains(&format!("more than {MAX_TURNS} loop turns")), "{e}");
+        let nested = |depth: usize| {
+            // O1001 calls O1002, ... to O(1000 + depth), which returns.
+            let subs: String = (1..=depth)
+                .map(|k| {
+                    let call = if k < depth {
+                        format!("M98 P{}\n", 1001 + k)
+                    } else {
+                        String::new()
+                    };
+                    format!("O{}\n{call}M99\n", 1000 + k)
+                })
+                .collect();
+            read(&fanuc_with("M98 P1001\n", &subs), &frame, &FANUC, &axes())
+        };
+        assert_eq!(nested(MAX_CALL_DEPTH).unwrap().program.blocks, moves);
+        let e = nested(MAX_CALL_DEPTH + 1).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("calls nested deeper than {MAX_CALL_DEPTH}")),
+            "{e}"
+        );
+    }
+
     /// A word the verification cannot simulate is refused, naming it and
     /// the block; a program read as it stands may carry its own name.
     #[test]
