@@ -236,7 +236,9 @@ fn loop_program(plain: &str, n: usize) -> String {
     let mut lines = plain.lines();
     for l in lines.by_ref() {
         if l.starts_with("N70 ") {
-            out.push_str(&format!("{l}\nR1=2\nWHILE R1<={n}\nC=R1*360/{n}\nR1=R1+1\nENDWHILE\n"));
+            out.push_str(&format!(
+                "{l}\nR1=2\nWHILE R1<={n}\nC=R1*360/{n}\nR1=R1+1\nENDWHILE\n"
+            ));
             break;
         }
         out.push_str(l);

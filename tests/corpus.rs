@@ -192,6 +192,7 @@ fn sinumerik_programs_verify_as_their_plain_twins() {
         let (code, err, _) = verified(&dir, file, "3K152VF20", "scripts/mandrel.rhai");
         assert_eq!(code, 1, "{file}: {err}");
         assert!(err.contains(says), "{file}: {err}");
+        assert_eq!(crate::common::rust_text(&err), None, "{file}: {err}");
     }
 }
 
@@ -225,9 +226,7 @@ fn what_is_not_read_is_refused_by_name() {
         let (code, err, _) = verified(&dir, file, "fanuc-0i-tc", "scripts/thread.rhai");
         assert_eq!(code, 1, "{file}: {err}");
         assert!(err.contains(says), "{file}: {err}");
-        for rust in ["Some(", "Unexpected {", "::", "None", "Err("] {
-            assert!(!err.contains(rust), "{file}: Rust's text in '{err}'");
-        }
+        assert_eq!(crate::common::rust_text(&err), None, "{file}: {err}");
     }
 }
 
@@ -363,5 +362,34 @@ fn linuxcnc_programs_verify_as_their_plain_twins_and_as_rs274_reads_them() {
             left.join("program.json"),
         )
         .unwrap();
+    }
+}
+
+/// What finds Rust's text in a message finds the examples and
+/// passes the control's words.
+#[test]
+fn rust_text_is_found_where_it_is() {
+    use crate::common::rust_text;
+    for (m, found) in [
+        (
+            "not G-code: Some(Unexpected { actual: \"C\" }) in 'N3000'",
+            "Some(",
+        ),
+        ("Some(UnknownContent { text: \"=\" })", "Some("),
+        ("expected [Number], got Unexpected { .. }", "Unexpected {"),
+        ("pilgrim_kernel::program::Error", "::"),
+        ("the value was None", "None"),
+        ("Err(\"x\")", "Err("),
+    ] {
+        assert_eq!(rust_text(m), Some(found), "{m}");
+    }
+    for m in [
+        "N30: G3: the end is 100.0523 mm from the centre I, K",
+        "#5001: a system variable (the control's own)",
+        "M99 in the main program (Fanuc: a return)",
+        "Nonexistent words: none; Noneless",
+        "at 10:30 (local) it ran",
+    ] {
+        assert_eq!(rust_text(m), None, "{m}");
     }
 }

@@ -1123,6 +1123,14 @@ fn mutate(subject: &Subject) -> (Tally, Vec<String>) {
                 match outcome {
                     Outcome::Refused(e) => {
                         tally.refused += 1;
+                        if let Some(rust) = crate::common::rust_text(&e.message)
+                            .or_else(|| crate::common::rust_text(&e.place))
+                        {
+                            fail(
+                                format!("rust text {rust}"),
+                                format!("'{mutant}': Rust's text {rust} in the refusal: {e}"),
+                            );
+                        }
                         // A block whose N the edit took away is named by
                         // its line (a program read as it stands numbers its
                         // blocks as it likes).

@@ -143,14 +143,14 @@ fn a_hand_edited_program_is_verified_as_it_stands() {
     };
     assert_eq!(finish(&report(&out.with_extension("verify"))), 90.0);
     assert!(finish(&report(&out)) > 90.0);
-    // An arc among the moves.
+    // An arc among the moves, with no circle.
     let (line, _) = move_after(&text, "pass 4", 5);
     let block = line.split_whitespace().next().unwrap().to_owned();
     let (code, _, err) = edit(&line, &line.replacen(' ', " G2 ", 1));
     assert_eq!(code, 1, "{err}");
     assert!(
         err.contains(&format!(
-            "{block}: G2 (circular interpolation clockwise on sinumerik): a word the verification cannot simulate"
+            "{block}: G2 without its circle: a centre (I, K), a radius or an opening angle"
         )),
         "{err}"
     );
@@ -163,6 +163,49 @@ fn a_hand_edited_program_is_verified_as_it_stands() {
         .as_str()
         .unwrap()
         .contains(&format!("{block}: G2")));
+}
+
+/// A program file (not a run's folder) whose finishing pass has a feed
+/// edited in one block: the feed rule names the edited block, the feed
+/// per revolution and the limit the family sets; the blocks after it at
+/// the same modal feed are not told again, and the deviation names the
+/// block whose move cut the surface.
+#[test]
+fn an_edited_feed_is_named_at_its_block() {
+    let out = default_run("mandrel", "feed");
+    let text = std::fs::read_to_string(out.join("program.mpf")).unwrap();
+    // The pass's traverse feed, as its first traverse block writes it.
+    let (first, _) = move_after(&text, "pass 4", 1);
+    let feed = first
+        .split_whitespace()
+        .find(|w| w.starts_with('F'))
+        .unwrap();
+    let (line, _) = move_after(&text, "pass 4", 40);
+    let (next, _) = move_after(&text, "pass 4", 41);
+    assert!(!line.contains(" F") && !next.contains(" F"));
+    let block = line.split_whitespace().next().unwrap().to_owned();
+    let file = out.parent().unwrap().join("FEED.MPF");
+    let edited = text
+        .replacen(&line, &format!("{line} F1200.0"), 1)
+        .replacen(&next, &format!("{next} {feed}"), 1);
+    std::fs::write(&file, edited).unwrap();
+    let (code, _, err) = pilgrim(&["verify", s(&file), "--family", "scripts/mandrel.rhai"]);
+    assert_eq!(code, 1, "{err}");
+    let said = format!("{block} in \"pass 4");
+    let fast: Vec<&str> = err
+        .lines()
+        .filter(|l| l.contains("mm per revolution, more than"))
+        .collect();
+    assert_eq!(fast.len(), 1, "{err}");
+    assert!(
+        fast[0].starts_with(&said)
+            && fast[0].contains("F1200.0 at S399 is 3.0075 mm per revolution"),
+        "{err}"
+    );
+    assert!(fast[0].contains("the finishing pass"), "{err}");
+    // The surface's deviation is where the edited feed cut it.
+    let deviated = err.lines().find(|l| l.contains("strays")).unwrap_or("");
+    assert!(deviated.contains(&format!("where {block} ")), "{err}");
 }
 
 /// A pass in which the steady rest moves while the wheel stands: the

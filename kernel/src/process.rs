@@ -38,6 +38,12 @@
 //! - **a finishing pass takes no more than the finishing stock**
 //!   ([`FINISH`]): each pass that leaves the part at its nominal removes at
 //!   most the machine's `finish_stock` (a family may set it for its run);
+//! - **a cutting move's feed within the family's limit** ([`FEED`]): a
+//!   feed move into or through the material moves at most the feed per
+//!   revolution its family allows there ([`Stock::feed_limit`]: a
+//!   grinding family's finishing pass the feed whose ridge is the
+//!   tolerance, any pass the wheel's width), named at the block that
+//!   wrote the feed;
 //! - **a ridge taller than the cut** ([`RIDGE`], a warning): a pass whose
 //!   feed leaves ridges taller than its cut leaves the surface before it
 //!   untouched at the crests.
@@ -69,6 +75,8 @@ pub const SPINDLE: &str = "spindle at speed and coolant on before cutting";
 pub const RIDING: &str = "the steady rest rides the part within its tolerance";
 /// The rule of the finishing stock.
 pub const FINISH: &str = "a finishing pass takes no more than the finishing stock";
+/// The rule of a cutting move's feed per revolution.
+pub const FEED: &str = "a cutting move's feed per revolution within the family's limit";
 /// The warning of a ridge taller than the cut.
 pub const RIDGE: &str = "a pass's ridge taller than its cut";
 
@@ -103,6 +111,24 @@ pub trait Stock {
 
     /// What each cutting pass removed.
     fn passes(&self) -> Vec<PassStock>;
+
+    /// The largest feed per revolution a cutting move of block `block`
+    /// (from 0) may have, with what sets it, or `None` where the family
+    /// states none (the default).
+    fn feed_limit(&self, block: usize) -> Option<FeedLimit> {
+        let _ = block;
+        None
+    }
+}
+
+/// The largest feed per revolution a family allows a cutting move.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FeedLimit {
+    /// The limit (mm per revolution).
+    pub per_rev: Real,
+    /// What sets it, for the finding ("the finishing pass's ridge at most
+    /// the tolerance 0.001 mm").
+    pub why: String,
 }
 
 /// A roller body's sizes (mm): a cylinder along its frame's Y, centred on
@@ -239,6 +265,10 @@ pub fn check(
         crate::replay::forward_rows(machine, &q, tool, k..k + 1)
     };
     let ends = crate::replay::replay(&written, machine, tool)?;
+    let speeds: Vec<Real> = crate::program::spindle_speeds(program).collect();
+    // The block that last broke the feed rule, and its feed: the blocks
+    // after it at the same modal feed are the same fault.
+    let mut fast: Option<(usize, Real)> = None;
     let mut ticker = crate::budget::Ticker::new("the process's rules", 64);
     for k in 1..n {
         ticker.tick()?;
@@ -290,6 +320,9 @@ pub fn check(
                 // straight along the move: a feed move is short, and the
                 // material smooth on its scale).
                 let (d0, d1) = (stock.tool_depth(k, p0), stock.tool_depth(k, p1));
+                if d0 > 0.0 || d1 > 0.0 {
+                    feed_rule(program, stock, k, b.feed, speeds[k], &mut fast, &mut out);
+                }
                 let deeper = d1 - d0.max(0.0);
                 let inside = if d0 >= 0.0 {
                     length
@@ -323,6 +356,49 @@ pub fn check(
     bodies(program, &written, machine, stock, limits, &mut out)?;
     finishing(program, stock, limits, &mut out);
     Ok(out)
+}
+
+/// Block `k`'s cutting move at `feed` (mm/min) and `rpm` against the feed
+/// per revolution `stock`'s family allows there; `fast` the last block
+/// found too fast and its feed (a modal feed's later blocks are not told
+/// again).
+fn feed_rule(
+    program: &AxisProgram,
+    stock: &dyn Stock,
+    k: usize,
+    feed: Real,
+    rpm: Real,
+    fast: &mut Option<(usize, Real)>,
+    out: &mut ProcessFindings,
+) {
+    let Some(limit) = stock.feed_limit(k).filter(|_| rpm > 0.0) else {
+        return;
+    };
+    let per_rev = feed / rpm;
+    if per_rev <= limit.per_rev * (1.0 + crate::tolerance::LIMIT_SLACK) {
+        return;
+    }
+    let told = fast.is_some_and(|(b, f)| b + 1 == k && f == feed);
+    *fast = Some((k, feed));
+    if told {
+        return;
+    }
+    let name = block_name(program, k);
+    out.errors.push(
+        Finding::new(
+            FEED,
+            format!(
+                "{name}: F{} at S{} is {} mm per revolution, more than {} mm: {} (at most F{} at this speed)",
+                crate::math::fixed(feed, 1),
+                crate::math::fixed(rpm, 0),
+                crate::math::fixed(per_rev, 4),
+                crate::math::fixed(limit.per_rev, 4),
+                limit.why,
+                crate::math::fixed((limit.per_rev * rpm * 10.0).floor() / 10.0, 1),
+            ),
+        )
+        .at(k, name),
+    );
 }
 
 /// The spindle and coolant before every cutting block (as written: a

@@ -682,3 +682,33 @@ pub fn with_control(toml: &str, control: &str) -> String {
         out
     }
 }
+
+/// The Rust text a message to a user holds, if any: a debug print of an
+/// option or a result (`Some(`, `None`, `Ok(`, `Err(`), of a parser's
+/// error (`Unexpected {`), or a type's path (`::`). One pass over the
+/// bytes: the mutation test asks it of every one of its millions of
+/// refusals.
+pub fn rust_text(message: &str) -> Option<&'static str> {
+    let b = message.as_bytes();
+    let before = |i: usize, w: &str| {
+        i >= w.len()
+            && &b[i - w.len()..i] == w.as_bytes()
+            && (i == w.len() || !b[i - w.len() - 1].is_ascii_alphanumeric())
+    };
+    for (i, &c) in b.iter().enumerate() {
+        match c {
+            b'(' if before(i, "Some") => return Some("Some("),
+            b'(' if before(i, "Ok") => return Some("Ok("),
+            b'(' if before(i, "Err") => return Some("Err("),
+            b'{' if before(i, "Unexpected ") => return Some("Unexpected {"),
+            b':' if b.get(i + 1) == Some(&b':') => return Some("::"),
+            b'e' if before(i + 1, "None")
+                && !b.get(i + 1).is_some_and(|n| n.is_ascii_alphanumeric()) =>
+            {
+                return Some("None")
+            }
+            _ => {}
+        }
+    }
+    None
+}

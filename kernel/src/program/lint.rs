@@ -476,7 +476,10 @@ mod tests {
             .blocks;
         assert_eq!(turns(MAX_TURNS).unwrap().program.blocks, moves);
         let e = turns(MAX_TURNS + 1).unwrap_err().to_string();
-        assert!(e.contains(&format!("more than {MAX_TURNS} loop turns")), "{e}");
+        assert!(
+            e.contains(&format!("more than {MAX_TURNS} loop turns")),
+            "{e}"
+        );
         let nested = |depth: usize| {
             // O1001 calls O1002, ... to O(1000 + depth), which returns.
             let subs: String = (1..=depth)

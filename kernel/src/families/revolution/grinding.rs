@@ -20,6 +20,11 @@ use crate::transform::ToolFrame;
 use std::collections::BTreeMap;
 use std::ops::Range;
 
+/// How far either side of a ridge's crest the touches that form it are
+/// looked for (mm): well below the least gap between touches the replay
+/// resolves.
+const CREST_SIDE: Real = 1e-4;
+
 /// A generatrix's sweeps so far, each with the block (from 1) of each of
 /// its touches.
 type Sweeps = Vec<(CapsuleEnvelope, Vec<usize>)>;
@@ -234,7 +239,10 @@ impl Setting<'_> {
         let worst_generatrix = met[spread.worst];
         keep(run, envs, &met, &t, blocks.clone());
         spread.deviation.block =
-            self.forming_block(&run.earlier[worst_generatrix], spread.deviation.at_z)?;
+            self.forming_block(&run.earlier[worst_generatrix], spread.deviation.at_z, {
+                let d = &spread.deviation;
+                d.max_above >= -d.max_below
+            })?;
         let f = if rpm > 0.0 { cutting_feed / rpm } else { 0.0 };
         let check = PassCheck {
             name: pass.name.clone(),
@@ -436,10 +444,18 @@ impl Setting<'_> {
         }
     }
 
-    /// The block whose touch forms the surface at `z` on a generatrix
+    /// The block whose move formed the surface at `z` on a generatrix
     /// with `sweeps` (this pass's last): of this pass's sweep or of the
-    /// earlier one lowest there; none where the blank is lowest.
-    fn forming_block(&self, sweeps: &Sweeps, z: Real) -> Result<Option<usize>, VerifyError> {
+    /// earlier one lowest there; none where the blank is lowest. Where the
+    /// surface stands `above` the nominal at a ridge's crest between two
+    /// touches, the move that made the gap is the later touch's: the block
+    /// whose own move (at its feed) left the material there.
+    fn forming_block(
+        &self,
+        sweeps: &Sweeps,
+        z: Real,
+        above: bool,
+    ) -> Result<Option<usize>, VerifyError> {
         let (this, before) = sweeps
             .split_last()
             .expect("this pass's sweep was just kept");
@@ -452,7 +468,19 @@ impl Setting<'_> {
         let blank_at = self.blank.map_or(Ok(Real::INFINITY), |b| b.eval(z))?;
         Ok(lowest
             .filter(|(s, _, _)| *s <= blank_at)
-            .and_then(|(_, e, b)| e.source_at(z).and_then(|i| b.get(i)).copied()))
+            .and_then(|(_, e, b)| {
+                let at = e.source_at(z)?;
+                let touch = if above {
+                    // The touches either side of a crest (in time order).
+                    [z - CREST_SIDE, z + CREST_SIDE]
+                        .into_iter()
+                        .filter_map(|q| e.source_at(q))
+                        .fold(at, usize::max)
+                } else {
+                    at
+                };
+                b.get(touch).copied()
+            }))
     }
 }
 

@@ -256,6 +256,9 @@ pub struct GroundStock {
     blocks: Vec<std::ops::Range<usize>>,
     wheel: Wheel,
     passes: Vec<crate::process::PassStock>,
+    /// The verification's tolerance (mm): the ridge a finishing pass may
+    /// leave.
+    tolerance: Real,
     /// The surface over every spindle phase before each cutting pass and
     /// after the last: what a body riding the part meets.
     phases: Vec<GroundSurface>,
@@ -342,6 +345,7 @@ impl GroundStock {
             blocks,
             wheel: *wheel,
             passes,
+            tolerance: check.tolerance,
             phases: Vec::new(),
             block_time: std::collections::BTreeMap::new(),
         })
@@ -430,6 +434,38 @@ impl crate::process::Stock for GroundStock {
 
     fn passes(&self) -> Vec<crate::process::PassStock> {
         self.passes.clone()
+    }
+
+    /// On the finishing pass (one that leaves the part at its nominal, or
+    /// the last), the feed whose ridge is the tolerance; on any, the
+    /// wheel's width (a turn's feed past it leaves a helix the wheel never
+    /// touches).
+    fn feed_limit(&self, block: usize) -> Option<crate::process::FeedLimit> {
+        let i = self.blocks.iter().position(|r| r.contains(&block))?;
+        let last = i + 1 == self.blocks.len();
+        let pass = self.passes.get(i)?;
+        let width = self.wheel.width;
+        let ridge = self.wheel.feed_for_ridge(self.tolerance);
+        Some(if (pass.finishes || last) && ridge < width {
+            crate::process::FeedLimit {
+                per_rev: ridge,
+                why: format!(
+                    "below it the finishing pass \"{}\" leaves ridges no higher than the tolerance {} mm (the wheel's rounding radius {} mm)",
+                    pass.name,
+                    self.tolerance,
+                    crate::math::fixed(self.wheel.rounding_radius, 3)
+                ),
+            }
+        } else {
+            crate::process::FeedLimit {
+                per_rev: width,
+                why: format!(
+                    "past the wheel's width ({} mm) a turn of pass \"{}\" leaves a helix the wheel never touches",
+                    crate::math::fixed(width, 3),
+                    pass.name
+                ),
+            }
+        })
     }
 }
 

@@ -276,9 +276,11 @@ impl Reader<'_> {
                     "{code} without its circle: a centre (I, K), a radius or an opening angle"
                 )))
             }
-            _ => return Err(fail(format!(
+            _ => {
+                return Err(fail(format!(
                 "{code} with its circle given twice (a centre, a radius and an angle: one of them)"
-            ))),
+            )))
+            }
         };
         let points = arc_points([z0, x0 * per], [z1, x1 * per], clockwise, circle)
             .map_err(|m| fail(format!("{code}: {m}")))?;
