@@ -371,7 +371,8 @@ fn verify_within(args: &VerifyArgs, catalog: &Catalog) -> Result<String, String>
             .find(|d| d.extension.eq_ignore_ascii_case(ext)),
         pilgrim_kernel::program::post::dialect(control),
     ) {
-        if theirs.name != ours.name {
+        // Two dialects may share an extension (Fanuc's and Haas's .nc).
+        if !ours.extension.eq_ignore_ascii_case(ext) {
             return Err(format!(
                 "{}: a .{ext} file is a {} program, and machine {}'s control reads {} (.{}): verify it on a machine whose control is {} (a machine file's control = \"{}\")",
                 file.display(),

@@ -393,3 +393,54 @@ fn rust_text_is_found_where_it_is() {
         assert_eq!(rust_text(m), None, "{m}");
     }
 }
+
+/// The one-block G76 (`G76 X Z I K D A P F`) on a Haas lathe, whose
+/// control takes the least cut, the finishing allowance and the chamfer
+/// from its settings, which the machine file states: the 0i-TC's two-block
+/// cycle of M20x2.5-6g written in one block (its one finishing pass, where
+/// the two-block form wrote two), verified as its G32 twin; alternating
+/// edges (P2) refused by name, and so is the cycle on a machine that does
+/// not state its settings.
+#[test]
+fn a_one_block_g76_verifies_as_its_plain_twin() {
+    let dir = scratch("corpus", "haas");
+    let lathe = pilgrim_kernel::machine::machine_file(&fanuc_0i_tc::describe(), "its crate");
+    let haas = crate::common::with_control(&lathe, "haas");
+    let bare = dir.join("haas-bare.toml");
+    std::fs::write(&bare, &haas).unwrap();
+    let machine = dir.join("haas-lathe.toml");
+    let settings = "[constants]\nthread_min_cut = 0.05\nthread_finish_allowance = 0.03\nthread_chamfer_leads = 0.0\nthread_chamfer_deg = 45.0\n";
+    assert!(haas.contains("[constants]\n"));
+    std::fs::write(&machine, haas.replacen("[constants]\n", settings, 1)).unwrap();
+    let (code, err, report) = verified(&dir, "haas/g76_m20.nc", s(&machine), "scripts/thread.rhai");
+    assert_eq!(code, 0, "{err}");
+    let (tcode, terr, treport) = verified(
+        &dir,
+        "haas/g76_m20.plain.nc",
+        s(&machine),
+        "scripts/thread.rhai",
+    );
+    assert_eq!(tcode, 0, "{terr}");
+    assert!(report["thread_verification"].is_object());
+    assert_eq!(figures(&report), figures(&treport));
+    assert_eq!(report["blocks"], treport["blocks"]);
+    for (file, on, says) in [
+        (
+            "haas/refused/alternating.nc",
+            &machine,
+            "G76 P2: alternating edges",
+        ),
+        (
+            "haas/g76_m20.nc",
+            &bare,
+            "give thread_min_cut (the least depth a roughing pass adds (mm)), thread_finish_allowance",
+        ),
+    ] {
+        let apart = dir.join(on.file_stem().unwrap());
+        std::fs::create_dir_all(&apart).unwrap();
+        let (code, err, _) = verified(&apart, file, s(on), "scripts/thread.rhai");
+        assert_eq!(code, 1, "{file}: {err}");
+        assert!(err.contains(says), "{file}: {err}");
+        assert_eq!(crate::common::rust_text(&err), None, "{file}: {err}");
+    }
+}

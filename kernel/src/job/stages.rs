@@ -360,6 +360,7 @@ impl Run<'_> {
             &info.axes,
             self.options.offsets.as_ref(),
             Some(&beside),
+            Some(&info.constants),
         )
         .map_err(|e| refused(e.to_string()))?;
         // No more blocks than a run writes: the replays' work is bounded.

@@ -227,6 +227,10 @@ pub struct FanucCycle {
     pub first: Real,
     /// L: the lead.
     pub lead: Real,
+    /// Whether the roughing passes cut a constant depth (`D_n = n dd`,
+    /// the one-block form's P3) rather than a constant area (`D_n = dd
+    /// sqrt(n)`, the two-block form and P1).
+    pub constant_depth: bool,
 }
 
 /// How a control of Fanuc's kind moves where its manual leaves room: the
@@ -290,9 +294,9 @@ fn fanuc_passes_text(c: &FanucCycle) -> Result<Vec<(Real, Real)>, String> {
     if !(c.min_cut >= 0.0) {
         return Err(format!("G76 Q(dd_min) {}: below 0", c.min_cut));
     }
-    if ![80.0, 60.0, 55.0, 30.0, 29.0, 0.0].contains(&c.angle_deg) {
+    if !(0.0..=120.0).contains(&c.angle_deg) {
         return Err(format!(
-            "G76 P..{:02}: the tool's angle must be 80, 60, 55, 30, 29 or 00",
+            "G76: the tool's angle {} deg is not from 0 to 120",
             c.angle_deg
         ));
     }
@@ -311,7 +315,8 @@ fn fanuc_passes_text(c: &FanucCycle) -> Result<Vec<(Real, Real)>, String> {
     let mut last: Real = 0.0;
     let mut n: Real = 1.0;
     loop {
-        let d = (c.first * n.sqrt()).max(last + c.min_cut).min(rough);
+        let law = if c.constant_depth { n } else { n.sqrt() };
+        let d = (c.first * law).max(last + c.min_cut).min(rough);
         out.push((d, (c.height - d) * tan));
         if out.len() > MAX_CYCLE_PASSES {
             return Err(format!(
@@ -514,6 +519,7 @@ mod tests {
             height: 0.974,
             first: 0.400,
             lead: 1.5,
+            constant_depth: false,
         };
         let round = |v: Real| (v * 1000.0).round() / 1000.0;
         let got: Vec<(Real, Real)> = fanuc_passes(&first)
@@ -572,6 +578,20 @@ mod tests {
         assert_eq!((moves[3].x, moves[4].x, moves[4].z), (24.0, 24.0, 5.0));
         let last = &moves[35..40];
         assert!((last[1].x - 18.052).abs() < 1e-12 && (last[2].z + 30.0).abs() < 1e-12);
+        // The one-block form's P3: a constant depth, D_n = n dd, capped at
+        // k - d, one finishing pass.
+        let depth = FanucCycle {
+            constant_depth: true,
+            finishes: 1,
+            first: 0.2,
+            ..first
+        };
+        let got: Vec<Real> = fanuc_passes(&depth)
+            .unwrap()
+            .into_iter()
+            .map(|(d, _)| round(d))
+            .collect();
+        assert_eq!(got, [0.2, 0.4, 0.6, 0.8, 0.954, 0.974]);
     }
 
     #[test]

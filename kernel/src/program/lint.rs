@@ -77,7 +77,7 @@ pub fn lint(
     match d.style {
         Style::Apt => lint_apt(text, program, d),
         Style::GCode => {
-            lint_gcode(text, program, d, axes, Mode::Lint, None, None).map(|r| r.linted)
+            lint_gcode(text, program, d, axes, Mode::Lint, Context::default()).map(|r| r.linted)
         }
     }
 }
@@ -122,7 +122,7 @@ pub fn read(
     d: &Dialect,
     axes: &[Axis],
 ) -> Result<TextProgram, LintError> {
-    read_with(text, frame, d, axes, None, None)
+    read_with(text, frame, d, axes, None, None, None)
 }
 
 /// [`read`] with the shop's offset table: a tool or work offset it gives
@@ -140,14 +140,30 @@ pub fn read_with(
     axes: &[Axis],
     offsets: Option<&super::offsets::Offsets>,
     beside: Option<super::reader::Beside<'_>>,
+    settings: Option<&std::collections::BTreeMap<String, Real>>,
 ) -> Result<TextProgram, LintError> {
     if d.style != Style::GCode {
         return Err(not_a_control_program(d));
     }
+    let context = Context {
+        offsets,
+        beside,
+        settings,
+    };
     Ok(assemble(
-        lint_gcode(text, frame, d, axes, Mode::Read, offsets, beside)?,
+        lint_gcode(text, frame, d, axes, Mode::Read, context)?,
         frame,
     ))
+}
+
+/// What a reading may follow besides the text: the shop's offset table,
+/// where a called subprogram's file is read, the machine's constants (the
+/// control's settings a cycle takes).
+#[derive(Default)]
+struct Context<'a> {
+    offsets: Option<&'a super::offsets::Offsets>,
+    beside: Option<super::reader::Beside<'a>>,
+    settings: Option<&'a std::collections::BTreeMap<String, Real>>,
 }
 
 /// Lints `text`, the program `program` written in `d`, as [`lint`] does,
@@ -168,7 +184,7 @@ pub fn lint_read(
         return Err(not_a_control_program(d));
     }
     let mut read = assemble(
-        lint_gcode(text, program, d, axes, Mode::Lint, None, None)?,
+        lint_gcode(text, program, d, axes, Mode::Lint, Context::default())?,
         program,
     );
     for (r, b) in read.program.blocks.iter_mut().zip(&program.blocks) {
@@ -279,8 +295,7 @@ fn lint_gcode(
     d: &Dialect,
     axes: &[Axis],
     mode: Mode,
-    offsets: Option<&super::offsets::Offsets>,
-    beside: Option<super::reader::Beside<'_>>,
+    context: Context<'_>,
 ) -> Result<ReadText, LintError> {
     let mut lines: Vec<&str> = text.split('\n').collect();
     if lines.last() != Some(&"") {
@@ -304,7 +319,10 @@ fn lint_gcode(
         }
     }
     let (reader, mut at) = Reader::new(&lines, program, d, axes, mode)?;
-    let mut reader = reader.with_offsets(offsets).with_beside(beside);
+    let mut reader = reader
+        .with_offsets(context.offsets)
+        .with_beside(context.beside)
+        .with_settings(context.settings);
     let mut blocks = Vec::new();
     let mut line = String::new();
     while let Some((f, i)) = reader.next_line(&mut at)? {

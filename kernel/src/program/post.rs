@@ -228,7 +228,34 @@ pub enum G76Form {
     /// Fanuc's two blocks `G76 P(m)(r)(a) Q R` then `G76 X Z R P Q F`
     /// ([`super::cycle::expand_fanuc`]), by the control's rules.
     FanucTwoBlock(super::cycle::FanucRules),
+    /// The one block `G76 X Z I K D A P F` of the Fanuc 10/11/15-T and
+    /// Haas lathes, the same law ([`super::cycle::expand_fanuc`]): the
+    /// least cut, the finishing allowance and the chamfer are the
+    /// control's settings, which the machine states among its constants
+    /// ([`ONE_BLOCK_SETTINGS`]).
+    OneBlock,
 }
+
+/// The machine constants a one-block G76 takes from the control's
+/// settings (Haas's settings 99, 86, 95 and 96), each with what it is.
+pub const ONE_BLOCK_SETTINGS: [(&str, &str); 4] = [
+    (
+        "thread_min_cut",
+        "the least depth a roughing pass adds (mm)",
+    ),
+    (
+        "thread_finish_allowance",
+        "the finishing pass's allowance (mm)",
+    ),
+    (
+        "thread_chamfer_leads",
+        "the pull-out's length at the thread's end, in leads",
+    ),
+    (
+        "thread_chamfer_deg",
+        "the pull-out's angle from the axis (deg)",
+    ),
+];
 
 /// A control's macro language ([`super::macros`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -677,8 +704,25 @@ pub fn plane_code(p: Plane) -> u32 {
     }
 }
 
+/// A Haas lathe (and a Fanuc 10/11/15-T): Fanuc's words and programs
+/// (system A), its threading cycle the one-block `G76 X Z I K D A P F`
+/// (Haas Lathe Operator's Manual, "G76 Threading Cycle, Multiple Pass";
+/// the least cut, the finishing allowance and the chamfer its settings,
+/// which the machine states). pilgrim writes it as it writes Fanuc's.
+pub const HAAS: Dialect = Dialect {
+    name: "haas",
+    reading: Reading {
+        g76: Some(G76Form::OneBlock),
+        // Haas Lathe Operator's Manual, "G-codes": G92 is the threading
+        // cycle there too.
+        meanings: FANUC.reading.meanings,
+        ..FANUC.reading
+    },
+    ..FANUC
+};
+
 /// Every dialect.
-pub const DIALECTS: [&Dialect; 4] = [&SINUMERIK, &FANUC, &LINUXCNC, &CLD];
+pub const DIALECTS: [&Dialect; 5] = [&SINUMERIK, &FANUC, &HAAS, &LINUXCNC, &CLD];
 
 /// The dialect called `name`.
 pub fn dialect(name: &str) -> Option<&'static Dialect> {
@@ -695,7 +739,9 @@ pub enum PostError {
     #[error(transparent)]
     OverTime(#[from] crate::budget::OverTime),
     /// No dialect of that name.
-    #[error("no post-processor dialect '{name}' (dialects: sinumerik, fanuc, linuxcnc, cld)")]
+    #[error(
+        "no post-processor dialect '{name}' (dialects: sinumerik, fanuc, haas, linuxcnc, cld)"
+    )]
     UnknownDialect {
         /// The name asked for.
         name: String,

@@ -152,6 +152,9 @@ pub struct Reader<'a> {
     beside: Option<Beside<'a>>,
     /// The file the line being read is in.
     current: usize,
+    /// The machine's constants, where the caller gives them: the settings
+    /// of the control a cycle takes what its words leave out from.
+    settings: Option<&'a std::collections::BTreeMap<String, Real>>,
 }
 
 /// Whether a G-code text is held to an axis program (the lint of a
@@ -357,6 +360,7 @@ impl<'a> Reader<'a> {
             files: vec![SourceFile::new(String::new(), lines, d)],
             beside: None,
             current: 0,
+            settings: None,
         };
         // The framing: % first and last where the dialect frames.
         if framed {
@@ -404,6 +408,29 @@ impl<'a> Reader<'a> {
     pub fn with_offsets(mut self, offsets: Option<&'a super::offsets::Offsets>) -> Self {
         self.offsets = offsets;
         self
+    }
+
+    /// The reader with the machine's constants `settings`, where a cycle
+    /// takes what its words leave out from the control's settings.
+    pub fn with_settings(
+        mut self,
+        settings: Option<&'a std::collections::BTreeMap<String, Real>>,
+    ) -> Self {
+        self.settings = settings;
+        self
+    }
+
+    /// The machine's constant `name` as a machine file names it, where the
+    /// caller gave the constants and it is a finite number (an angle's
+    /// `_deg` constant is kept in radians under its name without the
+    /// suffix, and given back in degrees).
+    fn setting(&self, name: &str) -> Option<Real> {
+        let m = self.settings?;
+        match name.strip_suffix("_deg") {
+            Some(base) => m.get(base).map(|r| r.to_degrees()),
+            None => m.get(name).copied(),
+        }
+        .filter(|v| v.is_finite())
     }
 
     /// The reader with `beside`, where a called subprogram's file is read

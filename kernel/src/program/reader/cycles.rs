@@ -30,8 +30,14 @@ impl Reader<'_> {
     ) -> Result<(), LintError> {
         let d = self.d;
         let fail = |m: String| self.err(self.place(b, at.k), m);
-        if let Some(crate::program::post::G76Form::FanucTwoBlock(rules)) = d.reading.g76 {
-            return self.fanuc_g76(at, b, said, &rules, out);
+        match d.reading.g76 {
+            Some(crate::program::post::G76Form::FanucTwoBlock(rules)) => {
+                return self.fanuc_g76(at, b, said, &rules, out);
+            }
+            Some(crate::program::post::G76Form::OneBlock) => {
+                return self.one_block_g76(at, b, said, out);
+            }
+            _ => {}
         }
         let values: Vec<(char, Real)> = said.read.iter().map(|(c, v, _)| (*c, *v)).collect();
         let (cycle, end_x) = cycle_words(&values, d).map_err(fail)?;

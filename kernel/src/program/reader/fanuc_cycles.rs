@@ -1,6 +1,8 @@
 //! Fanuc's threading cycles in a shop's program (system A): the two-block
 //! `G76` (its first block's words kept by the control for the next
-//! cycle) and the modal `G92`, each expanded as the control runs it
+//! cycle), the one-block `G76` of the Fanuc 10/11/15-T and Haas (the
+//! control's settings for what its words leave out, as the machine states
+//! them) and the modal `G92`, each expanded as the control runs it
 //! ([`crate::program::cycle::expand_fanuc`], [`crate::program::cycle::fanuc_g92`])
 //! and its moves read as blocks of their own.
 
@@ -78,6 +80,12 @@ impl Reader<'_> {
         if !second {
             let p = whole('P')?.ok_or_else(|| fail("G76 without P(m)(r)(a)".into()))?;
             let p = p as u64;
+            if ![80, 60, 55, 30, 29, 0].contains(&(p % 100)) {
+                return Err(fail(format!(
+                    "G76 P..{:02}: the tool's angle must be 80, 60, 55, 30, 29 or 00",
+                    p % 100
+                )));
+            }
             let first = FanucFirst {
                 finishes: (p / 10_000) as u32,
                 chamfer_tenths: ((p / 100) % 100) as u32,
@@ -121,9 +129,118 @@ impl Reader<'_> {
             first: whole('Q')?.ok_or_else(|| need('Q', "the first cut's depth"))?
                 * self.increment(),
             lead,
+            constant_depth: false,
         };
         let diameter = self.program.setup.radial == Some(super::Radial::Diameter);
         let moves = crate::program::cycle::expand_fanuc(&cycle, start, diameter, rules)
+            .map_err(|e| fail(e.message))?;
+        at.st.f = Some(lead);
+        at.st.lead = Some(lead);
+        self.cycle_moves(at, b, &moves, xz, out)
+    }
+
+    /// The one-block `G76 X Z I K D A P F` at block `b` (I the taper, K
+    /// the height, D the first cut's depth, A the tool's angle, P the
+    /// infeed: P1 one edge at a constant area, P3 one edge at a constant
+    /// depth), expanded from where the tool stands with the least cut, the
+    /// finishing allowance (one finishing pass takes it) and the chamfer
+    /// the machine's constants give ([`ONE_BLOCK_SETTINGS`]).
+    ///
+    /// # Failures
+    /// A word the cycle has not, a setting the machine does not state,
+    /// P2 or P4 (alternating edges, whose shifts no public source gives),
+    /// a cycle the control refuses.
+    ///
+    /// [`ONE_BLOCK_SETTINGS`]: crate::program::post::ONE_BLOCK_SETTINGS
+    pub(super) fn one_block_g76(
+        &self,
+        at: &mut Standing,
+        b: &Block,
+        said: &Said,
+        out: &mut Vec<ReadMove>,
+    ) -> Result<(), LintError> {
+        let fail = |m: String| self.err(self.place(b, at.k), m);
+        let allowed = ['X', 'Z', 'I', 'K', 'D', 'A', 'P', 'F'];
+        if let Some((c, _, t)) = said.read.iter().find(|(c, ..)| !allowed.contains(c)) {
+            return Err(fail(format!(
+                "{t}: not a word of the one-block G76 (X Z I K D A P F); {c} is {}",
+                if *c == 'U' || *c == 'W' {
+                    "incremental, which the verification does not read"
+                } else {
+                    "another word"
+                }
+            )));
+        }
+        let settings = crate::program::post::ONE_BLOCK_SETTINGS;
+        let missing: Vec<String> = (settings.iter())
+            .filter(|(name, _)| self.setting(name).is_none())
+            .map(|(name, what)| format!("{name} ({what})"))
+            .collect();
+        if !missing.is_empty() {
+            return Err(fail(format!(
+                "the one-block G76 takes its least cut, finishing allowance and chamfer from the control's settings (Haas's 99, 86, 95, 96), which machine {} does not state: give {} among its constants",
+                self.program.machine,
+                missing.join(", ")
+            )));
+        }
+        let setting = |name: &str| self.setting(name).unwrap_or_default();
+        let need = |c: char, what: &str| fail(format!("G76 without {c}, {what}"));
+        let method = Self::cycle_word(said, 'P').map_or(1.0, |(v, _)| v);
+        let whole =
+            (method.fract() == 0.0 && (1.0..=4.0).contains(&method)).then_some(method as u8);
+        let constant_depth = match whole {
+            Some(1) => false,
+            Some(3) => true,
+            Some(_) => {
+                return Err(fail(format!(
+                    "G76 P{method}: alternating edges, whose shifts from pass to pass no public source gives as a law; verify P1 or P3, or the passes written as blocks"
+                )))
+            }
+            None => {
+                return Err(fail(format!(
+                    "G76 P{method}: the infeed is P1 to P4 (one edge or alternating, a constant area or depth)"
+                )))
+            }
+        };
+        let leads = setting("thread_chamfer_leads");
+        let tenths = (leads * 10.0).round();
+        if !((0.0..=99.0).contains(&tenths) && (tenths - leads * 10.0).abs() < 1e-9) {
+            return Err(fail(format!(
+                "the machine's thread_chamfer_leads {leads}: the verification follows a chamfer of 0 to 9.9 leads, in tenths"
+            )));
+        }
+        let (start, xz) = self.cycle_ready(at, b, 76)?;
+        let x = Self::cycle_word(said, 'X').map_or(start[0], |(v, _)| v);
+        let z = Self::cycle_word(said, 'Z')
+            .map(|(v, _)| v)
+            .ok_or_else(|| need('Z', "the thread's end"))?;
+        let lead = match Self::cycle_word(said, 'F') {
+            Some((v, _)) => v,
+            None => at.st.lead.ok_or_else(|| need('F', "the lead"))?,
+        };
+        let cycle = FanucCycle {
+            finishes: 1,
+            chamfer_tenths: tenths as u32,
+            angle_deg: Self::cycle_word(said, 'A').map_or(0.0, |(v, _)| v),
+            min_cut: setting("thread_min_cut"),
+            allowance: setting("thread_finish_allowance"),
+            x,
+            z,
+            taper: self.cycle_length(said, 'I').unwrap_or(0.0),
+            height: self
+                .cycle_length(said, 'K')
+                .ok_or_else(|| need('K', "the thread's height"))?,
+            first: self
+                .cycle_length(said, 'D')
+                .ok_or_else(|| need('D', "the first cut's depth"))?,
+            lead,
+            constant_depth,
+        };
+        let rules = FanucRules {
+            chamfer_deg: setting("thread_chamfer_deg"),
+        };
+        let diameter = self.program.setup.radial == Some(super::Radial::Diameter);
+        let moves = crate::program::cycle::expand_fanuc(&cycle, start, diameter, &rules)
             .map_err(|e| fail(e.message))?;
         at.st.f = Some(lead);
         at.st.lead = Some(lead);
