@@ -206,6 +206,57 @@ fn an_edited_feed_is_named_at_its_block() {
     // The surface's deviation is where the edited feed cut it.
     let deviated = err.lines().find(|l| l.contains("strays")).unwrap_or("");
     assert!(deviated.contains(&format!("where {block} ")), "{err}");
+    // The page is about the user's program: it lists it, the failures
+    // link to their blocks, whose lines the listing marks.
+    let page = std::fs::read_to_string(page_named(&err)).unwrap();
+    assert!(
+        page.contains("FAILED: the program does not verify"),
+        "the banner"
+    );
+    assert!(!page.contains("no program was written"));
+    assert!(page.contains("<h2>Program: ") && page.contains("id=\"listing\""));
+    assert!(
+        page.contains("<li data-block=\""),
+        "a failure linked to its block"
+    );
+    let linked = page
+        .lines()
+        .find(|l| l.starts_with("<li data-block=") && l.contains("mm per revolution, more than"))
+        .unwrap_or("");
+    assert!(linked.contains(&block), "{linked}");
+}
+
+/// The page a failed command's message points to (`see PATH`).
+fn page_named(err: &str) -> std::path::PathBuf {
+    let at = err.rfind("see ").unwrap() + 4;
+    std::path::PathBuf::from(err[at..].trim())
+}
+
+/// A program refused as it is read: its page lists it, the refusal
+/// linked to the line it stands on.
+#[test]
+fn a_refused_program_is_listed_with_its_line() {
+    let dir = scratch("verify", "refused-listed");
+    let text = "%_N_X_MPF\nN1 G90 G94 G71\nN2 G54 G18 DIAMOF\nN3 T1 D1\nN4 S399 M3\nN5 M8\nN10 G0 X100.0 U150.0\nN20 Z-10.12\nN30 G3 Z-10.12 X19.7396 I-40.0 K91.5946 F1200.0\nN40 M30\n";
+    let file = dir.join("X.MPF");
+    std::fs::write(&file, text).unwrap();
+    let (code, _, err) = pilgrim(&[
+        "verify",
+        s(&file),
+        "--machine",
+        "3K152VF20",
+        "--family",
+        "scripts/mandrel.rhai",
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("N30: G3: the end is"), "{err}");
+    let page = std::fs::read_to_string(page_named(&err)).unwrap();
+    assert!(page.contains("FAILED: the program does not verify"));
+    assert!(
+        page.contains("<li data-line=\"9\">"),
+        "the refusal linked to line 9"
+    );
+    assert!(page.contains("<h2>Program: "));
 }
 
 /// A pass in which the steady rest moves while the wheel stands: the

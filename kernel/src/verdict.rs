@@ -77,6 +77,10 @@ pub struct Finding {
     /// count), where the scene of a failed run stands.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub block_index: Option<usize>,
+    /// The line (from 1) of the program's file a reading refused, where
+    /// the refusal stands on no move.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub line: Option<usize>,
     /// What is wrong, and what to change.
     pub message: String,
 }
@@ -88,8 +92,15 @@ impl Finding {
             rule: rule.to_owned(),
             block: None,
             block_index: None,
+            line: None,
             message: message.into(),
         }
+    }
+
+    /// The same on line `line` (from 1) of the program's file.
+    pub fn on_line(mut self, line: Option<usize>) -> Self {
+        self.line = line;
+        self
     }
 
     /// The same at block `index` (from 0) named `name`.

@@ -250,19 +250,21 @@ fn enter(stage: &mut dyn FnMut(&str), name: &'static str) -> Result<(), Error> {
     Ok(())
 }
 
-/// The failed run of `report` with the `files` made so far: the page and
+/// The failed run of `report` with the `files` made so far: the page (it
+/// lists `listed`, the user's program a verification read) and
 /// `report.json` added.
 fn failed_run(
     mut report: Report,
     mut files: Vec<(String, Vec<u8>)>,
     part_box: Option<([f64; 3], [f64; 3])>,
+    listed: Option<(&str, &str)>,
 ) -> Error {
     report.files = files
         .iter()
         .map(|f| f.0.clone())
         .chain(["report.html".to_owned(), "report.json".to_owned()])
         .collect();
-    let html = page::page_of(&report, &files, None, part_box);
+    let html = page::page_of(&report, &files, listed, part_box);
     files.push(("report.html".into(), html.into_bytes()));
     match report_json(&report) {
         Ok(json) => files.push(("report.json".into(), json)),

@@ -172,7 +172,7 @@ impl Run<'_> {
                 );
                 report.program_file = self.text.and(self.options.program_file.clone());
                 report.verdict = Verdict::of(true, failed, Vec::new(), Vec::new());
-                Err(failed_run(report, Vec::new(), None))
+                Err(failed_run(report, Vec::new(), None, self.listed()))
             }
             other => other,
         }
@@ -205,7 +205,16 @@ impl Run<'_> {
         );
         report.program_file = self.text.and(self.options.program_file.clone());
         report.verdict = Verdict::of(verified, failed, Vec::new(), Vec::new());
-        failed_run(report, Vec::new(), None)
+        failed_run(report, Vec::new(), None, self.listed())
+    }
+
+    /// The user's program a verification reads, its file's name and text:
+    /// the page lists it whatever the verdict.
+    fn listed(&self) -> Option<(&str, &str)> {
+        match (self.text, &self.options.program_file) {
+            (Some(text), Some(file)) => Some((file.as_str(), text)),
+            _ => None,
+        }
     }
 
     /// The machine with the constants the parameters set otherwise.
@@ -338,14 +347,15 @@ impl Run<'_> {
     ) -> Result<Programmed, Error> {
         let kin = plan.kin(self.machine);
         let info = kin.info();
-        let refused = |message: String| {
+        let refused_on = |message: String, line: Option<usize>| {
             self.early_report(
                 plan.checks.clone(),
                 info,
-                vec![Finding::new("the program's text", message)],
+                vec![Finding::new("the program's text", message).on_line(line)],
                 true,
             )
         };
+        let refused = |message: String| refused_on(message, None);
         let frame = crate::program::frame(info);
         let dir = self.options.program_dir.clone();
         let beside = move |name: &str| crate::files::beside(dir.as_deref(), name);
@@ -362,7 +372,7 @@ impl Run<'_> {
             Some(&beside),
             Some(&info.constants),
         )
-        .map_err(|e| refused(e.to_string()))?;
+        .map_err(|e| refused_on(e.to_string(), refused_line(&e, text)))?;
         // No more blocks than a run writes: the replays' work is bounded.
         crate::program::check_shape(&read).map_err(|m| refused(format!("the program: {m}")))?;
         let passes = crate::replay::passes_in(&read, kin, &plan.toolpath.tool.reference)
@@ -598,15 +608,14 @@ impl Run<'_> {
         crate::budget::check("the report")?;
         self.keep(&mut c.files, &mut report)?;
         if report.verdict.failed() {
-            return Err(failed_run(report, c.files, part_box));
+            return Err(failed_run(report, c.files, part_box, self.listed()));
         }
         let mut files = c.files;
         report.files.push("report.html".into());
         // The page lists the program the run wrote, or the file it verified.
-        let listed = match (self.text, &self.options.program_file) {
-            (Some(text), Some(file)) => Some((file.as_str(), text)),
-            _ => page::written_program(&files, plan.control.extension),
-        };
+        let listed = self
+            .listed()
+            .or_else(|| page::written_program(&files, plan.control.extension));
         let html = page::page_of(&report, &files, listed, part_box);
         files.push(("report.html".into(), html.into_bytes()));
         files.push(("report.json".into(), report_json(&report)?));
@@ -863,4 +872,28 @@ impl Run<'_> {
         }
         Ok(())
     }
+}
+
+/// The line (from 1) of the program's own `text` a reading's refusal `e`
+/// stands on: its `line N`, or the first line whose block is its `N`;
+/// none where it is in another file or names no place of the text.
+fn refused_line(e: &crate::program::lint::LintError, text: &str) -> Option<usize> {
+    let place = e.place.split(" in ").next().unwrap_or("");
+    if place.contains(" of ") {
+        return None;
+    }
+    if let Some(n) = place.strip_prefix("line ") {
+        return n.parse().ok();
+    }
+    let n = place
+        .strip_prefix('N')
+        .filter(|n| n.bytes().all(|b| b.is_ascii_digit()))?;
+    text.lines()
+        .position(|l| {
+            l.split_whitespace()
+                .next()
+                .and_then(|w| w.strip_prefix('N'))
+                .is_some_and(|w| w.trim_start_matches('0') == n.trim_start_matches('0'))
+        })
+        .map(|i| i + 1)
 }

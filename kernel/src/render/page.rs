@@ -85,13 +85,17 @@ fn verification(out: &mut String, r: &Report) {
 }
 
 /// The verdict at the top of the page: passed (each figure as a share of
-/// its tolerance), failed (what, where, and that no program was written)
-/// or not verified (the family declares no verification).
+/// its tolerance), failed (what, where, and that no program was written,
+/// or, verifying the user's file, that it does not verify) or not
+/// verified (the family declares no verification).
 fn banner(out: &mut String, r: &Report) {
     use crate::verdict::Status;
     let v = &r.verdict;
     let (class, head) = match v.status {
         Status::Passed => ("passed", "PASSED: every check and figure held"),
+        Status::Failed if r.program_file.is_some() => {
+            ("failed", "FAILED: the program does not verify")
+        }
         Status::Failed => ("failed", "FAILED: no program was written"),
         Status::NotVerified => (
             "unverified",
@@ -288,9 +292,16 @@ fn findings(out: &mut String, class: &str, prefix: &str, list: &[crate::verdict:
     }
     let _ = writeln!(out, "<ul{class}>");
     for f in list {
+        // A finding at a block or a line takes the listing (and the
+        // player) there.
+        let at = match (f.block_index, f.line) {
+            (Some(b), _) => format!(" data-block=\"{}\"", b.saturating_sub(1)),
+            (None, Some(l)) => format!(" data-line=\"{l}\""),
+            _ => String::new(),
+        };
         let _ = writeln!(
             out,
-            "<li>{prefix}<b>{}</b>{}: {}</li>",
+            "<li{at}>{prefix}<b>{}</b>{}: {}</li>",
             escape(&f.rule),
             f.block
                 .as_ref()
@@ -380,7 +391,16 @@ fn listing(out: &mut String, r: &Report, program: Option<(&str, &str)>) {
             Some(l as i64 - std::mem::replace(before, l as i64))
         })
         .collect();
-    let payload = serde_json::json!({ "text": text, "steps": steps }).to_string();
+    // The lines the verdict's failures stand on, marked.
+    let mut marks: Vec<usize> = (r.verdict.failures.iter())
+        .filter_map(|f| match (f.block_index, f.line) {
+            (Some(b), _) => r.program_lines.get(b.checked_sub(1)?).copied(),
+            (None, l) => l,
+        })
+        .collect();
+    marks.sort_unstable();
+    marks.dedup();
+    let payload = serde_json::json!({ "text": text, "steps": steps, "marks": marks }).to_string();
     // Level 3: within 15 % of the best size at a tenth of its time (the
     // caliber's program, in zlib: 0.74 MB in 40 ms, 0.64 MB in 0.5 s).
     let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::new(3));
@@ -401,7 +421,7 @@ const LISTING: &str = "(() => {
   const rows = pane.querySelector('.rows');
   const packed = Uint8Array.from(atob(document.getElementById('program').textContent), c => c.charCodeAt(0));
   const H = 17;
-  let lines = [], blockLine = [], now = -1;
+  let lines = [], blockLine = [], now = -1, marked = new Set();
   const draw = () => {
     const first = Math.max(0, Math.floor(pane.scrollTop / H) - 10);
     const last = Math.min(lines.length, first + Math.ceil(pane.clientHeight / H) + 20);
@@ -413,10 +433,20 @@ const LISTING: &str = "(() => {
       d.dataset.line = n;
       d.style.top = (n - 1) * H + 'px';
       if (n === now) d.className = 'now';
+      else if (marked.has(n)) d.className = 'fail';
       return d;
     }));
   };
   pane.addEventListener('scroll', () => requestAnimationFrame(draw));
+  // A line named (a failure's): highlighted and scrolled into the pane.
+  const goLine = n => {
+    now = n;
+    if (n > 0) pane.scrollTop = (n - 1) * H - pane.clientHeight / 2;
+    draw();
+  };
+  document.addEventListener('pilgrim-line', e => goLine(e.detail));
+  // A block named where no player follows it (a failed reading's page).
+  document.addEventListener('pilgrim-go', e => { if (!document.getElementById('scene')) goLine(blockLine[e.detail] || -1); });
   // The player's block: its line highlighted and scrolled into the pane.
   document.addEventListener('pilgrim-block', e => {
     now = blockLine[e.detail] || -1;
@@ -440,6 +470,8 @@ const LISTING: &str = "(() => {
     if (lines[lines.length - 1] === '') lines.pop();
     let l = 0;
     blockLine = p.steps.map(d => (l += d));
+    marked = new Set(p.marks || []);
+    document.body.dataset.marked = marked.size;
     rows.style.height = lines.length * H + 'px';
     document.body.dataset.listing = lines.length;
     draw();
@@ -635,7 +667,7 @@ fn plots_and_parameters(out: &mut String, inputs: &PageInputs<'_>) {
 fn scripts(out: &mut String, inputs: &PageInputs<'_>) {
     // Whatever names a block (a table's row, a plot's mark) takes the
     // player there, and the view to the machine.
-    out.push_str("<script>\ndocument.querySelectorAll('[data-block]').forEach(el => el.addEventListener('click', () => {\n  document.dispatchEvent(new CustomEvent('pilgrim-go', {detail: +el.dataset.block}));\n  document.querySelector('.twin').scrollIntoView({block: 'start'});\n}));\n// The pass the player is in, lit on the plots that mark passes.\nconst passMarks = [...document.querySelectorAll('.marks .pass')];\ndocument.addEventListener('pilgrim-block', e => passMarks.forEach(m => m.classList.toggle('now', +m.dataset.first <= e.detail && e.detail < +m.dataset.end)));\n</script>\n");
+    out.push_str("<script>\ndocument.querySelectorAll('[data-block]').forEach(el => el.addEventListener('click', () => {\n  document.dispatchEvent(new CustomEvent('pilgrim-go', {detail: +el.dataset.block}));\n  document.querySelector('.twin').scrollIntoView({block: 'start'});\n}));\ndocument.querySelectorAll('[data-line]').forEach(el => el.addEventListener('click', () => {\n  document.dispatchEvent(new CustomEvent('pilgrim-line', {detail: +el.dataset.line}));\n  document.querySelector('.twin').scrollIntoView({block: 'start'});\n}));\n// The pass the player is in, lit on the plots that mark passes.\nconst passMarks = [...document.querySelectorAll('.marks .pass')];\ndocument.addEventListener('pilgrim-block', e => passMarks.forEach(m => m.classList.toggle('now', +m.dataset.first <= e.detail && e.detail < +m.dataset.end)));\n</script>\n");
     if inputs.embedded_scene().is_some() {
         // The state of the 3-D view for whoever watches the page (and the
         // headless check): data-model on <body> becomes "loaded" or "error".
@@ -725,6 +757,7 @@ model-viewer { width: 100%; height: 400px; background: #20262e; display: block; 
 #listing .rows div { position: absolute; left: 0; right: 0; height: 17px; padding: 0 6px; white-space: pre; cursor: pointer; }
 #listing .rows div:hover { background: #eef3ff; }
 #listing .rows div.now { background: #ffe08a; }
+#listing .rows div.fail { background: #ffd0d0; }
 .player { margin: 6px 0; display: flex; gap: 10px; align-items: center; }
 .player input[type=range] { flex: 1; }
 tr[data-block] { cursor: pointer; }

@@ -92,7 +92,8 @@ pub(super) fn replay_on(
             }
         }
         if pass.cuts {
-            let (check, half) = on.pass(pass, rpm, &mut run)?;
+            let (mut check, half) = on.pass(pass, rpm, &mut run)?;
+            check.removed_mm = blank.map(|b| super::removed(&check, out.passes.last(), b, nominal));
             out.passes.push(check);
             half_worst = half;
         }
@@ -254,6 +255,8 @@ impl Setting<'_> {
             deviation: spread.deviation,
             phase_stand_off_mm: stand_off,
             phase_stand_off_z: stand_off_z,
+            removed_mm: None,
+            left_mm: spread.lo.iter().copied().fold(0.0, Real::max),
             along_z: bucketed(&zs, &spread.lo, &spread.hi, PROFILE_BUCKETS),
         };
         Ok((check, spread.half_worst))

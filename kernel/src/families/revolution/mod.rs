@@ -106,6 +106,15 @@ pub struct PassCheck {
     pub phase_stand_off_mm: Real,
     /// Where it is largest (z).
     pub phase_stand_off_z: Real,
+    /// The most it removed under the wheel's path (mm): the surface
+    /// before it (the pass before's, or the blank's) less the one it
+    /// leaves, at the valleys; none where there is no blank.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub removed_mm: Option<Real>,
+    /// The most it leaves above the nominal at the valleys between its
+    /// ridges (mm): the stock for the next pass.
+    #[serde(default)]
+    pub left_mm: Real,
     /// Its surface minus the nominal along z, for drawing: `[z, lowest,
     /// highest]` over the generatrices, in at most [`PROFILE_BUCKETS`]
     /// stretches of z (each the extremes within it, so no ridge is lost).
@@ -267,6 +276,27 @@ pub struct GroundStock {
     block_time: std::collections::BTreeMap<usize, (usize, Real)>,
 }
 
+/// What pass `p` removed (mm): the most, over its stretches along z, of
+/// the surface before it (the pass `before`'s, or the blank's over the
+/// nominal) less the one it leaves, at the valleys.
+fn removed(p: &PassCheck, before: Option<&PassCheck>, blank: &Profile, nominal: &Profile) -> Real {
+    let mut cut: Real = 0.0;
+    for (i, b) in p.along_z.iter().enumerate() {
+        let under = match before {
+            None => (blank.eval(b[0]).ok())
+                .zip(nominal.eval(b[0]).ok())
+                .map(|(x, y)| x - y),
+            Some(q) => (q.along_z.get(i))
+                .filter(|q| (q[0] - b[0]).abs() < crate::tolerance::SAME_LENGTH)
+                .map(|q| q[1]),
+        };
+        if let Some(under) = under {
+            cut = cut.max(under - b[1]);
+        }
+    }
+    cut
+}
+
 impl GroundStock {
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -312,25 +342,12 @@ impl GroundStock {
         // blank before the first.
         let mut passes = Vec::new();
         for (k, p) in check.passes.iter().enumerate() {
-            let mut cut: Real = 0.0;
-            for (i, b) in p.along_z.iter().enumerate() {
-                let before = if k == 0 {
-                    blank
-                        .eval(b[0])
-                        .ok()
-                        .zip(nominal.eval(b[0]).ok())
-                        .map(|(x, y)| x - y)
-                } else {
-                    check.passes[k - 1]
-                        .along_z
-                        .get(i)
-                        .filter(|q| (q[0] - b[0]).abs() < crate::tolerance::SAME_LENGTH)
-                        .map(|q| q[1])
-                };
-                if let Some(before) = before {
-                    cut = cut.max(before - b[1]);
-                }
-            }
+            let cut = removed(
+                p,
+                k.checked_sub(1).map(|j| &check.passes[j]),
+                blank,
+                nominal,
+            );
             passes.push(crate::process::PassStock {
                 name: p.name.clone(),
                 first_block: p.first_block - 1,

@@ -284,6 +284,8 @@ mod tests {
             deviation: d,
             phase_stand_off_mm: 0.0,
             phase_stand_off_z: 0.0,
+            removed_mm: None,
+            left_mm: 0.0,
             along_z,
         }
     }
