@@ -11,6 +11,16 @@ use crate::math::Real;
 use crate::program::cycle::{FanucCycle, FanucRules};
 use crate::program::lint::LintError;
 
+/// Where a Fanuc-kind G76 starts (`[X, Z]` as written, and the two axes'
+/// places) and ends (X, Z), with its lead.
+struct G76End {
+    start: [Real; 2],
+    xz: [usize; 2],
+    x: Real,
+    z: Real,
+    lead: Real,
+}
+
 impl Reader<'_> {
     /// The unit of a cycle's whole-number words (P, Q; R without its
     /// point): the control's least input increment.
@@ -107,15 +117,8 @@ impl Reader<'_> {
             ));
         };
         let need = |c: char, what: &str| fail(format!("G76 without {c}, {what}"));
-        let (start, xz) = self.cycle_ready(at, b, 76)?;
-        let x = Self::cycle_word(said, 'X').map_or(start[0], |(v, _)| v);
-        let z = Self::cycle_word(said, 'Z')
-            .map(|(v, _)| v)
-            .ok_or_else(|| need('Z', "the thread's end"))?;
-        let lead = match Self::cycle_word(said, 'F') {
-            Some((v, _)) => v,
-            None => at.st.lead.ok_or_else(|| need('F', "the lead"))?,
-        };
+        let end = self.g76_end(at, b, said)?;
+        let (x, z, lead) = (end.x, end.z, end.lead);
         let cycle = FanucCycle {
             finishes: f.finishes,
             chamfer_tenths: f.chamfer_tenths,
@@ -131,12 +134,7 @@ impl Reader<'_> {
             lead,
             constant_depth: false,
         };
-        let diameter = self.program.setup.radial == Some(super::Radial::Diameter);
-        let moves = crate::program::cycle::expand_fanuc(&cycle, start, diameter, rules)
-            .map_err(|e| fail(e.message))?;
-        at.st.f = Some(lead);
-        at.st.lead = Some(lead);
-        self.cycle_moves(at, b, &moves, xz, out)
+        self.g76_moves(at, b, &cycle, rules, &end, out)
     }
 
     /// The one-block `G76 X Z I K D A P F` at block `b` (I the taper, K
@@ -204,20 +202,15 @@ impl Reader<'_> {
         };
         let leads = setting("thread_chamfer_leads");
         let tenths = (leads * 10.0).round();
-        if !((0.0..=99.0).contains(&tenths) && (tenths - leads * 10.0).abs() < 1e-9) {
+        if !((0.0..=99.0).contains(&tenths)
+            && (tenths - leads * 10.0).abs() < crate::tolerance::COUNT_SLACK)
+        {
             return Err(fail(format!(
                 "the machine's thread_chamfer_leads {leads}: the verification follows a chamfer of 0 to 9.9 leads, in tenths"
             )));
         }
-        let (start, xz) = self.cycle_ready(at, b, 76)?;
-        let x = Self::cycle_word(said, 'X').map_or(start[0], |(v, _)| v);
-        let z = Self::cycle_word(said, 'Z')
-            .map(|(v, _)| v)
-            .ok_or_else(|| need('Z', "the thread's end"))?;
-        let lead = match Self::cycle_word(said, 'F') {
-            Some((v, _)) => v,
-            None => at.st.lead.ok_or_else(|| need('F', "the lead"))?,
-        };
+        let end = self.g76_end(at, b, said)?;
+        let (x, z, lead) = (end.x, end.z, end.lead);
         let cycle = FanucCycle {
             finishes: 1,
             chamfer_tenths: tenths as u32,
@@ -239,12 +232,51 @@ impl Reader<'_> {
         let rules = FanucRules {
             chamfer_deg: setting("thread_chamfer_deg"),
         };
+        self.g76_moves(at, b, &cycle, &rules, &end, out)
+    }
+
+    /// Where a Fanuc-kind G76 at block `b` (its words `said`) starts and
+    /// ends: the drive line's point and axes, the thread's end (X where
+    /// the cycle writes it, else the start's), the lead (F, else the
+    /// modal one).
+    fn g76_end(&self, at: &Standing, b: &Block, said: &Said) -> Result<G76End, LintError> {
+        let need =
+            |c: char, what: &str| self.err(self.place(b, at.k), format!("G76 without {c}, {what}"));
+        let (start, xz) = self.cycle_ready(at, b, 76)?;
+        let x = Self::cycle_word(said, 'X').map_or(start[0], |(v, _)| v);
+        let z = Self::cycle_word(said, 'Z')
+            .map(|(v, _)| v)
+            .ok_or_else(|| need('Z', "the thread's end"))?;
+        let lead = match Self::cycle_word(said, 'F') {
+            Some((v, _)) => v,
+            None => at.st.lead.ok_or_else(|| need('F', "the lead"))?,
+        };
+        Ok(G76End {
+            start,
+            xz,
+            x,
+            z,
+            lead,
+        })
+    }
+
+    /// A Fanuc-kind G76 `cycle` at block `b` from `end`'s start expanded
+    /// by `rules`, its lead modal after it, its moves pushed to `out`.
+    fn g76_moves(
+        &self,
+        at: &mut Standing,
+        b: &Block,
+        cycle: &FanucCycle,
+        rules: &FanucRules,
+        end: &G76End,
+        out: &mut Vec<ReadMove>,
+    ) -> Result<(), LintError> {
         let diameter = self.program.setup.radial == Some(super::Radial::Diameter);
-        let moves = crate::program::cycle::expand_fanuc(&cycle, start, diameter, &rules)
-            .map_err(|e| fail(e.message))?;
-        at.st.f = Some(lead);
-        at.st.lead = Some(lead);
-        self.cycle_moves(at, b, &moves, xz, out)
+        let moves = crate::program::cycle::expand_fanuc(cycle, end.start, diameter, rules)
+            .map_err(|e| self.err(self.place(b, at.k), e.message))?;
+        at.st.f = Some(end.lead);
+        at.st.lead = Some(end.lead);
+        self.cycle_moves(at, b, &moves, end.xz, out)
     }
 
     /// Fanuc's modal `G92` at block `b`: one pass from where the run of
