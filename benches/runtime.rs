@@ -181,11 +181,8 @@ fn plugin_batch(c: &mut Criterion) {
     g.finish();
 }
 
-/// The time limit the 1M-block verification is given (s).
-const LIMIT_SECONDS: f64 = 1.0;
-
-fn verify_deadline(c: &mut Criterion) {
-    use pilgrim_kernel::job::{self, JobOptions};
+/// The demo family's script and the vertical mill it runs on.
+fn demo_on_mill() -> (ScriptFamily, pilgrim_kernel::catalog::OpenMachine) {
     let family = ScriptFamily::load(
         Path::new("scripts/examples/mill_circle.rhai"),
         &Limits::default(),
@@ -193,7 +190,15 @@ fn verify_deadline(c: &mut Criterion) {
     )
     .unwrap();
     let catalog = pilgrim_kernel::catalog::Catalog::new(&[]).unwrap();
-    let machine = catalog.open("vertical-mill").unwrap();
+    (family, catalog.open("vertical-mill").unwrap())
+}
+
+/// The time limit the 1M-block verification is given (s).
+const LIMIT_SECONDS: f64 = 1.0;
+
+fn verify_deadline(c: &mut Criterion) {
+    use pilgrim_kernel::job::{self, JobOptions};
+    let (family, machine) = demo_on_mill();
     let sources = vec![ParamSource::Pairs {
         label: "the bench".into(),
         pairs: vec![("points".into(), "1000000".into())],
@@ -254,14 +259,7 @@ fn loop_program(plain: &str, n: usize) -> String {
 
 fn verify_loop(c: &mut Criterion) {
     use pilgrim_kernel::job::{self, JobOptions};
-    let family = ScriptFamily::load(
-        Path::new("scripts/examples/mill_circle.rhai"),
-        &Limits::default(),
-        &Access::default(),
-    )
-    .unwrap();
-    let catalog = pilgrim_kernel::catalog::Catalog::new(&[]).unwrap();
-    let machine = catalog.open("vertical-mill").unwrap();
+    let (family, machine) = demo_on_mill();
     let options = JobOptions::default();
     let mut g = c.benchmark_group("verify_loop");
     g.sample_size(10).measurement_time(Duration::from_secs(20));

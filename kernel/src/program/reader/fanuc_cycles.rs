@@ -11,6 +11,22 @@ use crate::math::Real;
 use crate::program::cycle::{FanucCycle, FanucRules};
 use crate::program::lint::LintError;
 
+/// The refusal of the first word of `said` that `cycle` (its name in the
+/// message) has not among its words `allowed`, if there is one.
+fn foreign_word(said: &Said, allowed: &[char], cycle: &str) -> Option<String> {
+    let (c, _, t) = said.read.iter().find(|(c, ..)| !allowed.contains(c))?;
+    let words: Vec<String> = allowed.iter().map(char::to_string).collect();
+    Some(format!(
+        "{t}: not a word of {cycle} ({}); {c} is {}",
+        words.join(" "),
+        if *c == 'U' || *c == 'W' {
+            "incremental, which the verification does not read"
+        } else {
+            "another word"
+        }
+    ))
+}
+
 /// Where a Fanuc-kind G76 starts (`[X, Z]` as written, and the two axes'
 /// places) and ends (X, Z), with its lead.
 struct G76End {
@@ -66,17 +82,13 @@ impl Reader<'_> {
         } else {
             &['P', 'Q', 'R']
         };
-        if let Some((c, _, t)) = said.read.iter().find(|(c, ..)| !allowed.contains(c)) {
-            return Err(fail(format!(
-                "{t}: not a word of G76's {} block ({}); {c} is {}",
-                if second { "second" } else { "first" },
-                allowed.iter().collect::<String>(),
-                if *c == 'U' || *c == 'W' {
-                    "incremental, which the verification does not read"
-                } else {
-                    "another word"
-                }
-            )));
+        let cycle = if second {
+            "G76's second block"
+        } else {
+            "G76's first block"
+        };
+        if let Some(m) = foreign_word(said, allowed, cycle) {
+            return Err(fail(m));
         }
         let whole = |c: char| -> Result<Option<Real>, LintError> {
             match Self::cycle_word(said, c) {
@@ -159,15 +171,8 @@ impl Reader<'_> {
     ) -> Result<(), LintError> {
         let fail = |m: String| self.err(self.place(b, at.k), m);
         let allowed = ['X', 'Z', 'I', 'K', 'D', 'A', 'P', 'F'];
-        if let Some((c, _, t)) = said.read.iter().find(|(c, ..)| !allowed.contains(c)) {
-            return Err(fail(format!(
-                "{t}: not a word of the one-block G76 (X Z I K D A P F); {c} is {}",
-                if *c == 'U' || *c == 'W' {
-                    "incremental, which the verification does not read"
-                } else {
-                    "another word"
-                }
-            )));
+        if let Some(m) = foreign_word(said, &allowed, "the one-block G76") {
+            return Err(fail(m));
         }
         let settings = crate::program::post::ONE_BLOCK_SETTINGS;
         let missing: Vec<String> = (settings.iter())
@@ -296,19 +301,8 @@ impl Reader<'_> {
         if !self.d.reading.g92_thread {
             return Err(fail("G92: not a threading cycle of this dialect".into()));
         }
-        if let Some((c, _, t)) = said
-            .read
-            .iter()
-            .find(|(c, ..)| !['X', 'Z', 'F', 'R'].contains(c))
-        {
-            return Err(fail(format!(
-                "{t}: not a word of G92 (X, Z, F, R); {c} {}",
-                if *c == 'U' || *c == 'W' {
-                    "is incremental, which the verification does not read"
-                } else {
-                    "is another word"
-                }
-            )));
+        if let Some(m) = foreign_word(said, &['X', 'Z', 'F', 'R'], "G92") {
+            return Err(fail(m));
         }
         let (here, xz) = self.cycle_ready(at, b, 92)?;
         let start = *at.st.cycle_start.get_or_insert(here);
