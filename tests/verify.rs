@@ -561,3 +561,42 @@ fn parameters_not_the_defaults_are_listed_with_their_source() {
     let verified = report(&out.with_extension("verify"));
     assert_eq!(verified["parameters"]["tolerance"]["from"], "--set");
 }
+
+/// A program that grinds only part of the nominal (the default program
+/// against a working part 50 mm longer) is verified on what it covers and
+/// says, as a finding of its report, the stretch it does not: never an
+/// exception without a report.
+#[test]
+fn a_program_covering_part_of_the_nominal_says_what_it_leaves() {
+    let out = default_run("mandrel", "cover");
+    let file = out.parent().unwrap().join("SHORT.MPF");
+    std::fs::copy(out.join("program.mpf"), &file).unwrap();
+    let (code, _, err) = pilgrim(&[
+        "verify",
+        s(&file),
+        "--family",
+        "scripts/mandrel.rhai",
+        "--set",
+        "l_r=450",
+    ]);
+    assert_eq!(code, 1, "{err}");
+    let said = "the program does not grind the nominal over z = 472.000 to 490.000 mm";
+    assert!(err.contains(said), "{err}");
+    let report: Value = serde_json::from_str(
+        &std::fs::read_to_string(page_named(&err).with_file_name("report.json")).unwrap(),
+    )
+    .unwrap();
+    let failures = report["verdict"]["failures"].as_array().unwrap();
+    assert!(failures
+        .iter()
+        .any(|f| f["rule"] == "the program grinds the whole nominal"
+            && f["message"].as_str().unwrap().contains(said)));
+    let finish = report["verification"]["passes"]
+        .as_array()
+        .unwrap()
+        .last()
+        .unwrap()
+        .clone();
+    assert_eq!(finish["uncovered"][0][0].as_f64(), Some(472.0));
+    assert!(finish["deviation"]["at_z"].as_f64().unwrap() <= 472.0);
+}

@@ -182,6 +182,9 @@ struct Spread {
     /// The least and the greatest over the generatrices at each z (mm).
     lo: Vec<Real>,
     hi: Vec<Real>,
+    /// Whether any generatrix has been ground at each z, by this pass or
+    /// an earlier one.
+    touched: Vec<bool>,
 }
 
 impl Setting<'_> {
@@ -245,6 +248,15 @@ impl Setting<'_> {
                 d.max_above >= -d.max_below
             })?;
         let f = if rpm > 0.0 { cutting_feed / rpm } else { 0.0 };
+        // What is judged: where the part has been ground.
+        let kept = |v: &[Real]| -> Vec<Real> {
+            v.iter()
+                .zip(&spread.touched)
+                .filter(|(_, t)| **t)
+                .map(|(x, _)| *x)
+                .collect()
+        };
+        let (zs_kept, lo_kept, hi_kept) = (kept(&zs), kept(&spread.lo), kept(&spread.hi));
         let check = PassCheck {
             name: pass.name.clone(),
             first_block: blocks.start + 1,
@@ -256,8 +268,9 @@ impl Setting<'_> {
             phase_stand_off_mm: stand_off,
             phase_stand_off_z: stand_off_z,
             removed_mm: None,
-            left_mm: spread.lo.iter().copied().fold(0.0, Real::max),
-            along_z: bucketed(&zs, &spread.lo, &spread.hi, PROFILE_BUCKETS),
+            left_mm: lo_kept.iter().copied().fold(0.0, Real::max),
+            uncovered: stretches(&zs, &spread.touched),
+            along_z: bucketed(&zs_kept, &lo_kept, &hi_kept, PROFILE_BUCKETS),
         };
         Ok((check, spread.half_worst))
     }
@@ -378,14 +391,21 @@ impl Setting<'_> {
         let (mut half_above, mut half_below) = (Real::NEG_INFINITY, Real::INFINITY);
         let mut lo = vec![Real::INFINITY; zs.len()];
         let mut hi = vec![Real::NEG_INFINITY; zs.len()];
+        // Where some generatrix has been ground, by this pass or before.
+        let mut touched = vec![false; zs.len()];
         for (g, env) in envs.iter().enumerate() {
             crate::budget::check("the grinding replay")?;
             let surface = env.eval_many(zs);
-            let under = cut_into(before, &earlier[met[g]], zs);
+            let (under, reached) = cut_into(before, &earlier[met[g]], zs);
             for (i, ((&z, &s), &p)) in zs.iter().zip(&surface).zip(profile).enumerate() {
                 // Where the sweep never reaches, the pass leaves what was
-                // there (a pass may cover a stretch only); where nothing
-                // was, no surface is known.
+                // there (a pass may cover a stretch only); where no pass
+                // has reached so far, the program has not ground the part
+                // there: not judged, but said ([`PassCheck::uncovered`]).
+                if !s.is_finite() && !reached[i] {
+                    continue;
+                }
+                touched[i] = true;
                 let left = if s.is_finite() {
                     s.min(under[i])
                 } else {
@@ -407,6 +427,9 @@ impl Setting<'_> {
                 }
             }
         }
+        if !touched.iter().any(|&t| t) {
+            return Err(self.never_reached(pass, met[0], self.range.0));
+        }
         let half_worst = if half_above >= -half_below {
             half_above.abs()
         } else {
@@ -425,6 +448,7 @@ impl Setting<'_> {
             half_worst,
             lo,
             hi,
+            touched,
         })
     }
 
@@ -487,19 +511,43 @@ impl Setting<'_> {
     }
 }
 
+/// The stretches `[from, to]` of `zs` where `touched` is false: where no
+/// pass has ground the part.
+fn stretches(zs: &[Real], touched: &[bool]) -> Vec<[Real; 2]> {
+    let mut out: Vec<[Real; 2]> = Vec::new();
+    let mut open: Option<Real> = None;
+    for (i, (&z, &t)) in zs.iter().zip(touched).enumerate() {
+        match (t, open) {
+            (false, None) => open = Some(z),
+            (true, Some(from)) => {
+                out.push([from, zs[i - 1]]);
+                open = None;
+            }
+            _ => {}
+        }
+    }
+    if let (Some(from), Some(&to)) = (open, zs.last()) {
+        out.push([from, to]);
+    }
+    out
+}
+
 /// The surface a sweep cuts into at `zs`: the lowest of the blank
 /// (`before`) and the generatrix's `earlier` sweeps (those not finite where
-/// they never reached: there they do not bound).
-fn cut_into(before: &[Real], earlier: &Sweeps, zs: &[Real]) -> Vec<Real> {
+/// they never reached: there they do not bound); and where any of those
+/// sweeps reached.
+fn cut_into(before: &[Real], earlier: &Sweeps, zs: &[Real]) -> (Vec<Real>, Vec<bool>) {
     let mut under = before.to_vec();
+    let mut reached = vec![false; zs.len()];
     for (e, _) in earlier {
-        for (u, s) in under.iter_mut().zip(e.eval_many(zs)) {
+        for ((u, r), s) in under.iter_mut().zip(&mut reached).zip(e.eval_many(zs)) {
             if s.is_finite() {
                 *u = u.min(s);
+                *r = true;
             }
         }
     }
-    under
+    (under, reached)
 }
 
 /// A pass's sweeps (`envs`, on the generatrices `met`, touched as `t`

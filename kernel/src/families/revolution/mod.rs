@@ -115,6 +115,11 @@ pub struct PassCheck {
     /// ridges (mm): the stock for the next pass.
     #[serde(default)]
     pub left_mm: Real,
+    /// The stretches of z `[from, to]` (mm) of the range checked that
+    /// neither this pass nor any before it has ground: not judged, and
+    /// said where it is the finish.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub uncovered: Vec<[Real; 2]>,
     /// Its surface minus the nominal along z, for drawing: `[z, lowest,
     /// highest]` over the generatrices, in at most [`PROFILE_BUCKETS`]
     /// stretches of z (each the extremes within it, so no ridge is lost).
@@ -585,9 +590,32 @@ impl GrindingCheck {
                 None => f,
             }
         });
-        (vec![figure], failure.into_iter().collect())
+        // What the program does not grind: verified on what it covers.
+        let uncovered = (!finish.uncovered.is_empty()).then(|| {
+            let stretches: Vec<String> = (finish.uncovered.iter())
+                .map(|[a, b]| {
+                    format!(
+                        "z = {} to {} mm",
+                        crate::math::fixed(*a, 3),
+                        crate::math::fixed(*b, 3)
+                    )
+                })
+                .collect();
+            Finding::new(
+                COVERAGE,
+                format!(
+                    "the program does not grind the nominal over {}: no pass's wheel reaches it (the rest is verified on what the program covers); extend the passes over it, or verify a nominal of what it grinds",
+                    stretches.join(", ")
+                ),
+            )
+        });
+        (vec![figure], failure.into_iter().chain(uncovered).collect())
     }
 }
+
+/// The rule of a grinding program that leaves a stretch of the nominal
+/// unground.
+pub const COVERAGE: &str = "the program grinds the whole nominal";
 
 /// The family, as the registry carries it.
 pub const FAMILY: super::Family = super::Family {

@@ -286,6 +286,7 @@ mod tests {
             phase_stand_off_z: 0.0,
             removed_mm: None,
             left_mm: 0.0,
+            uncovered: Vec::new(),
             along_z,
         }
     }
