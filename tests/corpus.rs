@@ -130,7 +130,8 @@ fn fanuc_programs_verify_as_their_plain_twins() {
 /// `WHILE` loop, the finishing pass a subprogram called by its name
 /// (`FINISH.SPF` beside it, ended by `M17`): verified as its plain twin;
 /// arcs by their radius and angle and a switch to diameter programming
-/// among the moves, as their twin by the arcs' centres.
+/// among the moves (both in exact stop, G60), as their twin by the arcs'
+/// centres; the continuous-path mode G64 refused.
 #[test]
 fn sinumerik_programs_verify_as_their_plain_twins() {
     let dir = scratch("corpus", "sinumerik");
@@ -187,6 +188,10 @@ fn sinumerik_programs_verify_as_their_plain_twins() {
         (
             "sinumerik/refused/arc_i_on_diameter.mpf",
             "G3 with I under diameter programming",
+        ),
+        (
+            "sinumerik/refused/g64.mpf",
+            "N1: G64 (continuous-path mode, its corners blended off the programmed points on sinumerik)",
         ),
     ] {
         let (code, err, _) = verified(&dir, file, "3K152VF20", "scripts/mandrel.rhai");

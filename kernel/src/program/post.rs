@@ -368,7 +368,9 @@ pub const SINUMERIK: Dialect = Dialect {
         point_needed: "",
         no_point: "",
         code_tenths: false,
-        read_g_codes: &[2, 3],
+        // G9 and G60, exact stop (the replay's path through every
+        // block's end point): read as the verification models them.
+        read_g_codes: &[2, 3, 9, 60],
         g76: None,
         g92_thread: false,
         // Programming Manual, Fundamentals, "List of G functions": group 6
@@ -400,6 +402,26 @@ pub const SINUMERIK: Dialect = Dialect {
             ("M0", "a programmed stop"),
             ("M4", "the spindle counter-clockwise"),
             ("M17", "the end of a subprogram"),
+            (
+                "G64",
+                "continuous-path mode, its corners blended off the programmed points",
+            ),
+            (
+                "G641",
+                "continuous-path mode with smoothing by distance (ADIS)",
+            ),
+            (
+                "G642",
+                "continuous-path mode with smoothing within the axes' tolerances",
+            ),
+            (
+                "G643",
+                "continuous-path mode with smoothing within the block",
+            ),
+            (
+                "G644",
+                "continuous-path mode with smoothing by the axes' dynamics",
+            ),
         ],
         macros: Some(MacroReading {
             language: MacroLanguage::Sinumerik,
@@ -591,7 +613,9 @@ pub const LINUXCNC: Dialect = Dialect {
         point_needed: "",
         no_point: "",
         code_tenths: true,
-        read_g_codes: &[],
+        // G61, exact path mode (the replay's path through every block's
+        // end point): read as the verification models it.
+        read_g_codes: &[61],
         g76: Some(G76Form::LinuxCnc),
         g92_thread: false,
         // G-code reference, "Modal groups": 2 (plane), 6 (units), 7
@@ -615,6 +639,11 @@ pub const LINUXCNC: Dialect = Dialect {
             ("G4", "a dwell"),
             ("G20", "inch units"),
             ("G33.1", "rigid tapping (it reverses the spindle)"),
+            ("G61.1", "exact stop mode"),
+            (
+                "G64",
+                "path blending, its corners cut off the programmed points",
+            ),
             ("G41", "cutter compensation left"),
             ("G42", "cutter compensation right"),
             ("G91", "incremental distance"),
