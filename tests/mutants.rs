@@ -323,6 +323,10 @@ enum Effect {
     Setup(u32),
     /// LinuxCNC's lathe diameter (G7) or radius (G8) mode.
     Radial(bool),
+    /// Exact stop or exact path (Sinumerik's G9 and G60, LinuxCNC's
+    /// G61): the path through every block's end point, which the replay
+    /// models; it changes nothing read.
+    Exact,
     /// The spindle on (M3) or stopped (M5).
     Spindle(bool),
     /// The coolant on (M8) or off (M9).
@@ -373,8 +377,9 @@ use Kind::*;
 /// 6; G54..G59 group 8; G71 group 13; G90 group 14; G94 group 15; a G
 /// function is a whole number), "Thread cutting with constant lead (G33)"
 /// (Z with the lead K, modal with G33; `SF=` the start offset, modal),
-/// "Feedrate (G93, G94, G95, F...)" (F modal), "M functions" (M3, M5, M30;
-/// M8/M9 the coolant, the machine maker's).
+/// "Feedrate (G93, G94, G95, F...)" (F modal), "Exact stop (G60, G9)"
+/// (group 10 and non-modal: the path through each end point), "M
+/// functions" (M3, M5, M30; M8/M9 the coolant, the machine maker's).
 const SINUMERIK: Rules = Rules {
     g: &[
         (0, Motion(Rapid)),
@@ -392,6 +397,8 @@ const SINUMERIK: Rules = Rules {
         (71, Setup(71)),
         (90, Setup(90)),
         (94, Setup(94)),
+        (9, Exact),
+        (60, Exact),
     ],
     m: &[
         (3, Spindle(true)),
@@ -454,7 +461,7 @@ const FANUC: Rules = Rules {
 
 /// LinuxCNC G-code reference, "G Codes" (G0, G1, G33 with K each block;
 /// G7 lathe diameter mode, G8 radius mode; G17..G19; G21; G40; G54..G59;
-/// G90; G94; G97), "M Codes" (M2 end, M3, M5, M8, M9), "Numbers" (a code
+/// G90; G94; G97; G61 exact path), "M Codes" (M2 end, M3, M5, M8, M9), "Numbers" (a code
 /// is read to a tenth: `G1.0` is G1). The reference for a changed reading
 /// is its own interpreter, rs274 (a sample left for CI).
 const LINUXCNC: Rules = Rules {
@@ -478,6 +485,7 @@ const LINUXCNC: Rules = Rules {
         (90, Setup(90)),
         (94, Setup(94)),
         (97, Setup(97)),
+        (61, Exact),
     ],
     m: &[
         (2, End),
@@ -659,6 +667,7 @@ fn expect_line(
                             at.stated.push(c);
                         }
                     }
+                    Exact => {}
                     Radial(diameter) => {
                         if at.moved || at.radial.is_some() {
                             return Err(format!("{w}: diameter or radius among the moves"));
