@@ -897,3 +897,32 @@ fn refused_line(e: &crate::program::lint::LintError, text: &str) -> Option<usize
         })
         .map(|i| i + 1)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::refused_line;
+    use crate::program::lint::LintError;
+
+    /// A refusal's line: its `line N`, or the line its `N` opens; none in
+    /// a subprogram's file or where the text has no such block.
+    #[test]
+    fn a_refusal_is_placed_on_its_line() {
+        let text = "%\nO0001\nN10 G00 X1.\nN020 G01 Z2.\n%\n";
+        let at = |place: &str| {
+            refused_line(
+                &LintError {
+                    what: "reading",
+                    dialect: "fanuc".into(),
+                    place: place.into(),
+                    message: String::new(),
+                },
+                text,
+            )
+        };
+        assert_eq!(at("line 2"), Some(2));
+        assert_eq!(at("N10"), Some(3));
+        assert_eq!(at("N20 in \"pass 1\""), Some(4));
+        assert_eq!(at("N10 of O2000"), None);
+        assert_eq!(at("N99"), None);
+    }
+}

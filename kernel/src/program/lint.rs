@@ -478,7 +478,8 @@ mod tests {
 
     /// The bounds of a reading are exact: a loop of MAX_TURNS turns is
     /// read, one turn more is refused; calls MAX_CALL_DEPTH deep are
-    /// followed, one deeper is refused.
+    /// followed, one deeper is refused; MAX_FILES files beside the program
+    /// are read, one more is refused.
     #[test]
     fn the_reading_bounds_are_exact() {
         use crate::program::macros::{MAX_CALL_DEPTH, MAX_TURNS};
@@ -516,6 +517,34 @@ mod tests {
         let e = nested(MAX_CALL_DEPTH + 1).unwrap_err().to_string();
         assert!(
             e.contains(&format!("calls nested deeper than {MAX_CALL_DEPTH}")),
+            "{e}"
+        );
+        // Each call of another file beside the program: MAX_FILES of them
+        // are read, one more is refused.
+        use crate::program::macros::MAX_FILES;
+        let beside = |name: &str| -> Result<Option<String>, crate::files::FileError> {
+            Ok(name
+                .strip_prefix('O')
+                .filter(|n| n.len() == 4 && !name.contains('.'))
+                .map(|n| format!("%\nO{n}\nM99\n%\n")))
+        };
+        let files = |n: usize| {
+            let calls: String = (1..=n).map(|k| format!("M98 P{}\n", 2000 + k)).collect();
+            read_with(
+                &fanuc_with(&calls, ""),
+                &frame,
+                &FANUC,
+                &axes(),
+                None,
+                Some(&beside),
+                None,
+            )
+        };
+        let read = files(MAX_FILES).unwrap();
+        assert_eq!((read.program.blocks, read.files.len()), (moves, MAX_FILES));
+        let e = files(MAX_FILES + 1).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("more than {MAX_FILES} subprogram files")),
             "{e}"
         );
     }
