@@ -21,7 +21,7 @@
 //!
 //! [`ArcReading`]: crate::program::post::ArcReading
 
-use super::{placed, Block, ReadMove, Reader, Said, Standing};
+use super::{Block, ReadMove, Reader, Said, Standing};
 use crate::math::Real;
 use crate::program::lint::LintError;
 use crate::toolpath::Motion;
@@ -316,7 +316,6 @@ impl Reader<'_> {
             first = false;
             at.k += 1;
         }
-        debug_assert_eq!(placed(&at.st).len(), going.len());
         Ok(())
     }
 }
