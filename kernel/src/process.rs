@@ -42,8 +42,8 @@
 //!   feed move into or through the material moves at most the feed per
 //!   revolution its family allows there ([`Stock::feed_limit`]: a
 //!   grinding family's finishing pass the feed whose ridge is the
-//!   tolerance, any pass the wheel's width), named at the block that
-//!   wrote the feed;
+//!   tolerance, any pass the wheel's width), wherever along the move the
+//!   tool is in the material, named at the block that wrote the feed;
 //! - **a ridge taller than the cut** ([`RIDGE`], a warning): a pass whose
 //!   feed leaves ridges taller than its cut leaves the surface before it
 //!   untouched at the crests.
@@ -267,7 +267,7 @@ pub fn check(
     let ends = crate::replay::replay(&written, machine, tool)?;
     let speeds: Vec<Real> = crate::program::spindle_speeds(program).collect();
     // The block that last broke the feed rule, and its feed: the blocks
-    // after it at the same modal feed are the same fault.
+    // right after it at the same modal feed are the same fault, not told.
     let mut fast: Option<(usize, Real)> = None;
     let mut ticker = crate::budget::Ticker::new("the process's rules", 64);
     for k in 1..n {
@@ -320,8 +320,25 @@ pub fn check(
                 // straight along the move: a feed move is short, and the
                 // material smooth on its scale).
                 let (d0, d1) = (stock.tool_depth(k, p0), stock.tool_depth(k, p1));
-                if d0 > 0.0 || d1 > 0.0 {
-                    feed_rule(program, stock, k, b.feed, speeds[k], &mut fast, &mut out);
+                // Too fast for the family's limit, and in the material
+                // anywhere along the move (its ends may both be clear).
+                if let Some((per_rev, limit)) = over_feed_limit(stock, k, b.feed, speeds[k]) {
+                    let steps = substeps(length, limits.rapid_clearance.max(0.05));
+                    let mut cuts = d0 > 0.0 || d1 > 0.0;
+                    for i in 1..steps {
+                        if cuts {
+                            break;
+                        }
+                        cuts = stock.tool_depth(k, &pose_at(k, i as Real / steps as Real)?) > 0.0;
+                    }
+                    if cuts {
+                        let told = fast.is_some_and(|(j, f)| j + 1 == k && f == b.feed);
+                        fast = Some((k, b.feed));
+                        if !told {
+                            out.errors
+                                .push(too_fast(program, k, b.feed, speeds[k], per_rev, &limit));
+                        }
+                    }
                 }
                 let deeper = d1 - d0.max(0.0);
                 let inside = if d0 >= 0.0 {
@@ -358,47 +375,43 @@ pub fn check(
     Ok(out)
 }
 
-/// Block `k`'s cutting move at `feed` (mm/min) and `rpm` against the feed
-/// per revolution `stock`'s family allows there; `fast` the last block
-/// found too fast and its feed (a modal feed's later blocks are not told
-/// again).
-fn feed_rule(
-    program: &AxisProgram,
+/// The feed per revolution of block `k` at `feed` (mm/min) and `rpm`,
+/// with the limit `stock`'s family sets there, where it is over it.
+fn over_feed_limit(
     stock: &dyn Stock,
     k: usize,
     feed: Real,
     rpm: Real,
-    fast: &mut Option<(usize, Real)>,
-    out: &mut ProcessFindings,
-) {
-    let Some(limit) = stock.feed_limit(k).filter(|_| rpm > 0.0) else {
-        return;
-    };
+) -> Option<(Real, FeedLimit)> {
+    let limit = stock.feed_limit(k).filter(|_| rpm > 0.0)?;
     let per_rev = feed / rpm;
-    if per_rev <= limit.per_rev * (1.0 + crate::tolerance::LIMIT_SLACK) {
-        return;
-    }
-    let told = fast.is_some_and(|(b, f)| b + 1 == k && f == feed);
-    *fast = Some((k, feed));
-    if told {
-        return;
-    }
+    (per_rev > limit.per_rev * (1.0 + crate::tolerance::LIMIT_SLACK)).then_some((per_rev, limit))
+}
+
+/// The finding of block `k`'s cut at `feed` and `rpm`, `per_rev` over
+/// `limit`.
+fn too_fast(
+    program: &AxisProgram,
+    k: usize,
+    feed: Real,
+    rpm: Real,
+    per_rev: Real,
+    limit: &FeedLimit,
+) -> Finding {
     let name = block_name(program, k);
-    out.errors.push(
-        Finding::new(
-            FEED,
-            format!(
-                "{name}: F{} at S{} is {} mm per revolution, more than {} mm: {} (at most F{} at this speed)",
-                crate::math::fixed(feed, 1),
-                crate::math::fixed(rpm, 0),
-                crate::math::fixed(per_rev, 4),
-                crate::math::fixed(limit.per_rev, 4),
-                limit.why,
-                crate::math::fixed((limit.per_rev * rpm * 10.0).floor() / 10.0, 1),
-            ),
-        )
-        .at(k, name),
-    );
+    Finding::new(
+        FEED,
+        format!(
+            "{name}: F{} at S{} is {} mm per revolution, more than {} mm: {} (at most F{} at this speed)",
+            crate::math::fixed(feed, 1),
+            crate::math::fixed(rpm, 0),
+            crate::math::fixed(per_rev, 4),
+            crate::math::fixed(limit.per_rev, 4),
+            limit.why,
+            crate::math::fixed((limit.per_rev * rpm * 10.0).floor() / 10.0, 1),
+        ),
+    )
+    .at(k, name)
 }
 
 /// The spindle and coolant before every cutting block (as written: a
@@ -680,6 +693,70 @@ fn finishing(
                 block_name(program, w.first_block),
             )
             .at_block(w.first_block),
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::machine::Machine;
+    use crate::program::{frame, Block};
+
+    /// Material only within 1 mm of x = 0, every move's feed limited to
+    /// 1 mm a revolution.
+    struct Ridge;
+
+    impl Stock for Ridge {
+        fn tool_depth(&self, _block: usize, pose: &[Real]) -> Real {
+            1.0 - pose[0].abs()
+        }
+        fn passes(&self) -> Vec<PassStock> {
+            Vec::new()
+        }
+        fn feed_limit(&self, _block: usize) -> Option<FeedLimit> {
+            Some(FeedLimit {
+                per_rev: 1.0,
+                why: "the test's limit".into(),
+            })
+        }
+    }
+
+    /// A feed move whose ends are both clear of the material but which
+    /// passes through it is held to the feed rule: the rule looks along
+    /// the whole move, not at its ends only.
+    #[test]
+    fn a_move_through_the_material_is_held_to_its_feed() {
+        let mill = crate::machine::ChainMachine::new(Machine::builtin("vertical-mill").unwrap());
+        let mut p = frame(MachineKinematics::info(&mill));
+        p.spindle_rpm = 100.0;
+        let block = |motion, x: Real, feed| Block {
+            motion,
+            values: vec![x, 0.0, 0.0, 0.0],
+            feed,
+            spindle: None,
+            comment: None,
+            keep: Vec::new(),
+            number: None,
+        };
+        p.blocks = vec![
+            block(Motion::Rapid, -10.0, 0.0),
+            block(Motion::Linear, 10.0, 6000.0),
+        ];
+        let found = check(
+            &p,
+            &mill,
+            &ToolFrame::default(),
+            Some(&Ridge),
+            &ProcessLimits::DEFAULT,
+        )
+        .unwrap();
+        let fast: Vec<&Finding> = found.errors.iter().filter(|f| f.rule == FEED).collect();
+        assert_eq!(fast.len(), 1, "{:?}", found.errors);
+        assert!(
+            fast[0].message.contains("60.0000 mm per revolution"),
+            "{}",
+            fast[0].message
         );
     }
 }
