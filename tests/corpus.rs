@@ -69,6 +69,15 @@ fn figures(report: &serde_json::Value) -> serde_json::Value {
     v
 }
 
+/// `file` of the corpus refused on `machine` against `family`: exit 1, a
+/// message that says `says`, and no Rust text in it.
+fn refused(dir: &Path, file: &str, machine: &str, family: &str, says: &str) {
+    let (code, err, _) = verified(dir, file, machine, family);
+    assert_eq!(code, 1, "{file}: {err}");
+    assert!(err.contains(says), "{file}: {err}");
+    assert_eq!(crate::common::rust_text(&err), None, "{file}: {err}");
+}
+
 /// `a` and `b` alike, every number within `tol`: `what` in the message.
 fn alike(a: &serde_json::Value, b: &serde_json::Value, tol: f64, what: &str) {
     use serde_json::Value::{Array, Number, Object};
@@ -194,10 +203,7 @@ fn sinumerik_programs_verify_as_their_plain_twins() {
             "N1: G64 (continuous-path mode, its corners blended off the programmed points on sinumerik)",
         ),
     ] {
-        let (code, err, _) = verified(&dir, file, "3K152VF20", "scripts/mandrel.rhai");
-        assert_eq!(code, 1, "{file}: {err}");
-        assert!(err.contains(says), "{file}: {err}");
-        assert_eq!(crate::common::rust_text(&err), None, "{file}: {err}");
+        refused(&dir, file, "3K152VF20", "scripts/mandrel.rhai", says);
     }
 }
 
@@ -228,10 +234,7 @@ fn what_is_not_read_is_refused_by_name() {
             "G42 (tool nose radius compensation right",
         ),
     ] {
-        let (code, err, _) = verified(&dir, file, "fanuc-0i-tc", "scripts/thread.rhai");
-        assert_eq!(code, 1, "{file}: {err}");
-        assert!(err.contains(says), "{file}: {err}");
-        assert_eq!(crate::common::rust_text(&err), None, "{file}: {err}");
+        refused(&dir, file, "fanuc-0i-tc", "scripts/thread.rhai", says);
     }
 }
 
@@ -443,9 +446,6 @@ fn a_one_block_g76_verifies_as_its_plain_twin() {
     ] {
         let apart = dir.join(on.file_stem().unwrap());
         std::fs::create_dir_all(&apart).unwrap();
-        let (code, err, _) = verified(&apart, file, s(on), "scripts/thread.rhai");
-        assert_eq!(code, 1, "{file}: {err}");
-        assert!(err.contains(says), "{file}: {err}");
-        assert_eq!(crate::common::rust_text(&err), None, "{file}: {err}");
+        refused(&apart, file, s(on), "scripts/thread.rhai", says);
     }
 }

@@ -522,11 +522,15 @@ mod tests {
             constant_depth: false,
         };
         let round = |v: Real| (v * 1000.0).round() / 1000.0;
-        let got: Vec<(Real, Real)> = fanuc_passes(&first)
-            .unwrap()
-            .into_iter()
-            .map(|(d, s)| (round(d), round(s)))
-            .collect();
+        // Each pass's depth and shift to 0.001 mm, as the manuals print them.
+        let rounded = |c: &FanucCycle| -> Vec<(Real, Real)> {
+            fanuc_passes(c)
+                .unwrap()
+                .into_iter()
+                .map(|(d, s)| (round(d), round(s)))
+                .collect()
+        };
+        let got = rounded(&first);
         let want = [
             (0.400, 0.331),
             (0.566, 0.236),
@@ -543,11 +547,7 @@ mod tests {
             chamfer_tenths: 10,
             ..first
         };
-        let got: Vec<(Real, Real)> = fanuc_passes(&clamped)
-            .unwrap()
-            .into_iter()
-            .map(|(d, s)| (round(d), round(s)))
-            .collect();
+        let got = rounded(&clamped);
         let want = [
             (0.400, 0.331),
             (0.566, 0.236),
@@ -586,11 +586,7 @@ mod tests {
             first: 0.2,
             ..first
         };
-        let got: Vec<Real> = fanuc_passes(&depth)
-            .unwrap()
-            .into_iter()
-            .map(|(d, _)| round(d))
-            .collect();
+        let got: Vec<Real> = rounded(&depth).into_iter().map(|(d, _)| d).collect();
         assert_eq!(got, [0.2, 0.4, 0.6, 0.8, 0.954, 0.974]);
     }
 
