@@ -253,15 +253,25 @@ pub fn check(
     let rows = crate::program::axis_rows(&written, info, &info.solved_axes, 0..n)
         .map_err(|e| crate::replay::VerifyError::Replay(e.to_string()))?;
     let width = info.solved_axes.len();
-    // The tool at `t` of the way through block k's move.
-    let pose_at = |k: usize, t: Real| -> Result<Vec<Real>, crate::replay::VerifyError> {
+    // The tool at `i / steps` of the way through block k's move, for i in
+    // 1..steps: rows of 6, in one call of the machine's kinematics (a
+    // plugin's is a call to another process).
+    let poses_along = |k: usize, steps: usize| -> Result<Vec<Real>, crate::replay::VerifyError> {
         let b = &rows[k * width..(k + 1) * width];
         let a = if k > 0 {
             &rows[(k - 1) * width..k * width]
         } else {
             b
         };
-        let q: Vec<Real> = a.iter().zip(b).map(|(a, b)| a + (b - a) * t).collect();
+        let q: Vec<Real> = (1..steps)
+            .flat_map(|i| {
+                let t = i as Real / steps as Real;
+                a.iter().zip(b).map(move |(a, b)| a + (b - a) * t)
+            })
+            .collect();
+        if q.is_empty() {
+            return Ok(Vec::new());
+        }
         crate::replay::forward_rows(machine, &q, tool, k..k + 1)
     };
     let ends = crate::replay::replay(&written, machine, tool)?;
@@ -283,12 +293,13 @@ pub fn check(
                 // The deepest the move takes the tool where it comes nearer
                 // the material than it started.
                 let mut worst: Option<(Real, Real)> = None;
+                let along = poses_along(k, steps)?;
                 for i in 1..=steps {
                     let t = i as Real / steps as Real;
                     let d = if i == steps {
                         stock.tool_depth(k, p1)
                     } else {
-                        stock.tool_depth(k, &pose_at(k, t)?)
+                        stock.tool_depth(k, &along[6 * (i - 1)..6 * i])
                     };
                     let nearer = d > d0 + RAPID_SLACK;
                     let bad = nearer && (d > RAPID_SLACK || d > -0.99 * limits.rapid_clearance);
@@ -324,13 +335,11 @@ pub fn check(
                 // anywhere along the move (its ends may both be clear).
                 if let Some((per_rev, limit)) = over_feed_limit(stock, k, b.feed, speeds[k]) {
                     let steps = substeps(length, limits.rapid_clearance.max(0.05));
-                    let mut cuts = d0 > 0.0 || d1 > 0.0;
-                    for i in 1..steps {
-                        if cuts {
-                            break;
-                        }
-                        cuts = stock.tool_depth(k, &pose_at(k, i as Real / steps as Real)?) > 0.0;
-                    }
+                    let cuts = d0 > 0.0
+                        || d1 > 0.0
+                        || (poses_along(k, steps)?)
+                            .chunks(6)
+                            .any(|pose| stock.tool_depth(k, pose) > 0.0);
                     if cuts {
                         let told = fast.is_some_and(|(j, f)| j + 1 == k && f == b.feed);
                         fast = Some((k, b.feed));
