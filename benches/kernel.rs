@@ -164,6 +164,7 @@ fn circle_program(n: usize) -> pilgrim_kernel::program::AxisProgram {
                 comment: (i == 0).then(|| "circle".to_owned()),
                 keep: Vec::new(),
                 number: None,
+                line: None,
             }
         })
         .collect();
@@ -180,6 +181,7 @@ fn circle_program(n: usize) -> pilgrim_kernel::program::AxisProgram {
         blocks,
         setup: ProgramSetup::default(),
         cycles: Vec::new(),
+        fanuc_cycles: Vec::new(),
     }
 }
 

@@ -19,6 +19,17 @@ fn run(name: &str, args: &[&str]) -> PathBuf {
     out
 }
 
+/// The built-in lathe with a LinuxCNC control, written into `dir`: its
+/// file.
+fn linuxcnc_lathe(dir: &std::path::Path) -> PathBuf {
+    let (code, toml, err) = pilgrim(&["machines", "--toml", "fanuc-0i-tc"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(toml.contains("control = \"fanuc\""), "{toml}");
+    let machine = dir.join("lathe.toml");
+    std::fs::write(&machine, crate::common::with_control(&toml, "linuxcnc")).unwrap();
+    machine
+}
+
 /// What a standard prints for a thread (mm): its pitch diameter's, its
 /// crest's and its root's limits, and its flanks (deg).
 struct Printed {
@@ -425,11 +436,7 @@ fn a_left_hand_is_cut_towards_the_tailstock() {
 #[test]
 fn a_g76_cycle_is_verified_as_the_control_makes_it() {
     let dir = scratch("thread", "g76-machine");
-    let (code, toml, err) = pilgrim(&["machines", "--toml", "fanuc-0i-tc"]);
-    assert_eq!(code, 0, "{err}");
-    assert!(toml.contains("control = \"fanuc\""), "{toml}");
-    let machine = dir.join("lathe.toml");
-    std::fs::write(&machine, crate::common::with_control(&toml, "linuxcnc")).unwrap();
+    let machine = linuxcnc_lathe(&dir);
     let sets = ["--set", "cycle=g76", "--set", "designation=Tr40x14(P7)"];
     let mut args = vec!["--machine", s(&machine), "--post", "fanuc"];
     args.extend(sets);
@@ -464,8 +471,8 @@ fn a_g76_cycle_is_verified_as_the_control_makes_it() {
             "cycle=g76",
             "--set",
             "flank_order=radial",
-            "--post",
-            "linuxcnc",
+            "--machine",
+            s(&machine),
         ],
     );
     let text = std::fs::read_to_string(radial.join("program.ngc")).unwrap();
@@ -535,6 +542,157 @@ fn a_g76_cycle_is_verified_as_the_control_makes_it() {
         .starts_with("program.n")));
 }
 
+/// On a control of Fanuc's kind (the default lathe), `cycle = g76` writes
+/// Fanuc's two-block G76, one per start: Tr40x14(P7) by a 30 degree tool,
+/// `m` = finish_passes + 1 passes at the full height, its passes those of
+/// the two-block law computed here from the words the file holds (D_n =
+/// dd sqrt(n), at least dd_min more, capped at k - d; each shifted towards
+/// the start by (k - D_n) tan 15 deg), both starts within their pitch
+/// diameter's band. The file verified as it stands gives the run's
+/// figures; with start 1's root edited 0.1 mm deeper it fails, naming the
+/// cycle's line (the file has no N words). A buttress is
+/// refused by a check naming the tool angle, and cut straight in (P..00)
+/// with flank_order radial.
+#[test]
+fn fanuc_g76_is_written_for_a_fanuc_lathe() {
+    let out = run(
+        "fanuc-g76",
+        &["--set", "cycle=g76", "--set", "designation=Tr40x14(P7)"],
+    );
+    let r = common::report_of(&out);
+    assert_eq!(r["verdict"]["status"], "passed", "{}", r["verdict"]);
+    let nc = std::fs::read_to_string(out.join("program.nc")).unwrap();
+    let firsts: Vec<&str> = nc.lines().filter(|l| l.starts_with("G76 P")).collect();
+    let seconds: Vec<&str> = nc.lines().filter(|l| l.starts_with("G76 X")).collect();
+    assert!(
+        firsts.len() == 2 && seconds.len() == 2 && !nc.contains("G32"),
+        "{nc}"
+    );
+    assert!(firsts.iter().all(|l| l.starts_with("G76 P030030 ")), "{nc}");
+    let w = |c: char| word(seconds[0], c).unwrap();
+    let unit = 0.001;
+    let (x, k, dd, lead) = (w('X'), w('P') * unit, w('Q') * unit, w('F'));
+    let dd_min = word(firsts[0], 'Q').unwrap() * unit;
+    let allowance = word(firsts[0], 'R').unwrap();
+    assert_eq!(lead, 14.0);
+    let mut law = Vec::new();
+    let mut last: f64 = 0.0;
+    for n in 1.. {
+        let d = (dd * f64::from(n).sqrt())
+            .max(last + dd_min)
+            .min(k - allowance);
+        law.push(d);
+        if d >= k - allowance {
+            break;
+        }
+        last = d;
+    }
+    law.extend([k; 3]);
+    let v = &r["thread_verification"];
+    let l = &v["limits"]["pitch_diameter"];
+    let (lo, hi) = (l["min"].as_f64().unwrap(), l["max"].as_f64().unwrap());
+    let passes = v["passes"].as_array().unwrap();
+    let tan = 15f64.to_radians().tan();
+    for start in 0..2 {
+        let of: Vec<&serde_json::Value> = passes.iter().filter(|p| p["start"] == start).collect();
+        assert_eq!(of.len(), law.len(), "start {start}");
+        let full = of.last().unwrap()["offset"].as_f64().unwrap();
+        for (n, (p, d)) in of.iter().zip(&law).enumerate() {
+            // The control's moves are in its least increment.
+            let px = p["x"].as_f64().unwrap();
+            assert!(
+                (px - (x + 2.0 * (k - d))).abs() < 6e-4,
+                "start {start} pass {}: X {px}, depth {d}",
+                n + 1
+            );
+            let shift = p["offset"].as_f64().unwrap() - full;
+            assert!(
+                (shift - (k - d) * tan).abs() < 1.1e-3,
+                "start {start} pass {}: shift {shift}",
+                n + 1
+            );
+        }
+        let d2 = v["starts"][start]["pitch_diameter"].as_f64().unwrap();
+        assert!(lo <= d2 && d2 <= hi, "{lo} {d2} {hi}");
+    }
+    // Read back as it stands: the same figures.
+    let dir = scratch("thread", "fanuc-g76-verify");
+    let verify = |file: &std::path::Path, name: &str| {
+        let report = dir.join(name);
+        let (code, _, err) = pilgrim(&[
+            "verify",
+            s(file),
+            "--family",
+            SCRIPT,
+            "--out",
+            s(&report),
+            "--quiet",
+            "--set",
+            "cycle=g76",
+            "--set",
+            "designation=Tr40x14(P7)",
+        ]);
+        (code, err, report)
+    };
+    let (code, err, report) = verify(&out.join("program.nc"), "as-it-stands");
+    assert_eq!(code, 0, "{err}");
+    let again = common::report_of(&report);
+    for start in 0..2 {
+        assert_eq!(
+            again["thread_verification"]["starts"][start]["pitch_diameter"],
+            v["starts"][start]["pitch_diameter"]
+        );
+    }
+    // Start 1's root edited 0.1 mm deeper: refused at the cycle's line.
+    let deeper = dir.join("deeper.nc");
+    let line = nc.lines().position(|l| l == seconds[0]).unwrap() + 1;
+    let edited = seconds[0].replacen(&format!("X{x:.3}"), &format!("X{:.3}", x - 0.2), 1);
+    std::fs::write(&deeper, nc.replacen(seconds[0], &edited, 1)).unwrap();
+    let (code, err, _) = verify(&deeper, "deeper");
+    assert_ne!(code, 0, "a root 0.1 mm deeper verified");
+    assert!(
+        err.contains(&format!("line {line} in \"START 1, G76 PASS 1\""))
+            && err.contains("beyond the nominal thread space"),
+        "{err}"
+    );
+    // A buttress: no Fanuc tool angle for flanks of 45 and 7 degrees.
+    let buttress = scratch("thread", "fanuc-g76-buttress").join("out");
+    let (code, _, err) = pilgrim(&[
+        "run",
+        SCRIPT,
+        "--out",
+        s(&buttress),
+        "--quiet",
+        "--set",
+        "cycle=g76",
+        "--set",
+        "designation=2-8 BUTT 7/45",
+    ]);
+    assert_ne!(code, 0);
+    assert!(
+        err.contains("Fanuc's G76 has the thread's tool angle")
+            && err.contains("flank_order = radial"),
+        "{err}"
+    );
+    let radial = run(
+        "fanuc-g76-radial",
+        &[
+            "--set",
+            "cycle=g76",
+            "--set",
+            "designation=2-8 BUTT 7/45",
+            "--set",
+            "flank_order=radial",
+        ],
+    );
+    let text = std::fs::read_to_string(radial.join("program.nc")).unwrap();
+    assert!(
+        text.lines().any(|l| l.starts_with("G76 P")
+            && word(l, 'P').is_some_and(|p| (p as u64).is_multiple_of(100))),
+        "{text}"
+    );
+}
+
 /// A script whose verify map gives the nut's outside as text is refused,
 /// naming the key and the value, and writes nothing.
 #[test]
@@ -598,6 +756,7 @@ fn a_worm_named_by_its_designation_is_cut_on_its_curved_flanks() {
         "ZI flanks {worst} mm off the involute helicoid"
     );
     // G76 on LinuxCNC: straight in, one cycle per start.
+    let lathe = linuxcnc_lathe(&scratch("thread", "worm-zi-g76-machine"));
     let g76 = run(
         "worm-zi-g76",
         &[
@@ -605,8 +764,8 @@ fn a_worm_named_by_its_designation_is_cut_on_its_curved_flanks() {
             "scripts/examples/thread-worm-zi.toml",
             "--set",
             "cycle=g76",
-            "--post",
-            "linuxcnc",
+            "--machine",
+            s(&lathe),
         ],
     );
     let ngc = std::fs::read_to_string(g76.join("program.ngc")).unwrap();

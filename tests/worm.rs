@@ -97,6 +97,7 @@ fn read_nc(nc: &str, rpm: f64) -> AxisProgram {
             comment: comment.take(),
             keep: vec![],
             number: None,
+            line: None,
         });
     }
     let axis = |n: &str| ProgramAxis {
@@ -116,6 +117,7 @@ fn read_nc(nc: &str, rpm: f64) -> AxisProgram {
         blocks,
         setup: Default::default(),
         cycles: Vec::new(),
+        fanuc_cycles: Vec::new(),
     }
 }
 

@@ -329,6 +329,15 @@ pub enum ParamError {
     },
 }
 
+/// What a text parameter names as its `machine` to read the machine's
+/// control (its dialect's name, `fanuc`, `linuxcnc`, ...): the run sets
+/// it, and refuses another value.
+pub const MACHINE_CONTROL: &str = "control";
+
+/// Where [`resolve_traced`] says a value came from when it is the spec's
+/// default.
+pub const DEFAULT_SOURCE: &str = "its default";
+
 /// The values of the parameters `specs`: defaults (a machine constant's
 /// value for a parameter tied to one that `constants` has), then each
 /// source in order; then every value against its spec's bounds.
@@ -374,7 +383,7 @@ pub fn resolve_traced(
                 })?
             }
             None => {
-                came_from.insert(s.name.clone(), "its default".into());
+                came_from.insert(s.name.clone(), DEFAULT_SOURCE.into());
                 s.default.clone()
             }
         };

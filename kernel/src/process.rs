@@ -747,6 +747,7 @@ mod tests {
             comment: None,
             keep: Vec::new(),
             number: None,
+            line: None,
         };
         p.blocks = vec![
             block(Motion::Rapid, -10.0, 0.0),

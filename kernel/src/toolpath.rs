@@ -114,7 +114,18 @@ pub struct PassCycle {
     /// How many passes.
     pub passes: usize,
     /// The cycle's words.
-    pub cycle: pilgrim_plugin_abi::types::ThreadCycle,
+    pub cycle: CycleWords,
+}
+
+/// A threading cycle's words, in the form of the control whose cycle it
+/// is: a program for that control writes the cycle, any other its moves.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "form", rename_all = "snake_case")]
+pub enum CycleWords {
+    /// LinuxCNC's `G76 P Z I J R K Q H`.
+    Linuxcnc(pilgrim_plugin_abi::types::ThreadCycle),
+    /// Fanuc's two-block `G76`.
+    FanucTwoBlock(pilgrim_plugin_abi::types::FanucThreadCycle),
 }
 
 /// A chart a run draws (`<file>.svg`) from one of the toolpath's tables:

@@ -681,6 +681,7 @@ mod tests {
             comment: None,
             keep: Vec::new(),
             number: None,
+            line: None,
         };
         p.blocks = vec![block(a), block(b)];
         p
@@ -718,6 +719,7 @@ mod tests {
                 comment: None,
                 keep: Vec::new(),
                 number: None,
+                line: None,
             })
             .collect();
         let solids = Solids {

@@ -404,11 +404,40 @@ pub fn params_traced(
             }
         }
     }
-    Ok(crate::params::resolve_traced(
-        family.params(),
-        &constants,
-        sources,
-    )?)
+    let (mut values, mut came_from) =
+        crate::params::resolve_traced(family.params(), &constants, sources)?;
+    let control = &machine.kinematics.info().control;
+    for s in family.params() {
+        if s.machine.as_deref() != Some(crate::params::MACHINE_CONTROL) {
+            continue;
+        }
+        let from = came_from.get(&s.name).cloned().unwrap_or_default();
+        match values.get(&s.name) {
+            Some(ParamValue::Text(t)) if t == control || from == crate::params::DEFAULT_SOURCE => {}
+            Some(ParamValue::Text(t)) => {
+                return Err(crate::params::ParamError::Bad {
+                    name: s.name.clone(),
+                    source_name: from,
+                    message: format!(
+                        "'{}' is not the machine's control ({control}): the parameter reads the machine's; choose the machine instead",
+                        crate::files::excerpt(t)
+                    ),
+                }
+                .into())
+            }
+            _ => {
+                return Err(crate::params::ParamError::Bad {
+                    name: s.name.clone(),
+                    source_name: "the family".into(),
+                    message: "a parameter that reads the machine's control must be text".into(),
+                }
+                .into())
+            }
+        }
+        values.insert(s.name.clone(), ParamValue::Text(control.clone()));
+        came_from.insert(s.name.clone(), "the machine's control".into());
+    }
+    Ok((values, came_from))
 }
 
 /// [`run`] of the program the run builds (`text` `None`), or [`verify`] of

@@ -24,7 +24,7 @@
 
 use crate::math::Real;
 use crate::toolpath::Motion;
-pub use pilgrim_plugin_abi::types::{CycleSpan, ThreadCycle};
+pub use pilgrim_plugin_abi::types::{CycleSpan, FanucCycleSpan, FanucThreadCycle, ThreadCycle};
 
 /// The most passes one cycle may make ((K / J)^R is refused above it).
 pub const MAX_CYCLE_PASSES: usize = 10_000;
@@ -199,46 +199,73 @@ fn expand_text(
     Ok(moves)
 }
 
-/// Fanuc's two-block threading cycle (`G76 P(m)(r)(a) Q(dd_min) R(d)`,
-/// then `G76 X Z R(i) P(k) Q(dd) F(L)`) as its words give it, every length
-/// a radius in mm (the words' least input units converted) but `x`, the
-/// thread's end as the program writes X.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FanucCycle {
-    /// m: the finishing passes at the full height.
-    pub finishes: u32,
-    /// r: the chamfer at the end, in tenths of the lead (0 to 99).
-    pub chamfer_tenths: u32,
-    /// a: the tool's angle (deg): 80, 60, 55, 30, 29 or 0.
-    pub angle_deg: Real,
-    /// dd_min: the least depth a roughing pass adds.
-    pub min_cut: Real,
-    /// d: the finishing allowance.
-    pub allowance: Real,
-    /// X: the thread's end at its full height (as the program writes X).
-    pub x: Real,
-    /// Z: the thread's end.
-    pub z: Real,
-    /// i: the taper, the radius at the start minus at the end.
-    pub taper: Real,
-    /// k: the thread's height.
-    pub height: Real,
-    /// dd: the first pass's depth.
-    pub first: Real,
-    /// L: the lead.
-    pub lead: Real,
-    /// Whether the roughing passes cut a constant depth (`D_n = n dd`,
-    /// the one-block form's P3) rather than a constant area (`D_n = dd
-    /// sqrt(n)`, the two-block form and P1).
-    pub constant_depth: bool,
-}
-
 /// How a control of Fanuc's kind moves where its manual leaves room: the
 /// chamfer's pull-out angle (deg from the axis; 45 on the 0i).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FanucRules {
     /// The pull-out's angle.
     pub chamfer_deg: Real,
+}
+
+/// The rules pilgrim's own Fanuc cycles are expanded by: they write no
+/// chamfer (the thread runs out over the toolpath's S2), so the control's
+/// pull-out angle never enters.
+pub const OWN_FANUC_RULES: FanucRules = FanucRules { chamfer_deg: 45.0 };
+
+/// Decimals of a Fanuc cycle's lengths: its least input increment (IS-B,
+/// 0.001 mm), in which its `P` and `Q` words are whole numbers.
+pub const FANUC_DECIMALS: usize = 3;
+
+/// `c` with each word rounded as its blocks write it ([`fanuc_blocks`]):
+/// lengths to [`FANUC_DECIMALS`], the lead to [`WORD_DECIMALS`], the
+/// angle to a whole degree.
+pub fn fanuc_as_written(c: &FanucThreadCycle) -> FanucThreadCycle {
+    let r = |v: Real, d: usize| (v * 10f64.powi(d as i32)).round() / 10f64.powi(d as i32);
+    let mm = |v: Real| r(v, FANUC_DECIMALS);
+    FanucThreadCycle {
+        angle_deg: c.angle_deg.round(),
+        min_cut: mm(c.min_cut),
+        allowance: mm(c.allowance),
+        x: mm(c.x),
+        z: mm(c.z),
+        taper: mm(c.taper),
+        height: mm(c.height),
+        first: mm(c.first),
+        lead: r(c.lead, WORD_DECIMALS),
+        ..*c
+    }
+}
+
+/// The two blocks of Fanuc's `G76` for `c` (as written: [`fanuc_as_written`]):
+/// `G76 P(m)(r)(a) Q(dd_min) R(d)` and `G76 X Z [R(i)] P(k) Q(dd) F(L)`,
+/// `P` and `Q` whole numbers of the least input increment, `R` with its
+/// point.
+pub fn fanuc_blocks(c: &FanucThreadCycle) -> [String; 2] {
+    let mm = |v: Real| crate::math::fixed(v, FANUC_DECIMALS);
+    let units = |v: Real| format!("{:.0}", v * 10f64.powi(FANUC_DECIMALS as i32));
+    let taper = if c.taper == 0.0 {
+        String::new()
+    } else {
+        format!(" R{}", mm(c.taper))
+    };
+    [
+        format!(
+            "G76 P{:02}{:02}{:02} Q{} R{}",
+            c.finishes,
+            c.chamfer_tenths,
+            c.angle_deg as u32,
+            units(c.min_cut),
+            mm(c.allowance)
+        ),
+        format!(
+            "G76 X{} Z{}{taper} P{} Q{} F{}",
+            mm(c.x),
+            mm(c.z),
+            units(c.height),
+            units(c.first),
+            crate::math::fixed(c.lead, WORD_DECIMALS)
+        ),
+    ]
 }
 
 /// The passes of Fanuc's two-block G76: each pass's depth below the crest
@@ -254,11 +281,11 @@ pub struct FanucRules {
 /// A word the control refuses (a height or first depth not above 0, the
 /// allowance not below the height, an angle not of the list, no finishing
 /// pass) or more than [`MAX_CYCLE_PASSES`] passes.
-pub fn fanuc_passes(c: &FanucCycle) -> Result<Vec<(Real, Real)>, super::ProgramFault> {
+pub fn fanuc_passes(c: &FanucThreadCycle) -> Result<Vec<(Real, Real)>, super::ProgramFault> {
     fanuc_passes_text(c).map_err(super::ProgramFault::new)
 }
 
-fn fanuc_passes_text(c: &FanucCycle) -> Result<Vec<(Real, Real)>, String> {
+fn fanuc_passes_text(c: &FanucThreadCycle) -> Result<Vec<(Real, Real)>, String> {
     for (w, v) in [
         ("P(k)", c.height),
         ("Q(dd)", c.first),
@@ -343,7 +370,7 @@ fn fanuc_passes_text(c: &FanucCycle) -> Result<Vec<(Real, Real)>, String> {
 /// # Failures
 /// As [`fanuc_passes`].
 pub fn expand_fanuc(
-    c: &FanucCycle,
+    c: &FanucThreadCycle,
     start: [Real; 2],
     diameter: bool,
     rules: &FanucRules,
@@ -507,7 +534,7 @@ mod tests {
     /// depths, the shifts towards the start, the clamp and the chamfer.
     #[test]
     fn fanuc_g76_worked_examples() {
-        let first = FanucCycle {
+        let first = FanucThreadCycle {
             finishes: 2,
             chamfer_tenths: 0,
             angle_deg: 60.0,
@@ -523,7 +550,7 @@ mod tests {
         };
         let round = |v: Real| (v * 1000.0).round() / 1000.0;
         // Each pass's depth and shift to 0.001 mm, as the manuals print them.
-        let rounded = |c: &FanucCycle| -> Vec<(Real, Real)> {
+        let rounded = |c: &FanucThreadCycle| -> Vec<(Real, Real)> {
             fanuc_passes(c)
                 .unwrap()
                 .into_iter()
@@ -542,7 +569,7 @@ mod tests {
             (0.974, 0.0),
         ];
         assert_eq!(got, want);
-        let clamped = FanucCycle {
+        let clamped = FanucThreadCycle {
             min_cut: 0.100,
             chamfer_tenths: 10,
             ..first
@@ -580,7 +607,7 @@ mod tests {
         assert!((last[1].x - 18.052).abs() < 1e-12 && (last[2].z + 30.0).abs() < 1e-12);
         // The one-block form's P3: a constant depth, D_n = n dd, capped at
         // k - d, one finishing pass.
-        let depth = FanucCycle {
+        let depth = FanucThreadCycle {
             constant_depth: true,
             finishes: 1,
             first: 0.2,

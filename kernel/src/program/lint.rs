@@ -248,6 +248,7 @@ fn assemble(read: ReadText, frame: &AxisProgram) -> TextProgram {
                 comment: b.comment,
                 keep,
                 number: b.number,
+                line: u32::try_from(b.via.unwrap_or(b.line) + 1).ok(),
             }
         })
         .collect();
@@ -264,6 +265,7 @@ fn assemble(read: ReadText, frame: &AxisProgram) -> TextProgram {
         blocks,
         setup: frame.setup.clone(),
         cycles: Vec::new(),
+        fanuc_cycles: Vec::new(),
     };
     TextProgram {
         program,
@@ -881,6 +883,7 @@ mod tests {
                 comment: comment.map(str::to_owned),
                 keep: Vec::new(),
                 number: None,
+                line: None,
             };
         let moves = expand(&c, [24.0, 5.0], false, None).unwrap();
         p.blocks = std::iter::once(block(Motion::Rapid, 24.0, 5.0, Some("drive line")))

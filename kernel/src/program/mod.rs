@@ -23,7 +23,7 @@ pub use post::{post, Dialect, PostError, PostProcessor, SharedPost};
 
 use crate::machine::{Axis, AxisKind, MachineError, MachineInfo, MachineKinematics};
 use crate::math::Real;
-use crate::toolpath::{pass_ranges, Motion, Pass, Toolpath, ToolpathError};
+use crate::toolpath::{pass_ranges, CycleWords, Motion, Pass, Toolpath, ToolpathError};
 use std::ops::Range;
 
 /// How near (in the last written digit's units) a value may be to half a
@@ -378,12 +378,15 @@ pub fn block_label(control: &str, index: usize) -> String {
 }
 
 /// The label block `index` (from 0) of `blocks` has in a program in the
-/// dialect `control`: the `N` its text gives it where it was read from a
-/// file ([`Block::number`]), else the writer's ([`block_label`]).
+/// dialect `control`: where it was read from a file, the `N` its text
+/// gives it ([`Block::number`]), else its line (`line 15`,
+/// [`Block::line`]); else the writer's ([`block_label`]).
 pub fn label_in(control: &str, blocks: &[Block], index: usize) -> String {
-    match blocks.get(index).and_then(|b| b.number) {
-        Some(n) => format!("N{n}"),
-        None => block_label(control, index),
+    let b = blocks.get(index);
+    match (b.and_then(|b| b.number), b.and_then(|b| b.line)) {
+        (Some(n), _) => format!("N{n}"),
+        (None, Some(l)) => format!("line {l}"),
+        (None, None) => block_label(control, index),
     }
 }
 
@@ -638,6 +641,7 @@ pub fn build(
             comment: (j == 0).then(|| toolpath.passes[p].name.clone()),
             keep: Vec::new(),
             number: None,
+            line: None,
         });
     }
     let col_axes: Vec<&Axis> = columns.iter().map(|(a, _)| *a).collect();
@@ -645,7 +649,7 @@ pub fn build(
     let names: Vec<&str> = columns.iter().map(|(a, _)| a.name.as_str()).collect();
     let blocks = with_start_and_end(blocks, &names, &info.setup);
     let name_of = |i: usize| name_in(&info.control, &blocks, i);
-    let cycles = cycle_spans(
+    let (cycles, fanuc_cycles) = cycle_spans(
         toolpath,
         &blocks,
         start_blocks(&info.setup),
@@ -741,14 +745,16 @@ pub fn build(
         blocks,
         setup: info.setup.clone(),
         cycles,
+        fanuc_cycles,
     })
 }
 
 /// The toolpath's threading cycles as runs of the program's `blocks`
 /// (the toolpath's own start `offset` blocks after the program's start),
-/// each checked to be the moves its cycle makes from the block before
-/// it: X and Z as the cycle puts them (X on diameter where the machine's
-/// setup programs it so), every other axis standing, within 1 um.
+/// LinuxCNC's and Fanuc's apart, each checked to be the moves its cycle
+/// makes from the block before it: X and Z as the cycle puts them (X on
+/// diameter where the machine's setup programs it so), every other axis
+/// standing, within 1 um.
 fn cycle_spans(
     toolpath: &Toolpath,
     blocks: &[Block],
@@ -756,7 +762,7 @@ fn cycle_spans(
     names: &[&str],
     info: &MachineInfo,
     name_of: &dyn Fn(usize) -> String,
-) -> Result<Vec<cycle::CycleSpan>, ProgramError> {
+) -> Result<(Vec<cycle::CycleSpan>, Vec<cycle::FanucCycleSpan>), ProgramError> {
     let ranges: Vec<std::ops::Range<usize>> = toolpath.pass_ranges().map(|(_, r)| r).collect();
     let diameter = info.setup.radial == Some(pilgrim_plugin_abi::types::Radial::Diameter);
     let (Some(x), Some(z)) = (
@@ -764,7 +770,7 @@ fn cycle_spans(
         names.iter().position(|n| *n == "Z"),
     ) else {
         return match toolpath.cycles.first() {
-            None => Ok(Vec::new()),
+            None => Ok((Vec::new(), Vec::new())),
             Some(_) => Err(ProgramError::Machine {
                 machine: info.name.clone(),
                 message:
@@ -773,7 +779,9 @@ fn cycle_spans(
             }),
         };
     };
-    let mut spans: Vec<cycle::CycleSpan> = Vec::new();
+    let mut linuxcnc: Vec<cycle::CycleSpan> = Vec::new();
+    let mut fanuc: Vec<cycle::FanucCycleSpan> = Vec::new();
+    let mut last_end = 0;
     for c in &toolpath.cycles {
         let (first, last) = (c.first_pass, c.first_pass + c.passes);
         let bad = |block: usize, message: String| ProgramError::Cycle {
@@ -791,33 +799,33 @@ fn cycle_spans(
             ));
         }
         let span = offset + ranges[first].start..offset + ranges[last - 1].end;
-        if span.start == 0
-            || spans
-                .last()
-                .is_some_and(|s| s.first + s.count > span.start - 1)
-        {
+        if span.start == 0 || last_end > span.start - 1 {
             return Err(bad(
                 span.start,
                 "a threading cycle with no move of its own before it (the drive line it starts from)".into(),
             ));
         }
-        if cycle::as_written(&c.cycle) != c.cycle {
+        let before = &blocks[span.start - 1];
+        let start = [before.values[x], before.values[z]];
+        let (moves, rounded) = match &c.cycle {
+            CycleWords::Linuxcnc(w) => (
+                cycle::expand(w, start, diameter, None),
+                (cycle::as_written(w) != *w).then(|| cycle::words(w)),
+            ),
+            CycleWords::FanucTwoBlock(w) => (
+                cycle::expand_fanuc(w, start, diameter, &cycle::OWN_FANUC_RULES),
+                (cycle::fanuc_as_written(w) != *w).then(|| cycle::fanuc_blocks(w).join(" ")),
+            ),
+        };
+        if let Some(words) = rounded {
             return Err(bad(
                 span.start,
                 format!(
-                    "the threading cycle's words are not as a program writes them ({}): round them with the cycle's own rounding",
-                    cycle::words(&c.cycle)
+                    "the threading cycle's words are not as a program writes them ({words}): round them with the cycle's own rounding"
                 ),
             ));
         }
-        let before = &blocks[span.start - 1];
-        let moves = cycle::expand(
-            &c.cycle,
-            [before.values[x], before.values[z]],
-            diameter,
-            None,
-        )
-        .map_err(|m| bad(span.start, m.message))?;
+        let moves = moves.map_err(|m| bad(span.start, m.message))?;
         if moves.len() != span.len() {
             return Err(bad(
                 span.start,
@@ -841,19 +849,27 @@ fn cycle_spans(
                 return Err(bad(
                     i,
                     format!(
-                        "{:?} to X{} Z{}, where the threading cycle makes {:?} to X{} Z{}",
+                        "{} to X{} Z{}, where the threading cycle makes {} to X{} Z{}",
                         b.motion, b.values[x], b.values[z], m.motion, m.x, m.z
                     ),
                 ));
             }
         }
-        spans.push(cycle::CycleSpan {
-            first: span.start,
-            count: span.len(),
-            cycle: c.cycle.clone(),
-        });
+        last_end = span.end;
+        match &c.cycle {
+            CycleWords::Linuxcnc(w) => linuxcnc.push(cycle::CycleSpan {
+                first: span.start,
+                count: span.len(),
+                cycle: w.clone(),
+            }),
+            CycleWords::FanucTwoBlock(w) => fanuc.push(cycle::FanucCycleSpan {
+                first: span.start,
+                count: span.len(),
+                cycle: *w,
+            }),
+        }
     }
-    Ok(spans)
+    Ok((linuxcnc, fanuc))
 }
 
 /// `blocks` (the toolpath's) with the setup's start before them and its end
@@ -875,6 +891,7 @@ fn with_start_and_end(blocks: Vec<Block>, axes: &[&str], setup: &ProgramSetup) -
         comment: None,
         keep,
         number: None,
+        line: None,
     };
     let mut out = Vec::with_capacity(blocks.len() + start_blocks(setup) + setup.retract.len());
     let mut moved: Vec<bool> = vec![false; axes.len()];
@@ -1058,6 +1075,7 @@ pub fn frame(info: &MachineInfo) -> AxisProgram {
         blocks: Vec::new(),
         setup: info.setup.clone(),
         cycles: Vec::new(),
+        fanuc_cycles: Vec::new(),
     }
 }
 
@@ -1160,6 +1178,7 @@ pub(crate) fn test_program() -> AxisProgram {
         comment: comment.map(str::to_owned),
         keep: Vec::new(),
         number: None,
+        line: None,
     };
     AxisProgram {
         name: "DEMO".into(),
@@ -1189,6 +1208,7 @@ pub(crate) fn test_program() -> AxisProgram {
         ],
         setup: ProgramSetup::default(),
         cycles: Vec::new(),
+        fanuc_cycles: Vec::new(),
     }
 }
 
@@ -1287,7 +1307,7 @@ mod tests {
             tp.cycles.push(PassCycle {
                 first_pass: 1,
                 passes: tp.passes.len() - 1,
-                cycle: c.clone(),
+                cycle: crate::toolpath::CycleWords::Linuxcnc(c.clone()),
             });
             tp
         };
@@ -1300,7 +1320,12 @@ mod tests {
         let e = build(&toolpath(&c, 0.01), &lathe, "t")
             .unwrap_err()
             .to_string();
-        assert!(e.contains("where the threading cycle makes"), "{e}");
+        assert!(
+            e.contains("where the threading cycle makes")
+                && e.contains("a rapid")
+                && !e.contains('{'),
+            "{e}"
+        );
         let loose = cycle::ThreadCycle { q: 29.51234, ..c };
         let e = build(&toolpath(&loose, 0.0), &lathe, "t")
             .unwrap_err()

@@ -119,10 +119,10 @@ pub struct Dialect {
     /// control has no word for it (then a program with one is refused,
     /// and a multi-start thread shifts its starts along Z instead).
     pub thread_start: Option<ThreadStart>,
-    /// The word of the threading cycle the dialect writes for a run of
-    /// blocks a cycle makes ([`super::cycle`]: LinuxCNC's `G76`), or
-    /// `None`: the blocks are written one by one.
-    pub thread_cycle: Option<&'static str>,
+    /// The threading cycle the dialect writes for a run of blocks one
+    /// makes ([`super::cycle`]), or `None`: the blocks are written one by
+    /// one (as they are for a cycle of another form).
+    pub thread_cycle: Option<WrittenCycle>,
     /// What the lint reads in a program of this dialect beyond the words
     /// above: the codes it writes, how the program names itself, the
     /// tool word's form.
@@ -218,6 +218,41 @@ pub struct ArcReading {
     pub radius: Option<&'static str>,
     /// The word giving the arc's opening angle in degrees (`AR=`), if any.
     pub angle: Option<&'static str>,
+}
+
+/// The threading cycle a dialect writes where a program's blocks are one's
+/// moves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WrittenCycle {
+    /// LinuxCNC's one block `G76 P Z I J R K Q H` (the program's `cycles`).
+    Linuxcnc,
+    /// Fanuc's two blocks `G76 P(m)(r)(a) Q R` and `G76 X Z P Q F` (the
+    /// program's `fanuc_cycles`).
+    FanucTwoBlock,
+}
+
+/// The threading cycle dialect `d` writes for the run of blocks from `k`
+/// of `program`, if one starts there: how many blocks it makes and its
+/// blocks' text (Fanuc's the least input's whole numbers in `P` and `Q`:
+/// a dialect of another increment writes the moves).
+fn cycle_at(program: &AxisProgram, d: &Dialect, k: usize) -> Option<(usize, Vec<String>)> {
+    match d.thread_cycle? {
+        WrittenCycle::Linuxcnc => {
+            let span = program.cycles.iter().find(|s| s.first == k)?;
+            Some((
+                span.count,
+                vec![format!("G76 {}", super::cycle::words(&span.cycle))],
+            ))
+        }
+        WrittenCycle::FanucTwoBlock => {
+            let unit = 10f64.powi(-(super::cycle::FANUC_DECIMALS as i32));
+            if d.reading.least_input != Some(unit) {
+                return None;
+            }
+            let span = program.fanuc_cycles.iter().find(|s| s.first == k)?;
+            Some((span.count, super::cycle::fanuc_blocks(&span.cycle).to_vec()))
+        }
+    }
 }
 
 /// The form of a dialect's `G76` threading cycle.
@@ -488,9 +523,11 @@ pub const FANUC: Dialect = Dialect {
         decimals: 0,
         modal: false,
     }),
-    thread_cycle: None,
+    thread_cycle: Some(WrittenCycle::FanucTwoBlock),
     reading: Reading {
-        g_codes: &[0, 1, 18, 17, 19, 21, 32, 40, 54, 55, 56, 57, 58, 59, 97, 98],
+        g_codes: &[
+            0, 1, 18, 17, 19, 21, 32, 40, 54, 55, 56, 57, 58, 59, 76, 97, 98,
+        ],
         m_codes: &[3, 5, 8, 9, 30],
         end_code: 30,
         name_line: None,
@@ -504,9 +541,10 @@ pub const FANUC: Dialect = Dialect {
         point_needed: "F",
         no_point: "Q",
         code_tenths: false,
-        // Read in a shop's program: the threading cycles (0i-TC Operator's
-        // Manual, "Multiple threading cycle (G76)", "Threading cycle (G92)").
-        read_g_codes: &[76, 92],
+        // Read in a shop's program: the simple threading cycle (0i-TC
+        // Operator's Manual, "Threading cycle (G92)"); the multiple one
+        // ("Multiple threading cycle (G76)") pilgrim writes too.
+        read_g_codes: &[92],
         g76: Some(G76Form::FanucTwoBlock(super::cycle::FanucRules {
             chamfer_deg: 45.0,
         })),
@@ -595,7 +633,7 @@ pub const LINUXCNC: Dialect = Dialect {
     feed_group: None,
     lead_every_block: true,
     thread_start: None,
-    thread_cycle: Some("G76"),
+    thread_cycle: Some(WrittenCycle::Linuxcnc),
     reading: Reading {
         g_codes: &[
             0, 1, 7, 8, 17, 18, 19, 21, 33, 40, 54, 55, 56, 57, 58, 59, 76, 90, 94, 97,
@@ -737,7 +775,8 @@ pub fn plane_code(p: Plane) -> u32 {
 /// (system A), its threading cycle the one-block `G76 X Z I K D A P F`
 /// (Haas Lathe Operator's Manual, "G76 Threading Cycle, Multiple Pass";
 /// the least cut, the finishing allowance and the chamfer its settings,
-/// which the machine states). pilgrim writes it as it writes Fanuc's.
+/// which the machine states). pilgrim writes Fanuc's words, a threading
+/// cycle's moves as blocks.
 pub const HAAS: Dialect = Dialect {
     name: "haas",
     reading: Reading {
@@ -745,8 +784,13 @@ pub const HAAS: Dialect = Dialect {
         // Haas Lathe Operator's Manual, "G-codes": G92 is the threading
         // cycle there too.
         meanings: FANUC.reading.meanings,
+        // pilgrim writes the one-block G76's moves (its settings are the
+        // machine's), so the cycle is read in a shop's program only.
+        g_codes: &[0, 1, 18, 17, 19, 21, 32, 40, 54, 55, 56, 57, 58, 59, 97, 98],
+        read_g_codes: &[76, 92],
         ..FANUC.reading
     },
+    thread_cycle: None,
     ..FANUC
 };
 
@@ -1050,18 +1094,17 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
         if k < made_by_cycle {
             continue;
         }
-        let span = d
-            .thread_cycle
-            .and_then(|word| Some((word, program.cycles.iter().find(|s| s.first == k)?)));
-        if let (Some((word, span)), Style::GCode) = (span, d.style) {
-            let blocks = program.blocks.get(k..k + span.count).unwrap_or_default();
-            if blocks.len() != span.count || blocks.iter().any(|b| b.spindle.is_some()) {
+        if let (Some((count, texts)), Style::GCode) = (cycle_at(program, d, k), d.style) {
+            let blocks = program.blocks.get(k..k + count).unwrap_or_default();
+            if blocks.len() != count
+                || count < texts.len()
+                || blocks.iter().any(|b| b.spindle.is_some())
+            {
                 return Err(PostError::BadBlock {
                     block: super::name_in(d.name, &program.blocks, k),
                     message: format!(
-                        "a threading cycle over {} blocks, {}",
-                        span.count,
-                        if blocks.len() != span.count {
+                        "a threading cycle over {count} blocks, {}",
+                        if blocks.len() != count {
                             "beyond the program's end"
                         } else {
                             "the spindle's speed changing in it"
@@ -1072,16 +1115,18 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
             if let Some(c) = &b.comment {
                 w.comment(c);
             }
-            w.block(&format!("{word} {}", super::cycle::words(&span.cycle)));
+            for text in &texts {
+                w.block(text);
+            }
             // The cycle's own moves keep their numbers (move i is
             // N(first + i step)), and it leaves the tool at its last.
-            w.skip(span.count - 1);
+            w.skip(count - texts.len());
             let decimals = program.decimals.unwrap_or(d.decimals);
-            for (slot, v) in last_words.iter_mut().zip(&blocks[span.count - 1].values) {
+            for (slot, v) in last_words.iter_mut().zip(&blocks[count - 1].values) {
                 *slot = Some(fixed(*v, decimals));
             }
-            last_motion = Some(word);
-            made_by_cycle = k + span.count;
+            last_motion = Some("G76");
+            made_by_cycle = k + count;
             continue;
         }
         if let Some(c) = &b.comment {

@@ -359,6 +359,7 @@ fn at_place(program: &AxisProgram, place: PosePlace) -> Result<AxisProgram, Scen
         blocks: vec![block],
         setup: program.setup.clone(),
         cycles: Vec::new(),
+        fanuc_cycles: Vec::new(),
     })
 }
 

@@ -5,8 +5,9 @@ use super::bind_offset::rounding_radius;
 use crate::binding::floats::{err, kernel, len_of, number, Column};
 use crate::binding::tool_number;
 use crate::math::Real;
+use crate::program::cycle::FanucThreadCycle;
 use crate::tool::{Tool, ToolShape, Wheel};
-use crate::toolpath::{ClPoint, Motion, Pass, Toolpath};
+use crate::toolpath::{ClPoint, CycleWords, Motion, Pass, Toolpath};
 use rhai::plugin::*;
 use rhai::{Array, EvalAltResult, Map};
 use std::cell::RefCell;
@@ -405,55 +406,182 @@ pub mod toolpath_api {
             q: word("q")?,
             h: h as u32,
         });
-        let mut t = tp.borrow_mut();
-        if !t.aux_names.is_empty() {
-            return err("add_thread_cycle: a toolpath with auxiliary values cannot hold a cycle (its moves carry none)");
-        }
-        let Some(last) = t.passes.last().and_then(|p| p.points.last()).cloned() else {
-            return err("add_thread_cycle: the toolpath has no point yet: the cycle starts where its last pass ends (the drive line)");
-        };
+        let crest_from = cycle.i;
         let scale = if diameter { 2.0 } else { 1.0 };
-        let start = [last.point[0] * scale, last.point[2]];
-        let moves = crate::program::cycle::expand(&cycle, start, diameter, None)
-            .map_err(|m| format!("add_thread_cycle: {m}"))?;
-        let crest = start[0] + cycle.i;
-        let point = |m: &crate::program::cycle::CycleMove| ClPoint {
-            point: [m.x / scale, 0.0, m.z],
-            axis: [0.0, 0.0, 1.0],
-            motion: m.motion,
-            feed: match m.motion {
-                Motion::Thread { lead, .. } => lead * t.spindle_rpm,
-                _ => 0.0,
-            },
-            aux: Vec::new(),
+        cycle_passes(
+            tp,
+            "add_thread_cycle",
+            name,
+            diameter,
+            &|start| crate::program::cycle::expand(&cycle, start, diameter, None),
+            &|start, x| (x - (start[0] + crest_from)).abs() / scale,
+            CycleWords::Linuxcnc(cycle.clone()),
+        )
+    }
+
+    /// The threading cycle a program for `control` (a dialect's name, as
+    /// a parameter reading the machine's control gives it) writes as a
+    /// cycle: `"linuxcnc"` (LinuxCNC's G76, [`add_thread_cycle`]),
+    /// `"fanuc"` (Fanuc's two-block G76, [`add_fanuc_thread_cycle`]), or
+    /// `""`: none, the moves are written as blocks.
+    pub fn written_thread_cycle(control: &str) -> String {
+        use crate::program::post::WrittenCycle;
+        match crate::program::post::dialect(control).and_then(|d| d.thread_cycle) {
+            Some(WrittenCycle::Linuxcnc) => "linuxcnc".into(),
+            Some(WrittenCycle::FanucTwoBlock) => "fanuc".into(),
+            None => String::new(),
+        }
+    }
+
+    /// Appends the passes Fanuc's two-block threading cycle makes from the
+    /// toolpath's last point (its drive line), as [`add_thread_cycle`]
+    /// does LinuxCNC's: its words in `words` (`m` the finishing passes,
+    /// `a` the tool's angle in degrees (80, 60, 55, 30, 29 or 0), `dd_min`
+    /// the least cut, `d` the finishing allowance, `x` the thread's end at
+    /// its full height as the program writes X, `z` its end, `k` the
+    /// thread's height, `dd` the first cut's depth, `f` the lead; lengths
+    /// radial in mm), each rounded as its blocks write it; no chamfer (the
+    /// thread runs out over the toolpath's own run-out), no taper. A
+    /// program for a control of Fanuc's kind writes the cycle as its two
+    /// `G76` blocks; any other, as its moves. Each pass is named `name n`.
+    /// Returns each pass's depth below the crest (radial, mm) and its
+    /// start's shift along Z (mm), as maps `#{ depth, shift }`.
+    #[rhai_fn(return_raw)]
+    pub fn add_fanuc_thread_cycle(
+        tp: &mut ToolpathHandle,
+        name: &str,
+        words: Map,
+        diameter: bool,
+    ) -> Result<Array, Box<EvalAltResult>> {
+        const KEYS: [&str; 9] = ["m", "a", "dd_min", "d", "x", "z", "k", "dd", "f"];
+        kernel(crate::names::check_name("pass name", name))?;
+        if let Some(k) = words.keys().find(|k| !KEYS.contains(&k.as_str())) {
+            return err(format!(
+                "add_fanuc_thread_cycle: unknown key '{k}' (keys: {})",
+                KEYS.join(", ")
+            ));
+        }
+        let word = |k: &str| -> Result<Real, Box<EvalAltResult>> {
+            words
+                .get(k)
+                .and_then(number)
+                .ok_or_else(|| format!("add_fanuc_thread_cycle: '{k}' must be a number").into())
         };
-        let first_pass = t.passes.len();
-        let mut depths = Array::new();
-        let mut passes = Vec::new();
-        for (n, four) in moves.chunks(4).enumerate() {
-            if four.len() < 4 {
-                passes.push(Pass {
-                    name: format!("{name} end"),
-                    points: four.iter().map(point).collect(),
-                });
-                continue;
-            }
-            let depth = (four[2].x - crest).abs() / scale;
-            let mut d = Map::new();
-            d.insert("depth".into(), depth.into());
-            d.insert("shift".into(), (four[0].z - start[1]).into());
-            depths.push(d.into());
+        let m = word("m")?;
+        if !((1.0..=99.0).contains(&m) && m.fract() == 0.0) {
+            return err(format!(
+                "add_fanuc_thread_cycle: m = {m}: the finishing passes must be a whole number from 1 to 99"
+            ));
+        }
+        let a = word("a")?;
+        if ![80.0, 60.0, 55.0, 30.0, 29.0, 0.0].contains(&a) {
+            return err(format!(
+                "add_fanuc_thread_cycle: a = {a}: Fanuc's G76 takes the tool's angle 80, 60, 55, 30, 29 or 0 deg"
+            ));
+        }
+        let cycle = crate::program::cycle::fanuc_as_written(&FanucThreadCycle {
+            finishes: m as u32,
+            chamfer_tenths: 0,
+            angle_deg: a,
+            min_cut: word("dd_min")?,
+            allowance: word("d")?,
+            x: word("x")?,
+            z: word("z")?,
+            taper: 0.0,
+            height: word("k")?,
+            first: word("dd")?,
+            lead: word("f")?,
+            constant_depth: false,
+        });
+        let scale = if diameter { 2.0 } else { 1.0 };
+        cycle_passes(
+            tp,
+            "add_fanuc_thread_cycle",
+            name,
+            diameter,
+            &|start| {
+                crate::program::cycle::expand_fanuc(
+                    &cycle,
+                    start,
+                    diameter,
+                    &crate::program::cycle::OWN_FANUC_RULES,
+                )
+            },
+            &|_, x| cycle.height - (x - cycle.x).abs() / scale,
+            CycleWords::FanucTwoBlock(cycle),
+        )
+    }
+}
+
+/// The passes a threading cycle makes (`expand` from the toolpath's last
+/// point, `[X, Z]` as the program writes them), appended to `tp` as its
+/// passes of four moves (a shorter rest: `name end`) and recorded as the
+/// cycle `words`; each pass's depth below the crest (`depth` of the
+/// start and its cut's X, radial) and its start's shift along Z, as maps
+/// `#{ depth, shift }`. `binding` names the caller in messages.
+#[allow(clippy::type_complexity)]
+fn cycle_passes(
+    tp: &mut ToolpathHandle,
+    binding: &str,
+    name: &str,
+    diameter: bool,
+    expand: &dyn Fn(
+        [Real; 2],
+    )
+        -> Result<Vec<crate::program::cycle::CycleMove>, crate::program::ProgramFault>,
+    depth: &dyn Fn([Real; 2], Real) -> Real,
+    words: CycleWords,
+) -> Result<Array, Box<EvalAltResult>> {
+    let mut t = tp.borrow_mut();
+    if !t.aux_names.is_empty() {
+        return err(format!("{binding}: a toolpath with auxiliary values cannot hold a cycle (its moves carry none)"));
+    }
+    let Some(last) = t.passes.last().and_then(|p| p.points.last()).cloned() else {
+        return err(format!("{binding}: the toolpath has no point yet: the cycle starts where its last pass ends (the drive line)"));
+    };
+    let scale = if diameter { 2.0 } else { 1.0 };
+    let start = [last.point[0] * scale, last.point[2]];
+    let moves = expand(start).map_err(|m| format!("{binding}: {m}"))?;
+    let spindle = t.spindle_rpm;
+    let point = |m: &crate::program::cycle::CycleMove| ClPoint {
+        point: [m.x / scale, 0.0, m.z],
+        axis: [0.0, 0.0, 1.0],
+        motion: m.motion,
+        feed: match m.motion {
+            Motion::Thread { lead, .. } => lead * spindle,
+            _ => 0.0,
+        },
+        aux: Vec::new(),
+    };
+    let first_pass = t.passes.len();
+    let mut depths = Array::new();
+    let mut passes = Vec::new();
+    for (n, four) in moves.chunks(4).enumerate() {
+        let Some(cut) = four
+            .iter()
+            .find(|m| matches!(m.motion, Motion::Thread { .. }))
+            .filter(|_| four.len() == 4)
+        else {
             passes.push(Pass {
-                name: format!("{name} {}", n + 1),
+                name: format!("{name} end"),
                 points: four.iter().map(point).collect(),
             });
-        }
-        t.cycles.push(crate::toolpath::PassCycle {
-            first_pass,
-            passes: passes.len(),
-            cycle,
+            continue;
+        };
+        let mut d = Map::new();
+        d.insert("depth".into(), depth(start, cut.x).into());
+        d.insert("shift".into(), (four[0].z - start[1]).into());
+        depths.push(d.into());
+        passes.push(Pass {
+            name: format!("{name} {}", n + 1),
+            points: four.iter().map(point).collect(),
         });
-        t.passes.extend(passes);
-        Ok(depths)
     }
+    t.cycles.push(crate::toolpath::PassCycle {
+        first_pass,
+        passes: passes.len(),
+        cycle: words,
+    });
+    t.passes.extend(passes);
+    Ok(depths)
 }

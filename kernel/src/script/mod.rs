@@ -507,11 +507,25 @@ impl ScriptFamily {
                     .unwrap_or_default()
             };
             let machine = Some(text("machine")).filter(|m| !m.is_empty());
-            if machine.is_some() && ParamValue::from_constant(0.0, &default).is_err() {
-                return Err(fam.contract(format!(
-                    "parameter '{name}' takes its default from a machine constant, so it must be a number or true/false, not {}",
-                    default.kind()
-                )));
+            let control = machine.as_deref() == Some(crate::params::MACHINE_CONTROL);
+            if machine.is_some()
+                && (if control {
+                    !matches!(default, ParamValue::Text(_))
+                } else {
+                    ParamValue::from_constant(0.0, &default).is_err()
+                })
+            {
+                return Err(fam.contract(if control {
+                    format!(
+                        "parameter '{name}' reads the machine's control, so it must be text, not {}",
+                        default.kind()
+                    )
+                } else {
+                    format!(
+                        "parameter '{name}' takes its default from a machine constant, so it must be a number or true/false, not {}",
+                        default.kind()
+                    )
+                }));
             }
             let bound = |k: &str| -> Result<Option<f64>, FamilyError> {
                 match field(k) {

@@ -735,6 +735,21 @@ pub enum Motion {
     },
 }
 
+impl std::fmt::Display for Motion {
+    /// The motion as a message names it: `a rapid`, `a straight cut`, `a
+    /// thread cut of lead 2.5 mm` (and its start angle where it has one).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Rapid => write!(f, "a rapid"),
+            Self::Linear => write!(f, "a straight cut"),
+            Self::Thread { lead, start_deg } if *start_deg != 0.0 => {
+                write!(f, "a thread cut of lead {lead} mm from {start_deg} deg")
+            }
+            Self::Thread { lead, .. } => write!(f, "a thread cut of lead {lead} mm"),
+        }
+    }
+}
+
 /// An axis of a program.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ProgramAxis {
@@ -770,6 +785,12 @@ pub struct Block {
     /// builds, whose writer numbers it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub number: Option<u32>,
+    /// Since 1.13: the line (from 1) of a program read from a file on
+    /// which the block's move stands (a subprogram's move: the line of its
+    /// call), naming the block where it carries no `N`; `None` for a
+    /// program the host builds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub line: Option<u32>,
 }
 
 /// A program for one machine: named axes in program units (mm, degrees)
@@ -809,6 +830,63 @@ pub struct AxisProgram {
     /// control makes them.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub cycles: Vec<CycleSpan>,
+    /// Since 1.13: runs of blocks Fanuc's two-block threading cycle makes,
+    /// written as its two `G76` blocks on a control of Fanuc's kind, as
+    /// their blocks elsewhere.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fanuc_cycles: Vec<FanucCycleSpan>,
+}
+
+/// Since 1.13: the blocks `first..first + count` of a program, which one
+/// Fanuc two-block threading cycle makes from where the block before them
+/// leaves the tool.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FanucCycleSpan {
+    /// The first block the cycle makes (from 0).
+    pub first: usize,
+    /// How many blocks it makes.
+    pub count: usize,
+    /// The cycle.
+    pub cycle: FanucThreadCycle,
+}
+
+/// Since 1.13: Fanuc's two-block threading cycle (`G76 P(m)(r)(a)
+/// Q(dd_min) R(d)`, then `G76 X Z R(i) P(k) Q(dd) F(L)`) as its words give
+/// it, every length a radius in mm (the words' least input units
+/// converted) but `x`, the thread's end as the program writes X. The
+/// passes: `D_1 = dd`, `D_n = dd sqrt(n)` (or `n dd` at a constant
+/// depth), at least `dd_min` more than the last, capped at `k - d`; then
+/// `m` passes at `k`; pass `n` shifted towards the start by `(k - D_n)
+/// tan(a/2)`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FanucThreadCycle {
+    /// m: the finishing passes at the full height.
+    pub finishes: u32,
+    /// r: the chamfer at the end, in tenths of the lead (0 to 99).
+    pub chamfer_tenths: u32,
+    /// a: the tool's angle (deg): 80, 60, 55, 30, 29 or 0.
+    pub angle_deg: f64,
+    /// dd_min: the least depth a roughing pass adds.
+    pub min_cut: f64,
+    /// d: the finishing allowance.
+    pub allowance: f64,
+    /// X: the thread's end at its full height (as the program writes X).
+    pub x: f64,
+    /// Z: the thread's end.
+    pub z: f64,
+    /// i: the taper, the radius at the start minus at the end.
+    pub taper: f64,
+    /// k: the thread's height.
+    pub height: f64,
+    /// dd: the first pass's depth.
+    pub first: f64,
+    /// L: the lead.
+    pub lead: f64,
+    /// Whether the roughing passes cut a constant depth (`D_n = n dd`,
+    /// the one-block form's P3) rather than a constant area (`D_n = dd
+    /// sqrt(n)`, the two-block form and P1).
+    #[serde(default)]
+    pub constant_depth: bool,
 }
 
 /// Since 1.11: the blocks `first..first + count` of a program, which one

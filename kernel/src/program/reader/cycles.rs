@@ -162,7 +162,7 @@ impl Reader<'_> {
             if bl.motion != mv.motion || off.is_some() {
                 let at = |x: Real| crate::math::fixed(x, decimals + 2);
                 return Err(fail(format!(
-                    "the threading cycle's move {} is {:?} to X{} Z{}, the axis program's {:?} to X{} Z{}",
+                    "the threading cycle's move {} is {} to X{} Z{}, the axis program's {} to X{} Z{}",
                     n + 1,
                     mv.motion,
                     at(mv.x),

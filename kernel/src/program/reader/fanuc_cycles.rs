@@ -8,7 +8,7 @@
 
 use super::{Block, FanucFirst, ReadMove, Reader, Said, Standing};
 use crate::math::Real;
-use crate::program::cycle::{FanucCycle, FanucRules};
+use crate::program::cycle::{FanucRules, FanucThreadCycle};
 use crate::program::lint::LintError;
 
 /// The refusal of the first word of `said` that `cycle` (its name in the
@@ -131,7 +131,7 @@ impl Reader<'_> {
         let need = |c: char, what: &str| fail(format!("G76 without {c}, {what}"));
         let end = self.g76_end(at, b, said)?;
         let (x, z, lead) = (end.x, end.z, end.lead);
-        let cycle = FanucCycle {
+        let cycle = FanucThreadCycle {
             finishes: f.finishes,
             chamfer_tenths: f.chamfer_tenths,
             angle_deg: f.angle_deg,
@@ -216,7 +216,7 @@ impl Reader<'_> {
         }
         let end = self.g76_end(at, b, said)?;
         let (x, z, lead) = (end.x, end.z, end.lead);
-        let cycle = FanucCycle {
+        let cycle = FanucThreadCycle {
             finishes: 1,
             chamfer_tenths: tenths as u32,
             angle_deg: Self::cycle_word(said, 'A').map_or(0.0, |(v, _)| v),
@@ -271,7 +271,7 @@ impl Reader<'_> {
         &self,
         at: &mut Standing,
         b: &Block,
-        cycle: &FanucCycle,
+        cycle: &FanucThreadCycle,
         rules: &FanucRules,
         end: &G76End,
         out: &mut Vec<ReadMove>,

@@ -88,6 +88,7 @@ fn cut_by(
         comment: None,
         keep: vec![],
         number: None,
+        line: None,
     };
     let clear = r_crest + s;
     for p in &passes {
@@ -128,6 +129,7 @@ fn cut_by(
         blocks,
         setup: Default::default(),
         cycles: Vec::new(),
+        fanuc_cycles: Vec::new(),
     };
     let lathe = ChainMachine::new(Machine::from_info(fanuc_0i_tc::describe()).unwrap());
     let req = ThreadRequest {
