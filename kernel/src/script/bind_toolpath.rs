@@ -377,19 +377,7 @@ pub mod toolpath_api {
         diameter: bool,
     ) -> Result<Array, Box<EvalAltResult>> {
         const KEYS: [&str; 8] = ["p", "z", "i", "j", "r", "k", "q", "h"];
-        kernel(crate::names::check_name("pass name", name))?;
-        if let Some(k) = words.keys().find(|k| !KEYS.contains(&k.as_str())) {
-            return err(format!(
-                "add_thread_cycle: unknown key '{k}' (keys: {})",
-                KEYS.join(", ")
-            ));
-        }
-        let word = |k: &str| -> Result<Real, Box<EvalAltResult>> {
-            words
-                .get(k)
-                .and_then(number)
-                .ok_or_else(|| format!("add_thread_cycle: '{k}' must be a number").into())
-        };
+        let word = cycle_word("add_thread_cycle", name, &words, &KEYS)?;
         let h = word("h")?;
         if !(h >= 0.0 && h.fract() == 0.0 && h <= 1000.0) {
             return err(format!(
@@ -454,19 +442,7 @@ pub mod toolpath_api {
         diameter: bool,
     ) -> Result<Array, Box<EvalAltResult>> {
         const KEYS: [&str; 9] = ["m", "a", "dd_min", "d", "x", "z", "k", "dd", "f"];
-        kernel(crate::names::check_name("pass name", name))?;
-        if let Some(k) = words.keys().find(|k| !KEYS.contains(&k.as_str())) {
-            return err(format!(
-                "add_fanuc_thread_cycle: unknown key '{k}' (keys: {})",
-                KEYS.join(", ")
-            ));
-        }
-        let word = |k: &str| -> Result<Real, Box<EvalAltResult>> {
-            words
-                .get(k)
-                .and_then(number)
-                .ok_or_else(|| format!("add_fanuc_thread_cycle: '{k}' must be a number").into())
-        };
+        let word = cycle_word("add_fanuc_thread_cycle", name, &words, &KEYS)?;
         let m = word("m")?;
         if !((1.0..=99.0).contains(&m) && m.fract() == 0.0) {
             return err(format!(
@@ -511,6 +487,34 @@ pub mod toolpath_api {
             CycleWords::FanucTwoBlock(cycle),
         )
     }
+}
+
+/// The reader of the words `words` of a cycle binding (`binding`, for
+/// messages; `name` the passes' name, checked) whose keys are `keys`: each
+/// key's number, or a refusal naming it.
+///
+/// # Failures
+/// A bad pass name or a key not among `keys`.
+#[allow(clippy::type_complexity)]
+fn cycle_word<'a>(
+    binding: &'a str,
+    name: &str,
+    words: &'a Map,
+    keys: &[&str],
+) -> Result<impl Fn(&str) -> Result<Real, Box<EvalAltResult>> + 'a, Box<EvalAltResult>> {
+    kernel(crate::names::check_name("pass name", name))?;
+    if let Some(k) = words.keys().find(|k| !keys.contains(&k.as_str())) {
+        return err(format!(
+            "{binding}: unknown key '{k}' (keys: {})",
+            keys.join(", ")
+        ));
+    }
+    Ok(move |k: &str| -> Result<Real, Box<EvalAltResult>> {
+        words
+            .get(k)
+            .and_then(number)
+            .ok_or_else(|| format!("{binding}: '{k}' must be a number").into())
+    })
 }
 
 /// The passes a threading cycle makes (`expand` from the toolpath's last
