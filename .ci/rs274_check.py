@@ -9,7 +9,8 @@ end the program, and every spindle-synchronised move
 place (X as a radius where the program is on diameter, G7) of the axis
 program's thread blocks, in order, within the program's 0.001 mm; and
 every move, rapid or cut, must be the axis program's block in order (a
-threading cycle's moves, G76, as LinuxCNC makes them). Each axis is
+threading cycle's moves, G76, as LinuxCNC makes them), with the dwells
+(G4) before it the block's `dwell_s`. Each axis is
 found in the canonical call by its name (X Y Z A B C, the order rs274
 writes them). An axis standalone rs274 does not have (the mandrel
 grinder's steady rest U: its axis mask is X Y Z A B C, whatever the INI
@@ -121,6 +122,18 @@ def check(d):
     # (not yet written) stands where it is.
     moves = [l for l in canon if "STRAIGHT_TRAVERSE(" in l or "STRAIGHT_FEED(" in l]
     blocks = program["blocks"]
+    # Every dwell (G4, DWELL(seconds)): its seconds stand before the next
+    # move, as the axis program's block's dwell_s.
+    dwelt, n = 0.0, 0
+    for line in canon:
+        if "DWELL(" in line:
+            dwelt += args(line)[0]
+        elif "STRAIGHT_TRAVERSE(" in line or "STRAIGHT_FEED(" in line:
+            if n < len(blocks) and abs(dwelt - blocks[n].get("dwell_s", 0.0)) > 1e-6:
+                return f"move {n + 1}: a dwell of {dwelt} s before it, the axis program's block {n + 1} says {blocks[n].get('dwell_s', 0.0)}"
+            dwelt, n = 0.0, n + 1
+    if dwelt > 0.0:
+        return f"a dwell of {dwelt} s after the last move"
     if len(moves) != len(blocks):
         return f"{len(moves)} moves read, the axis program has {len(blocks)} blocks"
     for n, (line, b) in enumerate(zip(moves, blocks)):

@@ -165,6 +165,7 @@ fn circle_program(n: usize) -> pilgrim_kernel::program::AxisProgram {
                 keep: Vec::new(),
                 number: None,
                 line: None,
+                dwell_s: 0.0,
             }
         })
         .collect();

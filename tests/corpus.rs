@@ -373,6 +373,97 @@ fn linuxcnc_programs_verify_as_their_plain_twins_and_as_rs274_reads_them() {
     }
 }
 
+/// A dwell (`G4`) in each control's own units: Fanuc's P in milliseconds,
+/// X with its point in seconds, U without one in the least input
+/// increment (0.001 s); Sinumerik's F in seconds and S in turns of the
+/// spindle; LinuxCNC's P in seconds (left for CI's `rs274`, whose DWELL
+/// calls must be the blocks' dwells). Each program verifies as its twin
+/// without the dwells, with the same moves, and its programmed time is the
+/// twin's and the dwells' seconds; the time with the axes' acceleration
+/// is longer by at least as much (the axes stop before a dwell). Fanuc's
+/// refusals: a point in P, a move in the dwell's block, a dwell with no
+/// move after it.
+#[test]
+fn dwells_stand_for_their_time_in_each_controls_units() {
+    let dir = scratch("corpus", "dwell");
+    let lathe = pilgrim_kernel::machine::machine_file(&fanuc_0i_tc::describe(), "its crate");
+    let linuxcnc = dir.join("linuxcnc-lathe.toml");
+    std::fs::write(&linuxcnc, crate::common::with_control(&lathe, "linuxcnc")).unwrap();
+    let thread = "scripts/thread.rhai";
+    for (program, twin, machine, family, seconds) in [
+        (
+            "fanuc/g92_dwell.nc",
+            "fanuc/g92_m20.plain.nc",
+            "fanuc-0i-tc",
+            thread,
+            1.5 + 0.5 + 0.25,
+        ),
+        (
+            "sinumerik/mandrel_dwell.mpf",
+            "sinumerik/mandrel.plain.mpf",
+            "3K152VF20",
+            "scripts/mandrel.rhai",
+            2.0 + 10.0 * 60.0 / 399.0,
+        ),
+        (
+            "linuxcnc/osub_dwell.ngc",
+            "linuxcnc/osub_while.plain.ngc",
+            s(&linuxcnc),
+            thread,
+            1.5 + 12.0 * 0.25,
+        ),
+    ] {
+        let (code, err, report) = verified(&dir, program, machine, family);
+        assert_eq!(code, 0, "{program}: {err}");
+        let (tcode, terr, treport) = verified(&dir, twin, machine, family);
+        assert_eq!(tcode, 0, "{twin}: {terr}");
+        assert_eq!(figures(&report), figures(&treport), "{program}");
+        assert_eq!(report["blocks"], treport["blocks"], "{program}");
+        let minutes = |r: &serde_json::Value, k: &str| r["times"][k].as_f64().unwrap();
+        let programmed = minutes(&report, "programmed_min") - minutes(&treport, "programmed_min");
+        assert!(
+            (programmed * 60.0 - seconds).abs() < 1e-9,
+            "{program}: {} s for dwells of {seconds} s",
+            programmed * 60.0
+        );
+        let accelerated =
+            minutes(&report, "accelerated_min") - minutes(&treport, "accelerated_min");
+        assert!(
+            accelerated * 60.0 >= seconds - 1e-9,
+            "{program}: {accelerated}"
+        );
+    }
+    let exe = std::env::current_exe().unwrap();
+    let left = (exe.ancestors().nth(3).unwrap()).join("linuxcnc-check/corpus-osub_dwell");
+    std::fs::create_dir_all(&left).unwrap();
+    std::fs::copy(
+        corpus().join("linuxcnc/osub_dwell.ngc"),
+        left.join("program.ngc"),
+    )
+    .unwrap();
+    std::fs::copy(
+        dir.join("linuxcnc-osub_dwell.ngc/program.json"),
+        left.join("program.json"),
+    )
+    .unwrap();
+    for (file, says) in [
+        (
+            "fanuc/refused/dwell_point_in_p.nc",
+            "line 7: P1.5: a decimal point in a dwell of milliseconds",
+        ),
+        (
+            "fanuc/refused/dwell_with_move.nc",
+            "Z5.0: another word in a dwell's block, which holds only G4 and its time (X, U or P on fanuc)",
+        ),
+        (
+            "fanuc/refused/dwell_last.nc",
+            "line 23: a dwell of 2 s after the last move",
+        ),
+    ] {
+        refused(&dir, file, "fanuc-0i-tc", thread, says);
+    }
+}
+
 /// What finds Rust's text in a message finds the examples and
 /// passes the control's words.
 #[test]

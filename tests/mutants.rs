@@ -333,6 +333,22 @@ enum Effect {
     Coolant(bool),
     /// The program's end (M30, LinuxCNC's M2).
     End,
+    /// A dwell (G4), in a block of its own: its time by one of the rules'
+    /// dwell addresses.
+    Dwell,
+}
+
+/// The unit of a dwell's address.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Unit {
+    /// Seconds.
+    Seconds,
+    /// Milliseconds, written without a point.
+    Millis,
+    /// Seconds with a point, milliseconds without.
+    ByPoint,
+    /// Turns of the spindle at the speed in force.
+    Turns,
 }
 
 /// A move's kind.
@@ -367,6 +383,8 @@ struct Rules {
     start_q: Option<(char, f64)>,
     /// The codes a program states before its first move.
     stated: &'static [u32],
+    /// A dwell's addresses and their units.
+    dwell: &'static [(char, Unit)],
 }
 
 use Effect::*;
@@ -378,8 +396,10 @@ use Kind::*;
 /// function is a whole number), "Thread cutting with constant lead (G33)"
 /// (Z with the lead K, modal with G33; `SF=` the start offset, modal),
 /// "Feedrate (G93, G94, G95, F...)" (F modal), "Exact stop (G60, G9)"
-/// (group 10 and non-modal: the path through each end point), "M
-/// functions" (M3, M5, M30; M8/M9 the coolant, the machine maker's).
+/// (group 10 and non-modal: the path through each end point), "Dwell time
+/// (G4)" (in a block of its own: F in seconds, S in turns of the master
+/// spindle), "M functions" (M3, M5, M30; M8/M9 the coolant, the machine
+/// maker's).
 const SINUMERIK: Rules = Rules {
     g: &[
         (0, Motion(Rapid)),
@@ -399,6 +419,7 @@ const SINUMERIK: Rules = Rules {
         (94, Setup(94)),
         (9, Exact),
         (60, Exact),
+        (4, Dwell),
     ],
     m: &[
         (3, Spindle(true)),
@@ -414,6 +435,7 @@ const SINUMERIK: Rules = Rules {
     one_f: false,
     start_q: None,
     stated: &[90, 94, 71],
+    dwell: &[('F', Unit::Seconds), ('S', Unit::Turns)],
 };
 
 /// FANUC Series 0i-TC Operator's Manual (B-64114EN), G code system A:
@@ -422,8 +444,10 @@ const SINUMERIK: Rules = Rules {
 /// point programming" (an axis value without a point in the least input
 /// increment, 0.001 mm with decimal-point input off, the factory
 /// setting), "Thread cutting (G32)" (the lead by F, the one modal F; Q the
-/// start angle in 0.001 deg, no decimal point, on its block only), "M
-/// codes" (M03, M05, M08, M09, M30).
+/// start angle in 0.001 deg, no decimal point, on its block only), "Dwell
+/// (G04)" (X or U in seconds with a point, in the least input increment
+/// without; P in milliseconds, no point), "M codes" (M03, M05, M08, M09,
+/// M30).
 const FANUC: Rules = Rules {
     g: &[
         (0, Motion(Rapid)),
@@ -442,6 +466,7 @@ const FANUC: Rules = Rules {
         (59, Offset(59)),
         (97, Setup(97)),
         (98, Setup(98)),
+        (4, Dwell),
     ],
     m: &[
         (3, Spindle(true)),
@@ -457,11 +482,17 @@ const FANUC: Rules = Rules {
     one_f: true,
     start_q: Some(('Q', 1000.0)),
     stated: &[21, 40, 98],
+    dwell: &[
+        ('X', Unit::ByPoint),
+        ('U', Unit::ByPoint),
+        ('P', Unit::Millis),
+    ],
 };
 
 /// LinuxCNC G-code reference, "G Codes" (G0, G1, G33 with K each block;
 /// G7 lathe diameter mode, G8 radius mode; G17..G19; G21; G40; G54..G59;
-/// G90; G94; G97; G61 exact path), "M Codes" (M2 end, M3, M5, M8, M9), "Numbers" (a code
+/// G90; G94; G97; G61 exact path; G4 a dwell of P seconds), "M Codes" (M2
+/// end, M3, M5, M8, M9), "Numbers" (a code
 /// is read to a tenth: `G1.0` is G1). The reference for a changed reading
 /// is its own interpreter, rs274 (a sample left for CI).
 const LINUXCNC: Rules = Rules {
@@ -486,6 +517,7 @@ const LINUXCNC: Rules = Rules {
         (94, Setup(94)),
         (97, Setup(97)),
         (61, Exact),
+        (4, Dwell),
     ],
     m: &[
         (2, End),
@@ -501,6 +533,7 @@ const LINUXCNC: Rules = Rules {
     one_f: false,
     start_q: None,
     stated: &[21, 40, 90, 94],
+    dwell: &[('P', Unit::Seconds)],
 };
 
 fn rules(d: &Dialect) -> &'static Rules {
@@ -530,6 +563,8 @@ struct Expect {
     stated: Vec<u32>,
     ended: bool,
     moved: bool,
+    /// The seconds of the dwells since the last move.
+    dwell: f64,
 }
 
 /// A move as the rules read it.
@@ -541,6 +576,7 @@ struct Move {
     lead: f64,
     start: f64,
     spindle: Option<f64>,
+    dwell: f64,
 }
 
 impl Move {
@@ -557,6 +593,7 @@ impl Move {
             lead,
             start,
             spindle: m.spindle,
+            dwell: m.dwell_s,
         }
     }
 }
@@ -591,7 +628,17 @@ fn expect_line(
     if text == "%" || text.starts_with("%_N_") {
         return Ok(());
     }
-    for (n, t) in tokens(text, d).into_iter().enumerate() {
+    let words = tokens(text, d);
+    let g4 = |t: &Token| {
+        let w = t.text.as_str();
+        w.starts_with('G')
+            && iso(w)
+            && (w[1..].parse::<f64>().ok()).is_some_and(|v| code_number(r, w, &w[1..], v) == Ok(4))
+    };
+    if words.iter().any(g4) {
+        return expect_dwell(r, at, &words);
+    }
+    for (n, t) in words.into_iter().enumerate() {
         let w = t.text.as_str();
         // Sinumerik's own words (the setup's; a start angle).
         if matches!(w, "DIAMOF" | "DIAMON") || w.starts_with("FGROUP(") {
@@ -619,21 +666,7 @@ fn expect_line(
                 continue;
             }
             'G' | 'M' => {
-                let code = if r.code_tenths {
-                    let tenths = value * 10.0;
-                    if number.starts_with(['+', '-']) || (tenths - tenths.round()).abs() > 1e-9 {
-                        return Err(format!("{w}: not a code"));
-                    }
-                    if tenths.round() % 10.0 != 0.0 {
-                        return Err(format!("{w}: a code with tenths the table has not"));
-                    }
-                    (tenths.round() / 10.0) as u32
-                } else {
-                    if !number.chars().all(|c| c.is_ascii_digit()) {
-                        return Err(format!("{w}: a code is a whole number"));
-                    }
-                    value as u32
-                };
+                let code = code_number(r, w, number, value)?;
                 let table = if letter == 'G' { r.g } else { r.m };
                 let Some((_, e)) = table.iter().find(|(c, _)| *c == code) else {
                     return Err(format!("{w}: not in the table"));
@@ -681,6 +714,7 @@ fn expect_line(
                     Spindle(on) => at.spindle = on,
                     Coolant(on) => at.coolant = on,
                     End => at.ended = true,
+                    Dwell => unreachable!("a dwell's block is read apart"),
                 }
                 continue;
             }
@@ -823,7 +857,72 @@ fn expect_line(
         lead: if kind == Thread { lead } else { 0.0 },
         start: if kind == Thread { start } else { 0.0 },
         spindle: at.speed_next.take(),
+        dwell: std::mem::take(&mut at.dwell),
     });
+    Ok(())
+}
+
+/// A code word's number (`number` after its letter, `value` its value)
+/// as the rules read it.
+fn code_number(r: &Rules, w: &str, number: &str, value: f64) -> Result<u32, Refusal> {
+    if r.code_tenths {
+        let tenths = value * 10.0;
+        if number.starts_with(['+', '-']) || (tenths - tenths.round()).abs() > 1e-9 {
+            return Err(format!("{w}: not a code"));
+        }
+        if tenths.round() % 10.0 != 0.0 {
+            return Err(format!("{w}: a code with tenths the table has not"));
+        }
+        Ok((tenths.round() / 10.0) as u32)
+    } else {
+        if !number.chars().all(|c| c.is_ascii_digit()) {
+            return Err(format!("{w}: a code is a whole number"));
+        }
+        Ok(value as u32)
+    }
+}
+
+/// A dwell's block (`words`, a G4 among them) as the rules read it: its
+/// number, G4 and one time, nothing else; the seconds kept for the next
+/// move.
+fn expect_dwell(r: &Rules, at: &mut Expect, words: &[Token]) -> Result<(), Refusal> {
+    let mut time = None;
+    for (n, t) in words.iter().enumerate() {
+        let w = t.text.as_str();
+        if !iso(w) || w[1..].matches('.').count() > 1 {
+            return Err(format!("{w}: not a word in a dwell's block"));
+        }
+        let (letter, number) = (w.chars().next().unwrap(), &w[1..]);
+        let value: f64 = number.parse().map_err(|_| format!("{w}: not a number"))?;
+        if letter == 'N' && n == 0 {
+            continue;
+        }
+        if letter == 'G' && code_number(r, w, number, value) == Ok(4) {
+            continue;
+        }
+        let Some((_, unit)) = r.dwell.iter().find(|(c, _)| *c == letter) else {
+            return Err(format!("{w}: another word in a dwell's block"));
+        };
+        if time.is_some() {
+            return Err(format!("{w}: a second time"));
+        }
+        if value < 0.0 {
+            return Err(format!("{w}: a time below 0"));
+        }
+        let point = number.contains('.');
+        time = Some(match unit {
+            Unit::Seconds => value,
+            Unit::Millis if point => return Err(format!("{w}: milliseconds with a point")),
+            Unit::Millis => value / 1000.0,
+            Unit::ByPoint if point => value,
+            Unit::ByPoint => value / 1000.0,
+            Unit::Turns => match at.speed {
+                Some(s) if at.spindle && s > 0.0 => value * 60.0 / s,
+                _ => return Err(format!("{w}: turns of a spindle that stands")),
+            },
+        });
+    }
+    at.dwell += time.ok_or("a dwell without its time")?;
     Ok(())
 }
 

@@ -98,6 +98,7 @@ fn read_nc(nc: &str, rpm: f64) -> AxisProgram {
             keep: vec![],
             number: None,
             line: None,
+            dwell_s: 0.0,
         });
     }
     let axis = |n: &str| ProgramAxis {

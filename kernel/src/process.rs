@@ -748,6 +748,7 @@ mod tests {
             keep: Vec::new(),
             number: None,
             line: None,
+            dwell_s: 0.0,
         };
         p.blocks = vec![
             block(Motion::Rapid, -10.0, 0.0),

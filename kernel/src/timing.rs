@@ -174,7 +174,9 @@ pub fn times(program: &AxisProgram, info: &MachineInfo, passes: &[ProgramPass]) 
     let mut corner = vec![0.0; n];
     for k in 1..n.saturating_sub(1) {
         let (m, next) = (&moves[k], &moves[k + 1]);
-        if m.length <= 0.0 || next.length <= 0.0 || m.stops || next.stops {
+        // A dwell before the next move stops the axes at this one's end.
+        let dwells = program.blocks[k + 1].dwell_s > 0.0;
+        if m.length <= 0.0 || next.length <= 0.0 || m.stops || next.stops || dwells {
             continue;
         }
         let mut v = m.speed.min(next.speed);
@@ -223,8 +225,14 @@ pub fn times(program: &AxisProgram, info: &MachineInfo, passes: &[ProgramPass]) 
             thread_sync_s += wait;
         }
     }
+    // A block's dwell before its move: the axes stand, the clock runs.
+    for (t, b) in accelerated.iter_mut().zip(&program.blocks) {
+        *t += b.dwell_s;
+    }
     let minutes = |t: &[Real]| t.iter().sum::<Real>() / 60.0;
-    let programmed: Vec<Real> = moves.iter().map(|m| m.programmed).collect();
+    let programmed: Vec<Real> = (moves.iter().zip(&program.blocks))
+        .map(|(m, b)| m.programmed + b.dwell_s)
+        .collect();
     Times {
         programmed_min: minutes(&programmed),
         accelerated_min: minutes(&accelerated),

@@ -682,6 +682,7 @@ mod tests {
             keep: Vec::new(),
             number: None,
             line: None,
+            dwell_s: 0.0,
         };
         p.blocks = vec![block(a), block(b)];
         p
@@ -720,6 +721,7 @@ mod tests {
                 keep: Vec::new(),
                 number: None,
                 line: None,
+                dwell_s: 0.0,
             })
             .collect();
         let solids = Solids {

@@ -249,6 +249,7 @@ fn assemble(read: ReadText, frame: &AxisProgram) -> TextProgram {
                 keep,
                 number: b.number,
                 line: u32::try_from(b.via.unwrap_or(b.line) + 1).ok(),
+                dwell_s: b.dwell_s,
             }
         })
         .collect();
@@ -884,6 +885,7 @@ mod tests {
                 keep: Vec::new(),
                 number: None,
                 line: None,
+                dwell_s: 0.0,
             };
         let moves = expand(&c, [24.0, 5.0], false, None).unwrap();
         p.blocks = std::iter::once(block(Motion::Rapid, 24.0, 5.0, Some("drive line")))

@@ -346,9 +346,10 @@ pub fn check_shape(program: &AxisProgram) -> Result<(), ProgramFault> {
         }
         if !(b.feed.is_finite() && b.feed >= 0.0)
             || b.spindle.is_some_and(|s| !(s.is_finite() && s >= 0.0))
+            || !(b.dwell_s.is_finite() && b.dwell_s >= 0.0)
         {
             return Err(ProgramFault::new(format!(
-                "{}: a feed or spindle speed that is not a finite number of at least 0",
+                "{}: a feed, spindle speed or dwell that is not a finite number of at least 0",
                 at()
             )));
         }
@@ -642,6 +643,7 @@ pub fn build(
             keep: Vec::new(),
             number: None,
             line: None,
+            dwell_s: 0.0,
         });
     }
     let col_axes: Vec<&Axis> = columns.iter().map(|(a, _)| *a).collect();
@@ -892,6 +894,7 @@ fn with_start_and_end(blocks: Vec<Block>, axes: &[&str], setup: &ProgramSetup) -
         keep,
         number: None,
         line: None,
+        dwell_s: 0.0,
     };
     let mut out = Vec::with_capacity(blocks.len() + start_blocks(setup) + setup.retract.len());
     let mut moved: Vec<bool> = vec![false; axes.len()];
@@ -1179,6 +1182,7 @@ pub(crate) fn test_program() -> AxisProgram {
         keep: Vec::new(),
         number: None,
         line: None,
+        dwell_s: 0.0,
     };
     AxisProgram {
         name: "DEMO".into(),

@@ -205,6 +205,25 @@ pub struct Reading {
     /// How a program read as it stands may give a circular move (G2, G3
     /// among [`Reading::read_g_codes`]), or `None`: the reader refuses arcs.
     pub arcs: Option<ArcReading>,
+    /// The addresses a dwell (`G4`, in a block of its own) gives its time
+    /// by, each with its unit, as the control's manual reads them; `&[]`:
+    /// the reader refuses a dwell.
+    pub dwell: &'static [(char, DwellUnit)],
+}
+
+/// The unit of a dwell's address ([`Reading::dwell`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DwellUnit {
+    /// Seconds (LinuxCNC's `P`, Sinumerik's `F`).
+    Seconds,
+    /// Milliseconds, a whole number without a decimal point (Fanuc's `P`:
+    /// a point in it is refused).
+    Milliseconds,
+    /// Seconds with a decimal point, milliseconds (the least input
+    /// increment, 0.001 s) without one (Fanuc's `X` and `U`, Haas's `P`).
+    SecondsByPoint,
+    /// Turns of the spindle at the speed in force (Sinumerik's `S`).
+    Revolutions,
 }
 
 /// How a dialect's circular interpolation (G2 clockwise, G3
@@ -405,7 +424,7 @@ pub const SINUMERIK: Dialect = Dialect {
         code_tenths: false,
         // G9 and G60, exact stop (the replay's path through every
         // block's end point): read as the verification models them.
-        read_g_codes: &[2, 3, 9, 60],
+        read_g_codes: &[2, 3, 4, 9, 60],
         g76: None,
         g92_thread: false,
         // Programming Manual, Fundamentals, "List of G functions": group 6
@@ -476,6 +495,9 @@ pub const SINUMERIK: Dialect = Dialect {
             radius: Some("CR="),
             angle: Some("AR="),
         }),
+        // Programming Manual, Fundamentals, "Dwell time (G4)": in seconds
+        // by F, in turns of the master spindle by S, in a block of its own.
+        dwell: &[('F', DwellUnit::Seconds), ('S', DwellUnit::Revolutions)],
     },
 };
 
@@ -544,7 +566,7 @@ pub const FANUC: Dialect = Dialect {
         // Read in a shop's program: the simple threading cycle (0i-TC
         // Operator's Manual, "Threading cycle (G92)"); the multiple one
         // ("Multiple threading cycle (G76)") pilgrim writes too.
-        read_g_codes: &[92],
+        read_g_codes: &[4, 92],
         g76: Some(G76Form::FanucTwoBlock(super::cycle::FanucRules {
             chamfer_deg: 45.0,
         })),
@@ -599,6 +621,15 @@ pub const FANUC: Dialect = Dialect {
             sub_name_line: None,
         }),
         arcs: None,
+        // 0i-TC Operator's Manual, "Dwell (G04)": X or U in seconds with a
+        // decimal point (else in the least input increment, 0.001 s), P in
+        // milliseconds without one; G99's dwell in turns (a parameter)
+        // does not arise, G98 the setup's feed.
+        dwell: &[
+            ('X', DwellUnit::SecondsByPoint),
+            ('U', DwellUnit::SecondsByPoint),
+            ('P', DwellUnit::Milliseconds),
+        ],
     },
 };
 
@@ -653,7 +684,7 @@ pub const LINUXCNC: Dialect = Dialect {
         code_tenths: true,
         // G61, exact path mode (the replay's path through every block's
         // end point): read as the verification models it.
-        read_g_codes: &[61],
+        read_g_codes: &[4, 61],
         g76: Some(G76Form::LinuxCnc),
         g92_thread: false,
         // G-code reference, "Modal groups": 2 (plane), 6 (units), 7
@@ -699,6 +730,8 @@ pub const LINUXCNC: Dialect = Dialect {
             sub_name_line: None,
         }),
         arcs: None,
+        // G-code reference, "G4 Dwell": P in seconds.
+        dwell: &[('P', DwellUnit::Seconds)],
     },
 };
 
@@ -759,6 +792,7 @@ pub const CLD: Dialect = Dialect {
         meanings: &[],
         macros: None,
         arcs: None,
+        dwell: &[],
     },
 };
 
@@ -787,7 +821,10 @@ pub const HAAS: Dialect = Dialect {
         // pilgrim writes the one-block G76's moves (its settings are the
         // machine's), so the cycle is read in a shop's program only.
         g_codes: &[0, 1, 18, 17, 19, 21, 32, 40, 54, 55, 56, 57, 58, 59, 97, 98],
-        read_g_codes: &[76, 92],
+        read_g_codes: &[4, 76, 92],
+        // Haas Lathe Operator's Manual, "G04 Dwell": P in seconds with a
+        // decimal point, in milliseconds without one.
+        dwell: &[('P', DwellUnit::SecondsByPoint)],
         ..FANUC.reading
     },
     thread_cycle: None,
@@ -1050,6 +1087,14 @@ pub fn post(program: &AxisProgram, dialect: &Dialect) -> Result<String, PostErro
             .find(|v| !v.is_finite())
         {
             return Err(bad(format!("value {v} is not a finite number")));
+        }
+        // A dwell is read from a shop's program; pilgrim's toolpaths have
+        // none, and a post that wrote one would need a lint that reads it.
+        if b.dwell_s != 0.0 {
+            return Err(bad(format!(
+                "a dwell of {} s, which pilgrim's posts do not write",
+                b.dwell_s
+            )));
         }
     }
     let mut w = Writer {

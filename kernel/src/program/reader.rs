@@ -23,6 +23,7 @@ use pilgrim_plugin_abi::types::Radial;
 mod arcs;
 mod codes;
 mod cycles;
+mod dwell;
 mod fanuc_cycles;
 mod flow;
 mod line;
@@ -45,6 +46,9 @@ pub struct ReadMove {
     pub feed: Real,
     /// The spindle's speed where the text sets one for this move.
     pub spindle: Option<Real>,
+    /// The seconds the axes stand before it, by the dwells (`G4`) read
+    /// since the move before.
+    pub dwell_s: Real,
     /// The last comment line since the move before: the pass it begins.
     pub comment: Option<String>,
     /// Its block number, where the text numbers blocks.
@@ -73,6 +77,10 @@ pub struct Standing {
     pending: Option<String>,
     /// A speed set among the moves, for the next move.
     speed_next: Option<Real>,
+    /// The seconds of the dwells read since the last move, for the next,
+    /// and where the first of them stands.
+    dwell_next: Real,
+    dwell_by: Option<String>,
     /// The name, number, tool and speed the text gives itself.
     name: Option<String>,
     number: Option<u32>,
@@ -88,6 +96,13 @@ pub struct Standing {
 }
 
 impl Standing {
+    /// The seconds of the dwells read since the last move, for the move
+    /// read now (none left for the next).
+    fn take_dwell(&mut self) -> Real {
+        self.dwell_by = None;
+        std::mem::take(&mut self.dwell_next)
+    }
+
     /// Moves read so far.
     pub fn moves(&self) -> usize {
         self.k
@@ -391,6 +406,8 @@ impl<'a> Reader<'a> {
             k: 0,
             pending: None,
             speed_next: None,
+            dwell_next: 0.0,
+            dwell_by: None,
             name: None,
             number: None,
             tool: None,
@@ -576,6 +593,14 @@ impl<'a> Reader<'a> {
         let Some(block) = self.block_of(at, i, text, code, own)? else {
             return Ok(());
         };
+        if self.is_dwell(&block) {
+            let s = self.dwell(at, &block)?;
+            if at.dwell_next == 0.0 {
+                at.dwell_by = Some(self.place(&block, at.k));
+            }
+            at.dwell_next += s;
+            return Ok(());
+        }
         let said = self.words_of(at, &block)?;
         self.setup_words(&mut at.st, &block, at.k, &said)?;
         if said.motion == Some(76) {
@@ -644,6 +669,15 @@ impl<'a> Reader<'a> {
         }
         if self.reading && at.k == 0 {
             return Err(self.fault(0, "no move: nothing to verify".into()));
+        }
+        if at.dwell_next > 0.0 {
+            return Err(self.err(
+                at.dwell_by.clone().unwrap_or_else(|| at_line(last)),
+                format!(
+                    "a dwell of {} s after the last move: the verification counts a dwell's time before the move that follows it, and none does",
+                    at.dwell_next
+                ),
+            ));
         }
         Ok(Linted {
             moves: at.k,

@@ -25,8 +25,9 @@
 // an axis's `max_accel`; 1.8: an axis's `turns_part`; 1.9: the body
 // shape `cone`; 1.10: a body's `reach`; 1.11: a program's threading
 // `cycles`; 1.12: the setup's `power_on`;
-// 1.13: a program's `fanuc_cycles`, a block's `line`).
-#define PILGRIM_ABI_MINOR 13
+// 1.13: a program's `fanuc_cycles`, a block's `line`; 1.14: a block's
+// `dwell_s`).
+#define PILGRIM_ABI_MINOR 14
 
 // The call succeeded.
 #define PILGRIM_STATUS_OK 0

@@ -100,8 +100,9 @@ pub const ABI_MAJOR: u32 = 1;
 /// an axis's `max_accel`; 1.8: an axis's `turns_part`; 1.9: the body
 /// shape `cone`; 1.10: a body's `reach`; 1.11: a program's threading
 /// `cycles`; 1.12: the setup's `power_on`;
-/// 1.13: a program's `fanuc_cycles`, a block's `line`).
-pub const ABI_MINOR: u32 = 13;
+/// 1.13: a program's `fanuc_cycles`, a block's `line`; 1.14: a block's
+/// `dwell_s`).
+pub const ABI_MINOR: u32 = 14;
 
 /// The call succeeded.
 pub const STATUS_OK: i32 = 0;

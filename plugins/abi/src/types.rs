@@ -791,6 +791,12 @@ pub struct Block {
     /// program the host builds.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub line: Option<u32>,
+    /// Since 1.14: the seconds the axes stand before the block's move (a
+    /// program read from a file: its dwells, `G4`, since the move before),
+    /// the spindle turning; 0 for a program the host builds, whose posts
+    /// write no dwell.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub dwell_s: f64,
 }
 
 /// A program for one machine: named axes in program units (mm, degrees)

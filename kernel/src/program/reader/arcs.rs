@@ -307,6 +307,7 @@ impl Reader<'_> {
                 values,
                 feed: at.st.f.unwrap_or_default(),
                 spindle: if first { at.speed_next.take() } else { None },
+                dwell_s: at.take_dwell(),
                 comment: if first { at.pending.take() } else { None },
                 number: b.number,
                 line: b.line,

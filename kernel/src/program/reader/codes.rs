@@ -72,13 +72,7 @@ impl Reader<'_> {
         } else {
             d.reading.m_codes
         };
-        // A code as the dialect reads it: to a tenth where it does
-        // (LinuxCNC's G1.0 is G1), else a whole number.
-        let code = if d.reading.code_tenths {
-            w.whole()
-        } else {
-            w.integer()
-        };
+        let code = self.code_number(w);
         // A shop's program may hold what pilgrim never writes (its cycles).
         let read_too = if self.reading && w.letter == 'G' {
             d.reading.read_g_codes
@@ -144,6 +138,17 @@ impl Reader<'_> {
             st.stated.push(n);
         }
         Ok(())
+    }
+
+    /// The number of code word `w` as the dialect reads it: to a tenth
+    /// where it does (LinuxCNC's G1.0 is G1), else a whole number; `None`
+    /// for a code it does not read so.
+    pub(super) fn code_number(&self, w: &Word) -> Option<u32> {
+        if self.d.reading.code_tenths {
+            w.whole()
+        } else {
+            w.integer()
+        }
     }
 
     /// Work offset `n` (the word `w`): the part zero is the work offset

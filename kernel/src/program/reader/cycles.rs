@@ -112,6 +112,7 @@ impl Reader<'_> {
                     _ => 0.0,
                 },
                 spindle: if n == 0 { at.speed_next.take() } else { None },
+                dwell_s: at.take_dwell(),
                 comment: if n == 0 { comment.clone() } else { None },
                 number: b.number,
                 line: b.line,

@@ -117,6 +117,7 @@ impl Reader<'_> {
                 Motion::Thread { lead, .. } => lead * st.speed.unwrap_or_default(),
             },
             spindle: at.speed_next.take(),
+            dwell_s: at.take_dwell(),
             comment: at.pending.take(),
             number: b.number,
             line: b.line,

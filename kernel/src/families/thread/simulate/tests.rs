@@ -89,6 +89,7 @@ fn cut_by(
         keep: vec![],
         number: None,
         line: None,
+        dwell_s: 0.0,
     };
     let clear = r_crest + s;
     for p in &passes {
