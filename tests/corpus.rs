@@ -78,6 +78,21 @@ fn refused(dir: &Path, file: &str, machine: &str, family: &str, says: &str) {
     assert_eq!(crate::common::rust_text(&err), None, "{file}: {err}");
 }
 
+/// LinuxCNC program `program` of the corpus, with the axis program its
+/// verification in `dir` read, left for CI's `rs274` check
+/// (`.ci/rs274_check.py`: LinuxCNC's own interpreter must make its moves).
+fn leave_for_rs274(dir: &Path, program: &str) {
+    let exe = std::env::current_exe().unwrap();
+    let name = Path::new(program).file_stem().unwrap().to_str().unwrap();
+    let left = (exe.ancestors().nth(3).unwrap())
+        .join("linuxcnc-check")
+        .join(format!("corpus-{name}"));
+    std::fs::create_dir_all(&left).unwrap();
+    std::fs::copy(corpus().join(program), left.join("program.ngc")).unwrap();
+    let read = dir.join(program.replace('/', "-")).join("program.json");
+    std::fs::copy(read, left.join("program.json")).unwrap();
+}
+
 /// `a` and `b` alike, every number within `tol`: `what` in the message.
 fn alike(a: &serde_json::Value, b: &serde_json::Value, tol: f64, what: &str) {
     use serde_json::Value::{Array, Number, Object};
@@ -348,8 +363,6 @@ fn linuxcnc_programs_verify_as_their_plain_twins_and_as_rs274_reads_them() {
     let lathe = pilgrim_kernel::machine::machine_file(&fanuc_0i_tc::describe(), "its crate");
     let machine = dir.join("linuxcnc-lathe.toml");
     std::fs::write(&machine, crate::common::with_control(&lathe, "linuxcnc")).unwrap();
-    let exe = std::env::current_exe().unwrap();
-    let check = exe.ancestors().nth(3).unwrap().join("linuxcnc-check");
     for name in ["osub_while", "repeat_params"] {
         let program = format!("linuxcnc/{name}.ngc");
         let twin = format!("linuxcnc/{name}.plain.ngc");
@@ -362,14 +375,7 @@ fn linuxcnc_programs_verify_as_their_plain_twins_and_as_rs274_reads_them() {
             figures(&treport),
             "{program} and its twin"
         );
-        let left = check.join(format!("corpus-{name}"));
-        std::fs::create_dir_all(&left).unwrap();
-        std::fs::copy(corpus().join(&program), left.join("program.ngc")).unwrap();
-        std::fs::copy(
-            dir.join(program.replace('/', "-")).join("program.json"),
-            left.join("program.json"),
-        )
-        .unwrap();
+        leave_for_rs274(&dir, &program);
     }
 }
 
@@ -433,19 +439,7 @@ fn dwells_stand_for_their_time_in_each_controls_units() {
             "{program}: {accelerated}"
         );
     }
-    let exe = std::env::current_exe().unwrap();
-    let left = (exe.ancestors().nth(3).unwrap()).join("linuxcnc-check/corpus-osub_dwell");
-    std::fs::create_dir_all(&left).unwrap();
-    std::fs::copy(
-        corpus().join("linuxcnc/osub_dwell.ngc"),
-        left.join("program.ngc"),
-    )
-    .unwrap();
-    std::fs::copy(
-        dir.join("linuxcnc-osub_dwell.ngc/program.json"),
-        left.join("program.json"),
-    )
-    .unwrap();
+    leave_for_rs274(&dir, "linuxcnc/osub_dwell.ngc");
     for (file, says) in [
         (
             "fanuc/refused/dwell_point_in_p.nc",
@@ -458,6 +452,101 @@ fn dwells_stand_for_their_time_in_each_controls_units() {
         (
             "fanuc/refused/dwell_last.nc",
             "line 23: a dwell of 2 s after the last move",
+        ),
+    ] {
+        refused(&dir, file, "fanuc-0i-tc", thread, says);
+    }
+}
+
+/// The blocks (from 0) of the program a verification in `dir`'s folder
+/// `out` read that set the spindle's speed, with the speed (rpm), and the
+/// program's blocks.
+fn read_speeds(dir: &Path, out: &str) -> (Vec<(usize, f64)>, usize) {
+    let text = std::fs::read_to_string(dir.join(out).join("program.json")).unwrap();
+    let program: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let blocks = program["blocks"].as_array().unwrap();
+    let set = (blocks.iter().enumerate())
+        .filter_map(|(k, b)| Some((k, b["spindle"].as_f64()?)))
+        .collect();
+    (set, blocks.len())
+}
+
+/// Constant surface speed (`G96`, S in m/min) as each control clamps it:
+/// Fanuc's `G50 S`, LinuxCNC's `D` in the G96 block, Sinumerik's `LIMS=`.
+/// Each program verifies as its twin, the same moves at the speeds in rpm
+/// written out by hand (`1000 v / (pi D)`, D the diameter a rapid ends
+/// at, the larger a cut passes, within the clamp); the speeds it reads
+/// are the formula's to the last bit, set where they change: a face at
+/// 150 m/min turns 1193.66 rpm at D40 and stays there cutting to D30, the
+/// rapid to D24 is held at 1800; the mandrel's approach and retraction at
+/// X100 (on radius, D200) turn 127.32 rpm at 80 m/min, every pass at
+/// LIMS=399. Refused: a thread under G96, G97 after it without its S, G50
+/// with an axis (a coordinate system setting).
+#[test]
+fn constant_surface_speed_turns_as_each_control_clamps_it() {
+    let dir = scratch("corpus", "g96");
+    let lathe = pilgrim_kernel::machine::machine_file(&fanuc_0i_tc::describe(), "its crate");
+    let linuxcnc = dir.join("linuxcnc-lathe.toml");
+    std::fs::write(&linuxcnc, crate::common::with_control(&lathe, "linuxcnc")).unwrap();
+    let thread = "scripts/thread.rhai";
+    let rpm = |v: f64, d: f64| 1000.0 * v / (std::f64::consts::PI * d);
+    let face = rpm(150.0, 40.0);
+    for (program, twin, machine, family, speeds) in [
+        (
+            "fanuc/g96_face.nc",
+            "fanuc/g96_face.plain.nc",
+            "fanuc-0i-tc",
+            thread,
+            vec![(0, face), (2, 1800.0), (4, 300.0)],
+        ),
+        (
+            "linuxcnc/osub_g96.ngc",
+            "linuxcnc/osub_g96.plain.ngc",
+            s(&linuxcnc),
+            thread,
+            // Its first pass goes straight to its depth.
+            vec![(0, face), (2, 1800.0), (3, 300.0)],
+        ),
+        (
+            "sinumerik/mandrel_g96.mpf",
+            "sinumerik/mandrel.plain.mpf",
+            "3K152VF20",
+            "scripts/mandrel.rhai",
+            // The last but one block the retraction to X100.
+            vec![
+                (0, rpm(80.0, 200.0)),
+                (2, 399.0),
+                (usize::MAX, rpm(80.0, 200.0)),
+            ],
+        ),
+    ] {
+        let (code, err, report) = verified(&dir, program, machine, family);
+        assert_eq!(code, 0, "{program}: {err}");
+        let (tcode, terr, treport) = verified(&dir, twin, machine, family);
+        assert_eq!(tcode, 0, "{twin}: {terr}");
+        assert_eq!(figures(&report), figures(&treport), "{program}");
+        assert_eq!(report["blocks"], treport["blocks"], "{program}");
+        let (read, n) = read_speeds(&dir, &program.replace('/', "-"));
+        let want: Vec<(usize, f64)> = (speeds.iter())
+            .map(|&(k, v)| (if k == usize::MAX { n - 2 } else { k }, v))
+            .collect();
+        assert_eq!(read, want, "{program}");
+        if program.ends_with(".ngc") {
+            leave_for_rs274(&dir, program);
+        }
+    }
+    for (file, says) in [
+        (
+            "fanuc/refused/g96_thread.nc",
+            "line 15: a threading cycle (G92) before constant spindle speed (G97)",
+        ),
+        (
+            "fanuc/refused/g97_without_s.nc",
+            "line 15: G97 after G96 without S",
+        ),
+        (
+            "fanuc/refused/g50_axis.nc",
+            "line 7: G50 with an axis: a coordinate system setting",
         ),
     ] {
         refused(&dir, file, "fanuc-0i-tc", thread, says);

@@ -336,6 +336,22 @@ enum Effect {
     /// A dwell (G4), in a block of its own: its time by one of the rules'
     /// dwell addresses.
     Dwell,
+    /// Constant surface speed on (G96: S in m/min) or off (G97: S in rpm,
+    /// written with it after G96).
+    Surface(bool),
+    /// Fanuc's G50: with S alone, the spindle's clamp.
+    Clamp,
+}
+
+/// How the spindle's clamp under G96 is written.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum ClampBy {
+    /// `G50 S` (Fanuc).
+    G50,
+    /// `D` in the G96 block (LinuxCNC).
+    D,
+    /// `LIMS=` (Sinumerik).
+    Lims,
 }
 
 /// The unit of a dwell's address.
@@ -385,6 +401,8 @@ struct Rules {
     stated: &'static [u32],
     /// A dwell's addresses and their units.
     dwell: &'static [(char, Unit)],
+    /// How the clamp of G96 is written.
+    clamp: ClampBy,
 }
 
 use Effect::*;
@@ -398,8 +416,9 @@ use Kind::*;
 /// "Feedrate (G93, G94, G95, F...)" (F modal), "Exact stop (G60, G9)"
 /// (group 10 and non-modal: the path through each end point), "Dwell time
 /// (G4)" (in a block of its own: F in seconds, S in turns of the master
-/// spindle), "M functions" (M3, M5, M30; M8/M9 the coolant, the machine
-/// maker's).
+/// spindle), "Constant cutting rate (G96/G97, LIMS)" (S in m/min at the
+/// transverse axis's diameter, LIMS= the upper limit), "M functions" (M3,
+/// M5, M30; M8/M9 the coolant, the machine maker's).
 const SINUMERIK: Rules = Rules {
     g: &[
         (0, Motion(Rapid)),
@@ -420,6 +439,8 @@ const SINUMERIK: Rules = Rules {
         (9, Exact),
         (60, Exact),
         (4, Dwell),
+        (96, Surface(true)),
+        (97, Surface(false)),
     ],
     m: &[
         (3, Spindle(true)),
@@ -436,6 +457,7 @@ const SINUMERIK: Rules = Rules {
     start_q: None,
     stated: &[90, 94, 71],
     dwell: &[('F', Unit::Seconds), ('S', Unit::Turns)],
+    clamp: ClampBy::Lims,
 };
 
 /// FANUC Series 0i-TC Operator's Manual (B-64114EN), G code system A:
@@ -446,8 +468,9 @@ const SINUMERIK: Rules = Rules {
 /// setting), "Thread cutting (G32)" (the lead by F, the one modal F; Q the
 /// start angle in 0.001 deg, no decimal point, on its block only), "Dwell
 /// (G04)" (X or U in seconds with a point, in the least input increment
-/// without; P in milliseconds, no point), "M codes" (M03, M05, M08, M09,
-/// M30).
+/// without; P in milliseconds, no point), "Constant surface speed control
+/// (G96, G97)" (S in m/min at the X coordinate's diameter; "Spindle speed
+/// clamp": G50 S), "M codes" (M03, M05, M08, M09, M30).
 const FANUC: Rules = Rules {
     g: &[
         (0, Motion(Rapid)),
@@ -464,9 +487,11 @@ const FANUC: Rules = Rules {
         (57, Offset(57)),
         (58, Offset(58)),
         (59, Offset(59)),
-        (97, Setup(97)),
+        (97, Surface(false)),
         (98, Setup(98)),
         (4, Dwell),
+        (96, Surface(true)),
+        (50, Clamp),
     ],
     m: &[
         (3, Spindle(true)),
@@ -487,12 +512,14 @@ const FANUC: Rules = Rules {
         ('U', Unit::ByPoint),
         ('P', Unit::Millis),
     ],
+    clamp: ClampBy::G50,
 };
 
 /// LinuxCNC G-code reference, "G Codes" (G0, G1, G33 with K each block;
 /// G7 lathe diameter mode, G8 radius mode; G17..G19; G21; G40; G54..G59;
-/// G90; G94; G97; G61 exact path; G4 a dwell of P seconds), "M Codes" (M2
-/// end, M3, M5, M8, M9), "Numbers" (a code
+/// G90; G94; G61 exact path; G4 a dwell of P seconds; G96 D S constant
+/// surface speed, S in its block, D its clamp, and G97 rpm), "M Codes" (M2 end, M3, M5,
+/// M8, M9), "Numbers" (a code
 /// is read to a tenth: `G1.0` is G1). The reference for a changed reading
 /// is its own interpreter, rs274 (a sample left for CI).
 const LINUXCNC: Rules = Rules {
@@ -515,9 +542,10 @@ const LINUXCNC: Rules = Rules {
         (59, Offset(59)),
         (90, Setup(90)),
         (94, Setup(94)),
-        (97, Setup(97)),
+        (97, Surface(false)),
         (61, Exact),
         (4, Dwell),
+        (96, Surface(true)),
     ],
     m: &[
         (2, End),
@@ -534,6 +562,7 @@ const LINUXCNC: Rules = Rules {
     start_q: None,
     stated: &[21, 40, 90, 94],
     dwell: &[('P', Unit::Seconds)],
+    clamp: ClampBy::D,
 };
 
 fn rules(d: &Dialect) -> &'static Rules {
@@ -565,6 +594,10 @@ struct Expect {
     moved: bool,
     /// The seconds of the dwells since the last move.
     dwell: f64,
+    /// G96 in force, its speed (m/min) once written, the clamp (rpm).
+    surface: bool,
+    vc: Option<f64>,
+    clamp: Option<f64>,
 }
 
 /// A move as the rules read it.
@@ -618,6 +651,7 @@ fn expect_line(
         .map(|a| a.name.chars().next().unwrap())
         .collect();
     let mut motion_here = None;
+    let (mut surface_here, mut clamp_here, mut d_here) = (None, false, None);
     let mut axis = vec![None; names.len()];
     let mut letters: Vec<char> = Vec::new();
     let (mut lead_here, mut start_here, mut s_here) = (None, None, None);
@@ -645,6 +679,14 @@ fn expect_line(
             if at.moved {
                 return Err(format!("{w} among the moves"));
             }
+            continue;
+        }
+        if let Some(v) = w.strip_prefix("LIMS=").filter(|_| r.clamp == ClampBy::Lims) {
+            let v: f64 = v.parse().map_err(|_| format!("{w}: not a clamp"))?;
+            if !(v >= 1.0) {
+                return Err(format!("{w}: a clamp below 1 rpm"));
+            }
+            at.clamp = Some(v);
             continue;
         }
         if let Some(v) = w.strip_prefix("SF=") {
@@ -715,6 +757,8 @@ fn expect_line(
                     Coolant(on) => at.coolant = on,
                     End => at.ended = true,
                     Dwell => unreachable!("a dwell's block is read apart"),
+                    Surface(on) => surface_here = Some(on),
+                    Clamp => clamp_here = true,
                 }
                 continue;
             }
@@ -749,6 +793,7 @@ fn expect_line(
             }
             'F' => at.f = Some(value),
             'S' => s_here = Some(value),
+            'D' if r.clamp == ClampBy::D => d_here = Some(value),
             c if c == r.lead => {
                 lead_here = Some(value);
                 lead_word = true;
@@ -770,6 +815,45 @@ fn expect_line(
                 }
             }
             _ => return Err(format!("{w}: an address the dialect does not read here")),
+        }
+    }
+    if let Some(v) = d_here {
+        if surface_here != Some(true) {
+            return Err(format!("D{v}: an address the dialect does not read here"));
+        }
+        if !(v >= 1.0) {
+            return Err(format!("D{v}: a clamp below 1 rpm"));
+        }
+        at.clamp = Some(v);
+    }
+    if clamp_here {
+        if axis.iter().any(Option::is_some) {
+            return Err("G50 with an axis".into());
+        }
+        let v = s_here.take().ok_or("G50 without S")?;
+        if !(v >= 1.0) {
+            return Err(format!("S{v}: a clamp below 1 rpm"));
+        }
+        at.clamp = Some(v);
+    }
+    if surface_here == Some(true) && r.clamp == ClampBy::D && s_here.is_none() {
+        return Err("G96 without S in its block".into());
+    }
+    if let Some(on) = surface_here {
+        if !on && at.vc.is_some() {
+            if s_here.is_none() {
+                return Err("G97 after G96 without S".into());
+            }
+            at.vc = None;
+        }
+        at.surface = on;
+    }
+    if at.surface {
+        if let Some(v) = s_here.take() {
+            if !(v > 0.0) {
+                return Err(format!("S{v}: a surface speed not above 0"));
+            }
+            at.vc = Some(v);
         }
     }
     if let Some(v) = s_here {
@@ -802,6 +886,9 @@ fn expect_line(
     }
     // A move.
     let kind = at.motion.ok_or("a move before a motion")?;
+    if at.surface {
+        surface_speed(subject, at, kind, &axis)?;
+    }
     if let Some(c) = r.stated.iter().find(|c| !at.stated.contains(c)) {
         return Err(format!("a move before G{c} is stated"));
     }
@@ -859,6 +946,57 @@ fn expect_line(
         spindle: at.speed_next.take(),
         dwell: std::mem::take(&mut at.dwell),
     });
+    Ok(())
+}
+
+/// The spindle's speed under G96 for a move of `kind` to `axis` (the
+/// values it writes) from where `at` stands: `1000 v / (pi D)` at the
+/// diameter a rapid ends at, the larger a cut passes (the X axis on the
+/// setup's programming), within the clamp and the spindle's range.
+fn surface_speed(
+    subject: &Subject,
+    at: &mut Expect,
+    kind: Kind,
+    axis: &[Option<f64>],
+) -> Result<(), Refusal> {
+    if kind == Thread {
+        return Err("a thread under G96".into());
+    }
+    let vc = at.vc.ok_or("a move under G96 before its speed")?;
+    let setup = &subject.frame.setup;
+    let i = (subject.frame.axes.iter())
+        .position(|a| a.name == setup.radial_axis)
+        .ok_or("G96 with no radial axis")?;
+    let per = match setup.radial.ok_or("G96 with no radial programming")? {
+        Radial::Radius => 2.0,
+        Radial::Diameter => 1.0,
+    };
+    let d = |v: Option<f64>| v.map_or(0.0, |v| v.abs() * per);
+    let to = axis[i].or(at.values[i]);
+    let dia = if kind == Rapid {
+        d(to)
+    } else {
+        d(at.values[i]).max(d(to))
+    };
+    let spindle =
+        (subject.axes.iter()).find(|a| a.kind == pilgrim_kernel::machine::AxisKind::Spindle);
+    let top = match (at.clamp, spindle) {
+        (Some(c), Some(s)) => c.min(s.max),
+        (Some(c), None) => c,
+        (None, Some(s)) => s.max,
+        (None, None) => return Err("G96 with no clamp".into()),
+    };
+    let low = spindle.map_or(1.0, |s| s.min.max(1.0));
+    let rpm = if dia > 0.0 {
+        (1000.0 * vc / (std::f64::consts::PI * dia)).min(top)
+    } else {
+        top
+    }
+    .max(low);
+    if at.speed != Some(rpm) {
+        at.speed = Some(rpm);
+        at.speed_next = Some(rpm);
+    }
     Ok(())
 }
 
@@ -933,6 +1071,7 @@ fn expect_program(subject: &Subject) -> (Vec<Expect>, Vec<Move>) {
     let mut at = Expect {
         values: vec![None; subject.frame.axes.len()],
         stated: stated.filter(|c| subject.power_on.g.contains(c)).collect(),
+        surface: subject.power_on.g.contains(&96),
         ..Expect::default()
     };
     let mut before = Vec::new();

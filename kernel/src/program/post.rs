@@ -209,6 +209,22 @@ pub struct Reading {
     /// by, each with its unit, as the control's manual reads them; `&[]`:
     /// the reader refuses a dwell.
     pub dwell: &'static [(char, DwellUnit)],
+    /// How the spindle's speed clamp under constant surface speed (`G96`,
+    /// its `S` in m/min) is written, where the reader reads `G96`.
+    pub speed_clamp: Option<SpeedClamp>,
+}
+
+/// How a dialect writes the clamp of the spindle's speed under constant
+/// surface speed ([`Reading::speed_clamp`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SpeedClamp {
+    /// `G50 S` in a block of its own (Fanuc's, Haas's lathes; G50 with an
+    /// axis, a coordinate system setting, refused).
+    G50,
+    /// `D` in the `G96` block (LinuxCNC).
+    DWithG96,
+    /// `LIMS=` (Sinumerik).
+    Lims,
 }
 
 /// The unit of a dwell's address ([`Reading::dwell`]).
@@ -424,7 +440,7 @@ pub const SINUMERIK: Dialect = Dialect {
         code_tenths: false,
         // G9 and G60, exact stop (the replay's path through every
         // block's end point): read as the verification models them.
-        read_g_codes: &[2, 3, 4, 9, 60],
+        read_g_codes: &[2, 3, 4, 9, 60, 96, 97],
         g76: None,
         g92_thread: false,
         // Programming Manual, Fundamentals, "List of G functions": group 6
@@ -498,6 +514,9 @@ pub const SINUMERIK: Dialect = Dialect {
         // Programming Manual, Fundamentals, "Dwell time (G4)": in seconds
         // by F, in turns of the master spindle by S, in a block of its own.
         dwell: &[('F', DwellUnit::Seconds), ('S', DwellUnit::Revolutions)],
+        // "Constant cutting rate (G96/G961/G962, G97/G971/G972, G973,
+        // LIMS, SCC)": S in m/min, LIMS= the upper speed limit.
+        speed_clamp: Some(SpeedClamp::Lims),
     },
 };
 
@@ -566,7 +585,7 @@ pub const FANUC: Dialect = Dialect {
         // Read in a shop's program: the simple threading cycle (0i-TC
         // Operator's Manual, "Threading cycle (G92)"); the multiple one
         // ("Multiple threading cycle (G76)") pilgrim writes too.
-        read_g_codes: &[4, 92],
+        read_g_codes: &[4, 50, 92, 96],
         g76: Some(G76Form::FanucTwoBlock(super::cycle::FanucRules {
             chamfer_deg: 45.0,
         })),
@@ -630,6 +649,9 @@ pub const FANUC: Dialect = Dialect {
             ('U', DwellUnit::SecondsByPoint),
             ('P', DwellUnit::Milliseconds),
         ],
+        // "Constant surface speed control (G96, G97)": S in m/min, the
+        // clamp by G50 S ("Spindle speed clamp").
+        speed_clamp: Some(SpeedClamp::G50),
     },
 };
 
@@ -684,7 +706,7 @@ pub const LINUXCNC: Dialect = Dialect {
         code_tenths: true,
         // G61, exact path mode (the replay's path through every block's
         // end point): read as the verification models it.
-        read_g_codes: &[4, 61],
+        read_g_codes: &[4, 61, 96],
         g76: Some(G76Form::LinuxCnc),
         g92_thread: false,
         // G-code reference, "Modal groups": 2 (plane), 6 (units), 7
@@ -732,6 +754,8 @@ pub const LINUXCNC: Dialect = Dialect {
         arcs: None,
         // G-code reference, "G4 Dwell": P in seconds.
         dwell: &[('P', DwellUnit::Seconds)],
+        // "G96, G97 Spindle Control Mode": G96 D(max rpm) S(m/min).
+        speed_clamp: Some(SpeedClamp::DWithG96),
     },
 };
 
@@ -793,6 +817,7 @@ pub const CLD: Dialect = Dialect {
         macros: None,
         arcs: None,
         dwell: &[],
+        speed_clamp: None,
     },
 };
 
@@ -821,7 +846,7 @@ pub const HAAS: Dialect = Dialect {
         // pilgrim writes the one-block G76's moves (its settings are the
         // machine's), so the cycle is read in a shop's program only.
         g_codes: &[0, 1, 18, 17, 19, 21, 32, 40, 54, 55, 56, 57, 58, 59, 97, 98],
-        read_g_codes: &[4, 76, 92],
+        read_g_codes: &[4, 50, 76, 92, 96],
         // Haas Lathe Operator's Manual, "G04 Dwell": P in seconds with a
         // decimal point, in milliseconds without one.
         dwell: &[('P', DwellUnit::SecondsByPoint)],

@@ -29,6 +29,7 @@ mod flow;
 mod line;
 mod moves;
 mod setup;
+mod surface;
 
 use flow::SourceFile;
 pub use flow::{Beside, MAX_SUB_BYTES};
@@ -200,6 +201,11 @@ struct State {
     /// The word and block that last turned the coolant on or off.
     coolant_by: Option<String>,
     constant_speed: bool,
+    /// Constant surface speed (`G96`) in force, its speed S (m/min) once
+    /// written, and the spindle's clamp (rpm) the program has set.
+    surface: bool,
+    surface_speed: Option<Real>,
+    clamp: Option<Real>,
     /// Diameter (true) or radius programming, once set.
     radial: Option<bool>,
     feed_group: bool,
@@ -255,6 +261,9 @@ enum OwnWord {
     ArcRadius(Real, String),
     /// `AR=`, an arc's opening angle (deg), with the word.
     ArcAngle(Real, String),
+    /// `LIMS=`, the spindle's clamp under constant surface speed (rpm),
+    /// with the word.
+    SpeedLimit(Real, String),
 }
 
 /// One block being read: where it is and what it holds.
@@ -287,6 +296,10 @@ struct Said {
     start_word: Option<String>,
     /// An arc's own words (its radius, its angle).
     arc: arcs::ArcWords,
+    /// `G96` (true) or `G97` (false) in the block, where it has one.
+    surface: Option<bool>,
+    /// Whether the block is Fanuc's `G50`: its S the spindle's clamp.
+    clamp: bool,
 }
 
 /// "line N" for line `l` (from 0).
@@ -400,6 +413,7 @@ impl<'a> Reader<'a> {
                     .copied()
                     .collect(),
                 constant_speed: on.contains(&97),
+                surface: on.contains(&96),
                 ..State::default()
             },
             last_n: None,

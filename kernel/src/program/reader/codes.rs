@@ -27,6 +27,15 @@ impl Reader<'_> {
                 }
                 OwnWord::ArcRadius(v, text) => said.arc.radius = Some((*v, text.clone())),
                 OwnWord::ArcAngle(v, text) => said.arc.angle = Some((*v, text.clone())),
+                OwnWord::SpeedLimit(v, text) => {
+                    if !(v.is_finite() && *v >= 1.0) {
+                        return Err(self.err(
+                            self.place(b, at.k),
+                            format!("{text}: a spindle's clamp is a speed of at least 1 rpm"),
+                        ));
+                    }
+                    at.st.clamp = Some(*v);
+                }
             }
         }
         let mut letters: Vec<char> = Vec::new();
@@ -119,7 +128,12 @@ impl Reader<'_> {
                 }
                 said.motion = Some(n)
             }
-            97 => st.constant_speed = true,
+            96 | 97 => {
+                said.surface = Some(n == 96);
+                st.constant_speed = n == 97;
+                st.surface = n == 96;
+            }
+            50 => said.clamp = true,
             // LinuxCNC's diameter (G7) and radius (G8) modes.
             7 | 8 => said.radial.push((n == 7, w.text())),
             n if d.reading.work_offsets.contains(&n) => {

@@ -101,6 +101,17 @@ impl Reader<'_> {
                     )
                 })?;
                 OwnWord::ArcAngle(a, word.to_owned())
+            } else if let Some(v) = (self.d.reading.speed_clamp)
+                .filter(|c| *c == crate::program::post::SpeedClamp::Lims)
+                .and_then(|_| word.strip_prefix("LIMS="))
+            {
+                let s = v.parse().map_err(|_| {
+                    self.fault(
+                        i,
+                        format!("'{word}' is not a spindle's clamp (a number of rpm)"),
+                    )
+                })?;
+                OwnWord::SpeedLimit(s, word.to_owned())
             } else {
                 continue;
             };

@@ -55,6 +55,7 @@ impl Reader<'_> {
                 "{w}: an arc's word outside an arc block (G2, G3)"
             )));
         }
+        self.clamp_word(at, b, &mut said)?;
         let read = std::mem::take(&mut said.read);
         let given = self.addresses(&mut at.st, b, k, read, arc.is_some())?;
         if let Some(m) = said.motion {
@@ -64,7 +65,7 @@ impl Reader<'_> {
             at.st.lead = Some(l);
         }
         let moves = given.axes.iter().any(Option::is_some);
-        if let Some(v) = given.speed {
+        if let Some(v) = self.surface_words(at, b, &said, given.speed, moves)? {
             self.speed(at, b, v, moves)?;
         }
         if !moves {
@@ -95,10 +96,17 @@ impl Reader<'_> {
             ));
         };
         let before = arc.map(|_| placed(&at.st));
+        let from = (at.st.surface)
+            .then(|| self.radial_index().and_then(|i| placed(&at.st)[i]))
+            .flatten();
         for (i, v) in given.axes.iter().enumerate() {
             if let Some(v) = v {
                 at.st.values[i] = Some(*v);
             }
+        }
+        if at.st.surface {
+            let rapid = said.motion.or(at.st.motion) == Some(0);
+            self.surface_move(at, b, from, rapid, arc.is_some())?;
         }
         let motion = self.motion(&mut at.st, b, k, &given, &said.start_word, block)?;
         let going = self.going(&at.st, b, k, block)?;
@@ -347,6 +355,11 @@ impl Reader<'_> {
         let d = self.d;
         let fail = |m: String| self.err(self.place(b, k), m);
         let read_lead = st.lead.unwrap_or(Real::NAN);
+        if st.surface {
+            return Err(fail(
+                "a thread under constant surface speed (G96): its lead is tied to the spindle's turn, whose speed G96 changes with the diameter; write G97 S(rpm) before it".into(),
+            ));
+        }
         if d.lead_every_block && lead.is_none() {
             return Err(fail(format!("a thread block without its lead {}", d.lead)));
         }
