@@ -73,7 +73,10 @@ impl Reader<'_> {
                 ));
             }
             let v = speed.ok_or_else(|| {
-                fail("G50 without S: the clamp of the spindle's speed is its S".into())
+                fail(format!(
+                    "G50 without S: on {} a coordinate system setting with an axis, which the verification does not follow, or the spindle's speed clamp with its S",
+                    self.d.name
+                ))
             })?;
             at.st.clamp = Some(positive_rpm(v, &format!("S{v}")).map_err(fail)?);
             return Ok(None);
