@@ -148,6 +148,53 @@ fn fanuc_programs_verify_as_their_plain_twins() {
     }
 }
 
+/// The verify page of a program that calls a subprogram beside it names,
+/// for the moves the calls made, the file and lines they were read from
+/// and the line of each call: `M98 P0102000` on line 10 runs O2000's four
+/// moves (its lines 6 to 9) ten times, `M98 P0022000` on line 12 twice.
+#[test]
+fn the_verify_page_names_what_a_call_expanded() {
+    let dir = scratch("corpus", "expanded");
+    let (code, err, report) = verified(
+        &dir,
+        "fanuc/m98_beside.nc",
+        "fanuc-0i-tc",
+        "scripts/thread.rhai",
+    );
+    assert_eq!(code, 0, "{err}");
+    let page =
+        std::fs::read_to_string(dir.join("fanuc-m98_beside.nc").join("report.html")).unwrap();
+    assert!(page.contains("Expanded from cycles, loops and subprograms"));
+    let rows: Vec<&str> = (page.lines())
+        .filter(|l| l.starts_with("<tr data-block=") && l.contains("O2000.nc"))
+        .collect();
+    assert_eq!(rows.len(), 2, "{rows:?}");
+    assert!(
+        rows[0].contains("<td>40</td><td>O2000.nc lines 6 to 9, called at line 10</td>"),
+        "{}",
+        rows[0]
+    );
+    assert!(
+        rows[1].contains("<td>8</td><td>O2000.nc lines 6 to 9, called at line 12</td>"),
+        "{}",
+        rows[1]
+    );
+    // The first call's moves follow the line before it, and the program's
+    // blocks are every move the calls made.
+    let first: usize = rows[0]["<tr data-block=\"".len()..]
+        .split('"')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(
+        first + 48 + 1,
+        report["blocks"].as_u64().unwrap() as usize,
+        "{}",
+        report["blocks"]
+    );
+}
+
 /// The Sinumerik corpus on the mandrel grinder: the default mandrel's
 /// motion with its feeds in a `DEF REAL` local and an R parameter's
 /// place, a jump over a block never run (`GOTOF` to a label), a counting

@@ -149,6 +149,11 @@ pub struct Report {
     /// Not in `report.json`: the run and the export read it with the text.
     #[serde(skip)]
     pub program_lines: Vec<usize>,
+    /// The runs of blocks a cycle, a loop or a subprogram's call made
+    /// from the program's text, each with the lines it was read from.
+    /// Not in `report.json`: the run and the export read it with the text.
+    #[serde(skip)]
+    pub program_expansions: Vec<crate::program::expansion::Expansion>,
 }
 
 impl Report {
@@ -272,6 +277,7 @@ impl Report {
             marks: BTreeMap::new(),
             playback: Vec::new(),
             program_lines: Vec::new(),
+            program_expansions: Vec::new(),
         }
     }
 }

@@ -128,7 +128,10 @@ pub fn export(
     all.extend(tool_steps);
     let view = scene::bounds_of(parts.iter().map(|(_, m)| m))
         .map(|b| scene::contact_box(b, &toolpath.tool, &pose));
-    report.program_lines = as_read.map(|r| r.lines).unwrap_or_default();
+    if let Some(read) = as_read {
+        report.program_lines = read.lines;
+        report.program_expansions = read.expansions;
+    }
     let html = page(run, &report, &all, text, view)?;
     all.push(("report.html".into(), html.into_bytes()));
     all.push(("report.json".into(), super::report_json(&report)?));

@@ -68,7 +68,7 @@ pub(super) struct Plan {
 /// The program: as built or as read; the program the verification
 /// replays where it is not that one (the text a control reads, read
 /// back); its passes; the posted programs (or why none); the data files;
-/// the text's line of each block.
+/// the text's line of each block and what the reading expanded.
 pub(super) struct Programmed {
     program: AxisProgram,
     read_back: Option<AxisProgram>,
@@ -76,6 +76,7 @@ pub(super) struct Programmed {
     posted: Result<Files, Error>,
     data: Files,
     lines: Vec<usize>,
+    expansions: Vec<crate::program::expansion::Expansion>,
 }
 
 /// What the checks found: the verification's outcome, the verdict's
@@ -322,9 +323,9 @@ impl Run<'_> {
             ("program.json".into(), program_json),
             ("report.csv".into(), csv),
         ];
-        let (posted, read_back, lines) = match posted {
-            Ok((files, read)) => (Ok(files), Some(read.program), read.lines),
-            Err(e) => (Err(e), None, Vec::new()),
+        let (posted, read_back, lines, expansions) = match posted {
+            Ok((files, read)) => (Ok(files), Some(read.program), read.lines, read.expansions),
+            Err(e) => (Err(e), None, Vec::new(), Vec::new()),
         };
         Ok(Programmed {
             program,
@@ -333,6 +334,7 @@ impl Run<'_> {
             posted,
             data,
             lines,
+            expansions,
         })
     }
 
@@ -362,6 +364,7 @@ impl Run<'_> {
         let crate::program::lint::TextProgram {
             program: read,
             lines,
+            expansions,
             ..
         } = crate::program::lint::read_with(
             text,
@@ -389,6 +392,7 @@ impl Run<'_> {
             posted: Ok(Vec::new()),
             data,
             lines,
+            expansions,
         })
     }
 }
@@ -726,6 +730,7 @@ impl Run<'_> {
             times: Some(times),
             program_file: self.text.and(self.options.program_file.clone()),
             program_lines: made.lines.clone(),
+            program_expansions: made.expansions.clone(),
             block_numbers: (program.blocks.iter().map(|b| b.number))
                 .collect::<Option<Vec<u32>>>()
                 .unwrap_or_default(),

@@ -97,6 +97,8 @@ pub struct TextProgram {
     pub sources: Vec<(usize, usize)>,
     /// The subprograms' files the text called.
     pub files: Vec<String>,
+    /// The runs of blocks a cycle, a loop or a call made.
+    pub expansions: Vec<super::expansion::Expansion>,
 }
 
 /// Reads `text`, a program in `d` for the machine whose axes (their
@@ -214,6 +216,14 @@ fn assemble(read: ReadText, frame: &AxisProgram) -> TextProgram {
         .map(|b| b.via.unwrap_or(b.line) + 1)
         .collect();
     let sources = read.blocks.iter().map(|b| (b.file, b.line + 1)).collect();
+    let origins: Vec<super::expansion::Origin> = (read.blocks.iter())
+        .map(|b| super::expansion::Origin {
+            file: b.file,
+            line: b.line,
+            via: b.via,
+        })
+        .collect();
+    let expansions = super::expansion::expansions(&origins, &read.files);
     let written: Vec<usize> = (0..frame.axes.len())
         .filter(|&i| read.blocks.iter().any(|b| b.values[i].is_some()))
         .collect();
@@ -273,6 +283,7 @@ fn assemble(read: ReadText, frame: &AxisProgram) -> TextProgram {
         lines,
         sources,
         files: read.files,
+        expansions,
     }
 }
 

@@ -9,6 +9,7 @@
 //! in a control's dialect ([`post()`]), or a plugin's own.
 
 pub mod cycle;
+pub mod expansion;
 pub mod lint;
 pub(crate) mod macros;
 pub mod offsets;
