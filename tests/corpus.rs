@@ -193,6 +193,7 @@ fn the_verify_page_names_what_a_call_expanded() {
         "{}",
         report["blocks"]
     );
+    crate::common::leave_page_for_chromium(&dir.join("fanuc-m98_beside.nc"), "corpus-m98-beside");
 }
 
 /// The Sinumerik corpus on the mandrel grinder: the default mandrel's

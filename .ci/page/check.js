@@ -6,7 +6,9 @@
 // - every plot decoded (each <figure> image has a size);
 // - the verdict at the top; the listing opened (every line), its line lit
 //   for the player's block; clicking the worst place (a plot's mark, else
-//   a figure's row) takes the slider to its block;
+//   a figure's row) takes the slider to its block; the first run of an
+//   expansion's table (a cycle's, a loop's, a call's moves) named over the
+//   listing when its row is clicked;
 // - the 3-D view loaded scene.glb and drew it: a screenshot of the viewer,
 //   kept beside the page as <name>.png, with pixels other than the
 //   background over at least 1% of the view and in the middle, where the
@@ -192,6 +194,20 @@ async function check(browser, file) {
         if (before === after) problems.push(`listing: line ${line[2]} left the slider at key ${after}`);
         view += `; listing line ${line[2]} (block ${block + 1}) took it from key ${before} to ${after}`;
       } else problems.push("listing: no line drawn");
+      // A run the reading expanded (a cycle, a loop, a call): its row takes
+      // the player to its first block, and the line over the listing names
+      // where that move was read from.
+      const run = await page.$("table.expanded tr[data-block]");
+      if (run) {
+        await run.click();
+        await page.evaluate(() => new Promise((ok) => requestAnimationFrame(() => setTimeout(ok, 50))));
+        const named = await page.evaluate(() => {
+          const row = document.querySelector("table.expanded tr[data-block]");
+          return [row.cells[2].textContent, document.getElementById("source").textContent];
+        });
+        if (!named[1].includes(named[0])) problems.push(`source: the first expanded run ("${named[0]}") named "${named[1]}" over the listing`);
+        else view += `; an expanded run's row named "${named[1]}"`;
+      }
     }
     // The verdict at the top, seen without scrolling.
     const top = await page.$eval("#verdict", (b) => b.getBoundingClientRect().top + window.scrollY);
