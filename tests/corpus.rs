@@ -148,6 +148,33 @@ fn fanuc_programs_verify_as_their_plain_twins() {
     }
 }
 
+/// A pass ends where the tool leaves the material, not only where a rapid
+/// takes it away: M20x2.5's G32 passes each left at feed (`G01 X23.790
+/// F500.`) and returned at feed above the thread (`Z2.562`) are the
+/// thirteen cutting passes of the twin that leaves and returns in rapids,
+/// with the same figures; the returns, clear of the material, cut nothing.
+#[test]
+fn a_return_at_feed_clear_of_the_material_is_no_pass() {
+    let dir = scratch("corpus", "feed-return");
+    let (code, err, report) = verified(
+        &dir,
+        "fanuc/g32_feed_return.nc",
+        "fanuc-0i-tc",
+        "scripts/thread.rhai",
+    );
+    assert_eq!(code, 0, "{err}");
+    let (tcode, terr, twin) = verified(
+        &dir,
+        "fanuc/g76_m20.plain.nc",
+        "fanuc-0i-tc",
+        "scripts/thread.rhai",
+    );
+    assert_eq!(tcode, 0, "{terr}");
+    assert_eq!(twin["cutting_passes"], 13);
+    assert_eq!(report["cutting_passes"], twin["cutting_passes"]);
+    assert_eq!(figures(&report), figures(&twin));
+}
+
 /// The verify page of a program that calls a subprogram beside it names,
 /// for the moves the calls made, the file and lines they were read from
 /// and the line of each call: `M98 P0102000` on line 10 runs O2000's four

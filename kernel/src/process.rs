@@ -223,6 +223,10 @@ fn substeps(length: Real, step: Real) -> usize {
     ((length / step).ceil() as usize).clamp(1, MAX_SUBSTEPS)
 }
 
+/// The shortest sub-step of a move the rules sample (mm), where the
+/// rapid clearance is shorter.
+pub const LEAST_SUBSTEP: Real = 0.05;
+
 /// The most sub-steps of one move.
 pub const MAX_SUBSTEPS: usize = 200;
 
@@ -247,34 +251,11 @@ pub fn check(
         return Ok(out);
     };
     let (written, _) = crate::replay::as_written(program);
-    let info = machine.info();
     let name = |k: usize| block_name(program, k);
     let n = written.blocks.len();
-    let rows = crate::program::axis_rows(&written, info, &info.solved_axes, 0..n)
-        .map_err(|e| crate::replay::VerifyError::Replay(e.to_string()))?;
-    let width = info.solved_axes.len();
-    // The tool at `i / steps` of the way through block k's move, for i in
-    // 1..steps: rows of 6, in one call of the machine's kinematics (a
-    // plugin's is a call to another process).
-    let poses_along = |k: usize, steps: usize| -> Result<Vec<Real>, crate::replay::VerifyError> {
-        let b = &rows[k * width..(k + 1) * width];
-        let a = if k > 0 {
-            &rows[(k - 1) * width..k * width]
-        } else {
-            b
-        };
-        let q: Vec<Real> = (1..steps)
-            .flat_map(|i| {
-                let t = i as Real / steps as Real;
-                a.iter().zip(b).map(move |(a, b)| a + (b - a) * t)
-            })
-            .collect();
-        if q.is_empty() {
-            return Ok(Vec::new());
-        }
-        crate::replay::forward_rows(machine, &q, tool, k..k + 1)
-    };
-    let ends = crate::replay::replay(&written, machine, tool)?;
+    let moves = Interpolated::new(&written, machine, tool)?;
+    let poses_along = |k: usize, steps: usize| moves.along(k, steps);
+    let ends = &moves.ends;
     let speeds: Vec<Real> = crate::program::spindle_speeds(program).collect();
     // The block that last broke the feed rule, and its feed: the blocks
     // right after it at the same modal feed are the same fault, not told.
@@ -284,11 +265,10 @@ pub fn check(
         ticker.tick()?;
         let b = &written.blocks[k];
         let (p0, p1) = (&ends[6 * (k - 1)..6 * k], &ends[6 * k..6 * k + 6]);
-        let length =
-            ((p1[0] - p0[0]).powi(2) + (p1[1] - p0[1]).powi(2) + (p1[2] - p0[2]).powi(2)).sqrt();
+        let length = moves.length(k);
         match b.motion {
             Motion::Rapid => {
-                let steps = substeps(length, limits.rapid_clearance.max(0.05));
+                let steps = substeps(length, limits.rapid_clearance.max(LEAST_SUBSTEP));
                 let d0 = stock.tool_depth(k, p0);
                 // The deepest the move takes the tool where it comes nearer
                 // the material than it started.
@@ -334,7 +314,7 @@ pub fn check(
                 // Too fast for the family's limit, and in the material
                 // anywhere along the move (its ends may both be clear).
                 if let Some((per_rev, limit)) = over_feed_limit(stock, k, b.feed, speeds[k]) {
-                    let steps = substeps(length, limits.rapid_clearance.max(0.05));
+                    let steps = substeps(length, limits.rapid_clearance.max(LEAST_SUBSTEP));
                     let cuts = d0 > 0.0
                         || d1 > 0.0
                         || (poses_along(k, steps)?)
@@ -382,6 +362,151 @@ pub fn check(
     bodies(program, &written, machine, stock, limits, &mut out)?;
     finishing(program, stock, limits, &mut out);
     Ok(out)
+}
+
+/// The tool along a program's moves as the control interpolates them:
+/// its axes' rows, the poses at the moves' ends, and the poses between.
+struct Interpolated<'a> {
+    /// The solved axes' values, a row per block.
+    rows: Vec<Real>,
+    /// The length of a row.
+    width: usize,
+    /// The tool at each block's end, rows of 6 in the part frame.
+    ends: Vec<Real>,
+    machine: &'a dyn MachineKinematics,
+    tool: &'a ToolFrame,
+}
+
+impl<'a> Interpolated<'a> {
+    /// The moves of `written` (a program as written) on `machine`, the
+    /// tool tracked at `tool`.
+    fn new(
+        written: &AxisProgram,
+        machine: &'a dyn MachineKinematics,
+        tool: &'a ToolFrame,
+    ) -> Result<Self, crate::replay::VerifyError> {
+        let info = machine.info();
+        let n = written.blocks.len();
+        let rows = crate::program::axis_rows(written, info, &info.solved_axes, 0..n)
+            .map_err(|e| crate::replay::VerifyError::Replay(e.to_string()))?;
+        Ok(Self {
+            rows,
+            width: info.solved_axes.len(),
+            ends: crate::replay::replay(written, machine, tool)?,
+            machine,
+            tool,
+        })
+    }
+
+    /// The tool at `i / steps` of the way through block `k`'s move, for i
+    /// in 1..steps: rows of 6, in one call of the machine's kinematics (a
+    /// plugin's is a call to another process).
+    fn along(&self, k: usize, steps: usize) -> Result<Vec<Real>, crate::replay::VerifyError> {
+        let w = self.width;
+        let b = &self.rows[k * w..(k + 1) * w];
+        let a = if k > 0 {
+            &self.rows[(k - 1) * w..k * w]
+        } else {
+            b
+        };
+        let q: Vec<Real> = (1..steps)
+            .flat_map(|i| {
+                let t = i as Real / steps as Real;
+                a.iter().zip(b).map(move |(a, b)| a + (b - a) * t)
+            })
+            .collect();
+        if q.is_empty() {
+            return Ok(Vec::new());
+        }
+        crate::replay::forward_rows(self.machine, &q, self.tool, k..k + 1)
+    }
+
+    /// The length of block `k`'s move (mm, in the part frame).
+    fn length(&self, k: usize) -> Real {
+        let e = &self.ends;
+        let (p0, p1) = (&e[6 * (k - 1)..6 * k], &e[6 * k..6 * k + 6]);
+        ((p1[0] - p0[0]).powi(2) + (p1[1] - p0[1]).powi(2) + (p1[2] - p0[2]).powi(2)).sqrt()
+    }
+}
+
+/// Where the tool meets the material on a program's feed moves: what a
+/// pass found from the motion needs to cut at all.
+pub struct Contact<'a> {
+    moves: Interpolated<'a>,
+    written: AxisProgram,
+    stock: &'a dyn Stock,
+    /// How near the material counts as on it (mm): the program's
+    /// resolution.
+    near: Real,
+    /// The sub-steps' length (mm).
+    step: Real,
+}
+
+impl<'a> Contact<'a> {
+    /// The feed moves of `program` on `machine` (the tool tracked at
+    /// `tool`) against `stock`, sampled every `step` mm (at most
+    /// [`MAX_SUBSTEPS`] a move).
+    ///
+    /// # Failures
+    /// The machine's kinematics failing on the program.
+    pub fn new(
+        program: &AxisProgram,
+        machine: &'a dyn MachineKinematics,
+        tool: &'a ToolFrame,
+        stock: &'a dyn Stock,
+        step: Real,
+    ) -> Result<Self, crate::replay::VerifyError> {
+        let (written, near) = crate::replay::as_written(program);
+        Ok(Self {
+            moves: Interpolated::new(&written, machine, tool)?,
+            written,
+            stock,
+            near,
+            step,
+        })
+    }
+
+    /// Whether a feed move of `blocks` (a rapid's or a thread's aside)
+    /// brings the tool onto the material (within the program's resolution
+    /// of it, or into it) anywhere past the move's start: a move that
+    /// starts on the surface it has just cut and leaves it does not; a
+    /// spark-out along the surface does. A thread's move cuts by what it
+    /// is.
+    ///
+    /// # Failures
+    /// The machine's kinematics failing between the moves' ends.
+    pub fn touches(
+        &self,
+        blocks: std::ops::Range<usize>,
+    ) -> Result<bool, crate::replay::VerifyError> {
+        let on = |k: usize, pose: &[Real]| self.stock.tool_depth(k, pose) > -self.near;
+        let feed: Vec<usize> = blocks
+            .filter(|&k| k > 0 && k < self.written.blocks.len())
+            .filter(|&k| self.written.blocks[k].motion != Motion::Rapid)
+            .collect();
+        let mut ticker = crate::budget::Ticker::new("the passes' contact with the material", 64);
+        for &k in &feed {
+            ticker.tick()?;
+            if matches!(self.written.blocks[k].motion, Motion::Thread { .. })
+                || on(k, &self.moves.ends[6 * k..6 * k + 6])
+            {
+                return Ok(true);
+            }
+        }
+        for &k in &feed {
+            ticker.tick()?;
+            let steps = substeps(self.moves.length(k), self.step);
+            if self
+                .moves
+                .along(k, steps)?
+                .chunks(6)
+                .any(|pose| on(k, pose))
+            {
+                return Ok(true);
+            }
+        }
+        Ok(false)
+    }
 }
 
 /// The feed per revolution of block `k` at `feed` (mm/min) and `rpm`,

@@ -431,17 +431,39 @@ impl<'a> Run<'a> {
             });
         }
         let requested = self.family.verification(self.values)?;
-        let ctx = self.replay_ctx(plan, made);
-        let (outcome, stock) = match &requested {
-            None => (None, None),
+        let verify = |made: &Programmed| match &requested {
+            None => Ok((None, None)),
             Some(r) => {
-                let v = r
-                    .verifier()
-                    .verify(&ctx)
+                let v = (r.verifier().verify(&self.replay_ctx(plan, made)))
                     .map_err(|e| self.verify_error(e))?;
-                (Some(v.outcome), v.stock)
+                Ok::<_, Error>((Some(v.outcome), v.stock))
             }
         };
+        let (mut outcome, mut stock) = verify(made)?;
+        // Passes found from a text's motion: one that never meets the
+        // material (a retract and a return at feed) cuts nothing, and the
+        // verification is made again on the passes that do.
+        let regrouped = match (self.text, stock.as_deref()) {
+            (Some(_), Some(s)) => {
+                let kin = plan.kin(self.machine);
+                let step = crate::process::ProcessLimits::of(kin.info()).rapid_clearance;
+                let contact = crate::process::Contact::new(
+                    made.verified(),
+                    kin,
+                    &plan.toolpath.tool.reference,
+                    s,
+                    step.max(crate::process::LEAST_SUBSTEP),
+                )
+                .map_err(|e| self.verify_error(e))?;
+                crate::replay::regrouped(made.verified(), &made.passes, |b| contact.touches(b))
+                    .map_err(|e| self.verify_error(e))?
+            }
+            _ => None,
+        };
+        if let Some(passes) = regrouped {
+            made.passes = passes;
+            (outcome, stock) = verify(made)?;
+        }
         let (mut figures, mut failures) = match &outcome {
             Some(o) => o.findings(made.verified()),
             None => (Vec::new(), Vec::new()),

@@ -265,6 +265,65 @@ pub fn passes_in(
             stepping.get_or_insert(k);
         }
     }
+    Ok(named(&written, &runs))
+}
+
+/// `passes` of `program` (as [`passes_in`] found them) with those whose
+/// blocks `touch` finds clear of the material no longer cutting passes: a
+/// move at feed away from the part and back above it (a retract and a
+/// return at feed, where a shop writes no rapid) cuts nothing. Each such
+/// pass's blocks join the pass after it, as its approach (or the start
+/// before the first cut, the end after the last); the passes named by
+/// their order are numbered again. `None` where every cutting pass
+/// touches the material.
+///
+/// # Failures
+/// `touch` failing.
+pub fn regrouped<E>(
+    program: &AxisProgram,
+    passes: &[ProgramPass],
+    mut touch: impl FnMut(std::ops::Range<usize>) -> Result<bool, E>,
+) -> Result<Option<Vec<ProgramPass>>, E> {
+    let mut clear = false;
+    let mut runs: Vec<(usize, bool)> = Vec::with_capacity(passes.len());
+    for p in passes {
+        let cuts = p.cuts && touch(p.blocks.clone())?;
+        clear |= p.cuts && !cuts;
+        runs.push((p.blocks.start, cuts));
+    }
+    if !clear {
+        return Ok(None);
+    }
+    let mut merged: Vec<(usize, bool)> = Vec::with_capacity(runs.len());
+    let mut pending: Option<usize> = None;
+    for (i, &(start, cuts)) in runs.iter().enumerate() {
+        let before_any_cut = merged.iter().all(|r| !r.1);
+        if i == 0 || (!cuts && before_any_cut) {
+            // The start, and what joins it before the first cut.
+            if merged.is_empty() {
+                merged.push((start, cuts));
+            }
+            continue;
+        }
+        let start = pending.take().unwrap_or(start);
+        match cuts {
+            true => merged.push((start, true)),
+            false => pending = Some(start),
+        }
+    }
+    if let Some(start) = pending {
+        merged.push((start, false));
+    }
+    Ok(Some(named(program, &merged)))
+}
+
+/// The passes of `written` that `runs` (each run's first block and
+/// whether it cuts, in order) make: each to the next run's first block,
+/// named by the first comment among its blocks, else by its order among
+/// the cutting passes (`pass 3`), `start` before the first cut and `end`
+/// after the last.
+fn named(written: &AxisProgram, runs: &[(usize, bool)]) -> Vec<ProgramPass> {
+    let n = written.blocks.len();
     // The trailing rapids after the last cut are the end.
     let mut out: Vec<ProgramPass> = Vec::with_capacity(runs.len());
     let mut cutting = 0;
@@ -296,7 +355,7 @@ pub fn passes_in(
             cuts: false,
         });
     }
-    Ok(out)
+    out
 }
 
 /// How far a cutting move may turn back against its pass's travel before
