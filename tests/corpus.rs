@@ -93,6 +93,40 @@ fn leave_for_rs274(dir: &Path, program: &str) {
     std::fs::copy(read, left.join("program.json")).unwrap();
 }
 
+/// The Fanuc 0i-TC lathe with a LinuxCNC control, as a machine file in
+/// `dir`.
+fn linuxcnc_lathe(dir: &Path) -> PathBuf {
+    let lathe = pilgrim_kernel::machine::machine_file(&fanuc_0i_tc::describe(), "its crate");
+    let file = dir.join("linuxcnc-lathe.toml");
+    std::fs::write(&file, crate::common::with_control(&lathe, "linuxcnc")).unwrap();
+    file
+}
+
+/// `program` of the corpus and its plain `twin`, verified on `machine`
+/// against `family`: both pass with the same figures and the same moves;
+/// their reports.
+fn as_twins(
+    dir: &Path,
+    program: &str,
+    twin: &str,
+    machine: &str,
+    family: &str,
+) -> (serde_json::Value, serde_json::Value) {
+    let (code, err, report) = verified(dir, program, machine, family);
+    assert_eq!(code, 0, "{program}: {err}");
+    let (tcode, terr, treport) = verified(dir, twin, machine, family);
+    assert_eq!(tcode, 0, "{twin}: {terr}");
+    assert_eq!(figures(&report), figures(&treport), "{program}");
+    assert_eq!(report["blocks"], treport["blocks"], "{program}");
+    (report, treport)
+}
+
+/// `file` of the corpus verified on the Fanuc 0i-TC lathe against the
+/// thread family's default (M20x2.5-6g), as [`verified`].
+fn on_fanuc(dir: &Path, file: &str) -> (i32, String, serde_json::Value) {
+    verified(dir, file, "fanuc-0i-tc", "scripts/thread.rhai")
+}
+
 /// `a` and `b` alike, every number within `tol`: `what` in the message.
 fn alike(a: &serde_json::Value, b: &serde_json::Value, tol: f64, what: &str) {
     use serde_json::Value::{Array, Number, Object};
@@ -131,9 +165,9 @@ fn fanuc_programs_verify_as_their_plain_twins() {
     ] {
         let program = format!("fanuc/{name}.nc");
         let twin = format!("fanuc/{name}.plain.nc");
-        let (code, err, report) = verified(&dir, &program, "fanuc-0i-tc", "scripts/thread.rhai");
+        let (code, err, report) = on_fanuc(&dir, &program);
         assert_eq!(code, 0, "{program}: {err}");
-        let (tcode, terr, treport) = verified(&dir, &twin, "fanuc-0i-tc", "scripts/thread.rhai");
+        let (tcode, terr, treport) = on_fanuc(&dir, &twin);
         assert_eq!(tcode, 0, "{twin}: {terr}");
         assert!(report["thread_verification"].is_object(), "{program}");
         assert_eq!(
@@ -156,19 +190,9 @@ fn fanuc_programs_verify_as_their_plain_twins() {
 #[test]
 fn a_return_at_feed_clear_of_the_material_is_no_pass() {
     let dir = scratch("corpus", "feed-return");
-    let (code, err, report) = verified(
-        &dir,
-        "fanuc/g32_feed_return.nc",
-        "fanuc-0i-tc",
-        "scripts/thread.rhai",
-    );
+    let (code, err, report) = on_fanuc(&dir, "fanuc/g32_feed_return.nc");
     assert_eq!(code, 0, "{err}");
-    let (tcode, terr, twin) = verified(
-        &dir,
-        "fanuc/g76_m20.plain.nc",
-        "fanuc-0i-tc",
-        "scripts/thread.rhai",
-    );
+    let (tcode, terr, twin) = on_fanuc(&dir, "fanuc/g76_m20.plain.nc");
     assert_eq!(tcode, 0, "{terr}");
     assert_eq!(twin["cutting_passes"], 13);
     assert_eq!(report["cutting_passes"], twin["cutting_passes"]);
@@ -182,12 +206,7 @@ fn a_return_at_feed_clear_of_the_material_is_no_pass() {
 #[test]
 fn the_verify_page_names_what_a_call_expanded() {
     let dir = scratch("corpus", "expanded");
-    let (code, err, report) = verified(
-        &dir,
-        "fanuc/m98_beside.nc",
-        "fanuc-0i-tc",
-        "scripts/thread.rhai",
-    );
+    let (code, err, report) = on_fanuc(&dir, "fanuc/m98_beside.nc");
     assert_eq!(code, 0, "{err}");
     let page =
         std::fs::read_to_string(dir.join("fanuc-m98_beside.nc").join("report.html")).unwrap();
@@ -467,9 +486,7 @@ fn linuxcnc_programs_verify_as_their_plain_twins_and_as_rs274_reads_them() {
 #[test]
 fn dwells_stand_for_their_time_in_each_controls_units() {
     let dir = scratch("corpus", "dwell");
-    let lathe = pilgrim_kernel::machine::machine_file(&fanuc_0i_tc::describe(), "its crate");
-    let linuxcnc = dir.join("linuxcnc-lathe.toml");
-    std::fs::write(&linuxcnc, crate::common::with_control(&lathe, "linuxcnc")).unwrap();
+    let linuxcnc = linuxcnc_lathe(&dir);
     let thread = "scripts/thread.rhai";
     for (program, twin, machine, family, seconds) in [
         (
@@ -494,12 +511,7 @@ fn dwells_stand_for_their_time_in_each_controls_units() {
             1.5 + 12.0 * 0.25,
         ),
     ] {
-        let (code, err, report) = verified(&dir, program, machine, family);
-        assert_eq!(code, 0, "{program}: {err}");
-        let (tcode, terr, treport) = verified(&dir, twin, machine, family);
-        assert_eq!(tcode, 0, "{twin}: {terr}");
-        assert_eq!(figures(&report), figures(&treport), "{program}");
-        assert_eq!(report["blocks"], treport["blocks"], "{program}");
+        let (report, treport) = as_twins(&dir, program, twin, machine, family);
         let minutes = |r: &serde_json::Value, k: &str| r["times"][k].as_f64().unwrap();
         let programmed = minutes(&report, "programmed_min") - minutes(&treport, "programmed_min");
         assert!(
@@ -560,9 +572,7 @@ fn read_speeds(dir: &Path, out: &str) -> (Vec<(usize, f64)>, usize) {
 #[test]
 fn constant_surface_speed_turns_as_each_control_clamps_it() {
     let dir = scratch("corpus", "g96");
-    let lathe = pilgrim_kernel::machine::machine_file(&fanuc_0i_tc::describe(), "its crate");
-    let linuxcnc = dir.join("linuxcnc-lathe.toml");
-    std::fs::write(&linuxcnc, crate::common::with_control(&lathe, "linuxcnc")).unwrap();
+    let linuxcnc = linuxcnc_lathe(&dir);
     let thread = "scripts/thread.rhai";
     let rpm = |v: f64, d: f64| 1000.0 * v / (std::f64::consts::PI * d);
     let face = rpm(150.0, 40.0);
@@ -595,12 +605,7 @@ fn constant_surface_speed_turns_as_each_control_clamps_it() {
             ],
         ),
     ] {
-        let (code, err, report) = verified(&dir, program, machine, family);
-        assert_eq!(code, 0, "{program}: {err}");
-        let (tcode, terr, treport) = verified(&dir, twin, machine, family);
-        assert_eq!(tcode, 0, "{twin}: {terr}");
-        assert_eq!(figures(&report), figures(&treport), "{program}");
-        assert_eq!(report["blocks"], treport["blocks"], "{program}");
+        as_twins(&dir, program, twin, machine, family);
         let (read, n) = read_speeds(&dir, &program.replace('/', "-"));
         let want: Vec<(usize, f64)> = (speeds.iter())
             .map(|&(k, v)| (if k == usize::MAX { n - 2 } else { k }, v))

@@ -79,6 +79,10 @@ pub(super) struct Programmed {
     expansions: Vec<crate::program::expansion::Expansion>,
 }
 
+/// The material a verification leaves, for the process's rules (`None`:
+/// the family's verification gives no blank).
+type Material = Option<Box<dyn crate::process::Stock>>;
+
 /// What the checks found: the verification's outcome, the verdict's
 /// figures, failures and warnings, the part's bodies and meshes, the
 /// machine's bodies placed, the collisions, the scene's block and what the
@@ -419,19 +423,18 @@ impl<'a> Run<'a> {
         }
     }
 
-    /// The checks: the family's verification of the program as written,
-    /// the part's bodies, the process's rules over the material the
-    /// verification knows and the collisions along the whole program, the
-    /// scene's block and what the verification shows there, the programs
-    /// (none where anything failed).
-    pub(super) fn check(&self, plan: &Plan, made: &mut Programmed) -> Result<Checked, Error> {
-        if self.options.pose_block == Some(0) {
-            return Err(Error::BlockFromOne {
-                option: "--pose-block",
-            });
-        }
-        let requested = self.family.verification(self.values)?;
-        let verify = |made: &Programmed| match &requested {
+    /// The family's verification of the program (`None` where the family
+    /// asks none), with the material it leaves. Passes found from a text's
+    /// motion that never meet the material (a retract and a return at
+    /// feed) cut nothing: the passes are regrouped and the verification is
+    /// made again on those that cut.
+    fn verification(
+        &self,
+        plan: &Plan,
+        made: &mut Programmed,
+        requested: Option<&crate::family::Verification>,
+    ) -> Result<(Option<Box<dyn Outcome>>, Material), Error> {
+        let verify = |made: &Programmed| match requested {
             None => Ok((None, None)),
             Some(r) => {
                 let v = (r.verifier().verify(&self.replay_ctx(plan, made)))
@@ -439,10 +442,7 @@ impl<'a> Run<'a> {
                 Ok::<_, Error>((Some(v.outcome), v.stock))
             }
         };
-        let (mut outcome, mut stock) = verify(made)?;
-        // Passes found from a text's motion: one that never meets the
-        // material (a retract and a return at feed) cuts nothing, and the
-        // verification is made again on the passes that do.
+        let (outcome, stock) = verify(made)?;
         let regrouped = match (self.text, stock.as_deref()) {
             (Some(_), Some(s)) => {
                 let kin = plan.kin(self.machine);
@@ -460,10 +460,28 @@ impl<'a> Run<'a> {
             }
             _ => None,
         };
-        if let Some(passes) = regrouped {
-            made.passes = passes;
-            (outcome, stock) = verify(made)?;
+        match regrouped {
+            Some(passes) => {
+                made.passes = passes;
+                verify(made)
+            }
+            None => Ok((outcome, stock)),
         }
+    }
+
+    /// The checks: the family's verification of the program as written,
+    /// the part's bodies, the process's rules over the material the
+    /// verification knows and the collisions along the whole program, the
+    /// scene's block and what the verification shows there, the programs
+    /// (none where anything failed).
+    pub(super) fn check(&self, plan: &Plan, made: &mut Programmed) -> Result<Checked, Error> {
+        if self.options.pose_block == Some(0) {
+            return Err(Error::BlockFromOne {
+                option: "--pose-block",
+            });
+        }
+        let requested = self.family.verification(self.values)?;
+        let (outcome, stock) = self.verification(plan, made, requested.as_ref())?;
         let (mut figures, mut failures) = match &outcome {
             Some(o) => o.findings(made.verified()),
             None => (Vec::new(), Vec::new()),
