@@ -572,7 +572,7 @@ mod tests {
         frame.blocks.clear();
         let text = post(&p, &SINUMERIK).unwrap();
         for (from, to, word) in [
-            ("G1 X40.000", "G96 G1 X40.000", "G96"),
+            ("G1 X40.000", "G41 G1 X40.000", "G41"),
             ("G1 X40.000", "G1 X40.000 R5", "R5"),
             ("M3", "M98", "M98"),
         ] {
