@@ -245,15 +245,33 @@ pub fn check(
     stock: Option<&dyn Stock>,
     limits: &ProcessLimits,
 ) -> Result<ProcessFindings, crate::replay::VerifyError> {
+    match stock {
+        Some(stock) => check_on(program, &Moves::new(program, machine, tool)?, stock, limits),
+        None => {
+            let mut out = ProcessFindings::default();
+            spindle_and_coolant(program, machine.info(), &mut out);
+            Ok(out)
+        }
+    }
+}
+
+/// [`check`] on `program`'s `moves` (made once for a run: the passes'
+/// [`Contact`] reads the same) against `stock`.
+///
+/// # Failures
+/// As [`check`].
+pub fn check_on(
+    program: &AxisProgram,
+    moves: &Moves<'_>,
+    stock: &dyn Stock,
+    limits: &ProcessLimits,
+) -> Result<ProcessFindings, crate::replay::VerifyError> {
     let mut out = ProcessFindings::default();
+    let machine = moves.machine;
     spindle_and_coolant(program, machine.info(), &mut out);
-    let Some(stock) = stock else {
-        return Ok(out);
-    };
-    let (written, _) = crate::replay::as_written(program);
+    let written = &moves.written;
     let name = |k: usize| block_name(program, k);
     let n = written.blocks.len();
-    let moves = Interpolated::new(&written, machine, tool)?;
     let poses_along = |k: usize, steps: usize| moves.along(k, steps);
     let ends = &moves.ends;
     let speeds: Vec<Real> = crate::program::spindle_speeds(program).collect();
@@ -359,14 +377,20 @@ pub fn check(
             Motion::Thread { .. } => {}
         }
     }
-    bodies(program, &written, machine, stock, limits, &mut out)?;
+    bodies(program, written, machine, stock, limits, &mut out)?;
     finishing(program, stock, limits, &mut out);
     Ok(out)
 }
 
-/// The tool along a program's moves as the control interpolates them:
-/// its axes' rows, the poses at the moves' ends, and the poses between.
-struct Interpolated<'a> {
+/// A program's moves as the control interpolates them, made once for a
+/// run: the program as written (its values rounded as the control reads
+/// them) and its resolution, its axes' rows, the tool's poses at the
+/// moves' ends, and the poses between on request.
+pub struct Moves<'a> {
+    /// The program as written.
+    written: AxisProgram,
+    /// Its resolution (mm): the last decimal it writes.
+    resolution: Real,
     /// The solved axes' values, a row per block.
     rows: Vec<Real>,
     /// The length of a row.
@@ -377,22 +401,28 @@ struct Interpolated<'a> {
     tool: &'a ToolFrame,
 }
 
-impl<'a> Interpolated<'a> {
-    /// The moves of `written` (a program as written) on `machine`, the
-    /// tool tracked at `tool`.
-    fn new(
-        written: &AxisProgram,
+impl<'a> Moves<'a> {
+    /// The moves of `program` as written, on `machine`, the tool tracked
+    /// at `tool`.
+    ///
+    /// # Failures
+    /// The machine's kinematics failing on the program.
+    pub fn new(
+        program: &AxisProgram,
         machine: &'a dyn MachineKinematics,
         tool: &'a ToolFrame,
     ) -> Result<Self, crate::replay::VerifyError> {
+        let (written, resolution) = crate::replay::as_written(program);
         let info = machine.info();
         let n = written.blocks.len();
-        let rows = crate::program::axis_rows(written, info, &info.solved_axes, 0..n)
+        let rows = crate::program::axis_rows(&written, info, &info.solved_axes, 0..n)
             .map_err(|e| crate::replay::VerifyError::Replay(e.to_string()))?;
         Ok(Self {
             rows,
             width: info.solved_axes.len(),
-            ends: crate::replay::replay(written, machine, tool)?,
+            ends: crate::replay::replay(&written, machine, tool)?,
+            written,
+            resolution,
             machine,
             tool,
         })
@@ -432,38 +462,17 @@ impl<'a> Interpolated<'a> {
 /// Where the tool meets the material on a program's feed moves: what a
 /// pass found from the motion needs to cut at all.
 pub struct Contact<'a> {
-    moves: Interpolated<'a>,
-    written: AxisProgram,
+    moves: &'a Moves<'a>,
     stock: &'a dyn Stock,
-    /// How near the material counts as on it (mm): the program's
-    /// resolution.
-    near: Real,
     /// The sub-steps' length (mm).
     step: Real,
 }
 
 impl<'a> Contact<'a> {
-    /// The feed moves of `program` on `machine` (the tool tracked at
-    /// `tool`) against `stock`, sampled every `step` mm (at most
-    /// [`MAX_SUBSTEPS`] a move).
-    ///
-    /// # Failures
-    /// The machine's kinematics failing on the program.
-    pub fn new(
-        program: &AxisProgram,
-        machine: &'a dyn MachineKinematics,
-        tool: &'a ToolFrame,
-        stock: &'a dyn Stock,
-        step: Real,
-    ) -> Result<Self, crate::replay::VerifyError> {
-        let (written, near) = crate::replay::as_written(program);
-        Ok(Self {
-            moves: Interpolated::new(&written, machine, tool)?,
-            written,
-            stock,
-            near,
-            step,
-        })
+    /// The feed moves of `moves` against `stock`, sampled every `step` mm
+    /// (at most [`MAX_SUBSTEPS`] a move).
+    pub fn new(moves: &'a Moves<'a>, stock: &'a dyn Stock, step: Real) -> Self {
+        Self { moves, stock, step }
     }
 
     /// Whether a feed move of `blocks` (a rapid's or a thread's aside)
@@ -479,15 +488,18 @@ impl<'a> Contact<'a> {
         &self,
         blocks: std::ops::Range<usize>,
     ) -> Result<bool, crate::replay::VerifyError> {
-        let on = |k: usize, pose: &[Real]| self.stock.tool_depth(k, pose) > -self.near;
+        let written = &self.moves.written;
+        // On the material: within the program's resolution of it.
+        let near = self.moves.resolution;
+        let on = |k: usize, pose: &[Real]| self.stock.tool_depth(k, pose) > -near;
         let feed: Vec<usize> = blocks
-            .filter(|&k| k > 0 && k < self.written.blocks.len())
-            .filter(|&k| self.written.blocks[k].motion != Motion::Rapid)
+            .filter(|&k| k > 0 && k < written.blocks.len())
+            .filter(|&k| written.blocks[k].motion != Motion::Rapid)
             .collect();
         let mut ticker = crate::budget::Ticker::new("the passes' contact with the material", 64);
         for &k in &feed {
             ticker.tick()?;
-            if matches!(self.written.blocks[k].motion, Motion::Thread { .. })
+            if matches!(written.blocks[k].motion, Motion::Thread { .. })
                 || on(k, &self.moves.ends[6 * k..6 * k + 6])
             {
                 return Ok(true);

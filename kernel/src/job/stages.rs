@@ -79,9 +79,10 @@ pub(super) struct Programmed {
     expansions: Vec<crate::program::expansion::Expansion>,
 }
 
-/// The material a verification leaves, for the process's rules (`None`:
-/// the family's verification gives no blank).
-type Material = Option<Box<dyn crate::process::Stock>>;
+/// The material a verification leaves and the program's moves against
+/// it, for the process's rules (`None`: the family's verification gives
+/// no blank).
+type Material<'p> = Option<(Box<dyn crate::process::Stock>, crate::process::Moves<'p>)>;
 
 /// What the checks found: the verification's outcome, the verdict's
 /// figures, failures and warnings, the part's bodies and meshes, the
@@ -424,16 +425,17 @@ impl<'a> Run<'a> {
     }
 
     /// The family's verification of the program (`None` where the family
-    /// asks none), with the material it leaves. Passes found from a text's
-    /// motion that never meet the material (a retract and a return at
-    /// feed) cut nothing: the passes are regrouped and the verification is
-    /// made again on those that cut.
-    fn verification(
-        &self,
-        plan: &Plan,
+    /// asks none), with the material it leaves and the program's moves
+    /// against it (made once: the process's rules read them too). Passes
+    /// found from a text's motion that never meet the material (a retract
+    /// and a return at feed) cut nothing: the passes are regrouped and the
+    /// verification is made again on those that cut.
+    fn verification<'p>(
+        &'p self,
+        plan: &'p Plan,
         made: &mut Programmed,
         requested: Option<&crate::family::Verification>,
-    ) -> Result<(Option<Box<dyn Outcome>>, Material), Error> {
+    ) -> Result<(Option<Box<dyn Outcome>>, Material<'p>), Error> {
         let verify = |made: &Programmed| match requested {
             None => Ok((None, None)),
             Some(r) => {
@@ -443,30 +445,32 @@ impl<'a> Run<'a> {
             }
         };
         let (outcome, stock) = verify(made)?;
-        let regrouped = match (self.text, stock.as_deref()) {
-            (Some(_), Some(s)) => {
-                let kin = plan.kin(self.machine);
+        let Some(stock) = stock else {
+            return Ok((outcome, None));
+        };
+        let kin = plan.kin(self.machine);
+        let moves = crate::process::Moves::new(made.verified(), kin, &plan.toolpath.tool.reference)
+            .map_err(|e| self.verify_error(e))?;
+        let regrouped = match self.text {
+            Some(_) => {
                 let step = crate::process::ProcessLimits::of(kin.info()).rapid_clearance;
                 let contact = crate::process::Contact::new(
-                    made.verified(),
-                    kin,
-                    &plan.toolpath.tool.reference,
-                    s,
+                    &moves,
+                    stock.as_ref(),
                     step.max(crate::process::LEAST_SUBSTEP),
-                )
-                .map_err(|e| self.verify_error(e))?;
+                );
                 crate::replay::regrouped(made.verified(), &made.passes, |b| contact.touches(b))
                     .map_err(|e| self.verify_error(e))?
             }
-            _ => None,
+            None => None,
         };
-        match regrouped {
-            Some(passes) => {
-                made.passes = passes;
-                verify(made)
-            }
-            None => Ok((outcome, stock)),
-        }
+        let Some(passes) = regrouped else {
+            return Ok((outcome, Some((stock, moves))));
+        };
+        // The program is the same: only its passes changed.
+        made.passes = passes;
+        let (outcome, stock) = verify(made)?;
+        Ok((outcome, stock.map(|s| (s, moves))))
     }
 
     /// The checks: the family's verification of the program as written,
@@ -481,7 +485,7 @@ impl<'a> Run<'a> {
             });
         }
         let requested = self.family.verification(self.values)?;
-        let (outcome, stock) = self.verification(plan, made, requested.as_ref())?;
+        let (outcome, material) = self.verification(plan, made, requested.as_ref())?;
         let (mut figures, mut failures) = match &outcome {
             Some(o) => o.findings(made.verified()),
             None => (Vec::new(), Vec::new()),
@@ -502,13 +506,14 @@ impl<'a> Run<'a> {
         let (process, collisions) = crate::budget::beside(
             || {
                 let limits = crate::process::ProcessLimits::of(kin.info());
-                crate::process::check(
-                    made.verified(),
-                    kin,
-                    &tool.reference,
-                    stock.as_deref(),
-                    &limits,
-                )
+                match &material {
+                    Some((stock, moves)) => {
+                        crate::process::check_on(made.verified(), moves, stock.as_ref(), &limits)
+                    }
+                    None => {
+                        crate::process::check(made.verified(), kin, &tool.reference, None, &limits)
+                    }
+                }
             },
             || collisions(made.verified(), info, &placement, tool, &meshes, tol),
         );
@@ -516,7 +521,7 @@ impl<'a> Run<'a> {
         failures.extend(process.errors);
         warnings.extend(process.warnings);
         figures.extend(process.figures);
-        if stock.is_none() {
+        if material.is_none() {
             warnings.push(Finding::new(
                 "the process",
                 "the rules that need the material (rapids through air only, into the stock at the infeed feed, the steady rest's approach, the finishing stock) were not checked: the family's verification gives no blank",

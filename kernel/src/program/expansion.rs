@@ -85,19 +85,20 @@ pub fn expansions(origins: &[Origin], files: &[String]) -> Vec<Expansion> {
     for o in origins {
         *count.entry((o.file, o.line)).or_default() += 1;
     }
-    let expanded = |o: &Origin| o.file != 0 || o.via.is_some() || count[&(o.file, o.line)] > 1;
     let mut runs: Vec<Expansion> = Vec::new();
+    // The last run's file, and the moves each of its lines made.
+    let mut run_file = 0;
     let mut per_line = std::collections::HashMap::<usize, usize>::new();
     for (k, o) in origins.iter().enumerate() {
-        if !expanded(o) {
+        let called = o.file != 0 || o.via.is_some();
+        if !called && count[&(o.file, o.line)] == 1 {
             continue;
         }
-        let called = o.file != 0 || o.via.is_some();
         let joins = runs.last().is_some_and(|r| {
             r.last + 1 == k
                 && (r.made == Made::Call) == called
                 && r.called_at == o.via.map(|l| l + 1)
-                && file_index(r, files) == o.file
+                && run_file == o.file
                 // A cycle whose every move is in the run ends at the next line.
                 && !(r.made == Made::Block
                     && o.line + 1 != r.lines.0
@@ -105,6 +106,7 @@ pub fn expansions(origins: &[Origin], files: &[String]) -> Vec<Expansion> {
         });
         if !joins {
             per_line.clear();
+            run_file = o.file;
             runs.push(Expansion {
                 first: k,
                 last: k,
@@ -129,14 +131,6 @@ pub fn expansions(origins: &[Origin], files: &[String]) -> Vec<Expansion> {
         }
     }
     runs
-}
-
-/// The file number of run `r`'s file among `files` (0: the program's own).
-fn file_index(r: &Expansion, files: &[String]) -> usize {
-    if r.file.is_empty() {
-        return 0;
-    }
-    files.iter().position(|f| *f == r.file).map_or(0, |i| i + 1)
 }
 
 #[cfg(test)]
