@@ -13,6 +13,12 @@
 //!   LinuxCNC's G76 makes it (`cycle = "g76"`), posted for LinuxCNC too
 //!   (the cycle written, its lint expanding it); and the pipe thread G 1/2
 //!   A of `scripts/examples/thread-g1-2a.toml`.
+//! - `thread_verify_text`: `verify` of a shop's M20x2.5 program read from
+//!   its text (`tests/corpus/fanuc/g76_m20.plain.nc`: G32 passes left and
+//!   returned in rapids), and the same passes left and returned at feed
+//!   (`g32_feed_return.nc`), whose thirteen returns clear of the material
+//!   the contact test finds and the verification is made again without:
+//!   what the regrouping costs.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use pilgrim_kernel::catalog::{Catalog, CompiledPlugin};
@@ -89,5 +95,35 @@ fn thread_job(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, thread_job);
+fn thread_verify_text(c: &mut Criterion) {
+    let catalog = Catalog::new(&[CompiledPlugin {
+        symbol: "pilgrim_plugin_fanuc_0i_tc",
+        entry: fanuc_0i_tc::pilgrim_plugin_fanuc_0i_tc,
+    }])
+    .unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let family = ScriptFamily::load(
+        &root.join("scripts/thread.rhai"),
+        &Limits::default(),
+        &Access::default(),
+    )
+    .unwrap();
+    let machine = catalog.open("fanuc-0i-tc").unwrap();
+    let options = JobOptions::default();
+    let mut g = c.benchmark_group("thread_verify_text");
+    g.sample_size(20).measurement_time(Duration::from_secs(10));
+    for (name, file) in [
+        ("m20_g32_rapid_returns", "g76_m20.plain.nc"),
+        ("m20_g32_feed_returns", "g32_feed_return.nc"),
+    ] {
+        let text = std::fs::read_to_string(root.join("tests/corpus/fanuc").join(file)).unwrap();
+        let verify = || job::verify(&family, &machine, &[], &text, &options, &mut |_| {});
+        let passes = verify().unwrap().report.cutting_passes;
+        assert_eq!(passes, 13, "{file}");
+        g.bench_function(name, |b| b.iter(|| black_box(verify().is_ok())));
+    }
+    g.finish();
+}
+
+criterion_group!(benches, thread_job, thread_verify_text);
 criterion_main!(benches);
