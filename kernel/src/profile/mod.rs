@@ -19,6 +19,7 @@ mod helicoid;
 mod law;
 mod simplify;
 mod smooth;
+mod spline;
 mod table;
 mod workbook;
 
@@ -28,6 +29,7 @@ pub use helicoid::FlankForm;
 pub use law::{uniform_grid, MandrelLaw};
 pub use simplify::{simplify_polyline, Polyline};
 pub use smooth::Smoothing;
+pub use spline::Swing;
 
 pub use table::{
     read_table, read_table_bytes, read_table_str, Table, TableError, TableFormat, MAX_CELLS,
@@ -163,19 +165,27 @@ pub enum Interpolation {
     Monotone,
     /// Straight lines between nodes: C0, with a kink at every node.
     Linear,
+    /// The natural cubic spline: C2, its second derivative zero at both
+    /// ends; smooth through a drawing's stations, but it may swing beyond
+    /// them beside a flat run ([`Profile::swing`]).
+    Natural,
 }
 
 impl Interpolation {
-    /// The interpolation named `name` (`parabolic`, `monotone` or
-    /// `linear`), or `None`.
+    /// The interpolation named `name` (one of [`Self::NAMES`], or
+    /// `pchip` for `monotone`), or `None`.
     pub fn named(name: &str) -> Option<Self> {
         match name.trim().to_ascii_lowercase().as_str() {
             "parabolic" => Some(Self::Parabolic),
             "monotone" | "pchip" => Some(Self::Monotone),
             "linear" => Some(Self::Linear),
+            "natural" => Some(Self::Natural),
             _ => None,
         }
     }
+
+    /// The interpolations' names, as a message lists them.
+    pub const NAMES: &'static str = "parabolic, monotone, linear, natural";
 }
 
 /// A curve `x(z)` sampled at strictly increasing `z`. See the [module docs](self).
@@ -376,6 +386,7 @@ impl Profile {
         match self.interpolation {
             Interpolation::Parabolic => self.parabolic_slopes(),
             Interpolation::Monotone => self.monotone_slopes(),
+            Interpolation::Natural => spline::natural_slopes(&self.z, &self.x),
             Interpolation::Linear => {
                 // Each node the mean of its two sides (the kinks' slopes
                 // are not used by the interpolation itself).
@@ -501,6 +512,22 @@ impl Profile {
     pub fn eval(&self, z: Real) -> Result<Real, ProfileError> {
         self.check_inside(std::slice::from_ref(&z))?;
         Ok(self.value_at(&self.slopes(), z))
+    }
+
+    /// Where the profile between two nodes goes furthest beyond the
+    /// range of those two nodes' values (a drawing's stations: the
+    /// interpolation's own swing, which the drawing does not give), or
+    /// `None` where it stays within them everywhere (a linear or monotone
+    /// profile always does).
+    pub fn swing(&self) -> Option<Swing> {
+        if self.interpolation == Interpolation::Linear && self.dx.is_none() {
+            return None;
+        }
+        // An interval beside a kink is straight (see `value_at`).
+        let straight = |i: usize| {
+            (self.d2x.as_deref()).is_some_and(|d2| d2[i].is_infinite() || d2[i + 1].is_infinite())
+        };
+        spline::largest_swing(&self.z, &self.x, &self.slopes(), &straight)
     }
 
     /// x at many z (as [`Self::eval`]).

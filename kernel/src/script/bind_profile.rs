@@ -8,6 +8,21 @@ use crate::profile::{Bulge, MandrelLaw, Polyline, Profile, ProfileBuilder, Smoot
 use rhai::plugin::*;
 use rhai::EvalAltResult;
 
+/// The interpolation named `name` in a script, or the error naming the
+/// accepted ones.
+pub(crate) fn interpolation(
+    name: &str,
+) -> Result<crate::profile::Interpolation, Box<EvalAltResult>> {
+    crate::profile::Interpolation::named(name).ok_or_else(|| {
+        format!(
+            "interpolation '{}' is none of {}",
+            crate::files::excerpt(name),
+            crate::profile::Interpolation::NAMES
+        )
+        .into()
+    })
+}
+
 /// Profiles and their generators.
 #[export_module]
 pub mod profile_api {
@@ -22,6 +37,49 @@ pub mod profile_api {
     pub fn profile(z: Numbers, x: Numbers) -> Result<Profile, Box<EvalAltResult>> {
         let (z, x) = (numbers(&z, "profile z")?, numbers(&x, "profile x")?);
         kernel(Profile::new(z.as_ref().clone(), x.as_ref().clone()))
+    }
+
+    /// A profile `x(z)` through a drawing's stations, interpolated between
+    /// them by `interpolation`: `"linear"` (straight between stations),
+    /// `"monotone"` (Fritsch-Carlson: never beyond two neighbouring
+    /// stations), `"natural"` (the natural cubic spline, C2) or
+    /// `"parabolic"` (the default of `profile(z, x)`). See `swing` for
+    /// how far a smooth one goes beyond its stations.
+    ///
+    /// ```rhai
+    /// let p = profile([0.0, 60.0, 340.0], [15.0, 15.0, 17.8], "monotone");
+    /// ```
+    #[rhai_fn(name = "profile", return_raw)]
+    pub fn profile_by(
+        z: Numbers,
+        x: Numbers,
+        interpolation: &str,
+    ) -> Result<Profile, Box<EvalAltResult>> {
+        let mode = super::interpolation(interpolation)?;
+        Ok(profile(z, x)?.with_interpolation(mode))
+    }
+
+    /// Where the profile goes furthest beyond the two stations (nodes)
+    /// of an interval, as a map `#{z, x, mm}` (`mm`: how far beyond the
+    /// nearer station's x), or `()` where it never does: a drawing gives
+    /// no such swing, so a family warns of one larger than its tolerance.
+    ///
+    /// ```rhai
+    /// let s = p.swing();
+    /// if s != () && s.mm > 0.001 { tp.warn(`the profile swings ${s.mm} mm at z = ${s.z}`); }
+    /// ```
+    #[rhai_fn(pure)]
+    pub fn swing(p: &mut Profile) -> Dynamic {
+        match p.swing() {
+            Some(s) => {
+                let mut m = rhai::Map::new();
+                m.insert("z".into(), s.z.into());
+                m.insert("x".into(), s.x.into());
+                m.insert("mm".into(), s.beyond.into());
+                m.into()
+            }
+            None => Dynamic::UNIT,
+        }
     }
 
     /// The profile's abscissae.

@@ -93,15 +93,11 @@ pub mod caliber_api {
     /// The groove with its tables interpolated between rows by `name`:
     /// `"monotone"` (Fritsch–Carlson: no overshoot, a constant stretch
     /// stays flat), `"parabolic"` (cubic Hermite with the slopes of the
-    /// parabola through each row and its neighbours) or `"linear"`.
+    /// parabola through each row and its neighbours), `"linear"` or
+    /// `"natural"` (the natural cubic spline).
     #[rhai_fn(pure, return_raw)]
     pub fn interpolated(g: &mut Groove, name: &str) -> Result<Groove, Box<EvalAltResult>> {
-        let mode = crate::profile::Interpolation::named(name).ok_or_else(|| {
-            format!(
-                "interpolation '{}' is none of monotone, parabolic, linear",
-                crate::files::excerpt(name)
-            )
-        })?;
+        let mode = crate::script::interpolation(name)?;
         Ok(g.clone().with_interpolation(mode))
     }
 
