@@ -18,6 +18,7 @@ mod compensate;
 mod containment;
 mod corpus;
 mod docs;
+mod drawings;
 mod hygiene;
 mod kept;
 mod machine_files;

@@ -207,7 +207,14 @@ impl Pass {
     /// round it: the highest generatrix (the crest a rest meets, whatever
     /// the spindle's phase) and the lowest (the swept envelope). Infinite
     /// where some generatrix is never touched.
-    fn cut(&self, s: Section, period: f64, phases: usize, z: f64, until: f64) -> (f64, f64) {
+    pub(crate) fn cut(
+        &self,
+        s: Section,
+        period: f64,
+        phases: usize,
+        z: f64,
+        until: f64,
+    ) -> (f64, f64) {
         self.cut_worn(s, period, phases, z, until, &|_| 0.0)
     }
 

@@ -107,6 +107,12 @@ pub trait Verifier: AnyVerifier + std::fmt::Debug {
     fn nominal(&self) -> Option<crate::compensate::Nominal> {
         None
     }
+
+    /// What the request itself warns of, before any program (a nominal
+    /// that strays from what its source gives); none by default.
+    fn warnings(&self) -> Vec<crate::verdict::Finding> {
+        Vec::new()
+    }
 }
 
 /// A request as [`std::any::Any`], for callers that know its type: every

@@ -134,3 +134,18 @@ pub fn take_warnings() -> Vec<String> {
 pub(crate) fn gone(old: &str, new: &str, why: &str) -> Box<EvalAltResult> {
     format!("{old} is an earlier release's form and no longer callable ({why}): use {new}").into()
 }
+
+/// The interpolation named `name` in a script, or the error naming the
+/// accepted ones.
+pub(crate) fn interpolation(
+    name: &str,
+) -> Result<crate::profile::Interpolation, Box<EvalAltResult>> {
+    crate::profile::Interpolation::named(name).ok_or_else(|| {
+        format!(
+            "interpolation '{}' is none of {}",
+            crate::files::excerpt(name),
+            crate::profile::Interpolation::NAMES
+        )
+        .into()
+    })
+}

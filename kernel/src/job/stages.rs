@@ -493,6 +493,7 @@ impl<'a> Run<'a> {
         let mut warnings: Vec<Finding> = (plan.toolpath.warnings.iter())
             .map(|w| Finding::new("the family", w.clone()))
             .collect();
+        warnings.extend(requested.iter().flat_map(|r| r.verifier().warnings()));
         let (parts, meshes) = self.bodies(outcome.as_deref())?;
         let kin = plan.kin(self.machine);
         let info = kin.info();

@@ -13,10 +13,12 @@
 mod capsule;
 mod drop;
 mod envelope;
+mod refine;
 
 pub use capsule::{flat_path, CapsuleEnvelope};
 pub use drop::{drop_circle, Drop};
 pub use envelope::{swept_circles, CircleEnvelope, SweptCircles};
+pub use refine::refined;
 
 use crate::math::{positive, Real};
 use crate::profile::{CurvatureViolation, Profile, ProfileError};
@@ -142,46 +144,56 @@ pub fn equidistant(
     radius: Real,
     side: Side,
 ) -> Result<Equidistant, ProfileError> {
+    equidistant_within(profile, radius, side, 0.0)
+}
+
+/// [`equidistant`], a concave kink that the tool bridges leaving at most
+/// `allowance` (mm) of material in the kink being no corner: a drawing's
+/// stations joined by straight lines kink by 1e-4 rad at a taper's
+/// stations, which a wheel of radius R bridges within `R (1 / cos(delta /
+/// 2) - 1)`, nanometres. There the centre touches both lines (the two
+/// offset lines' intersection). A concave kink bridged by more is a
+/// corner the tool cannot enter, refused with its z.
+///
+/// # Failures
+/// As [`equidistant`].
+pub fn equidistant_within(
+    profile: &Profile,
+    radius: Real,
+    side: Side,
+    allowance: Real,
+) -> Result<Equidistant, ProfileError> {
     positive("tool radius", radius)?;
     let slopes = profile.slopes();
     let d2 = profile.second_derivatives();
     let (pz, px) = (profile.z(), profile.x());
-    let found = violations(pz, &slopes, &d2, radius, side);
+    let sigma = side.sign();
+    let n = profile.len();
+    // The turn at a kink, from the chords beside it (as `Profile::eval`
+    // reads them): their two angles.
+    let turn = |i: usize| {
+        let left = (px[i] - px[i - 1]) / (pz[i] - pz[i - 1]);
+        let right = (px[i + 1] - px[i]) / (pz[i + 1] - pz[i]);
+        (left.atan(), right.atan())
+    };
+    let kink = |i: usize| i > 0 && i + 1 < n && d2[i].is_infinite();
+    let bridged = |i: usize| {
+        kink(i) && d2[i] * sigma > 0.0 && {
+            let (a, b) = turn(i);
+            radius * (1.0 / (0.5 * (b - a)).cos() - 1.0) <= allowance
+        }
+    };
+    let found: Vec<_> = violations(pz, &slopes, &d2, radius, side)
+        .into_iter()
+        .filter(|v| !bridged(v.index))
+        .collect();
     if !found.is_empty() {
         return Err(ProfileError::CurvatureBelowTool {
             tool_radius: radius,
             violations: found,
         });
     }
-    let sigma = side.sign();
-    let n = profile.len();
-    // Convex kinks (the slope jumps away from the tool; concave ones were
-    // refused above): there the centre swings round the corner on an arc.
-    let corners: Vec<usize> = (1..n.saturating_sub(1))
-        .filter(|&i| d2[i].is_infinite() && d2[i] * sigma < 0.0)
-        .collect();
-    drop(d2);
     let r = radius * sigma;
-    let centre = |z: Real, x: Real, s: Real| {
-        let c = 1.0 / (1.0 + s * s).sqrt();
-        (z - r * s * c, x + r * c)
-    };
-    if corners.is_empty() {
-        // One centre per node: the slopes become the result's as they are.
-        let (z, x) = pz
-            .iter()
-            .zip(px)
-            .zip(slopes.iter())
-            .map(|((&z, &x), &s)| centre(z, x, s))
-            .unzip();
-        return Ok(Equidistant {
-            z,
-            x,
-            slope: slopes.into_owned(),
-            radius,
-            side,
-        });
-    }
     let mut e = Equidistant {
         z: Vec::with_capacity(n),
         x: Vec::with_capacity(n),
@@ -189,25 +201,28 @@ pub fn equidistant(
         radius,
         side,
     };
-    let mut push = |z: Real, x: Real, s: Real| {
-        let (cz, cx) = centre(z, x, s);
-        e.z.push(cz);
-        e.x.push(cx);
+    // The centre at distance `reach` R along the normal of slope `s`.
+    let mut push = |z: Real, x: Real, s: Real, reach: Real| {
+        let c = reach / (1.0 + s * s).sqrt();
+        e.z.push(z - r * s * c);
+        e.x.push(x + r * c);
         e.slope.push(s);
     };
-    let mut next = corners.iter().peekable();
     for i in 0..n {
-        if next.next_if_eq(&&i).is_some() {
-            let left = (px[i] - px[i - 1]) / (pz[i] - pz[i - 1]);
-            let right = (px[i + 1] - px[i]) / (pz[i + 1] - pz[i]);
-            let (a, b) = (left.atan(), right.atan());
+        if kink(i) && d2[i] * sigma < 0.0 {
+            // A convex corner: the centre swings round it on an arc.
+            let (a, b) = turn(i);
             let steps = ((a - b).abs() / corner_step(radius)).ceil().max(1.0) as usize;
             for k in 0..=steps {
                 let gamma = a + (b - a) * k as Real / steps as Real;
-                push(pz[i], px[i], gamma.tan());
+                push(pz[i], px[i], gamma.tan(), 1.0);
             }
+        } else if bridged(i) {
+            let (a, b) = turn(i);
+            let half = 0.5 * (b - a);
+            push(pz[i], px[i], (a + half).tan(), 1.0 / half.cos());
         } else {
-            push(pz[i], px[i], slopes[i]);
+            push(pz[i], px[i], slopes[i], 1.0);
         }
     }
     Ok(e)
@@ -261,5 +276,41 @@ mod tests {
         let e = equidistant(&p, 2.0_f64.sqrt(), Side::Inside).unwrap();
         assert_near!(e.z[0], 1.0, 1e-12);
         assert_near!(e.x[0], -1.0, 1e-12);
+    }
+
+    /// A taper's stations joined by lines kink by 1e-4 rad: a wheel of 20
+    /// mm bridges each by nanometres, so within a tenth of a micron they
+    /// are no corners and its centre touches both lines; a real concave
+    /// corner is still refused, named as a corner.
+    #[test]
+    fn kinks_the_wheel_bridges_are_no_corners() {
+        let (z, d) = (
+            [0.0, 60.0, 120.0, 180.0, 240.0],
+            [18.0, 18.028, 18.064, 18.110, 18.156],
+        );
+        let x: Vec<Real> = d.iter().map(|d| d / 2.0).collect();
+        let p = crate::profile::polyline_through(&z, &x, &[], 1e-5).unwrap();
+        let e = equidistant(&p, 20.0, Side::Outside)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("z = 60.0000 (a corner:"), "{e}");
+        let c = equidistant_within(&p, 20.0, Side::Outside, 1e-4).unwrap();
+        assert_eq!(c.z.len(), z.len());
+        for i in 1..z.len() - 1 {
+            for j in [i - 1, i + 1] {
+                // Distance from the centre to the line through stations
+                // i and j.
+                let (dz, dx) = (z[j] - z[i], x[j] - x[i]);
+                let off = ((c.z[i] - z[i]) * dx - (c.x[i] - x[i]) * dz).abs() / dz.hypot(dx);
+                assert_near!(off, 20.0, 1e-9, "station {i} to {j}");
+            }
+        }
+        let shoulder =
+            crate::profile::polyline_through(&[0.0, 10.0, 20.0], &[5.0, 5.0, 8.0], &[], 1e-5)
+                .unwrap();
+        let e = equidistant_within(&shoulder, 2.0, Side::Outside, 1e-4)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("z = 10.0000 (a corner:"), "{e}");
     }
 }

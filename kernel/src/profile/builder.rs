@@ -1,5 +1,7 @@
 //! A whole part profile chained from lines, arcs and the mandrel law.
 
+mod corners;
+
 use super::{MandrelLaw, Profile, ProfileError};
 use crate::input::InputError;
 use crate::math::{finite, positive, Real};
@@ -29,6 +31,17 @@ enum Segment {
         bulge: Bulge,
     },
     Law(MandrelLaw),
+    /// The corner between the line before and the line after, rounded by
+    /// an arc of this radius tangent to both.
+    Fillet {
+        radius: Real,
+    },
+    /// The corner between the line before and the line after, cut by a
+    /// straight line from this far back along the one to this far along
+    /// the other.
+    Chamfer {
+        length: Real,
+    },
 }
 
 /// Chains segments into one profile, left to right along z: lines (a
@@ -144,6 +157,27 @@ impl ProfileBuilder {
         self
     }
 
+    /// Rounds the corner at the current point, between the line that ends
+    /// here and the next segment (a line), by an arc of `radius` tangent to
+    /// both, as a drawing's `R` at a corner: convex or concave as the
+    /// corner turns. The lines must be long enough for the arc's tangent
+    /// length `radius tan(delta / 2)` (`delta` the corner's turn), beside
+    /// any other fillet or chamfer on them.
+    pub fn fillet(mut self, radius: Real) -> Self {
+        self.segments.push(Segment::Fillet { radius });
+        self
+    }
+
+    /// Cuts the corner at the current point, between the line that ends
+    /// here and the next segment (a line), by a straight line from
+    /// `length` back along the first to `length` along the second (a
+    /// drawing's chamfer `length x` the bisecting angle; `C1` at a 90
+    /// degree shoulder is `chamfer(1.0)`).
+    pub fn chamfer(mut self, length: Real) -> Self {
+        self.segments.push(Segment::Chamfer { length });
+        self
+    }
+
     /// The end point so far.
     pub fn current(&self) -> (Real, Real) {
         self.current
@@ -174,8 +208,8 @@ impl ProfileBuilder {
         }
         let mut all = Nodes::default();
         let mut at = self.start;
-        for (i, seg) in self.segments.iter().enumerate() {
-            let nodes = match *seg {
+        for (i, seg) in corners::resolved(self.start, &self.segments)? {
+            let nodes = match seg {
                 Segment::Line { z, x } => line(i, at, (z, x), max_step)?,
                 Segment::Arc {
                     z,
@@ -194,6 +228,9 @@ impl ProfileBuilder {
                         });
                     }
                     law_nodes(&law, at.0, tol, max_step)?
+                }
+                Segment::Fillet { .. } | Segment::Chamfer { .. } => {
+                    unreachable!("corners are resolved into lines and arcs")
                 }
             };
             at = (*nodes.z.last().unwrap(), *nodes.x.last().unwrap());
@@ -400,5 +437,76 @@ mod tests {
             }
         }
         assert!(p.len() > 600);
+    }
+
+    /// A fillet is tangent to both lines it joins (no kink left), at its
+    /// radius from one centre; a chamfer leaves two kinks on its line; a
+    /// fillet too large for its lines is refused naming the corner.
+    #[test]
+    fn fillets_and_chamfers_round_and_cut_corners() {
+        // A cylinder at x = 10, then a cone falling 30 degrees (convex),
+        // then a cylinder at x = 10 - 10 tan 30 (concave).
+        let x2 = 10.0 - 10.0 * (30.0_f64).to_radians().tan();
+        let p = ProfileBuilder::start(0.0, 10.0)
+            .line_to(10.0, 10.0)
+            .fillet(3.0)
+            .line_to(20.0, x2)
+            .fillet(5.0)
+            .line_to(30.0, x2)
+            .build(1e-5, 1.0)
+            .unwrap();
+        assert!(p.second_derivatives().iter().all(|d| d.is_finite()));
+        let t = 3.0 * (15.0_f64).to_radians().tan();
+        // The convex arc's centre lies 3 mm below the first line, above
+        // its tangent point.
+        let (cz, cx) = (10.0 - t, 7.0);
+        let on_arc: Vec<usize> = (0..p.len())
+            .filter(|&i| p.z()[i] > 10.0 - t && p.z()[i] < 10.0 + t * 0.8)
+            .collect();
+        assert!(on_arc.len() > 3);
+        for &i in &on_arc {
+            assert_near!((p.z()[i] - cz).hypot(p.x()[i] - cx), 3.0, 1e-9);
+        }
+        assert_near!(p.eval(5.0).unwrap(), 10.0, 1e-12);
+        assert_near!(p.eval(25.0).unwrap(), x2, 1e-12);
+        // The concave one: curvature +1/5 on its nodes.
+        let k = p.curvature();
+        let i = p.z().iter().position(|&z| (z - 20.0).abs() < 0.3).unwrap();
+        assert_near!(k[i], 0.2, 1e-9);
+
+        let c = ProfileBuilder::start(0.0, 10.0)
+            .line_to(10.0, 10.0)
+            .chamfer(1.0)
+            .line_to(10.5, 5.0)
+            .build(1e-5, 1.0)
+            .unwrap();
+        let kinks = c
+            .second_derivatives()
+            .iter()
+            .filter(|d| d.is_infinite())
+            .count();
+        assert_eq!(kinks, 2);
+        assert_near!(c.eval(9.0).unwrap(), 10.0, 1e-12);
+
+        let e = ProfileBuilder::start(0.0, 10.0)
+            .line_to(10.0, 10.0)
+            .fillet(40.0)
+            .line_to(20.0, x2)
+            .build(1e-5, 1.0)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("segment 1: the fillet at the corner z = 10"),
+            "{e}"
+        );
+        assert!(e.contains("30.0000 deg"), "{e}");
+        let e = ProfileBuilder::start(0.0, 10.0)
+            .line_to(10.0, 10.0)
+            .fillet(1.0)
+            .line_to(20.0, 10.0)
+            .build(1e-5, 1.0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("in line"), "{e}");
     }
 }

@@ -20,6 +20,7 @@ mod law;
 mod simplify;
 mod smooth;
 mod spline;
+mod stations;
 mod table;
 mod workbook;
 
@@ -30,6 +31,7 @@ pub use law::{uniform_grid, MandrelLaw};
 pub use simplify::{simplify_polyline, Polyline};
 pub use smooth::Smoothing;
 pub use spline::Swing;
+pub use stations::{polyline_through, CornerForm};
 
 pub use table::{
     read_table, read_table_bytes, read_table_str, Table, TableError, TableFormat, MAX_CELLS,
@@ -138,7 +140,14 @@ fn list_violations(v: &[CurvatureViolation]) -> String {
     let mut s: Vec<String> = v
         .iter()
         .take(SHOWN)
-        .map(|c| format!("z = {} (rho = {})", fixed(c.z, 4), fixed(c.rho, 4)))
+        .map(|c| match c.rho {
+            // A kink: no fillet to judge, a corner the tool cannot enter.
+            0.0 => format!(
+                "z = {} (a corner: a fillet of at least the tool's radius grinds it)",
+                fixed(c.z, 4)
+            ),
+            rho => format!("z = {} (rho = {})", fixed(c.z, 4), fixed(rho, 4)),
+        })
         .collect();
     if v.len() > SHOWN {
         s.push(format!("... and {} more", v.len() - SHOWN));
@@ -181,6 +190,16 @@ impl Interpolation {
             "linear" => Some(Self::Linear),
             "natural" => Some(Self::Natural),
             _ => None,
+        }
+    }
+
+    /// Its name, as [`Self::named`] reads it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Parabolic => "parabolic",
+            Self::Monotone => "monotone",
+            Self::Linear => "linear",
+            Self::Natural => "natural",
         }
     }
 
@@ -512,6 +531,40 @@ impl Profile {
     pub fn eval(&self, z: Real) -> Result<Real, ProfileError> {
         self.check_inside(std::slice::from_ref(&z))?;
         Ok(self.value_at(&self.slopes(), z))
+    }
+
+    /// x, dx/dz and d2x/dz2 at any z of the range, of the curve
+    /// [`Self::eval`] reads: the cubic Hermite's own derivatives on its
+    /// interval (at a node, those of the interval it begins), a straight
+    /// interval's slope and zero beside a kink or on a linear profile.
+    ///
+    /// # Failures
+    /// z outside the profile's range, or not finite.
+    pub fn jet(&self, z: Real) -> Result<[Real; 3], ProfileError> {
+        self.check_inside(std::slice::from_ref(&z))?;
+        let i = self.interval(z);
+        let (z0, z1, x0, x1) = (self.z[i], self.z[i + 1], self.x[i], self.x[i + 1]);
+        let h = z1 - z0;
+        let kinked =
+            (self.d2x.as_deref()).is_some_and(|d2| d2[i].is_infinite() || d2[i + 1].is_infinite());
+        if kinked || (self.interpolation == Interpolation::Linear && self.dx.is_none()) {
+            let t = ((z - z0) / h).clamp(0.0, 1.0);
+            return Ok([x0 + t * (x1 - x0), (x1 - x0) / h, 0.0]);
+        }
+        let s = self.slopes();
+        let u = ((z - z0) / h).clamp(0.0, 1.0);
+        let (m0, m1) = (h * s[i], h * s[i + 1]);
+        // x(u) = x0 + a u + b u^2 + c u^3 (as in `spline::largest_swing`).
+        let (a, b, c) = (
+            m0,
+            3.0 * (x1 - x0) - 2.0 * m0 - m1,
+            m0 + m1 - 2.0 * (x1 - x0),
+        );
+        Ok([
+            x0 + u * (a + u * (b + u * c)),
+            (a + u * (2.0 * b + 3.0 * c * u)) / h,
+            (2.0 * b + 6.0 * c * u) / (h * h),
+        ])
     }
 
     /// Where the profile between two nodes goes furthest beyond the

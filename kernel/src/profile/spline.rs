@@ -128,7 +128,10 @@ mod tests {
         };
         for i in 1..z.len() - 1 {
             let (left, right) = (second(i - 1, 1.0), second(i, 0.0));
-            assert!((left - right).abs() < 1e-9 * (1.0 + left.abs()), "node {i}: {left} {right}");
+            assert!(
+                (left - right).abs() < 1e-9 * (1.0 + left.abs()),
+                "node {i}: {left} {right}"
+            );
         }
         assert!(second(0, 0.0).abs() < 1e-9);
         assert!(second(z.len() - 2, 1.0).abs() < 1e-9);
@@ -140,10 +143,17 @@ mod tests {
     fn a_swing_beyond_the_stations_is_found_where_it_turns() {
         let z = vec![0.0, 10.0, 20.0, 30.0, 40.0];
         let x = vec![20.0, 20.0, 20.0, 25.0, 30.0];
-        let at = |i| Profile::new(z.clone(), x.clone()).unwrap().with_interpolation(i);
+        let at = |i| {
+            Profile::new(z.clone(), x.clone())
+                .unwrap()
+                .with_interpolation(i)
+        };
         let parabolic = at(Interpolation::Parabolic).swing().unwrap();
         assert!(parabolic.z > 10.0 && parabolic.z < 20.0, "{parabolic:?}");
-        assert!(parabolic.x < 20.0 && parabolic.beyond > 0.1, "{parabolic:?}");
+        assert!(
+            parabolic.x < 20.0 && parabolic.beyond > 0.1,
+            "{parabolic:?}"
+        );
         let exact = at(Interpolation::Parabolic).eval(parabolic.z).unwrap();
         assert!((exact - parabolic.x).abs() < 1e-12);
         assert_eq!(at(Interpolation::Monotone).swing(), None);

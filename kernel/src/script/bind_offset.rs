@@ -27,6 +27,10 @@ fn to_side(s: &str) -> Result<Side, Box<EvalAltResult>> {
     }
 }
 
+/// The share of a tolerance a wheel path may stray from the curve it
+/// follows between nodes, and leave in a kink it bridges.
+const PATH_SHARE: Real = 0.1;
+
 /// Equidistants, drops, envelopes, wheel paths and ridges.
 #[export_module]
 pub mod offset_api {
@@ -122,6 +126,27 @@ pub mod offset_api {
     pub fn wheel_path(p: Profile, wheel: Tool) -> Result<Polyline, Box<EvalAltResult>> {
         let w = wheel_of(&wheel)?;
         let e = kernel(offset::equidistant(&p, w.rounding_radius, Side::Outside))?;
+        kernel(offset::flat_path(&e.z, &e.x, w.flat(), Side::Outside))
+    }
+
+    /// As `wheel_path(p, wheel)`, following the curve the wheel must grind
+    /// within a share of `tolerance` (mm): between the profile's nodes
+    /// (a drawing's stations, far apart) the path's blocks stay within a
+    /// tenth of it of the true path, and a concave kink the wheel bridges
+    /// within a tenth of it (a taper's stations joined by lines) is no
+    /// corner. A corner it cannot enter is refused, named by z.
+    #[rhai_fn(name = "wheel_path", return_raw)]
+    pub fn wheel_path_within(
+        p: Profile,
+        wheel: Tool,
+        tolerance: Real,
+    ) -> Result<Polyline, Box<EvalAltResult>> {
+        kernel(crate::math::positive("wheel path tolerance", tolerance))?;
+        let w = wheel_of(&wheel)?;
+        let r = w.rounding_radius;
+        let share = PATH_SHARE * tolerance;
+        let fine = kernel(offset::refined(&p, r, Side::Outside, share))?;
+        let e = kernel(offset::equidistant_within(&fine, r, Side::Outside, share))?;
         kernel(offset::flat_path(&e.z, &e.x, w.flat(), Side::Outside))
     }
 

@@ -8,19 +8,53 @@ use crate::profile::{Bulge, MandrelLaw, Polyline, Profile, ProfileBuilder, Smoot
 use rhai::plugin::*;
 use rhai::EvalAltResult;
 
-/// The interpolation named `name` in a script, or the error naming the
-/// accepted ones.
-pub(crate) fn interpolation(
-    name: &str,
-) -> Result<crate::profile::Interpolation, Box<EvalAltResult>> {
-    crate::profile::Interpolation::named(name).ok_or_else(|| {
-        format!(
-            "interpolation '{}' is none of {}",
-            crate::files::excerpt(name),
-            crate::profile::Interpolation::NAMES
-        )
-        .into()
-    })
+/// How far a station profile's fillets' chords may stray from their arcs
+/// unless the script says (mm): a tenth of a micron.
+const STATION_CHORDAL: Real = 1e-4;
+
+/// The keys `profile(z, x, interpolation, options)` reads.
+const STATION_KEYS: [&str; 3] = ["fillets", "chamfers", "chordal"];
+
+/// The corners a station profile's `options` give, or a refusal naming
+/// the key or entry that is wrong.
+fn corners(
+    options: &rhai::Map,
+) -> Result<Vec<(Real, crate::profile::CornerForm)>, Box<EvalAltResult>> {
+    use crate::binding::floats::{err, number};
+    use crate::profile::CornerForm;
+    if let Some(k) = options.keys().find(|k| !STATION_KEYS.contains(&k.as_str())) {
+        return err(format!(
+            "profile: unknown key '{}' (keys: {})",
+            crate::files::excerpt(k),
+            STATION_KEYS.join(", ")
+        ));
+    }
+    let mut out = Vec::new();
+    for (key, form) in [
+        ("fillets", CornerForm::Fillet as fn(Real) -> CornerForm),
+        ("chamfers", CornerForm::Chamfer),
+    ] {
+        let Some(list) = options.get(key) else {
+            continue;
+        };
+        let list = list
+            .clone()
+            .into_array()
+            .map_err(|_| format!("profile: '{key}' must be an array of [z, mm]"))?;
+        for (i, entry) in list.iter().enumerate() {
+            let pair = entry.clone().into_array().unwrap_or_default();
+            match pair
+                .iter()
+                .map(number)
+                .collect::<Option<Vec<Real>>>()
+                .as_deref()
+            {
+                Some(&[z, mm]) => out.push((z, form(mm))),
+                _ => return err(format!("profile: {key}[{i}] must be [z, mm], two numbers")),
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// Profiles and their generators.
@@ -40,7 +74,10 @@ pub mod profile_api {
     }
 
     /// A profile `x(z)` through a drawing's stations, interpolated between
-    /// them by `interpolation`: `"linear"` (straight between stations),
+    /// them by `interpolation`: `"linear"` (straight lines between the
+    /// stations, each station a corner: a wheel's path swings round a
+    /// convex one and is refused at a concave one it cannot enter, unless
+    /// the corner is given a fillet, see the four-argument form),
     /// `"monotone"` (Fritsch-Carlson: never beyond two neighbouring
     /// stations), `"natural"` (the natural cubic spline, C2) or
     /// `"parabolic"` (the default of `profile(z, x)`). See `swing` for
@@ -55,8 +92,45 @@ pub mod profile_api {
         x: Numbers,
         interpolation: &str,
     ) -> Result<Profile, Box<EvalAltResult>> {
-        let mode = super::interpolation(interpolation)?;
-        Ok(profile(z, x)?.with_interpolation(mode))
+        stations(z, x, interpolation, rhai::Map::new())
+    }
+
+    /// As `profile(z, x, interpolation)`, with the drawing's corners:
+    /// `options` may hold `fillets` and `chamfers` (arrays of `[z, mm]`:
+    /// the station's z and the fillet's radius, or the chamfer's length
+    /// along each line; only with `"linear"`) and `chordal` (mm, how far
+    /// a fillet's sampled chords may stray from its arc; default 1e-4).
+    /// Any other key is refused.
+    ///
+    /// ```rhai
+    /// let p = profile([0.0, 360.0, 375.0], [9.0, 9.135, 8.0], "linear", #{ fillets: [[360.0, 5.0]] });
+    /// ```
+    #[rhai_fn(name = "profile", return_raw)]
+    pub fn stations(
+        z: Numbers,
+        x: Numbers,
+        interpolation: &str,
+        options: rhai::Map,
+    ) -> Result<Profile, Box<EvalAltResult>> {
+        let mode = crate::binding::interpolation(interpolation)?;
+        let corners = super::corners(&options)?;
+        let (z, x) = (numbers(&z, "profile z")?, numbers(&x, "profile x")?);
+        if mode != crate::profile::Interpolation::Linear {
+            if !corners.is_empty() {
+                return crate::binding::floats::err(format!(
+                    "profile: fillets and chamfers join straight lines: give interpolation \"linear\", not \"{}\"",
+                    crate::files::excerpt(interpolation)
+                ));
+            }
+            let p = kernel(Profile::new(z.as_ref().clone(), x.as_ref().clone()))?;
+            return Ok(p.with_interpolation(mode));
+        }
+        let chordal = match options.get("chordal") {
+            None => STATION_CHORDAL,
+            Some(d) => crate::binding::floats::number(d)
+                .ok_or("profile: 'chordal' must be a number (mm)")?,
+        };
+        kernel(crate::profile::polyline_through(&z, &x, &corners, chordal))
     }
 
     /// Where the profile goes furthest beyond the two stations (nodes)

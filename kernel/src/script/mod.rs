@@ -26,7 +26,6 @@
 
 mod bind_offset;
 mod bind_profile;
-pub(crate) use bind_profile::interpolation;
 mod bind_table;
 mod bind_toolpath;
 mod bind_transform;

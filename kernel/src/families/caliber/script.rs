@@ -97,7 +97,7 @@ pub mod caliber_api {
     /// `"natural"` (the natural cubic spline).
     #[rhai_fn(pure, return_raw)]
     pub fn interpolated(g: &mut Groove, name: &str) -> Result<Groove, Box<EvalAltResult>> {
-        let mode = crate::script::interpolation(name)?;
+        let mode = crate::binding::interpolation(name)?;
         Ok(g.clone().with_interpolation(mode))
     }
 

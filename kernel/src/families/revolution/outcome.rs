@@ -64,7 +64,39 @@ impl Verifier for VerifyRequest {
             }],
         })
     }
+
+    /// A nominal interpolated through stations (no analytic derivatives)
+    /// that swings beyond two neighbouring stations by more than the
+    /// tolerance, within the range held to it: the stations do not give
+    /// that bulge, and the program would grind it.
+    fn warnings(&self) -> Vec<Finding> {
+        let p = &self.profile;
+        let swing = p.swing().filter(|s| {
+            !p.has_analytic_derivatives()
+                && s.beyond > self.tolerance
+                && (self.from..=self.to).contains(&s.z)
+        });
+        swing
+            .map(|s| {
+                Finding::new(
+                    SWING,
+                    format!(
+                        "the nominal's {} interpolation swings {} mm beyond its stations at z = {} mm (x = {} mm), more than the tolerance {} mm: its stations do not give that; interpolate them \"monotone\" or \"linear\" (with fillets), or give more stations",
+                        p.interpolation().name(),
+                        fixed(s.beyond, 4),
+                        fixed(s.z, 3),
+                        fixed(s.x, 4),
+                        self.tolerance
+                    ),
+                )
+            })
+            .into_iter()
+            .collect()
+    }
 }
+
+/// The rule of a nominal that swings beyond its stations.
+pub const SWING: &str = "the nominal follows its stations";
 
 /// The surface each pass left, for a family's own judgement: over z
 /// (`z_mm`, in the stretches the pass's drawing keeps, at most

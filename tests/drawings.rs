@@ -1,0 +1,152 @@
+//! Nominals as drawings give them: a tapered drawing mandrel from its
+//! table of stations (`scripts/examples/taper_mandrel.rhai`), ground and
+//! verified, its finish replayed here from the program's text against a
+//! nominal built here from the stations and the fillet's own geometry.
+
+use crate::common::{pilgrim, report_of, root, s, scratch};
+use crate::mandrel_fidelity::{phases_for, read_program, Pass, Section};
+use std::path::{Path, PathBuf};
+
+const SCRIPT: &str = "scripts/examples/taper_mandrel.rhai";
+
+fn taper_run(name: &str, sets: &[&str]) -> (PathBuf, i32, String) {
+    let out = scratch("drawings", name).join("run");
+    let mut args = vec!["run", SCRIPT, "--out", s(&out), "-q"];
+    for set in sets {
+        args.extend(["--set", set]);
+    }
+    let (code, _, err) = pilgrim(&args);
+    (out, code, err)
+}
+
+/// The stations (z, radius) of the shipped table.
+fn stations() -> Vec<(f64, f64)> {
+    let text =
+        std::fs::read_to_string(root().join("scripts/examples/taper_bar_stations.csv")).unwrap();
+    text.lines()
+        .skip(1)
+        .map(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            (c[0].parse().unwrap(), c[1].parse::<f64>().unwrap() / 2.0)
+        })
+        .collect()
+}
+
+/// The drawing's nominal radius at z: straight lines between stations, the
+/// corner at the second last station rounded by a tangent arc of `fillet`
+/// (its tangent points `fillet tan(turn / 2)` along each line, its centre
+/// `fillet` below both lines).
+fn drawn(st: &[(f64, f64)], fillet: f64, z: f64) -> f64 {
+    let k = st.len() - 2;
+    let (p0, p1, p2) = (st[k - 1], st[k], st[k + 1]);
+    let a = (p1.1 - p0.1).atan2(p1.0 - p0.0);
+    let b = (p2.1 - p1.1).atan2(p2.0 - p1.0);
+    let t = fillet * (0.5 * (a - b)).tan();
+    let (t1, t2) = (
+        (p1.0 - t * a.cos(), p1.1 - t * a.sin()),
+        (p1.0 + t * b.cos(), p1.1 + t * b.sin()),
+    );
+    if (t1.0..=t2.0).contains(&z) {
+        let (cz, cx) = (t1.0 + fillet * a.sin(), t1.1 - fillet * a.cos());
+        return cx + (fillet * fillet - (z - cz).powi(2)).sqrt();
+    }
+    let i = st
+        .windows(2)
+        .position(|w| z <= w[1].0)
+        .unwrap_or(st.len() - 2);
+    let (q0, q1) = (st[i], st[i + 1]);
+    q0.1 + (q1.1 - q0.1) * (z - q0.0) / (q1.0 - q0.0)
+}
+
+/// The lowest and highest the finishing (last) pass leaves from `nominal`
+/// over `[from, to]`, replayed from the program as the control moves it.
+fn finish_from(
+    dir: &Path,
+    rounding: f64,
+    from: f64,
+    to: f64,
+    nominal: &dyn Fn(f64) -> f64,
+) -> (f64, f64) {
+    let text = std::fs::read_to_string(dir.join("program.mpf")).unwrap();
+    let written = read_program(&text);
+    let passes: Vec<_> = written
+        .groups
+        .iter()
+        .filter(|g| g.0.starts_with("pass "))
+        .collect();
+    let finish = &passes.last().unwrap().1;
+    let before = *passes[passes.len() - 2].1.last().unwrap();
+    let pass = Pass::new(before, finish);
+    // A wheel rounded across its width: no flat.
+    let section = Section {
+        r: rounding,
+        flat: 0.0,
+    };
+    let period = 1.0 / written.spindle;
+    let phases = phases_for(&pass, section, period);
+    let (mut below, mut above) = (0.0_f64, 0.0_f64);
+    let n = 15_000;
+    for i in 0..=n {
+        let z = from + (to - from) * i as f64 / n as f64;
+        let (crest, valley) = pass.cut(section, period, phases, z, f64::INFINITY);
+        below = below.min(valley - nominal(z));
+        above = above.max(crest - nominal(z));
+    }
+    (below, above)
+}
+
+/// Joined by lines, the taper's stations kink by 1e-4 rad (no corners to
+/// a 20 mm rounding) and the taper meets the entry cone at a convex corner
+/// the drawing rounds with R10: the run passes, and the finish replayed
+/// from the program stays within the tolerance of the nominal drawn here,
+/// the fillet's arc included (no gouge at the corner); `pilgrim verify`
+/// agrees on the written program.
+#[test]
+fn the_taper_from_its_stations_with_a_fillet_is_ground_within_tolerance() {
+    let (out, code, err) = taper_run("linear", &[]);
+    assert_eq!(code, 0, "{err}");
+    let st = stations();
+    let end = st[st.len() - 1].0;
+    let (below, above) = finish_from(&out, 20.0, 0.0, end, &|z| drawn(&st, 10.0, z));
+    assert!(
+        below >= -0.002 && above <= 0.002,
+        "valleys {below} mm, crests {above} mm"
+    );
+    // Round the fillet too, on its own.
+    let k = st.len() - 2;
+    let (b, a) = finish_from(&out, 20.0, st[k].0 - 2.0, st[k].0 + 2.0, &|z| {
+        drawn(&st, 10.0, z)
+    });
+    assert!(b >= -0.002 && a <= 0.002, "at the fillet: {b}, {a}");
+    let (code, _, err) = pilgrim(&[
+        "verify",
+        s(&out),
+        "--out",
+        s(&out.with_file_name("check")),
+        "-q",
+    ]);
+    assert_eq!(code, 0, "{err}");
+}
+
+/// Monotone through the stations, the run passes within the tolerance;
+/// the natural spline swings beyond them before the cone, and the run
+/// says where and by how much.
+#[test]
+fn a_smooth_nominal_passes_and_a_swinging_one_is_warned_of() {
+    let (out, code, err) = taper_run("monotone", &["interpolation=monotone"]);
+    assert_eq!(code, 0, "{err}");
+    let report = report_of(&out);
+    assert_eq!(
+        report["verdict"]["status"], "passed",
+        "{}",
+        report["verdict"]
+    );
+    assert!(!report.to_string().contains("swings"));
+    let (out, code, err) = taper_run("natural", &["interpolation=natural"]);
+    assert_eq!(code, 0, "{err}");
+    let warnings = report_of(&out)["verdict"]["warnings"].to_string();
+    assert!(
+        warnings.contains("natural interpolation swings 0.6") && warnings.contains("at z = 337."),
+        "{warnings}"
+    );
+}
