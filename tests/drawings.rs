@@ -150,3 +150,80 @@ fn a_smooth_nominal_passes_and_a_swinging_one_is_warned_of() {
         "{warnings}"
     );
 }
+
+/// `program.mpf` with the finishing and spark-out passes' X tilted by
+/// `slope` about z = `pivot` wherever the wheel is at or past `from`.
+fn tilted(text: &str, from: f64, pivot: f64, slope: f64) -> String {
+    let starts: Vec<usize> = (text.lines().enumerate())
+        .filter(|(_, l)| l.starts_with("; pass "))
+        .map(|(i, _)| i)
+        .collect();
+    let first = starts[starts.len() - 2];
+    let mut z = f64::NAN;
+    let mut out = String::new();
+    for (i, line) in text.lines().enumerate() {
+        let mut words: Vec<String> = line.split_whitespace().map(str::to_owned).collect();
+        if let Some(w) = words
+            .iter()
+            .find(|w| w.starts_with('Z') && line.starts_with('N'))
+        {
+            z = w[1..].parse().unwrap();
+        }
+        if i > first && z >= from {
+            for w in words
+                .iter_mut()
+                .filter(|w| w.starts_with('X') && line.starts_with('N'))
+            {
+                let x: f64 = w[1..].parse().unwrap();
+                *w = format!("X{:.4}", x + slope * (z - pivot));
+            }
+        }
+        out.push_str(&words.join(" "));
+        out.push('\n');
+    }
+    out
+}
+
+/// The family's own figure, the entry cone's angle on the replayed part,
+/// passes `pilgrim verify` on the program as written and fails it on the
+/// program with its cone tilted by 2 arc-minutes (within the profile's
+/// band of 10 um held by the built-in figure, so only the family's own
+/// can see it).
+#[test]
+fn the_familys_own_figure_judges_an_edited_program() {
+    let (out, code, err) = taper_run("cone", &["tolerance=0.01"]);
+    assert_eq!(code, 0, "{err}");
+    let check = out.with_file_name("check");
+    // A looser tolerance than the family's is taken from the command
+    // line only.
+    let loose = ["--set", "tolerance=0.01"];
+    let (code, _, err) =
+        pilgrim(&[&["verify", s(&out), "--out", s(&check), "-q"][..], &loose].concat());
+    assert_eq!(code, 0, "{err}");
+    let figure = &report_of(&check)["verification"]["judged"]["figures"][0];
+    assert_eq!(
+        figure["name"],
+        "the entry cone's half-angle from the drawing's"
+    );
+    assert!(figure["value"].as_f64().unwrap().abs() < 0.5, "{figure}");
+
+    let st = stations();
+    let (z0, z1) = (st[st.len() - 2].0, st[st.len() - 1].0);
+    let program = out.join("program.mpf");
+    let text = std::fs::read_to_string(&program).unwrap();
+    let slope = (2.0_f64 / 60.0).to_radians().tan();
+    std::fs::write(&program, tilted(&text, z0 + 1.0, 0.5 * (z0 + z1), slope)).unwrap();
+    let edited = out.with_file_name("edited");
+    let (code, _, err) = pilgrim(&[&["verify", s(&out), "--out", s(&edited)][..], &loose].concat());
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("the entry cone's half-angle from the drawing's is"),
+        "{err}"
+    );
+    let report = report_of(&edited);
+    let figure = &report["verification"]["judged"]["figures"][0];
+    let off = figure["value"].as_f64().unwrap();
+    assert!((off - 2.0).abs() < 0.5, "{figure}");
+    // The profile's own figure still holds: only the family's saw it.
+    assert!(!err.contains("the finished surface strays"), "{err}");
+}

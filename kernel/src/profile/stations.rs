@@ -40,17 +40,19 @@ pub fn polyline_through(
             .position(|&zi| (zi - zc).abs() <= crate::tolerance::SAME_RATIO * (1.0 + zc.abs()));
         match i {
             Some(i) if i > 0 && i + 1 < z.len() => at[i] = Some(form),
-            _ => return Err(InputError::out_of_range(
-                "a station's corner z",
-                zc,
-                format!(
+            _ => {
+                return Err(InputError::out_of_range(
+                    "a station's corner z",
+                    zc,
+                    format!(
                     "the z of a station between the first and the last ({} stations, z {} to {})",
                     z.len(),
                     z[0],
                     z[z.len() - 1]
                 ),
-            )
-            .into()),
+                )
+                .into())
+            }
         }
     }
     let mut b = ProfileBuilder::start(z[0], x[0]);

@@ -122,12 +122,7 @@ impl Corner {
     }
 
     /// The points `t` back along the first line and `t` along the second.
-    fn cut(
-        &self,
-        i: usize,
-        t: Real,
-        what: &str,
-    ) -> Result<(Point, Point), ProfileError> {
+    fn cut(&self, i: usize, t: Real, what: &str) -> Result<(Point, Point), ProfileError> {
         let (za, xa) = (self.at.0 - self.from.0, self.at.1 - self.from.1);
         let (zb, xb) = (self.to.0 - self.at.0, self.to.1 - self.at.1);
         let (la, lb) = (za.hypot(xa), zb.hypot(xb));
