@@ -191,7 +191,20 @@ fn a_rest_arm_wide_enough_to_reach_the_chuck_is_refused() {
         &[("rest_arm_width = 40.0", "rest_arm_width = 200.0")],
     );
     let (r, _) = refused("rest-arm", "scripts/mandrel.rhai", &text);
-    collision(&r, "chuck", "rest_arm");
+    let f = collision(&r, "chuck", "rest_arm");
+    // What would resolve it: the constants that place and size both, the
+    // family's parameter that restates one, where the part is held, by
+    // how much they overlap.
+    let message = f["message"].as_str().unwrap();
+    for named in [
+        "the chuck's constants chuck_grip, chuck_length, chuck_radius",
+        "rest_offset_b (the family's rest_b)",
+        "rest_arm_width",
+        "where the family's part starts (z = ",
+        "they overlap by ",
+    ] {
+        assert!(message.contains(named), "{named}: {message}");
+    }
     // The default arm clears it: the same pair, measured, is the margin.
     assert_eq!(clearance(&r, "chuck", "rest_arm"), 0.0);
 }

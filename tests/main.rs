@@ -19,6 +19,7 @@ mod containment;
 mod corpus;
 mod docs;
 mod drawings;
+mod first_release;
 mod hygiene;
 mod kept;
 mod machine_files;

@@ -112,9 +112,13 @@ thread_local! {
 }
 
 /// Notes that the old form `old` was called; `new` replaces it.
+/// The date until which the script API's earlier forms are kept (each
+/// listed in CHANGELOG.md with it).
+pub const OLD_FORMS_UNTIL: &str = "2027-06-30";
+
 pub(crate) fn deprecated(old: &str, new: &str) {
     let text = format!(
-        "the script calls {old}, an earlier release's form: it still works, but use {new} (the old form goes in a later release; CHANGELOG.md)"
+        "the script calls {old}, an earlier release's form: it still works, but use {new} (the old form is kept until {OLD_FORMS_UNTIL}; CHANGELOG.md)"
     );
     CALLED.with(|c| {
         let mut c = c.borrow_mut();

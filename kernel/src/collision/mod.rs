@@ -112,6 +112,9 @@ pub struct Solids<'a> {
     /// The meshes' chordal tolerance (mm): the part's envelope is as much
     /// wider.
     pub tolerance: Real,
+    /// The family's parameters that restate a machine constant, as
+    /// (constant, parameter): a collision names them beside the constants.
+    pub restated: &'a [(String, String)],
 }
 
 /// The smallest clearance of one pair along the program.
@@ -202,6 +205,48 @@ struct Entity {
     /// It cuts the part (the tool) or rides it (a steady rest's roller).
     touches_part: bool,
     is_part: bool,
+    /// The machine constants that place and size it.
+    constants: Vec<String>,
+    /// The end of the part it stands at, and that end's z.
+    held_at: Option<(&'static str, Real)>,
+}
+
+/// What would resolve a collision of the two bodies: the constants that
+/// place and size each (with the family's parameters that restate them),
+/// where the part is held, the program's positions.
+fn resolved_by(pair: [&Entity; 2], restated: &[(String, String)]) -> String {
+    let named = |c: &String| match restated.iter().find(|(k, _)| k == c) {
+        Some((_, p)) => format!("{c} (the family's {p})"),
+        None => c.clone(),
+    };
+    let mut ways: Vec<String> = pair
+        .iter()
+        .filter(|e| !e.constants.is_empty())
+        .map(|e| {
+            let list: Vec<String> = e.constants.iter().map(named).collect();
+            format!("the {}'s constants {}", e.name, list.join(", "))
+        })
+        .collect();
+    for (end, z) in pair.iter().filter_map(|e| e.held_at) {
+        ways.push(format!(
+            "where the family's part {end}s (z = {} mm: the {} stands there)",
+            crate::math::fixed(z, 3),
+            if end == "start" {
+                "chuck's grip"
+            } else {
+                "tailstock"
+            }
+        ));
+    }
+    if pair.iter().any(|e| e.is_part) {
+        ways.push("the part's length or where the family puts its ends".into());
+    }
+    let last = "the program's positions";
+    if ways.is_empty() {
+        format!("change {last}")
+    } else {
+        format!("change {} or {last}", ways.join(", "))
+    }
 }
 
 /// The part at its largest: of `parts`, the body of the greatest volume
@@ -395,11 +440,16 @@ pub fn check(
         moved_by,
         touches_part,
         is_part,
+        constants: Vec::new(),
+        held_at: None,
     };
     match (solids.tool, placement.tool_axes()) {
         (Some((name, tool, mesh)), Some(axes)) => {
             match shapes::tool(tool, mesh, tool.spindle_centre()) {
-                Some(shaped) => entities.push(entity(name, shaped, Which::Tool, axes, true, false)),
+                Some(shaped) => entities.push(Entity {
+                    constants: pilgrim_plugin_abi::types::chain_constants(&info.chain),
+                    ..entity(name, shaped, Which::Tool, axes, true, false)
+                }),
                 None => out
                     .notes
                     .push(format!("the {name} has no solid: not checked")),
@@ -411,14 +461,18 @@ pub fn check(
         (None, _) => {}
     }
     for (i, b) in placement.bodies.iter().enumerate() {
-        entities.push(entity(
-            &b.name,
-            shapes::solid(&b.solid),
-            Which::Body(i),
-            b.moved_by.clone(),
-            b.rides,
-            false,
-        ));
+        entities.push(Entity {
+            constants: b.constants.clone(),
+            held_at: b.held_at,
+            ..entity(
+                &b.name,
+                shapes::solid(&b.solid),
+                Which::Body(i),
+                b.moved_by.clone(),
+                b.rides,
+                false,
+            )
+        });
     }
     if let Some((name, mesh)) = solids.part {
         // The bore counts where the tool cuts inside it.
@@ -638,14 +692,27 @@ pub fn check(
             block_index: s.min_block + 1,
         });
         if let Some(k) = s.hit {
+            let f = frames(&rows[k * w..(k + 1) * w])?;
+            let depth = parry3d_f64::query::contact(
+                &shapes::pose(&f[i]),
+                &*entities[i].shaped.shape,
+                &shapes::pose(&f[j]),
+                &*entities[j].shaped.shape,
+                0.0,
+            )
+            .ok()
+            .flatten()
+            .map_or(0.0, |c| (-c.dist).max(0.0));
             out.findings.push(
                 Finding::new(
                     COLLISION,
                     format!(
-                        "{}: the {} and the {} collide (clearance 0 mm: they touch or overlap); change the machine's body sizes or where it holds the part (its constants), or the program's positions",
+                        "{}: the {} and the {} collide (they overlap by {} mm there); {}",
                         block_name(program, k),
                         bodies[0],
-                        bodies[1]
+                        bodies[1],
+                        crate::math::fixed(depth, 3),
+                        resolved_by([&entities[i], &entities[j]], solids.restated)
                     ),
                 )
                 .at(k, block_name(program, k)),
@@ -728,6 +795,7 @@ mod tests {
             tool: None,
             part: None,
             tolerance: 0.01,
+            restated: &[],
         };
         let found = check(&program, &info, &placement, solids).unwrap();
         let c = found
@@ -769,6 +837,7 @@ mod tests {
             tool: None,
             part: None,
             tolerance: 0.01,
+            restated: &[],
         };
         let found = check(&program, machine.info(), &placement, solids).unwrap();
         let pair = |c: &&Clearance| {

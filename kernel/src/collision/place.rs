@@ -31,6 +31,12 @@ pub struct PlacedBody {
     pub rides: bool,
     /// The axes that move it relative to the part, sorted.
     pub moved_by: Vec<String>,
+    /// The machine constants that place and size it (a body on the tool:
+    /// the tool chain's too), for a collision's message.
+    pub constants: Vec<String>,
+    /// For a body standing at an end of the part (a chuck, a tailstock):
+    /// which end, and its z (mm).
+    pub held_at: Option<(&'static str, Real)>,
     pub(super) carrier: Carrier,
 }
 
@@ -95,6 +101,7 @@ impl Placement {
                     .matrix(&vec![0.0; body.chain().dof()])
                     .map_err(CollisionError::from)
             };
+            let mut held_at = None;
             let (carrier, moved_by) = match spec.mount {
                 Mount::Part => {
                     let names = body.chain().axis_names().to_vec();
@@ -134,17 +141,24 @@ impl Placement {
                     } else {
                         hi
                     };
+                    held_at = Some((if z == lo { "start" } else { "end" }, z));
                     (
                         Carrier::Fixed(Mat4::new_translation(&Vec3::new(0.0, 0.0, z)) * own()?),
                         Vec::new(),
                     )
                 }
             };
+            let mut constants = spec.constants();
+            if spec.mount == Mount::Tool {
+                constants.extend(pilgrim_plugin_abi::types::chain_constants(&info.chain));
+            }
             bodies.push(PlacedBody {
                 name: spec.name.clone(),
                 solid,
                 rides: spec.approach_feed.is_some(),
                 moved_by: sorted(&moved_by),
+                constants,
+                held_at,
                 carrier,
             });
         }

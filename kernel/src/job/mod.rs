@@ -12,6 +12,7 @@
 //! finished run's tool at another block.
 
 mod compensate;
+mod constants;
 mod export;
 pub mod kept;
 mod stages;
@@ -287,6 +288,7 @@ fn collisions(
     tool: &crate::tool::Tool,
     parts: &[(String, crate::mesh::TriMesh)],
     tol: f64,
+    restated: &[(String, String)],
 ) -> Result<crate::collision::Collisions, Error> {
     let (written, _) = crate::replay::as_written(program);
     let unplaced = scene::ToolAt {
@@ -304,6 +306,7 @@ fn collisions(
             tool: tool_mesh.as_ref().map(|(m, n)| (*n, tool, Some(m))),
             part,
             tolerance: tol,
+            restated,
         },
     )
     .map_err(|e| match e {

@@ -473,6 +473,31 @@ impl<'a> Run<'a> {
         Ok((outcome, stock.map(|s| (s, moves))))
     }
 
+    /// What the run warns of before any check: the family's own warnings,
+    /// its verification's (a nominal that strays from its source), and
+    /// which of a family's parameter and a machine constant set a quantity.
+    fn stated(&self, plan: &Plan, requested: Option<&crate::family::Verification>) -> Vec<Finding> {
+        let mut warnings: Vec<Finding> = (plan.toolpath.warnings.iter())
+            .map(|w| Finding::new("the family", w.clone()))
+            .collect();
+        warnings.extend(requested.iter().flat_map(|r| r.verifier().warnings()));
+        warnings.extend(super::constants::stated(
+            self.family.params(),
+            self.values,
+            self.origins,
+            self.machine.kinematics.info(),
+        ));
+        warnings
+    }
+
+    /// The family's parameters that restate a machine constant, as
+    /// (constant, parameter).
+    fn restated(&self) -> Vec<(String, String)> {
+        (self.family.params().iter())
+            .filter_map(|p| Some((p.machine.clone()?, p.name.clone())))
+            .collect()
+    }
+
     /// The checks: the family's verification of the program as written,
     /// the part's bodies, the process's rules over the material the
     /// verification knows and the collisions along the whole program, the
@@ -490,15 +515,13 @@ impl<'a> Run<'a> {
             Some(o) => o.findings(made.verified()),
             None => (Vec::new(), Vec::new()),
         };
-        let mut warnings: Vec<Finding> = (plan.toolpath.warnings.iter())
-            .map(|w| Finding::new("the family", w.clone()))
-            .collect();
-        warnings.extend(requested.iter().flat_map(|r| r.verifier().warnings()));
+        let mut warnings = self.stated(plan, requested.as_ref());
         let (parts, meshes) = self.bodies(outcome.as_deref())?;
         let kin = plan.kin(self.machine);
         let info = kin.info();
         let tol = self.options.mesh_tolerance;
         let tool = &plan.toolpath.tool;
+        let restated = self.restated();
         // One placement of the machine's bodies for the check and the scene.
         let placement = scene::placement(kin, &made.program, tool, &meshes)?;
         // The process, checked as well as the geometry; and, on a second
@@ -516,7 +539,17 @@ impl<'a> Run<'a> {
                     }
                 }
             },
-            || collisions(made.verified(), info, &placement, tool, &meshes, tol),
+            || {
+                collisions(
+                    made.verified(),
+                    info,
+                    &placement,
+                    tool,
+                    &meshes,
+                    tol,
+                    &restated,
+                )
+            },
         );
         let (process, collisions) = (process?, collisions?);
         failures.extend(process.errors);

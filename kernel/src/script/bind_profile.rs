@@ -333,6 +333,29 @@ pub mod builder_api {
         b.cylinder(length)
     }
 
+    /// Rounds the corner at the current point, between the line ending
+    /// here and the next `line_to`, by an arc of `radius` tangent to both
+    /// (convex or concave as the corner turns): a drawing's `R` at a
+    /// corner, its tangent points found by the kernel. Refused, naming the
+    /// corner, where the lines are too short for it or in line.
+    ///
+    /// ```rhai
+    /// let p = profile_start(0.0, 18.0).line_to(25.0, 18.0).fillet(3.0).line_to(40.0, 15.0).build(1e-4, 0.5);
+    /// ```
+    #[rhai_fn(name = "fillet")]
+    pub fn fillet(b: ProfileBuilder, radius: Real) -> ProfileBuilder {
+        b.fillet(radius)
+    }
+
+    /// Cuts the corner at the current point, between the line ending here
+    /// and the next `line_to`, by a straight line from `length` back along
+    /// the one to `length` along the other (a chamfer `C length` at a
+    /// square shoulder).
+    #[rhai_fn(name = "chamfer")]
+    pub fn chamfer(b: ProfileBuilder, length: Real) -> ProfileBuilder {
+        b.chamfer(length)
+    }
+
     /// An arc of `radius` to `(z, x)`, bulging "out" (convex, centre below)
     /// or "in" (a fillet, centre above).
     #[rhai_fn(name = "arc_to", return_raw)]

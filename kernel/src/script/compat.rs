@@ -7,11 +7,11 @@
 //!
 //! `eval(p, z)` (today `x_at`) cannot be kept: `eval` is a Rhai keyword,
 //! which no function may be named, and no release could call it. Two old
-//! forms are not kept either: `rest_track` on a bare profile (the rest now
-//! rides the surface the passes cut, which needs the feed and the spindle
-//! speed the old call did not give), and the intermediate
-//! `cut(Profile, Path, Tool, float)`. Calling them is an error naming the
-//! replacement, not "function not found".
+//! form is not kept either: the intermediate `cut(Profile, Path, Tool,
+//! float)`, which lived between two releases. Calling it is an error
+//! naming the replacement, not "function not found". (The first
+//! release's `rest_track` on a bare profile is kept, with the ridge-free
+//! model it had, by the revolution family, whose function it is.)
 
 use crate::binding::floats::{err, kernel, Floats, Numbers};
 pub use crate::binding::take_warnings;
@@ -173,23 +173,6 @@ pub mod compat_api {
             .map(|(&a, &b)| a.min(b))
             .collect();
         kernel(Profile::new(z.0.to_vec(), x))
-    }
-
-    /// Not kept: see the module's docs.
-    #[rhai_fn(name = "rest_track", return_raw)]
-    pub fn rest_track_profile(
-        _previous: Profile,
-        _cz: Floats,
-        _cx: Floats,
-        _wheel_radius: Real,
-        _r_o: Real,
-        _b: Real,
-    ) -> Result<Map, Box<EvalAltResult>> {
-        Err(gone(
-            "rest_track(previous, cz, cx, wheel_radius, r_o, b)",
-            "rest_track(surface, centres, wheel, steady_rest(r_o, b, sample, tolerance), feed, spindle_rpm)",
-            "the rest rides the surface the passes cut, which needs the feed and the spindle speed",
-        ))
     }
 
     /// Not kept: see the module's docs.

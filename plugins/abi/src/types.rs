@@ -384,6 +384,40 @@ pub enum BodyShape {
     },
 }
 
+impl BodyShape {
+    /// Its sizes, numbers or constants' names.
+    pub fn quantities(&self) -> Vec<&Quantity> {
+        match self {
+            Self::Roller { radius, length } | Self::Cylinder { radius, length } => {
+                vec![radius, length]
+            }
+            Self::Block { size } => size.iter().collect(),
+            Self::Cone {
+                radius,
+                end_radius,
+                length,
+            } => vec![radius, end_radius, length],
+            Self::Guard {
+                inner,
+                outer,
+                width,
+                ..
+            } => vec![inner, outer, width],
+        }
+    }
+}
+
+/// The machine constants a chain's factors take, each once, in order.
+pub fn chain_constants(chain: &[FactorSpec]) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for name in chain.iter().filter_map(|f| f.constant.as_ref()) {
+        if !out.contains(name) {
+            out.push(name.clone());
+        }
+    }
+    out
+}
+
 /// Since 1.7: the frame a body's chain starts from.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -498,6 +532,21 @@ pub struct BodySpec {
 }
 
 impl BodySpec {
+    /// The machine constants that place it (its chain's) and size it
+    /// (its shape's), each once, in the order they appear: what a
+    /// collision of the body can be resolved by.
+    pub fn constants(&self) -> Vec<String> {
+        let mut out = chain_constants(&self.chain);
+        for q in self.shape.iter().flat_map(BodyShape::quantities) {
+            if let Quantity::Constant(name) = q {
+                if !out.contains(name) {
+                    out.push(name.clone());
+                }
+            }
+        }
+        out
+    }
+
     /// A body of `shape` on `mount`, placed there by `chain`, described as
     /// `description`; no label, riding nothing.
     pub fn mounted(

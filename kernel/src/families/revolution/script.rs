@@ -295,6 +295,56 @@ pub mod revolution_api {
 pub mod revolution_compat_api {
     use super::*;
 
+    /// The first release's steady rest along a pass (kept until the date
+    /// CHANGELOG.md names): the wheel's rounding centres at `(cz, cx)`, the
+    /// rest's support of radius `r_o` at `b` along z from the wheel,
+    /// riding `previous`, the surface before the pass, ridge-free (the
+    /// model it had: the surface the pass is cutting, and the ridges
+    /// between turns, are today's `rest_track`'s). A map of `centre_x`
+    /// (the exact drop), `seed_centre_x` (the seed's formula),
+    /// `contact_z` and `contact_x`, one per point of the pass: no blocks
+    /// are added.
+    #[rhai_fn(name = "rest_track", return_raw)]
+    pub fn rest_track_first_release(
+        previous: Profile,
+        cz: Floats,
+        cx: Floats,
+        wheel_radius: Real,
+        r_o: Real,
+        b: Real,
+    ) -> Result<rhai::Map, Box<EvalAltResult>> {
+        deprecated(
+            "rest_track(previous, cz, cx, wheel_radius, r_o, b)",
+            "rest_track(ground_surface(previous), path(cz, cx), wheel, steady_rest(r_o, b, sample, tolerance), feed, spindle_rpm, infeed)",
+        );
+        kernel(crate::math::positive("wheel radius", wheel_radius))?;
+        if cz.0.len() != cx.0.len() {
+            return crate::binding::floats::err(format!(
+                "rest_track: cz has {} points and cx {}",
+                cz.0.len(),
+                cx.0.len()
+            ));
+        }
+        let mut columns: [Vec<Real>; 4] = Default::default();
+        for &z in cz.0.iter() {
+            let drop = kernel(rest::exact_u(&previous, z + b, r_o))?;
+            let seed = kernel(rest::seed_u(&previous, z + b, r_o))?;
+            for (c, v) in
+                columns
+                    .iter_mut()
+                    .zip([drop.centre_x, seed, drop.contact_z, drop.contact_x])
+            {
+                c.push(v);
+            }
+        }
+        let names = ["centre_x", "seed_centre_x", "contact_z", "contact_x"];
+        Ok(names
+            .into_iter()
+            .zip(columns)
+            .map(|(k, v)| (k.into(), Dynamic::from(Floats::new(v))))
+            .collect())
+    }
+
     /// Earlier form of the steady rest's seed formula at `z_r`.
     #[rhai_fn(return_raw)]
     pub fn rest_seed_u(surface: Profile, z_r: Real, r_o: Real) -> Result<Real, Box<EvalAltResult>> {
