@@ -1244,3 +1244,75 @@ fn corrections_converge_round_after_round() {
         }
     }
 }
+
+/// A wheel wearing linearly along the finishing pass with a 2 um bump on
+/// the part besides (a local heat or a chip under the rest): held to the
+/// default uncertainty (1 um) the fit is the straight line through the
+/// wear, and the part it predicts after the correction is off by the bump;
+/// the run says so, naming where, by how much and the uncertainty that
+/// would follow it, and writes no program. Held to that uncertainty
+/// (the table holds diameters to 0.01 um), the corrected program replayed
+/// with the same error is within the tolerance at the measured places.
+#[test]
+fn a_bump_the_fit_does_not_follow_is_named() {
+    let dir = scratch("compensate", "bump");
+    let run = mandrel_run(&dir);
+    let bump = |z: f64| 0.002 * (-((z - 200.0) / 15.0).powi(2)).exp();
+    let error = |share: f64, z: f64| worn(share, z) + bump(z);
+    // Measured every 5 mm (the bump is 30 mm wide), but on the edge at
+    // z = 400.
+    let places: Vec<f64> = (0..=88)
+        .map(|i| 5.0 * i as f64)
+        .filter(|&z| z != 400.0)
+        .collect();
+    let measured = dir.join("bump.csv");
+    let bench = finish_with(&run, "program.mpf", &places, &error);
+    let mut table = String::from("z_mm,d_mm\n");
+    for (z, (hi, _)) in places.iter().zip(&bench) {
+        table += &format!("{z:.1},{:.5}\n", 2.0 * hi);
+    }
+    std::fs::write(&measured, table).unwrap();
+    let out = dir.join("corrected");
+    let (code, _, err) = compensate(&run, &measured, &out, &[]);
+    assert_eq!(code, 1, "{err}");
+    let line = err
+        .lines()
+        .find(|l| {
+            l.contains("the correction, its fit held to the uncertainty 0.001 mm, leaves the part")
+        })
+        .unwrap_or_else(|| panic!("{err}"));
+    // Named on the bump (its crest at z = 200, 15 mm its half-width).
+    let at: f64 = line
+        .split("at z_mm = ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no place: {line}"));
+    assert!((at - 200.0).abs() <= 15.0, "{line}");
+    assert!(!out.join("program.mpf").exists());
+    let report = common::report_of(&out);
+    let figure = (report["verdict"]["figures"].as_array().unwrap().iter())
+        .find(|f| f["name"] == "the part after the correction: its radius from the nominal")
+        .unwrap_or_else(|| panic!("{}", report["verdict"]));
+    assert!(figure["value"].as_f64().unwrap().abs() > 0.0015, "{figure}");
+    // The uncertainty it names follows the bump.
+    let named = line
+        .split("--uncertainty ")
+        .nth(1)
+        .and_then(|r| r.split(')').next())
+        .unwrap_or_else(|| panic!("no uncertainty named: {line}"));
+    let out = dir.join("followed");
+    let (code, _, err) = compensate(&run, &measured, &out, &["--uncertainty", named]);
+    assert_eq!(code, 0, "{err}");
+    // At the measured places, as the message says (between them the fit
+    // is not measured: on a 0.5 mm grid the default finish's own 0.93 um
+    // and what the fit leaves between places reach 1.06 um).
+    let after: f64 = (finish_with(&out, "program.mpf", &places, &error).iter())
+        .zip(&places)
+        .map(|(&(hi, _), &z)| (hi - law(z) / 2.0).abs())
+        .fold(0.0, f64::max);
+    assert!(after <= 0.001, "after: {after} mm");
+    // The corrected program says it is one, by its name.
+    let program = std::fs::read_to_string(out.join("program.mpf")).unwrap();
+    assert!(program.starts_with("%_N_MANDREL_C1_MPF"), "{}", &program[..80]);
+}

@@ -72,6 +72,11 @@ pub struct Quantity {
     /// Its correction's column in the correction's table (`dr_mm`), the
     /// target's shift in the quantity's own measure.
     pub key: String,
+    /// How far the finished part may stray from the nominal in it (mm),
+    /// where the family holds it to one tolerance: the part a corrected
+    /// run predicts (the measured error repeating, less the correction)
+    /// is judged against it. `None`: not judged so (a thread's limits).
+    pub tolerance: Option<Real>,
 }
 
 impl Nominal {

@@ -103,6 +103,9 @@ pub(super) struct Checked {
     pose_place: scene::PosePlace,
     overlay: Option<TriMesh>,
     files: Files,
+    /// Which of `files` are the programs (dropped if a failure comes
+    /// after them).
+    program_files: Vec<String>,
     tables: Tables,
     plots: Vec<PlotSpec>,
 }
@@ -154,6 +157,18 @@ impl Checked {
     pub(super) fn add(&mut self, tables: Tables, plots: Vec<PlotSpec>) {
         self.tables.extend(tables);
         self.plots.extend(plots);
+    }
+
+    /// Adds figures and failures found after the checks (a corrected
+    /// run's predicted part): they count in the verdict as the checks'.
+    pub(super) fn judge(&mut self, figures: Vec<crate::verdict::Figure>, failures: Vec<Finding>) {
+        self.figures.extend(figures);
+        if !failures.is_empty() {
+            // A run that failed writes no program a control could load.
+            let programs = std::mem::take(&mut self.program_files);
+            self.files.retain(|f| !programs.contains(&f.0));
+        }
+        self.failures.extend(failures);
     }
 }
 
@@ -574,6 +589,7 @@ impl<'a> Run<'a> {
             pose_place: scene::PosePlace::at_end(0),
             overlay: None,
             files: Vec::new(),
+            program_files: Vec::new(),
             tables: Self::tables(plan, outcome.as_deref()),
             plots: Vec::new(),
             outcome,
@@ -655,6 +671,7 @@ impl<'a> Run<'a> {
         let (table, mut files): (Vec<_>, Vec<_>) = std::mem::take(&mut made.data)
             .into_iter()
             .partition(|f| f.0 == "report.csv");
+        c.program_files = programs.iter().map(|p| p.0.clone()).collect();
         files.extend(programs);
         files.extend(table);
         c.files = files;

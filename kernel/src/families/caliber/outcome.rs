@@ -72,6 +72,7 @@ impl Verifier for GrooveRequest {
                 nominal: in_deg(p)?,
                 along: true,
                 key: key.into(),
+                tolerance: None,
             })
         };
         Some(crate::compensate::Nominal {

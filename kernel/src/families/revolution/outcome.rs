@@ -61,6 +61,7 @@ impl Verifier for VerifyRequest {
                 nominal: self.profile.clone(),
                 along: true,
                 key: "dr_mm".into(),
+                tolerance: Some(self.tolerance),
             }],
         })
     }

@@ -69,6 +69,7 @@ impl Verifier for ThreadRequest {
                 nominal: crate::profile::Profile::new(along.clone(), vec![nominal; 3]).ok()?,
                 along: false,
                 key: format!("{key}_{k}_mm"),
+                tolerance: None,
             })
         };
         let quantities = (1..=w.starts)

@@ -13,6 +13,7 @@
 //! its nominal ([`crate::family::Verifier::nominal`]); the run knows no
 //! family by name.
 
+mod after;
 mod annex;
 mod change;
 mod fit;
@@ -156,18 +157,24 @@ fn correct(
         options,
         vec![(CORRECTION_FILE.into(), correction.csv.clone())],
     )?;
-    let (mut out, (records, moved)) =
-        corrected_run(prior, catalog, &family, first, records, &quantities).map_err(
-            |e| match e {
-                // A corrected run that fails its checks leaves its report.
-                Error::Failed(failed) => Error::Failed(failed),
-                refused => CompensateError::Corrected {
-                    file: measured.source().to_owned(),
-                    why: refused.to_string(),
-                }
-                .into(),
-            },
-        )?;
+    let (mut out, (records, moved)) = corrected_run(
+        prior,
+        catalog,
+        &family,
+        first,
+        records,
+        &quantities,
+        options,
+    )
+    .map_err(|e| match e {
+        // A corrected run that fails its checks leaves its report.
+        Error::Failed(failed) => Error::Failed(failed),
+        refused => CompensateError::Corrected {
+            file: measured.source().to_owned(),
+            why: refused.to_string(),
+        }
+        .into(),
+    })?;
     // None where the run stopped at its time limit before its program was
     // checked (its report says so).
     let moved = moved.transpose()?.flatten();
@@ -223,6 +230,7 @@ fn corrected_run(
     first: FirstProgram,
     mut records: Vec<QuantityRecord>,
     quantities: &[Quantity],
+    options: &CompensateOptions,
 ) -> Result<(JobOutput, Found), Error> {
     let machine = catalog.open(&prior.spec)?;
     let sources = vec![
@@ -232,10 +240,15 @@ fn corrected_run(
             pairs: vec![(CORRECTION.into(), CORRECTION_FILE.into())],
         },
     ];
-    let options = JobOptions {
-        program_name: (prior.script.file_stem().and_then(|s| s.to_str()))
-            .unwrap_or("pilgrim")
-            .to_owned(),
+    let job_options = JobOptions {
+        // The corrected program says it is one: its name carries the
+        // correction's generation (Sinumerik's `%_N_MANDREL_C1_MPF`,
+        // Fanuc's header comment beside the O-number it keeps).
+        program_name: format!(
+            "{}_C{}",
+            (prior.script.file_stem().and_then(|s| s.to_str())).unwrap_or("pilgrim"),
+            prior.lineage.generation
+        ),
         keep: Some(super::Keep {
             script: prior.script.clone(),
             tables: prior.tables_read.clone(),
@@ -248,7 +261,7 @@ fn corrected_run(
         machine: &machine,
         values: &values,
         origins: &origins,
-        options: &options,
+        options: &job_options,
         text: None,
     };
     let nominal = &prior.nominal;
@@ -264,6 +277,8 @@ fn corrected_run(
             nominal.coordinate,
             checked.tables(),
         );
+        let (figures, failures) = after::judged(&records, quantities, nominal.coordinate, options);
+        checked.judge(figures, failures);
         let (tables, mut plots) =
             annex::annex(nominal.coordinate, quantities, &records, nominal.names());
         checked.add(tables, Vec::new());
