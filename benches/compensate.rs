@@ -67,6 +67,7 @@ fn compensate(c: &mut Criterion) {
         uncertainty: 0.001,
         limit: 0.1,
         limits: Limits::default(),
+        columns: Vec::new(),
     };
     let mut g = c.benchmark_group("compensate");
     g.sample_size(10).measurement_time(Duration::from_secs(20));

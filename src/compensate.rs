@@ -14,6 +14,7 @@ pub struct CompensateArgs {
     pub gain: f64,
     pub uncertainty: f64,
     pub limit: f64,
+    pub columns: Vec<(String, String)>,
     pub out: PathBuf,
     pub script_seconds: f64,
     pub run_seconds: f64,
@@ -32,6 +33,7 @@ pub fn compensate(args: &CompensateArgs, catalog: &Catalog) -> Result<String, St
             gain: args.gain,
             uncertainty: args.uncertainty,
             limit: args.limit,
+            columns: args.columns.clone(),
             limits: Limits {
                 max_seconds: args.script_seconds,
                 ..Limits::default()

@@ -201,6 +201,13 @@ enum Command {
         /// read as a radius, another part's file), not the part's tolerance.
         #[arg(long, value_name = "MM", default_value_t = 0.1)]
         limit: f64,
+        /// The measurement's columns by the family's names, as a measuring
+        /// program names them: `z="Position Z [mm]",d="Istwert D [mm]"`
+        /// (each NAME the family's column, `z_mm`, or its name before the
+        /// unit, `z`; each COLUMN a header, a letter or a number). Only the
+        /// columns mapped are read.
+        #[arg(long, value_name = "NAME=COLUMN,...", value_parser = column_map)]
+        columns: Option<ColumnMap>,
         /// Where the corrected run goes. Default: DIR-compensated.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -519,6 +526,7 @@ fn main() -> ExitCode {
             gain,
             uncertainty,
             limit,
+            columns,
             out,
             script_seconds,
             run_seconds,
@@ -529,6 +537,7 @@ fn main() -> ExitCode {
                 gain: *gain,
                 uncertainty: *uncertainty,
                 limit: *limit,
+                columns: columns.clone().map(|c| c.0).unwrap_or_default(),
                 out: out.clone().unwrap_or_else(|| compensate::default_out(dir)),
                 script_seconds: *script_seconds,
                 run_seconds: *run_seconds,
@@ -590,4 +599,27 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// `--columns`' value: (NAME, COLUMN) pairs.
+#[derive(Debug, Clone)]
+struct ColumnMap(Vec<(String, String)>);
+
+/// `--columns`' value: `NAME=COLUMN` pairs separated by commas (a
+/// column's header may hold spaces and brackets, not a comma).
+fn column_map(text: &str) -> Result<ColumnMap, String> {
+    text.split(',')
+        .map(|pair| {
+            let (name, column) = pair
+                .split_once('=')
+                .ok_or_else(|| format!("'{pair}' is not NAME=COLUMN"))?;
+            let unquote = |s: &str| s.trim().trim_matches('"').trim().to_owned();
+            let (name, column) = (unquote(name), unquote(column));
+            if name.is_empty() || column.is_empty() {
+                return Err(format!("'{pair}' is not NAME=COLUMN"));
+            }
+            Ok((name, column))
+        })
+        .collect::<Result<_, _>>()
+        .map(ColumnMap)
 }

@@ -1314,5 +1314,73 @@ fn a_bump_the_fit_does_not_follow_is_named() {
     assert!(after <= 0.001, "after: {after} mm");
     // The corrected program says it is one, by its name.
     let program = std::fs::read_to_string(out.join("program.mpf")).unwrap();
-    assert!(program.starts_with("%_N_MANDREL_C1_MPF"), "{}", &program[..80]);
+    assert!(
+        program.starts_with("%_N_MANDREL_C1_MPF"),
+        "{}",
+        &program[..80]
+    );
+}
+
+/// A CMM's export as a German-language measuring program writes it
+/// (feature, position Z, actual D, nominal D, deviation; once with
+/// semicolons and decimal commas, once with commas and points), its
+/// columns mapped by the user: both read the same, only the mapped columns
+/// are read, and two mapped columns of one quantity must agree.
+#[test]
+fn a_measuring_programs_columns_are_mapped() {
+    let dir = scratch("compensate", "cmm");
+    let run = mandrel_run(&dir);
+    let fixtures = common::root().join("tests/fixtures/cmm");
+    let columns = r#"z="Position Z [mm]",d="Istwert D [mm]""#;
+    let mut places = Vec::new();
+    for file in [
+        "mandrel-cmm-semicolon-german-headers.csv",
+        "mandrel-cmm-comma-german-headers.csv",
+    ] {
+        let out = dir.join(file.trim_end_matches(".csv"));
+        let (code, said, err) =
+            compensate(&run, &fixtures.join(file), &out, &["--columns", columns]);
+        assert_eq!(code, 0, "{file}: {err}");
+        assert!(
+            said.contains("(B (Position Z [mm]) as z_mm, C (Istwert D [mm]) as d_mm)"),
+            "{said}"
+        );
+        let c = json(&out.join("compensation.json"));
+        places.push(c["quantities"][0]["places"].clone());
+        assert_eq!(c["quantities"][0]["column"], "d_mm", "{file}");
+    }
+    assert_eq!(places[0], places[1]);
+    assert!(places[0].as_array().unwrap().len() > 20);
+    let semicolons = fixtures.join("mandrel-cmm-semicolon-german-headers.csv");
+    // Unmapped, the family's names are not there.
+    let (code, _, err) = compensate(&run, &semicolons, &dir.join("unmapped"), &[]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("no column 'z_mm'") && err.contains("B (Position Z [mm])"),
+        "{err}"
+    );
+    // A key the family does not measure.
+    let (code, _, err) = compensate(
+        &run,
+        &semicolons,
+        &dir.join("key"),
+        &["--columns", "q=B,d=C"],
+    );
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("--columns: 'q' is none of the family's columns (z_mm, r_mm, d_mm)"),
+        "{err}"
+    );
+    // The deviation mapped as the radius disagrees with the diameter.
+    let (code, _, err) = compensate(
+        &run,
+        &semicolons,
+        &dir.join("both"),
+        &[
+            "--columns",
+            r#"z="Position Z [mm]",d="Istwert D [mm]",r="Abweichung [mm]""#,
+        ],
+    );
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("r_mm") && err.contains("d_mm"), "{err}");
 }

@@ -180,6 +180,14 @@ pub enum CompensateError {
         /// Where and what, both sides named.
         what: String,
     },
+    /// A `--columns` key that is none of the family's measured columns.
+    #[error("--columns: '{key}' is none of the family's columns ({known}); map each as NAME=COLUMN, e.g. z=\"Position Z [mm]\"")]
+    ColumnKey {
+        /// The key given.
+        key: String,
+        /// The family's columns.
+        known: String,
+    },
     /// An option bounding the correction out of its range.
     #[error("{what} is {value}; it must be {range}")]
     Option {

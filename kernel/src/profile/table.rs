@@ -406,6 +406,56 @@ impl Table {
         h.finalize().iter().map(|b| format!("{b:02x}")).collect()
     }
 
+    /// The table of only the columns `mapping` names, each `(name, column)`
+    /// taking the column given by header, letter or number
+    /// ([`Self::column_index`]) under the header `name`: a measuring
+    /// program's own column names read under the ones a reader asks for.
+    /// Rows keep their numbers, so a bad cell is still named by the file's
+    /// row; the source names the columns mapped.
+    ///
+    /// # Failures
+    /// A column the table does not have, or one mapped twice.
+    pub fn mapped(&self, mapping: &[(String, String)]) -> Result<Table, TableError> {
+        let mut cols = Vec::with_capacity(mapping.len());
+        for (name, column) in mapping {
+            let i = self.column_index(column)?;
+            if let Some(k) = cols.iter().position(|&c| c == i) {
+                return Err(TableError::UnknownColumn {
+                    file: self.source.clone(),
+                    column: format!(
+                        "{} for {} (already read for {})",
+                        self.column_label(i),
+                        crate::files::excerpt(name),
+                        crate::files::excerpt(&mapping[k].0)
+                    ),
+                    available: "each column once".into(),
+                });
+            }
+            cols.push(i);
+        }
+        let shown: Vec<String> = (mapping.iter().zip(&cols))
+            .map(|((name, _), &i)| {
+                format!(
+                    "{} as {}",
+                    self.column_label(i),
+                    crate::files::excerpt(name)
+                )
+            })
+            .collect();
+        Ok(Table {
+            source: format!("{} ({})", self.source, shown.join(", ")),
+            headers: mapping.iter().map(|(n, _)| n.clone()).collect(),
+            rows: (self.rows.iter())
+                .map(|(n, cells)| {
+                    let row = cols
+                        .iter()
+                        .map(|&i| cells.get(i).cloned().unwrap_or(Cell::Empty));
+                    (*n, row.collect())
+                })
+                .collect(),
+        })
+    }
+
     /// The header row (empty if the first row held numbers only).
     pub fn headers(&self) -> &[String] {
         &self.headers

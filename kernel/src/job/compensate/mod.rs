@@ -59,6 +59,10 @@ pub struct CompensateOptions {
     pub limit: f64,
     /// The family's script's limits.
     pub limits: Limits,
+    /// The measurement's columns by the family's names, as the user maps
+    /// them (`z` or `z_mm` to `Position Z [mm]`): only these are read.
+    /// Empty: the family's own names, read from the table as they are.
+    pub columns: Vec<(String, String)>,
 }
 
 impl CompensateOptions {
@@ -126,12 +130,54 @@ pub fn compensate(
 ) -> Result<(JobOutput, Compensation), Error> {
     options.check()?;
     let prior = Prior::open(dir, catalog, measured, options)?;
+    let mapped;
+    let measured = if options.columns.is_empty() {
+        measured
+    } else {
+        mapped = mapped_columns(measured, &prior.nominal, &options.columns)?;
+        &mapped
+    };
     let (corrected, again) = crate::budget::beside(
         || correct(&prior, catalog, measured, options),
         || prior.predicted_again(catalog, options),
     );
     prior.same_prediction(&again?)?;
     corrected
+}
+
+/// `measured` with only the columns `columns` maps, under the family's
+/// names: each key the family's column (`z_mm`) or its name before the
+/// unit (`z`).
+///
+/// # Failures
+/// A key none of the family's columns; a column the table lacks.
+fn mapped_columns(
+    measured: &Table,
+    nominal: &crate::compensate::Nominal,
+    columns: &[(String, String)],
+) -> Result<Table, Error> {
+    let mut known: Vec<&str> = vec![nominal.coordinate];
+    for q in &nominal.quantities {
+        known.extend(q.values.iter().map(|v| v.0));
+        known.extend(q.select.map(|s| s.0));
+    }
+    known.dedup();
+    let mut mapping = Vec::new();
+    for (key, column) in columns {
+        let name = (known.iter())
+            .find(|k| {
+                k.eq_ignore_ascii_case(key)
+                    || k.split('_')
+                        .next()
+                        .is_some_and(|p| p.eq_ignore_ascii_case(key))
+            })
+            .ok_or_else(|| CompensateError::ColumnKey {
+                key: crate::files::excerpt(key),
+                known: known.join(", "),
+            })?;
+        mapping.push(((*name).to_owned(), column.clone()));
+    }
+    Ok(measured.mapped(&mapping).map_err(CompensateError::from)?)
 }
 
 /// The run corrected by `measured`: the fit, the correction, the corrected
