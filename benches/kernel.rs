@@ -208,12 +208,51 @@ fn lint_1m(c: &mut Criterion) {
     g.finish();
 }
 
+/// A DXF drawing's nominal read from 1,000 entities: the upper half of a
+/// turned outline as LINEs (a wave over 500 mm) on layer PROFILE, its
+/// faces and axis besides, in millimetres.
+fn dxf_1000(c: &mut Criterion) {
+    let n = 996;
+    let x = |i: usize| 20.0 + 2.0 * (i as f64 * 0.02).sin();
+    let z = |i: usize| 0.5 * i as f64;
+    let mut text = String::from(
+        "0\nSECTION\n2\nHEADER\n9\n$ACADVER\n1\nAC1015\n9\n$INSUNITS\n70\n4\n0\nENDSEC\n0\nSECTION\n2\nENTITIES\n",
+    );
+    let mut line = |h: usize, a: (f64, f64), b: (f64, f64)| {
+        text += &format!(
+            "0\nLINE\n5\n{h:X}\n8\nPROFILE\n10\n{}\n20\n{}\n30\n0\n11\n{}\n21\n{}\n31\n0\n",
+            a.0, a.1, b.0, b.1
+        );
+    };
+    for i in 0..n {
+        line(i + 16, (z(i), x(i)), (z(i + 1), x(i + 1)));
+    }
+    line(2000, (0.0, 0.0), (0.0, x(0)));
+    line(2001, (z(n), x(n)), (z(n), 0.0));
+    line(2002, (0.0, 0.0), (z(n), 0.0));
+    line(2003, (0.0, -x(0)), (z(n), -x(n)));
+    text += "0\nENDSEC\n0\nEOF\n";
+    let bytes = text.into_bytes();
+    let options = pilgrim_kernel::profile::DxfOptions {
+        layer: "PROFILE".into(),
+        diameter: false,
+        chordal: 1e-4,
+    };
+    let mut g = c.benchmark_group("dxf");
+    g.throughput(Throughput::Elements(1000));
+    g.bench_function("dxf_import_1000_entities", |b| {
+        b.iter(|| pilgrim_kernel::profile::profile_from_dxf(&bytes, "wave.dxf", &options).unwrap())
+    });
+    g.finish();
+}
+
 criterion_group!(
     kernel,
     chain_fk,
     ik_5axis,
     equidistant_1m,
     envelope_100k,
-    lint_1m
+    lint_1m,
+    dxf_1000
 );
 criterion_main!(kernel);

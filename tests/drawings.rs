@@ -203,7 +203,7 @@ fn the_familys_own_figure_judges_an_edited_program() {
     let figure = &report_of(&check)["verification"]["judged"]["figures"][0];
     assert_eq!(
         figure["name"],
-        "the entry cone's half-angle from the drawing's"
+        "the entry cone's half-angle from the nominal's"
     );
     assert!(figure["value"].as_f64().unwrap().abs() < 0.5, "{figure}");
 
@@ -217,7 +217,7 @@ fn the_familys_own_figure_judges_an_edited_program() {
     let (code, _, err) = pilgrim(&[&["verify", s(&out), "--out", s(&edited)][..], &loose].concat());
     assert_eq!(code, 1, "{err}");
     assert!(
-        err.contains("the entry cone's half-angle from the drawing's is"),
+        err.contains("the entry cone's half-angle from the nominal's is"),
         "{err}"
     );
     let report = report_of(&edited);
@@ -226,4 +226,95 @@ fn the_familys_own_figure_judges_an_edited_program() {
     assert!((off - 2.0).abs() < 0.5, "{figure}");
     // The profile's own figure still holds: only the family's saw it.
     assert!(!err.contains("the finished surface strays"), "{err}");
+}
+
+/// The drawing plug's DXF, written by ezdxf (`scripts/examples/
+/// drawing_plug_dxf.py`), read as its nominal: in inches, the land's
+/// radius, the fillet's arc about its centre, the corner's bulge, the nose
+/// SPLINE within the chordal tolerance of the Bezier its four control
+/// points make (evaluated here by Bernstein's polynomials); and the
+/// example ground from it runs and verifies.
+#[test]
+fn the_dxf_plug_is_read_as_drawn_and_verified() {
+    use pilgrim_kernel::profile::{profile_from_dxf, DxfOptions};
+    let bytes = std::fs::read(root().join("scripts/examples/drawing_plug.dxf")).unwrap();
+    let chordal = 1e-4;
+    let options = DxfOptions {
+        layer: "PROFILE".into(),
+        diameter: false,
+        chordal,
+    };
+    let p = profile_from_dxf(&bytes, "drawing_plug.dxf", &options).unwrap();
+    let inch = 25.4;
+    let a = 11.0_f64.to_radians();
+    let (rb, rl, zc, rc, rf) = (0.7, 0.6, 1.0, 0.12, 0.25);
+    let zf = zc + (rb - rl) / a.tan();
+    let tf = rf * (a / 2.0).tan();
+    let ze = zf + tf + 0.8;
+    assert_eq!(p.z_range(), (-12.0 * inch, (ze + 0.22) * inch));
+    // The stem, the back cylinder, the land.
+    for (z, r) in [(-6.0, 0.47), (0.5, rb), (ze - 0.4, rl)] {
+        let x = p.eval(z * inch).unwrap();
+        assert!((x - r * inch).abs() < 1e-9, "z = {z} in: {x}");
+    }
+    // The fillet: its centre above the land's start, rf from its arc.
+    let (cz, cx) = ((zf + tf) * inch, (rl + rf) * inch);
+    let z = (zf + 0.3 * tf) * inch;
+    let x = p.eval(z).unwrap();
+    assert!(
+        ((z - cz).hypot(x - cx) - rf * inch).abs() < chordal,
+        "fillet at {z}: {x}"
+    );
+    // The corner's arc, about its centre below the back cylinder.
+    let tc = rc * (a / 2.0).tan();
+    let (kz, kx) = ((zc - tc) * inch, (rb - rc) * inch);
+    let z = zc * inch;
+    let x = p.eval(z).unwrap();
+    assert!(
+        ((z - kz).hypot(x - kx) - rc * inch).abs() < chordal,
+        "corner: {x}"
+    );
+    // The nose: a cubic Bezier, sampled within the chordal tolerance.
+    let ctrl = [
+        (ze, rl),
+        (ze + 0.08, rl),
+        (ze + 0.16, rl - 0.04),
+        (ze + 0.22, rl - 0.12),
+    ];
+    for k in 1..50 {
+        let t = k as f64 / 50.0;
+        let b = [
+            (1.0 - t).powi(3),
+            3.0 * t * (1.0 - t).powi(2),
+            3.0 * t * t * (1.0 - t),
+            t.powi(3),
+        ];
+        let z = inch * b.iter().zip(&ctrl).map(|(w, c)| w * c.0).sum::<f64>();
+        let x = inch * b.iter().zip(&ctrl).map(|(w, c)| w * c.1).sum::<f64>();
+        let got = p.eval(z).unwrap();
+        assert!(
+            (got - x).abs() <= 1.05 * chordal,
+            "nose at t = {t}: {got} against {x}"
+        );
+    }
+    let out = scratch("drawings", "dxf").join("run");
+    let (code, _, err) = pilgrim(&[
+        "run",
+        "scripts/examples/drawing_plug_dxf.rhai",
+        "--out",
+        s(&out),
+        "-q",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(report_of(&out)["verdict"]["status"], "passed");
+    // The drawing is kept beside the run, and the run verifies from it.
+    assert!(out.join("drawing_plug.dxf").exists());
+    let (code, _, err) = pilgrim(&[
+        "verify",
+        s(&out),
+        "--out",
+        s(&out.with_file_name("check")),
+        "-q",
+    ]);
+    assert_eq!(code, 0, "{err}");
 }

@@ -14,6 +14,7 @@
 //! ```
 
 mod builder;
+mod dxf;
 mod ellipse;
 mod helicoid;
 mod law;
@@ -25,6 +26,7 @@ mod table;
 mod workbook;
 
 pub use builder::{Bulge, ProfileBuilder};
+pub use dxf::{profile_from_dxf, DxfError, DxfOptions};
 pub use ellipse::EllipseSection;
 pub use helicoid::FlankForm;
 pub use law::{uniform_grid, MandrelLaw};
@@ -542,14 +544,18 @@ impl Profile {
     /// z outside the profile's range, or not finite.
     pub fn jet(&self, z: Real) -> Result<[Real; 3], ProfileError> {
         self.check_inside(std::slice::from_ref(&z))?;
-        let i = self.interval(z);
+        Ok(self.jet_in(self.interval(z), z))
+    }
+
+    /// [`Self::jet`] on the interval `i`.
+    fn jet_in(&self, i: usize, z: Real) -> [Real; 3] {
         let (z0, z1, x0, x1) = (self.z[i], self.z[i + 1], self.x[i], self.x[i + 1]);
         let h = z1 - z0;
         let kinked =
             (self.d2x.as_deref()).is_some_and(|d2| d2[i].is_infinite() || d2[i + 1].is_infinite());
         if kinked || (self.interpolation == Interpolation::Linear && self.dx.is_none()) {
             let t = ((z - z0) / h).clamp(0.0, 1.0);
-            return Ok([x0 + t * (x1 - x0), (x1 - x0) / h, 0.0]);
+            return [x0 + t * (x1 - x0), (x1 - x0) / h, 0.0];
         }
         let s = self.slopes();
         let u = ((z - z0) / h).clamp(0.0, 1.0);
@@ -560,11 +566,40 @@ impl Profile {
             3.0 * (x1 - x0) - 2.0 * m0 - m1,
             m0 + m1 - 2.0 * (x1 - x0),
         );
-        Ok([
+        [
             x0 + u * (a + u * (b + u * c)),
             (a + u * (2.0 * b + 3.0 * c * u)) / h,
             (2.0 * b + 6.0 * c * u) / (h * h),
-        ])
+        ]
+    }
+
+    /// The profile over `[from, to]` only: its nodes inside, and the curve
+    /// [`Self::eval`] reads at the two ends, with its derivatives there
+    /// ([`Self::jet`]: at a kink, the side inside the range): a ground
+    /// stretch of a whole part's outline.
+    ///
+    /// # Failures
+    /// `from` or `to` outside the range or not finite; fewer than
+    /// [`MIN_POINTS`] nodes between them.
+    pub fn between(&self, from: Real, to: Real) -> Result<Profile, ProfileError> {
+        let (d1, d2) = (self.slopes(), self.second_derivatives());
+        let mut out: [Vec<Real>; 4] = Default::default();
+        let mut push = |v: [Real; 4]| out.iter_mut().zip(v).for_each(|(c, v)| c.push(v));
+        let [x, s, k] = self.jet(from)?;
+        push([from, x, s, k]);
+        for i in (0..self.len()).filter(|&i| self.z[i] > from && self.z[i] < to) {
+            push([self.z[i], self.x[i], d1[i], d2[i]]);
+        }
+        // At `to`, the interval ending there.
+        self.check_inside(std::slice::from_ref(&to))?;
+        let mut i = self.interval(to);
+        if i > 0 && self.z[i] == to {
+            i -= 1;
+        }
+        let [x, s, k] = self.jet_in(i, to);
+        push([to, x, s, k]);
+        let [z, x, d1, d2] = out;
+        Ok(Profile::with_derivatives(z, x, d1, d2)?.with_interpolation(self.interpolation))
     }
 
     /// Where the profile between two nodes goes furthest beyond the

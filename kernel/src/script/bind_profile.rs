@@ -333,6 +333,14 @@ pub mod builder_api {
         b.cylinder(length)
     }
 
+    /// The profile over `[from, to]` only (a ground stretch of a whole
+    /// part's outline), its ends on the curve with the derivatives of the
+    /// side inside.
+    #[rhai_fn(pure, return_raw)]
+    pub fn between(p: &mut Profile, from: Real, to: Real) -> Result<Profile, Box<EvalAltResult>> {
+        kernel(p.between(from, to))
+    }
+
     /// Rounds the corner at the current point, between the line ending
     /// here and the next `line_to`, by an arc of `radius` tangent to both
     /// (convex or concave as the corner turns): a drawing's `R` at a

@@ -57,6 +57,70 @@ pub mod table_api {
     }
 }
 
+/// The file `name` directly inside one of `dirs` (canonical), by its
+/// plain name: no directory in it, no link leading elsewhere.
+fn beside(dirs: &[PathBuf], name: &str) -> Option<PathBuf> {
+    let plain = Path::new(name)
+        .file_name()
+        .is_some_and(|f| f == std::ffi::OsStr::new(name))
+        && name != "."
+        && name != "..";
+    if !plain {
+        return None;
+    }
+    dirs.iter()
+        .filter_map(|d| d.join(name).canonicalize().ok().map(|c| (d, c)))
+        .find(|(d, c)| c.parent() == Some(d.as_path()) && c.is_file())
+        .map(|(_, c)| c)
+}
+
+/// The keys `read_dxf(name, options)` reads.
+const DXF_KEYS: [&str; 3] = ["layer", "diameter", "chordal"];
+
+/// A DXF drawing's nominal, options read strictly.
+fn dxf_profile(
+    path: &Path,
+    name: &str,
+    options: &rhai::Map,
+) -> Result<crate::profile::Profile, Box<EvalAltResult>> {
+    if let Some(k) = options.keys().find(|k| !DXF_KEYS.contains(&k.as_str())) {
+        return Err(format!(
+            "read_dxf: unknown key '{}' (keys: {})",
+            crate::files::excerpt(k),
+            DXF_KEYS.join(", ")
+        )
+        .into());
+    }
+    let layer = match options.get("layer") {
+        Some(l) => l
+            .clone()
+            .into_string()
+            .map_err(|_| "read_dxf: 'layer' must be text")?,
+        None => return Err("read_dxf: give the outline's layer: #{ layer: \"PROFILE\" }".into()),
+    };
+    let diameter = match options.get("diameter") {
+        Some(d) => d
+            .as_bool()
+            .map_err(|_| "read_dxf: 'diameter' must be true or false")?,
+        None => false,
+    };
+    let chordal = match options.get("chordal") {
+        Some(c) => super::floats::number(c).ok_or("read_dxf: 'chordal' must be a number (mm)")?,
+        None => DXF_CHORDAL,
+    };
+    let bytes = kernel(crate::files::read_bytes(path, crate::files::MAX_DATA_BYTES))?;
+    let opts = crate::profile::DxfOptions {
+        layer,
+        diameter,
+        chordal,
+    };
+    kernel(crate::profile::profile_from_dxf(&bytes, name, &opts))
+}
+
+/// How far a DXF's splines and arcs may be approximated unless the script
+/// says (mm): a tenth of a micron.
+const DXF_CHORDAL: crate::math::Real = 1e-4;
+
 /// `read_table(name)`: a file directly inside one of the input
 /// directories, by its plain name (no directory in it: a script reads
 /// beside itself and beside the parameter file, never below or above).
@@ -68,6 +132,7 @@ pub(super) fn register(engine: &mut Engine, access: &Access) {
         .collect();
     let given = access.tables.clone();
     let log = access.read.clone();
+    let dirs_dxf = dirs.clone();
     rhai::FuncRegistration::new("read_table")
         .with_params_info(["name: &str", "Table"])
         .with_comments([
@@ -89,26 +154,44 @@ pub(super) fn register(engine: &mut Engine, access: &Access) {
                     )
                     .into()
                 };
-                let plain = Path::new(name)
-                    .file_name()
-                    .is_some_and(|f| f == std::ffi::OsStr::new(name))
-                    && name != "."
-                    && name != "..";
-                if !plain {
-                    return Err(refused());
-                }
                 if let Some((_, text)) = given.iter().find(|(n, _)| n == name) {
                     return kernel(crate::profile::read_table_str(text, name));
                 }
-                let found = dirs
-                    .iter()
-                    .filter_map(|d| d.join(name).canonicalize().ok().map(|c| (d, c)))
-                    .find(|(d, c)| c.parent() == Some(d.as_path()) && c.is_file());
-                let Some((_, canon)) = found else {
-                    return Err(refused());
-                };
+                let canon = beside(&dirs, name).ok_or_else(refused)?;
                 log.record(&canon);
                 kernel(crate::profile::read_table(&canon))
+            },
+        );
+    let log_dxf = access.read.clone();
+    rhai::FuncRegistration::new("read_dxf")
+        .with_params_info(["name: &str", "options: Map", "Profile"])
+        .with_comments([
+            "/// The nominal a DXF drawing beside the script or the parameter file gives",
+            "/// (named by its file name alone): the chain of LWPOLYLINE (bulges as arcs),",
+            "/// LINE, ARC and SPLINE on `options.layer`, in the drawing's units",
+            "/// (`$INSUNITS`: mm, cm, m or inches), z along the drawing's X, the radius",
+            "/// along its Y (`diameter: true`: the diameter), from its origin; the half",
+            "/// with Y >= 0 of a full outline, its end faces dropped. `chordal` (mm,",
+            "/// default 1e-4): how far a SPLINE's chords and an arc's may stray from it.",
+            "/// An open chain, a gap, a face inside the outline, unknown units are",
+            "/// refused, naming the entity (type and handle) and where.",
+            "///",
+            "/// ```rhai",
+            "/// let p = read_dxf(\"plug.dxf\", #{ layer: \"PROFILE\" });",
+            "/// ```",
+        ])
+        .register_into_engine(
+            engine,
+            move |name: &str, options: rhai::Map| -> Result<crate::profile::Profile, Box<EvalAltResult>> {
+                let canon = beside(&dirs_dxf, name).ok_or_else(|| -> Box<EvalAltResult> {
+                    format!(
+                        "{}: not a readable file beside the script or the parameter file (a drawing is named by its file name alone)",
+                        crate::files::excerpt(name)
+                    )
+                    .into()
+                })?;
+                log_dxf.record(&canon);
+                dxf_profile(&canon, name, &options)
             },
         );
 }

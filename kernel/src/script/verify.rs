@@ -226,6 +226,14 @@ impl Verifier for ScriptRequest {
             Replay::Base(base) => base.nominal(),
         }
     }
+
+    /// A built-in form's warnings (its nominal's), the judge added or not.
+    fn warnings(&self) -> Vec<crate::verdict::Finding> {
+        match &self.replay {
+            Replay::Polar(_) => Vec::new(),
+            Replay::Base(base) => base.verifier().warnings(),
+        }
+    }
 }
 
 /// The nominal radius over angle a script's own verification on the
