@@ -485,7 +485,7 @@ fn scripts_of_the_first_release_still_run() {
         "fn params() { #{} }\n\
          fn toolpath(p) {\n\
            let b = profile(floats([0.0, 5.0, 10.0]), floats([5.0, 5.0, 5.0]));\n\
-           rest_track(b, floats([0.0, 10.0]), floats([13.0, 13.0]), 8.0, 10.0, 20.0)\n\
+           cut(b, path(floats([0.0, 10.0]), floats([13.0, 13.0])), wheel_tool(\"wheel\", 1, 100.0, 8.0, 16.0), 100.0)\n\
          }\n",
     )
     .unwrap();
@@ -500,7 +500,8 @@ fn scripts_of_the_first_release_still_run() {
     ]);
     assert_ne!(code, 0);
     assert!(
-        err.contains("earlier release") && err.contains("rest_track(surface, centres, wheel"),
+        err.contains("earlier release")
+            && err.contains("cut(ground_surface(previous), centres, wheel, feed, spindle_rpm)"),
         "{err}"
     );
     assert!(!out.exists());

@@ -19,6 +19,13 @@ fn taper_run(name: &str, sets: &[&str]) -> (PathBuf, i32, String) {
     (out, code, err)
 }
 
+/// `pilgrim verify` of the run in `out` (into `check` beside it) passes.
+fn verifies(out: &Path) {
+    let check = out.with_file_name("check");
+    let (code, _, err) = pilgrim(&["verify", s(out), "--out", s(&check), "-q"]);
+    assert_eq!(code, 0, "{err}");
+}
+
 /// The stations (z, radius) of the shipped table.
 fn stations() -> Vec<(f64, f64)> {
     let text =
@@ -118,14 +125,7 @@ fn the_taper_from_its_stations_with_a_fillet_is_ground_within_tolerance() {
         drawn(&st, 10.0, z)
     });
     assert!(b >= -0.002 && a <= 0.002, "at the fillet: {b}, {a}");
-    let (code, _, err) = pilgrim(&[
-        "verify",
-        s(&out),
-        "--out",
-        s(&out.with_file_name("check")),
-        "-q",
-    ]);
-    assert_eq!(code, 0, "{err}");
+    verifies(&out);
 }
 
 /// Monotone through the stations, the run passes within the tolerance;
@@ -309,12 +309,5 @@ fn the_dxf_plug_is_read_as_drawn_and_verified() {
     assert_eq!(report_of(&out)["verdict"]["status"], "passed");
     // The drawing is kept beside the run, and the run verifies from it.
     assert!(out.join("drawing_plug.dxf").exists());
-    let (code, _, err) = pilgrim(&[
-        "verify",
-        s(&out),
-        "--out",
-        s(&out.with_file_name("check")),
-        "-q",
-    ]);
-    assert_eq!(code, 0, "{err}");
+    verifies(&out);
 }

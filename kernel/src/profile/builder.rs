@@ -36,6 +36,12 @@ enum Segment {
     Fillet {
         radius: Real,
     },
+    /// An arc to this point tangent to the line before it, its radius
+    /// what the two ends and that tangent make.
+    TangentArc {
+        z: Real,
+        x: Real,
+    },
     /// The corner between the line before and the line after, cut by a
     /// straight line from this far back along the one to this far along
     /// the other.
@@ -168,6 +174,17 @@ impl ProfileBuilder {
         self
     }
 
+    /// An arc from the current point to `(z, x)` tangent to the line that
+    /// ends here (a drawing's arc dimensioned by its end and "tangent"):
+    /// its radius follows, `|chord|^2 / (2 |tangent x chord|)`. Refused,
+    /// naming the segment, after anything but a line, or where the end
+    /// lies on the line's own direction.
+    pub fn tangent_arc_to(mut self, z: Real, x: Real) -> Self {
+        self.segments.push(Segment::TangentArc { z, x });
+        self.current = (z, x);
+        self
+    }
+
     /// Cuts the corner at the current point, between the line that ends
     /// here and the next segment (a line), by a straight line from
     /// `length` back along the first to `length` along the second (a
@@ -229,8 +246,8 @@ impl ProfileBuilder {
                     }
                     law_nodes(&law, at.0, tol, max_step)?
                 }
-                Segment::Fillet { .. } | Segment::Chamfer { .. } => {
-                    unreachable!("corners are resolved into lines and arcs")
+                Segment::Fillet { .. } | Segment::Chamfer { .. } | Segment::TangentArc { .. } => {
+                    unreachable!("corners and tangent arcs are resolved into lines and arcs")
                 }
             };
             at = (*nodes.z.last().unwrap(), *nodes.x.last().unwrap());
@@ -508,5 +525,29 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("in line"), "{e}");
+    }
+
+    /// An arc given by its end and "tangent" leaves the line before it
+    /// with no kink, at the radius its ends make; an end on the line's
+    /// own direction is refused.
+    #[test]
+    fn a_tangent_arc_leaves_its_line_smoothly() {
+        let p = ProfileBuilder::start(0.0, 10.0)
+            .line_to(10.0, 10.0)
+            .tangent_arc_to(14.0, 8.0)
+            .build(1e-6, 1.0)
+            .unwrap();
+        assert!(p.second_derivatives().iter().all(|d| d.is_finite()));
+        // Chord (4, -2): radius 20 / 4 = 5, centre 5 below (10, 10).
+        for (z, x) in p.z().iter().zip(p.x()).filter(|(z, _)| **z > 10.0) {
+            assert_near!((z - 10.0).hypot(x - 5.0), 5.0, 1e-9);
+        }
+        let e = ProfileBuilder::start(0.0, 10.0)
+            .line_to(10.0, 10.0)
+            .tangent_arc_to(14.0, 10.0)
+            .build(1e-6, 1.0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("segment 1 (an arc tangent"), "{e}");
     }
 }

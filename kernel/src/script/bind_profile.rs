@@ -355,6 +355,14 @@ pub mod builder_api {
         b.fillet(radius)
     }
 
+    /// An arc from the current point to `(z, x)` tangent to the line
+    /// ending here (a drawing's arc given by its end and "tangent"): its
+    /// radius follows from the two. Refused after anything but a line.
+    #[rhai_fn(name = "tangent_arc_to")]
+    pub fn tangent_arc_to(b: ProfileBuilder, z: Real, x: Real) -> ProfileBuilder {
+        b.tangent_arc_to(z, x)
+    }
+
     /// Cuts the corner at the current point, between the line ending here
     /// and the next `line_to`, by a straight line from `length` back along
     /// the one to `length` along the other (a chamfer `C length` at a

@@ -43,6 +43,41 @@ pub(super) fn resolved(
                 out.push((i, Segment::Line { z: t2.0, x: t2.1 }));
                 (from, at) = (t2, t2);
             }
+            Segment::TangentArc { z, x } => {
+                let what =
+                    format!("segment {i} (an arc tangent to the line before it, to z = {z})");
+                let Some((_, Segment::Line { .. })) = out.last() else {
+                    return Err(InputError::out_of_range(what, z, "an arc after a line").into());
+                };
+                let (dz, dx) = (at.0 - from.0, at.1 - from.1);
+                let len = dz.hypot(dx);
+                let (cz, cx) = (z - at.0, x - at.1);
+                let cross = (dz * cx - dx * cz) / len;
+                let chord2 = cz * cz + cx * cx;
+                if cross.abs() <= crate::tolerance::SAME_RATIO * chord2.sqrt() {
+                    return Err(InputError::out_of_range(
+                        what,
+                        z,
+                        "an end off the line's direction (on it, the arc is the line)",
+                    )
+                    .into());
+                }
+                // The centre on the line's normal at `at`, on the side the
+                // end turns to: above (concave) where it turns to +x.
+                let radius = chord2 / (2.0 * cross.abs());
+                let bulge = if cross > 0.0 { Bulge::In } else { Bulge::Out };
+                // The shorter arc: the end within half a turn of the tangent.
+                if (dz * cz + dx * cx) / len < 0.0 {
+                    return Err(InputError::out_of_range(
+                        what,
+                        z,
+                        "an end ahead of the tangent (the arc would turn more than half a turn)",
+                    )
+                    .into());
+                }
+                out.push((i, arc((z, x), radius, bulge)));
+                (from, at) = ((z, x), (z, x));
+            }
             other => {
                 from = at;
                 at = end_of(&other, at);
@@ -67,7 +102,7 @@ fn end_of(seg: &Segment, at: (Real, Real)) -> (Real, Real) {
     match *seg {
         Segment::Line { z, x } | Segment::Arc { z, x, .. } => (z, x),
         Segment::Law(law) => (at.0 + law.l_r, law.x(law.l_r)),
-        Segment::Fillet { .. } | Segment::Chamfer { .. } => at,
+        Segment::Fillet { .. } | Segment::Chamfer { .. } | Segment::TangentArc { .. } => at,
     }
 }
 
