@@ -110,6 +110,7 @@ fn run_within(args: &RunArgs, catalog: &Catalog) -> Result<String, String> {
             tables: read,
         }),
         offsets: None,
+        corrected_by: None,
     };
     let out = match job::run(&family, &machine, &sources, &options, &mut |s| next(s)) {
         Ok(out) => out,

@@ -55,6 +55,11 @@ pub struct Report {
     pub machine_spec: String,
     /// The control's dialect.
     pub control: String,
+    /// What corrected the run, where `pilgrim compensate` made it: the
+    /// measurement's file, the generation, the gain and uncertainty, as
+    /// the page's heading says it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub corrected_by: Option<String>,
     /// The program file a verification read (`pilgrim verify`), as shown
     /// in messages; none for a run, whose program is its own.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -231,6 +236,7 @@ impl Report {
             script: family.name().to_owned(),
             machine: info.name.clone(),
             machine_spec: machine.spec.clone(),
+            corrected_by: None,
             program_file: None,
             block_numbers: Vec::new(),
             control: info.control.clone(),

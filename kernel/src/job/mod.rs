@@ -73,6 +73,9 @@ pub struct JobOptions {
     /// dialect's rule (`O1234.nc`, `KONTUR.SPF`, `name.ngc`), never by a
     /// path.
     pub program_dir: Option<std::path::PathBuf>,
+    /// What corrected the run (`pilgrim compensate`), for its report and
+    /// page; `None` for a run of its own.
+    pub corrected_by: Option<String>,
 }
 
 /// The tables a run keeps by name, each its columns by name.
@@ -92,6 +95,7 @@ impl Default for JobOptions {
             keep: None,
             offsets: None,
             program_dir: None,
+            corrected_by: None,
         }
     }
 }

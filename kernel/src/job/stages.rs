@@ -799,6 +799,7 @@ impl Run<'_> {
             std::mem::take(&mut c.figures),
         );
         Ok(Report {
+            corrected_by: self.options.corrected_by.clone(),
             passes: made.passes.len(),
             cutting_passes: made.passes.iter().filter(|p| p.cuts).count(),
             points: toolpath.point_count(),

@@ -589,6 +589,13 @@ pub fn report_html(inputs: &PageInputs<'_>) -> String {
         escape(&r.control),
         escape(&r.machine_spec)
     );
+    if let Some(c) = &r.corrected_by {
+        let _ = writeln!(
+            out,
+            "<p class=\"sub corrected\">A corrected program: {}.</p>",
+            escape(c)
+        );
+    }
     banner(&mut out, r);
     twin(&mut out, inputs);
     summary(&mut out, r);

@@ -210,7 +210,10 @@ fn correct(
         first,
         records,
         &quantities,
-        options,
+        Asked {
+            options,
+            measured_file: measured.source(),
+        },
     )
     .map_err(|e| match e {
         // A corrected run that fails its checks leaves its report.
@@ -262,6 +265,13 @@ type Found = (
     Option<Result<Option<change::Moved>, RunError>>,
 );
 
+/// What `compensate` was asked, as the corrected run needs it: the
+/// options, and the measurement's file (named on its page).
+struct Asked<'a> {
+    options: &'a CompensateOptions,
+    measured_file: &'a str,
+}
+
 /// The corrected run, in the run's stages: once its verification has
 /// predicted its part, the correction's tables made with the part after,
 /// and how far its program's path moved from the `first` run's, per pass
@@ -276,8 +286,12 @@ fn corrected_run(
     first: FirstProgram,
     mut records: Vec<QuantityRecord>,
     quantities: &[Quantity],
-    options: &CompensateOptions,
+    asked: Asked<'_>,
 ) -> Result<(JobOutput, Found), Error> {
+    let Asked {
+        options,
+        measured_file,
+    } = asked;
     let machine = catalog.open(&prior.spec)?;
     let sources = vec![
         prior.base.clone(),
@@ -299,6 +313,14 @@ fn corrected_run(
             script: prior.script.clone(),
             tables: prior.tables_read.clone(),
         }),
+        corrected_by: Some(format!(
+            "generation {} of {}, corrected by the measurement {} at gain {} (its fit held to the uncertainty {} mm); the correction in correction.csv, the fit in compensation.json",
+            prior.lineage.generation,
+            prior.shown,
+            crate::files::excerpt(measured_file),
+            options.gain,
+            options.uncertainty
+        )),
         ..JobOptions::default()
     };
     let (values, origins) = super::params_traced(family, &machine, &sources)?;
