@@ -124,117 +124,7 @@ pub fn profile_from_dxf(
         if !e.common.layer.eq_ignore_ascii_case(&options.layer) {
             continue;
         }
-        let name = |kind: &str| format!("{kind} #{}", e.common.handle.as_string());
-        match &e.specific {
-            dxf::entities::EntityType::Line(l) => pieces.push(Piece {
-                a: point(l.p1.x, l.p1.y),
-                b: point(l.p2.x, l.p2.y),
-                arc: None,
-                name: name("LINE"),
-            }),
-            dxf::entities::EntityType::Arc(a) => {
-                let at = |deg: Real| {
-                    let t = deg.to_radians();
-                    point(
-                        a.center.x + a.radius * t.cos(),
-                        a.center.y + a.radius * t.sin(),
-                    )
-                };
-                let (p, q) = (at(a.start_angle), at(a.end_angle));
-                if options.diameter {
-                    return Err(entity(file, &name("ARC"), p, "an arc on a drawing of diameters is no circle in the section: draw the radius (diameter: false)".into()));
-                }
-                let sweep = (a.end_angle - a.start_angle).rem_euclid(360.0);
-                if sweep >= 180.0 {
-                    return Err(entity(
-                        file,
-                        &name("ARC"),
-                        p,
-                        format!(
-                            "sweeps {sweep:.3} deg: more than half a turn is not a profile x(z)"
-                        ),
-                    ));
-                }
-                // Counter-clockwise from p to q: seen with z increasing
-                // (p left of q) it bulges toward -x.
-                let ccw_left_to_right = p.0 < q.0;
-                let bulge = if ccw_left_to_right {
-                    Bulge::In
-                } else {
-                    Bulge::Out
-                };
-                pieces.push(Piece {
-                    a: p,
-                    b: q,
-                    arc: Some((a.radius * scale, bulge)),
-                    name: name("ARC"),
-                });
-            }
-            dxf::entities::EntityType::LwPolyline(l) => {
-                let v = &l.vertices;
-                let closed = l.flags & 1 == 1;
-                let n = if closed {
-                    v.len()
-                } else {
-                    v.len().saturating_sub(1)
-                };
-                for i in 0..n {
-                    let (s, t) = (&v[i], &v[(i + 1) % v.len()]);
-                    let (p, q) = (point(s.x, s.y), point(t.x, t.y));
-                    let arc = if s.bulge == 0.0 {
-                        None
-                    } else {
-                        if options.diameter {
-                            return Err(entity(file, &name("LWPOLYLINE"), p, "a bulge on a drawing of diameters is no circle in the section: draw the radius (diameter: false)".into()));
-                        }
-                        let theta = 4.0 * s.bulge.abs().atan();
-                        let chord = (q.0 - p.0).hypot(q.1 - p.1);
-                        if theta >= std::f64::consts::PI {
-                            return Err(entity(
-                                file,
-                                &name("LWPOLYLINE"),
-                                p,
-                                format!(
-                                    "a bulge of {} sweeps half a turn or more: not a profile x(z)",
-                                    s.bulge
-                                ),
-                            ));
-                        }
-                        // Positive bulge: counter-clockwise from s to t.
-                        let ccw = s.bulge > 0.0;
-                        let bulge = if ccw == (p.0 < q.0) {
-                            Bulge::In
-                        } else {
-                            Bulge::Out
-                        };
-                        Some((chord / (2.0 * (0.5 * theta).sin()), bulge))
-                    };
-                    pieces.push(Piece {
-                        a: p,
-                        b: q,
-                        arc,
-                        name: format!("{} segment {}", name("LWPOLYLINE"), i + 1),
-                    });
-                }
-            }
-            dxf::entities::EntityType::Spline(sp) => {
-                let points = spline_points(sp, scale, y_scale, options.chordal).map_err(|why| {
-                    DxfError::Entity {
-                        file: file.into(),
-                        what: format!("{}: {why}", name("SPLINE")),
-                    }
-                })?;
-                for w in points.windows(2) {
-                    pieces.push(Piece {
-                        a: w[0],
-                        b: w[1],
-                        arc: None,
-                        name: name("SPLINE"),
-                    });
-                }
-            }
-            _ => {}
-        }
+        pieces_of(e, &point, (scale, y_scale), options, file, &mut pieces)?;
     }
     let upper = upper_half(pieces);
     if upper.is_empty() {
@@ -274,6 +164,129 @@ pub fn profile_from_dxf(
                 },
             }
         })
+}
+
+/// The pieces (in mm) one entity of the outline's layer gives, appended
+/// to `pieces`: a LINE, an ARC, an LWPOLYLINE's segments (bulges as arcs),
+/// a SPLINE's chords; other entities give none.
+fn pieces_of(
+    e: &dxf::entities::Entity,
+    point: &dyn Fn(Real, Real) -> (Real, Real),
+    (scale, y_scale): (Real, Real),
+    options: &DxfOptions,
+    file: &str,
+    pieces: &mut Vec<Piece>,
+) -> Result<(), DxfError> {
+    let name = |kind: &str| format!("{kind} #{}", e.common.handle.as_string());
+    match &e.specific {
+        dxf::entities::EntityType::Line(l) => pieces.push(Piece {
+            a: point(l.p1.x, l.p1.y),
+            b: point(l.p2.x, l.p2.y),
+            arc: None,
+            name: name("LINE"),
+        }),
+        dxf::entities::EntityType::Arc(a) => {
+            let at = |deg: Real| {
+                let t = deg.to_radians();
+                point(
+                    a.center.x + a.radius * t.cos(),
+                    a.center.y + a.radius * t.sin(),
+                )
+            };
+            let (p, q) = (at(a.start_angle), at(a.end_angle));
+            if options.diameter {
+                return Err(entity(file, &name("ARC"), p, "an arc on a drawing of diameters is no circle in the section: draw the radius (diameter: false)".into()));
+            }
+            let sweep = (a.end_angle - a.start_angle).rem_euclid(360.0);
+            if sweep >= 180.0 {
+                return Err(entity(
+                    file,
+                    &name("ARC"),
+                    p,
+                    format!("sweeps {sweep:.3} deg: more than half a turn is not a profile x(z)"),
+                ));
+            }
+            // Counter-clockwise from p to q: seen with z increasing
+            // (p left of q) it bulges toward -x.
+            let ccw_left_to_right = p.0 < q.0;
+            let bulge = if ccw_left_to_right {
+                Bulge::In
+            } else {
+                Bulge::Out
+            };
+            pieces.push(Piece {
+                a: p,
+                b: q,
+                arc: Some((a.radius * scale, bulge)),
+                name: name("ARC"),
+            });
+        }
+        dxf::entities::EntityType::LwPolyline(l) => {
+            let v = &l.vertices;
+            let closed = l.flags & 1 == 1;
+            let n = if closed {
+                v.len()
+            } else {
+                v.len().saturating_sub(1)
+            };
+            for i in 0..n {
+                let (s, t) = (&v[i], &v[(i + 1) % v.len()]);
+                let (p, q) = (point(s.x, s.y), point(t.x, t.y));
+                let arc = if s.bulge == 0.0 {
+                    None
+                } else {
+                    if options.diameter {
+                        return Err(entity(file, &name("LWPOLYLINE"), p, "a bulge on a drawing of diameters is no circle in the section: draw the radius (diameter: false)".into()));
+                    }
+                    let theta = 4.0 * s.bulge.abs().atan();
+                    let chord = (q.0 - p.0).hypot(q.1 - p.1);
+                    if theta >= std::f64::consts::PI {
+                        return Err(entity(
+                            file,
+                            &name("LWPOLYLINE"),
+                            p,
+                            format!(
+                                "a bulge of {} sweeps half a turn or more: not a profile x(z)",
+                                s.bulge
+                            ),
+                        ));
+                    }
+                    // Positive bulge: counter-clockwise from s to t.
+                    let ccw = s.bulge > 0.0;
+                    let bulge = if ccw == (p.0 < q.0) {
+                        Bulge::In
+                    } else {
+                        Bulge::Out
+                    };
+                    Some((chord / (2.0 * (0.5 * theta).sin()), bulge))
+                };
+                pieces.push(Piece {
+                    a: p,
+                    b: q,
+                    arc,
+                    name: format!("{} segment {}", name("LWPOLYLINE"), i + 1),
+                });
+            }
+        }
+        dxf::entities::EntityType::Spline(sp) => {
+            let points = spline_points(sp, scale, y_scale, options.chordal).map_err(|why| {
+                DxfError::Entity {
+                    file: file.into(),
+                    what: format!("{}: {why}", name("SPLINE")),
+                }
+            })?;
+            for w in points.windows(2) {
+                pieces.push(Piece {
+                    a: w[0],
+                    b: w[1],
+                    arc: None,
+                    name: name("SPLINE"),
+                });
+            }
+        }
+        _ => {}
+    }
+    Ok(())
 }
 
 /// The drawing's length unit in mm.
