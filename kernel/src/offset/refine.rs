@@ -44,35 +44,34 @@ pub fn refined(
         if d2[i].is_infinite() || d2[i + 1].is_infinite() {
             continue;
         }
-        // Pieces still to judge, nearest first: (z0, z1, depth).
-        let mut todo = vec![(pz[i], pz[i + 1], 0u32)];
-        let ends = |z: Real| -> Result<([Real; 3], (Real, Real)), ProfileError> {
+        // A place of the curve: z, its jet and the centre over it.
+        let at = |z: Real| -> Result<Place, ProfileError> {
             let j = profile.jet(z)?;
-            Ok((j, centre(z, j[0], j[1])))
+            Ok((z, j, centre(z, j[0], j[1])))
         };
+        // Pieces still to judge, left first: a piece that holds adds its
+        // right end (the interval's own end excepted), so nodes come in
+        // order. Only the middle is evaluated per piece.
+        let mut todo = vec![(at(pz[i])?, at(pz[i + 1])?, 0u32)];
         while let Some((a, b, depth)) = todo.pop() {
-            let (_, ca) = ends(a)?;
-            let (_, cb) = ends(b)?;
-            let m = 0.5 * (a + b);
-            let (jm, cm) = ends(m)?;
-            if depth >= MAX_DEPTH || off_chord(ca, cb, cm) <= sag {
+            let m = at(0.5 * (a.0 + b.0))?;
+            if depth < MAX_DEPTH && off_chord(a.2, b.2, m.2) > sag {
+                todo.push((m, b, depth + 1));
+                todo.push((a, m, depth + 1));
                 continue;
             }
-            // Judge the left half first; `m` is a node once both are.
-            todo.push((m, b, depth + 1));
-            todo.push((a, m, depth + 1));
-            out.pending.push((m, jm));
-            out.flush_below(todo.last().map_or(b, |t| t.0));
-            if out.z.len() + out.pending.len() > MAX_NODES {
-                return Err(crate::input::InputError::out_of_range(
-                    "tool path's chordal sag",
-                    sag,
-                    format!("a sag giving at most {MAX_NODES} nodes"),
-                )
-                .into());
+            if b.0 < pz[i + 1] {
+                out.push(b.0, b.1[0], b.1[1], b.1[2]);
+                if out.z.len() > MAX_NODES {
+                    return Err(crate::input::InputError::out_of_range(
+                        "tool path's chordal sag",
+                        sag,
+                        format!("a sag giving at most {MAX_NODES} nodes"),
+                    )
+                    .into());
+                }
             }
         }
-        out.flush_below(Real::INFINITY);
     }
     let last = pz.len() - 1;
     out.push(pz[last], px[last], slopes[last], d2[last]);
@@ -90,14 +89,17 @@ fn off_chord(a: (Real, Real), b: (Real, Real), m: (Real, Real)) -> Real {
     ((m.0 - a.0) * dx - (m.1 - a.1) * dz).abs() / len
 }
 
-/// Nodes with their derivatives, and the added ones not yet in order.
+/// A place of the curve: its z, its jet (x and two derivatives) and the
+/// tool's centre over it.
+type Place = (Real, [Real; 3], (Real, Real));
+
+/// Nodes with their derivatives.
 #[derive(Default)]
 struct Jets {
     z: Vec<Real>,
     x: Vec<Real>,
     d1: Vec<Real>,
     d2: Vec<Real>,
-    pending: Vec<(Real, [Real; 3])>,
 }
 
 impl Jets {
@@ -106,20 +108,6 @@ impl Jets {
         self.x.push(x);
         self.d1.push(d1);
         self.d2.push(d2);
-    }
-
-    /// Moves the added nodes below `z` (every piece left starts at or
-    /// after it) into the nodes, in order.
-    fn flush_below(&mut self, z: Real) {
-        self.pending
-            .sort_by(|a, b| b.0.partial_cmp(&a.0).unwrap_or(std::cmp::Ordering::Equal));
-        while let Some(&(zm, j)) = self.pending.last() {
-            if zm >= z {
-                break;
-            }
-            self.pending.pop();
-            self.push(zm, j[0], j[1], j[2]);
-        }
     }
 }
 

@@ -318,10 +318,7 @@ fn entity(file: &str, name: &str, at: (Real, Real), why: String) -> DxfError {
 /// The pieces at or above the axis (the half with Y >= 0 of a full
 /// outline), the faces (pieces along x) at the ends dropped.
 fn upper_half(pieces: Vec<Piece>) -> Vec<Piece> {
-    let size = pieces
-        .iter()
-        .flat_map(|p| [p.a.0.abs(), p.a.1.abs(), p.b.0.abs(), p.b.1.abs()])
-        .fold(1.0, Real::max);
+    let size = extent(&pieces);
     let eps = crate::tolerance::SAME_RATIO * size;
     let mut out = Vec::new();
     for p in pieces {
@@ -332,22 +329,24 @@ fn upper_half(pieces: Vec<Piece>) -> Vec<Piece> {
         if p.a.1.abs() <= eps && p.b.1.abs() <= eps {
             continue;
         }
-        if (p.b.0 - p.a.0).abs() <= eps {
-            // A face: only at the chain's ends (checked when chained).
-            out.push(Piece { arc: None, ..p });
-            continue;
-        }
+        // A face (along x) is kept: `chained` allows one at an end only.
         out.push(p);
     }
     out
 }
 
-/// The pieces as one chain with z increasing, the end faces dropped.
-fn chained(mut pieces: Vec<Piece>, file: &str) -> Result<Vec<Piece>, DxfError> {
-    let size = pieces
+/// The largest coordinate of the pieces (mm, at least 1): the scale the
+/// comparisons of their ends are made at.
+fn extent(pieces: &[Piece]) -> Real {
+    pieces
         .iter()
         .flat_map(|p| [p.a.0.abs(), p.a.1.abs(), p.b.0.abs(), p.b.1.abs()])
-        .fold(1.0, Real::max);
+        .fold(1.0, Real::max)
+}
+
+/// The pieces as one chain with z increasing, the end faces dropped.
+fn chained(mut pieces: Vec<Piece>, file: &str) -> Result<Vec<Piece>, DxfError> {
+    let size = extent(&pieces);
     let gap = crate::tolerance::SAME_RATIO * size * 1e3;
     let face = |p: &Piece| (p.b.0 - p.a.0).abs() <= crate::tolerance::SAME_RATIO * size;
     // Start at the least z of the pieces that advance.
@@ -356,15 +355,7 @@ fn chained(mut pieces: Vec<Piece>, file: &str) -> Result<Vec<Piece>, DxfError> {
             *p = p.clone().reversed();
         }
     }
-    let mut faces: Vec<Piece> = Vec::new();
-    pieces.retain(|p| {
-        if face(p) {
-            faces.push(p.clone());
-            false
-        } else {
-            true
-        }
-    });
+    let (faces, mut pieces): (Vec<Piece>, Vec<Piece>) = pieces.into_iter().partition(face);
     pieces.sort_by(|a, b| a.a.0.total_cmp(&b.a.0));
     let lo = pieces.iter().map(|p| p.a.0).fold(Real::INFINITY, Real::min);
     let hi = pieces
