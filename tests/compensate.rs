@@ -305,6 +305,16 @@ fn the_mandrel_is_corrected_by_its_measured_error() {
         "{after_um:?}"
     );
     assert!(out.join("compensation.svg").is_file() && page.contains("alt=\"compensation.svg\""));
+    // The charts' titles say which program they chart: the first run's
+    // are the nominal's, the corrected run's say the correction's.
+    let titled = |dir: &std::path::Path, file: &str| {
+        std::fs::read_to_string(dir.join(file))
+            .unwrap()
+            .contains("the program corrected (generation 1)")
+    };
+    for file in ["deviation.svg", "finish.svg", "stock.svg"] {
+        assert!(!titled(&run, file) && titled(&out, file), "{file}");
+    }
     common::check_page(&out, "program.mpf", 8.0);
     common::leave_page_for_chromium(&out, "compensated-mandrel");
     // The corrected run verified again as it stands (after a hand edit):
@@ -331,6 +341,8 @@ fn the_mandrel_is_corrected_by_its_measured_error() {
     let twice = dir.join("twice");
     let (code, _, err) = compensate(&out, &again, &twice, &[]);
     assert_eq!(code, 0, "{err}");
+    let finish = std::fs::read_to_string(twice.join("finish.svg")).unwrap();
+    assert!(finish.contains("the program corrected (generation 2)"));
     let kept = correction_off(&twice, &wear);
     assert!(
         kept < 3e-4,

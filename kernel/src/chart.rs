@@ -81,6 +81,16 @@ impl From<serde_json::Error> for DrawError {
     }
 }
 
+/// A chart's title: `base`, and for a corrected run (`corrected` its
+/// correction's generation) that the program it charts is that
+/// correction's, whose surface stands off the nominal by the correction.
+pub fn titled(base: &str, corrected: Option<u32>) -> String {
+    match corrected {
+        Some(g) => format!("{base}; the program corrected (generation {g})"),
+        None => base.to_owned(),
+    }
+}
+
 /// The chart `spec` from `toolpath`'s tables as SVG text.
 ///
 /// # Failures

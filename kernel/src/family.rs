@@ -174,6 +174,18 @@ pub struct FilesContext<'a> {
     pub replay: ReplayContext<'a>,
     /// The part's bodies (of revolution, for the profile's picture).
     pub parts: &'a [PartBody],
+    /// The correction's generation of a corrected run (`pilgrim
+    /// compensate`), which its charts' titles say; `None` for a run of its
+    /// own.
+    pub corrected: Option<u32>,
+}
+
+impl FilesContext<'_> {
+    /// A chart's title as this run's charts show it: `base`, and for a
+    /// corrected run which correction drew it.
+    pub fn title(&self, base: &str) -> String {
+        crate::chart::titled(base, self.corrected)
+    }
 }
 
 /// A verification's files (name, bytes: plots and tables, in order) and

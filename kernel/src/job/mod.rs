@@ -73,9 +73,20 @@ pub struct JobOptions {
     /// dialect's rule (`O1234.nc`, `KONTUR.SPF`, `name.ngc`), never by a
     /// path.
     pub program_dir: Option<std::path::PathBuf>,
-    /// What corrected the run (`pilgrim compensate`), for its report and
-    /// page; `None` for a run of its own.
-    pub corrected_by: Option<String>,
+    /// What corrected the run (`pilgrim compensate`), for its report, its
+    /// page and its charts' titles; `None` for a run of its own.
+    pub corrected_by: Option<CorrectedBy>,
+}
+
+/// What corrected a run: the correction's generation (its charts' titles
+/// say it) and the sentence its report and page show.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CorrectedBy {
+    /// 1 for the first correction of a program, 2 for its correction's.
+    pub generation: u32,
+    /// The generation, the run it corrects, the measurement, the gain and
+    /// the uncertainty, in one sentence.
+    pub said: String,
 }
 
 /// The tables a run keeps by name, each its columns by name.

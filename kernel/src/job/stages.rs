@@ -799,7 +799,7 @@ impl Run<'_> {
             std::mem::take(&mut c.figures),
         );
         Ok(Report {
-            corrected_by: self.options.corrected_by.clone(),
+            corrected_by: self.options.corrected_by.as_ref().map(|c| c.said.clone()),
             passes: made.passes.len(),
             cutting_passes: made.passes.iter().filter(|p| p.cuts).count(),
             points: toolpath.point_count(),
@@ -875,6 +875,7 @@ impl Run<'_> {
         let ctx = FilesContext {
             replay: self.replay_ctx(plan, made),
             parts: &c.parts,
+            corrected: self.options.corrected_by.as_ref().map(|c| c.generation),
         };
         let crate::family::Drawn { files: made, marks } = o.files(&ctx, &report.tables)?;
         // Marks over a plot it drew, by the plot's name.
@@ -937,6 +938,8 @@ impl Run<'_> {
                     continue;
                 }
             }
+            let generation = self.options.corrected_by.as_ref().map(|c| c.generation);
+            plot.title = crate::chart::titled(&plot.title, generation);
             let plot = &plot;
             let text = crate::chart::chart_svg(&charted, plot)
                 .map_err(|message| self.contract(message))?;

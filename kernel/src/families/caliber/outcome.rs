@@ -188,7 +188,7 @@ impl Outcome for GrooveOutcome {
                     .collect()
             })
             .unwrap_or_default();
-        let (map, marks) = super::deviation_map_svg(&self.check, &passes)?;
+        let (map, marks) = super::deviation_map_svg(&self.check, &passes, ctx.corrected)?;
         let section = super::section_svg(&self.check, &self.request, self.wheel.rounding_radius)?;
         Ok(crate::family::Drawn {
             files: vec![

@@ -41,13 +41,15 @@ fn level(v: f64, limit: f64) -> usize {
 /// `deviation_map.svg`: each cell of the check's map coloured by its
 /// distance (um) on a scale of +- the tolerance (or the largest distance,
 /// if larger), cells of one colour along theta drawn as one rectangle;
-/// the colour bar beside it; the worst places marked.
+/// the colour bar beside it; the worst places marked; the title says which
+/// correction's program it charts, if `corrected`.
 ///
 /// # Failures
 /// An empty map; plotters failing.
 pub fn deviation_map_svg(
     check: &GrooveCheck,
     passes: &[(std::ops::Range<usize>, f64)],
+    corrected: Option<u32>,
 ) -> Result<(String, Marks), DrawError> {
     let m = &check.map;
     let (nt, np) = (
@@ -75,9 +77,12 @@ pub fn deviation_map_svg(
         let (p0, p1) = (m.psi_deg[0], m.psi_deg[np]);
         let mut chart = ChartBuilder::on(&main)
             .caption(
-                format!(
-                    "Groove minus swept wheel, um (+ material left, - gouge); tolerance +-{} um",
-                    crate::math::fixed(check.tolerance * 1e3, 1)
+                crate::chart::titled(
+                    &format!(
+                        "Groove minus swept wheel, um (+ material left, - gouge); tolerance +-{} um",
+                        crate::math::fixed(check.tolerance * 1e3, 1)
+                    ),
+                    corrected,
                 ),
                 ("sans-serif", 17),
             )

@@ -242,7 +242,7 @@ impl Outcome for GrindingOutcome {
         let n = &self.request;
         let start = |z: f64| Some(n.blank.as_deref()?.eval(z).ok()? - n.profile.eval(z).ok()?);
         for (name, text, marks) in
-            super::deviation_svgs(&self.check, start, r.program.blocks.len())?
+            super::deviation_svgs(&self.check, start, r.program.blocks.len(), ctx.corrected)?
         {
             drawn.marks.insert(name.clone(), marks);
             drawn.files.push((name, text.into_bytes()));

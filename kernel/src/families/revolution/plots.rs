@@ -208,7 +208,8 @@ pub fn removed(passes: &[PassCheck], start: impl Fn(f64) -> Option<f64>) -> Vec<
 /// `deviation.svg`, `finish.svg` and `stock.svg` of a grinding replay,
 /// `start` the blank's surface minus the nominal at z (mm) where there is
 /// a blank, with the page's marks: the finish's worst place on the first
-/// two, each pass's line on the stock (the program having `blocks`).
+/// two, each pass's line on the stock (the program having `blocks`); the
+/// titles say which correction's program they chart, if `corrected`.
 ///
 /// # Failures
 /// A replay with no pass drawn; drawing failing.
@@ -216,7 +217,9 @@ pub fn deviation_svgs(
     check: &GrindingCheck,
     start: impl Fn(f64) -> Option<f64>,
     blocks: usize,
+    corrected: Option<u32>,
 ) -> Result<[(String, String, Marks); 3], DrawError> {
+    let title = |base: &str| crate::chart::titled(base, corrected);
     let all: Vec<&PassCheck> = check.passes.iter().collect();
     let finish = all
         .last()
@@ -230,7 +233,9 @@ pub fn deviation_svgs(
     let (deviation, deviation_marks) = at_worst(draw(
         &all,
         (
-            "Each pass's surface minus the nominal (lowest and highest over the generatrices)",
+            &title(
+                "Each pass's surface minus the nominal (lowest and highest over the generatrices)",
+            ),
             "surface minus nominal, um",
         ),
         None,
@@ -238,7 +243,7 @@ pub fn deviation_svgs(
     let (finish_svg, finish_marks) = at_worst(draw(
         &[finish],
         (
-            "The finish against the tolerance (ridges included)",
+            &title("The finish against the tolerance (ridges included)"),
             "surface minus nominal, um",
         ),
         Some(check.tolerance),
@@ -246,7 +251,7 @@ pub fn deviation_svgs(
     let (stock_svg, mut stock_marks, map) = draw(
         &stock.iter().collect::<Vec<_>>(),
         (
-            "The stock each pass removed, at the valleys and at the ridges' tops",
+            &title("The stock each pass removed, at the valleys and at the ridges' tops"),
             "stock removed, um",
         ),
         None,

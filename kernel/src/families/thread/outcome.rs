@@ -227,7 +227,7 @@ impl Outcome for ThreadOutcome {
     ) -> Result<crate::family::Drawn, crate::family::DrawError> {
         let table = pass_table(&self.check, tables.get("passes"))?;
         let workbook = super::pass_workbook(&self.check, tables.get("passes"))?;
-        let (svg, marks) = passes_svg(&self.check, ctx.replay.program.blocks.len())?;
+        let (svg, marks) = passes_svg(&self.check, ctx.replay.program.blocks.len(), ctx.corrected)?;
         Ok(crate::family::Drawn {
             files: vec![
                 ("passes.csv".into(), table.into_bytes()),

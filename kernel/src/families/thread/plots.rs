@@ -23,11 +23,16 @@ fn pass_colour(k: usize, n: usize) -> HSLColor {
 /// each pass's chip in its colour, a colour strip below naming the first
 /// and the last pass; and the page's marks, each pass's chip outlined
 /// from its thread block to the next pass's (the program having
-/// `blocks`).
+/// `blocks`); the title says which correction's program it charts, if
+/// `corrected`.
 ///
 /// # Failures
 /// Drawing failing.
-pub fn passes_svg(check: &ThreadCheck, blocks: usize) -> Result<(String, Marks), DrawError> {
+pub fn passes_svg(
+    check: &ThreadCheck,
+    blocks: usize,
+    corrected: Option<u32>,
+) -> Result<(String, Marks), DrawError> {
     let (w0, lead) = check.window;
     let (mut r0, mut r1) = (f64::INFINITY, f64::NEG_INFINITY);
     for chip in check.chips.iter().flatten().flatten() {
@@ -51,8 +56,11 @@ pub fn passes_svg(check: &ThreadCheck, blocks: usize) -> Result<(String, Marks),
         let (top, bottom) = root.split_vertically(640);
         let mut chart = ChartBuilder::on(&top)
             .caption(
-                format!(
-                    "Stock removed pass by pass in the axial section ({n} thread passes, one lead)"
+                crate::chart::titled(
+                    &format!(
+                        "Stock removed pass by pass in the axial section ({n} thread passes, one lead)"
+                    ),
+                    corrected,
                 ),
                 ("sans-serif", 22),
             )

@@ -313,14 +313,17 @@ fn corrected_run(
             script: prior.script.clone(),
             tables: prior.tables_read.clone(),
         }),
-        corrected_by: Some(format!(
-            "generation {} of {}, corrected by the measurement {} at gain {} (its fit held to the uncertainty {} mm); the correction in correction.csv, the fit in compensation.json",
-            prior.lineage.generation,
-            prior.shown,
-            crate::files::excerpt(measured_file),
-            options.gain,
-            options.uncertainty
-        )),
+        corrected_by: Some(crate::job::CorrectedBy {
+            generation: prior.lineage.generation,
+            said: format!(
+                "generation {} of {}, corrected by the measurement {} at gain {} (its fit held to the uncertainty {} mm); the correction in correction.csv, the fit in compensation.json",
+                prior.lineage.generation,
+                prior.shown,
+                crate::files::excerpt(measured_file),
+                options.gain,
+                options.uncertainty
+            ),
+        }),
         ..JobOptions::default()
     };
     let (values, origins) = super::params_traced(family, &machine, &sources)?;
