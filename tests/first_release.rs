@@ -11,12 +11,27 @@ const FIXTURES: &str = "tests/fixtures/families-first-release";
 
 /// The roll's steady rest is the first release's `rest_track` on a bare
 /// profile: it runs, through today's kernel, and says which form replaces
-/// it and until when the old one is kept.
+/// it and until when the old one is kept. Its program, replayed with the
+/// true wheel as the first release did not, gouges the taper by 2 mm (the
+/// 40 mm wheel's 20 mm flat on a ball's path) and ridges the barrel at
+/// 7.5 mm a turn: the failure says what to change, and changed so, on the
+/// command line alone, the family verifies on the run and on `pilgrim
+/// verify` of what it wrote.
 #[test]
-fn the_first_releases_rest_track_runs_with_a_warning() {
-    let out = scratch("first-release", "roll").join("run");
+fn the_first_releases_roll_runs_and_is_told_what_to_change() {
+    let dir = scratch("first-release", "roll");
     let script = root().join(FIXTURES).join("roll.rhai");
-    let (_, _, err) = pilgrim(&["run", s(&script), "--out", s(&out)]);
+    let run = |name: &str, set: &[&str]| {
+        let out = dir.join(name);
+        let mut args = vec!["run", s(&script), "--out", s(&out)];
+        for v in set {
+            args.extend(["--set", v]);
+        }
+        let (code, _, err) = pilgrim(&args);
+        (code, err, out)
+    };
+    let (code, err, out) = run("as-written", &[]);
+    assert_eq!(code, 1, "{err}");
     assert!(!err.contains("no longer callable"), "{err}");
     let warnings = report_of(&out)["verdict"]["warnings"].to_string();
     assert!(
@@ -26,9 +41,31 @@ fn the_first_releases_rest_track_runs_with_a_warning() {
             && warnings.contains("kept until 2027-06-30"),
         "{warnings}"
     );
+    for named in [
+        "strays -2.0000",
+        "the wheel's flat (20.000 mm between its roundings) cuts",
+        "a wheel no wider than twice its rounding radius (20.000 mm)",
+        "a finishing feed of at most 40.0 mm/min (0.2000 mm per revolution at 200 rpm)",
+    ] {
+        assert!(err.contains(named), "{named}: {err}");
+    }
+    // Those two changed, the pass's end is what is left, and said.
+    let (code, err, _) = run("at-the-feed", &["wheel_w=20", "feed=40"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("the wheel leaves the end at z = 0.000 mm within its last revolution"),
+        "{err}"
+    );
+    // A slower feed finishes the end within the tolerance too.
+    let (code, err, out) = run("changed", &["wheel_w=20", "feed=30"]);
+    assert_eq!(code, 0, "{err}");
+    let report = report_of(&out);
+    assert_eq!(report["verdict"]["status"], "passed");
     // The rest's U rides the surface before each pass at every block.
     let program = std::fs::read_to_string(out.join("toolpath.json")).unwrap();
     assert!(program.contains("\"U\""), "no U in the toolpath");
+    let (code, _, err) = pilgrim(&["verify", s(&out), "--out", s(&dir.join("check")), "-q"]);
+    assert_eq!(code, 0, "{err}");
 }
 
 /// The drawing plug, refused on the chuck meeting the steady rest, says

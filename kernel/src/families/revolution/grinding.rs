@@ -98,9 +98,10 @@ pub(super) fn replay_on(
             half_worst = half;
         }
     }
-    if out.passes.is_empty() {
+    let Some(finish) = out.passes.last_mut() else {
         return Err(VerifyError::NoCuttingPass);
-    }
+    };
+    finish.to_change = to_change(finish, wheel, (tolerance, range), &run.earlier);
     let stock = match blank {
         Some(b) => {
             run.phase_states.push(run.phases);
@@ -120,6 +121,67 @@ pub(super) fn replay_on(
         None => None,
     };
     Ok((out, stock, half_worst))
+}
+
+/// What would bring the finishing pass `finish` within `tolerance`, where
+/// the replay can tell:
+/// - its ridges above the tolerance: the feed (mm/min, at its speed) whose
+///   ridges are half of it;
+/// - a gouge the wheel's flat cuts deeper than its roundings at the
+///   program's points would (`earlier`: every generatrix's sweeps): the
+///   path is a ball's of the rounding radius, which a wheel with a flat
+///   does not follow;
+/// - material left within a turn's feed of an end of `range`: the wheel
+///   leaves the end within its last revolution there.
+fn to_change(
+    finish: &PassCheck,
+    wheel: &Wheel,
+    (tolerance, range): (Real, (Real, Real)),
+    earlier: &[Sweeps],
+) -> Vec<String> {
+    let mut out = Vec::new();
+    if finish.ridge_mm > tolerance && finish.spindle_rpm > 0.0 {
+        let f = wheel.feed_for_ridge(0.5 * tolerance);
+        out.push(format!(
+            "a finishing feed of at most {} mm/min ({} mm per revolution at {} rpm) leaves ridges of half the tolerance",
+            crate::math::fixed(f * finish.spindle_rpm, 1),
+            crate::math::fixed(f, 4),
+            crate::math::fixed(finish.spindle_rpm, 0)
+        ));
+    }
+    let d = &finish.deviation;
+    let flat = wheel.flat();
+    if flat > 0.0 && d.max_below < -tolerance {
+        // The sweep that cut deepest there, against its roundings alone.
+        let z = d.below_z;
+        let deepest = (earlier.iter().flatten())
+            .map(|(env, _)| (env.eval(z), env))
+            .filter(|(v, _)| v.is_finite())
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        if let Some((cut, env)) = deepest {
+            let deeper = env.circles().eval(z) - cut;
+            if deeper > tolerance {
+                out.push(format!(
+                    "the wheel's flat ({} mm between its roundings) cuts {} mm deeper there than its roundings at the program's points would: the path is a ball's of the rounding radius; a wheel with a flat needs the flat's path (wheel_path(profile, wheel, tolerance) in a script), or a wheel no wider than twice its rounding radius ({} mm)",
+                    crate::math::fixed(flat, 3),
+                    crate::math::fixed(deeper, 5),
+                    crate::math::fixed(2.0 * wheel.rounding_radius, 3)
+                ));
+            }
+        }
+    }
+    let f = finish.feed_per_rev_mm;
+    let at_end = [range.0, range.1]
+        .into_iter()
+        .find(|e| (d.above_z - e).abs() <= f);
+    if let Some(end) = at_end.filter(|_| d.max_above > tolerance) {
+        out.push(format!(
+            "the wheel leaves the end at z = {} mm within its last revolution, the helix unfinished there: run the pass past the end by at least a revolution's feed ({} mm), or let the wheel stand a revolution at it",
+            crate::math::fixed(end, 3),
+            crate::math::fixed(f, 4)
+        ));
+    }
+    out
 }
 
 /// A rapid moves the wheel as fast as the slowest linear axis may (mm/min).
@@ -271,6 +333,7 @@ impl Setting<'_> {
             left_mm: lo_kept.iter().copied().fold(0.0, Real::max),
             uncovered: stretches(&zs, &spread.touched),
             along_z: bucketed(&zs_kept, &lo_kept, &hi_kept, PROFILE_BUCKETS),
+            to_change: Vec::new(),
         };
         Ok((check, spread.half_worst))
     }

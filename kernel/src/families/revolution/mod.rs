@@ -125,6 +125,11 @@ pub struct PassCheck {
     /// stretches of z (each the extremes within it, so no ridge is lost).
     #[serde(skip)]
     pub along_z: Vec<[Real; 3]>,
+    /// What would bring the finish within the tolerance, where the replay
+    /// can tell (the finishing pass only): a feed whose ridges it holds, a
+    /// path for the wheel's flat.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub to_change: Vec<String>,
 }
 
 /// The most stretches of z a pass's deviation is kept in for drawing.
@@ -497,12 +502,13 @@ impl crate::process::Stock for GroundStock {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error(
     "the finished surface strays {} mm from the nominal profile at z = {}, \
-     where {} cuts it ({pass}: {} mm per revolution, a ridge of {} mm) (tolerance {tolerance} mm)",
+     where {} cuts it ({pass}: {} mm per revolution, a ridge of {} mm) (tolerance {tolerance} mm){}",
     crate::math::fixed(*deviation, 5),
     crate::math::fixed(*z, 3),
     block.as_deref().unwrap_or("an unknown block"),
     crate::math::fixed(*feed_per_rev, 4),
-    crate::math::fixed(*ridge, 5)
+    crate::math::fixed(*ridge, 5),
+    to_change.iter().map(|c| format!("; {c}")).collect::<String>()
 )]
 pub struct FinishFailure {
     /// The signed deviation (mm; negative: a gouge).
@@ -520,6 +526,8 @@ pub struct FinishFailure {
     ridge: Real,
     /// The tolerance (mm).
     tolerance: Real,
+    /// What would change it ([`PassCheck::to_change`]).
+    to_change: Vec<String>,
 }
 
 impl GrindingCheck {
@@ -541,6 +549,7 @@ impl GrindingCheck {
             feed_per_rev: finish.feed_per_rev_mm,
             ridge: finish.ridge_mm,
             tolerance: self.tolerance,
+            to_change: finish.to_change.clone(),
         })
     }
 

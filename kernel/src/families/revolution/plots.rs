@@ -293,6 +293,7 @@ mod tests {
             left_mm: 0.0,
             uncovered: Vec::new(),
             along_z,
+            to_change: Vec::new(),
         }
     }
 
