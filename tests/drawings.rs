@@ -39,6 +39,14 @@ fn stations() -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// The stations the nominal aims at: the first one's Ø18 h4 (ISO 286-2's
+/// table: 0/-5 um) at its band's middle, 1.25 um low on the radius.
+fn aimed_stations() -> Vec<(f64, f64)> {
+    let mut st = stations();
+    st[0].1 -= 0.00125;
+    st
+}
+
 /// The drawing's nominal radius at z: straight lines between stations, the
 /// corner at the second last station rounded by a tangent arc of `fillet`
 /// (its tangent points `fillet tan(turn / 2)` along each line, its centre
@@ -106,13 +114,24 @@ fn finish_from(
 /// a 20 mm rounding) and the taper meets the entry cone at a convex corner
 /// the drawing rounds with R10: the run passes, and the finish replayed
 /// from the program stays within the tolerance of the nominal drawn here,
-/// the fillet's arc included (no gouge at the corner); `pilgrim verify`
-/// agrees on the written program.
+/// the fillet's arc included (no gouge at the corner), and within its own
+/// band (h4, half the general tolerance's width) at the first station;
+/// `pilgrim verify` agrees on the written program.
 #[test]
 fn the_taper_from_its_stations_with_a_fillet_is_ground_within_tolerance() {
     let (out, code, err) = taper_run("linear", &[]);
     assert_eq!(code, 0, "{err}");
-    let st = stations();
+    let st = aimed_stations();
+    let (below, above) = finish_from(&out, 20.0, 0.0, 0.0, &|z| drawn(&st, 10.0, z));
+    assert!(
+        below >= -0.00125 && above <= 0.00125,
+        "at the h4 station: valleys {below} mm, crests {above} mm"
+    );
+    let band = &report_of(&out)["verdict"].to_string();
+    assert!(
+        band.contains("its own band, station 2 (z = 0 mm), d 18 h4: +0/-0.005 mm"),
+        "{band}"
+    );
     let end = st[st.len() - 1].0;
     let (below, above) = finish_from(&out, 20.0, 0.0, end, &|z| drawn(&st, 10.0, z));
     assert!(
@@ -128,12 +147,19 @@ fn the_taper_from_its_stations_with_a_fillet_is_ground_within_tolerance() {
     verifies(&out);
 }
 
-/// Monotone through the stations, the run passes within the tolerance;
-/// the natural spline swings beyond them before the cone, and the run
-/// says where and by how much.
+/// Monotone through the stations, the run leaves the first station
+/// outside its h4 band (said with the station and its fit) and passes
+/// within h5; the natural spline swings beyond them before the cone, and
+/// the run says where and by how much.
 #[test]
 fn a_smooth_nominal_passes_and_a_swinging_one_is_warned_of() {
-    let (out, code, err) = taper_run("monotone", &["interpolation=monotone"]);
+    let (_, code, err) = taper_run("monotone-h4", &["interpolation=monotone"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("beyond its own band of ±0.00125 mm on the radius (station 2 (z = 0 mm), d 18 h4: +0/-0.005 mm)"),
+        "{err}"
+    );
+    let (out, code, err) = taper_run("monotone", &["interpolation=monotone", "back_fit=h5"]);
     assert_eq!(code, 0, "{err}");
     let report = report_of(&out);
     assert_eq!(
@@ -142,7 +168,7 @@ fn a_smooth_nominal_passes_and_a_swinging_one_is_warned_of() {
         report["verdict"]
     );
     assert!(!report.to_string().contains("swings"));
-    let (out, code, err) = taper_run("natural", &["interpolation=natural"]);
+    let (out, code, err) = taper_run("natural", &["interpolation=natural", "back_fit=h5"]);
     assert_eq!(code, 0, "{err}");
     let warnings = report_of(&out)["verdict"]["warnings"].to_string();
     assert!(
@@ -191,12 +217,12 @@ fn tilted(text: &str, from: f64, pivot: f64, slope: f64) -> String {
 /// can see it).
 #[test]
 fn the_familys_own_figure_judges_an_edited_program() {
-    let (out, code, err) = taper_run("cone", &["tolerance=0.01"]);
+    let (out, code, err) = taper_run("cone", &["tolerance=0.01", "back_fit=h8"]);
     assert_eq!(code, 0, "{err}");
     let check = out.with_file_name("check");
     // A looser tolerance than the family's is taken from the command
     // line only.
-    let loose = ["--set", "tolerance=0.01"];
+    let loose = ["--set", "tolerance=0.01", "--set", "back_fit=h8"];
     let (code, _, err) =
         pilgrim(&[&["verify", s(&out), "--out", s(&check), "-q"][..], &loose].concat());
     assert_eq!(code, 0, "{err}");

@@ -62,6 +62,7 @@ pub mod error;
 pub mod families;
 pub mod family;
 pub mod files;
+pub mod fits;
 mod html;
 mod input;
 pub mod job;

@@ -33,7 +33,7 @@ pub use law::{uniform_grid, MandrelLaw};
 pub use simplify::{simplify_polyline, Polyline};
 pub use smooth::Smoothing;
 pub use spline::Swing;
-pub use stations::{polyline_through, CornerForm};
+pub use stations::{aimed, polyline_through, CornerForm};
 
 pub use table::{
     read_table, read_table_bytes, read_table_str, Table, TableError, TableFormat, MAX_CELLS,
@@ -225,6 +225,28 @@ pub struct Profile {
     /// must not estimate them again each time: that is O(nodes) a call).
     #[serde(skip)]
     estimated: SlopeCache,
+    /// The stretches a drawing tolerances on their own ([`Band`]), in z
+    /// order; none where the whole profile holds one tolerance.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    bands: Vec<Band>,
+}
+
+/// A stretch of a profile a drawing gives its own tolerance (a station's
+/// or an element's fit or limits): the profile there is aimed at the
+/// band's middle, and a verification judges the stretch against its
+/// half-width instead of the general tolerance.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Band {
+    /// Where it starts (z, mm).
+    pub from: Real,
+    /// Where it ends (z, mm; `from` for a single station).
+    pub to: Real,
+    /// Half the band's width on the radius (mm): the profile is its
+    /// middle.
+    pub half: Real,
+    /// Where the drawing gives it, as a message names it ("stations 1 to
+    /// 2 (z = 0 to 60 mm), d 18 h4: 0/-0.005 mm").
+    pub source: String,
 }
 
 /// A profile's estimated node slopes, computed once; not part of what the
@@ -287,6 +309,7 @@ impl Profile {
             dx: None,
             d2x: None,
             estimated: SlopeCache::default(),
+            bands: Vec::new(),
         })
     }
 
@@ -325,6 +348,19 @@ impl Profile {
         self.interpolation = interpolation;
         self.estimated = SlopeCache::default();
         self
+    }
+
+    /// The profile with its own tolerance `bands` ([`Band`]), sorted by
+    /// where they start.
+    pub fn with_bands(mut self, mut bands: Vec<Band>) -> Self {
+        bands.sort_by(|a, b| a.from.total_cmp(&b.from));
+        self.bands = bands;
+        self
+    }
+
+    /// The stretches a drawing tolerances on their own.
+    pub fn bands(&self) -> &[Band] {
+        &self.bands
     }
 
     /// How the profile is interpolated between its nodes.
@@ -599,7 +635,18 @@ impl Profile {
         let [x, s, k] = self.jet_in(i, to);
         push([to, x, s, k]);
         let [z, x, d1, d2] = out;
-        Ok(Profile::with_derivatives(z, x, d1, d2)?.with_interpolation(self.interpolation))
+        // The bands over the stretch kept, cut to it.
+        let bands = (self.bands.iter())
+            .filter(|b| b.to >= from && b.from <= to)
+            .map(|b| Band {
+                from: b.from.max(from),
+                to: b.to.min(to),
+                ..b.clone()
+            })
+            .collect();
+        Ok(Profile::with_derivatives(z, x, d1, d2)?
+            .with_interpolation(self.interpolation)
+            .with_bands(bands))
     }
 
     /// Where the profile between two nodes goes furthest beyond the
@@ -812,6 +859,7 @@ impl Profile {
             dx: None,
             d2x: None,
             estimated: SlopeCache::default(),
+            bands: Vec::new(),
         }
     }
 }

@@ -69,3 +69,126 @@ pub fn polyline_through(
     Ok(b.build(chordal, span)?
         .with_interpolation(Interpolation::Linear))
 }
+
+/// The stations `x` (radii) aimed at the middle of the tolerances a
+/// drawing gives their diameters (`tolerances[i]`, `None` for the general
+/// one; [`crate::fits::limits`]), and the profile's bands: each run of
+/// neighbouring stations with the same tolerance is one, from the first's
+/// z to the last's (a lone station's at its z), half the narrowest of
+/// their bands wide on the radius.
+///
+/// # Failures
+/// A tolerance that cannot be read (naming the station); as many
+/// tolerances as stations not given.
+pub fn aimed(
+    z: &[Real],
+    x: &[Real],
+    tolerances: &[Option<String>],
+) -> Result<(Vec<Real>, Vec<super::Band>), ProfileError> {
+    for (what, n) in [
+        ("the stations' x", x.len()),
+        ("the stations' tolerances", tolerances.len()),
+    ] {
+        if n != z.len() {
+            return Err(InputError::LengthMismatch {
+                what: what.into(),
+                left: n,
+                right: z.len(),
+            }
+            .into());
+        }
+    }
+    let mut limits = Vec::with_capacity(z.len());
+    for (i, t) in tolerances.iter().enumerate() {
+        limits.push(match t {
+            Some(t) => {
+                Some(
+                    crate::fits::limits(t, 2.0 * x[i]).map_err(|e| InputError::BadText {
+                        what: format!("station {} (z = {} mm): tolerance", i + 1, z[i]),
+                        value: crate::names::quoted(t),
+                        reason: e.why,
+                    })?,
+                )
+            }
+            None => None,
+        });
+    }
+    let aimed = (x.iter().zip(&limits))
+        .map(|(x, l)| x + l.as_ref().map_or(0.0, |l| 0.5 * l.middle()))
+        .collect();
+    let mut bands = Vec::new();
+    let mut i = 0;
+    while i < z.len() {
+        let Some(first) = &limits[i] else {
+            i += 1;
+            continue;
+        };
+        let mut j = i;
+        while j + 1 < z.len() && limits[j + 1].as_ref().is_some_and(|l| l.text == first.text) {
+            j += 1;
+        }
+        let half = (limits[i..=j].iter().flatten())
+            .map(|l| 0.5 * l.half_width())
+            .fold(Real::INFINITY, Real::min);
+        let said = |k: usize| {
+            let l = limits[k]
+                .as_ref()
+                .map_or((0.0, 0.0), |l| (l.upper, l.lower));
+            format!("d {} {}: {:+}/{:+} mm", 2.0 * x[k], first.text, l.0, l.1)
+        };
+        let source = if i == j {
+            format!("station {} (z = {} mm), {}", i + 1, z[i], said(i))
+        } else {
+            format!(
+                "stations {} to {} (z = {} to {} mm), {}",
+                i + 1,
+                j + 1,
+                z[i],
+                z[j],
+                said(i)
+            )
+        };
+        bands.push(super::Band {
+            from: z[i],
+            to: z[j],
+            half,
+            source,
+        });
+        i = j + 1;
+    }
+    Ok((aimed, bands))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A land h6 over two stations and a lone gauge diameter ±0.004: the
+    /// stations moved to the bands' middles, two bands, the land's half
+    /// of IT6 on the radius.
+    #[test]
+    fn stations_aim_at_their_bands_middles() {
+        let z = [0.0, 20.0, 40.0, 60.0];
+        let x = [20.0, 20.0, 22.0, 22.0];
+        let t = [
+            Some("h6".to_owned()),
+            Some("h6".to_owned()),
+            None,
+            Some("±0.004".to_owned()),
+        ];
+        let (a, bands) = aimed(&z, &x, &t).unwrap();
+        // Ø40 h6: 0/-0.016 on the diameter, -0.004 on the radius.
+        assert!((a[0] - 19.996).abs() < 1e-12 && (a[1] - 19.996).abs() < 1e-12);
+        assert_eq!((a[2], a[3]), (22.0, 22.0));
+        assert_eq!(bands.len(), 2);
+        assert_eq!((bands[0].from, bands[0].to), (0.0, 20.0));
+        assert!((bands[0].half - 0.004).abs() < 1e-12);
+        assert!(bands[0]
+            .source
+            .starts_with("stations 1 to 2 (z = 0 to 20 mm), d 40 h6"));
+        assert_eq!((bands[1].from, bands[1].to), (60.0, 60.0));
+        assert!((bands[1].half - 0.002).abs() < 1e-12);
+        let e = aimed(&z, &x, &[None, Some("H7".into()), None, None]).unwrap_err();
+        assert!(e.to_string().contains("station 2 (z = 20 mm)"), "{e}");
+    }
+}

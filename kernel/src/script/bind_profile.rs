@@ -13,7 +13,36 @@ use rhai::EvalAltResult;
 const STATION_CHORDAL: Real = 1e-4;
 
 /// The keys `profile(z, x, interpolation, options)` reads.
-const STATION_KEYS: [&str; 3] = ["fillets", "chamfers", "chordal"];
+const STATION_KEYS: [&str; 4] = ["fillets", "chamfers", "chordal", "tolerances"];
+
+/// The stations' own tolerances a station profile's `options` give (one
+/// a station: a text, `""` or `()` for the general one), or a refusal
+/// naming the entry that is wrong.
+fn tolerances(options: &rhai::Map, n: usize) -> Result<Vec<Option<String>>, Box<EvalAltResult>> {
+    let Some(list) = options.get("tolerances") else {
+        return Ok(vec![None; n]);
+    };
+    let list = (list.clone().into_array()).map_err(|_| {
+        "profile: 'tolerances' must be an array, one a station (\"h6\", \"±0.01\", \"+0.02/-0.01\", or \"\" for the general tolerance)"
+    })?;
+    if list.len() != n {
+        return err(format!(
+            "profile: 'tolerances' has {} entries for {n} stations: give one a station (\"\" for the general tolerance)",
+            list.len()
+        ));
+    }
+    (list.iter().enumerate())
+        .map(|(i, t)| {
+            if t.is_unit() {
+                return Ok(None);
+            }
+            let t = t.clone().into_string().map_err(|_| {
+                format!("profile: tolerances[{i}] must be a text (\"h6\", \"±0.01\") or \"\"")
+            })?;
+            Ok((!t.trim().is_empty()).then_some(t))
+        })
+        .collect()
+}
 
 /// The corners a station profile's `options` give, or a refusal naming
 /// the key or entry that is wrong.
@@ -57,6 +86,36 @@ fn corners(
     Ok(out)
 }
 
+/// The profile through stations `(z, x)` by `mode`, with `corners` (only
+/// for a linear one) and the `chordal` `options` gives (`interpolation`
+/// as the script wrote it, for messages).
+fn unbanded(
+    z: &[Real],
+    x: &[Real],
+    mode: crate::profile::Interpolation,
+    corners: &[(Real, crate::profile::CornerForm)],
+    options: &rhai::Map,
+    interpolation: &str,
+) -> Result<Profile, Box<EvalAltResult>> {
+    if mode != crate::profile::Interpolation::Linear {
+        if !corners.is_empty() {
+            return err(format!(
+                "profile: fillets and chamfers join straight lines: give interpolation \"linear\", not \"{}\"",
+                crate::files::excerpt(interpolation)
+            ));
+        }
+        let p = kernel(Profile::new(z.to_vec(), x.to_vec()))?;
+        return Ok(p.with_interpolation(mode));
+    }
+    let chordal = match options.get("chordal") {
+        None => STATION_CHORDAL,
+        Some(d) => {
+            crate::binding::floats::number(d).ok_or("profile: 'chordal' must be a number (mm)")?
+        }
+    };
+    kernel(crate::profile::polyline_through(z, x, corners, chordal))
+}
+
 /// Profiles and their generators.
 #[export_module]
 pub mod profile_api {
@@ -98,8 +157,12 @@ pub mod profile_api {
     /// As `profile(z, x, interpolation)`, with the drawing's corners:
     /// `options` may hold `fillets` and `chamfers` (arrays of `[z, mm]`:
     /// the station's z and the fillet's radius, or the chamfer's length
-    /// along each line; only with `"linear"`) and `chordal` (mm, how far
-    /// a fillet's sampled chords may stray from its arc; default 1e-4).
+    /// along each line; only with `"linear"`), `chordal` (mm, how far
+    /// a fillet's sampled chords may stray from its arc; default 1e-4)
+    /// and `tolerances` (one a station, on its diameter `2 x`: an ISO 286
+    /// shaft fit `"h6"`, `"±0.01"`, `"+0.02/-0.01"`, or `""` for the
+    /// general one: the station is aimed at its band's middle, and a run
+    /// of neighbouring stations with the same one is judged against it).
     /// Any other key is refused.
     ///
     /// ```rhai
@@ -115,22 +178,12 @@ pub mod profile_api {
         let mode = crate::binding::interpolation(interpolation)?;
         let corners = super::corners(&options)?;
         let (z, x) = (numbers(&z, "profile z")?, numbers(&x, "profile x")?);
-        if mode != crate::profile::Interpolation::Linear {
-            if !corners.is_empty() {
-                return crate::binding::floats::err(format!(
-                    "profile: fillets and chamfers join straight lines: give interpolation \"linear\", not \"{}\"",
-                    crate::files::excerpt(interpolation)
-                ));
-            }
-            let p = kernel(Profile::new(z.as_ref().clone(), x.as_ref().clone()))?;
-            return Ok(p.with_interpolation(mode));
-        }
-        let chordal = match options.get("chordal") {
-            None => STATION_CHORDAL,
-            Some(d) => crate::binding::floats::number(d)
-                .ok_or("profile: 'chordal' must be a number (mm)")?,
-        };
-        kernel(crate::profile::polyline_through(&z, &x, &corners, chordal))
+        // Stations a drawing tolerances on their own: aimed at their
+        // bands' middles, the bands kept for the verification.
+        let given = super::tolerances(&options, z.len())?;
+        let (x, bands) = kernel(crate::profile::aimed(&z, &x, &given))?;
+        let p = unbanded(&z, &x, mode, &corners, &options, interpolation)?;
+        Ok(p.with_bands(bands))
     }
 
     /// Where the profile goes furthest beyond the two stations (nodes)

@@ -7,7 +7,9 @@
 
 use super::phases::{Infeed, TimedPath};
 use super::surface::{touches, GroundSurface, PassLayer, Touches, WheelSection};
-use super::{bucketed, Deviation, GrindingCheck, GroundStock, PassCheck, PROFILE_BUCKETS};
+use super::{
+    bucketed, BandCheck, Deviation, GrindingCheck, GroundStock, PassCheck, PROFILE_BUCKETS,
+};
 use crate::machine::{Axis, AxisKind, MachineInfo, MachineKinematics};
 use crate::math::{positive, Real};
 use crate::offset::{CapsuleEnvelope, Side};
@@ -121,6 +123,68 @@ pub(super) fn replay_on(
         None => None,
     };
     Ok((out, stock, half_worst))
+}
+
+/// The deviation's largest (in size) and where, from its most above and
+/// below; the generatrix of it (of `g_above` and `g_below`). Where every z
+/// ground has a band of its own, the general tolerance judges nothing: 0.
+fn settle(d: &mut Deviation, g_above: usize, g_below: usize) -> usize {
+    if d.max_above == Real::NEG_INFINITY {
+        d.max_above = 0.0;
+    }
+    if d.max_below == Real::INFINITY {
+        d.max_below = 0.0;
+    }
+    if d.max_above >= -d.max_below {
+        (d.max_abs, d.at_z) = (d.max_above.abs(), d.above_z);
+        g_above
+    } else {
+        (d.max_abs, d.at_z) = (d.max_below.abs(), d.below_z);
+        g_below
+    }
+}
+
+/// Whether `z` is in band `b`'s stretch (its ends included).
+fn within(b: &crate::profile::Band, z: Real) -> bool {
+    let slack = crate::tolerance::SAME_RATIO * (1.0 + z.abs());
+    z >= b.from - slack && z <= b.to + slack
+}
+
+/// The pass's surface (`spread` at `zs`) in each of `bands`, where it
+/// has been ground.
+fn band_checks(bands: &[crate::profile::Band], zs: &[Real], spread: &Spread) -> Vec<BandCheck> {
+    bands
+        .iter()
+        .filter_map(|b| {
+            let mut c = BandCheck {
+                band: b.clone(),
+                max_above: Real::NEG_INFINITY,
+                max_below: Real::INFINITY,
+                at_z: b.from,
+            };
+            let (mut above_z, mut below_z) = (b.from, b.from);
+            for (i, &z) in zs.iter().enumerate() {
+                if !(spread.touched[i] && within(b, z)) {
+                    continue;
+                }
+                if spread.hi[i] > c.max_above {
+                    (c.max_above, above_z) = (spread.hi[i], z);
+                }
+                if spread.lo[i] < c.max_below {
+                    (c.max_below, below_z) = (spread.lo[i], z);
+                }
+            }
+            if !c.max_above.is_finite() {
+                return None;
+            }
+            c.at_z = if c.max_above >= -c.max_below {
+                above_z
+            } else {
+                below_z
+            };
+            Some(c)
+        })
+        .collect()
 }
 
 /// What would bring the finishing pass `finish` within `tolerance`, where
@@ -262,21 +326,7 @@ impl Setting<'_> {
         let blocks = pass.blocks.clone();
         let (timed, cutting_feed) = self.timed(blocks.clone())?;
         let t = touches(&timed, rpm, self.m)?;
-        run.phase_states.push(run.phases.clone());
-        // The same section at the same moments, over every spindle phase.
-        let section = WheelSection {
-            radius: self.wheel.rounding_radius,
-            flat: self.wheel.flat(),
-        };
-        let layer = PassLayer::timed(timed, section, rpm)?;
-        let pass_index = run.cut_blocks.len();
-        run.block_time.extend(
-            blocks
-                .clone()
-                .zip(layer.path().times())
-                .map(|(k, &tm)| (k, (pass_index, tm))),
-        );
-        run.phases = run.phases.with(layer);
+        self.add_layer(timed, rpm, &blocks, run)?;
         // Each generatrix met: the wheel's section at its touches.
         let met: Vec<usize> = (0..t.z.len()).filter(|&g| !t.z[g].is_empty()).collect();
         let envs = met
@@ -288,11 +338,25 @@ impl Setting<'_> {
             .collect::<Result<Vec<_>, _>>()?;
         let zs = self.grid(&envs, &run.earlier)?;
         let profile = self.nominal.eval_many(&zs)?;
+        // The stretches with their own bands, judged apart.
+        let bands = self.nominal.bands();
+        let banded: Vec<bool> = (zs.iter())
+            .map(|&z| bands.iter().any(|b| within(b, z)))
+            .collect();
         let before = match self.blank {
             Some(b) => b.eval_many(&zs)?,
             None => vec![Real::INFINITY; zs.len()],
         };
-        let mut spread = self.spread(pass, &zs, &profile, &before, &envs, &met, &run.earlier)?;
+        let mut spread = self.spread(
+            pass,
+            (&zs, &banded),
+            &profile,
+            &before,
+            &envs,
+            &met,
+            &run.earlier,
+        )?;
+        let bands = band_checks(bands, &zs, &spread);
         // The phases' surface against the highest generatrix.
         let envelope = run.phases.cut_many(&zs);
         let (mut stand_off, mut stand_off_z) = (0.0, self.range.0);
@@ -334,8 +398,34 @@ impl Setting<'_> {
             uncovered: stretches(&zs, &spread.touched),
             along_z: bucketed(&zs_kept, &lo_kept, &hi_kept, PROFILE_BUCKETS),
             to_change: Vec::new(),
+            bands,
         };
         Ok((check, spread.half_worst))
+    }
+
+    /// The pass's layer (the wheel's true section along `timed` at
+    /// `rpm`, over every spindle phase) added to `run`'s, its blocks timed.
+    fn add_layer(
+        &self,
+        timed: TimedPath,
+        rpm: Real,
+        blocks: &Range<usize>,
+        run: &mut Run,
+    ) -> Result<(), VerifyError> {
+        run.phase_states.push(run.phases.clone());
+        let section = WheelSection {
+            radius: self.wheel.rounding_radius,
+            flat: self.wheel.flat(),
+        };
+        let layer = PassLayer::timed(timed, section, rpm)?;
+        let pass_index = run.cut_blocks.len();
+        run.block_time.extend(
+            (blocks.clone())
+                .zip(layer.path().times())
+                .map(|(k, &tm)| (k, (pass_index, tm))),
+        );
+        run.phases = run.phases.with(layer);
+        Ok(())
     }
 
     /// The wheel's path over `blocks` in the (z, x) plane, each point
@@ -420,6 +510,12 @@ impl Setting<'_> {
         for env in envs.iter().chain(earlier.iter().flatten().map(|(e, _)| e)) {
             zs.extend(env.kinks(z0, z1));
         }
+        // Each band's ends: a station's band is judged at its z.
+        zs.extend(
+            (self.nominal.bands().iter())
+                .flat_map(|b| [b.from, b.to])
+                .filter(|z| (z0..=z1).contains(z)),
+        );
         zs.sort_by(Real::total_cmp);
         zs.dedup();
         Ok(zs)
@@ -432,7 +528,7 @@ impl Setting<'_> {
     fn spread(
         &self,
         pass: &ProgramPass,
-        zs: &[Real],
+        (zs, banded): (&[Real], &[bool]),
         profile: &[Real],
         before: &[Real],
         envs: &[CapsuleEnvelope],
@@ -479,6 +575,9 @@ impl Setting<'_> {
                 }
                 let e = left - p;
                 (lo[i], hi[i]) = (lo[i].min(e), hi[i].max(e));
+                if banded[i] {
+                    continue;
+                }
                 if e > d.max_above {
                     (d.max_above, d.above_z, g_above) = (e, z, g);
                 }
@@ -498,13 +597,7 @@ impl Setting<'_> {
         } else {
             half_below.abs()
         };
-        let worst = if d.max_above >= -d.max_below {
-            (d.max_abs, d.at_z) = (d.max_above.abs(), d.above_z);
-            g_above
-        } else {
-            (d.max_abs, d.at_z) = (d.max_below.abs(), d.below_z);
-            g_below
-        };
+        let worst = settle(&mut d, g_above, g_below);
         Ok(Spread {
             deviation: d,
             worst,

@@ -130,6 +130,49 @@ pub struct PassCheck {
     /// path for the wheel's flat.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub to_change: Vec<String>,
+    /// Its surface in each stretch the nominal tolerances on its own
+    /// ([`crate::profile::Band`]), which its deviation leaves out.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub bands: Vec<BandCheck>,
+}
+
+/// A pass's surface in a stretch with its own band.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BandCheck {
+    /// The band: its stretch, its half-width on the radius and where the
+    /// drawing gives it.
+    pub band: crate::profile::Band,
+    /// The most material left above the nominal there (mm).
+    pub max_above: Real,
+    /// The deepest cut below it there (mm, <= 0 where any).
+    pub max_below: Real,
+    /// Where the larger of the two in size is (z).
+    pub at_z: Real,
+}
+
+impl BandCheck {
+    /// The larger of its deviations in size, signed (mm).
+    pub fn worst(&self) -> Real {
+        if self.max_above >= -self.max_below {
+            self.max_above
+        } else {
+            self.max_below
+        }
+    }
+
+    /// Its failure, if the surface leaves the band.
+    pub fn failure(&self) -> Option<String> {
+        let w = self.worst();
+        (w.abs() > self.band.half).then(|| {
+            format!(
+                "the finished surface strays {} mm from the nominal at z = {} mm, beyond its own band of ±{} mm on the radius ({})",
+                crate::math::fixed(w, 5),
+                crate::math::fixed(self.at_z, 3),
+                crate::math::fixed(self.band.half, 5),
+                self.band.source
+            )
+        })
+    }
 }
 
 /// The most stretches of z a pass's deviation is kept in for drawing.
@@ -558,8 +601,9 @@ impl GrindingCheck {
     /// # Failures
     /// [`Self::failure`].
     pub fn verified(self, program: &AxisProgram) -> Result<Self, VerifyError> {
-        match self.failure(program) {
-            Some(e) => Err(VerifyError::Failed(e.to_string())),
+        let band = || (self.passes.last()?.bands.iter()).find_map(BandCheck::failure);
+        match self.failure(program).map(|e| e.to_string()).or_else(band) {
+            Some(e) => Err(VerifyError::Failed(e)),
             None => Ok(self),
         }
     }
@@ -618,7 +662,27 @@ impl GrindingCheck {
                 ),
             )
         });
-        (vec![figure], failure.into_iter().chain(uncovered).collect())
+        // Each stretch with its own band, against it.
+        let mut figures = vec![figure];
+        let mut failures: Vec<Finding> = failure.into_iter().collect();
+        for b in &finish.bands {
+            let place = format!("z = {} mm", crate::math::fixed(b.at_z, 3));
+            figures.push(Figure::new(
+                &format!(
+                    "{}: the surface in its own band, {}",
+                    finish.name, b.band.source
+                ),
+                b.worst(),
+                b.band.half,
+                "mm",
+                place,
+            ));
+            failures.extend(
+                b.failure()
+                    .map(|m| Finding::new("verification", VerifyError::Failed(m).to_string())),
+            );
+        }
+        (figures, failures.into_iter().chain(uncovered).collect())
     }
 }
 

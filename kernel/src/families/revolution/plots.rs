@@ -294,6 +294,7 @@ mod tests {
             uncovered: Vec::new(),
             along_z,
             to_change: Vec::new(),
+            bands: Vec::new(),
         }
     }
 

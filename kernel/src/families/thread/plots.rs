@@ -44,6 +44,10 @@ pub fn passes_svg(
     let pad = 0.05 * (r1 - r0).max(1.0);
     let (r0, r1) = (r0 - 3.0 * pad, r1 + pad);
     let n = check.chips.len();
+    let title = crate::chart::titled(
+        &format!("Stock removed pass by pass in the axial section ({n} thread passes, one lead)"),
+        corrected,
+    );
     let mut svg = String::new();
     let mut marks = Marks {
         size: [1100, 700],
@@ -55,15 +59,7 @@ pub fn passes_svg(
         root.fill(&WHITE).map_err(e)?;
         let (top, bottom) = root.split_vertically(640);
         let mut chart = ChartBuilder::on(&top)
-            .caption(
-                crate::chart::titled(
-                    &format!(
-                        "Stock removed pass by pass in the axial section ({n} thread passes, one lead)"
-                    ),
-                    corrected,
-                ),
-                ("sans-serif", 22),
-            )
+            .caption(title, ("sans-serif", 22))
             .margin(16)
             .x_label_area_size(48)
             .y_label_area_size(80)

@@ -272,6 +272,41 @@ struct Asked<'a> {
     measured_file: &'a str,
 }
 
+/// The options of the corrected run: its program's name carrying the
+/// correction's generation, the inputs kept, what corrected it.
+fn corrected_options(
+    prior: &Prior,
+    options: &CompensateOptions,
+    measured_file: &str,
+) -> JobOptions {
+    JobOptions {
+        // The corrected program says it is one: its name carries the
+        // correction's generation (Sinumerik's `%_N_MANDREL_C1_MPF`,
+        // Fanuc's header comment beside the O-number it keeps).
+        program_name: format!(
+            "{}_C{}",
+            (prior.script.file_stem().and_then(|s| s.to_str())).unwrap_or("pilgrim"),
+            prior.lineage.generation
+        ),
+        keep: Some(super::Keep {
+            script: prior.script.clone(),
+            tables: prior.tables_read.clone(),
+        }),
+        corrected_by: Some(crate::job::CorrectedBy {
+            generation: prior.lineage.generation,
+            said: format!(
+                "generation {} of {}, corrected by the measurement {} at gain {} (its fit held to the uncertainty {} mm); the correction in correction.csv, the fit in compensation.json",
+                prior.lineage.generation,
+                prior.shown,
+                crate::files::excerpt(measured_file),
+                options.gain,
+                options.uncertainty
+            ),
+        }),
+        ..JobOptions::default()
+    }
+}
+
 /// The corrected run, in the run's stages: once its verification has
 /// predicted its part, the correction's tables made with the part after,
 /// and how far its program's path moved from the `first` run's, per pass
@@ -300,32 +335,7 @@ fn corrected_run(
             pairs: vec![(CORRECTION.into(), CORRECTION_FILE.into())],
         },
     ];
-    let job_options = JobOptions {
-        // The corrected program says it is one: its name carries the
-        // correction's generation (Sinumerik's `%_N_MANDREL_C1_MPF`,
-        // Fanuc's header comment beside the O-number it keeps).
-        program_name: format!(
-            "{}_C{}",
-            (prior.script.file_stem().and_then(|s| s.to_str())).unwrap_or("pilgrim"),
-            prior.lineage.generation
-        ),
-        keep: Some(super::Keep {
-            script: prior.script.clone(),
-            tables: prior.tables_read.clone(),
-        }),
-        corrected_by: Some(crate::job::CorrectedBy {
-            generation: prior.lineage.generation,
-            said: format!(
-                "generation {} of {}, corrected by the measurement {} at gain {} (its fit held to the uncertainty {} mm); the correction in correction.csv, the fit in compensation.json",
-                prior.lineage.generation,
-                prior.shown,
-                crate::files::excerpt(measured_file),
-                options.gain,
-                options.uncertainty
-            ),
-        }),
-        ..JobOptions::default()
-    };
+    let job_options = corrected_options(prior, options, measured_file);
     let (values, origins) = super::params_traced(family, &machine, &sources)?;
     let run = stages::Run {
         family,
