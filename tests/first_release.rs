@@ -140,7 +140,8 @@ fn the_run_says_which_of_a_default_and_a_constant_wins() {
 /// The plug as today's API writes it (`scripts/examples/drawing_plug.rhai`:
 /// its corners by `fillet`, what the first release's refusals named
 /// changed) runs and verifies, its own figure (the land's form) beside
-/// the profile's, on the run and on `pilgrim verify` of what it wrote.
+/// the profile's and the land's own band (its h4), on the run and on
+/// `pilgrim verify` of what it wrote.
 #[test]
 fn the_plugs_example_runs_and_verifies() {
     let dir = scratch("first-release", "plug-example");
@@ -165,6 +166,19 @@ fn the_plugs_example_runs_and_verifies() {
         );
         let spread = figure["value"].as_f64().unwrap();
         assert!(spread > 0.0 && spread <= 0.002, "{figure}");
+        // The land's own fit (Ø30 h4: 0/-6 um), judged over the land.
+        let band = (report["verdict"]["figures"].as_array().unwrap().iter())
+            .find(|f| f["name"].as_str().unwrap().contains("its own band"))
+            .unwrap_or_else(|| panic!("{}", report["verdict"]));
+        assert!(
+            band["name"]
+                .as_str()
+                .unwrap()
+                .ends_with("d 30.000 h4: +0/-0.006 mm")
+                && band["tolerance"].as_f64() == Some(0.0015)
+                && band["value"].as_f64().unwrap().abs() <= 0.0015,
+            "{band}"
+        );
         assert_eq!(report["verdict"]["status"], "passed");
     }
 }

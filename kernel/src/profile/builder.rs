@@ -1,5 +1,6 @@
 //! A whole part profile chained from lines, arcs and the mandrel law.
 
+mod bands;
 mod corners;
 
 use super::{MandrelLaw, Profile, ProfileError};
@@ -72,7 +73,20 @@ pub struct ProfileBuilder {
     start: (Real, Real),
     current: (Real, Real),
     segments: Vec<Segment>,
+    /// The elements a drawing tolerances on their own: the segment's index
+    /// and the tolerance on its diameter, as written.
+    #[serde(default)]
+    bands: Vec<(usize, String)>,
+    /// The joints a drawing declares tangent: after the segment of each
+    /// index.
+    #[serde(default)]
+    tangent: Vec<usize>,
 }
+
+/// How far a joint declared tangent may turn (rad): a drawing's
+/// dimensions rounded to a micrometre over elements of a few millimetres
+/// turn by less.
+const TANGENT_TURN: Real = 1e-4;
 
 /// Nodes of one segment with their analytic derivatives.
 #[derive(Default)]
@@ -125,6 +139,8 @@ impl ProfileBuilder {
             start: (z, x),
             current: (z, x),
             segments: Vec::new(),
+            bands: Vec::new(),
+            tangent: Vec::new(),
         }
     }
 
@@ -195,6 +211,29 @@ impl ProfileBuilder {
         self
     }
 
+    /// Gives the element that ends here (a line or an arc) its own
+    /// tolerance on its diameter (`"h6"`, `"±0.01"`, `"+0.02/-0.01"`; as
+    /// [`crate::fits::limits`], the size its larger diameter): both its
+    /// ends are moved to the band's middle (the elements beside it meet
+    /// them there) and the profile carries the band ([`super::Band`]).
+    /// Refused at [`Self::build`], naming the element, after anything but
+    /// a line or an arc, after the mandrel law's end, or where two
+    /// neighbours would move their shared point to two middles.
+    pub fn toleranced(mut self, tolerance: &str) -> Self {
+        let last = self.segments.len().checked_sub(1).unwrap_or(usize::MAX);
+        self.bands.push((last, tolerance.to_owned()));
+        self
+    }
+
+    /// Declares the joint at the current point tangent, as a drawing says
+    /// an arc meets a line: [`Self::build`] refuses it, naming the joint
+    /// and its turn, where the elements meet at an angle (over 1e-4 rad).
+    pub fn tangent(mut self) -> Self {
+        let last = self.segments.len().checked_sub(1).unwrap_or(usize::MAX);
+        self.tangent.push(last);
+        self
+    }
+
     /// The end point so far.
     pub fn current(&self) -> (Real, Real) {
         self.current
@@ -223,9 +262,11 @@ impl ProfileBuilder {
             }
             .into());
         }
+        let (start, segments, bands) = bands::aimed(self.start, &self.segments, &self.bands)?;
         let mut all = Nodes::default();
-        let mut at = self.start;
-        for (i, seg) in corners::resolved(self.start, &self.segments)? {
+        let mut at = start;
+        let mut last = None;
+        for (i, seg) in corners::resolved(start, &segments)? {
             let nodes = match seg {
                 Segment::Line { z, x } => line(i, at, (z, x), max_step)?,
                 Segment::Arc {
@@ -250,11 +291,48 @@ impl ProfileBuilder {
                     unreachable!("corners and tangent arcs are resolved into lines and arcs")
                 }
             };
+            if let Some(k) = last.filter(|&k| k != i && self.tangent.contains(&k)) {
+                tangent_joint(k, &all, &nodes)?;
+            }
+            last = Some(i);
             at = (*nodes.z.last().unwrap(), *nodes.x.last().unwrap());
             all.append(nodes);
         }
-        Profile::with_derivatives(all.z, all.x, all.d1, all.d2)
+        if let Some(&k) =
+            (self.tangent.iter()).find(|&&k| k == usize::MAX || k + 1 >= self.segments.len())
+        {
+            return Err(InputError::out_of_range(
+                "a joint declared tangent",
+                k.min(self.segments.len()) as Real,
+                "after an element and before the next",
+            )
+            .into());
+        }
+        Ok(Profile::with_derivatives(all.z, all.x, all.d1, all.d2)?.with_bands(bands))
     }
+}
+
+/// The joint after segment `k` between the nodes so far and the next
+/// segment's, declared tangent: refused where it turns by more than
+/// [`TANGENT_TURN`], naming it, where it is and by how much.
+fn tangent_joint(k: usize, before: &Nodes, after: &Nodes) -> Result<(), ProfileError> {
+    let (Some(l), Some(r)) = (before.d1.last(), after.d1.first()) else {
+        return Ok(());
+    };
+    let turn = (r.atan() - l.atan()).abs();
+    if turn <= TANGENT_TURN {
+        return Ok(());
+    }
+    let z = after.z[0];
+    Err(InputError::out_of_range(
+        format!("the joint after segment {k} at z = {z} mm, declared tangent, turns by (deg)"),
+        turn.to_degrees(),
+        format!(
+            "at most {} deg: the elements beside it meet at an angle; correct the drawing's element (its radius, centre or end) or drop the tangency",
+            TANGENT_TURN.to_degrees()
+        ),
+    )
+    .into())
 }
 
 fn advance(segment: usize, from: Real, to: Real) -> Result<(), ProfileError> {

@@ -425,6 +425,32 @@ pub mod builder_api {
         b.chamfer(length)
     }
 
+    /// Gives the element ending here (a line or an arc) a drawing's own
+    /// tolerance on its diameter (`"h6"`, `"±0.01"`, `"+0.02/-0.01"`): its
+    /// ends move to the band's middle, and a revolution's verification
+    /// judges its stretch against the band. Refused at `build`, naming
+    /// the segment, after a fillet, a chamfer or the mandrel law.
+    ///
+    /// ```rhai
+    /// let p = profile_start(0.0, 15.0).line_to(10.0, 20.0).line_to(30.0, 20.0).toleranced("h6").line_to(40.0, 16.0).build(1e-4, 0.5);
+    /// ```
+    #[rhai_fn(name = "toleranced")]
+    pub fn toleranced(b: ProfileBuilder, tolerance: &str) -> ProfileBuilder {
+        b.toleranced(tolerance)
+    }
+
+    /// Declares the joint at the current point tangent, as a drawing says
+    /// an arc meets a line: `build` refuses it, naming the joint and its
+    /// turn, where the two meet at an angle.
+    ///
+    /// ```rhai
+    /// let p = profile_start(0.0, 20.0).line_to(10.0, 20.0).tangent().arc_to(16.0, 18.0, 10.0, "out").build(1e-4, 0.5);
+    /// ```
+    #[rhai_fn(name = "tangent")]
+    pub fn tangent(b: ProfileBuilder) -> ProfileBuilder {
+        b.tangent()
+    }
+
     /// An arc of `radius` to `(z, x)`, bulging "out" (convex, centre below)
     /// or "in" (a fillet, centre above).
     #[rhai_fn(name = "arc_to", return_raw)]
