@@ -6,6 +6,10 @@ use crate::input::InputError;
 use crate::math::Real;
 use crate::profile::{Band, ProfileError};
 
+/// A chain aimed at its bands' middles: its start, its segments, its
+/// bands.
+pub(super) type Aimed = ((Real, Real), Vec<Segment>, Vec<Band>);
+
 /// Where segment `k` ends, if it is a line or an arc (given by its end).
 fn end_of(segments: &[Segment], k: usize) -> Option<(Real, Real)> {
     match segments.get(k)? {
@@ -30,7 +34,7 @@ pub(super) fn aimed(
     start: (Real, Real),
     segments: &[Segment],
     bands: &[(usize, String)],
-) -> Result<((Real, Real), Vec<Segment>, Vec<Band>), ProfileError> {
+) -> Result<Aimed, ProfileError> {
     let refuse = |k: usize, why: String| -> ProfileError {
         InputError::BadText {
             what: format!("segment {k}: tolerance"),
