@@ -337,3 +337,37 @@ fn the_dxf_plug_is_read_as_drawn_and_verified() {
     assert!(out.join("drawing_plug.dxf").exists());
     verifies(&out);
 }
+
+/// A station mistyped (Ø17.156 for Ø18.156 at z = 240) makes the nominal
+/// a valley no 20 mm rounding enters: the run is refused naming the
+/// station as the profile numbers it (the stem's point first), its z and
+/// its value, not a block; `pilgrim verify` of a good program against
+/// that family says the same.
+#[test]
+fn a_mistyped_station_is_named_where_the_nominal_cannot_be_ground() {
+    let dir = scratch("drawings", "mistyped");
+    std::fs::create_dir_all(&dir).unwrap();
+    let script = dir.join("taper_mandrel.rhai");
+    std::fs::copy(root().join(SCRIPT), &script).unwrap();
+    let table = std::fs::read_to_string(root().join("scripts/examples/taper_bar_stations.csv"))
+        .unwrap()
+        .replace("\n240,18.156,", "\n240,17.156,");
+    std::fs::write(dir.join("taper_bar_stations.csv"), table).unwrap();
+    let named = "z = 240.0000 (a corner: a fillet of at least the tool's radius grinds it; the nominal's station 6 (z = 240 mm, x = 8.578 mm))";
+    let (code, _, err) = pilgrim(&["run", s(&script), "--out", s(&dir.join("run")), "-q"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains(named), "{err}");
+    let (good, code, err) = taper_run("for-the-mistyped", &[]);
+    assert_eq!(code, 0, "{err}");
+    let (code, _, err) = pilgrim(&[
+        "verify",
+        s(&good.join("program.mpf")),
+        "--family",
+        s(&script),
+        "--out",
+        s(&dir.join("check")),
+        "-q",
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains(named), "{err}");
+}

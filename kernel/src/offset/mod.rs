@@ -80,13 +80,24 @@ pub fn curvature_violations(
     radius: Real,
     side: Side,
 ) -> Vec<CurvatureViolation> {
-    violations(
-        profile.z(),
-        &profile.slopes(),
-        &profile.second_derivatives(),
-        radius,
-        side,
+    sourced(
+        profile,
+        violations(
+            profile.z(),
+            &profile.slopes(),
+            &profile.second_derivatives(),
+            radius,
+            side,
+        ),
     )
+}
+
+/// `found` with the profile's source at each ([`Profile::source_at`]).
+fn sourced(profile: &Profile, mut found: Vec<CurvatureViolation>) -> Vec<CurvatureViolation> {
+    for v in &mut found {
+        v.source = profile.source_at(v.z).map(|s| s.label.clone());
+    }
+    found
 }
 
 /// [`curvature_violations`] on derivatives already at hand.
@@ -106,6 +117,7 @@ fn violations(
                 index: i,
                 z: z[i],
                 rho: 1.0 / k,
+                source: None,
             });
         }
     }
@@ -147,6 +159,33 @@ pub fn equidistant(
     equidistant_within(profile, radius, side, 0.0)
 }
 
+/// The places a tool of `radius` on `side` cannot follow `profile`
+/// ([`curvature_violations`]), less the concave kinks it bridges leaving
+/// at most `allowance` (mm) in them (as [`equidistant_within`] takes
+/// them), each with its source.
+pub fn unbridged(
+    profile: &Profile,
+    radius: Real,
+    side: Side,
+    allowance: Real,
+) -> Vec<CurvatureViolation> {
+    let (pz, px, d2) = (profile.z(), profile.x(), profile.second_derivatives());
+    let n = profile.len();
+    let bridged = |i: usize| {
+        i > 0 && i + 1 < n && d2[i].is_infinite() && d2[i] * side.sign() > 0.0 && {
+            // The turn from the chords beside the kink.
+            let a = ((px[i] - px[i - 1]) / (pz[i] - pz[i - 1])).atan();
+            let b = ((px[i + 1] - px[i]) / (pz[i + 1] - pz[i])).atan();
+            radius * (1.0 / (0.5 * (b - a)).cos() - 1.0) <= allowance
+        }
+    };
+    let found = violations(pz, &profile.slopes(), &d2, radius, side);
+    sourced(
+        profile,
+        found.into_iter().filter(|v| !bridged(v.index)).collect(),
+    )
+}
+
 /// [`equidistant`], a concave kink that the tool bridges leaving at most
 /// `allowance` (mm) of material in the kink being no corner: a drawing's
 /// stations joined by straight lines kink by 1e-4 rad at a taper's
@@ -177,16 +216,7 @@ pub fn equidistant_within(
         (left.atan(), right.atan())
     };
     let kink = |i: usize| i > 0 && i + 1 < n && d2[i].is_infinite();
-    let bridged = |i: usize| {
-        kink(i) && d2[i] * sigma > 0.0 && {
-            let (a, b) = turn(i);
-            radius * (1.0 / (0.5 * (b - a)).cos() - 1.0) <= allowance
-        }
-    };
-    let found: Vec<_> = violations(pz, &slopes, &d2, radius, side)
-        .into_iter()
-        .filter(|v| !bridged(v.index))
-        .collect();
+    let found = unbridged(profile, radius, side, allowance);
     if !found.is_empty() {
         return Err(ProfileError::CurvatureBelowTool {
             tool_radius: radius,
@@ -217,7 +247,9 @@ pub fn equidistant_within(
                 let gamma = a + (b - a) * k as Real / steps as Real;
                 push(pz[i], px[i], gamma.tan(), 1.0);
             }
-        } else if bridged(i) {
+        } else if kink(i) {
+            // A concave kink left (not refused above) is one the tool
+            // bridges: the centre touches both lines.
             let (a, b) = turn(i);
             let half = 0.5 * (b - a);
             push(pz[i], px[i], (a + half).tan(), 1.0 / half.cos());

@@ -75,8 +75,11 @@ pub fn refined(
     }
     let last = pz.len() - 1;
     out.push(pz[last], px[last], slopes[last], d2[last]);
+    // The same curve: the same drawing's bands and sources.
     Ok(Profile::with_derivatives(out.z, out.x, out.d1, out.d2)?
-        .with_interpolation(profile.interpolation()))
+        .with_interpolation(profile.interpolation())
+        .with_bands(profile.bands().to_vec())
+        .with_sources(profile.sources().to_vec()))
 }
 
 /// How far `m` lies from the line through `a` and `b`.

@@ -266,6 +266,7 @@ impl ProfileBuilder {
         let mut all = Nodes::default();
         let mut at = start;
         let mut last = None;
+        let mut sources: Vec<super::Source> = Vec::new();
         for (i, seg) in corners::resolved(start, &segments)? {
             let nodes = match seg {
                 Segment::Line { z, x } => line(i, at, (z, x), max_step)?,
@@ -296,6 +297,15 @@ impl ProfileBuilder {
             }
             last = Some(i);
             at = (*nodes.z.last().unwrap(), *nodes.x.last().unwrap());
+            match sources.last_mut() {
+                Some(s) if s.index == i => s.to = at.0,
+                _ => sources.push(super::Source {
+                    from: nodes.z[0],
+                    to: at.0,
+                    index: i,
+                    label: described(i, &self.segments[i]),
+                }),
+            }
             all.append(nodes);
         }
         if let Some(&k) =
@@ -308,8 +318,25 @@ impl ProfileBuilder {
             )
             .into());
         }
-        Ok(Profile::with_derivatives(all.z, all.x, all.d1, all.d2)?.with_bands(bands))
+        Ok(Profile::with_derivatives(all.z, all.x, all.d1, all.d2)?
+            .with_bands(bands)
+            .with_sources(sources))
     }
+}
+
+/// Segment `i` as a message names it (its values as given).
+fn described(i: usize, segment: &Segment) -> String {
+    let what = match *segment {
+        Segment::Line { z, x } => format!("the line to z = {z} mm, x = {x} mm"),
+        Segment::Arc { z, x, radius, .. } => {
+            format!("the arc of radius {radius} mm to z = {z} mm, x = {x} mm")
+        }
+        Segment::TangentArc { z, x } => format!("the tangent arc to z = {z} mm, x = {x} mm"),
+        Segment::Law(_) => "the mandrel law".to_owned(),
+        Segment::Fillet { radius } => format!("the fillet of radius {radius} mm"),
+        Segment::Chamfer { length } => format!("the chamfer of {length} mm"),
+    };
+    format!("segment {i} ({what})")
 }
 
 /// The joint after segment `k` between the nodes so far and the next

@@ -143,7 +143,20 @@ pub fn profile_from_dxf(
         };
     }
     let span = chain[chain.len() - 1].b.0 - chain[0].a.0;
+    // Each stretch named by its entity, as the drawing's author knows it.
+    let named = |p: Profile| {
+        let sources = (p.sources().iter())
+            .map(|s| super::Source {
+                label: chain.get(s.index).map_or(s.label.clone(), |c| {
+                    format!("{} (from z = {:.4}, x = {:.4} mm)", c.name, c.a.0, c.a.1)
+                }),
+                ..s.clone()
+            })
+            .collect();
+        p.with_sources(sources)
+    };
     b.build(options.chordal, span.max(options.chordal))
+        .map(named)
         .map_err(|e| {
             // The builder names segments by index: the chain's own names.
             let text = e.to_string();
@@ -520,6 +533,28 @@ mod tests {
             diameter: false,
             chordal: 1e-4,
         }
+    }
+
+    /// A valley the drawing gives (entities A2 and A3 meeting concave at
+    /// z = 80 mm): a 5 mm tool's refusal names the entity that ends there,
+    /// by its handle, as the profile's source.
+    #[test]
+    fn where_a_tool_cannot_follow_the_drawing_names_its_entity() {
+        let upper = [
+            line("A1", "PROFILE", (0.0, 2.0), (5.0, 2.0)),
+            line("A2", "PROFILE", (5.0, 2.0), (8.0, 1.5)),
+            line("A3", "PROFILE", (8.0, 1.5), (10.0, 2.0)),
+        ]
+        .concat();
+        let p = profile_from_dxf(&drawing(5, &upper), "t.dxf", &options()).unwrap();
+        let s = p.source_at(65.0).unwrap();
+        assert_eq!(s.label, "LINE #A2 (from z = 50.0000, x = 20.0000 mm)");
+        let e = crate::offset::equidistant(&p, 5.0, crate::offset::Side::Outside).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("z = 80.0000 (a corner: a fillet of at least the tool's radius grinds it; the nominal's LINE #A2"),
+            "{e}"
+        );
     }
 
     /// A stepped outline's upper half in centimetres, its faces and the

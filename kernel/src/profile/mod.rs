@@ -33,7 +33,7 @@ pub use law::{uniform_grid, MandrelLaw};
 pub use simplify::{simplify_polyline, Polyline};
 pub use smooth::Smoothing;
 pub use spline::Swing;
-pub use stations::{aimed, polyline_through, CornerForm};
+pub use stations::{aimed, polyline_through, station_sources, CornerForm};
 
 pub use table::{
     read_table, read_table_bytes, read_table_str, Table, TableError, TableFormat, MAX_CELLS,
@@ -127,7 +127,7 @@ pub enum ProfileError {
 }
 
 /// A node where the tool's radius exceeds the profile's radius of curvature.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CurvatureViolation {
     /// Index of the node.
     pub index: usize,
@@ -135,6 +135,10 @@ pub struct CurvatureViolation {
     pub z: Real,
     /// The profile's radius of curvature there (mm).
     pub rho: Real,
+    /// What of the drawing the profile takes there ([`Source`]), where
+    /// the profile says.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source: Option<String>,
 }
 
 fn list_violations(v: &[CurvatureViolation]) -> String {
@@ -145,16 +149,27 @@ fn list_violations(v: &[CurvatureViolation]) -> String {
         .map(|c| match c.rho {
             // A kink: no fillet to judge, a corner the tool cannot enter.
             0.0 => format!(
-                "z = {} (a corner: a fillet of at least the tool's radius grinds it)",
-                fixed(c.z, 4)
+                "z = {} (a corner: a fillet of at least the tool's radius grinds it{})",
+                fixed(c.z, 4),
+                from_source(c)
             ),
-            rho => format!("z = {} (rho = {})", fixed(c.z, 4), fixed(rho, 4)),
+            rho => format!(
+                "z = {} (rho = {}{})",
+                fixed(c.z, 4),
+                fixed(rho, 4),
+                from_source(c)
+            ),
         })
         .collect();
     if v.len() > SHOWN {
         s.push(format!("... and {} more", v.len() - SHOWN));
     }
     s.join(", ")
+}
+
+/// `; the nominal's <source>` where a violation's source is known.
+fn from_source(c: &CurvatureViolation) -> String {
+    (c.source.as_ref()).map_or(String::new(), |s| format!("; the nominal's {s}"))
 }
 
 /// How a profile without analytic derivatives is interpolated between its
@@ -229,6 +244,25 @@ pub struct Profile {
     /// order; none where the whole profile holds one tolerance.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     bands: Vec<Band>,
+    /// What of a drawing each stretch comes from ([`Source`]), in z order;
+    /// none for a profile from samples.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    sources: Vec<Source>,
+}
+
+/// What of a drawing a stretch of a profile comes from (a station, an
+/// element of a chain, a DXF entity), as messages name it: where the
+/// nominal itself cannot be ground, a message names it there.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Source {
+    /// Where it starts (z, mm).
+    pub from: Real,
+    /// Where it ends (z, mm).
+    pub to: Real,
+    /// Its index in what built the profile (a station's, a segment's).
+    pub index: usize,
+    /// As messages name it ("station 7 (z = 360 mm, x = 9.135 mm)").
+    pub label: String,
 }
 
 /// A stretch of a profile a drawing gives its own tolerance (a station's
@@ -310,6 +344,7 @@ impl Profile {
             d2x: None,
             estimated: SlopeCache::default(),
             bands: Vec::new(),
+            sources: Vec::new(),
         })
     }
 
@@ -361,6 +396,25 @@ impl Profile {
     /// The stretches a drawing tolerances on their own.
     pub fn bands(&self) -> &[Band] {
         &self.bands
+    }
+
+    /// The profile with what of a drawing each stretch comes from
+    /// ([`Source`]), sorted by where they start.
+    pub fn with_sources(mut self, mut sources: Vec<Source>) -> Self {
+        sources.sort_by(|a, b| a.from.total_cmp(&b.from));
+        self.sources = sources;
+        self
+    }
+
+    /// What of a drawing each stretch comes from.
+    pub fn sources(&self) -> &[Source] {
+        &self.sources
+    }
+
+    /// What of a drawing the profile takes at `z` (the first stretch
+    /// holding it), if it says.
+    pub fn source_at(&self, z: Real) -> Option<&Source> {
+        self.sources.iter().find(|s| z >= s.from && z <= s.to)
     }
 
     /// How the profile is interpolated between its nodes.
@@ -644,9 +698,18 @@ impl Profile {
                 ..b.clone()
             })
             .collect();
+        let sources = (self.sources.iter())
+            .filter(|s| s.to >= from && s.from <= to)
+            .map(|s| Source {
+                from: s.from.max(from),
+                to: s.to.min(to),
+                ..s.clone()
+            })
+            .collect();
         Ok(Profile::with_derivatives(z, x, d1, d2)?
             .with_interpolation(self.interpolation)
-            .with_bands(bands))
+            .with_bands(bands)
+            .with_sources(sources))
     }
 
     /// Where the profile between two nodes goes furthest beyond the
@@ -860,6 +923,7 @@ impl Profile {
             d2x: None,
             estimated: SlopeCache::default(),
             bands: Vec::new(),
+            sources: Vec::new(),
         }
     }
 }

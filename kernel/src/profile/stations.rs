@@ -159,6 +159,29 @@ pub fn aimed(
     Ok((aimed, bands))
 }
 
+/// The stations `(z, x)` as the profile's sources ([`super::Source`]):
+/// each from half-way to the one before to half-way to the one after,
+/// named by its number (from 1) and its values as given.
+pub fn station_sources(z: &[Real], x: &[Real]) -> Vec<super::Source> {
+    let n = z.len().min(x.len());
+    (0..n)
+        .map(|i| super::Source {
+            from: if i == 0 {
+                z[0]
+            } else {
+                0.5 * (z[i - 1] + z[i])
+            },
+            to: if i + 1 == n {
+                z[i]
+            } else {
+                0.5 * (z[i] + z[i + 1])
+            },
+            index: i + 1,
+            label: format!("station {} (z = {} mm, x = {} mm)", i + 1, z[i], x[i]),
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -181,9 +181,10 @@ pub mod profile_api {
         // Stations a drawing tolerances on their own: aimed at their
         // bands' middles, the bands kept for the verification.
         let given = super::tolerances(&options, z.len())?;
+        let sources = crate::profile::station_sources(&z, &x);
         let (x, bands) = kernel(crate::profile::aimed(&z, &x, &given))?;
         let p = unbanded(&z, &x, mode, &corners, &options, interpolation)?;
-        Ok(p.with_bands(bands))
+        Ok(p.with_bands(bands).with_sources(sources))
     }
 
     /// Where the profile goes furthest beyond the two stations (nodes)

@@ -103,7 +103,7 @@ pub(super) fn replay_on(
     let Some(finish) = out.passes.last_mut() else {
         return Err(VerifyError::NoCuttingPass);
     };
-    finish.to_change = to_change(finish, wheel, (tolerance, range), &run.earlier);
+    finish.to_change = to_change(finish, (wheel, nominal), (tolerance, range), &run.earlier);
     let stock = match blank {
         Some(b) => {
             run.phase_states.push(run.phases);
@@ -196,14 +196,42 @@ fn band_checks(bands: &[crate::profile::Band], zs: &[Real], spread: &Spread) -> 
 ///   path is a ball's of the rounding radius, which a wheel with a flat
 ///   does not follow;
 /// - material left within a turn's feed of an end of `range`: the wheel
-///   leaves the end within its last revolution there.
+///   leaves the end within its last revolution there;
+/// - material left where the `nominal` itself is concave tighter than the
+///   wheel's rounding (a corner it does not bridge within a tenth of the
+///   tolerance): no program grinds it, and its source is named.
 fn to_change(
     finish: &PassCheck,
-    wheel: &Wheel,
+    (wheel, nominal): (&Wheel, &Profile),
     (tolerance, range): (Real, (Real, Real)),
     earlier: &[Sweeps],
 ) -> Vec<String> {
     let mut out = Vec::new();
+    let d = &finish.deviation;
+    let reach = wheel.rounding_radius + 0.5 * wheel.flat();
+    let tight = (d.max_above > tolerance)
+        .then(|| {
+            let found = crate::offset::unbridged(
+                nominal,
+                wheel.rounding_radius,
+                Side::Outside,
+                0.1 * tolerance,
+            );
+            found.into_iter().find(|v| (v.z - d.above_z).abs() <= reach)
+        })
+        .flatten();
+    if let Some(v) = tight {
+        let what = match v.rho {
+            0.0 => "a concave corner".to_owned(),
+            rho => format!("concave at a radius of {} mm", crate::math::fixed(rho, 4)),
+        };
+        out.push(format!(
+            "the nominal itself is {what} at z = {} mm{}, tighter than the wheel's rounding ({} mm): no program grinds it with this wheel; check the drawing's value there, or give it a fillet of at least the rounding",
+            crate::math::fixed(v.z, 3),
+            v.source.map_or(String::new(), |s| format!(" ({s})")),
+            crate::math::fixed(wheel.rounding_radius, 3)
+        ));
+    }
     if finish.ridge_mm > tolerance && finish.spindle_rpm > 0.0 {
         let f = wheel.feed_for_ridge(0.5 * tolerance);
         out.push(format!(
@@ -213,7 +241,6 @@ fn to_change(
             crate::math::fixed(finish.spindle_rpm, 0)
         ));
     }
-    let d = &finish.deviation;
     let flat = wheel.flat();
     if flat > 0.0 && d.max_below < -tolerance {
         // The sweep that cut deepest there, against its roundings alone.

@@ -168,6 +168,22 @@ mod tests {
         assert!((p.eval(20.0).unwrap() - 18.0).abs() < 1e-12);
     }
 
+    /// Each stretch of a chain names the segment it comes from, a fillet
+    /// its own arc and the lines it trims theirs.
+    #[test]
+    fn a_chain_names_its_segments_as_sources() {
+        let p = ProfileBuilder::start(0.0, 20.0)
+            .line_to(10.0, 20.0)
+            .fillet(2.0)
+            .line_to(20.0, 15.0)
+            .build(1e-4, 1.0)
+            .unwrap();
+        let at = |z: f64| p.source_at(z).unwrap().label.clone();
+        assert_eq!(at(5.0), "segment 0 (the line to z = 10 mm, x = 20 mm)");
+        assert_eq!(at(10.0), "segment 1 (the fillet of radius 2 mm)");
+        assert_eq!(at(18.0), "segment 2 (the line to z = 20 mm, x = 15 mm)");
+    }
+
     /// A line and an arc declared tangent: passed where the arc's centre
     /// lies on the line's normal, refused (naming the joint and its turn)
     /// where it does not.
