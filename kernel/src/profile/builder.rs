@@ -81,7 +81,15 @@ pub struct ProfileBuilder {
     /// index.
     #[serde(default)]
     tangent: Vec<usize>,
+    /// The arcs given by their centre: the segment's index and how far
+    /// its start and its end lie from the centre, as drawn (mm).
+    #[serde(default)]
+    centred: Vec<(usize, Real, Real)>,
 }
+
+/// How far a drawing's arc given by its centre may have its ends at two
+/// distances from it (mm): dimensions rounded to a tenth of a micrometre.
+const CENTRED_RADII: Real = 1e-4;
 
 /// How far a joint declared tangent may turn (rad): a drawing's
 /// dimensions rounded to a micrometre over elements of a few millimetres
@@ -141,6 +149,7 @@ impl ProfileBuilder {
             segments: Vec::new(),
             bands: Vec::new(),
             tangent: Vec::new(),
+            centred: Vec::new(),
         }
     }
 
@@ -169,6 +178,25 @@ impl ProfileBuilder {
         });
         self.current = (z, x);
         self
+    }
+
+    /// A circular arc to `(z, x)` about the centre `(cz, cx)`, as a drawing
+    /// dimensions an arc by its centre: its radius the end's distance
+    /// from the centre, bulging away from it. Refused at [`Self::build`],
+    /// naming the segment and both distances, where the current point
+    /// lies at another distance from the centre (over 1e-4 mm).
+    pub fn arc_about(self, z: Real, x: Real, cz: Real, cx: Real) -> Self {
+        let (z0, x0) = self.current;
+        let (r0, r1) = ((z0 - cz).hypot(x0 - cx), (z - cz).hypot(x - cx));
+        let bulge = if cx < 0.5 * (x0 + x) {
+            Bulge::Out
+        } else {
+            Bulge::In
+        };
+        let index = self.segments.len();
+        let mut b = self.arc_to(z, x, r1, bulge);
+        b.centred.push((index, r0, r1));
+        b
     }
 
     /// The mandrel law from the current z over its length L_r. The current x
@@ -260,6 +288,16 @@ impl ProfileBuilder {
                 got: 0,
                 min: 1,
             }
+            .into());
+        }
+        if let Some(&(i, r0, r1)) =
+            (self.centred.iter()).find(|c| (c.1 - c.2).abs() > CENTRED_RADII)
+        {
+            return Err(InputError::out_of_range(
+                format!("segment {i}: an arc about its centre ends at a distance (mm) from it"),
+                r1,
+                format!("the distance its start lies at, {r0} mm (within {CENTRED_RADII} mm): the drawing's centre or one of its ends is off"),
+            )
             .into());
         }
         let (start, segments, bands) = bands::aimed(self.start, &self.segments, &self.bands)?;

@@ -474,6 +474,19 @@ pub mod builder_api {
         Ok(b.arc_to(z, x, radius, bulge))
     }
 
+    /// An arc to `(z, x)` about the centre `(cz, cx)` (a drawing's arc
+    /// dimensioned by its centre), bulging away from it. Refused at
+    /// `build` where the current point lies at another distance from the
+    /// centre than the end.
+    ///
+    /// ```rhai
+    /// let p = profile_start(0.0, 20.0).line_to(10.0, 20.0).tangent().arc_about(16.0, 18.0, 10.0, 10.0).build(1e-4, 0.5);
+    /// ```
+    #[rhai_fn(name = "arc_about")]
+    pub fn arc_about(b: ProfileBuilder, z: Real, x: Real, cz: Real, cx: Real) -> ProfileBuilder {
+        b.arc_about(z, x, cz, cx)
+    }
+
     /// The mandrel law from the current z (the current x must be d_min / 2).
     #[rhai_fn(name = "law")]
     pub fn law(b: ProfileBuilder, law: MandrelLaw) -> ProfileBuilder {

@@ -168,6 +168,31 @@ mod tests {
         assert!((p.eval(20.0).unwrap() - 18.0).abs() < 1e-12);
     }
 
+    /// An arc given by its centre: its radius and bulge from it, a tangent
+    /// joint where the centre lies on the line's normal; refused where
+    /// its ends lie at two distances from the centre.
+    #[test]
+    fn an_arc_about_its_centre() {
+        let p = ProfileBuilder::start(0.0, 20.0)
+            .line_to(10.0, 20.0)
+            .tangent()
+            .arc_about(16.0, 18.0, 10.0, 10.0)
+            .build(1e-4, 1.0)
+            .unwrap();
+        let x = p.eval(13.0).unwrap();
+        assert!((x - (10.0 + (100.0_f64 - 9.0).sqrt())).abs() < 1e-6, "{x}");
+        let e = ProfileBuilder::start(0.0, 20.0)
+            .line_to(10.0, 20.0)
+            .arc_about(16.0, 18.5, 10.0, 10.0)
+            .build(1e-4, 1.0)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("segment 1: an arc about its centre") && e.contains("10 mm"),
+            "{e}"
+        );
+    }
+
     /// Each stretch of a chain names the segment it comes from, a fillet
     /// its own arc and the lines it trims theirs.
     #[test]
