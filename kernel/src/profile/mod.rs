@@ -250,6 +250,54 @@ pub struct Profile {
     sources: Vec<Source>,
 }
 
+/// What a profile says of a stretch of z ([`Band`], [`Source`]).
+trait Stretch: Clone {
+    /// Where it starts and ends (z, mm).
+    fn span(&self) -> (Real, Real);
+    /// The same over `from` to `to`.
+    fn spanning(&self, from: Real, to: Real) -> Self;
+}
+
+impl Stretch for Band {
+    fn span(&self) -> (Real, Real) {
+        (self.from, self.to)
+    }
+    fn spanning(&self, from: Real, to: Real) -> Self {
+        Self {
+            from,
+            to,
+            ..self.clone()
+        }
+    }
+}
+
+impl Stretch for Source {
+    fn span(&self) -> (Real, Real) {
+        (self.from, self.to)
+    }
+    fn spanning(&self, from: Real, to: Real) -> Self {
+        Self {
+            from,
+            to,
+            ..self.clone()
+        }
+    }
+}
+
+/// `items` sorted by where they start.
+fn sorted<T: Stretch>(mut items: Vec<T>) -> Vec<T> {
+    items.sort_by(|a, b| a.span().0.total_cmp(&b.span().0));
+    items
+}
+
+/// Those of `items` over `from` to `to`, cut to it.
+fn clipped<T: Stretch>(items: &[T], from: Real, to: Real) -> Vec<T> {
+    (items.iter())
+        .filter(|s| s.span().1 >= from && s.span().0 <= to)
+        .map(|s| s.spanning(s.span().0.max(from), s.span().1.min(to)))
+        .collect()
+}
+
 /// What of a drawing a stretch of a profile comes from (a station, an
 /// element of a chain, a DXF entity), as messages name it: where the
 /// nominal itself cannot be ground, a message names it there.
@@ -387,9 +435,8 @@ impl Profile {
 
     /// The profile with its own tolerance `bands` ([`Band`]), sorted by
     /// where they start.
-    pub fn with_bands(mut self, mut bands: Vec<Band>) -> Self {
-        bands.sort_by(|a, b| a.from.total_cmp(&b.from));
-        self.bands = bands;
+    pub fn with_bands(mut self, bands: Vec<Band>) -> Self {
+        self.bands = sorted(bands);
         self
     }
 
@@ -400,9 +447,8 @@ impl Profile {
 
     /// The profile with what of a drawing each stretch comes from
     /// ([`Source`]), sorted by where they start.
-    pub fn with_sources(mut self, mut sources: Vec<Source>) -> Self {
-        sources.sort_by(|a, b| a.from.total_cmp(&b.from));
-        self.sources = sources;
+    pub fn with_sources(mut self, sources: Vec<Source>) -> Self {
+        self.sources = sorted(sources);
         self
     }
 
@@ -689,27 +735,11 @@ impl Profile {
         let [x, s, k] = self.jet_in(i, to);
         push([to, x, s, k]);
         let [z, x, d1, d2] = out;
-        // The bands over the stretch kept, cut to it.
-        let bands = (self.bands.iter())
-            .filter(|b| b.to >= from && b.from <= to)
-            .map(|b| Band {
-                from: b.from.max(from),
-                to: b.to.min(to),
-                ..b.clone()
-            })
-            .collect();
-        let sources = (self.sources.iter())
-            .filter(|s| s.to >= from && s.from <= to)
-            .map(|s| Source {
-                from: s.from.max(from),
-                to: s.to.min(to),
-                ..s.clone()
-            })
-            .collect();
+        // The bands and sources over the stretch kept, cut to it.
         Ok(Profile::with_derivatives(z, x, d1, d2)?
             .with_interpolation(self.interpolation)
-            .with_bands(bands)
-            .with_sources(sources))
+            .with_bands(clipped(&self.bands, from, to))
+            .with_sources(clipped(&self.sources, from, to)))
     }
 
     /// Where the profile between two nodes goes furthest beyond the

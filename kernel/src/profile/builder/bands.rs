@@ -134,6 +134,11 @@ mod tests {
         assert!((p.eval(0.0).unwrap() - 15.0).abs() < 1e-12);
         let b = &p.bands()[0];
         assert_eq!((b.from, b.to), (10.0, 30.0));
+        // A stretch cut out keeps what it holds of the band and sources.
+        let cut = p.between(15.0, 35.0).unwrap();
+        assert_eq!((cut.bands()[0].from, cut.bands()[0].to), (15.0, 30.0));
+        let spans: Vec<(f64, f64)> = cut.sources().iter().map(|s| (s.from, s.to)).collect();
+        assert_eq!(spans, [(15.0, 30.0), (30.0, 35.0)]);
         assert!((b.half - 0.004).abs() < 1e-12);
         assert!(
             b.source
