@@ -258,31 +258,20 @@ trait Stretch: Clone {
     fn spanning(&self, from: Real, to: Real) -> Self;
 }
 
-impl Stretch for Band {
-    fn span(&self) -> (Real, Real) {
-        (self.from, self.to)
-    }
-    fn spanning(&self, from: Real, to: Real) -> Self {
-        Self {
-            from,
-            to,
-            ..self.clone()
+/// [`Stretch`] for a struct with `from` and `to`.
+macro_rules! stretch {
+    ($($t:ty),*) => {$(
+        impl Stretch for $t {
+            fn span(&self) -> (Real, Real) {
+                (self.from, self.to)
+            }
+            fn spanning(&self, from: Real, to: Real) -> Self {
+                Self { from, to, ..self.clone() }
+            }
         }
-    }
+    )*};
 }
-
-impl Stretch for Source {
-    fn span(&self) -> (Real, Real) {
-        (self.from, self.to)
-    }
-    fn spanning(&self, from: Real, to: Real) -> Self {
-        Self {
-            from,
-            to,
-            ..self.clone()
-        }
-    }
-}
+stretch!(Band, Source);
 
 /// `items` sorted by where they start.
 fn sorted<T: Stretch>(mut items: Vec<T>) -> Vec<T> {
