@@ -282,6 +282,26 @@ fn a_buttress_is_roughed_along_its_load_flank() {
     }
 }
 
+/// Designations as drawings spell them (ISO 2904's `Tr 40x7`, spaces
+/// round the `x`, a two-part class) run and verify on the defaults, the
+/// report naming the thread as the standard prints it.
+#[test]
+fn designations_as_drawings_spell_them_run_and_verify() {
+    let dir = scratch("thread", "spelled");
+    for (spelled, printed) in [("Tr 40x7", "Tr40x7"), ("m20 x 2.5-4g6g", "M20-4g6g")] {
+        let out = dir.join(printed);
+        let set = format!("designation={spelled}");
+        let (code, _, err) = pilgrim(&["run", SCRIPT, "--out", s(&out), "-q", "--set", &set]);
+        assert_eq!(code, 0, "{spelled}: {err}");
+        let r = common::report_of(&out);
+        assert_eq!(r["verdict"]["status"], "passed", "{spelled}");
+        assert!(
+            r.to_string().contains(&format!("\"{printed}")),
+            "{spelled}: no {printed}"
+        );
+    }
+}
+
 /// What the family cannot read or cannot yet cut is refused before any
 /// output, naming the value: a designation of no standard, a class the
 /// standard lacks, a drawing's unknown word; a nut whose outside is inside

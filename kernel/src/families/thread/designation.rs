@@ -22,7 +22,11 @@
 //!   worm's normal one; external, its limits stated. pilgrim's own
 //!   shorthand: DIN 3975 names the quantities, not a one-line form.
 //! - a trailing `LH` makes it left-handed (`RH`, the default, may be
-//!   written).
+//!   written), in either case.
+//! - the metric and trapezoidal prefixes in any case, with a space after
+//!   them (ISO 2904's `Tr 40x7`) and spaces round the `x` (`M20 x 2.5`);
+//!   a metric class in two parts, the pitch diameter's and the crest's
+//!   (`M20x2.5-5g6g`).
 //!
 //! What a designation leaves to the drawing (internal or external where
 //! its class does not say, the stated limits, the buttress's load flank)
@@ -65,13 +69,17 @@ pub fn designated(text: &str, drawing: &Drawing) -> Result<ThreadProfile, InputE
             "not a designation (at most {MAX_LEN} printable characters)"
         )));
     }
-    let mut words: Vec<&str> = text.split([' ', '-']).filter(|w| !w.is_empty()).collect();
+    let spelled = spelled(text);
+    let mut words: Vec<&str> = spelled
+        .split([' ', '-'])
+        .filter(|w| !w.is_empty())
+        .collect();
     let hand = match words.last() {
-        Some(&"LH") => {
+        Some(w) if w.eq_ignore_ascii_case("LH") => {
             words.pop();
             Hand::Left
         }
-        Some(&"RH") => {
+        Some(w) if w.eq_ignore_ascii_case("RH") => {
             words.pop();
             Hand::Right
         }
@@ -112,6 +120,38 @@ pub fn designated(text: &str, drawing: &Drawing) -> Result<ThreadProfile, InputE
         InputError::BadText { ref what, .. } if what == "thread designation" => e,
         other => r.bad(&other.to_string()),
     })
+}
+
+/// A metric or trapezoidal designation as the standards print it, from
+/// the ways drawings write it: the prefix in any case (`m20`, `TR40`), a
+/// space after it (ISO 2904's own `Tr 40x7`), spaces round the `x` and an
+/// `X` for it (`M20 x 2.5`, `Tr40X7`). Other forms are left as written.
+fn spelled(text: &str) -> String {
+    let t = text.trim();
+    let lower = t.to_ascii_lowercase();
+    let (prefix, rest) = if lower.starts_with("tr") {
+        ("Tr", &t[2..])
+    } else if lower.starts_with('m') {
+        ("M", &t[1..])
+    } else {
+        return t.to_owned();
+    };
+    let rest = rest.trim_start();
+    if !rest.starts_with(|c: char| c.is_ascii_digit()) {
+        return t.to_owned();
+    }
+    let chars: Vec<char> = rest.chars().collect();
+    let mut out = String::from(prefix);
+    for (i, &c) in chars.iter().enumerate() {
+        let prev = out.chars().last();
+        let next = chars[i + 1..].iter().find(|c| **c != ' ').copied();
+        match c {
+            ' ' if prev == Some('x') || matches!(next, Some('x' | 'X')) => {}
+            'X' if prev.is_some_and(|p| p.is_ascii_digit()) => out.push('x'),
+            _ => out.push(c),
+        }
+    }
+    out
 }
 
 /// A designation being read: its text and the drawing's other notes.
@@ -310,6 +350,39 @@ mod tests {
 
     fn read(t: &str) -> ThreadProfile {
         designated(t, &DRAWING).unwrap_or_else(|e| panic!("{t}: {e}"))
+    }
+
+    /// Designations as drawings spell them read as the canonical ones;
+    /// a two-part class takes the pitch diameter's limits from its first
+    /// grade and the crest's from its second.
+    #[test]
+    fn designations_as_drawings_spell_them() {
+        for (spelled, canonical) in [
+            ("Tr 40x7", "Tr40x7"),
+            ("tr40 x 7", "Tr40x7"),
+            ("TR40X14(P7) lh", "Tr40x14(P7)-LH"),
+            ("M20 x 2.5-6g", "M20x2.5-6g"),
+            ("m20x2.5-6g", "M20x2.5-6g"),
+            ("M 20 X 2.5 - 6H", "M20x2.5-6H"),
+            ("M20x2.5-6g LH", "M20x2.5-6g-LH"),
+        ] {
+            assert_eq!(read(spelled), read(canonical), "{spelled}");
+        }
+        // A class in two parts: the pitch diameter's grade, the crest's.
+        let (two, pitch, crest) = (read("M20x2.5-5g6g"), read("M20x2.5-5g"), read("M20x2.5-6g"));
+        assert_eq!(two.limits.pitch_diameter, pitch.limits.pitch_diameter);
+        assert_eq!(two.limits.crest, crest.limits.crest);
+        assert!(two.designation.contains("5g6g"), "{}", two.designation);
+        let nut = read("M20x2.5-5H6H");
+        assert_eq!(nut.limits.crest, read("M20x2.5-6H").limits.crest);
+        assert_eq!(
+            nut.limits.pitch_diameter,
+            read("M20x2.5-5H").limits.pitch_diameter
+        );
+        let e = designated("M20x2.5-5g6h", &DRAWING)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("5g6h"), "{e}");
     }
 
     /// Each form reads into the standard's profile, as its own function

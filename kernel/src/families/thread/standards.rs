@@ -129,17 +129,27 @@ pub fn metric(
             },
         )
     };
+    // `6g`, or the pitch diameter's and the crest's apart (`5g6g`,
+    // ISO 965-1's two-part class), both of one position.
+    let factor = |grade: Option<u32>| {
+        (GRADES.iter().find(|g| Some(g.0) == grade).map(|g| g.1)).ok_or_else(bad_class)
+    };
     let mut chars = class.chars();
-    let grade = chars
-        .next()
-        .and_then(|c| c.to_digit(10))
-        .ok_or_else(bad_class)?;
-    let position = chars.as_str();
-    let factor = GRADES
-        .iter()
-        .find(|g| g.0 == grade)
-        .map(|g| g.1)
-        .ok_or_else(bad_class)?;
+    let grade = chars.next().and_then(|c| c.to_digit(10));
+    let rest = chars.as_str();
+    let (position, crest) = match rest.find(|c: char| c.is_ascii_digit()) {
+        Some(i) => {
+            let (p, tail) = rest.split_at(i);
+            let mut t = tail.chars();
+            let g = t.next().and_then(|c| c.to_digit(10));
+            if t.as_str() != p {
+                return Err(bad_class());
+            }
+            (p, g)
+        }
+        None => (rest, grade),
+    };
+    let (factor, crest_factor) = (factor(grade)?, factor(crest)?);
     let Some(&(_, dev)) = DEVIATIONS
         .iter()
         .find(|(p, _)| (p - pitch).abs() < crate::tolerance::SAME_LENGTH)
@@ -159,8 +169,13 @@ pub fn metric(
     };
     let mean = (range[0] * range[1]).sqrt();
     let basic = MetricBasic::of(d, pitch);
-    let limits = metric_limits(&basic, internal, class, (position, factor, dev, mean))
-        .ok_or_else(bad_class)?;
+    let limits = metric_limits(
+        &basic,
+        internal,
+        class,
+        (position, [factor, crest_factor], dev, mean),
+    )
+    .ok_or_else(bad_class)?;
     let (h, d1, d2) = (basic.h, basic.d1, basic.d2);
     let fine = if starts == 1 && (pitch - coarse_pitch(d)).abs() < crate::tolerance::SAME_LENGTH {
         format!("M{}", number(d))
@@ -223,7 +238,7 @@ fn metric_limits(
     basic: &MetricBasic,
     internal: bool,
     class: &str,
-    (position, factor, dev, mean): (&str, Real, [Real; 3], Real),
+    (position, [factor, crest_factor], dev, mean): (&str, [Real; 2], [Real; 3], Real),
 ) -> Option<ThreadLimits> {
     let MetricBasic {
         d,
@@ -241,7 +256,7 @@ fn metric_limits(
             _ => return None,
         } * um;
         let td2 = r40(1.32 * factor * 90.0 * pitch.powf(0.4) * mean.powf(0.1)) * um;
-        let td1 = r40(factor * 230.0 * pitch.powf(0.7)) * um;
+        let td1 = r40(crest_factor * 230.0 * pitch.powf(0.7)) * um;
         ThreadLimits {
             pitch_diameter: Limits {
                 min: d2 + ei,
@@ -266,7 +281,7 @@ fn metric_limits(
             "e" => dev[0],
             _ => return None,
         } * um;
-        let td = r40(factor * (180.0 * pitch.powf(2.0 / 3.0) - 3.15 / pitch.sqrt())) * um;
+        let td = r40(crest_factor * (180.0 * pitch.powf(2.0 / 3.0) - 3.15 / pitch.sqrt())) * um;
         let d3 = d1 - h / 6.0;
         ThreadLimits {
             pitch_diameter: Limits {
