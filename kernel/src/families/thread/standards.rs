@@ -129,26 +129,9 @@ pub fn metric(
             },
         )
     };
-    // `6g`, or the pitch diameter's and the crest's apart (`5g6g`,
-    // ISO 965-1's two-part class), both of one position.
-    let factor = |grade: Option<u32>| {
-        (GRADES.iter().find(|g| Some(g.0) == grade).map(|g| g.1)).ok_or_else(bad_class)
-    };
-    let mut chars = class.chars();
-    let grade = chars.next().and_then(|c| c.to_digit(10));
-    let rest = chars.as_str();
-    let (position, crest) = match rest.find(|c: char| c.is_ascii_digit()) {
-        Some(i) => {
-            let (p, tail) = rest.split_at(i);
-            let mut t = tail.chars();
-            let g = t.next().and_then(|c| c.to_digit(10));
-            if t.as_str() != p {
-                return Err(bad_class());
-            }
-            (p, g)
-        }
-        None => (rest, grade),
-    };
+    let factor =
+        |grade: u32| (GRADES.iter().find(|g| g.0 == grade).map(|g| g.1)).ok_or_else(bad_class);
+    let (position, grade, crest) = class_grades(class).ok_or_else(bad_class)?;
     let (factor, crest_factor) = (factor(grade)?, factor(crest)?);
     let Some(&(_, dev)) = DEVIATIONS
         .iter()
@@ -227,6 +210,24 @@ impl MetricBasic {
             d1: d - 1.25 * h,
             d2: d - 0.75 * h,
         }
+    }
+}
+
+/// A metric class's position and its grades, the pitch diameter's and
+/// the crest's: `6g` one grade for both, `5g6g` (ISO 965-1's two-part
+/// class) each its own, both of one position; `None` for another form.
+fn class_grades(class: &str) -> Option<(&str, u32, u32)> {
+    let mut chars = class.chars();
+    let grade = chars.next()?.to_digit(10)?;
+    let rest = chars.as_str();
+    match rest.find(|c: char| c.is_ascii_digit()) {
+        Some(i) => {
+            let (position, tail) = rest.split_at(i);
+            let mut t = tail.chars();
+            let crest = t.next()?.to_digit(10)?;
+            (t.as_str() == position).then_some((position, grade, crest))
+        }
+        None => Some((rest, grade, grade)),
     }
 }
 
