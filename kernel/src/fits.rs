@@ -158,6 +158,15 @@ impl Limits {
     pub fn half_width(&self) -> Real {
         0.5 * (self.upper - self.lower)
     }
+
+    /// As a message names them on the diameter `size` (as the caller
+    /// writes it): `d 18 h4: +0/-0.005 mm`.
+    pub fn said(&self, size: &str) -> String {
+        format!(
+            "d {size} {}: {:+}/{:+} mm",
+            self.text, self.upper, self.lower
+        )
+    }
 }
 
 /// A tolerance a drawing writes that cannot be read, and why.

@@ -130,12 +130,7 @@ pub fn aimed(
         let half = (limits[i..=j].iter().flatten())
             .map(|l| 0.5 * l.half_width())
             .fold(Real::INFINITY, Real::min);
-        let said = |k: usize| {
-            let l = limits[k]
-                .as_ref()
-                .map_or((0.0, 0.0), |l| (l.upper, l.lower));
-            format!("d {} {}: {:+}/{:+} mm", 2.0 * x[k], first.text, l.0, l.1)
-        };
+        let said = |k: usize| first.said(&(2.0 * x[k]).to_string());
         let source = if i == j {
             format!("station {} (z = {} mm), {}", i + 1, z[i], said(i))
         } else {

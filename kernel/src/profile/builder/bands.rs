@@ -35,10 +35,10 @@ pub(super) fn aimed(
     segments: &[Segment],
     bands: &[(usize, String)],
 ) -> Result<Aimed, ProfileError> {
-    let refuse = |k: usize, why: String| -> ProfileError {
+    let refuse = |k: usize, text: &str, why: String| -> ProfileError {
         InputError::BadText {
             what: format!("segment {k}: tolerance"),
-            value: String::new(),
+            value: crate::names::quoted(text),
             reason: why,
         }
         .into()
@@ -50,10 +50,8 @@ pub(super) fn aimed(
         let end = end_of(segments, k).ok_or_else(|| {
             refuse(
                 k,
-                format!(
-                    "{} is given to a line or an arc it follows, and none ends here",
-                    crate::names::quoted(text)
-                ),
+                text,
+                "is given to the line or arc it follows, and none ends here".into(),
             )
         })?;
         // The point the element starts at: the last end before it.
@@ -66,16 +64,16 @@ pub(super) fn aimed(
         let from = match before {
             None => start,
             Some(j) => end_of(segments, j).ok_or_else(|| {
-                refuse(k, "the element starts where the mandrel law ends, which the law fixes: tolerance a line or an arc after a line or an arc".into())
+                refuse(k, text, "the element starts where the mandrel law ends, which the law fixes: tolerance a line or an arc after a line or an arc".into())
             })?,
         };
         let limits = crate::fits::limits(text, 2.0 * from.1.max(end.1))
-            .map_err(|e| refuse(k, e.to_string()))?;
+            .map_err(|e| refuse(k, text, e.why))?;
         let m = 0.5 * limits.middle();
         for point in [before, Some(k)] {
             match shifts.iter().find(|s| s.0 == point) {
                 Some(s) if (s.1 - m).abs() > crate::tolerance::SAME_LENGTH => {
-                    return Err(refuse(k, format!("it shares a point with segment {}, whose tolerance aims it at another middle: give the two one tolerance, or an element between them", s.2)));
+                    return Err(refuse(k, text, format!("it shares a point with segment {}, whose tolerance aims it at another middle: give the two one tolerance, or an element between them", s.2)));
                 }
                 Some(_) => {}
                 None => shifts.push((point, m, k)),
@@ -86,13 +84,10 @@ pub(super) fn aimed(
             to: end.0,
             half: 0.5 * limits.half_width(),
             source: format!(
-                "segment {k} (z = {} to {} mm), d {} {}: {:+}/{:+} mm",
+                "segment {k} (z = {} to {} mm), {}",
                 crate::math::fixed(from.0, 3),
                 crate::math::fixed(end.0, 3),
-                crate::math::fixed(2.0 * from.1.max(end.1), 3),
-                limits.text,
-                limits.upper,
-                limits.lower
+                limits.said(&crate::math::fixed(2.0 * from.1.max(end.1), 3))
             ),
         });
     }
