@@ -13,5 +13,6 @@ mod rest;
 mod robustness;
 mod script;
 mod tables;
+mod thread_limits;
 mod transform;
 mod verify;

@@ -369,9 +369,17 @@ mod tests {
             assert_eq!(read(spelled), read(canonical), "{spelled}");
         }
         // A class in two parts: the pitch diameter's grade, the crest's.
-        let (two, pitch, crest) = (read("M20x2.5-5g6g"), read("M20x2.5-5g"), read("M20x2.5-6g"));
-        assert_eq!(two.limits.pitch_diameter, pitch.limits.pitch_diameter);
+        // ISO 965-1's Td2 in grade 5 for 11.2 to 22.4 mm at P 2.5 is 132 um;
+        // grade 5 has no Td, so `5g` alone is no class.
+        let (two, crest) = (read("M20x2.5-5g6g"), read("M20x2.5-6g"));
+        let band = two.limits.pitch_diameter.max - two.limits.pitch_diameter.min;
+        assert!((band - 0.132).abs() < 1e-12, "{band}");
+        assert_eq!(
+            two.limits.pitch_diameter.max,
+            crest.limits.pitch_diameter.max
+        );
         assert_eq!(two.limits.crest, crest.limits.crest);
+        assert!(designated("M20x2.5-5g", &DRAWING).is_err());
         assert!(two.designation.contains("5g6g"), "{}", two.designation);
         let nut = read("M20x2.5-5H6H");
         assert_eq!(nut.limits.crest, read("M20x2.5-6H").limits.crest);

@@ -22,6 +22,7 @@
 //! radial.
 
 mod designation;
+pub mod iso965;
 mod outcome;
 mod plan;
 mod plots;

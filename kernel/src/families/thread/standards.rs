@@ -2,14 +2,12 @@
 //!
 //! - **ISO metric** (ISO 68-1 basic profile, ISO 965-1 tolerances): 60
 //!   degrees, `H = sqrt(3)/2 P`; `d2 = d - 3/4 H` (0.649519 P), `d1 = d -
-//!   5/4 H` (1.082532 P); an external thread's rounded root `d3 = d1 - H/6` (radius `H/6`).
-//!   Grade 6 pitch-diameter tolerance `90 P^0.4 d^0.1` um (d the
-//!   geometric mean of the standard's diameter range), the internal thread's
-//!   1.32 times it, major `180 P^(2/3) - 3.15 / sqrt(P)`, internal minor
-//!   `230 P^0.7` (P >= 1), each rounded to the R40 series; other grades
-//!   scaled by ISO 965-1's factors (4: 0.63, 5: 0.8, 7: 1.25, 8: 1.6). The
-//!   fundamental deviations of positions e, f, g, h (external) and G, H
-//!   (internal) are ISO 965-1's table, by pitch.
+//!   5/4 H` (1.082532 P); an external thread's rounded root `d3 = d1 -
+//!   H/6` (radius `H/6`). The tolerances and fundamental deviations are
+//!   ISO 965-1's published tables ([`super::iso965`]), not the formulas
+//!   behind them: a class is a grade and a position (`6g`, `6H`) or two
+//!   grades of one position (`5g6g`: the pitch diameter's, then the
+//!   crest's), and a grade or pitch the tables do not hold is refused.
 //! - **Trapezoidal** (ISO 2904): 30 degrees, `H1 = P/2`, the crest
 //!   clearance `ac` by pitch, `h3 = H4 = H1 + ac`; `d2 = d - P/2`, `d3 = d
 //!   - 2 h3`, `D1 = d - P`, `D4 = d + 2 ac`. Limits stated (see
@@ -40,6 +38,7 @@
 //! Hand-written: these are tables and one-line formulas of the standards,
 //! with no crate that holds them.
 
+use super::iso965::{self, Quantity};
 use super::profile::{Hand, Limits, ThreadLimits, ThreadProfile, ThreadSection};
 use crate::input::InputError;
 use crate::math::{positive, Real};
@@ -47,59 +46,6 @@ use crate::profile::FlankForm;
 
 /// The mm of an inch.
 pub const INCH: Real = 25.4;
-
-/// ISO 965-1's fundamental deviations (um) by pitch (mm): e, f, g (the
-/// external thread's upper deviations, negative) and G (the internal
-/// thread's lower, positive, the same size as g's).
-const DEVIATIONS: [(Real, [Real; 3]); 19] = [
-    (0.5, [50.0, 36.0, 20.0]),
-    (0.6, [53.0, 36.0, 21.0]),
-    (0.7, [56.0, 38.0, 22.0]),
-    (0.75, [56.0, 38.0, 22.0]),
-    (0.8, [60.0, 38.0, 24.0]),
-    (1.0, [60.0, 40.0, 26.0]),
-    (1.25, [63.0, 42.0, 28.0]),
-    (1.5, [67.0, 45.0, 32.0]),
-    (1.75, [71.0, 48.0, 34.0]),
-    (2.0, [71.0, 52.0, 38.0]),
-    (2.5, [80.0, 58.0, 42.0]),
-    (3.0, [85.0, 63.0, 48.0]),
-    (3.5, [90.0, 70.0, 53.0]),
-    (4.0, [95.0, 75.0, 60.0]),
-    (4.5, [100.0, 80.0, 63.0]),
-    (5.0, [106.0, 85.0, 71.0]),
-    (5.5, [112.0, 90.0, 75.0]),
-    (6.0, [118.0, 95.0, 80.0]),
-    (8.0, [140.0, 118.0, 100.0]),
-];
-
-/// ISO 965-1's diameter ranges (mm) over which the tolerances are
-/// computed at the range's geometric mean.
-const RANGES: [Real; 9] = [0.99, 1.4, 2.8, 5.6, 11.2, 22.4, 45.0, 90.0, 180.0];
-
-/// ISO 965-1's grade factors on grade 6.
-const GRADES: [(u32, Real); 5] = [(4, 0.63), (5, 0.8), (6, 1.0), (7, 1.25), (8, 1.6)];
-
-/// The R40 preferred numbers of a decade.
-const R40: [Real; 40] = [
-    100.0, 106.0, 112.0, 118.0, 125.0, 132.0, 140.0, 150.0, 160.0, 170.0, 180.0, 190.0, 200.0,
-    212.0, 224.0, 236.0, 250.0, 265.0, 280.0, 300.0, 315.0, 335.0, 355.0, 375.0, 400.0, 425.0,
-    450.0, 475.0, 500.0, 530.0, 560.0, 600.0, 630.0, 670.0, 710.0, 750.0, 800.0, 850.0, 900.0,
-    950.0,
-];
-
-/// `v` rounded to the nearest R40 number.
-fn r40(v: Real) -> Real {
-    let decade = 10.0_f64.powf((v / 100.0).log10().floor());
-    let x = v / decade;
-    let mut best = R40[0];
-    for c in R40.iter().copied().chain([1000.0]) {
-        if (c - x).abs() < (best - x).abs() {
-            best = c;
-        }
-    }
-    best * decade
-}
 
 /// An ISO metric thread `M d x P`, external or internal, of tolerance
 /// class `class` (grade and position: `6g`, `6H`, `4h`, ...), `starts`
@@ -118,47 +64,18 @@ pub fn metric(
 ) -> Result<ThreadProfile, InputError> {
     positive("major diameter d", d)?;
     positive("pitch P", pitch)?;
-    let bad_class = || {
-        InputError::out_of_range(
-            format!("tolerance class '{class}'"),
-            0.0,
+    let (position, grade, crest) = class_grades(class).ok_or_else(|| {
+        iso965::bad_class(
+            class,
             if internal {
-                "a grade 4 to 8 and G or H, as 6H"
+                "is not a grade and G or H, as 6H, nor two grades of one position, as 5H6H"
             } else {
-                "a grade 4 to 8 and e, f, g or h, as 6g"
+                "is not a grade and e, f, g or h, as 6g, nor two grades of one position, as 5g6g"
             },
         )
-    };
-    let factor =
-        |grade: u32| (GRADES.iter().find(|g| g.0 == grade).map(|g| g.1)).ok_or_else(bad_class);
-    let (position, grade, crest) = class_grades(class).ok_or_else(bad_class)?;
-    let (factor, crest_factor) = (factor(grade)?, factor(crest)?);
-    let Some(&(_, dev)) = DEVIATIONS
-        .iter()
-        .find(|(p, _)| (p - pitch).abs() < crate::tolerance::SAME_LENGTH)
-    else {
-        return Err(InputError::out_of_range(
-            "pitch P",
-            pitch,
-            "a pitch of ISO 965-1's table: 0.5 to 6 mm or 8 mm",
-        ));
-    };
-    let Some(range) = RANGES.windows(2).find(|w| d > w[0] && d <= w[1]) else {
-        return Err(InputError::out_of_range(
-            "major diameter d",
-            d,
-            "above 1 and at most 180 mm (ISO 965-1's ranges)",
-        ));
-    };
-    let mean = (range[0] * range[1]).sqrt();
+    })?;
     let basic = MetricBasic::of(d, pitch);
-    let limits = metric_limits(
-        &basic,
-        internal,
-        class,
-        (position, [factor, crest_factor], dev, mean),
-    )
-    .ok_or_else(bad_class)?;
+    let limits = metric_limits(&basic, internal, class, (position, grade, crest))?;
     let (h, d1, d2) = (basic.h, basic.d1, basic.d2);
     let fine = if starts == 1 && (pitch - coarse_pitch(d)).abs() < crate::tolerance::SAME_LENGTH {
         format!("M{}", number(d))
@@ -231,16 +148,18 @@ fn class_grades(class: &str) -> Option<(&str, u32, u32)> {
     }
 }
 
-/// The limits of `basic` in `class` (its tolerance position, its grade's
-/// factor, the pitch's fundamental deviations of e, f, g (um) and the
-/// diameter range's geometric mean); none for a position the thread
-/// cannot have.
+/// The limits of `basic` in `class` (its tolerance position, the pitch
+/// diameter's grade and the crest's), from ISO 965-1's tables.
+///
+/// # Failures
+/// A position the thread cannot have (lower case is external, upper case
+/// internal), a cell the tables do not hold.
 fn metric_limits(
     basic: &MetricBasic,
     internal: bool,
     class: &str,
-    (position, [factor, crest_factor], dev, mean): (&str, [Real; 2], [Real; 3], Real),
-) -> Option<ThreadLimits> {
+    (position, grade, crest): (&str, u32, u32),
+) -> Result<ThreadLimits, InputError> {
     let MetricBasic {
         d,
         pitch,
@@ -248,16 +167,24 @@ fn metric_limits(
         d1,
         d2,
     } = *basic;
-    let um = 1e-3;
-    let td2 = r40(factor * 90.0 * pitch.powf(0.4) * mean.powf(0.1));
-    Some(if internal {
-        let ei = match position {
-            "H" => 0.0,
-            "G" => dev[2],
-            _ => return None,
-        } * um;
-        let td2 = r40(1.32 * factor * 90.0 * pitch.powf(0.4) * mean.powf(0.1)) * um;
-        let td1 = r40(crest_factor * 230.0 * pitch.powf(0.7)) * um;
+    let upper = position.chars().all(|c| c.is_ascii_uppercase());
+    if upper != internal {
+        return Err(iso965::bad_class(
+            class,
+            if internal {
+                "is not an internal thread's: its position is G or H (upper case), as 6H"
+            } else {
+                "is not an external thread's: its position is e, f, g or h (lower case), as 6g"
+            },
+        ));
+    }
+    let deviation = iso965::deviation(position, pitch, class)?;
+    let table = |q, g| iso965::tolerance(q, d, pitch, g, class);
+    let source = format!("ISO 965-1 {class}");
+    Ok(if internal {
+        let ei = deviation;
+        let td2 = table(Quantity::NutPitch, grade)?;
+        let td1 = table(Quantity::NutMinor, crest)?;
         ThreadLimits {
             pitch_diameter: Limits {
                 min: d2 + ei,
@@ -272,21 +199,16 @@ fn metric_limits(
                 min: d + ei,
                 max: d + ei + h / 8.0,
             },
-            source: format!("ISO 965-1 {class}"),
+            source,
         }
     } else {
-        let es = -match position {
-            "h" => 0.0,
-            "g" => dev[2],
-            "f" => dev[1],
-            "e" => dev[0],
-            _ => return None,
-        } * um;
-        let td = r40(crest_factor * (180.0 * pitch.powf(2.0 / 3.0) - 3.15 / pitch.sqrt())) * um;
+        let es = deviation;
+        let td2 = table(Quantity::BoltPitch, grade)?;
+        let td = table(Quantity::BoltMajor, crest)?;
         let d3 = d1 - h / 6.0;
         ThreadLimits {
             pitch_diameter: Limits {
-                min: d2 + es - td2 * um,
+                min: d2 + es - td2,
                 max: d2 + es,
             },
             crest: Limits {
@@ -297,10 +219,10 @@ fn metric_limits(
             // at most d3 shifted by the deviation, at least a pitch
             // diameter's tolerance below it.
             root: Limits {
-                min: d3 + es - td2 * um,
+                min: d3 + es - td2,
                 max: d3 + es,
             },
-            source: format!("ISO 965-1 {class}"),
+            source,
         }
     })
 }
