@@ -13,6 +13,7 @@
 //! thread's opens inwards, from its root (the major) to its crest (the
 //! minor, the bore). Lengths in mm, angles in radians.
 
+use super::wires;
 use crate::math::Real;
 use crate::profile::FlankForm;
 use serde::{Deserialize, Serialize};
@@ -294,26 +295,60 @@ impl ThreadSection {
 
     /// The measurement over wires (external) or between balls (internal)
     /// of diameter `wire` laid in opposite spaces, the pitch diameter at
-    /// `pitch_diameter`: each wire touches both flanks of its space, its
-    /// centre `wire / 2 / sin(b)` from the flanks' meeting point (`b` the
-    /// half-angle). Symmetric straight-flanked profiles only (`None`
-    /// otherwise); the lead angle's small correction left out.
+    /// `pitch_diameter`: each wire or ball as it rests on the helicoid
+    /// ([`wires::resting`], the lead angle included). Straight flanks only
+    /// (`None` for curved ones, or where the body misses a flank).
     pub fn over_wires(&self, wire: Real, pitch_diameter: Real) -> Option<Real> {
-        if (self.flanks[0] - self.flanks[1]).abs() > crate::tolerance::ROUNDING
-            || !self.form.is_axial()
-        {
+        if !self.form.is_axial() {
             return None;
         }
-        let b = self.flanks[0];
-        let s = self.opening();
-        Some(pitch_diameter + s * (wire * (1.0 + 1.0 / b.sin()) - self.space_at_pitch / b.tan()))
+        // The flank lines `z = a + b r` of the space centred on z = 0, as
+        // wide as `space_at_pitch` at the pitch diameter.
+        let (s, r1, half) = (
+            self.opening(),
+            pitch_diameter / 2.0,
+            self.space_at_pitch / 2.0,
+        );
+        let [t0, t1] = self.flanks.map(Real::tan);
+        let left = [-half + s * r1 * t0, -s * t0];
+        let right = [half - s * r1 * t1, s * t1];
+        self.over_flanks(wire, pitch_diameter, left, right)
     }
 
-    /// The best wire of a symmetric straight-flanked profile: the one that
-    /// touches its flanks at the pitch diameter.
+    /// The measurement over wires of diameter `wire` laid in spaces whose
+    /// flanks are the lines `left` and `right` (`z = a + b r` over this
+    /// section's radius), the wires at the lead angle of
+    /// `pitch_diameter`. An internal thread's twin, simulated in rho = -r
+    /// (its radii negative), gets its measurement between balls negative,
+    /// to be turned back with the twin's other diameters.
+    pub fn over_flanks(
+        &self,
+        wire: Real,
+        pitch_diameter: Real,
+        left: [Real; 2],
+        right: [Real; 2],
+    ) -> Option<Real> {
+        let twin = self.pitch_diameter < 0.0;
+        let s: Real = if twin { -1.0 } else { 1.0 };
+        let space = wires::Space {
+            left: [left[0], s * left[1]],
+            right: [right[0], s * right[1]],
+            internal: self.internal || twin,
+            lead: self.lead(),
+        };
+        let band = (
+            (self.root_diameter / 2.0).abs(),
+            (self.crest_diameter / 2.0).abs(),
+        );
+        wires::resting(&space, wire, pitch_diameter, band).map(|rest| s * rest.m)
+    }
+
+    /// The best wire of a straight-flanked profile: the one whose contacts
+    /// straddle the pitch line equally ([`wires::best_wire`]; for symmetric
+    /// flanks both on it).
     pub fn best_wire(&self) -> Option<Real> {
-        ((self.flanks[0] - self.flanks[1]).abs() <= crate::tolerance::ROUNDING
-            && self.form.is_axial())
-        .then(|| self.space_at_pitch / self.flanks[0].cos())
+        self.form
+            .is_axial()
+            .then(|| wires::best_wire(self.flanks, self.space_at_pitch))
     }
 }

@@ -69,19 +69,6 @@ pub(super) fn pitch_diameter(
     lo + hi
 }
 
-/// The measurement over two wires of diameter `wire` laid in spaces whose
-/// flanks are the lines `left` and `right` (`z = a + b r`), opposite each
-/// other: each wire's centre where the space is as wide as the wire
-/// reaches across it, touching both flanks.
-pub(super) fn over_wires(t: &ThreadSection, wire: Real, left: [Real; 2], right: [Real; 2]) -> Real {
-    // A wire touching a flank at `a` from the radial has its centre
-    // wire / 2 / cos(a) from it along the axis.
-    let (a_l, a_r) = ((-left[1]).atan(), right[1].atan());
-    let across = 0.5 * wire * (1.0 / a_l.cos() + 1.0 / a_r.cos());
-    let r_centre = (across - (right[0] - left[0])) / (right[1] - left[1]);
-    2.0 * r_centre + t.opening() * wire
-}
-
 /// The least-squares slope `b` of `z = a + b r`.
 pub(super) fn slope(samples: &[(Real, Real)]) -> Real {
     line(samples)[1]
@@ -248,7 +235,7 @@ fn measure_start(
         ),
         over_wires: (req.limits.as_ref())
             .and(w.best_wire())
-            .map(|wire| over_wires(w, wire, line(&left), line(&right))),
+            .and_then(|wire| w.over_flanks(wire, w.pitch_diameter, line(&left), line(&right))),
     };
     Ok((p, worst_at, nominal_flanks_deg(&aimed, &radii)))
 }

@@ -68,7 +68,7 @@ fn cut_by(
     let passes = plan(t, &cutter, &settings).unwrap();
     // A worm's long lead slower, and its deep space's edges further
     // out, S1 within the run-in before the face.
-    let (length, rpm, run_in) = if t.lead() > 10.0 {
+    let (length, rpm, run_in) = if t.lead() > 6.0 {
         (30.0, 60.0, 5.0 + t.depth())
     } else {
         (30.0, 300.0, 5.0)
@@ -182,7 +182,8 @@ fn a_metric_thread_is_held_to_its_pitch_diameter() {
     // Over wires: the best wire 0.57735 P (1.4434 mm) laid against the
     // cut flanks measures what the formula gives at the pitch
     // diameter measured, within 1 um, inside what 6g allows (M moves
-    // with the pitch diameter one for one at 60 degrees).
+    // with the pitch diameter one for one at 60 degrees, the lead angle's
+    // share changing by 0.04 um over the band).
     let wire = held.wire.unwrap();
     assert!((wire - 2.5 / 3f64.sqrt()).abs() < 1e-12, "{wire}");
     let m = held.starts[0].over_wires.unwrap();
@@ -194,7 +195,7 @@ fn a_metric_thread_is_held_to_its_pitch_diameter() {
     assert!((m - want).abs() < 1e-3, "M {m} vs {want}");
     let [lo, hi] = held.over_wires_limits.unwrap();
     assert!(
-        lo < m && m < hi && (hi - lo - 0.17).abs() < 1e-9,
+        lo < m && m < hi && (hi - lo - 0.17).abs() < 0.1e-3,
         "{lo} {m} {hi}"
     );
 }
@@ -380,6 +381,55 @@ fn a_buttress_holds_its_two_flank_angles() {
     let (figures, _) = check.findings();
     let angle = figures.iter().find(|f| f.name == "flank angle").unwrap();
     assert!(angle.value.abs() < 0.05, "{angle:?}");
+}
+
+/// Over wires with the lead angle, from the cut: a Tr40x7 and a
+/// two-start Tr40x14(P7), each start's measurement over its best wires
+/// laid against the cut flanks within 1 um of ASME B1.2's lead-corrected
+/// formula at the pitch diameter measured, the lead angle's share 24.3 and
+/// 97 um over the axial section's figure (12 % and 49 % of a 0.2 mm
+/// band).
+#[test]
+fn over_wires_carry_the_lead_angle_on_every_start() {
+    use crate::families::thread::wires::lead_corrected;
+    let stated = standards::StatedLimits {
+        pitch_allowance: 0.0,
+        pitch_tolerance: 0.2,
+        crest_tolerance: 0.3,
+        root_tolerance: 0.5,
+    };
+    for (starts, share) in [(1, 24.3e-3), (2, 97.0e-3)] {
+        let profile =
+            standards::trapezoidal(40.0, 7.0, false, starts, Hand::Right, stated).unwrap();
+        let check = cut(&profile, 0.1, FlankOrder::Alternating)
+            .unwrap()
+            .verified()
+            .unwrap();
+        let (t, wire) = (&profile.section, check.wire.unwrap());
+        assert_eq!(check.starts.len(), starts as usize);
+        for s in &check.starts {
+            let m = s.over_wires.unwrap();
+            let (half, d2) = (t.flanks[0], s.pitch_diameter);
+            let formula = lead_corrected(half, t.space_at_pitch, d2, t.lead(), wire);
+            let axial = lead_corrected(half, t.space_at_pitch, d2, 0.0, wire);
+            assert!(
+                (m - formula).abs() < 1e-3,
+                "start {}: M {m} vs {formula}",
+                s.start + 1
+            );
+            assert!(
+                (m - axial - share).abs() < 1e-3,
+                "start {}: {}",
+                s.start + 1,
+                m - axial
+            );
+        }
+        let [lo, hi] = check.over_wires_limits.unwrap();
+        assert!(check
+            .starts
+            .iter()
+            .all(|s| (lo..=hi).contains(&s.over_wires.unwrap())));
+    }
 }
 
 /// A ZI worm's flanks are curves in the axial section (its axial angle
