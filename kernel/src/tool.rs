@@ -4,6 +4,7 @@ use crate::input::InputError;
 use crate::math::{positive, Point3, Real, Vec3};
 use crate::transform::ToolFrame;
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 
 mod thread_cutter;
 
@@ -133,6 +134,13 @@ pub struct Tool {
     /// Where a wheel's frame has its origin (how its solid is placed).
     #[serde(default, skip_serializing_if = "WheelOrigin::is_periphery")]
     pub origin: WheelOrigin,
+    /// The tool's own sizes of the machine's bodies that ride with it
+    /// (its holder's, its boring bar's), by the names of the machine
+    /// constants those bodies are sized by: a tool table's row says them,
+    /// the run places the bodies with them in place of the machine's
+    /// values. Empty: the machine's.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub bodies: BTreeMap<String, Real>,
 }
 
 /// Where a wheel's own frame has its origin: the machine's programmed point
@@ -180,6 +188,7 @@ impl Tool {
                 axis: Vec3::z(),
             },
             origin: WheelOrigin::Periphery,
+            bodies: BTreeMap::new(),
         }
     }
 
@@ -192,6 +201,7 @@ impl Tool {
             shape: ToolShape::Wheel(wheel),
             reference: ToolFrame::default(),
             origin: WheelOrigin::Centre,
+            bodies: BTreeMap::new(),
         }
     }
 
@@ -211,6 +221,7 @@ impl Tool {
             shape: ToolShape::ThreadCutter(cutter),
             reference: ToolFrame::default(),
             origin: WheelOrigin::Periphery,
+            bodies: BTreeMap::new(),
         }
     }
 
@@ -232,6 +243,7 @@ impl Tool {
             shape: ToolShape::EndMill { diameter, length },
             reference: ToolFrame::default(),
             origin: WheelOrigin::Periphery,
+            bodies: BTreeMap::new(),
         })
     }
 }

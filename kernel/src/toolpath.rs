@@ -101,6 +101,11 @@ pub struct Toolpath {
     /// each as its cycle where its dialect has it.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub cycles: Vec<PassCycle>,
+    /// The part is held at its start alone (a short part in the chuck):
+    /// the machine's bodies that stand at the part's end (a tailstock)
+    /// are away.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub free_end: bool,
 }
 
 /// Passes `first_pass..first_pass + passes` of a toolpath: the moves a
@@ -216,6 +221,7 @@ impl Toolpath {
             plots: Vec::new(),
             warnings: Vec::new(),
             cycles: Vec::new(),
+            free_end: false,
         }
     }
 

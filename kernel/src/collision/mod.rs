@@ -62,7 +62,7 @@
 pub mod place;
 pub mod shapes;
 
-pub use place::{PlacedBody, Placement};
+pub use place::{Holding, PlacedBody, Placement};
 
 use crate::machine::MachineInfo;
 use crate::math::{Mat4, Real};
@@ -179,6 +179,16 @@ pub enum CollisionError {
     /// The check ran past the run's time budget.
     #[error(transparent)]
     OverTime(#[from] crate::budget::OverTime),
+    /// A tool's own size of a body riding with it that no such body has.
+    #[error("tool '{tool}' gives the machine's constant '{constant}', which sizes no body riding with it alone (it may give: {allowed})")]
+    ToolSizes {
+        /// The tool.
+        tool: String,
+        /// The constant named.
+        constant: String,
+        /// The constants it may give.
+        allowed: String,
+    },
 }
 
 /// Which solid an entity of the check is.
@@ -726,7 +736,6 @@ pub fn check(
 mod tests {
     use super::*;
     use crate::machine::{ChainMachine, Machine, MachineKinematics};
-    use crate::math::Vec3;
     use crate::program::{Block, ProgramAxis};
     use crate::toolpath::Motion;
 
@@ -767,7 +776,7 @@ mod tests {
         let info = lz_250::describe();
         let axes: Vec<String> = ["A", "X", "Z", "B"].map(str::to_owned).to_vec();
         let placement =
-            Placement::new(&info, &axes, Vec3::zeros(), Some((-40.0, 40.0)), false).unwrap();
+            Placement::new(&info, &axes, &Holding::default(), Some((-40.0, 40.0))).unwrap();
         let mut program = one_move([0.0, 0.0], [0.0, 0.0]);
         program.axes = axes
             .iter()
@@ -824,9 +833,8 @@ mod tests {
         let placement = Placement::new(
             machine.info(),
             &axes,
-            Vec3::zeros(),
+            &Holding::default(),
             Some((-100.0, 0.0)),
-            false,
         )
         .unwrap();
         // The tool's tip from radius 100 at z = -300 to radius 130 at z = 0:

@@ -8,6 +8,7 @@ use super::CollisionError;
 use crate::machine::{bodies_of, Machine, MachineInfo, Mount, Solid};
 use crate::math::{Mat4, Real, Vec3};
 use crate::transform::Chain;
+use std::collections::BTreeMap;
 
 /// What places a body.
 #[derive(Debug, Clone)]
@@ -58,23 +59,58 @@ pub struct Placement {
     pub notes: Vec<String>,
 }
 
+/// What the run's tool and part bring to the machine's bodies: where the
+/// tool's spindle centre is, whether it cuts inside a bore, its own sizes
+/// of the bodies that ride with it, whether the part's end is free.
+#[derive(Debug, Clone, Default)]
+pub struct Holding {
+    /// The tool's spindle centre in the tool frame.
+    pub tool_centre: Vec3,
+    /// The tool cuts inside a bore: the bodies for such tools hold it.
+    pub inside: bool,
+    /// The tool's name, for a message about its sizes.
+    pub tool: String,
+    /// The tool's own sizes of the bodies riding with it
+    /// ([`crate::tool::Tool::bodies`]).
+    pub tool_bodies: BTreeMap<String, Real>,
+    /// The part is held at its start alone: bodies at its end are away.
+    pub free_end: bool,
+}
+
+impl Holding {
+    /// What `tool` brings, and the part's end free where `free_end`.
+    pub fn of(tool: &crate::tool::Tool, free_end: bool) -> Self {
+        Self {
+            tool_centre: tool.spindle_centre(),
+            inside: tool.cuts_inside(),
+            tool: tool.name.clone(),
+            tool_bodies: tool.bodies.clone(),
+            free_end,
+        }
+    }
+}
+
 impl Placement {
     /// The bodies of the machine `info` with a solid, for a program over
-    /// `program_axes`: the tool's spindle centre at `tool_centre` in the
-    /// tool frame, the part's solids from `part_z.0` to `part_z.1` along
-    /// its axis (none: bodies at its ends are left out); the bodies there
-    /// for a tool that cuts inside a bore where `inside`, from outside
-    /// otherwise (a body's `reach`).
+    /// `program_axes`, held as `holding` says (the bodies there for a
+    /// tool that cuts inside a bore where it does, from outside otherwise:
+    /// a body's `reach`; the tool's own sizes of the bodies riding with
+    /// it in place of the machine's), the part's solids from `part_z.0`
+    /// to `part_z.1` along its axis (none: bodies at its ends are left
+    /// out).
     ///
     /// # Failures
-    /// A description that does not compile (it did when loaded).
+    /// A description that does not compile (it did when loaded); a size
+    /// the tool gives that is not one of the bodies riding with it.
     pub fn new(
         info: &MachineInfo,
         program_axes: &[String],
-        tool_centre: Vec3,
+        holding: &Holding,
         part_z: Option<(Real, Real)>,
-        inside: bool,
     ) -> Result<Self, CollisionError> {
+        let held = with_tool_sizes(info, holding)?;
+        let info = &held;
+        let (tool_centre, inside) = (holding.tool_centre, holding.inside);
         let tool_chain = if info.chain.is_empty() {
             None
         } else {
@@ -127,6 +163,13 @@ impl Placement {
                         Carrier::Tool(Mat4::new_translation(&tool_centre) * own()?),
                         tool_axes.clone(),
                     )
+                }
+                Mount::PartEnd if holding.free_end => {
+                    notes.push(format!(
+                        "body {}: the part is held at its start alone (its end free): away",
+                        spec.name
+                    ));
+                    continue;
                 }
                 Mount::PartStart | Mount::PartEnd => {
                     let Some((lo, hi)) = part_z else {
@@ -263,4 +306,45 @@ fn sorted(names: &[String]) -> Vec<String> {
     let mut v = names.to_vec();
     v.sort();
     v
+}
+
+/// The machine `info` with the tool's own sizes of the bodies riding with
+/// it in place of the machine's constants of those names.
+///
+/// # Failures
+/// A size named for a constant that no body riding with the tool (for
+/// its reach) is sized or placed by, or that another body or the tool's
+/// chain also reads: the message names the tool and the constants it may
+/// give.
+fn with_tool_sizes(info: &MachineInfo, holding: &Holding) -> Result<MachineInfo, CollisionError> {
+    if holding.tool_bodies.is_empty() {
+        return Ok(info.clone());
+    }
+    let mut riding = std::collections::BTreeSet::new();
+    let mut others = std::collections::BTreeSet::new();
+    others.extend(pilgrim_plugin_abi::types::chain_constants(&info.chain));
+    for body in &info.bodies {
+        if body.mount == Mount::Tool && body.reach.holds(holding.inside) {
+            riding.extend(body.constants());
+        } else {
+            others.extend(body.constants());
+        }
+    }
+    let allowed: Vec<&String> = riding.difference(&others).collect();
+    let mut held = info.clone();
+    for (name, value) in &holding.tool_bodies {
+        if !allowed.contains(&name) {
+            return Err(CollisionError::ToolSizes {
+                tool: holding.tool.clone(),
+                constant: name.clone(),
+                allowed: allowed
+                    .iter()
+                    .map(|s| s.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            });
+        }
+        held.constants.insert(name.clone(), *value);
+    }
+    Ok(held)
 }

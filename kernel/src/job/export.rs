@@ -99,7 +99,7 @@ pub fn export(
         kin.info(),
         &passes,
     );
-    let placement = scene::placement(kin, &program, &toolpath.tool, &parts)?;
+    let placement = scene::placement(kin, &program, &toolpath, &parts)?;
     let staged = scene::stage(
         kin,
         &program,

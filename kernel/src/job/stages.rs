@@ -538,7 +538,7 @@ impl<'a> Run<'a> {
         let tool = &plan.toolpath.tool;
         let restated = self.restated();
         // One placement of the machine's bodies for the check and the scene.
-        let placement = scene::placement(kin, &made.program, tool, &meshes)?;
+        let placement = scene::placement(kin, &made.program, &plan.toolpath, &meshes)?;
         // The process, checked as well as the geometry; and, on a second
         // thread, the machine's bodies, the tool and the part clear of each
         // other along the whole program (neither reads the other).

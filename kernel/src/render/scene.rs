@@ -120,30 +120,24 @@ pub fn thread_blade(c: &crate::tool::ThreadCutter, at: &ToolAt) -> crate::blade:
 /// A body placed in the part frame: name, mesh in its own frame, pose.
 pub type Placed = (String, TriMesh, Mat4);
 
-/// The machine's bodies placed for `program` and `tool`
-/// ([`crate::collision::Placement`]: on the part frame by their chains, on
-/// the tool from its spindle centre, at the ends of `parts`' largest
-/// body): one placement for the collision check, the still scene and its
-/// motion.
+/// The machine's bodies placed for `program` and `toolpath`'s tool and
+/// part ([`crate::collision::Placement`]: on the part frame by their
+/// chains, on the tool from its spindle centre with the tool's own sizes,
+/// at the ends of `parts`' largest body, none at a free end): one
+/// placement for the collision check, the still scene and its motion.
 ///
 /// # Failures
 /// A body's description failing.
 pub fn placement(
     machine: &dyn MachineKinematics,
     program: &AxisProgram,
-    tool: &Tool,
+    toolpath: &crate::toolpath::Toolpath,
     parts: &[(String, TriMesh)],
 ) -> Result<crate::collision::Placement, SceneError> {
     let axes: Vec<String> = program.axes.iter().map(|a| a.name.clone()).collect();
     let part_z = crate::collision::part_at_largest(parts).map(|(_, m)| crate::collision::part_z(m));
-    crate::collision::Placement::new(
-        machine.info(),
-        &axes,
-        tool.spindle_centre(),
-        part_z,
-        tool.cuts_inside(),
-    )
-    .map_err(placing)
+    let holding = crate::collision::Holding::of(&toolpath.tool, toolpath.free_end);
+    crate::collision::Placement::new(machine.info(), &axes, &holding, part_z).map_err(placing)
 }
 
 fn placing(e: crate::collision::CollisionError) -> SceneError {

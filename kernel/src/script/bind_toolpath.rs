@@ -113,6 +113,18 @@ pub mod toolpath_api {
         ))))
     }
 
+    /// Holds the part at its start alone (a short part in the chuck): the
+    /// machine's bodies that stand at the part's end (a tailstock) are
+    /// away, for the collision check and the scene.
+    ///
+    /// ```rhai
+    /// if p.length < 5.0 * t.crest_diameter { tp.free_end(); }
+    /// ```
+    #[rhai_fn(name = "free_end")]
+    pub fn free_end(tp: &mut ToolpathHandle) {
+        tp.borrow_mut().free_end = true;
+    }
+
     /// Notes a figure about the toolpath for the run's report.
     #[rhai_fn(name = "note", return_raw)]
     pub fn note(
