@@ -28,7 +28,12 @@ use std::time::Duration;
 fn first_run(catalog: &Catalog, family: &str) -> std::path::PathBuf {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let script = root.join(format!("scripts/{family}.rhai"));
-    let loaded = ScriptFamily::load(&script, &Limits::default(), &Access::default()).unwrap();
+    // A script reads its tables (the thread's tool table) beside itself.
+    let access = Access {
+        input_dirs: vec![root.join("scripts")],
+        ..Access::default()
+    };
+    let loaded = ScriptFamily::load(&script, &Limits::default(), &access).unwrap();
     let machine = catalog
         .open(&loaded.default_machine().unwrap().unwrap())
         .unwrap();

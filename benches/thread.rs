@@ -12,7 +12,11 @@
 //!   inside its bore on the boring bar); the default M20 planned as
 //!   LinuxCNC's G76 makes it (`cycle = "g76"`), posted for LinuxCNC too
 //!   (the cycle written, its lint expanding it); and the pipe thread G 1/2
-//!   A of `scripts/examples/thread-g1-2a.toml`.
+//!   A of `scripts/examples/thread-g1-2a.toml`; and the common sizes the
+//!   default tool table (`scripts/thread-tools.csv`) makes go through:
+//!   M8x1.25-6g (chuck alone, the long holder), M10x1.5-6g, M12x1.5-6H
+//!   (the 7 mm bar), M36x4-6H, M42x4.5-6H (the 20 mm bar) and `Tr 40x7`
+//!   as ISO 2904 spells it (30 mm each).
 //! - `thread_verify_text`: `verify` of a shop's M20x2.5 program read from
 //!   its text (`tests/corpus/fanuc/g76_m20.plain.nc`: G32 passes left and
 //!   returned in rapids), and the same passes left and returned at feed
@@ -48,6 +52,12 @@ fn thread_job(c: &mut Criterion) {
             text: std::fs::read_to_string(root.join("scripts/examples").join(file)).unwrap(),
         }]
     };
+    let designation = |d: &str| {
+        vec![ParamSource::Toml {
+            label: d.into(),
+            text: format!("designation = \"{d}\"\n"),
+        }]
+    };
     let g76 = vec![ParamSource::Toml {
         label: "cycle".into(),
         text: "cycle = \"g76\"\n".into(),
@@ -71,12 +81,25 @@ fn thread_job(c: &mut Criterion) {
             example("thread-worm-zi.toml"),
             &options,
         ),
+        ("m8x1_25_6g_end_to_end", designation("M8x1.25-6g"), &options),
+        ("m10x1_5_6g_end_to_end", designation("M10x1.5-6g"), &options),
+        ("m12x1_5_6h_end_to_end", designation("M12x1.5-6H"), &options),
+        ("m36x4_6h_end_to_end", designation("M36x4-6H"), &options),
+        ("m42x4_5_6h_end_to_end", designation("M42x4.5-6H"), &options),
+        (
+            "tr_40x7_spelled_end_to_end",
+            designation("Tr 40x7"),
+            &options,
+        ),
     ] {
         let run = || {
             let family = ScriptFamily::load(
                 &root.join("scripts/thread.rhai"),
                 &Limits::default(),
-                &Access::default(),
+                &Access {
+                    input_dirs: vec![root.join("scripts")],
+                    ..Access::default()
+                },
             )
             .unwrap();
             let machine = catalog.open("fanuc-0i-tc").unwrap();
@@ -105,7 +128,10 @@ fn thread_verify_text(c: &mut Criterion) {
     let family = ScriptFamily::load(
         &root.join("scripts/thread.rhai"),
         &Limits::default(),
-        &Access::default(),
+        &Access {
+            input_dirs: vec![root.join("scripts")],
+            ..Access::default()
+        },
     )
     .unwrap();
     let machine = catalog.open("fanuc-0i-tc").unwrap();

@@ -19,6 +19,13 @@ fn run(name: &str, args: &[&str]) -> PathBuf {
     out
 }
 
+/// The default tool table copied into `dir`, beside a copy of the script
+/// that reads it there.
+fn copy_tools(dir: &std::path::Path) {
+    let table = "scripts/thread-tools.csv";
+    std::fs::copy(common::root().join(table), dir.join("thread-tools.csv")).unwrap();
+}
+
 /// The built-in lathe with a LinuxCNC control, written into `dir`: its
 /// file.
 fn linuxcnc_lathe(dir: &std::path::Path) -> PathBuf {
@@ -740,6 +747,7 @@ fn a_verify_map_with_a_bad_outside_is_refused() {
     assert!(text.contains(from));
     let script = dir.join("thread.rhai");
     std::fs::write(&script, text.replace(from, "outside_diameter: \"wide\",")).unwrap();
+    copy_tools(&dir);
     let out = dir.join("out");
     let (code, _, err) = pilgrim(&["run", s(&script), "--out", s(&out), "--quiet"]);
     assert_ne!(code, 0);
@@ -840,6 +848,7 @@ fn a_corrected_start_is_measured_from_its_cut_root() {
     let dir = scratch("thread", "corrected-root");
     let script = dir.join("thread.rhai");
     std::fs::copy(common::root().join(SCRIPT), &script).unwrap();
+    copy_tools(&dir);
     std::fs::write(
         dir.join("correction.csv"),
         "z_mm,dd2_1_mm,dd2_2_mm\n-30,-0.0231,-0.05\n-15,-0.0231,-0.05\n0,-0.0231,-0.05\n",
@@ -871,4 +880,122 @@ fn a_corrected_start_is_measured_from_its_cut_root() {
         let now = d2(&out, k) - d2(&first, k);
         assert!((now - moved).abs() < 2e-3, "start {}: moved {now}", k + 1);
     }
+}
+
+/// The radius of a body's solid about the part's axis (mm): its STL's
+/// vertices farthest from the axis of its own cylinder (the file's own
+/// frame: the cylinder along Z), read back from the file the run wrote.
+fn cylinder_radius(file: &std::path::Path) -> f64 {
+    let mut f = std::fs::File::open(file).unwrap();
+    let mesh = stl_io::read_stl(&mut f).unwrap();
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for v in &mesh.vertices {
+        for k in 0..2 {
+            lo[k] = lo[k].min(f64::from(v[k]));
+            hi[k] = hi[k].max(f64::from(v[k]));
+        }
+    }
+    0.25 * ((hi[0] - lo[0]) + (hi[1] - lo[1]))
+}
+
+/// The common sizes on the default lathe and the default tool table
+/// (`scripts/thread-tools.csv`), the machine's bodies as built in: small
+/// bolts held in the chuck alone on the long holder, small nuts on the
+/// small bars, deep nuts on the bar whose insert reaches their depth. Each
+/// run passes, its program calls the table's tool, and the boring bar in
+/// the scene is the row's (its solid's radius read back from the STL).
+#[test]
+fn common_sizes_run_on_the_default_tool_table() {
+    for (designation, tool, bar_radius) in [
+        (
+            "M8x1.25-6g",
+            "16ER 60 DEG ON A LONG 20 MM HOLDER FOR SMALL PARTS",
+            None,
+        ),
+        // Turned to the middle of 6g's major band, 9.85 mm: below the
+        // 25 mm holder's least major of 10.
+        (
+            "M10x1.5-6g",
+            "16ER 60 DEG ON A LONG 20 MM HOLDER FOR SMALL PARTS",
+            None,
+        ),
+        ("M24x3-6g", "16ER 60 DEG ON A 25 MM HOLDER", None),
+        ("M12x1.5-6H", "CARBIDE BAR 7 MM FOR SMALL BORES", Some(3.5)),
+        ("M36x4-6H", "22IR 60 DEG ON A 20 MM BAR", Some(10.0)),
+        ("M42x4.5-6H", "22IR 60 DEG ON A 20 MM BAR", Some(10.0)),
+        ("Tr 40x7", "27ER TRAPEZOIDAL 30 DEG ON A 25 MM HOLDER", None),
+    ] {
+        let name = designation.replace(|c: char| !c.is_ascii_alphanumeric(), "_");
+        let out = run(&name, &["--set", &format!("designation={designation}")]);
+        let r = common::report_of(&out);
+        assert_eq!(r["verdict"]["status"], "passed", "{designation}");
+        let nc = std::fs::read_to_string(out.join("program.nc")).unwrap();
+        assert!(nc.contains(&format!(": {tool})")), "{designation}: {nc}");
+        if let Some(radius) = bar_radius {
+            let got = cylinder_radius(&out.join("boring_bar.stl"));
+            assert!(
+                (got - radius).abs() < 0.05,
+                "{designation}: bar radius {got}"
+            );
+        }
+        assert_eq!(r["machine"], "fanuc-0i-tc", "{designation}");
+    }
+}
+
+/// A thread no tool of the table cuts is refused before any output, the
+/// message naming the table, the nearest tool and what it lacks; a shop's
+/// own table beside its parameter file is read in place of the default,
+/// and a size it gives for a body that does not ride with the tool is
+/// refused naming the constants it may give.
+#[test]
+fn the_tool_table_is_the_shops_and_a_misfit_names_the_nearest_tool() {
+    let dir = scratch("thread", "tool-table");
+    // The run refused, writing nothing into `out`: its message.
+    let refused = |out: &std::path::Path, args: [&str; 2]| {
+        let mut all = vec!["run", SCRIPT, "--out", s(out), "--quiet"];
+        all.extend(args);
+        let (code, _, err) = pilgrim(&all);
+        assert_ne!(code, 0, "{args:?}");
+        assert!(!out.exists(), "{args:?}: output written");
+        err
+    };
+    let err = refused(&dir.join("m8-nut"), ["--set", "designation=M8x1.25-6H"]);
+    assert!(err.contains("no tool of"), "{err}");
+    assert!(err.contains("thread-tools.csv cuts M8-6H"), "{err}");
+    assert!(
+        err.contains("'carbide bar 5 mm for small bores', needs a bore of 8 mm or more"),
+        "{err}"
+    );
+
+    let shop = dir.join("shop");
+    std::fs::create_dir_all(&shop).unwrap();
+    let head = "name,number,side,profile_deg,pitch_min_mm,pitch_max_mm,nose_mm,depth_mm,shank_mm,least_diameter_mm,longest_mm,body:bar_radius,body:bar_tip,body:bar_length,body:chuck_gap";
+    std::fs::write(
+        shop.join("our-tools.csv"),
+        format!("{head}\nour 12 mm bar,14,internal,60,1,2.5,,1.5,12,18,50,6,8.5,60,\n"),
+    )
+    .unwrap();
+    let params = shop.join("nut.toml");
+    std::fs::write(
+        &params,
+        "designation = \"M24x2-6H\"\ntools = \"our-tools.csv\"\n",
+    )
+    .unwrap();
+    let out = run("shop-nut", &["--params", s(&params)]);
+    let nc = std::fs::read_to_string(out.join("program.nc")).unwrap();
+    assert!(nc.contains("TOOL T14: OUR 12 MM BAR)"), "{nc}");
+    let got = cylinder_radius(&out.join("boring_bar.stl"));
+    assert!((got - 6.0).abs() < 0.05, "bar radius {got}");
+
+    std::fs::write(
+        shop.join("our-tools.csv"),
+        format!("{head}\nour 12 mm bar,14,internal,60,1,2.5,,1.5,12,18,50,6,8.5,60,10\n"),
+    )
+    .unwrap();
+    let err = refused(&dir.join("bad-body"), ["--params", s(&params)]);
+    assert!(
+        err.contains("tool 'our 12 mm bar' gives the machine's constant 'chuck_gap'"),
+        "{err}"
+    );
+    assert!(err.contains("bar_length, bar_radius, bar_tip"), "{err}");
 }

@@ -32,6 +32,7 @@ mod servo;
 mod simulate;
 mod solid;
 pub mod standards;
+pub mod tools;
 pub mod wires;
 mod workbook;
 mod worm_sizes;

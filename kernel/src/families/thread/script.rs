@@ -12,6 +12,7 @@ use crate::families::thread::{self, FlankOrder, PlanSettings, ThreadCutter, Thre
 use crate::families::thread::{Drawing, Hand, ThreadProfile};
 use crate::family::Verification;
 use crate::math::Real;
+use crate::profile::Table;
 use crate::tool::Tool;
 use crate::tool::ToolShape;
 use rhai::plugin::*;
@@ -239,6 +240,56 @@ pub mod thread_api {
         let c = kernel(t.section.form_cutter(nose_radius))?;
         Ok(Tool::thread_cutter(name, number, c))
     }
+    /// The largest tool of the tool table `tools` (read by `read_table`;
+    /// its columns in `docs/families.md`) that cuts this thread over
+    /// `length` mm: `#{ name, number, nose (mm; 0: the standard's root
+    /// rounding), row (as the table numbers it), shank, least_diameter (mm:
+    /// the least major or bore it works on), bodies (its
+    /// sizes of the machine's bodies riding with it, for `with_bodies`) }`.
+    /// None fits: the error names the nearest tool and what it lacks.
+    ///
+    /// ```rhai
+    /// let pick = t.pick_tool(read_table("thread-tools.csv"), 30.0);
+    /// let c = thread_cutter(pick.name, pick.number, t.root_space, 0.2, 30.0, 30.0, 3.0)
+    ///     .with_bodies(pick.bodies);
+    /// ```
+    #[rhai_fn(pure, return_raw)]
+    pub fn pick_tool(
+        t: &mut ThreadProfile,
+        tools: Table,
+        length: Real,
+    ) -> Result<Map, Box<EvalAltResult>> {
+        let table = kernel(thread::tools::ToolTable::read(&tools))?;
+        let aimed = t.aimed();
+        let need = thread::tools::Need {
+            thread: t.designation.clone(),
+            inside: aimed.internal,
+            included: aimed
+                .form
+                .is_axial()
+                .then(|| (aimed.flanks[0] + aimed.flanks[1]).to_degrees()),
+            pitch: aimed.pitch,
+            depth: aimed.depth(),
+            diameter: aimed.crest_diameter,
+            length,
+        };
+        let tool = kernel(table.pick(&need))?;
+        let mut m = Map::new();
+        m.insert("name".into(), tool.name.clone().into());
+        m.insert("number".into(), i64::from(tool.number).into());
+        m.insert("nose".into(), tool.nose.unwrap_or(0.0).into());
+        m.insert("row".into(), (tool.row as i64).into());
+        m.insert("shank".into(), tool.shank.into());
+        m.insert("least_diameter".into(), tool.least_diameter.into());
+        let bodies: Map = tool
+            .bodies
+            .iter()
+            .map(|(k, v)| (k.as_str().into(), (*v).into()))
+            .collect();
+        m.insert("bodies".into(), bodies.into());
+        Ok(m)
+    }
+
     /// One space's area in the axial section, as the cut aims at it
     /// (mm^2).
     #[rhai_fn(get = "space_area", pure)]

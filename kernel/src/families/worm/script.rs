@@ -190,6 +190,31 @@ pub mod worm_api {
         })
     }
 
+    /// The tool `tool` with its own sizes of the machine's bodies that ride
+    /// with it (`bodies`: machine constant to mm, as a tool table's row
+    /// gives them: its holder's, its boring bar's); the run places those
+    /// bodies with them. A constant no such body is sized by is refused
+    /// when the run places the bodies.
+    ///
+    /// ```rhai
+    /// let tool = thread_cutter("bar 8", 4, 0.2, 0.1, 30.0, 30.0, 1.5).inside_bore()
+    ///     .with_bodies(#{ bar_radius: 4.0, bar_tip: 5.3, bar_length: 40.0 });
+    /// ```
+    #[rhai_fn(return_raw)]
+    pub fn with_bodies(tool: Tool, bodies: Map) -> Result<Tool, Box<EvalAltResult>> {
+        let mut out = std::collections::BTreeMap::new();
+        for (k, v) in bodies {
+            let value = crate::binding::floats::number(&v)
+                .filter(|x| x.is_finite() && *x > 0.0)
+                .ok_or_else(|| format!("with_bodies: '{k}' must be a size of more than 0 (mm)"))?;
+            out.insert(k.to_string(), value);
+        }
+        Ok(Tool {
+            bodies: out,
+            ..tool
+        })
+    }
+
     /// The cutter's width at `r` above its tip (mm).
     #[rhai_fn(return_raw)]
     pub fn cutter_width(tool: Tool, r: Real) -> Result<Real, Box<EvalAltResult>> {
