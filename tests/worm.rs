@@ -924,7 +924,7 @@ pub(crate) fn check_workbook(out: &std::path::Path) {
             ("chip area (mm²)", "chip_area"),
             ("left flank load (mm²)", "left_area"),
             ("X (mm)", "x"),
-            ("lead error at the face", "face_lead_error"),
+            ("lead error at the face (ratio)", "face_lead_error"),
         ] {
             assert_eq!(number(&row[col(name)]), p[key].as_f64().unwrap(), "{name}");
         }
@@ -934,9 +934,58 @@ pub(crate) fn check_workbook(out: &std::path::Path) {
     let want = v["starts"].as_array().unwrap();
     assert_eq!(rows.len(), want.len() + 1);
     let head: Vec<String> = rows[0].iter().map(|c| c.to_string()).collect();
-    let t = head.iter().position(|h| h == "thickness (mm)").unwrap();
+    let at = |name: &str| {
+        head.iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("no column {name} in {head:?}"))
+    };
+    let wires = v["over_wires_limits"].as_array();
     for (row, s) in rows[1..].iter().zip(want) {
-        assert_eq!(number(&row[t]), s["thickness"].as_f64().unwrap());
+        for (name, key) in [
+            ("thickness (mm)", "thickness"),
+            ("pitch diameter (mm)", "pitch_diameter"),
+            ("root diameter (mm)", "root_diameter"),
+            ("tip diameter (mm)", "tip_diameter"),
+        ] {
+            assert_eq!(number(&row[at(name)]), s[key].as_f64().unwrap(), "{name}");
+        }
+        if let Some(m) = s["over_wires"].as_f64() {
+            assert_eq!(number(&row[at("over wires M (mm)")]), m);
+            let m_limits = wires.expect("the over-wire limits");
+            assert_eq!(
+                number(&row[at("least M (mm)")]),
+                m_limits[0].as_f64().unwrap()
+            );
+            assert_eq!(
+                number(&row[at("greatest M (mm)")]),
+                m_limits[1].as_f64().unwrap()
+            );
+        }
+        for (k, side) in ["left", "right"].iter().enumerate() {
+            let nominal = v["nominal_flanks_deg"][k].as_f64().unwrap();
+            let got = number(&row[at(&format!("nominal {side} flank angle (deg)"))]);
+            assert_eq!(got, nominal, "{side}");
+        }
+    }
+    // Every column but the counts and the codes carries its unit.
+    for sheet in ["passes", "starts"] {
+        let range = book.worksheet_range(sheet).unwrap();
+        let first = range.rows().next().unwrap();
+        for h in first.iter().map(|c| c.to_string()) {
+            let bare = [
+                "block",
+                "name",
+                "start",
+                "plan: pass",
+                "plan: kind",
+                "plan: flank",
+                "plan: start",
+            ];
+            assert!(
+                h.ends_with(')') || bare.contains(&h.as_str()),
+                "{sheet}: {h}"
+            );
+        }
     }
     let figures = book.worksheet_range("figures").unwrap();
     let removed = figures

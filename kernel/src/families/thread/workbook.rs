@@ -76,7 +76,10 @@ fn passes_sheet(
     planned: Option<&BTreeMap<String, Vec<f64>>>,
 ) -> Result<(), XlsxError> {
     let plan = super::plots::plan_columns(check, planned);
-    let plan_names: Vec<String> = plan.iter().map(|(k, _)| format!("plan: {k}")).collect();
+    let plan_names: Vec<String> = plan
+        .iter()
+        .map(|(k, _)| format!("plan: {k}{}", plan_unit(k)))
+        .collect();
     let mut columns: Vec<Column<'_>> = vec![
         ("block", None),
         ("name", None),
@@ -89,9 +92,9 @@ fn passes_sheet(
         ("beyond the nominal (mm)", Some(5)),
         ("chip thickness (mm)", Some(5)),
         ("approach S1 (mm)", Some(3)),
-        ("lead error at the face", Some(6)),
+        ("lead error at the face (ratio)", Some(6)),
         ("run-out S2 (mm)", Some(3)),
-        ("lead error at the end", Some(6)),
+        ("lead error at the end (ratio)", Some(6)),
     ];
     columns.extend(plan_names.iter().map(|n| (n.as_str(), Some(5))));
     let formats: Vec<Format> = columns.iter().map(|c| format_of(c.1)).collect();
@@ -127,45 +130,92 @@ fn passes_sheet(
     Ok(())
 }
 
-/// The sheet `starts`: each start's finished profile beside the nominal.
+/// The unit a plan's column is in, as a header shows it (` (mm)`); none
+/// for its codes and counts (`kind`, `flank`, `start`).
+fn plan_unit(column: &str) -> &'static str {
+    match column {
+        "planned_area" => " (mm²)",
+        "depth" | "cumulative" | "offset" => " (mm)",
+        _ => "",
+    }
+}
+
+/// The sheet `starts`: each start's finished profile beside the nominal,
+/// and as the gauges take it (its pitch diameter, the measurement over
+/// wires or between balls) beside the limits.
 fn starts_sheet(book: &mut Workbook, check: &ThreadCheck) -> Result<(), XlsxError> {
     let (thickness, root, tip) = check.nominal;
-    let columns: [Column<'_>; 13] = [
+    let columns: [Column<'_>; 24] = [
         ("start", None),
         ("position error (mm)", Some(4)),
         ("thickness (mm)", Some(4)),
         ("nominal thickness (mm)", Some(4)),
         ("left flank angle (deg)", Some(4)),
+        ("nominal left flank angle (deg)", Some(4)),
         ("right flank angle (deg)", Some(4)),
-        ("nominal flank angle (deg)", Some(4)),
+        ("nominal right flank angle (deg)", Some(4)),
         ("left flank form (mm)", Some(4)),
         ("right flank form (mm)", Some(4)),
+        ("pitch diameter (mm)", Some(4)),
+        ("least pitch diameter (mm)", Some(4)),
+        ("greatest pitch diameter (mm)", Some(4)),
+        ("over wires M (mm)", Some(4)),
+        ("least M (mm)", Some(4)),
+        ("greatest M (mm)", Some(4)),
         ("root diameter (mm)", Some(4)),
         ("nominal root diameter (mm)", Some(4)),
+        ("least root diameter (mm)", Some(4)),
+        ("greatest root diameter (mm)", Some(4)),
         ("tip diameter (mm)", Some(4)),
         ("nominal tip diameter (mm)", Some(4)),
+        ("least tip diameter (mm)", Some(4)),
+        ("greatest tip diameter (mm)", Some(4)),
     ];
     let formats: Vec<Format> = columns.iter().map(|c| format_of(c.1)).collect();
     let sheet = book.add_worksheet().set_name("starts")?;
     header(sheet, &columns)?;
+    let limits = check.limits.as_ref();
+    let band = |f: fn(&crate::families::thread::ThreadLimits) -> super::Limits| {
+        limits.map(f).map(|l| [Some(l.min), Some(l.max)])
+    };
+    let [pd_min, pd_max] = band(|l| l.pitch_diameter).unwrap_or([None; 2]);
+    let [root_min, root_max] = band(|l| l.root).unwrap_or([None; 2]);
+    let [tip_min, tip_max] = band(|l| l.crest).unwrap_or([None; 2]);
+    let [m_min, m_max] = check
+        .over_wires_limits
+        .map_or([None; 2], |[a, b]| [Some(a), Some(b)]);
+    let [nominal_left, nominal_right] = check.nominal_flanks_deg;
     for (i, s) in check.starts.iter().enumerate() {
         let values = [
-            f64::from(s.start + 1),
-            s.position_error,
-            s.thickness,
-            thickness,
-            s.left_angle_deg,
-            s.right_angle_deg,
-            check.nominal_alpha_deg,
-            s.left_form,
-            s.right_form,
-            s.root_diameter,
-            root,
-            s.tip_diameter,
-            tip,
+            Some(f64::from(s.start + 1)),
+            Some(s.position_error),
+            Some(s.thickness),
+            Some(thickness),
+            Some(s.left_angle_deg),
+            Some(nominal_left),
+            Some(s.right_angle_deg),
+            Some(nominal_right),
+            Some(s.left_form),
+            Some(s.right_form),
+            Some(s.pitch_diameter),
+            pd_min,
+            pd_max,
+            s.over_wires,
+            m_min,
+            m_max,
+            Some(s.root_diameter),
+            Some(root),
+            root_min,
+            root_max,
+            Some(s.tip_diameter),
+            Some(tip),
+            tip_min,
+            tip_max,
         ];
         for (j, v) in values.into_iter().enumerate() {
-            sheet.write_number_with_format(i as u32 + 1, j as u16, v, &formats[j])?;
+            if let Some(v) = v.filter(|v| v.is_finite()) {
+                sheet.write_number_with_format(i as u32 + 1, j as u16, v, &formats[j])?;
+            }
         }
     }
     Ok(())
