@@ -1,7 +1,9 @@
 //! The gauges of the finished section: the pitch diameter, the
 //! measurement over wires, the flanks' angles and form, the root and crest.
 
-use super::{space_edges, thread_middle, vertical_top, StartProfile, ThreadRequest, INSIDE};
+use super::{
+    extreme_top, space_edges, thread_middle, vertical_top, StartProfile, ThreadRequest, INSIDE,
+};
 use crate::families::thread::{ThreadCutter, ThreadSection};
 use crate::math::Real;
 use crate::replay::VerifyError;
@@ -216,10 +218,14 @@ fn measure_start(
         right_angle_deg: slope(&right).atan().to_degrees(),
         left_form: form[0],
         right_form: form[1],
-        root_diameter: 2.0 * vertical_top(m, c).unwrap_or(0.0),
-        // The thread's middle (the last start's at the window's end:
-        // 1 um inside it).
-        tip_diameter: 2.0 * vertical_top(m, c + thread_middle(w)[1] - 1e-3).unwrap_or(0.0),
+        // The space's bottom: its lowest point between the flanks at the
+        // pitch line (not where the tip's centre stood: a buttress's nose
+        // arc on its 7 degree corner reaches deeper).
+        root_diameter: 2.0 * extreme_top(m, zl, zr, true).unwrap_or(0.0),
+        // The crest's top, from the flank to the thread's middle (the last
+        // start's at the window's end: 1 um inside it).
+        tip_diameter: 2.0
+            * extreme_top(m, zr, c + thread_middle(w)[1] - 1e-3, false).unwrap_or(0.0),
         // Searched over the straight flanks: from where the nose's
         // arc meets them to the crest.
         pitch_diameter: pitch_diameter(

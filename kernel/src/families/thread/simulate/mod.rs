@@ -41,8 +41,8 @@ pub use cut::simulate;
 use gauge::{diameter, flank_radii, measure, mirrored_limits, nominal_flanks_deg};
 pub use request::{ThreadRequest, ThreadTolerances, LEAD_ERROR};
 use section::{
-    edges, flipped, no_section, nominal_spaces, segment_distance, space_edges, thread_middle,
-    vertical_top,
+    edges, extreme_top, flipped, no_section, nominal_spaces, segment_distance, space_edges,
+    thread_middle, vertical_top,
 };
 pub(super) use section::{poly, rect};
 pub use stock::ThreadStock;

@@ -57,6 +57,23 @@ pub(super) fn vertical_top(m: &MultiPolygon<Real>, z: Real) -> Option<Real> {
         .max_by(Real::total_cmp)
 }
 
+/// The lowest (`lowest`) or the highest of the material's tops over `z`
+/// in `[a, b]`: a space's bottom between its flanks, a thread's crest.
+/// The boundary is piecewise linear, so its extremes lie at its vertices
+/// or at the interval's ends: those are the places looked at.
+pub(super) fn extreme_top(m: &MultiPolygon<Real>, a: Real, b: Real, lowest: bool) -> Option<Real> {
+    let vertices = edges(m).map(|(p, _)| p.x).filter(|z| *z > a && *z < b);
+    let tops = [a, b]
+        .into_iter()
+        .chain(vertices)
+        .filter_map(|z| vertical_top(m, z));
+    if lowest {
+        tops.min_by(Real::total_cmp)
+    } else {
+        tops.max_by(Real::total_cmp)
+    }
+}
+
 /// The space around `c` at radius `r`: the material's boundary just left
 /// and just right of it, if `c` is in a space there.
 pub(super) fn space_edges(m: &MultiPolygon<Real>, r: Real, c: Real) -> Option<(Real, Real)> {

@@ -383,6 +383,65 @@ fn a_buttress_holds_its_two_flank_angles() {
     assert!(angle.value.abs() < 0.05, "{angle:?}");
 }
 
+/// Roots at the space's bottom, crests at their top: a 7/45 buttress's
+/// root is where the simulated space is deepest (its nose arc on the 7
+/// degree corner), not where the finishing tip's centre stood, and its
+/// crest the thread's highest point; both sought here over a grid of the
+/// finished section one lead long (one start: one space, one thread).
+#[test]
+fn roots_are_measured_at_the_spaces_bottom() {
+    let stated = standards::StatedLimits {
+        pitch_allowance: 0.0,
+        pitch_tolerance: 0.1,
+        crest_tolerance: 0.2,
+        root_tolerance: 0.3,
+    };
+    let profile = standards::buttress(
+        2.0,
+        8.0,
+        false,
+        standards::LoadFlank::TowardsChuck,
+        1,
+        Hand::Right,
+        stated,
+    )
+    .unwrap();
+    // The cutter as the family's script makes it: the tip the space at
+    // the root, the nose the largest the tip holds between the flanks
+    // (0.9 of it), the standard's rounding at most.
+    let check = cut_by(&profile, 0.05, FlankOrder::Right, -1.0, |t| {
+        let inset = |a: Real| (1.0 - a.sin()) / a.cos();
+        let tip = t.root_space();
+        let nose = t
+            .root_radius
+            .min(0.9 * tip / (inset(t.flanks[0]) + inset(t.flanks[1])));
+        ThreadCutter::new(tip, nose, t.flanks[0], t.flanks[1], 3.0).unwrap()
+    })
+    .unwrap()
+    .verified()
+    .unwrap();
+    let (z0, lead) = check.window;
+    let n = 40_000;
+    let tops: Vec<Real> = (1..n)
+        .filter_map(|i| {
+            super::section::vertical_top(&check.section, z0 + lead * i as Real / n as Real)
+        })
+        .collect();
+    let deepest = 2.0 * tops.iter().copied().fold(Real::INFINITY, Real::min);
+    let highest = 2.0 * tops.iter().copied().fold(Real::NEG_INFINITY, Real::max);
+    let s = &check.starts[0];
+    assert!(
+        (s.root_diameter - deepest).abs() < 0.2e-3,
+        "root {} where the space is deepest at {deepest}",
+        s.root_diameter
+    );
+    assert!(
+        (s.tip_diameter - highest).abs() < 0.2e-3,
+        "tip {} where the thread is highest at {highest}",
+        s.tip_diameter
+    );
+}
+
 /// Over wires with the lead angle, from the cut: a Tr40x7 and a
 /// two-start Tr40x14(P7), each start's measurement over its best wires
 /// laid against the cut flanks within 1 um of ASME B1.2's lead-corrected
