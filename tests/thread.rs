@@ -169,6 +169,25 @@ fn each_default_thread_is_verified_against_its_standard() {
             assert!(pd[0] < d2 && d2 < pd[1], "{name}: {d2} outside {pd:?}");
             let aim = 0.5 * (pd[0] + pd[1]);
             assert!((d2 - aim).abs() < 0.005, "{name}: {d2} vs the aim {aim}");
+            // The GO gauge goes on: the functional pitch diameter within
+            // the maximum-material limit (a bolt's greatest, a nut's
+            // least), beyond the simple one by what the flanks and the
+            // lead add (a few micrometres on a cut this true).
+            let functional = f("functional_pitch_diameter");
+            let (go, sign) = if v["internal"] == true {
+                (pd[0], -1.0)
+            } else {
+                (pd[1], 1.0)
+            };
+            assert!(
+                sign * (go - functional) > 0.0,
+                "{name}: functional {functional}"
+            );
+            let over = sign * (functional - d2);
+            assert!(
+                (-1e-3..0.01).contains(&over),
+                "{name}: functional {functional}, simple {d2}"
+            );
             for (k, lim) in [
                 ("root_diameter", band("root")),
                 ("tip_diameter", band("crest")),

@@ -949,6 +949,9 @@ pub(crate) fn check_workbook(out: &std::path::Path) {
         ] {
             assert_eq!(number(&row[at(name)]), s[key].as_f64().unwrap(), "{name}");
         }
+        if let Some(d) = s["functional_pitch_diameter"].as_f64() {
+            assert_eq!(number(&row[at("functional pitch diameter (mm)")]), d);
+        }
         if let Some(m) = s["over_wires"].as_f64() {
             assert_eq!(number(&row[at("over wires M (mm)")]), m);
             let m_limits = wires.expect("the over-wire limits");

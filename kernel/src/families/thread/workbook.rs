@@ -141,11 +141,11 @@ fn plan_unit(column: &str) -> &'static str {
 }
 
 /// The sheet `starts`: each start's finished profile beside the nominal,
-/// and as the gauges take it (its pitch diameter, the measurement over
-/// wires or between balls) beside the limits.
+/// and as the gauges take it (its simple and functional pitch diameters,
+/// the measurement over wires or between balls) beside the limits.
 fn starts_sheet(book: &mut Workbook, check: &ThreadCheck) -> Result<(), XlsxError> {
     let (thickness, root, tip) = check.nominal;
-    let columns: [Column<'_>; 24] = [
+    let columns: [Column<'_>; 25] = [
         ("start", None),
         ("position error (mm)", Some(4)),
         ("thickness (mm)", Some(4)),
@@ -157,6 +157,7 @@ fn starts_sheet(book: &mut Workbook, check: &ThreadCheck) -> Result<(), XlsxErro
         ("left flank form (mm)", Some(4)),
         ("right flank form (mm)", Some(4)),
         ("pitch diameter (mm)", Some(4)),
+        ("functional pitch diameter (mm)", Some(4)),
         ("least pitch diameter (mm)", Some(4)),
         ("greatest pitch diameter (mm)", Some(4)),
         ("over wires M (mm)", Some(4)),
@@ -198,6 +199,7 @@ fn starts_sheet(book: &mut Workbook, check: &ThreadCheck) -> Result<(), XlsxErro
             Some(s.left_form),
             Some(s.right_form),
             Some(s.pitch_diameter),
+            s.functional_pitch_diameter,
             pd_min,
             pd_max,
             s.over_wires,

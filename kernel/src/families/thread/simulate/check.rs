@@ -84,6 +84,14 @@ pub struct StartProfile {
     /// its flanks are symmetric.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub over_wires: Option<Real>,
+    /// The functional (virtual) pitch diameter, as a GO gauge feels it:
+    /// the perfect mating thread's that just fits the start's space at
+    /// every radius its flanks were measured at, along the whole thread
+    /// (the lead's error in) (mm; none where a flank lies along the
+    /// radial). Held to the maximum-material limit; the simple
+    /// `pitch_diameter` to both.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub functional_pitch_diameter: Option<Real>,
 }
 
 /// The simulation's result (`report.json`'s `thread_verification`; the
@@ -329,6 +337,7 @@ impl ThreadCheck {
             s.tip_diameter = -s.tip_diameter;
             s.pitch_diameter = -s.pitch_diameter;
             s.over_wires = s.over_wires.map(|m| -m);
+            s.functional_pitch_diameter = s.functional_pitch_diameter.map(|d| -d);
         }
         self.nominal.1 = -self.nominal.1;
         self.nominal.2 = -self.nominal.2;

@@ -454,7 +454,7 @@ impl<'a> Cut<'a> {
         lead_error: Real,
     ) -> ThreadCheck {
         let (req, w) = (self.req, &self.req.section);
-        let (starts, unmeasured) = measure(&material, req, self.cutter);
+        let (starts, unmeasured) = measure(&material, req, self.cutter, lead_error);
         let nominal_flanks = nominal_flanks_deg(w, &flank_radii(w, req.flank_margin, self.cutter));
         failures.extend(unmeasured);
         ThreadCheck {

@@ -7,6 +7,7 @@ use super::{
 use crate::families::thread::{ThreadCutter, ThreadSection};
 use crate::math::Real;
 use crate::replay::VerifyError;
+use crate::tolerance::DERIVATIVE_STEP;
 use crate::verdict::Finding;
 use geo::MultiPolygon;
 
@@ -124,12 +125,13 @@ pub(super) fn measure(
     m: &MultiPolygon<Real>,
     req: &ThreadRequest,
     cutter: &ThreadCutter,
+    lead_error: Real,
 ) -> (Vec<StartProfile>, Vec<Finding>) {
     let fail = |m: String| Finding::new("verification", VerifyError::Failed(m).to_string());
     let mut failures = Vec::new();
     let mut out = Vec::new();
     for k in 0..req.section.starts {
-        match measure_start(m, req, cutter, k) {
+        match measure_start(m, req, cutter, k, lead_error) {
             Ok((p, worst_at, angles)) => {
                 failures.extend(
                     start_faults(req, &p, worst_at, angles)
@@ -163,7 +165,9 @@ fn space_of(m: &MultiPolygon<Real>, k: u32, c: Real, r: Real) -> Result<(Real, R
 }
 
 /// Start `k`'s finished profile, the radii where its flanks' form is
-/// worst (left, right), and its aimed flanks' angles there (deg).
+/// worst (left, right), and its aimed flanks' angles there (deg); the
+/// lead's error over the thread, `lead_error`, for its functional pitch
+/// diameter.
 ///
 /// # Failures
 /// Its space, or the next start's at the pitch line, not there.
@@ -172,6 +176,7 @@ fn measure_start(
     req: &ThreadRequest,
     cutter: &ThreadCutter,
     k: u32,
+    lead_error: Real,
 ) -> Result<(StartProfile, [Real; 2], [Real; 2]), String> {
     let w = &req.section;
     let (r_a, r1) = (w.crest_diameter / 2.0, w.pitch_diameter / 2.0);
@@ -242,8 +247,78 @@ fn measure_start(
         over_wires: (req.limits.as_ref())
             .and(w.best_wire())
             .and_then(|wire| w.over_flanks(wire, w.pitch_diameter, line(&left), line(&right))),
+        functional_pitch_diameter: functional_pitch_diameter(&aimed, c, &left, &right, lead_error),
     };
     Ok((p, worst_at, nominal_flanks_deg(&aimed, &radii)))
+}
+
+/// How many steps the search for a GO gauge's axial place takes: each
+/// keeps two thirds of the bracket, 120 take a millimetre below 1e-21 mm.
+const GAUGE_PLACE_STEPS: usize = 120;
+
+/// The least a flank's place may move per millimetre of pitch diameter
+/// for a GO gauge to be fitted by its pitch diameter alone: a flank along
+/// the radial (a square thread's) does not move, and has no functional
+/// pitch diameter.
+const LEAST_FLANK_SHIFT: Real = 1e-6;
+
+/// The functional (virtual) pitch diameter of a start, as a GO gauge
+/// feels it: the pitch diameter of the perfect mating thread (the aimed
+/// section's form, its pitch exact) that just fits the start's space at
+/// every radius its flanks were measured at (`left`, `right`: `(r, z)`
+/// of the space's flanks, centred on `c`), the space also displaced by up
+/// to `lead_error` along the thread (the programmed lead's error: a
+/// gauge engages the whole length). The gauge's tooth narrows with its
+/// pitch diameter at each flank by that flank's shift per millimetre of
+/// pitch diameter (tan a / 2 for a straight flank); its axial place is
+/// free and chosen for the least diameter (a convex search: the most of
+/// lines in it). For straight flanks this is `d2 + 2 (uL + uR) / (tan
+/// aL + tan aR)` with `uL`, `uR` the flanks' largest intrusions into the
+/// aimed space; the lead's share `|dP| cot a` on a symmetric thread (ISO
+/// 1502's `f_P`), the flanks' angles and form theirs. None where a flank
+/// does not move with the pitch diameter.
+fn functional_pitch_diameter(
+    aimed: &ThreadSection,
+    c: Real,
+    left: &[(Real, Real)],
+    right: &[(Real, Real)],
+    lead_error: Real,
+) -> Option<Real> {
+    let (d0, h) = (aimed.pitch_diameter, DERIVATIVE_STEP);
+    let (wide, narrow) = (aimed.aimed(d0 - h), aimed.aimed(d0 + h));
+    // (uL, uR, the flanks' shifts per mm of pitch diameter) at each radius
+    // and each place along the thread.
+    let mut rows = Vec::with_capacity(2 * left.len());
+    for (&(r, zl), &(_, zr)) in left.iter().zip(right) {
+        let (reach, w, n) = (aimed.reach(r), wide.reach(r), narrow.reach(r));
+        let shift = [0, 1].map(|k| (w[k] - n[k]) / (2.0 * h));
+        if shift.iter().any(|v| !(*v > LEAST_FLANK_SHIFT)) {
+            return None;
+        }
+        let (ul, ur) = (zl - (c - reach[0]), (c + reach[1]) - zr);
+        for along in [0.0, lead_error] {
+            rows.push((ul + along, ur - along, shift));
+        }
+    }
+    let need = |s: Real| {
+        rows.iter()
+            .map(|(ul, ur, k)| ((ul - s) / k[0]).max((ur + s) / k[1]))
+            .fold(Real::NEG_INFINITY, Real::max)
+    };
+    let span = rows
+        .iter()
+        .map(|r| r.0.abs() + r.1.abs())
+        .fold(1.0, Real::max);
+    let (mut lo, mut hi) = (-span, span);
+    for _ in 0..GAUGE_PLACE_STEPS {
+        let (a, b) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
+        if need(a) < need(b) {
+            hi = b;
+        } else {
+            lo = a;
+        }
+    }
+    (!rows.is_empty()).then(|| d0 + need(0.5 * (lo + hi)))
 }
 
 /// What of start `p` fails against the nominal: its flanks' form (worst
@@ -285,7 +360,10 @@ fn start_faults(
     }
     match &req.limits {
         None => faults.extend(nominal_faults(req, p)),
-        Some(l) => faults.extend(limit_faults(w, l, &aimed, p)),
+        Some(l) => {
+            faults.extend(limit_faults(w, l, &aimed, p));
+            faults.extend(go_fault(w, l, &aimed, p));
+        }
     }
     if p.position_error.abs() > tol.position {
         faults.push(format!(
@@ -321,6 +399,31 @@ fn nominal_faults(req: &ThreadRequest, p: &StartProfile) -> Vec<String> {
         }
     }
     faults
+}
+
+/// A standard thread's start `p` as its GO gauge takes it: its
+/// functional pitch diameter within the maximum-material limit (an
+/// external thread's greatest pitch diameter, a nut's least; the largest
+/// here, where a nut is its twin in rho = -r), moved with a correction as
+/// [`limit_faults`] moves the band.
+fn go_fault(
+    w: &ThreadSection,
+    l: &crate::families::thread::ThreadLimits,
+    aimed: &ThreadSection,
+    p: &StartProfile,
+) -> Option<String> {
+    let functional = p.functional_pitch_diameter?;
+    let by = aimed.pitch_diameter - w.pitch_diameter;
+    (functional - by > l.pitch_diameter.max).then(|| {
+        format!(
+            "start {}: functional pitch diameter {:.4} mm beyond the maximum-material limit {:.4} mm: a GO gauge does not go on ({}; the simple pitch diameter {:.4} mm; the flanks' angles, form and the lead's error add the rest)",
+            p.start + 1,
+            functional.abs(),
+            (l.pitch_diameter.max + by).abs(),
+            l.source,
+            p.pitch_diameter.abs()
+        )
+    })
 }
 
 /// A standard thread's start `p` against its limits `l`. A corrected

@@ -442,6 +442,100 @@ fn roots_are_measured_at_the_spaces_bottom() {
     );
 }
 
+/// The least pitch diameter of a perfect GO gauge's tooth (the aimed
+/// form at that pitch diameter, over the radii `band`) that fits the
+/// finished section's space centred near `c` without cutting into it,
+/// its axial place free: sought here with polygon booleans (the tooth
+/// against the material), by bisection on the diameter at each place and
+/// a search over the places.
+fn go_gauge_fit(check: &ThreadCheck, aimed: &ThreadSection, c: Real, band: [Real; 2]) -> Real {
+    use geo::{Area, BooleanOps};
+    let fits = |d: Real, s: Real| {
+        let g = aimed.aimed(d);
+        let ([a0, b0], [a1, b1]) = (g.reach(band[0]), g.reach(band[1]));
+        let tooth = super::poly(&[
+            [c + s - a0, band[0]],
+            [c + s + b0, band[0]],
+            [c + s + b1, band[1]],
+            [c + s - a1, band[1]],
+        ]);
+        let tooth = geo::MultiPolygon::new(vec![tooth]);
+        check.section.intersection(&tooth).unsigned_area() < 1e-12
+    };
+    let least_at = |s: Real| {
+        let (mut lo, mut hi) = (aimed.pitch_diameter - 0.3, aimed.pitch_diameter + 0.3);
+        for _ in 0..48 {
+            let m = 0.5 * (lo + hi);
+            if fits(m, s) {
+                hi = m;
+            } else {
+                lo = m;
+            }
+        }
+        hi
+    };
+    let (mut lo, mut hi) = (-0.1, 0.1);
+    for _ in 0..48 {
+        let (a, b) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
+        if least_at(a) < least_at(b) {
+            hi = b;
+        } else {
+            lo = a;
+        }
+    }
+    least_at(0.5 * (lo + hi))
+}
+
+/// The functional pitch diameter, as a GO gauge feels it: an M20 cut by a
+/// cutter whose flanks stand half a degree wider than the thread's (the
+/// flanks' angles off, the space opened towards the crest) measures its
+/// simple pitch diameter where the space is P/2 wide, and a functional
+/// one larger, where a perfect gauge's tooth found by polygon booleans
+/// against the finished section just fits (within 0.3 um); a cut to the
+/// thread's own angles has the two within a micrometre.
+#[test]
+fn the_functional_pitch_diameter_is_where_a_perfect_gauge_fits() {
+    let profile = standards::metric(20.0, 2.5, false, "6g", 1, Hand::Right).unwrap();
+    let opening = profile.section.opening();
+    let aimed = ThreadSection {
+        crest_diameter: profile.limits.crest.middle(),
+        ..profile
+            .section
+            .aimed(profile.section.pitch_diameter - opening * 0.1)
+    };
+    let band = [
+        aimed.root_diameter / 2.0 + 2.0 * 0.15 + 0.1,
+        aimed.crest_diameter / 2.0 - 0.1,
+    ];
+    for (wider_deg, apart) in [(0.0, 1e-3), (0.5, 1.0)] {
+        let check = if wider_deg == 0.0 {
+            cut(&profile, 0.1, FlankOrder::Alternating).unwrap()
+        } else {
+            cut_by(&profile, 0.1, FlankOrder::Alternating, -1.0, |t| {
+                let wider = 0.5f64.to_radians();
+                let f = [t.flanks[0] + wider, t.flanks[1] + wider];
+                ThreadCutter::new(t.root_space(), 0.15, f[0], f[1], 3.0).unwrap()
+            })
+            .unwrap()
+        };
+        let s = &check.starts[0];
+        let functional = s.functional_pitch_diameter.unwrap();
+        let (z0, lead) = check.window;
+        let c = z0 + (5.0 - z0).rem_euclid(lead);
+        let fitted = go_gauge_fit(&check, &aimed, c, band);
+        assert!(
+            (functional - fitted).abs() < 0.3e-3,
+            "{wider_deg}: functional {functional}, the gauge fits at {fitted} (window {z0} + {lead}, c {c})"
+        );
+        let over = functional - s.pitch_diameter;
+        if wider_deg == 0.0 {
+            assert!(over.abs() < apart, "{over}");
+        } else {
+            assert!(over > 5e-3 && over < apart, "{over}");
+        }
+    }
+}
+
 /// Over wires with the lead angle, from the cut: a Tr40x7 and a
 /// two-start Tr40x14(P7), each start's measurement over its best wires
 /// laid against the cut flanks within 1 um of ASME B1.2's lead-corrected
