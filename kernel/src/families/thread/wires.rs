@@ -280,16 +280,7 @@ mod tests {
     /// The least of `f` over `[lo, hi]` by ternary search (`f` unimodal
     /// there).
     fn least(lo: Real, hi: Real, f: impl Fn(Real) -> Real) -> Real {
-        let (mut lo, mut hi) = (lo, hi);
-        for _ in 0..200 {
-            let (a, b) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
-            if f(a) < f(b) {
-                hi = b;
-            } else {
-                lo = a;
-            }
-        }
-        f(0.5 * (lo + hi))
+        f(crate::math::least_by_thirds(lo, hi, 200, &f))
     }
 
     #[test]

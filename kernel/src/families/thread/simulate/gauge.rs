@@ -253,7 +253,7 @@ fn measure_start(
 }
 
 /// How many steps the search for a GO gauge's axial place takes: each
-/// keeps two thirds of the bracket, 120 take a millimetre below 1e-21 mm.
+/// keeps two thirds of the bracket ([`crate::math::least_by_thirds`]).
 const GAUGE_PLACE_STEPS: usize = 120;
 
 /// The least a flank's place may move per millimetre of pitch diameter
@@ -309,16 +309,8 @@ fn functional_pitch_diameter(
         .iter()
         .map(|r| r.0.abs() + r.1.abs())
         .fold(1.0, Real::max);
-    let (mut lo, mut hi) = (-span, span);
-    for _ in 0..GAUGE_PLACE_STEPS {
-        let (a, b) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
-        if need(a) < need(b) {
-            hi = b;
-        } else {
-            lo = a;
-        }
-    }
-    (!rows.is_empty()).then(|| d0 + need(0.5 * (lo + hi)))
+    let place = crate::math::least_by_thirds(-span, span, GAUGE_PLACE_STEPS, need);
+    (!rows.is_empty()).then(|| d0 + need(place))
 }
 
 /// What of start `p` fails against the nominal: its flanks' form (worst

@@ -331,28 +331,27 @@ fn a_left_hand_is_cut_towards_the_tailstock() {
     );
 }
 
-/// A 7/45 buttress (1-8, its load flank the space's towards +Z), its
-/// roughing passes on the load flank: each flank holds its own angle,
-/// 45 and 7 degrees, and the pitch diameter its aim within its stated
-/// band.
-#[test]
-fn a_buttress_holds_its_two_flank_angles() {
+/// A 7/45 buttress of `diameter` inches, 8 threads per inch, external,
+/// its load flank towards the chuck, its limits stated (pitch diameter
+/// 0.1 mm, crest 0.2, root 0.3).
+fn buttress_8_tpi(diameter: Real) -> ThreadProfile {
     let stated = standards::StatedLimits {
         pitch_allowance: 0.0,
         pitch_tolerance: 0.1,
         crest_tolerance: 0.2,
         root_tolerance: 0.3,
     };
-    let profile = standards::buttress(
-        1.0,
-        8.0,
-        false,
-        standards::LoadFlank::TowardsChuck,
-        1,
-        Hand::Right,
-        stated,
-    )
-    .unwrap();
+    let (load, hand) = (standards::LoadFlank::TowardsChuck, Hand::Right);
+    standards::buttress(diameter, 8.0, false, load, 1, hand, stated).unwrap()
+}
+
+/// A 7/45 buttress (1-8, its load flank the space's towards +Z), its
+/// roughing passes on the load flank: each flank holds its own angle,
+/// 45 and 7 degrees, and the pitch diameter its aim within its stated
+/// band.
+#[test]
+fn a_buttress_holds_its_two_flank_angles() {
+    let profile = buttress_8_tpi(1.0);
     let check = cut(&profile, 0.05, FlankOrder::Right)
         .unwrap()
         .verified()
@@ -390,22 +389,7 @@ fn a_buttress_holds_its_two_flank_angles() {
 /// finished section one lead long (one start: one space, one thread).
 #[test]
 fn roots_are_measured_at_the_spaces_bottom() {
-    let stated = standards::StatedLimits {
-        pitch_allowance: 0.0,
-        pitch_tolerance: 0.1,
-        crest_tolerance: 0.2,
-        root_tolerance: 0.3,
-    };
-    let profile = standards::buttress(
-        2.0,
-        8.0,
-        false,
-        standards::LoadFlank::TowardsChuck,
-        1,
-        Hand::Right,
-        stated,
-    )
-    .unwrap();
+    let profile = buttress_8_tpi(2.0);
     // The cutter as the family's script makes it: the tip the space at
     // the root, the nose the largest the tip holds between the flanks
     // (0.9 of it), the standard's rounding at most.
@@ -474,16 +458,7 @@ fn go_gauge_fit(check: &ThreadCheck, aimed: &ThreadSection, c: Real, band: [Real
         }
         hi
     };
-    let (mut lo, mut hi) = (-0.1, 0.1);
-    for _ in 0..48 {
-        let (a, b) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
-        if least_at(a) < least_at(b) {
-            hi = b;
-        } else {
-            lo = a;
-        }
-    }
-    least_at(0.5 * (lo + hi))
+    least_at(crate::math::least_by_thirds(-0.1, 0.1, 48, least_at))
 }
 
 /// The functional pitch diameter, as a GO gauge feels it: an M20 cut by a
