@@ -180,6 +180,7 @@ impl ThreadCheck {
     /// the starts and passes, and what failed.
     pub fn findings(&self) -> (Vec<Figure>, Vec<Finding>) {
         let mut figures = self.start_figures();
+        figures.extend(self.gauge_figures());
         figures.push(Figure::new(
             "the lead over the thread",
             self.lead_error,
@@ -197,16 +198,9 @@ impl ThreadCheck {
     /// start's place.
     fn start_figures(&self) -> Vec<Figure> {
         let t = &self.tolerances;
-        let worst = |f: &dyn Fn(&StartProfile) -> Real| {
-            (self.starts.iter())
-                .map(|s| (f(s), s.start))
-                .max_by(|a, b| a.0.abs().total_cmp(&b.0.abs()))
-        };
         let mut figures = Vec::new();
-        let mut start_figure = |name: &str, f: &dyn Fn(&StartProfile) -> Real, tol: Real, unit| {
-            if let Some((v, s)) = worst(f) {
-                figures.push(Figure::new(name, v, tol, unit, format!("start {}", s + 1)));
-            }
+        let mut start_figure = |name: &str, f: Of<'_, StartProfile>, tol: Real, unit| {
+            figures.extend(self.worst_start(name, f, tol, unit));
         };
         let larger = |l: Real, r: Real| if l.abs() >= r.abs() { l } else { r };
         start_figure(
@@ -273,6 +267,61 @@ impl ThreadCheck {
             t.position,
             "mm",
         );
+        figures
+    }
+
+    /// The figure `name` of the start where `f` is largest, against `tol`.
+    fn worst_start(
+        &self,
+        name: &str,
+        f: Of<'_, StartProfile>,
+        tol: Real,
+        unit: &str,
+    ) -> Option<Figure> {
+        let (v, s) = (self.starts.iter())
+            .map(|s| (f(s), s.start))
+            .max_by(|a, b| a.0.abs().total_cmp(&b.0.abs()))?;
+        Some(Figure::new(name, v, tol, unit, format!("start {}", s + 1)))
+    }
+
+    /// The figures as the gauges take them, each the worst start's: the GO
+    /// gauge's functional pitch diameter (the simple one lies on the
+    /// band's other side of it, so beyond half the band from the middle
+    /// is beyond the maximum-material limit), and the reading over wires
+    /// (between balls) within what the band allows.
+    fn gauge_figures(&self) -> Vec<Figure> {
+        let mut figures = Vec::new();
+        if let Some(l) = &self.limits {
+            let (middle, half) = (l.pitch_diameter.middle(), 0.5 * l.pitch_diameter.width());
+            if self
+                .starts
+                .iter()
+                .all(|s| s.functional_pitch_diameter.is_some())
+            {
+                figures.extend(self.worst_start(
+                    "functional pitch diameter (GO gauge)",
+                    &|s| s.functional_pitch_diameter.unwrap_or(middle) - middle,
+                    half,
+                    "mm",
+                ));
+            }
+        }
+        if let Some([lo, hi]) = self.over_wires_limits {
+            if self.starts.iter().all(|s| s.over_wires.is_some()) {
+                let middle = 0.5 * (lo + hi);
+                let name = if self.internal {
+                    "between balls"
+                } else {
+                    "over wires"
+                };
+                figures.extend(self.worst_start(
+                    name,
+                    &|s| s.over_wires.unwrap_or(middle) - middle,
+                    0.5 * (hi - lo),
+                    "mm",
+                ));
+            }
+        }
         figures
     }
 
