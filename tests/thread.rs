@@ -905,16 +905,16 @@ fn a_corrected_start_is_measured_from_its_cut_root() {
 /// vertices farthest from the axis of its own cylinder (the file's own
 /// frame: the cylinder along Z), read back from the file the run wrote.
 fn cylinder_radius(file: &std::path::Path) -> f64 {
-    let mut f = std::fs::File::open(file).unwrap();
-    let mesh = stl_io::read_stl(&mut f).unwrap();
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for v in &mesh.vertices {
-        for k in 0..2 {
-            lo[k] = lo[k].min(f64::from(v[k]));
-            hi[k] = hi[k].max(f64::from(v[k]));
-        }
-    }
-    0.25 * ((hi[0] - lo[0]) + (hi[1] - lo[1]))
+    let vertices = crate::worm::stl_vertices(file);
+    let extent = |k: usize| {
+        let (lo, hi) = vertices
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v[k]), hi.max(v[k]))
+            });
+        hi - lo
+    };
+    0.25 * (extent(0) + extent(1))
 }
 
 /// The common sizes on the default lathe and the default tool table

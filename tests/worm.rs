@@ -909,12 +909,14 @@ pub(crate) fn check_workbook(out: &std::path::Path) {
     };
     let passes = book.worksheet_range("passes").unwrap();
     let rows: Vec<&[Data]> = passes.rows().collect();
-    let head: Vec<String> = rows[0].iter().map(|c| c.to_string()).collect();
-    let col = |name: &str| {
+    // A sheet's column by its header.
+    let column_of = |rows: &[&[Data]], name: &str| {
+        let head: Vec<String> = rows[0].iter().map(|c| c.to_string()).collect();
         head.iter()
             .position(|h| h == name)
             .unwrap_or_else(|| panic!("no column {name} in {head:?}"))
     };
+    let col = |name: &str| column_of(&rows, name);
     let want = v["passes"].as_array().unwrap();
     assert_eq!(rows.len(), want.len() + 1);
     for (row, p) in rows[1..].iter().zip(want) {
@@ -933,12 +935,7 @@ pub(crate) fn check_workbook(out: &std::path::Path) {
     let rows: Vec<&[Data]> = starts.rows().collect();
     let want = v["starts"].as_array().unwrap();
     assert_eq!(rows.len(), want.len() + 1);
-    let head: Vec<String> = rows[0].iter().map(|c| c.to_string()).collect();
-    let at = |name: &str| {
-        head.iter()
-            .position(|h| h == name)
-            .unwrap_or_else(|| panic!("no column {name} in {head:?}"))
-    };
+    let at = |name: &str| column_of(&rows, name);
     let wires = v["over_wires_limits"].as_array();
     for (row, s) in rows[1..].iter().zip(want) {
         for (name, key) in [
@@ -999,8 +996,8 @@ pub(crate) fn check_workbook(out: &std::path::Path) {
     assert_eq!(removed[2].to_string(), "mm²");
 }
 
-/// The vertices of a run's `worm.stl` (f32 binary STL), each once per
-/// facet.
+/// The vertices of a run's STL (`worm.stl`, a body's; f32 binary), each
+/// once per facet.
 pub(crate) fn stl_vertices(path: &Path) -> Vec<[f64; 3]> {
     let stl = std::fs::read(path).unwrap();
     let facets = u32::from_le_bytes(stl[80..84].try_into().unwrap()) as usize;

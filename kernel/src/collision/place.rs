@@ -109,7 +109,7 @@ impl Placement {
         part_z: Option<(Real, Real)>,
     ) -> Result<Self, CollisionError> {
         let held = with_tool_sizes(info, holding)?;
-        let info = &held;
+        let info: &MachineInfo = &held;
         let (tool_centre, inside) = (holding.tool_centre, holding.inside);
         let tool_chain = if info.chain.is_empty() {
             None
@@ -316,9 +316,12 @@ fn sorted(names: &[String]) -> Vec<String> {
 /// its reach) is sized or placed by, or that another body or the tool's
 /// chain also reads: the message names the tool and the constants it may
 /// give.
-fn with_tool_sizes(info: &MachineInfo, holding: &Holding) -> Result<MachineInfo, CollisionError> {
+fn with_tool_sizes<'a>(
+    info: &'a MachineInfo,
+    holding: &Holding,
+) -> Result<std::borrow::Cow<'a, MachineInfo>, CollisionError> {
     if holding.tool_bodies.is_empty() {
-        return Ok(info.clone());
+        return Ok(std::borrow::Cow::Borrowed(info));
     }
     let mut riding = std::collections::BTreeSet::new();
     let mut others = std::collections::BTreeSet::new();
@@ -346,5 +349,5 @@ fn with_tool_sizes(info: &MachineInfo, holding: &Holding) -> Result<MachineInfo,
         }
         held.constants.insert(name.clone(), *value);
     }
-    Ok(held)
+    Ok(std::borrow::Cow::Owned(held))
 }

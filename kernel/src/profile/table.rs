@@ -554,6 +554,31 @@ impl Table {
             .collect()
     }
 
+    /// The numbers of one column where its cells hold one, none where
+    /// they are empty (a column a row may leave blank, as a tool table's
+    /// optional sizes).
+    ///
+    /// # Failures
+    /// An unknown column; a cell that is text or not finite (named by row
+    /// and column).
+    pub fn optional(&self, name: &str) -> Result<Vec<Option<Real>>, TableError> {
+        let col = self.column_index(name)?;
+        let blank = |(_, cells): &&(usize, Vec<Cell>)| {
+            matches!(cells.get(col).unwrap_or(&Cell::Empty), Cell::Empty)
+        };
+        let filled = Table {
+            source: self.source.clone(),
+            headers: self.headers.clone(),
+            rows: self.rows.iter().filter(|r| !blank(r)).cloned().collect(),
+        };
+        let mut numbers = filled.column(name)?.into_iter();
+        Ok(self
+            .rows
+            .iter()
+            .map(|r| if blank(&r) { None } else { numbers.next() })
+            .collect())
+    }
+
     /// The cells of one column as text, every data row (numbers as
     /// written by Rust's shortest form, empty cells empty): a column of
     /// notes or names, such as a groove table's zones.

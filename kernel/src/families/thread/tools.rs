@@ -23,6 +23,7 @@
 //! | `longest_mm` | the longest thread it reaches along; empty: any |
 //! | `body:<constant>` | its value of the machine constant `<constant>` sizing a body that rides with it; empty: the machine's |
 
+use super::standards::number;
 use crate::math::Real;
 use crate::profile::{Table, TableError};
 use std::collections::BTreeMap;
@@ -153,21 +154,6 @@ struct Columns {
 impl Columns {
     fn of(table: &Table) -> Result<Self, ToolError> {
         let file = table.source().to_owned();
-        let optional_column = |c: &str| -> Result<Vec<Option<Real>>, ToolError> {
-            table
-                .texts(c)?
-                .iter()
-                .enumerate()
-                .map(|(i, t)| {
-                    optional(t).map_err(|message| ToolError::Cell {
-                        file: file.clone(),
-                        row: table.row_number(i),
-                        column: c.to_owned(),
-                        message,
-                    })
-                })
-                .collect()
-        };
         Ok(Self {
             names: table.texts("name")?,
             numbers: table.column("number")?,
@@ -175,13 +161,13 @@ impl Columns {
             profiles: table.texts("profile_deg")?,
             sizes: NUMBER_COLUMNS
                 .iter()
-                .map(|c| optional_column(c))
+                .map(|c| table.optional(c))
                 .collect::<Result<_, _>>()?,
             bodies: table
                 .headers()
                 .iter()
                 .filter_map(|h| h.strip_prefix(BODY_COLUMN).map(|c| (h, c)))
-                .map(|(h, c)| optional_column(h).map(|v| (c.trim().to_owned(), v)))
+                .map(|(h, c)| table.optional(h).map(|v| (c.trim().to_owned(), v)))
                 .collect::<Result<_, _>>()?,
             file,
         })
@@ -380,7 +366,7 @@ impl TableTool {
                 format!(
                     "carries inserts of {} deg, not {}",
                     angles(&self.profiles),
-                    round(a)
+                    number(a)
                 ),
                 1.0,
             )),
@@ -394,9 +380,9 @@ impl TableTool {
             out.push((
                 format!(
                     "cuts pitches {} to {} mm, not {}",
-                    round(self.pitch[0]),
-                    round(self.pitch[1]),
-                    round(need.pitch)
+                    number(self.pitch[0]),
+                    number(self.pitch[1]),
+                    number(need.pitch)
                 ),
                 off,
             ));
@@ -405,8 +391,8 @@ impl TableTool {
             out.push((
                 format!(
                     "reaches {} mm deep, the thread {}",
-                    round(self.depth),
-                    round(need.depth)
+                    number(self.depth),
+                    number(need.depth)
                 ),
                 short(self.depth, need.depth),
             ));
@@ -416,8 +402,8 @@ impl TableTool {
                 format!(
                     "needs {} of {} mm or more, the thread's is {}",
                     if need.inside { "a bore" } else { "a major" },
-                    round(self.least_diameter),
-                    round(need.diameter)
+                    number(self.least_diameter),
+                    number(need.diameter)
                 ),
                 short(self.least_diameter, need.diameter),
             ));
@@ -426,8 +412,8 @@ impl TableTool {
             out.push((
                 format!(
                     "reaches {} mm along, the thread is {} long",
-                    round(l),
-                    round(need.length)
+                    number(l),
+                    number(need.length)
                 ),
                 short(l, need.length),
             ));
@@ -443,37 +429,21 @@ impl Need {
             "{}, {}, pitch {} mm, {} mm deep, {} {} mm, {} mm long",
             if self.inside { "internal" } else { "external" },
             self.included
-                .map_or("curved flanks".to_owned(), |a| format!("{} deg", round(a))),
-            round(self.pitch),
-            round(self.depth),
+                .map_or("curved flanks".to_owned(), |a| format!("{} deg", number(a))),
+            number(self.pitch),
+            number(self.depth),
             if self.inside { "bore" } else { "major" },
-            round(self.diameter),
-            round(self.length)
+            number(self.diameter),
+            number(self.length)
         )
     }
 }
 
-/// A cell's number, or none where it is empty.
-fn optional(text: &str) -> Result<Option<Real>, String> {
-    let t = text.trim();
-    if t.is_empty() {
-        return Ok(None);
-    }
-    match t.parse::<Real>() {
-        Ok(v) if v.is_finite() => Ok(Some(v)),
-        _ => Err(format!("'{}' is not a number", crate::files::excerpt(t))),
-    }
-}
-
-/// A length or angle as a message shows it: to the micrometre, no
-/// trailing zeros.
-fn round(v: Real) -> String {
-    let s = format!("{v:.3}");
-    s.trim_end_matches('0').trim_end_matches('.').to_owned()
-}
-
 fn angles(a: &[Real]) -> String {
-    a.iter().map(|v| round(*v)).collect::<Vec<_>>().join(" or ")
+    a.iter()
+        .map(|v| number(*v))
+        .collect::<Vec<_>>()
+        .join(" or ")
 }
 
 #[cfg(test)]
@@ -555,6 +525,9 @@ mod tests {
                 "holder 25,1,external,sixty",
                 "row 2, column profile_deg: 'sixty'",
             ),
+            // The name reaches the program's tool line: a character a
+            // control reads as a comment's end is refused.
+            ("holder (25),1,external,60", "row 2, column name: "),
         ] {
             let text = TABLE.replacen("holder 25,1,external,60", bad, 1);
             let e = ToolTable::read(&crate::profile::read_table_str(&text, "tools.csv").unwrap())
@@ -568,6 +541,14 @@ mod tests {
             .to_string();
         assert!(
             e.contains("row 2, column depth_mm: the cell is empty"),
+            "{e}"
+        );
+        let text = TABLE.replacen(",,1.9,25,10,,,", ",,deep,25,10,,,", 1);
+        let e = ToolTable::read(&crate::profile::read_table_str(&text, "tools.csv").unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("row 2, column H (depth_mm): 'deep' is not a number"),
             "{e}"
         );
     }

@@ -300,6 +300,9 @@ fn functional_pitch_diameter(
             rows.push((ul + along, ur - along, shift));
         }
     }
+    if rows.is_empty() {
+        return None;
+    }
     let need = |s: Real| {
         rows.iter()
             .map(|(ul, ur, k)| ((ul - s) / k[0]).max((ur + s) / k[1]))
@@ -310,7 +313,7 @@ fn functional_pitch_diameter(
         .map(|r| r.0.abs() + r.1.abs())
         .fold(1.0, Real::max);
     let place = crate::math::least_by_thirds(-span, span, GAUGE_PLACE_STEPS, need);
-    (!rows.is_empty()).then(|| d0 + need(place))
+    Some(d0 + need(place))
 }
 
 /// What of start `p` fails against the nominal: its flanks' form (worst

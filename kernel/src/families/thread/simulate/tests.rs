@@ -511,6 +511,40 @@ fn the_functional_pitch_diameter_is_where_a_perfect_gauge_fits() {
     }
 }
 
+/// A start whose simple pitch diameter lies inside 6g's band but whose
+/// GO gauge would not go on (the cutter's flanks half a degree wide,
+/// which opens the space 28 um; the section aimed 20 um over the band's
+/// top, so the simple one lies 8 um under it) fails by its functional
+/// pitch diameter,
+/// named with the limit, and by nothing of the simple one.
+#[test]
+fn a_go_gauge_that_does_not_go_on_fails_the_start() {
+    let profile = standards::metric(20.0, 2.5, false, "6g", 1, Hand::Right).unwrap();
+    let aim = profile.section.pitch_diameter - profile.limits.pitch_diameter.max - 0.02;
+    let check = cut_by(&profile, aim, FlankOrder::Alternating, -1.0, |t| {
+        let wider = 0.5f64.to_radians();
+        let f = [t.flanks[0] + wider, t.flanks[1] + wider];
+        ThreadCutter::new(t.root_space(), 0.15, f[0], f[1], 3.0).unwrap()
+    })
+    .unwrap();
+    let s = &check.starts[0];
+    let max = profile.limits.pitch_diameter.max;
+    assert!(s.pitch_diameter < max, "{}", s.pitch_diameter);
+    assert!(s.functional_pitch_diameter.unwrap() > max);
+    let texts: Vec<String> = check.failures.iter().map(|f| f.message.clone()).collect();
+    assert!(
+        texts
+            .iter()
+            .any(|t| t.contains("start 1: functional pitch diameter")
+                && t.contains(&format!("maximum-material limit {max:.4} mm"))),
+        "{texts:?}"
+    );
+    assert!(
+        !texts.iter().any(|t| t.contains("start 1: pitch diameter")),
+        "{texts:?}"
+    );
+}
+
 /// Over wires with the lead angle, from the cut: a Tr40x7 and a
 /// two-start Tr40x14(P7), each start's measurement over its best wires
 /// laid against the cut flanks within 1 um of ASME B1.2's lead-corrected
