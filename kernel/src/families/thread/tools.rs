@@ -509,6 +509,12 @@ mod tests {
         assert!(e.contains("carries inserts of 60 deg, not 29"), "{e}");
     }
 
+    /// What reading the table `text` answers, refused.
+    fn refused(text: &str) -> String {
+        let table = crate::profile::read_table_str(text, "tools.csv").unwrap();
+        ToolTable::read(&table).unwrap_err().to_string()
+    }
+
     /// A bad cell is refused by its row and column.
     #[test]
     fn a_bad_cell_names_its_row_and_column() {
@@ -530,23 +536,17 @@ mod tests {
             ("holder (25),1,external,60", "row 2, column name: "),
         ] {
             let text = TABLE.replacen("holder 25,1,external,60", bad, 1);
-            let e = ToolTable::read(&crate::profile::read_table_str(&text, "tools.csv").unwrap())
-                .unwrap_err()
-                .to_string();
+            let e = refused(&text);
             assert!(e.contains(want), "{e}");
         }
         let text = TABLE.replacen(",,1.9,25,10,,,", ",,,25,10,,,", 1);
-        let e = ToolTable::read(&crate::profile::read_table_str(&text, "tools.csv").unwrap())
-            .unwrap_err()
-            .to_string();
+        let e = refused(&text);
         assert!(
             e.contains("row 2, column depth_mm: the cell is empty"),
             "{e}"
         );
         let text = TABLE.replacen(",,1.9,25,10,,,", ",,deep,25,10,,,", 1);
-        let e = ToolTable::read(&crate::profile::read_table_str(&text, "tools.csv").unwrap())
-            .unwrap_err()
-            .to_string();
+        let e = refused(&text);
         assert!(
             e.contains("row 2, column H (depth_mm): 'deep' is not a number"),
             "{e}"
